@@ -3,7 +3,20 @@
 //! Rigid-body simulation (Bullet through a thin C++ shim, and Rapier) beside the closed-form
 //! theory and measured data of G. A. T. Pender and M. Uhrin, "Predicting Non-Square 2D Dice
 //! Probabilities", Eur. J. Phys. 35 (2014), arXiv:1407.6307.
+//!
+//! Modules: `block` (the die and its sides' names), `scene` (what a throw happens in),
+//! `throws` (initial conditions, keyed or DicePhys's sequence), `engine` (Bullet, Rapier),
+//! `settle` (at rest, outcome), `roll` (one roll), `batch` (many, in parallel), `cli`.
 
+pub mod batch;
 pub mod block;
 pub mod cli;
+pub mod cputime;
+pub mod engine;
 pub mod error;
+pub mod glibc;
+pub mod roll;
+pub mod scene;
+pub mod settle;
+pub mod summary;
+pub mod throws;

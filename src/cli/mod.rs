@@ -1,8 +1,12 @@
 //! The command line: a thin layer over the library. Each subcommand has a module of its own.
 
+use crate::error::{Error, Result};
 use clap::{Parser, Subcommand};
+use std::path::Path;
 
-pub mod theory;
+pub mod args;
+pub mod roll;
+pub mod trace;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -18,8 +22,12 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// The paper's closed-form theory for a block, or its whole experimental table.
-    Theory(theory::TheoryArgs),
+    /// Roll one block many times on one engine: counts, ratio, theory, cost.
+    Roll(roll::RollArgs),
+    /// One throw's trajectory as CSV (step, time, position, orientation, velocities, energy).
+    Trace(trace::TraceArgs),
+
+
 }
 
 /// Runs the command line; returns the process exit code (0 ok, 2 bad input, 1 failure).
@@ -29,7 +37,9 @@ pub fn main() -> i32 {
         Err(e) => return clap_error(e),
     };
     let result = match cli.command {
-        Command::Theory(a) => theory::run(&a),
+        Command::Roll(a) => roll::run(&a),
+        Command::Trace(a) => trace::run(&a),
+
     };
     match result {
         Ok(()) => 0,
@@ -64,4 +74,32 @@ fn clap_error(e: clap::Error) -> i32 {
             2
         }
     }
+}
+
+/// Fails early, before any simulation, if `path` cannot be written.
+pub fn check_writable(path: &Path) -> Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        return Err(Error::Usage(format!(
+            "{}: directory {} does not exist",
+            path.display(),
+            dir.display()
+        )));
+    }
+    let probe = dir.join(format!(".dicephys-probe-{}", std::process::id()));
+    std::fs::write(&probe, b"")
+        .map_err(|e| Error::Usage(format!("{}: cannot write there ({e})", path.display())))?;
+    let _ = std::fs::remove_file(probe);
+    Ok(())
+}
+
+/// Writes a whole file or nothing: a temporary file beside it, then a rename.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let tmp = path.with_extension(format!("tmp-{}", std::process::id()));
+    std::fs::write(&tmp, bytes)
+        .and_then(|_| std::fs::rename(&tmp, path))
+        .map_err(|e| Error::Run(format!("{}: {e}", path.display())))
 }

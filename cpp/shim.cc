@@ -1,0 +1,125 @@
+#include "dicephys/cpp/shim.h"
+
+#include <btBulletDynamicsCommon.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "dicephys/src/engine/bullet.rs.h"
+
+namespace dicephys {
+
+namespace {
+btVector3 vec(const std::array<double, 3>& a) { return btVector3(a[0], a[1], a[2]); }
+std::array<double, 3> arr(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
+}  // namespace
+
+BulletWorld::BulletWorld(const BulletScene& s)
+    : dt_(s.dt),
+      mass_(s.mass),
+      die_friction_(s.die_friction),
+      die_restitution_(s.die_restitution),
+      planar_(s.planar),
+      gyroscopic_(s.gyroscopic_implicit),
+      deactivation_(s.deactivation) {
+  config_ = std::make_unique<btDefaultCollisionConfiguration>();
+  dispatcher_ = std::make_unique<btCollisionDispatcher>(config_.get());
+  broadphase_ = std::make_unique<btDbvtBroadphase>();
+  solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
+  world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
+                                                     solver_.get(), config_.get());
+  world_->setGravity(btVector3(0, -s.gravity, 0));
+  btContactSolverInfo& info = world_->getSolverInfo();
+  info.m_splitImpulse = s.split_impulse ? 1 : 0;
+  info.m_restitutionVelocityThreshold = s.restitution_velocity_threshold;
+  info.m_numIterations = s.solver_iterations;
+
+  // The floor: top face at y = 0. DicePhys's is a 10000 x 100 x 10000 m static box.
+  btTransform floor_at;
+  floor_at.setIdentity();
+  if (s.plane_floor) {
+    floor_shape_ = std::make_unique<btStaticPlaneShape>(btVector3(0, 1, 0), 0);
+  } else {
+    floor_shape_ = std::make_unique<btBoxShape>(btVector3(5000., 50., 5000.));
+    floor_at.setOrigin(btVector3(0, -50, 0));
+  }
+  btRigidBody::btRigidBodyConstructionInfo floor_info(0.0, nullptr, floor_shape_.get());
+  floor_info.m_startWorldTransform = floor_at;
+  floor_info.m_friction = s.floor_friction;
+  floor_info.m_restitution = s.floor_restitution;
+  floor_ = std::make_unique<btRigidBody>(floor_info);
+  world_->addRigidBody(floor_.get());
+
+  die_shape_ = std::make_unique<btBoxShape>(
+      btVector3(0.5 * s.sides[0], 0.5 * s.sides[1], 0.5 * s.sides[2]));
+}
+
+BulletWorld::~BulletWorld() {
+  if (die_) world_->removeRigidBody(die_.get());
+  if (floor_) world_->removeRigidBody(floor_.get());
+}
+
+// A throw starts from a new body, built as DicePhys builds it, so nothing of the previous
+// roll (contact manifolds, solver caches, sleeping timers, forces) can leak into this one.
+void BulletWorld::reset(const BodyStateFfi& start) {
+  if (die_) {
+    world_->removeRigidBody(die_.get());
+    die_.reset();
+  }
+  btVector3 inertia(0, 0, 0);
+  die_shape_->calculateLocalInertia(mass_, inertia);
+  btRigidBody::btRigidBodyConstructionInfo info(mass_, nullptr, die_shape_.get(), inertia);
+  btTransform at;
+  at.setRotation(btQuaternion(start.rotation[0], start.rotation[1], start.rotation[2],
+                              start.rotation[3]));
+  at.setOrigin(vec(start.position));
+  info.m_startWorldTransform = at;
+  info.m_friction = die_friction_;
+  info.m_restitution = die_restitution_;
+  die_ = std::make_unique<btRigidBody>(info);
+  // Bullet 2.83+ turns on implicit gyroscopic forces per body; 2.81 had none (flags 0).
+  die_->setFlags(gyroscopic_ ? BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_BODY : 0);
+  die_->setLinearVelocity(vec(start.linear_velocity));
+  die_->setAngularVelocity(vec(start.angular_velocity));
+  if (planar_) {
+    // DicePhys's 2D mode: motion locked to the x-y plane, rotation about z only.
+    die_->setLinearFactor(btVector3(1, 1, 0));
+    die_->setAngularFactor(btVector3(0, 0, 1));
+  }
+  if (!deactivation_) die_->setActivationState(DISABLE_DEACTIVATION);
+  world_->addRigidBody(die_.get());
+}
+
+// One fixed step per call, as DicePhys: stepSimulation(dt, 1, dt).
+void BulletWorld::step() {
+  if (!die_) throw std::logic_error("step before reset");
+  world_->stepSimulation(dt_, 1, dt_);
+}
+
+// Steps n times without returning to Rust: used only to measure what the FFI costs.
+void BulletWorld::step_n(std::uint32_t n) {
+  if (!die_) throw std::logic_error("step before reset");
+  for (std::uint32_t i = 0; i < n; ++i) world_->stepSimulation(dt_, 1, dt_);
+}
+
+BodyStateFfi BulletWorld::state() const {
+  BodyStateFfi out{};
+  if (!die_) return out;
+  const btTransform& t = die_->getWorldTransform();
+  const btQuaternion q = t.getRotation();
+  out.position = arr(t.getOrigin());
+  out.rotation = {q.x(), q.y(), q.z(), q.w()};
+  out.linear_velocity = arr(die_->getLinearVelocity());
+  out.angular_velocity = arr(die_->getAngularVelocity());
+  out.sleeping = die_->getActivationState() == ISLAND_SLEEPING;
+  return out;
+}
+
+std::unique_ptr<BulletWorld> new_world(const BulletScene& scene) {
+  if (!(scene.dt > 0) || !(scene.mass > 0)) throw std::invalid_argument("bad scene");
+  return std::make_unique<BulletWorld>(scene);
+}
+
+std::int32_t bullet_version() { return btGetVersion(); }
+
+}  // namespace dicephys

@@ -1,0 +1,152 @@
+//! Many rolls in parallel, and their tally. Each thread keeps one world and reuses it; every
+//! throw is a pure function of its index, and the tally is exact integers, so the result is
+//! the same for any thread count or order.
+
+use crate::block::Outcome;
+use crate::engine::{new_engine, Engine, EngineKind};
+use crate::roll::{roll, Failure, Fate, RollRecord, Settle};
+use crate::scene::Scene;
+use crate::throws::Throws;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+/// Exact counts over a set of rolls.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct Tally {
+    /// Settled rolls by the side standing vertical.
+    pub counts: Counts,
+    pub unconverged: u64,
+    pub failed: BTreeMap<String, u64>,
+    pub rolls: u64,
+    /// Steps simulated over all rolls.
+    pub steps: u64,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct Counts {
+    pub breadth: u64,
+    pub width: u64,
+    pub length: u64,
+    pub unknown: u64,
+}
+
+impl Counts {
+    pub fn add(&mut self, o: Outcome) {
+        match o {
+            Outcome::Breadth => self.breadth += 1,
+            Outcome::Width => self.width += 1,
+            Outcome::Length => self.length += 1,
+            Outcome::Unknown => self.unknown += 1,
+        }
+    }
+}
+
+impl Tally {
+    pub fn add(&mut self, r: &RollRecord) {
+        self.rolls += 1;
+        self.steps += r.steps;
+        match r.fate {
+            Fate::Settled(o) => self.counts.add(o),
+            Fate::Unconverged(_) => self.unconverged += 1,
+            Fate::Failed(f) => *self.failed.entry(f.name().to_string()).or_insert(0) += 1,
+        }
+    }
+
+    pub fn failed_total(&self) -> u64 {
+        self.failed.values().sum()
+    }
+
+    pub fn failed_of(&self, f: Failure) -> u64 {
+        self.failed.get(f.name()).copied().unwrap_or(0)
+    }
+
+    pub fn merge(&mut self, o: &Tally) {
+        self.counts.breadth += o.counts.breadth;
+        self.counts.width += o.counts.width;
+        self.counts.length += o.counts.length;
+        self.counts.unknown += o.counts.unknown;
+        self.unconverged += o.unconverged;
+        for (k, v) in &o.failed {
+            *self.failed.entry(k.clone()).or_insert(0) += v;
+        }
+        self.rolls += o.rolls;
+        self.steps += o.steps;
+    }
+
+    pub fn of(records: &[RollRecord]) -> Tally {
+        let mut t = Tally::default();
+        for r in records {
+            t.add(r);
+        }
+        t
+    }
+}
+
+/// Rolls throws `indices` with `threads` threads (0: all cores); records in index order.
+/// `progress` is called with the number of rolls finished so far, from any thread.
+pub fn run(
+    engine: EngineKind,
+    scene: &Scene,
+    throws: &Throws,
+    settle: &Settle,
+    indices: std::ops::Range<u64>,
+    threads: usize,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<Vec<RollRecord>, String> {
+    // Fail early, once, if the engine cannot be built for this scene.
+    new_engine(engine, scene)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| e.to_string())?;
+    let done = std::sync::atomic::AtomicU64::new(0);
+    let records = pool.install(|| {
+        indices
+            .into_par_iter()
+            .map_init(
+                || new_engine(engine, scene).ok(),
+                |world, i| {
+                    let throw = throws.get(i);
+                    let r = roll_one(world, engine, scene, &throw, settle);
+                    let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                    progress(n);
+                    r
+                },
+            )
+            .collect()
+    });
+    Ok(records)
+}
+
+/// One roll that cannot take the batch down: an engine panic is caught, counted as an engine
+/// failure, and the thread's world is rebuilt for the next throw.
+fn roll_one(
+    world: &mut Option<Box<dyn Engine>>,
+    kind: EngineKind,
+    scene: &Scene,
+    throw: &crate::throws::Throw,
+    settle: &Settle,
+) -> RollRecord {
+    if world.is_none() {
+        *world = new_engine(kind, scene).ok();
+    }
+    let failed = RollRecord {
+        throw: *throw,
+        fate: Fate::Failed(Failure::Engine),
+        steps: 0,
+    };
+    let Some(engine) = world.as_mut() else {
+        return failed;
+    };
+    match catch_unwind(AssertUnwindSafe(|| {
+        roll(engine.as_mut(), scene, throw, settle)
+    })) {
+        Ok(r) => r,
+        Err(_) => {
+            *world = None;
+            failed
+        }
+    }
+}

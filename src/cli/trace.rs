@@ -1,0 +1,110 @@
+//! `dicephys trace`: one throw's trajectory as CSV, for looking at a single roll.
+
+use super::args::{parse_engine, SceneArgs, ThrowArgs};
+use crate::engine::{new_engine, BodyState, EngineKind};
+use crate::error::{Error, Result};
+use crate::roll::{roll_observed, Fate, Settle, DEFAULT_MAX_STEPS};
+use crate::scene::Scene;
+use crate::throws::Throws;
+use clap::Args;
+use std::io::Write;
+
+#[derive(Args, Debug)]
+pub struct TraceArgs {
+    #[arg(long, default_value = "bullet", value_parser = parse_engine)]
+    pub engine: EngineKind,
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub throw: ThrowArgs,
+    /// Which throw.
+    #[arg(long, default_value_t = 0)]
+    pub index: u64,
+    /// Print every Nth step (the first and the last are always printed).
+    #[arg(long, default_value_t = 1)]
+    pub every: u64,
+    #[arg(long, default_value_t = DEFAULT_MAX_STEPS)]
+    pub max_steps: u64,
+}
+
+/// Kinetic (translational + rotational) and potential energy, J, with the floor at y = 0.
+pub fn energy(scene: &Scene, s: &BodyState) -> (f64, f64) {
+    let m = scene.mass();
+    let [a, b, c] = scene.body_sides();
+    // A box's principal moments about its centre: m/12 (b² + c²) etc.
+    let inertia = nalgebra::Vector3::new(b * b + c * c, a * a + c * c, a * a + b * b) * (m / 12.0);
+    let w_body = s.rotation.inverse() * s.angular_velocity;
+    let rot = 0.5 * w_body.component_mul(&w_body).dot(&inertia);
+    let kin = 0.5 * m * s.linear_velocity.norm_squared() + rot;
+    (kin, m * scene.gravity * s.position.y)
+}
+
+pub fn run(a: &TraceArgs) -> Result<()> {
+    let scene = a.scene.scene()?;
+    let ranges = a.throw.ranges()?;
+    if a.every == 0 || a.max_steps == 0 {
+        return Err(Error::Usage("--every and --max-steps must be at least 1".into()));
+    }
+    let throws = Throws::new(a.throw.throws, a.throw.seed, ranges, a.index + 1);
+    let throw = throws.get(a.index);
+    let mut engine = new_engine(a.engine, &scene).map_err(Error::Run)?;
+    let out = std::io::stdout();
+    let mut out = std::io::BufWriter::new(out.lock());
+    let _ = writeln!(
+        out,
+        "step,time_s,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,kinetic_j,potential_j,total_j,sleeping"
+    );
+    let mut last = None;
+    let line = |step: u64, s: &BodyState| -> String {
+        let q = s.rotation.quaternion();
+        let (k, p) = energy(&scene, s);
+        format!(
+            "{},{:.6},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9e},{:.9e},{:.9e},{}",
+            step,
+            step as f64 * scene.dt,
+            s.position.x,
+            s.position.y,
+            s.position.z,
+            q.w,
+            q.i,
+            q.j,
+            q.k,
+            s.linear_velocity.x,
+            s.linear_velocity.y,
+            s.linear_velocity.z,
+            s.angular_velocity.x,
+            s.angular_velocity.y,
+            s.angular_velocity.z,
+            k,
+            p,
+            k + p,
+            s.sleeping as u8
+        )
+    };
+    let settle = Settle {
+        max_steps: a.max_steps,
+    };
+    let record = roll_observed(engine.as_mut(), &scene, &throw, &settle, |step, s| {
+        let l = line(step, s);
+        if step % a.every == 0 {
+            let _ = writeln!(out, "{l}");
+            last = None;
+        } else {
+            last = Some(l);
+        }
+    });
+    if let Some(l) = last {
+        let _ = writeln!(out, "{l}");
+    }
+    let _ = out.flush();
+    let fate = match record.fate {
+        Fate::Settled(o) => format!("settled, {} vertical", o.name()),
+        Fate::Unconverged(o) => format!("unconverged ({} vertical at the cap)", o.name()),
+        Fate::Failed(f) => format!("failed: {}", f.name()),
+    };
+    eprintln!(
+        "throw {}: drop {:.4} m, v {:.4} m/s, spin {:.3} rad/s: {} after {} steps",
+        a.index, throw.drop_height, throw.velocity, throw.spin, fate, record.steps
+    );
+    Ok(())
+}

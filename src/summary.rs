@@ -1,0 +1,151 @@
+//! A run's result as it is reported: configuration, exact counts, the ratio with its error,
+//! the theory beside it, and what it cost.
+
+use crate::batch::{Counts, Tally};
+use crate::engine::EngineKind;
+use crate::roll::Settle;
+use crate::scene::Scene;
+use crate::throws::{ThrowKind, ThrowRanges};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct RunSummary {
+    pub engine: String,
+    pub engine_version: String,
+    pub preset: String,
+    pub block_mm: [f64; 3],
+    pub mode: String,
+    pub rolls: u64,
+    pub seed: u64,
+    pub throws: ThrowKind,
+    pub ranges: ThrowRanges,
+    pub dt: f64,
+    pub friction: f64,
+    pub restitution: f64,
+    pub density: f64,
+    pub floor: String,
+    pub max_steps: u64,
+    pub counts: Counts,
+    pub unconverged: u64,
+    pub failed: BTreeMap<String, u64>,
+    pub failed_total: u64,
+    /// N(breadth vertical) / N(width vertical), the paper's ratio.
+    pub ratio: f64,
+    /// The paper's binomial error of the ratio.
+    pub ratio_err: f64,
+    /// The 2D theory's ratio (eq. MasterEqu) for this block.
+    pub theory_ratio: f64,
+    /// (ratio − theory) / ratio_err.
+    pub z_theory: f64,
+    pub steps_total: u64,
+    pub steps_mean: f64,
+    pub wall_s: f64,
+    pub cpu_s: f64,
+    pub cpu_ms_per_roll: f64,
+    pub threads: usize,
+    pub dicephys_version: String,
+}
+
+impl RunSummary {
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        engine: EngineKind,
+        scene: &Scene,
+        seed: u64,
+        throws: ThrowKind,
+        ranges: &ThrowRanges,
+        settle: &Settle,
+        tally: &Tally,
+        wall_s: f64,
+        cpu_s: f64,
+        threads: usize,
+    ) -> RunSummary {
+        let (ratio, ratio_err) = crate::stats::ratio(tally.counts.breadth, tally.counts.width);
+        let theory_ratio = crate::theory::ratio_from_r(scene.block.r());
+        RunSummary {
+            engine: engine.name().into(),
+            engine_version: engine.version(),
+            preset: scene.preset.name().into(),
+            block_mm: scene.block.mm(),
+            mode: scene.mode.name().into(),
+            rolls: tally.rolls,
+            seed,
+            throws,
+            ranges: *ranges,
+            dt: scene.dt,
+            friction: scene.friction,
+            restitution: scene.restitution,
+            density: scene.density,
+            floor: format!("{:?}", scene.floor).to_lowercase(),
+            max_steps: settle.max_steps,
+            counts: tally.counts.clone(),
+            unconverged: tally.unconverged,
+            failed: tally.failed.clone(),
+            failed_total: tally.failed_total(),
+            ratio,
+            ratio_err,
+            theory_ratio,
+            z_theory: (ratio - theory_ratio) / ratio_err,
+            steps_total: tally.steps,
+            steps_mean: tally.steps as f64 / tally.rolls.max(1) as f64,
+            wall_s,
+            cpu_s,
+            cpu_ms_per_roll: 1000.0 * cpu_s / tally.rolls.max(1) as f64,
+            threads,
+            dicephys_version: env!("CARGO_PKG_VERSION").into(),
+        }
+    }
+
+    /// The human summary: counts, the ratio with its error, theory and σ, failures, cost.
+    pub fn human(&self) -> String {
+        let c = &self.counts;
+        let mut s = String::new();
+        s += &format!(
+            "{} {} {} mm, {} rolls, {} throws seed {}, dt {} s, μ {}, e {}, preset {}, floor {}\n",
+            self.engine,
+            self.mode,
+            crate::block::Block::from_mm(self.block_mm[0], self.block_mm[1], self.block_mm[2])
+                .map(|b| b.to_string())
+                .unwrap_or_default(),
+            self.rolls,
+            self.throws.name(),
+            self.seed,
+            self.dt,
+            self.friction,
+            self.restitution,
+            self.preset,
+            self.floor
+        );
+        s += &format!(
+            "  breadth vertical {:>8}   width vertical {:>8}   length vertical {:>6}   unknown {:>6}\n",
+            c.breadth, c.width, c.length, c.unknown
+        );
+        s += &format!(
+            "  ratio breadth/width  {:.4} ± {:.4}   theory {:.4}   ({:+.1} σ)\n",
+            self.ratio, self.ratio_err, self.theory_ratio, self.z_theory
+        );
+        let failed: Vec<String> = self.failed.iter().map(|(k, v)| format!("{k} {v}")).collect();
+        s += &format!(
+            "  unconverged {} (cap {} steps)   failed {}{}\n",
+            self.unconverged,
+            self.max_steps,
+            self.failed_total,
+            if failed.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", failed.join(", "))
+            }
+        );
+        s += &format!(
+            "  steps/roll {:.0}   wall {:.2} s   CPU {:.2} s ({:.3} ms/roll, {} threads)   {}\n",
+            self.steps_mean,
+            self.wall_s,
+            self.cpu_s,
+            self.cpu_ms_per_roll,
+            self.threads,
+            self.engine_version
+        );
+        s
+    }
+}
