@@ -7,3 +7,4 @@
 pub mod block;
 pub mod cli;
 pub mod error;
+pub mod stats;
