@@ -8,3 +8,4 @@ pub mod block;
 pub mod cli;
 pub mod error;
 pub mod stats;
+pub mod theory;
