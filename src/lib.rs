@@ -7,5 +7,6 @@
 pub mod block;
 pub mod cli;
 pub mod error;
+pub mod paper_data;
 pub mod stats;
 pub mod theory;
