@@ -54,12 +54,22 @@ fn clap_error(e: clap::Error) -> i32 {
             2
         }
         _ => {
+            // clap's message is its first paragraph (some, like a missing argument, span two
+            // lines); join it into one line and leave out the usage and help hints after it.
             let text = e.render().to_string();
-            let line = text
+            let paragraph: Vec<&str> = text
                 .lines()
-                .find(|l| !l.trim().is_empty())
-                .unwrap_or("bad command line")
-                .trim_start_matches("error: ");
+                .map(str::trim)
+                .skip_while(|l| l.is_empty())
+                .take_while(|l| !l.is_empty())
+                .collect();
+            let line = paragraph.join(" ");
+            let line = line.trim_start_matches("error: ");
+            let line = if line.is_empty() {
+                "bad command line"
+            } else {
+                line
+            };
             eprintln!("dicephys: {line}");
             2
         }
