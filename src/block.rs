@@ -31,7 +31,9 @@ impl Block {
     pub fn from_mm(length: f64, breadth: f64, width: f64) -> Result<Block, String> {
         for (name, v) in [("length", length), ("breadth", breadth), ("width", width)] {
             if !v.is_finite() || v <= 0.0 {
-                return Err(format!("block {name} must be a positive finite number of mm, got {v}"));
+                return Err(format!(
+                    "block {name} must be a positive finite number of mm, got {v}"
+                ));
             }
             if v / 1000.0 > MAX_SIDE_M {
                 return Err(format!(
@@ -40,7 +42,11 @@ impl Block {
                 ));
             }
         }
-        let (breadth, width) = if breadth >= width { (breadth, width) } else { (width, breadth) };
+        let (breadth, width) = if breadth >= width {
+            (breadth, width)
+        } else {
+            (width, breadth)
+        };
         let sides = [length, breadth, width];
         let max = sides.iter().cloned().fold(f64::MIN, f64::max);
         let min = sides.iter().cloned().fold(f64::MAX, f64::min);
@@ -65,7 +71,11 @@ impl Block {
 
     /// The sides in mm, (length, breadth, width).
     pub fn mm(&self) -> [f64; 3] {
-        [self.length * 1000.0, self.breadth * 1000.0, self.width * 1000.0]
+        [
+            self.length * 1000.0,
+            self.breadth * 1000.0,
+            self.width * 1000.0,
+        ]
     }
 
     /// The side lengths along the body's x, y, z axes (breadth, width, length), in metres.
@@ -161,7 +171,17 @@ mod tests {
 
     #[test]
     fn refuses_bad_blocks() {
-        for s in ["0x24x20", "abc", "140x-1x20", "NaNx24x20", "140x24", "140x24x20x3", "inf x1x1", "20000x24x20", "1000x0.5x100"] {
+        for s in [
+            "0x24x20",
+            "abc",
+            "140x-1x20",
+            "NaNx24x20",
+            "140x24",
+            "140x24x20x3",
+            "inf x1x1",
+            "20000x24x20",
+            "1000x0.5x100",
+        ] {
             assert!(s.parse::<Block>().is_err(), "{s} accepted");
         }
     }

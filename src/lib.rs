@@ -6,7 +6,8 @@
 //!
 //! Modules: `block` (the die and its sides' names), `scene` (what a throw happens in),
 //! `throws` (initial conditions, keyed or DicePhys's sequence), `engine` (Bullet, Rapier),
-//! `settle` (at rest, outcome), `roll` (one roll), `batch` (many, in parallel), `cli`.
+//! `settle` (at rest, outcome), `theory` and `paper_data` (the paper's closed forms and table),
+//! `stats` (binomial errors, z, χ²), `roll` (one roll), `batch` (many, in parallel), `cli`.
 
 pub mod batch;
 pub mod block;
@@ -15,8 +16,11 @@ pub mod cputime;
 pub mod engine;
 pub mod error;
 pub mod glibc;
+pub mod paper_data;
 pub mod roll;
 pub mod scene;
 pub mod settle;
+pub mod stats;
 pub mod summary;
+pub mod theory;
 pub mod throws;

@@ -52,7 +52,9 @@ impl FromStr for Preset {
         match s {
             "dicephys281" => Ok(Preset::Dicephys281),
             "bullet3" => Ok(Preset::Bullet3),
-            _ => Err(format!("unknown preset '{s}' (known: dicephys281, bullet3)")),
+            _ => Err(format!(
+                "unknown preset '{s}' (known: dicephys281, bullet3)"
+            )),
         }
     }
 }

@@ -61,7 +61,8 @@ impl RunSummary {
         cpu_s: f64,
         threads: usize,
     ) -> RunSummary {
-        let (ratio, ratio_err) = crate::stats::ratio(tally.counts.breadth, tally.counts.width);
+        let r = crate::stats::ratio(tally.counts.breadth, tally.counts.width);
+        let (ratio, ratio_err) = (r.value, r.err);
         let theory_ratio = crate::theory::ratio_from_r(scene.block.r());
         RunSummary {
             engine: engine.name().into(),
@@ -125,7 +126,11 @@ impl RunSummary {
             "  ratio breadth/width  {:.4} ± {:.4}   theory {:.4}   ({:+.1} σ)\n",
             self.ratio, self.ratio_err, self.theory_ratio, self.z_theory
         );
-        let failed: Vec<String> = self.failed.iter().map(|(k, v)| format!("{k} {v}")).collect();
+        let failed: Vec<String> = self
+            .failed
+            .iter()
+            .map(|(k, v)| format!("{k} {v}"))
+            .collect();
         s += &format!(
             "  unconverged {} (cap {} steps)   failed {}{}\n",
             self.unconverged,

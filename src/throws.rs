@@ -131,7 +131,9 @@ impl FromStr for ThrowKind {
         match s {
             "keyed" => Ok(ThrowKind::Keyed),
             "dicephys" => Ok(ThrowKind::Dicephys),
-            _ => Err(format!("unknown throw source '{s}' (known: keyed, dicephys)")),
+            _ => Err(format!(
+                "unknown throw source '{s}' (known: keyed, dicephys)"
+            )),
         }
     }
 }
@@ -148,9 +150,14 @@ impl ThrowKind {
 /// Where throws come from.
 #[derive(Clone, Debug)]
 pub enum Throws {
-    Keyed { seed: u64, ranges: ThrowRanges },
+    Keyed {
+        seed: u64,
+        ranges: ThrowRanges,
+    },
     /// DicePhys's sequence, throws 0..n drawn up front.
-    Dicephys { throws: Vec<Throw> },
+    Dicephys {
+        throws: Vec<Throw>,
+    },
 }
 
 impl Throws {

@@ -105,9 +105,16 @@ impl SceneArgs {
             return Err(usage(format!("--dt {}: must be in (0, 0.1] s", self.dt)));
         }
         if !(self.friction.is_finite() && self.friction >= 0.0) {
-            return Err(usage(format!("--friction {}: must be finite and >= 0", self.friction)));
+            return Err(usage(format!(
+                "--friction {}: must be finite and >= 0",
+                self.friction
+            )));
         }
-        let e_max = if self.allow_restitution_above_one { 10.0 } else { 1.0 };
+        let e_max = if self.allow_restitution_above_one {
+            10.0
+        } else {
+            1.0
+        };
         if !(self.restitution.is_finite() && self.restitution >= 0.0 && self.restitution <= e_max) {
             return Err(usage(format!(
                 "--restitution {}: must be in [0, 1] (above 1 only with --allow-restitution-above-one)",
@@ -137,7 +144,10 @@ impl ThrowArgs {
             return Err(usage(format!("--spin {}: must be >= 0 rad/s", self.spin)));
         }
         if self.drop_height.lo < 0.0 {
-            return Err(usage(format!("--drop-height {}: must be >= 0 m", self.drop_height)));
+            return Err(usage(format!(
+                "--drop-height {}: must be >= 0 m",
+                self.drop_height
+            )));
         }
         for (name, r, max) in [
             ("--velocity", self.velocity, 100.0),
@@ -145,7 +155,9 @@ impl ThrowArgs {
             ("--drop-height", self.drop_height, 100.0),
         ] {
             if r.lo.abs() > max || r.hi.abs() > max {
-                return Err(usage(format!("{name} {r}: magnitudes above {max} are not accepted")));
+                return Err(usage(format!(
+                    "{name} {r}: magnitudes above {max} are not accepted"
+                )));
             }
         }
         if self.throws == ThrowKind::Dicephys && self.seed > u32::MAX as u64 {

@@ -6,6 +6,7 @@ use std::path::Path;
 
 pub mod args;
 pub mod roll;
+pub mod theory;
 pub mod trace;
 
 #[derive(Parser, Debug)]
@@ -22,12 +23,12 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
+    /// The paper's closed-form theory for a block, or its whole experimental table.
+    Theory(theory::TheoryArgs),
     /// Roll one block many times on one engine: counts, ratio, theory, cost.
     Roll(roll::RollArgs),
     /// One throw's trajectory as CSV (step, time, position, orientation, velocities, energy).
     Trace(trace::TraceArgs),
-
-
 }
 
 /// Runs the command line; returns the process exit code (0 ok, 2 bad input, 1 failure).
@@ -37,9 +38,9 @@ pub fn main() -> i32 {
         Err(e) => return clap_error(e),
     };
     let result = match cli.command {
+        Command::Theory(a) => theory::run(&a),
         Command::Roll(a) => roll::run(&a),
         Command::Trace(a) => trace::run(&a),
-
     };
     match result {
         Ok(()) => 0,
@@ -64,12 +65,22 @@ fn clap_error(e: clap::Error) -> i32 {
             2
         }
         _ => {
+            // clap's message is its first paragraph (some, like a missing argument, span two
+            // lines); join it into one line and leave out the usage and help hints after it.
             let text = e.render().to_string();
-            let line = text
+            let paragraph: Vec<&str> = text
                 .lines()
-                .find(|l| !l.trim().is_empty())
-                .unwrap_or("bad command line")
-                .trim_start_matches("error: ");
+                .map(str::trim)
+                .skip_while(|l| l.is_empty())
+                .take_while(|l| !l.is_empty())
+                .collect();
+            let line = paragraph.join(" ");
+            let line = line.trim_start_matches("error: ");
+            let line = if line.is_empty() {
+                "bad command line"
+            } else {
+                line
+            };
             eprintln!("dicephys: {line}");
             2
         }

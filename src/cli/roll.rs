@@ -87,8 +87,9 @@ pub fn run(a: &RollArgs) -> Result<()> {
 
 /// The per-throw CSV: index, initial conditions, status, outcome, steps, simulated time.
 pub fn per_roll_csv(records: &[RollRecord], dt: f64) -> String {
-    let mut s =
-        String::from("index,drop_height_m,velocity_m_s,spin_rad_s,status,outcome,steps,sim_time_s\n");
+    let mut s = String::from(
+        "index,drop_height_m,velocity_m_s,spin_rad_s,status,outcome,steps,sim_time_s\n",
+    );
     for r in records {
         let (status, outcome) = match r.fate {
             Fate::Settled(o) => ("settled", o.name()),

@@ -43,7 +43,9 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     let scene = a.scene.scene()?;
     let ranges = a.throw.ranges()?;
     if a.every == 0 || a.max_steps == 0 {
-        return Err(Error::Usage("--every and --max-steps must be at least 1".into()));
+        return Err(Error::Usage(
+            "--every and --max-steps must be at least 1".into(),
+        ));
     }
     let throws = Throws::new(a.throw.throws, a.throw.seed, ranges, a.index + 1);
     let throw = throws.get(a.index);
