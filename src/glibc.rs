@@ -44,7 +44,7 @@ impl GlibcRand {
     }
 
     /// The next `rand()`, in [0, RAND_MAX].
-    pub fn next(&mut self) -> i32 {
+    pub fn next_rand(&mut self) -> i32 {
         // ring holds the last 34 values; slot i is the oldest (r[n-34]).
         let n31 = self.r[(self.i + 3) % 34]; // r[n-31]
         let n3 = self.r[(self.i + 31) % 34]; // r[n-3]
@@ -59,7 +59,7 @@ impl GlibcRand {
     pub fn uniform(&mut self, from: f64, to: f64) -> f64 {
         let (from, to) = if to < from { (to, from) } else { (from, to) };
         let range = to - from;
-        range * self.next() as f64 / RAND_MAX as f64 + from
+        range * self.next_rand() as f64 / RAND_MAX as f64 + from
     }
 }
 
@@ -78,7 +78,7 @@ mod tests {
         // state, so this is the only test that touches them.
         for seed in [0u32, 1, 2385, 123_456_789, u32::MAX] {
             let mut g = GlibcRand::new(seed);
-            let ours: Vec<i32> = (0..1000).map(|_| g.next()).collect();
+            let ours: Vec<i32> = (0..1000).map(|_| g.next_rand()).collect();
             let theirs: Vec<i32> = unsafe {
                 srand(seed);
                 (0..1000).map(|_| rand()).collect()
@@ -91,8 +91,8 @@ mod tests {
     fn known_first_values_for_seed_1() {
         // glibc's well-known first outputs after srand(1).
         let mut g = GlibcRand::new(1);
-        assert_eq!(g.next(), 1_804_289_383);
-        assert_eq!(g.next(), 846_930_886);
-        assert_eq!(g.next(), 1_681_692_777);
+        assert_eq!(g.next_rand(), 1_804_289_383);
+        assert_eq!(g.next_rand(), 846_930_886);
+        assert_eq!(g.next_rand(), 1_681_692_777);
     }
 }
