@@ -17,9 +17,9 @@ impl GlibcRand {
     pub fn new(seed: u32) -> GlibcRand {
         let seed = if seed == 0 { 1 } else { seed };
         let mut r = [0i64; 344];
-        r[0] = seed as i64;
-        // glibc seeds the LCG from the unsigned seed (a `long`), though it stores r[0] as int32.
-        let mut word = seed as i64;
+        // glibc keeps the seed as an int32: a seed above 2³¹ − 1 starts the LCG negative.
+        let mut word = seed as i32 as i64;
+        r[0] = word;
         for slot in r.iter_mut().take(31).skip(1) {
             // 16807 * word % 2147483647 without overflow (Schrage), as glibc computes it.
             let hi = word / 127_773;

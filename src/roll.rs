@@ -89,44 +89,46 @@ pub fn roll_observed(
     scene: &Scene,
     throw: &Throw,
     settle: &Settle,
-    mut observe: impl FnMut(u64, &BodyState),
+    observe: impl FnMut(u64, &BodyState),
 ) -> RollRecord {
-    let failed = |steps, f| RollRecord {
+    let (fate, steps) = run_from(engine, &throw.start(scene), settle, observe);
+    RollRecord {
         throw: *throw,
-        fate: Fate::Failed(f),
+        fate,
         steps,
-    };
-    let start = throw.start(scene);
-    if engine.reset(&start).is_err() {
-        return failed(0, Failure::Engine);
+    }
+}
+
+/// Steps the die from `start` until it is at rest, reaches the step cap, or fails; returns
+/// how it ended and the number of steps taken.
+pub fn run_from(
+    engine: &mut dyn Engine,
+    start: &BodyState,
+    settle: &Settle,
+    mut observe: impl FnMut(u64, &BodyState),
+) -> (Fate, u64) {
+    if engine.reset(start).is_err() {
+        return (Fate::Failed(Failure::Engine), 0);
     }
     observe(0, &engine.state());
     let mut rest = RestDetector::default();
     let mut steps = 0;
-    let mut state = start;
+    let mut state = *start;
     while steps < settle.max_steps {
         if engine.step().is_err() {
-            return failed(steps, Failure::Engine);
+            return (Fate::Failed(Failure::Engine), steps);
         }
         steps += 1;
         state = engine.state();
         observe(steps, &state);
         if let Some(f) = check(&state) {
-            return failed(steps, f);
+            return (Fate::Failed(f), steps);
         }
         if rest.push(&state) {
-            return RollRecord {
-                throw: *throw,
-                fate: Fate::Settled(classify(&state)),
-                steps,
-            };
+            return (Fate::Settled(classify(&state)), steps);
         }
     }
-    RollRecord {
-        throw: *throw,
-        fate: Fate::Unconverged(classify(&state)),
-        steps,
-    }
+    (Fate::Unconverged(classify(&state)), steps)
 }
 
 pub fn roll(engine: &mut dyn Engine, scene: &Scene, throw: &Throw, settle: &Settle) -> RollRecord {
