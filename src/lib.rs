@@ -16,6 +16,7 @@ pub mod cputime;
 pub mod engine;
 pub mod error;
 pub mod glibc;
+pub mod paper;
 pub mod paper_data;
 pub mod roll;
 pub mod scene;

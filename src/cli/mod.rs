@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 use std::path::Path;
 
 pub mod args;
+pub mod paper;
 pub mod roll;
 pub mod theory;
 pub mod trace;
@@ -23,6 +24,8 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
+    /// Reproduce the paper: its table, theory, simulations and figures, into --out.
+    Paper(paper::PaperArgs),
     /// The paper's closed-form theory for a block, or its whole experimental table.
     Theory(theory::TheoryArgs),
     /// Roll one block many times on one engine: counts, ratio, theory, cost.
@@ -38,6 +41,7 @@ pub fn main() -> i32 {
         Err(e) => return clap_error(e),
     };
     let result = match cli.command {
+        Command::Paper(a) => paper::run(&a),
         Command::Theory(a) => theory::run(&a),
         Command::Roll(a) => roll::run(&a),
         Command::Trace(a) => trace::run(&a),
