@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 use std::path::Path;
 
 pub mod args;
+pub mod crosscheck;
 pub mod paper;
 pub mod roll;
 pub mod theory;
@@ -24,6 +25,8 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
+    /// The same throws on several engines: counts, ratios, σ apart, per-throw agreement, cost.
+    Crosscheck(crosscheck::CrosscheckArgs),
     /// Reproduce the paper: its table, theory, simulations and figures, into --out.
     Paper(paper::PaperArgs),
     /// The paper's closed-form theory for a block, or its whole experimental table.
@@ -41,6 +44,7 @@ pub fn main() -> i32 {
         Err(e) => return clap_error(e),
     };
     let result = match cli.command {
+        Command::Crosscheck(a) => crosscheck::run(&a),
         Command::Paper(a) => paper::run(&a),
         Command::Theory(a) => theory::run(&a),
         Command::Roll(a) => roll::run(&a),
