@@ -22,6 +22,11 @@ pub struct Tally {
     pub rolls: u64,
     /// Steps simulated over all rolls.
     pub steps: u64,
+    /// Auditing the early stop: rolls the certificate fired on, how many of those settled on
+    /// another side than it named, and the steps at which it fired, summed.
+    pub certified: u64,
+    pub certified_wrong: u64,
+    pub certified_steps: u64,
 }
 
 #[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
@@ -47,6 +52,15 @@ impl Tally {
     pub fn add(&mut self, r: &RollRecord) {
         self.rolls += 1;
         self.steps += r.steps;
+        if let Some((step, o)) = r.certified {
+            self.certified += 1;
+            self.certified_steps += step;
+            let wrong = match r.fate {
+                Fate::Settled(s) | Fate::Unconverged(s) => s != o,
+                Fate::Failed(_) => false,
+            };
+            self.certified_wrong += wrong as u64;
+        }
         match r.fate {
             Fate::Settled(o) => self.counts.add(o),
             Fate::Unconverged(_) => self.unconverged += 1,
@@ -73,6 +87,9 @@ impl Tally {
         }
         self.rolls += o.rolls;
         self.steps += o.steps;
+        self.certified += o.certified;
+        self.certified_wrong += o.certified_wrong;
+        self.certified_steps += o.certified_steps;
     }
 
     pub fn of(records: &[RollRecord]) -> Tally {
@@ -136,6 +153,7 @@ fn roll_one(
         throw: *throw,
         fate: Fate::Failed(Failure::Engine),
         steps: 0,
+        certified: None,
     };
     let Some(engine) = world.as_mut() else {
         return failed;

@@ -99,6 +99,7 @@ pub fn run(
     let throws = Throws::new(ThrowKind::Keyed, cfg.seed, ranges, 0);
     let settle = Settle {
         max_steps: cfg.max_steps,
+        ..Settle::default()
     };
     let mut done_before = 0u64;
     let mut simulations = Vec::new();

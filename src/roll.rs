@@ -4,7 +4,7 @@
 use crate::block::Outcome;
 use crate::engine::{BodyState, Engine};
 use crate::scene::Scene;
-use crate::settle::{classify, RestDetector};
+use crate::settle::{classify, Certificate, DieShape, RestDetector};
 use crate::throws::Throw;
 use serde::Serialize;
 
@@ -50,6 +50,9 @@ pub struct RollRecord {
     pub throw: Throw,
     pub fate: Fate,
     pub steps: u64,
+    /// With `Settle::audit`: the first step at which the energy certificate held, and the
+    /// outcome it certified.
+    pub certified: Option<(u64, Outcome)>,
 }
 
 impl RollRecord {
@@ -58,16 +61,38 @@ impl RollRecord {
     }
 }
 
+/// The rule that ends a roll.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Rule {
+    /// DicePhys's: at rest by the vector sums of the last 10 steps' velocities.
+    Dicephys,
+    /// The exact early stop: the energy is below the barrier out of the current face
+    /// (`settle::Certificate`); falls back to DicePhys's rule if that comes first.
+    Certificate,
+}
+
 /// What stops a roll.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Settle {
     pub max_steps: u64,
+    pub rule: Rule,
+    /// The certificate's reserve, a fraction of the barrier (`settle::Certificate`).
+    pub margin: f64,
+    /// Record when the certificate would first have stopped the roll, without stopping it.
+    pub audit: bool,
 }
+
+/// The certificate's default margin: measured to be never wrong (see README, "Speed").
+pub const DEFAULT_MARGIN: f64 = 0.1;
 
 impl Default for Settle {
     fn default() -> Self {
         Settle {
             max_steps: DEFAULT_MAX_STEPS,
+            rule: Rule::Dicephys,
+            margin: DEFAULT_MARGIN,
+            audit: false,
         }
     }
 }
@@ -91,24 +116,34 @@ pub fn roll_observed(
     settle: &Settle,
     observe: impl FnMut(u64, &BodyState),
 ) -> RollRecord {
-    let (fate, steps) = run_from(engine, &throw.start(scene), settle, observe);
+    let (fate, steps, certified) = run_from(engine, scene, &throw.start(scene), settle, observe);
     RollRecord {
         throw: *throw,
         fate,
         steps,
+        certified,
     }
 }
 
-/// Steps the die from `start` until it is at rest, reaches the step cap, or fails; returns
-/// how it ended and the number of steps taken.
+/// Steps the die from `start` until it is at rest (or certain), reaches the step cap, or
+/// fails; returns how it ended, the number of steps taken, and (auditing) when the
+/// certificate first held.
 pub fn run_from(
     engine: &mut dyn Engine,
+    scene: &Scene,
     start: &BodyState,
     settle: &Settle,
     mut observe: impl FnMut(u64, &BodyState),
-) -> (Fate, u64) {
+) -> (Fate, u64, Option<(u64, Outcome)>) {
+    let die = DieShape::of(scene);
+    let certificate = Certificate {
+        margin: settle.margin,
+    };
+    let stop_early = settle.rule == Rule::Certificate;
+    let watch = stop_early || settle.audit;
+    let mut certified = None;
     if engine.reset(start).is_err() {
-        return (Fate::Failed(Failure::Engine), 0);
+        return (Fate::Failed(Failure::Engine), 0, None);
     }
     observe(0, &engine.state());
     let mut rest = RestDetector::default();
@@ -116,19 +151,27 @@ pub fn run_from(
     let mut state = *start;
     while steps < settle.max_steps {
         if engine.step().is_err() {
-            return (Fate::Failed(Failure::Engine), steps);
+            return (Fate::Failed(Failure::Engine), steps, certified);
         }
         steps += 1;
         state = engine.state();
         observe(steps, &state);
         if let Some(f) = check(&state) {
-            return (Fate::Failed(f), steps);
+            return (Fate::Failed(f), steps, certified);
+        }
+        if watch && certified.is_none() {
+            if let Some(o) = certificate.certain(&die, &state) {
+                certified = Some((steps, o));
+                if stop_early {
+                    return (Fate::Settled(o), steps, certified);
+                }
+            }
         }
         if rest.push(&state) {
-            return (Fate::Settled(classify(&state)), steps);
+            return (Fate::Settled(classify(&state)), steps, certified);
         }
     }
-    (Fate::Unconverged(classify(&state)), steps)
+    (Fate::Unconverged(classify(&state)), steps, certified)
 }
 
 pub fn roll(engine: &mut dyn Engine, scene: &Scene, throw: &Throw, settle: &Settle) -> RollRecord {

@@ -72,3 +72,138 @@ pub fn classify(s: &BodyState) -> Outcome {
     }
     Outcome::Unknown
 }
+
+/// The paper's "static" states made exact: once the die's mechanical energy is below the
+/// lowest barrier out of the face region it is in, its outcome can no longer change.
+///
+/// Let g be the downward unit vertical in body coordinates and s = (a, b, c)/2 the box's half
+/// sides. A box touching the floor with down-direction g has its centre at height
+/// h(g) = Σ sᵢ|gᵢ| (the support function), and never lower: y ≥ h(g) while it is above the
+/// floor. Call "region i" the directions g whose downward ray from the centre leaves the box
+/// through a face normal to axis i (|gᵢ|/sᵢ largest). On the boundary between region i and
+/// region j the ray hits an edge, and h there is at least the edge-balance height
+/// B_ij = √(sᵢ² + sⱼ²) (a linear function on a circle arc takes its least value at an end;
+/// the other end, a vertex, is higher). So with E = ½mv² + ½ω·Iω + mgy below mg·Bᵢ, where
+/// Bᵢ = min over j≠i of B_ij, h(g) ≤ y ≤ E/mg < Bᵢ for ever (energy never rises), g cannot
+/// leave region i, and the die comes to rest on face i: axis i vertical. In 2D (rotation about
+/// z only) the same holds with j ranging over x and y alone: the paper's E_Trans (eq. Etrans)
+/// is mg·B for the one edge of the cross-section.
+///
+/// Engines inject a little energy at contacts and let the die sink into the floor, so the
+/// test keeps a margin: the die's energy above its resting height on face i must be below
+/// (1 − margin) of the barrier above that height.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Certificate {
+    /// Fraction of the barrier kept in reserve, in [0, 1).
+    pub margin: f64,
+}
+
+/// What the certificate needs to know of the scene.
+#[derive(Clone, Copy, Debug)]
+pub struct DieShape {
+    pub half: Vector3<f64>,
+    pub mass: f64,
+    /// Principal moments of inertia about the body axes.
+    pub inertia: Vector3<f64>,
+    pub gravity: f64,
+    /// Rotation about z only (2D): region and barrier over the x and y axes.
+    pub planar: bool,
+}
+
+impl DieShape {
+    pub fn of(scene: &crate::scene::Scene) -> DieShape {
+        let [a, b, c] = scene.body_sides();
+        let m = scene.mass();
+        DieShape {
+            half: Vector3::new(a, b, c) / 2.0,
+            mass: m,
+            // A box's principal moments about its centre: m/12 (b² + c²), etc.
+            inertia: Vector3::new(b * b + c * c, a * a + c * c, a * a + b * b) * (m / 12.0),
+            gravity: scene.gravity,
+            planar: scene.mode == crate::scene::Mode::TwoD,
+        }
+    }
+
+    /// Kinetic plus potential energy (floor top at y = 0).
+    pub fn energy(&self, s: &BodyState) -> f64 {
+        let w = s.rotation.inverse() * s.angular_velocity;
+        0.5 * self.mass * s.linear_velocity.norm_squared()
+            + 0.5 * w.component_mul(&w).dot(&self.inertia)
+            + self.mass * self.gravity * s.position.y
+    }
+}
+
+const SIDES: [Outcome; 3] = [Outcome::Breadth, Outcome::Width, Outcome::Length];
+
+impl Certificate {
+    /// The outcome, if it is already certain.
+    pub fn certain(&self, die: &DieShape, s: &BodyState) -> Option<Outcome> {
+        let down = s.rotation.inverse() * Vector3::new(0.0, -1.0, 0.0);
+        let axes: &[usize] = if die.planar { &[0, 1] } else { &[0, 1, 2] };
+        let i = *axes.iter().max_by(|&&p, &&q| {
+            (down[p].abs() / die.half[p]).total_cmp(&(down[q].abs() / die.half[q]))
+        })?;
+        let barrier = axes
+            .iter()
+            .filter(|&&j| j != i)
+            .map(|&j| die.half[i].hypot(die.half[j]))
+            .fold(f64::INFINITY, f64::min);
+        let rest = die.half[i];
+        let mg = die.mass * die.gravity;
+        let excess = die.energy(s) / mg - rest;
+        (excess < (1.0 - self.margin) * (barrier - rest)).then_some(SIDES[i])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Mode, Scene};
+    use nalgebra::UnitQuaternion;
+
+    fn state(y: f64, rot: UnitQuaternion<f64>, v: f64, w: f64) -> BodyState {
+        BodyState {
+            position: Vector3::new(0.0, y, 0.0),
+            rotation: rot,
+            linear_velocity: Vector3::new(v, 0.0, 0.0),
+            angular_velocity: Vector3::new(0.0, 0.0, w),
+            sleeping: false,
+        }
+    }
+
+    #[test]
+    fn a_die_at_rest_is_certain_and_a_flying_one_is_not() {
+        let scene = Scene::paper("140x24x20".parse().unwrap(), Mode::ThreeD);
+        let die = DieShape::of(&scene);
+        let c = Certificate { margin: 0.1 };
+        let id = UnitQuaternion::identity();
+        assert_eq!(
+            c.certain(&die, &state(0.010, id, 0.0, 0.0)),
+            Some(Outcome::Width)
+        );
+        let on_side = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 1.5);
+        assert_eq!(
+            c.certain(&die, &state(0.012, on_side, 0.0, 0.0)),
+            Some(Outcome::Breadth)
+        );
+        // Dropped from 0.3 m: far above every barrier.
+        assert_eq!(c.certain(&die, &state(0.3, id, 0.0, 0.0)), None);
+        // On the floor but spinning fast enough to tip over.
+        assert_eq!(c.certain(&die, &state(0.010, id, 0.0, 60.0)), None);
+    }
+
+    #[test]
+    fn the_barrier_is_the_edge_balance_height() {
+        // 2D, width face down (identity): barrier ½√(b² + w²) above the floor.
+        let scene = Scene::paper("140x24x20".parse().unwrap(), Mode::TwoD);
+        let die = DieShape::of(&scene);
+        let c = Certificate { margin: 0.0 };
+        let id = UnitQuaternion::identity();
+        let b = 0.5 * (0.024f64).hypot(0.020);
+        assert_eq!(
+            c.certain(&die, &state(b - 1e-6, id, 0.0, 0.0)),
+            Some(Outcome::Width)
+        );
+        assert_eq!(c.certain(&die, &state(b + 1e-6, id, 0.0, 0.0)), None);
+    }
+}

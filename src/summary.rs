@@ -3,7 +3,7 @@
 
 use crate::batch::{Counts, Tally};
 use crate::engine::EngineKind;
-use crate::roll::Settle;
+use crate::roll::{Rule, Settle};
 use crate::scene::Scene;
 use crate::throws::{ThrowKind, ThrowRanges};
 use serde::Serialize;
@@ -26,6 +26,8 @@ pub struct RunSummary {
     pub density: f64,
     pub floor: String,
     pub max_steps: u64,
+    /// What ended each roll: DicePhys's rest rule or the energy certificate.
+    pub settle: Rule,
     pub counts: Counts,
     pub unconverged: u64,
     pub failed: BTreeMap<String, u64>,
@@ -45,6 +47,23 @@ pub struct RunSummary {
     pub cpu_ms_per_roll: f64,
     pub threads: usize,
     pub dicephys_version: String,
+    /// Present when auditing the early stop (`--audit`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub audit: Option<Audit>,
+}
+
+/// How the energy certificate would have done on these rolls.
+#[derive(Clone, Debug, Serialize)]
+pub struct Audit {
+    pub margin: f64,
+    /// Rolls on which it fired before DicePhys's rule stopped them.
+    pub certified: u64,
+    /// Of those, rolls whose final side differs from the one it named.
+    pub wrong: u64,
+    /// Mean step at which it fired, over the rolls it fired on.
+    pub certified_steps_mean: f64,
+    /// Mean steps of the full settle.
+    pub full_steps_mean: f64,
 }
 
 impl RunSummary {
@@ -80,6 +99,7 @@ impl RunSummary {
             density: scene.density,
             floor: format!("{:?}", scene.floor).to_lowercase(),
             max_steps: settle.max_steps,
+            settle: settle.rule,
             counts: tally.counts.clone(),
             unconverged: tally.unconverged,
             failed: tally.failed.clone(),
@@ -95,6 +115,13 @@ impl RunSummary {
             cpu_ms_per_roll: 1000.0 * cpu_s / tally.rolls.max(1) as f64,
             threads,
             dicephys_version: env!("CARGO_PKG_VERSION").into(),
+            audit: settle.audit.then(|| Audit {
+                margin: settle.margin,
+                certified: tally.certified,
+                wrong: tally.certified_wrong,
+                certified_steps_mean: tally.certified_steps as f64 / tally.certified.max(1) as f64,
+                full_steps_mean: tally.steps as f64 / tally.rolls.max(1) as f64,
+            }),
         }
     }
 
@@ -151,6 +178,13 @@ impl RunSummary {
             self.threads,
             self.engine_version
         );
+        if let Some(a) = &self.audit {
+            s += &format!(
+                "  audit of the early stop (margin {}): fired on {} rolls, wrong on {}; \
+                 mean step {:.0} against {:.0} for the full settle\n",
+                a.margin, a.certified, a.wrong, a.certified_steps_mean, a.full_steps_mean
+            );
+        }
         s
     }
 }

@@ -33,10 +33,14 @@ fn settle_at_rest(
 ) -> Fate {
     let scene = Scene::paper(block(), mode);
     let mut e = new_engine(engine, &scene).unwrap();
-    let (fate, _) = run_from(
+    let (fate, _, _) = run_from(
         e.as_mut(),
+        &scene,
         &at_rest(rotation, half),
-        &Settle { max_steps: 20_000 },
+        &Settle {
+            max_steps: 20_000,
+            ..Settle::default()
+        },
         |_, _| {},
     );
     fate

@@ -3,7 +3,7 @@
 use crate::block::Block;
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
-use crate::roll::{Settle, DEFAULT_MAX_STEPS};
+use crate::roll::{Rule, Settle, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
 use crate::scene::{Floor, Mode, Preset, Scene};
 use crate::throws::{Range, ThrowKind, ThrowRanges};
 use clap::Args;
@@ -72,6 +72,17 @@ pub struct RunArgs {
     /// Steps after which a roll not at rest counts as unconverged.
     #[arg(long, default_value_t = DEFAULT_MAX_STEPS)]
     pub max_steps: u64,
+    /// What ends a roll: dicephys (at rest by DicePhys's rule) or certificate (the exact early
+    /// stop: energy below the barrier out of the current face).
+    #[arg(long, default_value = "dicephys", value_parser = ["dicephys", "certificate"])]
+    pub settle: String,
+    /// The certificate's reserve, a fraction of the barrier in [0, 1).
+    #[arg(long, default_value_t = DEFAULT_MARGIN)]
+    pub margin: f64,
+    /// Settle by DicePhys's rule but record when the certificate would have stopped each roll
+    /// and whether it named the same outcome.
+    #[arg(long)]
+    pub audit: bool,
 }
 
 pub fn parse_block(s: &str) -> std::result::Result<Block, String> {
@@ -188,8 +199,21 @@ impl RunArgs {
         if self.threads > 1024 {
             return Err(usage(format!("--threads {}: at most 1024", self.threads)));
         }
+        if !(self.margin.is_finite() && (0.0..1.0).contains(&self.margin)) {
+            return Err(usage(format!(
+                "--margin {}: must be in [0, 1)",
+                self.margin
+            )));
+        }
+        let rule = match self.settle.as_str() {
+            "certificate" => Rule::Certificate,
+            _ => Rule::Dicephys,
+        };
         Ok(Settle {
             max_steps: self.max_steps,
+            rule,
+            margin: self.margin,
+            audit: self.audit,
         })
     }
 }

@@ -85,6 +85,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     };
     let settle = Settle {
         max_steps: a.max_steps,
+        ..Settle::default()
     };
     let record = roll_observed(engine.as_mut(), &scene, &throw, &settle, |step, s| {
         let l = line(step, s);
