@@ -7,7 +7,8 @@
 //! Modules: `block` (the die and its sides' names), `scene` (what a throw happens in),
 //! `throws` (initial conditions, keyed or DicePhys's sequence), `engine` (Bullet, Rapier),
 //! `settle` (at rest, outcome), `theory` and `paper_data` (the paper's closed forms and table),
-//! `stats` (binomial errors, z, χ²), `roll` (one roll), `batch` (many, in parallel), `cli`.
+//! `stats` (binomial errors, z, χ²), `figures` (the paper's figures as SVG and PNG),
+//! `roll` (one roll), `batch` (many, in parallel), `cli`.
 
 pub mod batch;
 pub mod block;
@@ -15,6 +16,7 @@ pub mod cli;
 pub mod cputime;
 pub mod engine;
 pub mod error;
+pub mod figures;
 pub mod glibc;
 pub mod paper;
 pub mod paper_data;
