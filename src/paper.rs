@@ -48,6 +48,8 @@ pub struct Provenance {
     pub command_line: String,
     pub dicephys_version: String,
     pub engines: Vec<String>,
+    /// The engines' short names, as in `simulations[].engine`.
+    pub engines_short: Vec<String>,
     pub preset: String,
     pub dt: f64,
     pub seed: u64,
@@ -165,6 +167,7 @@ pub fn run(
             command_line,
             dicephys_version: env!("CARGO_PKG_VERSION").into(),
             engines: cfg.engines.iter().map(|e| e.version()).collect(),
+            engines_short: cfg.engines.iter().map(|e| e.name().to_string()).collect(),
             preset: crate::scene::Preset::Dicephys281.name().into(),
             dt: cfg.dt,
             seed: cfg.seed,
@@ -430,6 +433,53 @@ pub fn results_csv(res: &PaperResults) -> String {
 }
 
 /// The paper's figures, drawn from the results; returns their names (each has .svg and .png).
-pub fn write_figures(_dir: &std::path::Path, _res: &PaperResults) -> Result<Vec<&'static str>> {
-    Ok(Vec::new())
+pub fn write_figures(dir: &std::path::Path, res: &PaperResults) -> Result<Vec<&'static str>> {
+    use crate::figures::{self, Point, SimSeries};
+    let mut sims = Vec::new();
+    for engine in &res.provenance.engines_short {
+        for (mode, name) in [("2d", "2D"), ("3d", "3D")] {
+            let mut points: Vec<Point> = res
+                .simulations
+                .iter()
+                .filter(|c| &c.engine == engine && c.mode == mode)
+                .filter_map(|c| {
+                    let row = res.table.rows.iter().find(|r| r.row == c.row)?;
+                    Some(Point {
+                        x: row.r.value,
+                        y: c.ratio.value,
+                        y_err: c.ratio.err,
+                    })
+                })
+                .collect();
+            points.sort_by(|a, b| a.x.total_cmp(&b.x));
+            sims.push(SimSeries {
+                label: format!("{} {name} simulation", engine_label(engine)),
+                two_d: mode == "2d",
+                points,
+            });
+        }
+    }
+    let run = |r: std::result::Result<(), String>| r.map_err(Error::Run);
+    run(figures::master_graph(
+        dir,
+        "master_graph",
+        &figures::paper_experiment_points(),
+        &sims,
+    ))?;
+    run(figures::prob_2d(dir, "prob_2d"))?;
+    run(figures::len_graph(
+        dir,
+        "len_graph",
+        &figures::paper_length_groups(),
+    ))?;
+    run(figures::dreidel(dir, "dreidel", 0.1))?;
+    Ok(vec!["master_graph", "prob_2d", "len_graph", "dreidel"])
+}
+
+fn engine_label(name: &str) -> String {
+    match name {
+        "bullet" => "Bullet".into(),
+        "rapier" => "Rapier".into(),
+        other => other.into(),
+    }
 }

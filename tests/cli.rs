@@ -162,6 +162,33 @@ fn a_tiny_paper_run_is_complete_and_repeatable() {
         assert_eq!(x["ratio"], y["ratio"]);
     }
     assert!(dir.join("report.md").exists());
+    for (fig, series) in [
+        (
+            "master_graph",
+            &[
+                "theory",
+                "no bounce",
+                "printed on MDF",
+                "Bullet 2D simulation",
+                "Bullet 3D simulation",
+            ][..],
+        ),
+        ("prob_2d", &["theory"][..]),
+        ("len_graph", &["printed 24x20 on MDF"][..]),
+        ("dreidel", &["first order"][..]),
+    ] {
+        let svg = std::fs::read_to_string(dir.join(format!("{fig}.svg"))).unwrap();
+        assert!(
+            svg.trim_start().starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
+            "{fig}.svg"
+        );
+        assert_eq!(svg.matches("<svg").count(), svg.matches("</svg>").count());
+        for name in series {
+            assert!(svg.contains(name), "{fig}.svg lacks the series '{name}'");
+        }
+        let png = std::fs::read(dir.join(format!("{fig}.png"))).unwrap();
+        assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "{fig}.png");
+    }
     assert!(dir.join("results.csv").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
