@@ -90,6 +90,21 @@ void BulletWorld::reset(const BodyStateFfi& start) {
   world_->addRigidBody(die_.get());
 }
 
+// Moves the die to a state mid-roll, keeping its contacts and timers: Rust uses it to jump
+// over a stretch of free flight it has integrated in closed form exactly as Bullet would.
+void BulletWorld::set_state(const BodyStateFfi& now) {
+  if (!die_) throw std::logic_error("set_state before reset");
+  btTransform at;
+  at.setRotation(btQuaternion(now.rotation[0], now.rotation[1], now.rotation[2], now.rotation[3]));
+  at.setOrigin(vec(now.position));
+  die_->setWorldTransform(at);
+  die_->setInterpolationWorldTransform(at);
+  die_->setLinearVelocity(vec(now.linear_velocity));
+  die_->setAngularVelocity(vec(now.angular_velocity));
+  die_->setInterpolationLinearVelocity(vec(now.linear_velocity));
+  die_->setInterpolationAngularVelocity(vec(now.angular_velocity));
+}
+
 // One fixed step per call, as DicePhys: stepSimulation(dt, 1, dt).
 void BulletWorld::step() {
   if (!die_) throw std::logic_error("step before reset");

@@ -27,6 +27,7 @@ class BulletWorld {
   BulletWorld& operator=(const BulletWorld&) = delete;
 
   void reset(const BodyStateFfi& start);
+  void set_state(const BodyStateFfi& now);
   void step();
   void step_n(std::uint32_t n);
   BodyStateFfi state() const;

@@ -22,6 +22,8 @@ pub struct Tally {
     pub rolls: u64,
     /// Steps simulated over all rolls.
     pub steps: u64,
+    /// Steps the engines took (fewer where free flight was coasted).
+    pub engine_steps: u64,
     /// Auditing the early stop: rolls the certificate fired on, how many of those settled on
     /// another side than it named, and the steps at which it fired, summed.
     pub certified: u64,
@@ -52,6 +54,7 @@ impl Tally {
     pub fn add(&mut self, r: &RollRecord) {
         self.rolls += 1;
         self.steps += r.steps;
+        self.engine_steps += r.engine_steps;
         if let Some((step, o)) = r.certified {
             self.certified += 1;
             self.certified_steps += step;
@@ -87,6 +90,7 @@ impl Tally {
         }
         self.rolls += o.rolls;
         self.steps += o.steps;
+        self.engine_steps += o.engine_steps;
         self.certified += o.certified;
         self.certified_wrong += o.certified_wrong;
         self.certified_steps += o.certified_steps;
@@ -153,6 +157,7 @@ fn roll_one(
         throw: *throw,
         fate: Fate::Failed(Failure::Engine),
         steps: 0,
+        engine_steps: 0,
         certified: None,
     };
     let Some(engine) = world.as_mut() else {

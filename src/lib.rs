@@ -17,6 +17,7 @@ pub mod cputime;
 pub mod engine;
 pub mod error;
 pub mod figures;
+pub mod flight;
 pub mod glibc;
 pub mod paper;
 pub mod paper_data;

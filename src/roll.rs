@@ -3,6 +3,7 @@
 
 use crate::block::Outcome;
 use crate::engine::{BodyState, Engine};
+use crate::flight::Flight;
 use crate::scene::Scene;
 use crate::settle::{classify, Certificate, DieShape, RestDetector};
 use crate::throws::Throw;
@@ -50,6 +51,8 @@ pub struct RollRecord {
     pub throw: Throw,
     pub fate: Fate,
     pub steps: u64,
+    /// Steps the engine itself took (fewer than `steps` where free flight was coasted).
+    pub engine_steps: u64,
     /// With `Settle::audit`: the first step at which the energy certificate held, and the
     /// outcome it certified.
     pub certified: Option<(u64, Outcome)>,
@@ -81,6 +84,9 @@ pub struct Settle {
     pub margin: f64,
     /// Record when the certificate would first have stopped the roll, without stopping it.
     pub audit: bool,
+    /// Jump over free flight in closed form (`flight::Flight`) where the engine's flight is
+    /// ballistic.
+    pub fast_flight: bool,
 }
 
 /// The certificate's default margin: measured to be never wrong (see README, "Speed").
@@ -93,6 +99,7 @@ impl Default for Settle {
             rule: Rule::Dicephys,
             margin: DEFAULT_MARGIN,
             audit: false,
+            fast_flight: false,
         }
     }
 }
@@ -116,62 +123,98 @@ pub fn roll_observed(
     settle: &Settle,
     observe: impl FnMut(u64, &BodyState),
 ) -> RollRecord {
-    let (fate, steps, certified) = run_from(engine, scene, &throw.start(scene), settle, observe);
+    let end = run_from(engine, scene, &throw.start(scene), settle, observe);
     RollRecord {
         throw: *throw,
-        fate,
-        steps,
-        certified,
+        fate: end.fate,
+        steps: end.steps,
+        engine_steps: end.engine_steps,
+        certified: end.certified,
     }
 }
 
+/// How a roll from a start state ended.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct End {
+    pub fate: Fate,
+    /// Simulated steps (time = steps × dt).
+    pub steps: u64,
+    /// Steps the engine took.
+    pub engine_steps: u64,
+    pub certified: Option<(u64, Outcome)>,
+}
+
 /// Steps the die from `start` until it is at rest (or certain), reaches the step cap, or
-/// fails; returns how it ended, the number of steps taken, and (auditing) when the
-/// certificate first held.
+/// fails.
 pub fn run_from(
     engine: &mut dyn Engine,
     scene: &Scene,
     start: &BodyState,
     settle: &Settle,
     mut observe: impl FnMut(u64, &BodyState),
-) -> (Fate, u64, Option<(u64, Outcome)>) {
+) -> End {
     let die = DieShape::of(scene);
     let certificate = Certificate {
         margin: settle.margin,
     };
     let stop_early = settle.rule == Rule::Certificate;
     let watch = stop_early || settle.audit;
-    let mut certified = None;
+    let flight = (settle.fast_flight && engine.ballistic_flight()).then(|| Flight::of(scene));
+    let mut end = End {
+        fate: Fate::Failed(Failure::Engine),
+        steps: 0,
+        engine_steps: 0,
+        certified: None,
+    };
     if engine.reset(start).is_err() {
-        return (Fate::Failed(Failure::Engine), 0, None);
+        return end;
     }
     observe(0, &engine.state());
     let mut rest = RestDetector::default();
-    let mut steps = 0;
     let mut state = *start;
-    while steps < settle.max_steps {
+    while end.steps < settle.max_steps {
+        if let Some(f) = &flight {
+            if f.lowest_point(&state) > f.clearance {
+                let (coasted, n) = f.coast(&state, settle.max_steps - end.steps);
+                if n > 0 {
+                    if engine.set_state(&coasted).is_err() {
+                        return end;
+                    }
+                    end.steps += n;
+                    state = coasted;
+                    observe(end.steps, &state);
+                    rest.push(&state);
+                    continue;
+                }
+            }
+        }
         if engine.step().is_err() {
-            return (Fate::Failed(Failure::Engine), steps, certified);
+            return end;
         }
-        steps += 1;
+        end.steps += 1;
+        end.engine_steps += 1;
         state = engine.state();
-        observe(steps, &state);
+        observe(end.steps, &state);
         if let Some(f) = check(&state) {
-            return (Fate::Failed(f), steps, certified);
+            end.fate = Fate::Failed(f);
+            return end;
         }
-        if watch && certified.is_none() {
+        if watch && end.certified.is_none() {
             if let Some(o) = certificate.certain(&die, &state) {
-                certified = Some((steps, o));
+                end.certified = Some((end.steps, o));
                 if stop_early {
-                    return (Fate::Settled(o), steps, certified);
+                    end.fate = Fate::Settled(o);
+                    return end;
                 }
             }
         }
         if rest.push(&state) {
-            return (Fate::Settled(classify(&state)), steps, certified);
+            end.fate = Fate::Settled(classify(&state));
+            return end;
         }
     }
-    (Fate::Unconverged(classify(&state)), steps, certified)
+    end.fate = Fate::Unconverged(classify(&state));
+    end
 }
 
 pub fn roll(engine: &mut dyn Engine, scene: &Scene, throw: &Throw, settle: &Settle) -> RollRecord {

@@ -42,6 +42,9 @@ pub struct RunSummary {
     pub z_theory: f64,
     pub steps_total: u64,
     pub steps_mean: f64,
+    /// Steps the engine took per roll (below steps_mean where free flight was coasted).
+    pub engine_steps_mean: f64,
+    pub fast_flight: bool,
     pub wall_s: f64,
     pub cpu_s: f64,
     pub cpu_ms_per_roll: f64,
@@ -110,6 +113,8 @@ impl RunSummary {
             z_theory: (ratio - theory_ratio) / ratio_err,
             steps_total: tally.steps,
             steps_mean: tally.steps as f64 / tally.rolls.max(1) as f64,
+            engine_steps_mean: tally.engine_steps as f64 / tally.rolls.max(1) as f64,
+            fast_flight: settle.fast_flight,
             wall_s,
             cpu_s,
             cpu_ms_per_roll: 1000.0 * cpu_s / tally.rolls.max(1) as f64,
@@ -170,8 +175,9 @@ impl RunSummary {
             }
         );
         s += &format!(
-            "  steps/roll {:.0}   wall {:.2} s   CPU {:.2} s ({:.3} ms/roll, {} threads)   {}\n",
+            "  steps/roll {:.0} ({:.0} by the engine)   wall {:.2} s   CPU {:.2} s ({:.3} ms/roll, {} threads)   {}\n",
             self.steps_mean,
+            self.engine_steps_mean,
             self.wall_s,
             self.cpu_s,
             self.cpu_ms_per_roll,

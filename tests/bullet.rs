@@ -33,7 +33,7 @@ fn settle_at_rest(
 ) -> Fate {
     let scene = Scene::paper(block(), mode);
     let mut e = new_engine(engine, &scene).unwrap();
-    let (fate, _, _) = run_from(
+    let end = run_from(
         e.as_mut(),
         &scene,
         &at_rest(rotation, half),
@@ -43,7 +43,7 @@ fn settle_at_rest(
         },
         |_, _| {},
     );
-    fate
+    end.fate
 }
 
 #[test]

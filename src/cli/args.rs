@@ -83,6 +83,10 @@ pub struct RunArgs {
     /// and whether it named the same outcome.
     #[arg(long)]
     pub audit: bool,
+    /// Jump over free flight in closed form (exact to rounding where the engine's flight is
+    /// ballistic: Bullet with the dicephys281 preset, Rapier).
+    #[arg(long)]
+    pub fast_flight: bool,
 }
 
 pub fn parse_block(s: &str) -> std::result::Result<Block, String> {
@@ -214,6 +218,7 @@ impl RunArgs {
             rule,
             margin: self.margin,
             audit: self.audit,
+            fast_flight: self.fast_flight,
         })
     }
 }

@@ -49,6 +49,7 @@ mod ffi {
 
         fn new_world(scene: &BulletScene) -> Result<UniquePtr<BulletWorld>>;
         fn reset(self: Pin<&mut BulletWorld>, start: &BodyStateFfi) -> Result<()>;
+        fn set_state(self: Pin<&mut BulletWorld>, now: &BodyStateFfi) -> Result<()>;
         fn step(self: Pin<&mut BulletWorld>) -> Result<()>;
         fn step_n(self: Pin<&mut BulletWorld>, n: u32) -> Result<()>;
         fn state(self: &BulletWorld) -> BodyStateFfi;
@@ -93,6 +94,7 @@ unsafe impl Send for ffi::BulletWorld {}
 
 pub struct Bullet {
     world: UniquePtr<ffi::BulletWorld>,
+    gyroscopic: bool,
 }
 
 impl Bullet {
@@ -116,7 +118,10 @@ impl Bullet {
             deactivation: true,
         };
         let world = ffi::new_world(&desc).map_err(|e| format!("bullet: {e}"))?;
-        Ok(Bullet { world })
+        Ok(Bullet {
+            world,
+            gyroscopic: s.gyroscopic_implicit,
+        })
     }
 
     /// Steps `n` times inside C++ with no call back into Rust: the benchmark's baseline
@@ -126,17 +131,35 @@ impl Bullet {
     }
 }
 
+fn to_ffi(s: &BodyState) -> ffi::BodyStateFfi {
+    let q = s.rotation.quaternion();
+    ffi::BodyStateFfi {
+        position: s.position.into(),
+        rotation: [q.i, q.j, q.k, q.w],
+        linear_velocity: s.linear_velocity.into(),
+        angular_velocity: s.angular_velocity.into(),
+        sleeping: false,
+    }
+}
+
 impl Engine for Bullet {
     fn reset(&mut self, start: &BodyState) -> Result<(), String> {
-        let q = start.rotation.quaternion();
-        let s = ffi::BodyStateFfi {
-            position: start.position.into(),
-            rotation: [q.i, q.j, q.k, q.w],
-            linear_velocity: start.linear_velocity.into(),
-            angular_velocity: start.angular_velocity.into(),
-            sleeping: false,
-        };
-        self.world.pin_mut().reset(&s).map_err(|e| e.to_string())
+        self.world
+            .pin_mut()
+            .reset(&to_ffi(start))
+            .map_err(|e| e.to_string())
+    }
+
+    fn set_state(&mut self, now: &BodyState) -> Result<(), String> {
+        self.world
+            .pin_mut()
+            .set_state(&to_ffi(now))
+            .map_err(|e| e.to_string())
+    }
+
+    /// Free flight is ballistic unless Bullet's implicit gyroscopic force turns ω.
+    fn ballistic_flight(&self) -> bool {
+        !self.gyroscopic
     }
 
     fn step(&mut self) -> Result<(), String> {

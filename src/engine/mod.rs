@@ -34,6 +34,11 @@ impl BodyState {
 pub trait Engine: Send {
     /// Puts the die in its starting state, with nothing left over from an earlier throw.
     fn reset(&mut self, start: &BodyState) -> Result<(), String>;
+    /// Moves the die to `now` mid-roll (after a stretch of free flight integrated outside).
+    fn set_state(&mut self, now: &BodyState) -> Result<(), String>;
+    /// True if, out of contact, the engine moves the die exactly as `flight::Flight` does
+    /// (gravity, symplectic Euler, constant angular velocity).
+    fn ballistic_flight(&self) -> bool;
     /// Advances the world by one fixed time step.
     fn step(&mut self) -> Result<(), String>;
     fn state(&self) -> BodyState;
