@@ -1065,21 +1065,6 @@ mod tests {
         assert!((groups[2].points[1].y - 84.0 / 416.0).abs() < 1e-12);
     }
 
-    /// Writes every figure into `$DICEPHYS_FIGURES_DIR` to look at (ignored; run with
-    /// `DICEPHYS_FIGURES_DIR=/some/dir cargo test --lib figures -- --ignored`).
-    #[test]
-    #[ignore]
-    fn write_examples() {
-        let Some(dir) = std::env::var_os("DICEPHYS_FIGURES_DIR") else {
-            return;
-        };
-        let dir = PathBuf::from(dir);
-        master_graph(&dir, "master_graph", &paper_experiment_points(), &sims()).unwrap();
-        prob_2d(&dir, "prob_2d").unwrap();
-        len_graph(&dir, "len_graph", &paper_length_groups()).unwrap();
-        dreidel(&dir, "dreidel", 0.1).unwrap();
-    }
-
     #[test]
     fn tick_labels_drop_trailing_zeros() {
         assert_eq!(tick(&100.0), "100");

@@ -11,6 +11,8 @@ use std::io::Write;
 
 #[derive(Args, Debug)]
 pub struct TraceArgs {
+    /// Physics engine: bullet, rapier (in 2D a true 2D body), rapier-locked (in 2D a locked 3D
+    /// body, as DicePhys).
     #[arg(long, default_value = "bullet", value_parser = parse_engine)]
     pub engine: EngineKind,
     #[command(flatten)]

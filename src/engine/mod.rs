@@ -1,13 +1,15 @@
 //! The physics engines behind one interface. Everything else (throws, settling, outcomes,
 //! batches, reports) is shared code that sees only this trait.
 
-use crate::scene::Scene;
+use crate::scene::{Mode, Scene};
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::Serialize;
 use std::fmt;
 use std::str::FromStr;
 
 pub mod bullet;
+pub mod rapier2d;
+pub mod rapier3d;
 
 /// The die's state in world coordinates (y up, floor top at y = 0).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -48,12 +50,27 @@ pub trait Engine: Send {
 #[serde(rename_all = "snake_case")]
 pub enum EngineKind {
     Bullet,
+    /// Rapier: 3D with `rapier3d-f64`; 2D with `rapier2d-f64`, a true 2D body.
+    Rapier,
+    /// Rapier, 2D as DicePhys ran it: a 3D body with locked axes (3D: as `Rapier`). A check
+    /// of the 2D engine against the locked 3D body.
+    #[serde(rename = "rapier-locked")]
+    RapierLocked,
 }
+
+/// Every engine, in the order `FromStr`'s error lists them.
+pub const ENGINES: [EngineKind; 3] = [
+    EngineKind::Bullet,
+    EngineKind::Rapier,
+    EngineKind::RapierLocked,
+];
 
 impl EngineKind {
     pub fn name(self) -> &'static str {
         match self {
             EngineKind::Bullet => "bullet",
+            EngineKind::Rapier => "rapier",
+            EngineKind::RapierLocked => "rapier-locked",
         }
     }
 
@@ -61,6 +78,16 @@ impl EngineKind {
     pub fn version(self) -> String {
         match self {
             EngineKind::Bullet => format!("Bullet {} (double precision)", bullet::version()),
+            // The version is the rapier3d-f64 crate's own (its VERSION const, the crate's
+            // CARGO_PKG_VERSION); a test checks that rapier2d-f64 is the same release.
+            EngineKind::Rapier => format!(
+                "Rapier {} (f64; 2D: rapier2d, a 2D body)",
+                rapier3d::version()
+            ),
+            EngineKind::RapierLocked => format!(
+                "Rapier {} (f64; 2D: rapier3d, a locked 3D body)",
+                rapier3d::version()
+            ),
         }
     }
 }
@@ -74,10 +101,10 @@ impl fmt::Display for EngineKind {
 impl FromStr for EngineKind {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "bullet" => Ok(EngineKind::Bullet),
-            _ => Err(format!("unknown engine '{s}' (known: bullet)")),
-        }
+        ENGINES.into_iter().find(|e| e.name() == s).ok_or_else(|| {
+            let known: Vec<&str> = ENGINES.iter().map(|e| e.name()).collect();
+            format!("unknown engine '{s}' (known: {})", known.join(", "))
+        })
     }
 }
 
@@ -85,5 +112,11 @@ impl FromStr for EngineKind {
 pub fn new_engine(kind: EngineKind, scene: &Scene) -> Result<Box<dyn Engine>, String> {
     match kind {
         EngineKind::Bullet => Ok(Box::new(bullet::Bullet::new(scene)?)),
+        EngineKind::Rapier if scene.mode == Mode::TwoD => {
+            Ok(Box::new(rapier2d::Rapier2d::new(scene)?))
+        }
+        EngineKind::Rapier | EngineKind::RapierLocked => {
+            Ok(Box::new(rapier3d::Rapier3d::new(scene)?))
+        }
     }
 }
