@@ -480,6 +480,7 @@ fn engine_label(name: &str) -> String {
     match name {
         "bullet" => "Bullet".into(),
         "rapier" => "Rapier".into(),
+        "rapier-locked" => "Rapier (locked 3D)".into(),
         other => other.into(),
     }
 }

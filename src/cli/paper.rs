@@ -13,13 +13,13 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct PaperArgs {
     /// Rolls per simulated cell (block × engine × 2D/3D); 100000 is the paper's own scale.
-    #[arg(long, default_value_t = 4000)]
+    #[arg(long, default_value_t = 5000)]
     pub rolls: u64,
     /// Seed of the keyed throws.
     #[arg(long, default_value_t = 2385)]
     pub seed: u64,
     /// Engines to simulate with (comma-separated).
-    #[arg(long, value_delimiter = ',', default_value = "bullet", value_parser = parse_engine)]
+    #[arg(long, value_delimiter = ',', default_value = "bullet,rapier", value_parser = parse_engine)]
     pub engines: Vec<EngineKind>,
     /// Fixed time step, s.
     #[arg(long, default_value_t = 0.001)]
