@@ -11,6 +11,7 @@
 //! `roll` (one roll), `batch` (many, in parallel), `cli`.
 
 pub mod batch;
+pub mod bench;
 pub mod block;
 pub mod cli;
 pub mod cputime;

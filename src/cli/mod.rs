@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 use std::path::Path;
 
 pub mod args;
+pub mod bench;
 pub mod crosscheck;
 pub mod paper;
 pub mod roll;
@@ -25,6 +26,8 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
+    /// Speed of each engine and lever against the faithful configuration, side by side.
+    Bench(bench::BenchArgs),
     /// The same throws on several engines: counts, ratios, σ apart, per-throw agreement, cost.
     Crosscheck(crosscheck::CrosscheckArgs),
     /// Reproduce the paper: its table, theory, simulations and figures, into --out.
@@ -44,6 +47,7 @@ pub fn main() -> i32 {
         Err(e) => return clap_error(e),
     };
     let result = match cli.command {
+        Command::Bench(a) => bench::run(&a),
         Command::Crosscheck(a) => crosscheck::run(&a),
         Command::Paper(a) => paper::run(&a),
         Command::Theory(a) => theory::run(&a),

@@ -1,0 +1,299 @@
+//! `dicephys bench`: the standard workload (140x24x20, 3D and 2D, dt = 1 ms, the paper's throw
+//! ranges, a fixed seed) for each engine and each speed lever, on 1 thread and on all, against
+//! the faithful configuration (Bullet, DicePhys's rest rule, box floor, dicephys281) measured
+//! in the same run. Speed is reported as ratios measured side by side: this machine is noisy.
+
+use crate::batch::{self, Tally};
+use crate::cputime::{peak_rss_bytes, process_cpu_seconds};
+use crate::engine::EngineKind;
+use crate::roll::{Fate, RollRecord, Rule, Settle};
+use crate::scene::{Floor, Mode, Scene};
+use crate::stats;
+use crate::throws::{ThrowKind, ThrowRanges, Throws};
+use serde::Serialize;
+use std::time::Instant;
+
+/// DicePhys 2.81's CPU time per 3D roll of 140x24x20 on this kind of machine, one core
+/// (shared/reference/dicephys-2.81.md): the yardstick for "ten times DicePhys".
+pub const DICEPHYS_MS_PER_ROLL_3D: f64 = 4.22;
+pub const DICEPHYS_MS_PER_ROLL_2D: f64 = 2.50;
+
+/// One way of rolling: an engine and the levers it uses.
+#[derive(Clone, Debug, Serialize)]
+pub struct Method {
+    pub name: String,
+    pub engine: EngineKind,
+    pub floor: Floor,
+    pub rule: Rule,
+    pub fast_flight: bool,
+}
+
+impl Method {
+    pub fn new(
+        name: &str,
+        engine: EngineKind,
+        floor: Floor,
+        rule: Rule,
+        fast_flight: bool,
+    ) -> Method {
+        Method {
+            name: name.into(),
+            engine,
+            floor,
+            rule,
+            fast_flight,
+        }
+    }
+
+    pub fn faithful() -> Method {
+        Method::new(
+            "faithful",
+            EngineKind::Bullet,
+            Floor::Box,
+            Rule::Dicephys,
+            false,
+        )
+    }
+
+    pub fn settle(&self, base: &Settle) -> Settle {
+        Settle {
+            rule: self.rule,
+            fast_flight: self.fast_flight,
+            ..*base
+        }
+    }
+}
+
+/// The methods the benchmark compares: each lever on its own, then together.
+pub fn methods() -> Vec<Method> {
+    use EngineKind::*;
+    use Floor::*;
+    use Rule::*;
+    vec![
+        Method::faithful(),
+        Method::new("early stop", Bullet, Box, Certificate, false),
+        Method::new("fast flight", Bullet, Box, Dicephys, true),
+        Method::new("plane floor", Bullet, Plane, Dicephys, false),
+        Method::new("early stop + flight", Bullet, Box, Certificate, true),
+        Method::new("all + plane floor", Bullet, Plane, Certificate, true),
+        Method::new("rapier", Rapier, Box, Dicephys, false),
+        Method::new("rapier early stop", Rapier, Box, Certificate, false),
+    ]
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchRow {
+    pub method: String,
+    pub engine: String,
+    pub mode: String,
+    pub threads: usize,
+    pub rolls: u64,
+    pub rolls_per_s: f64,
+    pub cpu_ms_per_roll: f64,
+    pub us_per_engine_step: f64,
+    pub steps_per_roll: f64,
+    pub engine_steps_per_roll: f64,
+    /// Rolls per second over the faithful method's, same mode and threads, same run.
+    pub speedup: f64,
+    /// Rolls per second over DicePhys 2.81's on one core (reference timing, not this run).
+    pub vs_dicephys: f64,
+    pub ratio: f64,
+    pub ratio_err: f64,
+    /// (ratio − faithful ratio) / combined error, on the same throws.
+    pub z_vs_faithful: f64,
+    /// Fraction of throws with the same outcome as the faithful method.
+    pub same_outcome: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct FfiCost {
+    pub steps: u64,
+    pub rust_loop_s: f64,
+    pub cpp_loop_s: f64,
+    /// (Rust loop − C++ loop) / C++ loop: what one cxx call (step + state read) per step costs.
+    pub overhead: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Bench {
+    pub rows: Vec<BenchRow>,
+    pub ffi: FfiCost,
+    pub peak_rss_mb: f64,
+    pub seed: u64,
+}
+
+fn same_fraction(a: &[RollRecord], b: &[RollRecord]) -> f64 {
+    let same = a
+        .iter()
+        .zip(b)
+        .filter(|(x, y)| match (x.fate, y.fate) {
+            (Fate::Settled(p), Fate::Settled(q)) => p == q,
+            _ => false,
+        })
+        .count();
+    same as f64 / a.len().max(1) as f64
+}
+
+/// Runs the benchmark; `log` gets a line per measurement as it finishes.
+pub fn run(rolls: u64, seed: u64, all_threads: usize, log: &dyn Fn(&str)) -> Result<Bench, String> {
+    let block = "140x24x20".parse().map_err(|e: String| e)?;
+    let throws = Throws::new(ThrowKind::Keyed, seed, ThrowRanges::default(), 0);
+    let base = Settle::default();
+    let mut rows = Vec::new();
+    for mode in [Mode::ThreeD, Mode::TwoD] {
+        let mut thread_counts = vec![1];
+        if all_threads > 1 {
+            thread_counts.push(all_threads);
+        }
+        for &threads in &thread_counts {
+            let mut faithful: Option<(Vec<RollRecord>, f64)> = None;
+            for m in methods() {
+                let mut scene = Scene::paper(block, mode);
+                scene.floor = m.floor;
+                let settle = m.settle(&base);
+                let wall = Instant::now();
+                let cpu = process_cpu_seconds();
+                let recs = batch::run(
+                    m.engine,
+                    &scene,
+                    &throws,
+                    &settle,
+                    0..rolls,
+                    threads,
+                    &|_| {},
+                )?;
+                let cpu_s = process_cpu_seconds() - cpu;
+                let wall_s = wall.elapsed().as_secs_f64();
+                let t = Tally::of(&recs);
+                let r = stats::ratio(t.counts.breadth, t.counts.width);
+                let rolls_per_s = rolls as f64 / wall_s;
+                let (speedup, z, same) = match &faithful {
+                    None => (1.0, 0.0, 1.0),
+                    Some((f, f_rps)) => {
+                        let ft = Tally::of(f);
+                        let fr = stats::ratio(ft.counts.breadth, ft.counts.width);
+                        (
+                            rolls_per_s / f_rps,
+                            stats::z_score(r.value, r.err, fr.value, fr.err),
+                            same_fraction(f, &recs),
+                        )
+                    }
+                };
+                let dicephys_ms = match mode {
+                    Mode::ThreeD => DICEPHYS_MS_PER_ROLL_3D,
+                    Mode::TwoD => DICEPHYS_MS_PER_ROLL_2D,
+                };
+                let row = BenchRow {
+                    method: m.name.clone(),
+                    engine: m.engine.name().into(),
+                    mode: mode.name().into(),
+                    threads,
+                    rolls,
+                    rolls_per_s,
+                    cpu_ms_per_roll: 1000.0 * cpu_s / rolls as f64,
+                    us_per_engine_step: 1e6 * cpu_s / t.engine_steps.max(1) as f64,
+                    steps_per_roll: t.steps as f64 / rolls as f64,
+                    engine_steps_per_roll: t.engine_steps as f64 / rolls as f64,
+                    speedup,
+                    vs_dicephys: rolls_per_s * dicephys_ms / 1000.0,
+                    ratio: r.value,
+                    ratio_err: r.err,
+                    z_vs_faithful: z,
+                    same_outcome: same,
+                };
+                log(&format_row(&row));
+                if faithful.is_none() {
+                    faithful = Some((recs, rolls_per_s));
+                }
+                rows.push(row);
+            }
+        }
+    }
+    let ffi = ffi_cost(&Scene::paper(block, Mode::ThreeD))?;
+    log(&format!(
+        "FFI: {} steps, Rust loop (one cxx call per step + a state read) {:.3} s, C++ loop {:.3} s: overhead {:+.1} %",
+        ffi.steps,
+        ffi.rust_loop_s,
+        ffi.cpp_loop_s,
+        100.0 * ffi.overhead
+    ));
+    Ok(Bench {
+        rows,
+        ffi,
+        peak_rss_mb: peak_rss_bytes() as f64 / 1e6,
+        seed,
+    })
+}
+
+/// What one cxx call per step costs: the same 1,000-step stretch of the same throws, stepped
+/// from Rust (a call per step and a state read, as a roll does) and inside C++ alone,
+/// interleaved and repeated so that machine noise falls on both alike.
+pub fn ffi_cost(scene: &Scene) -> Result<FfiCost, String> {
+    let mut bullet = crate::engine::bullet::Bullet::new(scene)?;
+    let throws = Throws::new(ThrowKind::Keyed, 1, ThrowRanges::default(), 0);
+    let n = 1000u32;
+    let (mut rust_s, mut cpp_s) = (0.0, 0.0);
+    let mut sink = 0.0;
+    for i in 0..200u64 {
+        let start = throws.get(i).start(scene);
+        use crate::engine::Engine;
+        bullet.reset(&start)?;
+        let t = Instant::now();
+        for _ in 0..n {
+            bullet.step()?;
+            sink += bullet.state().position.y;
+        }
+        rust_s += t.elapsed().as_secs_f64();
+        bullet.reset(&start)?;
+        let t = Instant::now();
+        bullet.step_n(n)?;
+        sink += bullet.state().position.y;
+        cpp_s += t.elapsed().as_secs_f64();
+    }
+    std::hint::black_box(sink);
+    Ok(FfiCost {
+        steps: 200 * n as u64,
+        rust_loop_s: rust_s,
+        cpp_loop_s: cpp_s,
+        overhead: rust_s / cpp_s - 1.0,
+    })
+}
+
+pub fn header() -> String {
+    format!(
+        "{:<20} {:>4} {:>3} {:>9} {:>8} {:>8} {:>7} {:>7} {:>8} {:>8} {:>15} {:>6} {:>6}",
+        "method",
+        "mode",
+        "thr",
+        "rolls/s",
+        "ms/roll",
+        "µs/step",
+        "steps",
+        "engine",
+        "speedup",
+        "×DicePhys",
+        "ratio",
+        "z",
+        "same"
+    )
+}
+
+pub fn format_row(r: &BenchRow) -> String {
+    format!(
+        "{:<20} {:>4} {:>3} {:>9.0} {:>8.3} {:>8.2} {:>7.0} {:>7.0} {:>7.2}x {:>8.1}x {:>7.4} ± {:.4} {:>+6.1} {:>5.1}%",
+        r.method,
+        r.mode,
+        r.threads,
+        r.rolls_per_s,
+        r.cpu_ms_per_roll,
+        r.us_per_engine_step,
+        r.steps_per_roll,
+        r.engine_steps_per_roll,
+        r.speedup,
+        r.vs_dicephys,
+        r.ratio,
+        r.ratio_err,
+        r.z_vs_faithful,
+        100.0 * r.same_outcome
+    )
+}

@@ -1,0 +1,49 @@
+//! `dicephys bench`: speed of every engine and lever against the faithful configuration.
+
+use crate::bench;
+use crate::error::{Error, Result};
+use clap::Args;
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Rolls per measurement.
+    #[arg(long, default_value_t = 2000)]
+    pub rolls: u64,
+    #[arg(long, default_value_t = 2385)]
+    pub seed: u64,
+    /// Threads for the "all threads" measurements (0: one per core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(a: &BenchArgs) -> Result<()> {
+    if a.rolls == 0 {
+        return Err(Error::Usage("--rolls 0: need at least one roll".into()));
+    }
+    let threads = if a.threads == 0 {
+        rayon::current_num_threads()
+    } else {
+        a.threads
+    };
+    let quiet = a.json;
+    if !quiet {
+        println!("{}", bench::header());
+    }
+    let b = bench::run(a.rolls, a.seed, threads, &|line| {
+        if !quiet {
+            println!("{line}");
+        }
+    })
+    .map_err(Error::Run)?;
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&b).map_err(|e| Error::Run(e.to_string()))?
+        );
+    } else {
+        println!("peak RSS {:.1} MB", b.peak_rss_mb);
+    }
+    Ok(())
+}
