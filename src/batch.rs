@@ -8,12 +8,12 @@ use crate::roll::{roll, Failure, Fate, RollRecord, Settle};
 use crate::scene::Scene;
 use crate::throws::Throws;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 /// Exact counts over a set of rolls.
-#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Tally {
     /// Settled rolls by the side standing vertical.
     pub counts: Counts,
@@ -31,7 +31,7 @@ pub struct Tally {
     pub certified_steps: u64,
 }
 
-#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Counts {
     pub breadth: u64,
     pub width: u64,
@@ -116,6 +116,20 @@ pub fn run(
     threads: usize,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<Vec<RollRecord>, String> {
+    let list: Vec<u64> = indices.collect();
+    run_indices(engine, scene, throws, settle, &list, threads, progress)
+}
+
+/// As `run`, for any list of throw indices (a shard, a chunk of a checkpointed run).
+pub fn run_indices(
+    engine: EngineKind,
+    scene: &Scene,
+    throws: &Throws,
+    settle: &Settle,
+    indices: &[u64],
+    threads: usize,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<Vec<RollRecord>, String> {
     // Fail early, once, if the engine cannot be built for this scene.
     new_engine(engine, scene)?;
     let pool = rayon::ThreadPoolBuilder::new()
@@ -125,10 +139,10 @@ pub fn run(
     let done = std::sync::atomic::AtomicU64::new(0);
     let records = pool.install(|| {
         indices
-            .into_par_iter()
+            .par_iter()
             .map_init(
                 || new_engine(engine, scene).ok(),
-                |world, i| {
+                |world, &i| {
                     let throw = throws.get(i);
                     let r = roll_one(world, engine, scene, &throw, settle);
                     let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;

@@ -8,7 +8,7 @@
 //! Engine axes, one place for all engines (as DicePhys): body x = breadth, body y = width,
 //! body z = length. The world's y axis is up.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt;
 
 /// Largest side accepted, in metres.
@@ -117,7 +117,7 @@ fn fmt_mm(v: f64) -> String {
 }
 
 /// The side of the block that stands vertical when it comes to rest.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, PartialOrd, Ord)]
 #[serde(rename_all = "snake_case")]
 pub enum Outcome {
     /// The breadth stands upright: the block lies on a length × width face.

@@ -8,6 +8,8 @@ pub enum Error {
     Usage(String),
     /// A failure while running (I/O, an engine that cannot start): exit code 1.
     Run(String),
+    /// Stopped by Ctrl-C before the end, with what was done kept: exit code 130.
+    Interrupted(String),
 }
 
 impl Error {
@@ -15,6 +17,7 @@ impl Error {
         match self {
             Error::Usage(_) => 2,
             Error::Run(_) => 1,
+            Error::Interrupted(_) => 130,
         }
     }
 }
@@ -22,7 +25,7 @@ impl Error {
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Error::Usage(m) | Error::Run(m) => f.write_str(m),
+            Error::Usage(m) | Error::Run(m) | Error::Interrupted(m) => f.write_str(m),
         }
     }
 }

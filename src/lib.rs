@@ -13,6 +13,7 @@
 pub mod batch;
 pub mod bench;
 pub mod block;
+pub mod checkpoint;
 pub mod cli;
 pub mod cputime;
 pub mod engine;

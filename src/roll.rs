@@ -7,13 +7,13 @@ use crate::flight::Flight;
 use crate::scene::Scene;
 use crate::settle::{classify, Certificate, DieShape, RestDetector};
 use crate::throws::Throw;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// DicePhys's cap: a roll not at rest after this many steps is unconverged.
 pub const DEFAULT_MAX_STEPS: u64 = 20_000_000;
 
 /// Why a roll failed: the engine's state stopped making sense.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, PartialOrd, Ord)]
 #[serde(rename_all = "snake_case")]
 pub enum Failure {
     /// Position, orientation or a velocity became NaN or infinite.
@@ -36,7 +36,7 @@ impl Failure {
 }
 
 /// How a roll ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Fate {
     /// At rest; the side standing vertical.
@@ -46,7 +46,7 @@ pub enum Fate {
     Failed(Failure),
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RollRecord {
     pub throw: Throw,
     pub fate: Fate,
@@ -65,7 +65,7 @@ impl RollRecord {
 }
 
 /// The rule that ends a roll.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Rule {
     /// DicePhys's: at rest by the vector sums of the last 10 steps' velocities.

@@ -6,10 +6,10 @@ use crate::engine::EngineKind;
 use crate::roll::{Rule, Settle};
 use crate::scene::Scene;
 use crate::throws::{ThrowKind, ThrowRanges};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RunSummary {
     pub engine: String,
     pub engine_version: String,
@@ -50,13 +50,42 @@ pub struct RunSummary {
     pub cpu_ms_per_roll: f64,
     pub threads: usize,
     pub dicephys_version: String,
+    /// The run's result-defining arguments (as `merge` compares them), when run from the
+    /// command line.
+    pub args: Vec<String>,
+    /// This run's share of the throws, `k` of `n` (indices ≡ k mod n).
+    pub shard: Option<Shard>,
+    /// Stopped before all rolls were made (Ctrl-C): the counts cover `rolls` only.
+    pub partial: bool,
+    /// The exact integer tally, for `merge`.
+    pub tally: Tally,
     /// Present when auditing the early stop (`--audit`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub audit: Option<Audit>,
 }
 
+/// A share of a run's throws: indices i with i mod n = k.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    pub k: u64,
+    pub n: u64,
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Shard, String> {
+        let bad = || format!("shard '{s}' is not K/N with 0 <= K < N");
+        let (k, n) = s.split_once('/').ok_or_else(bad)?;
+        let (k, n): (u64, u64) = (k.parse().map_err(|_| bad())?, n.parse().map_err(|_| bad())?);
+        if n == 0 || k >= n {
+            return Err(bad());
+        }
+        Ok(Shard { k, n })
+    }
+}
+
 /// How the energy certificate would have done on these rolls.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Audit {
     pub margin: f64,
     /// Rolls on which it fired before DicePhys's rule stopped them.
@@ -120,6 +149,10 @@ impl RunSummary {
             cpu_ms_per_roll: 1000.0 * cpu_s / tally.rolls.max(1) as f64,
             threads,
             dicephys_version: env!("CARGO_PKG_VERSION").into(),
+            args: Vec::new(),
+            shard: None,
+            partial: false,
+            tally: tally.clone(),
             audit: settle.audit.then(|| Audit {
                 margin: settle.margin,
                 certified: tally.certified,
@@ -134,6 +167,9 @@ impl RunSummary {
     pub fn human(&self) -> String {
         let c = &self.counts;
         let mut s = String::new();
+        if self.partial {
+            s += "PARTIAL: stopped before all rolls were made; the counts cover these rolls only\n";
+        }
         s += &format!(
             "{} {} {} mm, {} rolls, {} throws seed {}, dt {} s, μ {}, e {}, preset {}, floor {}\n",
             self.engine,

@@ -13,12 +13,12 @@ use crate::scene::Scene;
 use nalgebra::{UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
 
 /// A closed interval `lo..=hi` to draw uniformly from; `lo == hi` fixes the value.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Range {
     pub lo: f64,
     pub hi: f64,
@@ -74,7 +74,7 @@ impl fmt::Display for Range {
 }
 
 /// The ranges throws are drawn from; default: the paper's table of initial conditions.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ThrowRanges {
     /// Linear velocity along x, m/s.
     pub velocity: Range,
@@ -95,7 +95,7 @@ impl Default for ThrowRanges {
 }
 
 /// One throw's drawn numbers.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Throw {
     pub index: u64,
     pub drop_height: f64,
@@ -118,7 +118,7 @@ impl Throw {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ThrowKind {
     Keyed,

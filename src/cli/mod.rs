@@ -7,8 +7,10 @@ use std::path::Path;
 pub mod args;
 pub mod bench;
 pub mod crosscheck;
+pub mod merge;
 pub mod paper;
 pub mod roll;
+pub mod runargs;
 pub mod theory;
 pub mod trace;
 
@@ -30,6 +32,8 @@ pub enum Command {
     Bench(bench::BenchArgs),
     /// The same throws on several engines: counts, ratios, σ apart, per-throw agreement, cost.
     Crosscheck(crosscheck::CrosscheckArgs),
+    /// Combine the --json outputs of `roll --shard K/N` runs into the unsharded result.
+    Merge(merge::MergeArgs),
     /// Reproduce the paper: its table, theory, simulations and figures, into --out.
     Paper(paper::PaperArgs),
     /// The paper's closed-form theory for a block, or its whole experimental table.
@@ -42,13 +46,30 @@ pub enum Command {
 
 /// Runs the command line; returns the process exit code (0 ok, 2 bad input, 1 failure).
 pub fn main() -> i32 {
-    let cli = match Cli::try_parse() {
+    // Ctrl-C: the first asks long runs to stop cleanly between chunks (they keep their
+    // checkpoint and print a partial report); a second ends the process at once.
+    let _ = ctrlc::set_handler(|| {
+        if crate::checkpoint::STOP.swap(true, std::sync::atomic::Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+        eprintln!("dicephys: stopping after the current chunk (Ctrl-C again to quit now)");
+    });
+    let argv = match resume_argv(std::env::args().collect()) {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("dicephys: {e}");
+            return e.exit_code();
+        }
+    };
+    let _ = runargs::EFFECTIVE.set(argv.clone());
+    let cli = match Cli::try_parse_from(argv) {
         Ok(cli) => cli,
         Err(e) => return clap_error(e),
     };
     let result = match cli.command {
         Command::Bench(a) => bench::run(&a),
         Command::Crosscheck(a) => crosscheck::run(&a),
+        Command::Merge(a) => merge::run(&a),
         Command::Paper(a) => paper::run(&a),
         Command::Theory(a) => theory::run(&a),
         Command::Roll(a) => roll::run(&a),
@@ -121,8 +142,59 @@ pub fn check_writable(path: &Path) -> Result<()> {
 
 /// Writes a whole file or nothing: a temporary file beside it, then a rename.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = path.with_extension(format!("tmp-{}", std::process::id()));
-    std::fs::write(&tmp, bytes)
-        .and_then(|_| std::fs::rename(&tmp, path))
+    crate::checkpoint::write_atomic(path, bytes)
         .map_err(|e| Error::Run(format!("{}: {e}", path.display())))
+}
+
+/// `dicephys roll --resume DIR [--threads T] [--json]` becomes the stored run's own command
+/// line with `--checkpoint DIR`, so a resumed run is configured exactly as it started.
+fn resume_argv(argv: Vec<String>) -> Result<Vec<String>> {
+    let Some(pos) = argv
+        .iter()
+        .position(|a| a == "--resume" || a.starts_with("--resume="))
+    else {
+        return Ok(argv);
+    };
+    if argv.get(1).map(String::as_str) != Some("roll") {
+        return Err(Error::Usage(
+            "--resume: only `dicephys roll --resume DIR` resumes".into(),
+        ));
+    }
+    let dir = match argv[pos].split_once('=') {
+        Some((_, d)) => d.to_string(),
+        None => argv
+            .get(pos + 1)
+            .cloned()
+            .ok_or_else(|| Error::Usage("--resume: name the checkpoint directory".into()))?,
+    };
+    let file = Path::new(&dir).join("args.json");
+    let text = std::fs::read_to_string(&file).map_err(|e| {
+        Error::Usage(format!(
+            "--resume {dir}: no checkpoint there ({}: {e})",
+            file.display()
+        ))
+    })?;
+    let stored: Vec<String> = serde_json::from_str(&text).map_err(|e| {
+        Error::Usage(format!(
+            "--resume {dir}: {} is damaged ({e})",
+            file.display()
+        ))
+    })?;
+    let extra = runargs::without(&argv[2..], &[("--resume", true)]);
+    let allowed = runargs::without(
+        &extra,
+        &[("--threads", true), ("--json", false), ("--per-roll", true)],
+    );
+    if !allowed.is_empty() {
+        return Err(Error::Usage(format!(
+            "--resume takes only --threads, --json and --per-roll besides, not {}",
+            allowed.join(" ")
+        )));
+    }
+    let mut out = vec![argv[0].clone(), "roll".to_string()];
+    out.extend(stored);
+    out.extend(extra);
+    out.push("--checkpoint".into());
+    out.push(dir);
+    Ok(out)
 }

@@ -1,12 +1,13 @@
 //! `dicephys roll`: many throws of one block on one engine.
 
 use super::args::{parse_engine, RunArgs, SceneArgs, ThrowArgs};
-use crate::batch::{self, Tally};
+use crate::batch::Tally;
+use crate::checkpoint;
 use crate::cputime::process_cpu_seconds;
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
 use crate::roll::{Fate, RollRecord};
-use crate::summary::RunSummary;
+use crate::summary::{RunSummary, Shard};
 use crate::throws::Throws;
 use clap::Args;
 use std::path::PathBuf;
@@ -30,6 +31,21 @@ pub struct RollArgs {
     /// Write one CSV row per throw to this file.
     #[arg(long, value_name = "FILE.csv")]
     pub per_roll: Option<PathBuf>,
+    /// Keep a checkpoint here as the run goes (chunks of 1,000 rolls, written atomically);
+    /// `dicephys roll --resume DIR` continues it, bit for bit.
+    #[arg(long, value_name = "DIR")]
+    pub checkpoint: Option<PathBuf>,
+    /// Continue the run checkpointed in DIR, with the configuration stored there.
+    #[arg(long, value_name = "DIR")]
+    pub resume: Option<PathBuf>,
+    /// Roll only throws with index ≡ K (mod N); `dicephys merge` combines the shards' --json
+    /// outputs into the unsharded result.
+    #[arg(long, value_name = "K/N", value_parser = parse_shard)]
+    pub shard: Option<Shard>,
+}
+
+fn parse_shard(s: &str) -> std::result::Result<Shard, String> {
+    s.parse()
 }
 
 pub fn run(a: &RollArgs) -> Result<()> {
@@ -45,22 +61,32 @@ pub fn run(a: &RollArgs) -> Result<()> {
     } else {
         a.run.threads
     };
+    let indices: Vec<u64> = match a.shard {
+        Some(Shard { k, n }) => (k..a.run.rolls).step_by(n as usize).collect(),
+        None => (0..a.run.rolls).collect(),
+    };
+    let args = super::runargs::current();
+    if let Some(dir) = &a.checkpoint {
+        open_checkpoint(dir, &super::runargs::defining(&args))?;
+    }
     let wall = Instant::now();
     let cpu = process_cpu_seconds();
-    let records = batch::run(
+    let done = checkpoint::run(
         a.engine,
         &scene,
         &throws,
         &settle,
-        0..a.run.rolls,
+        &indices,
         threads,
+        a.checkpoint.as_deref(),
         &|_| {},
     )
     .map_err(Error::Run)?;
+    let records = done.records;
     let cpu_s = process_cpu_seconds() - cpu;
     let wall_s = wall.elapsed().as_secs_f64();
     let tally = Tally::of(&records);
-    let summary = RunSummary::new(
+    let mut summary = RunSummary::new(
         a.engine,
         &scene,
         a.throw.seed,
@@ -72,6 +98,9 @@ pub fn run(a: &RollArgs) -> Result<()> {
         cpu_s,
         threads,
     );
+    summary.args = super::runargs::defining_unsharded(&args);
+    summary.shard = a.shard;
+    summary.partial = !done.complete;
     if let Some(p) = &a.per_roll {
         write_per_roll(p, &records, scene.dt)?;
     }
@@ -83,7 +112,45 @@ pub fn run(a: &RollArgs) -> Result<()> {
     } else {
         print!("{}", summary.human());
     }
+    if !done.complete {
+        return Err(Error::Interrupted(match &a.checkpoint {
+            Some(d) => format!(
+                "interrupted after {} of {} rolls; continue with: dicephys roll --resume {}",
+                records.len(),
+                indices.len(),
+                d.display()
+            ),
+            None => format!(
+                "interrupted after {} of {} rolls",
+                records.len(),
+                indices.len()
+            ),
+        }));
+    }
     Ok(())
+}
+
+/// Creates the checkpoint directory with the run's arguments in it, or checks that an existing
+/// one holds this very run.
+fn open_checkpoint(dir: &std::path::Path, args: &[String]) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| {
+        Error::Usage(format!(
+            "--checkpoint {}: cannot create it ({e})",
+            dir.display()
+        ))
+    })?;
+    let file = dir.join("args.json");
+    let want = serde_json::to_string(args).map_err(|e| Error::Run(e.to_string()))?;
+    match std::fs::read_to_string(&file) {
+        Ok(have) if have.trim() == want => Ok(()),
+        Ok(_) => Err(Error::Usage(format!(
+            "--checkpoint {}: it holds another run; resume that with --resume, or use a new directory",
+            dir.display()
+        ))),
+        Err(_) => super::write_atomic(&file, want.as_bytes()).map_err(|e| {
+            Error::Usage(format!("--checkpoint {}: cannot write there ({e})", dir.display()))
+        }),
+    }
 }
 
 /// The per-throw CSV: index, initial conditions, status, outcome, steps, simulated time.
