@@ -9,8 +9,10 @@ use crate::scene::Scene;
 use crate::throws::Throws;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::Mutex;
 
 /// Exact counts over a set of rolls.
 #[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -105,7 +107,7 @@ impl Tally {
     }
 }
 
-/// Rolls throws `indices` with `threads` threads (0: all cores); records in index order.
+/// Rolls throws `indices` with `threads` threads; records in index order.
 /// `progress` is called with the number of rolls finished so far, from any thread.
 pub fn run(
     engine: EngineKind,
@@ -132,40 +134,68 @@ pub fn run_indices(
 ) -> Result<Vec<RollRecord>, String> {
     // Fail early, once, if the engine cannot be built for this scene.
     new_engine(engine, scene)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| e.to_string())?;
+    let pool = pool(threads)?;
     let done = std::sync::atomic::AtomicU64::new(0);
     let records = pool.install(|| {
         indices
             .par_iter()
-            .map_init(
-                || new_engine(engine, scene).ok(),
-                |world, &i| {
-                    let throw = throws.get(i);
-                    let r = roll_one(world, engine, scene, &throw, settle);
-                    let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                    progress(n);
-                    r
-                },
-            )
+            .map(|&i| {
+                let throw = throws.get(i);
+                let r =
+                    WORLD.with(|w| roll_one(&mut w.borrow_mut(), engine, scene, &throw, settle));
+                let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                progress(n);
+                r
+            })
             .collect()
     });
     Ok(records)
 }
 
+/// A pool per thread count, kept for the process: its threads, and the worlds they keep, live
+/// from one batch (or chunk) to the next.
+fn pool(threads: usize) -> Result<std::sync::Arc<rayon::ThreadPool>, String> {
+    static POOLS: Mutex<Vec<(usize, std::sync::Arc<rayon::ThreadPool>)>> = Mutex::new(Vec::new());
+    let mut pools = POOLS.lock().map_err(|e| e.to_string())?;
+    if let Some((_, p)) = pools.iter().find(|(t, _)| *t == threads) {
+        return Ok(p.clone());
+    }
+    let p = std::sync::Arc::new(
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| e.to_string())?,
+    );
+    pools.push((threads, p.clone()));
+    Ok(p)
+}
+
+/// Each worker thread's world, reused while the engine and scene stay the same.
+struct World {
+    kind: EngineKind,
+    scene: Scene,
+    engine: Box<dyn Engine>,
+}
+
+thread_local! {
+    static WORLD: RefCell<Option<World>> = const { RefCell::new(None) };
+}
+
 /// One roll that cannot take the batch down: an engine panic is caught, counted as an engine
 /// failure, and the thread's world is rebuilt for the next throw.
 fn roll_one(
-    world: &mut Option<Box<dyn Engine>>,
+    world: &mut Option<World>,
     kind: EngineKind,
     scene: &Scene,
     throw: &crate::throws::Throw,
     settle: &Settle,
 ) -> RollRecord {
-    if world.is_none() {
-        *world = new_engine(kind, scene).ok();
+    if !matches!(world, Some(w) if w.kind == kind && w.scene == *scene) {
+        *world = new_engine(kind, scene).ok().map(|engine| World {
+            kind,
+            scene: scene.clone(),
+            engine,
+        });
     }
     let failed = RollRecord {
         throw: *throw,
@@ -174,11 +204,11 @@ fn roll_one(
         engine_steps: 0,
         certified: None,
     };
-    let Some(engine) = world.as_mut() else {
+    let Some(w) = world.as_mut() else {
         return failed;
     };
     match catch_unwind(AssertUnwindSafe(|| {
-        roll(engine.as_mut(), scene, throw, settle)
+        roll(w.engine.as_mut(), scene, throw, settle)
     })) {
         Ok(r) => r,
         Err(_) => {

@@ -4,7 +4,7 @@
 //! (configuration, seed, index), so the resumed result is bit-identical to an uninterrupted
 //! one. A stop request (Ctrl-C) is honoured between chunks.
 
-use crate::batch;
+use crate::batch::{self, Tally};
 use crate::engine::EngineKind;
 use crate::roll::{RollRecord, Settle};
 use crate::scene::Scene;
@@ -34,33 +34,71 @@ fn chunk_path(dir: &Path, first: u64, len: usize) -> PathBuf {
     dir.join(format!("chunk-{first:012}-{len}.json"))
 }
 
-/// The outcome of a chunked run: the records rolled (in index order) and whether all were.
+/// The throws of a run or of one shard: indices k, k + n, k + 2n, … below `end`, generated
+/// chunk by chunk so that a run of any size holds one chunk's indices at a time.
+#[derive(Clone, Copy, Debug)]
+pub struct Indices {
+    pub k: u64,
+    pub n: u64,
+    pub end: u64,
+}
+
+impl Indices {
+    pub fn all(end: u64) -> Indices {
+        Indices { k: 0, n: 1, end }
+    }
+
+    pub fn len(&self) -> u64 {
+        if self.k >= self.end {
+            0
+        } else {
+            (self.end - self.k).div_ceil(self.n)
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The `c`-th chunk of at most `CHUNK` indices.
+    fn chunk(&self, c: u64) -> Vec<u64> {
+        let first = c * CHUNK as u64;
+        let last = (first + CHUNK as u64).min(self.len());
+        (first..last).map(|j| self.k + j * self.n).collect()
+    }
+}
+
+/// The outcome of a chunked run: the exact tally of the rolls made, and whether all were.
 pub struct Chunked {
-    pub records: Vec<RollRecord>,
+    pub tally: Tally,
     pub complete: bool,
     /// Rolls taken from the checkpoint rather than rolled now.
     pub resumed: u64,
 }
 
 /// Rolls `indices` chunk by chunk, reading finished chunks from `dir` and writing new ones
-/// there. Stops early (complete = false) if a stop is requested.
+/// there; each chunk's records go to `sink` in index order and are then dropped, so memory
+/// stays flat however many rolls. Stops early (complete = false) if a stop is requested.
 #[allow(clippy::too_many_arguments)]
 pub fn run(
     engine: EngineKind,
     scene: &Scene,
     throws: &Throws,
     settle: &Settle,
-    indices: &[u64],
+    indices: Indices,
     threads: usize,
     dir: Option<&Path>,
     progress: &(dyn Fn(u64) + Sync),
+    sink: &mut dyn FnMut(&[RollRecord]) -> Result<(), String>,
 ) -> Result<Chunked, String> {
-    let mut records = Vec::with_capacity(indices.len());
+    let mut tally = Tally::default();
     let mut resumed = 0;
-    for chunk in indices.chunks(CHUNK) {
+    for c in 0..indices.len().div_ceil(CHUNK as u64) {
+        let chunk = indices.chunk(c);
+        let chunk = &chunk[..];
         if stop_requested() {
             return Ok(Chunked {
-                records,
+                tally,
                 complete: false,
                 resumed,
             });
@@ -76,11 +114,12 @@ pub fn run(
                 return Err(format!("{}: its throws are not this chunk's", p.display()));
             }
             resumed += recs.len() as u64;
-            records.extend(recs);
-            progress(records.len() as u64);
+            recs.iter().for_each(|r| tally.add(r));
+            sink(&recs)?;
+            progress(tally.rolls);
             continue;
         }
-        let base = records.len() as u64;
+        let base = tally.rolls;
         let recs = batch::run_indices(engine, scene, throws, settle, chunk, threads, &|n| {
             progress(base + n)
         })?;
@@ -88,10 +127,11 @@ pub fn run(
             let json = serde_json::to_string(&recs).map_err(|e| e.to_string())?;
             write_atomic(p, json.as_bytes()).map_err(|e| format!("{}: {e}", p.display()))?;
         }
-        records.extend(recs);
+        recs.iter().for_each(|r| tally.add(r));
+        sink(&recs)?;
     }
     Ok(Chunked {
-        records,
+        tally,
         complete: true,
         resumed,
     })

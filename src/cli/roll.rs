@@ -1,7 +1,6 @@
 //! `dicephys roll`: many throws of one block on one engine.
 
 use super::args::{parse_engine, RunArgs, SceneArgs, ThrowArgs};
-use crate::batch::Tally;
 use crate::checkpoint;
 use crate::cputime::process_cpu_seconds;
 use crate::engine::EngineKind;
@@ -10,6 +9,7 @@ use crate::roll::{Fate, RollRecord};
 use crate::summary::{RunSummary, Shard};
 use crate::throws::Throws;
 use clap::Args;
+use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -61,14 +61,39 @@ pub fn run(a: &RollArgs) -> Result<()> {
     } else {
         a.run.threads
     };
-    let indices: Vec<u64> = match a.shard {
-        Some(Shard { k, n }) => (k..a.run.rolls).step_by(n as usize).collect(),
-        None => (0..a.run.rolls).collect(),
+    let indices = match a.shard {
+        Some(Shard { k, n }) => checkpoint::Indices {
+            k,
+            n,
+            end: a.run.rolls,
+        },
+        None => checkpoint::Indices::all(a.run.rolls),
     };
     let args = super::runargs::current();
     if let Some(dir) = &a.checkpoint {
         open_checkpoint(dir, &super::runargs::defining(&args))?;
     }
+    // The per-roll CSV grows chunk by chunk in a temporary file, renamed into place at the end.
+    let mut csv = match &a.per_roll {
+        Some(p) => {
+            let tmp = p.with_extension(format!("tmp-{}", std::process::id()));
+            let mut f = std::io::BufWriter::new(
+                std::fs::File::create(&tmp)
+                    .map_err(|e| Error::Usage(format!("--per-roll {}: {e}", p.display())))?,
+            );
+            f.write_all(PER_ROLL_HEADER.as_bytes())?;
+            Some((tmp, f))
+        }
+        None => None,
+    };
+    let dt = scene.dt;
+    let mut sink = |recs: &[RollRecord]| -> std::result::Result<(), String> {
+        if let Some((_, f)) = csv.as_mut() {
+            f.write_all(per_roll_rows(recs, dt).as_bytes())
+                .map_err(|e| e.to_string())?;
+        }
+        Ok(())
+    };
     let wall = Instant::now();
     let cpu = process_cpu_seconds();
     let done = checkpoint::run(
@@ -76,16 +101,22 @@ pub fn run(a: &RollArgs) -> Result<()> {
         &scene,
         &throws,
         &settle,
-        &indices,
+        indices,
         threads,
         a.checkpoint.as_deref(),
         &|_| {},
+        &mut sink,
     )
     .map_err(Error::Run)?;
-    let records = done.records;
     let cpu_s = process_cpu_seconds() - cpu;
     let wall_s = wall.elapsed().as_secs_f64();
-    let tally = Tally::of(&records);
+    let tally = done.tally;
+    if let (Some((tmp, f)), Some(p)) = (csv, &a.per_roll) {
+        f.into_inner()
+            .map_err(|e| Error::Run(e.to_string()))?
+            .sync_all()?;
+        std::fs::rename(&tmp, p)?;
+    }
     let mut summary = RunSummary::new(
         a.engine,
         &scene,
@@ -101,9 +132,6 @@ pub fn run(a: &RollArgs) -> Result<()> {
     summary.args = super::runargs::defining_unsharded(&args);
     summary.shard = a.shard;
     summary.partial = !done.complete;
-    if let Some(p) = &a.per_roll {
-        write_per_roll(p, &records, scene.dt)?;
-    }
     if a.json {
         println!(
             "{}",
@@ -116,13 +144,13 @@ pub fn run(a: &RollArgs) -> Result<()> {
         return Err(Error::Interrupted(match &a.checkpoint {
             Some(d) => format!(
                 "interrupted after {} of {} rolls; continue with: dicephys roll --resume {}",
-                records.len(),
+                tally.rolls,
                 indices.len(),
                 d.display()
             ),
             None => format!(
                 "interrupted after {} of {} rolls",
-                records.len(),
+                tally.rolls,
                 indices.len()
             ),
         }));
@@ -153,11 +181,13 @@ fn open_checkpoint(dir: &std::path::Path, args: &[String]) -> Result<()> {
     }
 }
 
-/// The per-throw CSV: index, initial conditions, status, outcome, steps, simulated time.
-pub fn per_roll_csv(records: &[RollRecord], dt: f64) -> String {
-    let mut s = String::from(
-        "index,drop_height_m,velocity_m_s,spin_rad_s,status,outcome,steps,sim_time_s\n",
-    );
+/// The per-throw CSV's header.
+pub const PER_ROLL_HEADER: &str =
+    "index,drop_height_m,velocity_m_s,spin_rad_s,status,outcome,steps,sim_time_s\n";
+
+/// Per-throw CSV rows: index, initial conditions, status, outcome, steps, simulated time.
+pub fn per_roll_rows(records: &[RollRecord], dt: f64) -> String {
+    let mut s = String::new();
     for r in records {
         let (status, outcome) = match r.fate {
             Fate::Settled(o) => ("settled", o.name()),
@@ -178,8 +208,4 @@ pub fn per_roll_csv(records: &[RollRecord], dt: f64) -> String {
         );
     }
     s
-}
-
-fn write_per_roll(path: &std::path::Path, records: &[RollRecord], dt: f64) -> Result<()> {
-    super::write_atomic(path, per_roll_csv(records, dt).as_bytes())
 }
