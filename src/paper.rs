@@ -3,8 +3,8 @@
 //! e = 0.5) our simulations in 3D and 2D on each engine, with z-scores against experiment and
 //! theory.
 
-use crate::batch::{self, Tally};
 use crate::block::Block;
+use crate::checkpoint;
 use crate::cli::theory::{table_report, TableReport};
 use crate::cputime::process_cpu_seconds;
 use crate::engine::EngineKind;
@@ -59,6 +59,8 @@ pub struct Provenance {
 
 #[derive(Clone, Debug, Serialize)]
 pub struct PaperResults {
+    /// Stopped by Ctrl-C: only the cells in `simulations` were (wholly or partly) rolled.
+    pub partial: bool,
     pub provenance: Provenance,
     pub table: TableReport,
     pub simulations: Vec<SimCell>,
@@ -92,8 +94,10 @@ pub fn total_rolls(cfg: &PaperConfig) -> Result<u64> {
 pub fn run(
     cfg: &PaperConfig,
     command_line: String,
+    checkpoint_dir: Option<&std::path::Path>,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<PaperResults> {
+    let mut partial = false;
     let table = table_report()?;
     let wall = Instant::now();
     let cpu0 = process_cpu_seconds();
@@ -105,27 +109,41 @@ pub fn run(
     };
     let mut done_before = 0u64;
     let mut simulations = Vec::new();
-    for (row, label, block) in simulated_rows(&table) {
+    'cells: for (row, label, block) in simulated_rows(&table) {
         let t = table.rows.iter().find(|r| r.row == row).expect("row");
         for &engine in &cfg.engines {
             for mode in [Mode::ThreeD, Mode::TwoD] {
+                if partial {
+                    break 'cells;
+                }
                 let mut scene = Scene::paper(block, mode);
                 scene.dt = cfg.dt;
                 let cell_wall = Instant::now();
                 let cell_cpu = process_cpu_seconds();
                 let base = done_before;
-                let records = batch::run(
+                let dir =
+                    checkpoint_dir.map(|d| d.join(format!("row{row}-{engine}-{}", mode.name())));
+                if let Some(d) = &dir {
+                    std::fs::create_dir_all(d)
+                        .map_err(|e| Error::Run(format!("{}: {e}", d.display())))?;
+                }
+                let done = checkpoint::run(
                     engine,
                     &scene,
                     &throws,
                     &settle,
-                    0..cfg.rolls,
+                    checkpoint::Indices::all(cfg.rolls),
                     cfg.threads,
+                    dir.as_deref(),
                     &|n| progress(base + n),
+                    &mut |_| Ok(()),
                 )
                 .map_err(Error::Run)?;
                 done_before += cfg.rolls;
-                let tally = Tally::of(&records);
+                let tally = done.tally;
+                if !done.complete {
+                    partial = true;
+                }
                 let run = RunSummary::new(
                     engine,
                     &scene,
@@ -163,6 +181,7 @@ pub fn run(
         }
     }
     Ok(PaperResults {
+        partial,
         provenance: Provenance {
             command_line,
             dicephys_version: env!("CARGO_PKG_VERSION").into(),
@@ -246,6 +265,10 @@ pub fn report_markdown(res: &PaperResults, figures: &[&str]) -> String {
     };
     let mut s = String::new();
     s += "# Pender & Uhrin (2014) reproduced by dicephys\n\n";
+    if res.partial {
+        s += "**PARTIAL**: stopped before every cell was simulated; run the same command again \
+              to continue from the checkpoint.\n\n";
+    }
     s += &format!(
         "Command: `{}`  \nDate: {}  \ndicephys {}; engines: {}; preset {}; dt {} s; seed {}; \
          {} rolls per simulated cell (keyed throws, the paper's ranges); wall {:.0} s, CPU {:.0} s.\n\n",

@@ -85,7 +85,27 @@ pub fn run(a: &PaperArgs) -> Result<()> {
         b
     };
     let command_line = std::env::args().collect::<Vec<_>>().join(" ");
-    let res = paper::run(&cfg, command_line, &|n| bar.set_position(n))?;
+    // Cells are rolled in checkpointed chunks under --out/checkpoint: the same command run
+    // again (after a crash or Ctrl-C) continues where it stopped.
+    let ck = a.out.join("checkpoint");
+    let key = serde_json::to_string(&PaperConfig {
+        threads: 0,
+        ..cfg.clone()
+    })
+    .map_err(|e| Error::Run(e.to_string()))?;
+    let key_file = ck.join("config.json");
+    if std::fs::read_to_string(&key_file).ok().as_deref() != Some(key.as_str()) {
+        if ck.exists() {
+            eprintln!(
+                "dicephys: {} held another configuration; starting afresh",
+                ck.display()
+            );
+            std::fs::remove_dir_all(&ck)?;
+        }
+        std::fs::create_dir_all(&ck)?;
+        super::write_atomic(&key_file, key.as_bytes())?;
+    }
+    let res = paper::run(&cfg, command_line, Some(&ck), &|n| bar.set_position(n))?;
     bar.finish_and_clear();
     let figures = crate::paper::write_figures(&a.out, &res)?;
     let json = serde_json::to_string_pretty(&res).map_err(|e| Error::Run(e.to_string()))?;
