@@ -9,7 +9,7 @@ use crate::cli::theory::{table_report, TableReport};
 use crate::cputime::process_cpu_seconds;
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
-use crate::roll::Settle;
+use crate::roll::{Rule, Settle};
 use crate::scene::{Mode, Scene};
 use crate::stats::{self, Ratio};
 use crate::summary::RunSummary;
@@ -26,6 +26,8 @@ pub struct PaperConfig {
     pub dt: f64,
     pub threads: usize,
     pub max_steps: u64,
+    /// DicePhys's rest rule and stepped flight, instead of the early stop and fast flight.
+    pub faithful: bool,
 }
 
 /// One simulated cell: a block of the table, an engine, 2D or 3D.
@@ -105,6 +107,12 @@ pub fn run(
     let throws = Throws::new(ThrowKind::Keyed, cfg.seed, ranges, 0);
     let settle = Settle {
         max_steps: cfg.max_steps,
+        rule: if cfg.faithful {
+            Rule::Dicephys
+        } else {
+            Rule::Certificate
+        },
+        fast_flight: !cfg.faithful,
         ..Settle::default()
     };
     let mut done_before = 0u64;

@@ -72,9 +72,9 @@ pub struct RunArgs {
     /// Steps after which a roll not at rest counts as unconverged.
     #[arg(long, default_value_t = DEFAULT_MAX_STEPS)]
     pub max_steps: u64,
-    /// What ends a roll: dicephys (at rest by DicePhys's rule) or certificate (the exact early
-    /// stop: energy below the barrier out of the current face).
-    #[arg(long, default_value = "dicephys", value_parser = ["dicephys", "certificate"])]
+    /// What ends a roll: certificate (the exact early stop: energy below the barrier out of
+    /// the current face; the default) or dicephys (at rest by DicePhys's rule).
+    #[arg(long, default_value = "certificate", value_parser = ["dicephys", "certificate"])]
     pub settle: String,
     /// The certificate's reserve, a fraction of the barrier in [0, 1).
     #[arg(long, default_value_t = DEFAULT_MARGIN)]
@@ -83,10 +83,14 @@ pub struct RunArgs {
     /// and whether it named the same outcome.
     #[arg(long)]
     pub audit: bool,
-    /// Jump over free flight in closed form (exact to rounding where the engine's flight is
-    /// ballistic: Bullet with the dicephys281 preset, Rapier).
+    /// Free flight: fast (integrated in closed form where the engine's flight is ballistic,
+    /// the default) or stepped (every step by the engine).
+    #[arg(long, default_value = "fast", value_parser = ["fast", "stepped"])]
+    pub flight: String,
+    /// DicePhys exactly as the paper ran it: --settle dicephys --flight stepped (with the
+    /// defaults --floor box --preset dicephys281).
     #[arg(long)]
-    pub fast_flight: bool,
+    pub faithful: bool,
 }
 
 pub fn parse_block(s: &str) -> std::result::Result<Block, String> {
@@ -209,8 +213,9 @@ impl RunArgs {
                 self.margin
             )));
         }
+        // An audit compares the certificate with the full settle, so it settles fully.
         let rule = match self.settle.as_str() {
-            "certificate" => Rule::Certificate,
+            "certificate" if !self.faithful && !self.audit => Rule::Certificate,
             _ => Rule::Dicephys,
         };
         Ok(Settle {
@@ -218,7 +223,7 @@ impl RunArgs {
             rule,
             margin: self.margin,
             audit: self.audit,
-            fast_flight: self.fast_flight,
+            fast_flight: self.flight == "fast" && !self.faithful,
         })
     }
 }

@@ -33,6 +33,10 @@ pub struct PaperArgs {
     /// Output directory.
     #[arg(long, default_value = "paper-out")]
     pub out: PathBuf,
+    /// DicePhys exactly as the paper ran it (its rest rule, every flight step stepped) instead
+    /// of the exact early stop and closed-form flight.
+    #[arg(long)]
+    pub faithful: bool,
     /// Print results.json to stdout too (and no progress bar).
     #[arg(long)]
     pub json: bool,
@@ -70,6 +74,7 @@ pub fn run(a: &PaperArgs) -> Result<()> {
         dt: a.dt,
         threads,
         max_steps: a.max_steps,
+        faithful: a.faithful,
     };
     let total = paper::total_rolls(&cfg)?;
     let bar = if a.json || !std::io::stderr().is_terminal() {
