@@ -23,6 +23,17 @@ pub struct BodyState {
 }
 
 impl BodyState {
+    /// At rest at the origin, unrotated: the state of a world with no die in it yet.
+    pub fn at_origin() -> BodyState {
+        BodyState {
+            position: Vector3::zeros(),
+            rotation: UnitQuaternion::identity(),
+            linear_velocity: Vector3::zeros(),
+            angular_velocity: Vector3::zeros(),
+            sleeping: false,
+        }
+    }
+
     pub fn is_finite(&self) -> bool {
         let q = self.rotation.quaternion();
         self.position.iter().all(|v| v.is_finite())

@@ -73,6 +73,16 @@ impl Rapier2d {
     }
 }
 
+/// A state in the x-y plane as a 2D pose: the quaternion (cos θ/2, 0, 0, sin θ/2) becomes the
+/// unit complex (cos θ, sin θ).
+fn planar_pose(s: &BodyState) -> Pose {
+    let q = s.rotation.quaternion();
+    let (c, sin) = (q.w * q.w - q.k * q.k, 2.0 * q.w * q.k);
+    let mut rotation = Rotation::from_cos_sin_unchecked(c, sin);
+    rotation.normalize_mut();
+    Pose::from_parts(Vector::new(s.position.x, s.position.y), rotation)
+}
+
 impl Engine for Rapier2d {
     /// As in 3D, a throw starts from a new body and collider. The start must lie in the
     /// plane: a rotation about z only, no z position or velocity, spin about z only.
@@ -90,14 +100,9 @@ impl Engine for Rapier2d {
         if let Some(h) = self.die.take() {
             self.world.remove_body(h);
         }
-        // The quaternion (cos θ/2, 0, 0, sin θ/2) as the unit complex (cos θ, sin θ).
-        let (c, s) = (q.w * q.w - q.k * q.k, 2.0 * q.w * q.k);
-        let mut rotation = Rotation::from_cos_sin_unchecked(c, s);
-        rotation.normalize_mut();
-        let p = &start.position;
         let v = &start.linear_velocity;
         let body = RigidBodyBuilder::dynamic()
-            .pose(Pose::from_parts(Vector::new(p.x, p.y), rotation))
+            .pose(planar_pose(start))
             .linvel(Vector::new(v.x, v.y))
             .angvel(start.angular_velocity.z);
         let (h, _) = self.world.insert(body, self.die_collider.clone());
@@ -107,13 +112,9 @@ impl Engine for Rapier2d {
 
     fn set_state(&mut self, now: &BodyState) -> Result<(), String> {
         let h = self.die.ok_or("rapier2d: set_state before reset")?;
-        let q = now.rotation.quaternion();
-        let (c, s) = (q.w * q.w - q.k * q.k, 2.0 * q.w * q.k);
-        let mut rotation = Rotation::from_cos_sin_unchecked(c, s);
-        rotation.normalize_mut();
-        let (p, v) = (&now.position, &now.linear_velocity);
+        let v = &now.linear_velocity;
         let b = &mut self.world.bodies[h];
-        b.set_position(Pose::from_parts(Vector::new(p.x, p.y), rotation), true);
+        b.set_position(planar_pose(now), true);
         b.set_linvel(Vector::new(v.x, v.y), true);
         b.set_angvel(now.angular_velocity.z, true);
         Ok(())
@@ -138,13 +139,7 @@ impl Engine for Rapier2d {
 
     fn state(&self) -> BodyState {
         let Some(h) = self.die else {
-            return BodyState {
-                position: Vector3::zeros(),
-                rotation: UnitQuaternion::identity(),
-                linear_velocity: Vector3::zeros(),
-                angular_velocity: Vector3::zeros(),
-                sleeping: false,
-            };
+            return BodyState::at_origin();
         };
         let b = &self.world.bodies[h];
         let t = b.translation();

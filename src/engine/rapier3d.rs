@@ -165,13 +165,7 @@ impl Engine for Rapier3d {
 
     fn state(&self) -> BodyState {
         let Some(h) = self.die else {
-            return BodyState {
-                position: Vector3::zeros(),
-                rotation: UnitQuaternion::identity(),
-                linear_velocity: Vector3::zeros(),
-                angular_velocity: Vector3::zeros(),
-                sleeping: false,
-            };
+            return BodyState::at_origin();
         };
         let b = &self.world.bodies[h];
         let q = b.rotation();
