@@ -24,7 +24,8 @@ BulletWorld::BulletWorld(const BulletScene& s)
       deactivation_(s.deactivation) {
   config_ = std::make_unique<btDefaultCollisionConfiguration>();
   dispatcher_ = std::make_unique<btCollisionDispatcher>(config_.get());
-  broadphase_ = std::make_unique<btDbvtBroadphase>();
+  // Two bodies: the simplest broadphase does (the pair is the same; measured identical).
+  broadphase_ = std::make_unique<btSimpleBroadphase>(4);
   solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
   world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
                                                      solver_.get(), config_.get());
