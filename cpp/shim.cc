@@ -30,6 +30,8 @@ BulletWorld::BulletWorld(const BulletScene& s)
   world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
                                                      solver_.get(), config_.get());
   world_->setGravity(btVector3(0, -s.gravity, 0));
+  // The floor never moves: do not recompute its bounding box every step.
+  world_->setForceUpdateAllAabbs(false);
   btContactSolverInfo& info = world_->getSolverInfo();
   info.m_splitImpulse = s.split_impulse ? 1 : 0;
   info.m_restitutionVelocityThreshold = s.restitution_velocity_threshold;
