@@ -114,9 +114,30 @@ pub struct FfiCost {
     pub overhead: f64,
 }
 
+/// Per mode: the fastest proven Bullet method whose ratio stays within the accuracy bound of
+/// the faithful one's (|z| ≤ `Z_BOUND` on the same throws), on all threads.
+#[derive(Clone, Debug, Serialize)]
+pub struct Verdict {
+    pub mode: String,
+    pub method: String,
+    pub threads: usize,
+    pub rolls_per_s: f64,
+    /// Over the faithful method on the same number of threads.
+    pub speedup: f64,
+    /// Over the faithful method on one thread (DicePhys is single-threaded).
+    pub speedup_vs_faithful_1_thread: f64,
+    pub vs_dicephys: f64,
+    pub z_vs_faithful: f64,
+}
+
+/// The accuracy bound: a method's ratio within this many combined standard errors of the
+/// faithful method's, on the same throws.
+pub const Z_BOUND: f64 = 2.0;
+
 #[derive(Clone, Debug, Serialize)]
 pub struct Bench {
     pub rows: Vec<BenchRow>,
+    pub verdicts: Vec<Verdict>,
     pub ffi: FfiCost,
     pub peak_rss_mb: f64,
     pub seed: u64,
@@ -217,8 +238,43 @@ pub fn run(rolls: u64, seed: u64, all_threads: usize, log: &dyn Fn(&str)) -> Res
         ffi.cpp_loop_s,
         100.0 * ffi.overhead
     ));
+    let verdicts: Vec<Verdict> = [Mode::ThreeD, Mode::TwoD]
+        .iter()
+        .filter_map(|mode| {
+            let of_mode = |t: usize| {
+                rows.iter()
+                    .filter(move |r| r.mode == mode.name() && r.threads == t)
+            };
+            let faithful_1 = of_mode(1).find(|r| r.method == "faithful")?.rolls_per_s;
+            let proven: Vec<String> = methods()
+                .into_iter()
+                .filter(|m| m.proven && m.engine == EngineKind::Bullet)
+                .map(|m| m.name)
+                .collect();
+            let best = of_mode(all_threads.max(1))
+                .filter(|r| proven.contains(&r.method) && r.z_vs_faithful.abs() <= Z_BOUND)
+                .max_by(|a, b| a.rolls_per_s.total_cmp(&b.rolls_per_s))?;
+            Some(Verdict {
+                mode: mode.name().into(),
+                method: best.method.clone(),
+                threads: best.threads,
+                rolls_per_s: best.rolls_per_s,
+                speedup: best.speedup,
+                speedup_vs_faithful_1_thread: best.rolls_per_s / faithful_1,
+                vs_dicephys: best.vs_dicephys,
+                z_vs_faithful: best.z_vs_faithful,
+            })
+        })
+        .collect();
+    for v in &verdicts {
+        log(&format!(
+            "fastest within |z| <= {Z_BOUND} of faithful, {}: {} on {} threads, {:.0} rolls/s: {:.2}x faithful on {} threads, {:.2}x faithful on 1 thread, {:.1}x DicePhys",
+            v.mode, v.method, v.threads, v.rolls_per_s, v.speedup, v.threads, v.speedup_vs_faithful_1_thread, v.vs_dicephys
+        ));
+    }
     Ok(Bench {
         rows,
+        verdicts,
         ffi,
         peak_rss_mb: peak_rss_bytes() as f64 / 1e6,
         seed,
