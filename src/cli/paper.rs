@@ -13,7 +13,7 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct PaperArgs {
     /// Rolls per simulated cell (block × engine × 2D/3D); 100000 is the paper's own scale.
-    #[arg(long, default_value_t = 5000)]
+    #[arg(long, default_value_t = 10000)]
     pub rolls: u64,
     /// Seed of the keyed throws.
     #[arg(long, default_value_t = 2385)]
