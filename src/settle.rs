@@ -124,6 +124,13 @@ impl DieShape {
         }
     }
 
+    /// Height of the die's lowest point above the floor's top: y − Σ hᵢ |(Rᵀ ŷ)ᵢ| (in 2D the
+    /// body turns about z only, so z adds nothing).
+    pub fn lowest_point(&self, s: &BodyState) -> f64 {
+        let up = s.rotation.inverse() * Vector3::y();
+        s.position.y - up.abs().dot(&self.half)
+    }
+
     /// Kinetic plus potential energy (floor top at y = 0).
     pub fn energy(&self, s: &BodyState) -> f64 {
         let w = s.rotation.inverse() * s.angular_velocity;
