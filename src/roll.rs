@@ -117,8 +117,8 @@ impl Default for Settle {
 pub const TUNNEL_DEPTH: f64 = 0.5;
 
 /// Energy gain: a real roll never gains mechanical energy (contacts only dissipate; free flight
-/// keeps it, and the engines' symplectic Euler loses ½mg²dt² a step). So a rise of the kinetic
-/// + potential energy (`DieShape::energy`) above its lowest value so far by more than this
+/// keeps it, and the engines' symplectic Euler loses ½mg²dt² a step). So a rise of the
+/// kinetic plus potential energy (`DieShape::energy`) above its lowest value so far by more than this
 /// fraction of the starting energy is the engine injecting energy: at a contact (restitution
 /// above 1, a penetration pushed out too hard) or between contacts.
 pub const ENERGY_GAIN_TOLERANCE: f64 = 0.01;
