@@ -50,18 +50,23 @@ const LINES: [RGBColor; 12] = [
     RGBColor(110, 110, 110),
 ];
 
-/// A value for a log10 tick: 1/1000 style below 1 for time steps, else plain.
-fn log_tick_dt(v: &f64) -> String {
-    crate::sweeps::dt_label(10f64.powf(*v))
+/// `x` rounded to two significant figures.
+fn two_figures(x: f64) -> f64 {
+    if !(x.is_finite() && x > 0.0) {
+        return x;
+    }
+    let p = 10f64.powf(x.log10().floor() - 1.0);
+    (x / p).round() * p
 }
 
+/// A log10 tick for a time step: 1/N, N to two significant figures.
+fn log_tick_dt(v: &f64) -> String {
+    format!("1/{}", two_figures(10f64.powf(-*v)))
+}
+
+/// A log10 tick: the value to two significant figures.
 fn log_tick(v: &f64) -> String {
-    let x = 10f64.powf(*v);
-    if x >= 10.0 {
-        format!("{x:.0}")
-    } else {
-        format!("{x:.2}")
-    }
+    tick(&two_figures(10f64.powf(*v)))
 }
 
 /// `chart` with its own x tick labels.
@@ -88,6 +93,7 @@ fn chart_x<'a, DB: DrawingBackend>(
         .y_desc(y_desc)
         .axis_desc_style((FONT, 20))
         .label_style((FONT, 16))
+        .x_labels(7)
         .x_label_formatter(x_fmt)
         .y_label_formatter(&tick)
         .light_line_style(RGBColor(243, 243, 243))
@@ -226,11 +232,13 @@ impl Figure for Tradeoff<'_> {
             )?;
             chart
                 .draw_series(front.iter().map(|m| {
-                    Text::new(
-                        m.label.clone(),
-                        (m.cost.log10(), m.error),
-                        (FONT, 13).into_font().color(&color),
-                    )
+                    // The name beside its marker, a little up and to the right.
+                    EmptyElement::at((m.cost.log10(), m.error))
+                        + Text::new(
+                            m.label.clone(),
+                            (9, -16),
+                            (FONT, 13).into_font().color(&color),
+                        )
                 }))
                 .map_err(plot_err)?;
         }
