@@ -31,6 +31,10 @@ pub struct Tally {
     pub certified: u64,
     pub certified_wrong: u64,
     pub certified_steps: u64,
+    /// Rolls in which the engine injected energy (`RollRecord::energy_gain`), whatever their
+    /// fate.
+    #[serde(default)]
+    pub energy_gain: u64,
 }
 
 #[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -57,6 +61,7 @@ impl Tally {
         self.rolls += 1;
         self.steps += r.steps;
         self.engine_steps += r.engine_steps;
+        self.energy_gain += r.energy_gain as u64;
         if let Some((step, o)) = r.certified {
             self.certified += 1;
             self.certified_steps += step;
@@ -96,6 +101,7 @@ impl Tally {
         self.certified += o.certified;
         self.certified_wrong += o.certified_wrong;
         self.certified_steps += o.certified_steps;
+        self.energy_gain += o.energy_gain;
     }
 
     pub fn of(records: &[RollRecord]) -> Tally {
@@ -203,6 +209,7 @@ fn roll_one(
         steps: 0,
         engine_steps: 0,
         certified: None,
+        energy_gain: false,
     };
     let Some(w) = world.as_mut() else {
         return failed;

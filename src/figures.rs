@@ -25,6 +25,8 @@ use plotters::prelude::*;
 use crate::paper_data::{self, PaperRow};
 use crate::theory::{self, dreidel as dr};
 
+pub mod sweeps;
+
 /// One plotted value with its one-standard-error bar (`y_err` 0, negative or non-finite: no bar).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Point {

@@ -41,8 +41,7 @@ impl Flight {
 
     /// Height of the die's lowest point above the floor: y − Σ hᵢ |(Rᵀ ŷ)ᵢ|.
     pub fn lowest_point(&self, s: &BodyState) -> f64 {
-        let up = s.rotation.inverse() * Vector3::y();
-        s.position.y - up.abs().dot(&self.half)
+        crate::settle::lowest_point(&self.half, s)
     }
 
     /// The rotation one step applies, as Bullet's `integrateTransform` builds it.

@@ -28,5 +28,6 @@ pub mod scene;
 pub mod settle;
 pub mod stats;
 pub mod summary;
+pub mod sweeps;
 pub mod theory;
 pub mod throws;

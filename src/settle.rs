@@ -124,6 +124,12 @@ impl DieShape {
         }
     }
 
+    /// Height of the die's lowest point above the floor's top: y − Σ hᵢ |(Rᵀ ŷ)ᵢ| (in 2D the
+    /// body turns about z only, so z adds nothing).
+    pub fn lowest_point(&self, s: &BodyState) -> f64 {
+        lowest_point(&self.half, s)
+    }
+
     /// Kinetic plus potential energy (floor top at y = 0).
     pub fn energy(&self, s: &BodyState) -> f64 {
         let w = s.rotation.inverse() * s.angular_velocity;
@@ -131,6 +137,13 @@ impl DieShape {
             + 0.5 * w.component_mul(&w).dot(&self.inertia)
             + self.mass * self.gravity * s.position.y
     }
+}
+
+/// Height above the floor of the lowest point of a box with half sides `half`:
+/// y − Σ hᵢ |(Rᵀ ŷ)ᵢ| (the support function in the downward direction).
+pub fn lowest_point(half: &Vector3<f64>, s: &BodyState) -> f64 {
+    let up = s.rotation.inverse() * Vector3::y();
+    s.position.y - up.abs().dot(half)
 }
 
 const SIDES: [Outcome; 3] = [Outcome::Breadth, Outcome::Width, Outcome::Length];

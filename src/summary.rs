@@ -32,6 +32,13 @@ pub struct RunSummary {
     pub unconverged: u64,
     pub failed: BTreeMap<String, u64>,
     pub failed_total: u64,
+    /// Rolls in which the engine injected energy: kinetic + potential rose above its lowest
+    /// value so far by more than `energy_gain_tolerance` of the starting energy. A flag on
+    /// rolls of any fate, not a failure.
+    #[serde(default)]
+    pub energy_gain: u64,
+    #[serde(default)]
+    pub energy_gain_tolerance: f64,
     /// N(breadth vertical) / N(width vertical), the paper's ratio.
     pub ratio: f64,
     /// The paper's binomial error of the ratio.
@@ -136,6 +143,8 @@ impl RunSummary {
             unconverged: tally.unconverged,
             failed: tally.failed.clone(),
             failed_total: tally.failed_total(),
+            energy_gain: tally.energy_gain,
+            energy_gain_tolerance: crate::roll::ENERGY_GAIN_TOLERANCE,
             ratio,
             ratio_err,
             theory_ratio,
@@ -200,7 +209,7 @@ impl RunSummary {
             .map(|(k, v)| format!("{k} {v}"))
             .collect();
         s += &format!(
-            "  unconverged {} (cap {} steps)   failed {}{}\n",
+            "  unconverged {} (cap {} steps)   failed {}{}   energy gain {} (> {} % of the start)\n",
             self.unconverged,
             self.max_steps,
             self.failed_total,
@@ -208,7 +217,9 @@ impl RunSummary {
                 String::new()
             } else {
                 format!(" ({})", failed.join(", "))
-            }
+            },
+            self.energy_gain,
+            100.0 * self.energy_gain_tolerance
         );
         s += &format!(
             "  steps/roll {:.0} ({:.0} by the engine)   wall {:.2} s   CPU {:.2} s ({:.3} ms/roll, {} threads)   {}\n",

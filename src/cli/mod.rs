@@ -11,6 +11,7 @@ pub mod merge;
 pub mod paper;
 pub mod roll;
 pub mod runargs;
+pub mod sweeps;
 pub mod theory;
 pub mod trace;
 
@@ -32,8 +33,14 @@ pub enum Command {
     Bench(bench::BenchArgs),
     /// The same throws on several engines: counts, ratios, σ apart, per-throw agreement, cost.
     Crosscheck(crosscheck::CrosscheckArgs),
+    /// The paper's convergence test: the ratio against dt per block, engine, 2D/3D.
+    Converge(sweeps::ConvergeArgs),
     /// Combine the --json outputs of `roll --shard K/N` runs into the unsharded result.
     Merge(merge::MergeArgs),
+    /// Where engines fail: unconverged, unknown, non-finite, tunnelled, energy gain by cell.
+    Stability(sweeps::StabilityArgs),
+    /// Accuracy against cost across methods, with the Pareto front.
+    Tradeoff(sweeps::TradeoffArgs),
     /// Reproduce the paper: its table, theory, simulations and figures, into --out.
     Paper(paper::PaperArgs),
     /// The paper's closed-form theory for a block, or its whole experimental table.
@@ -68,7 +75,10 @@ pub fn main() -> i32 {
     };
     let result = match cli.command {
         Command::Bench(a) => bench::run(&a),
+        Command::Converge(a) => sweeps::converge(&a),
         Command::Crosscheck(a) => crosscheck::run(&a),
+        Command::Stability(a) => sweeps::stability(&a),
+        Command::Tradeoff(a) => sweeps::tradeoff(&a),
         Command::Merge(a) => merge::run(&a),
         Command::Paper(a) => paper::run(&a),
         Command::Theory(a) => theory::run(&a),

@@ -1,0 +1,412 @@
+//! `dicephys converge`, `tradeoff` and `stability`: the sweeps (`crate::sweeps`), each writing
+//! `<command>.json`, `report.md` and its figures into --out.
+
+use super::args::{parse_block, parse_engine};
+use crate::block::Block;
+use crate::engine::EngineKind;
+use crate::error::{Error, Result};
+use crate::figures::sweeps as fig;
+use crate::figures::Point;
+use crate::sweeps::{converge, dt_label, parse_dt, stability, tradeoff};
+use clap::Args;
+use std::path::{Path, PathBuf};
+
+#[derive(Args, Debug)]
+pub struct ConvergeArgs {
+    /// Blocks, LENGTHxBREADTHxWIDTH in mm (comma-separated).
+    #[arg(long, value_delimiter = ',', default_value = "140x24x20,140x22x13,140x30x10", value_parser = parse_block)]
+    pub blocks: Vec<Block>,
+    /// Time steps, s or 1/N (comma-separated); the paper's full set is
+    /// 1/60,1/120,1/240,1/500,1/1000,1/2000,1/5000,1/10000.
+    #[arg(long, value_delimiter = ',', default_value = "1/60,1/250,1/1000,1/5000", value_parser = parse_dt)]
+    pub dts: Vec<f64>,
+    #[arg(long, value_delimiter = ',', default_value = "bullet,rapier", value_parser = parse_engine)]
+    pub engines: Vec<EngineKind>,
+    /// Rolls per cell (block × engine × mode × dt).
+    #[arg(long, default_value_t = 200)]
+    pub rolls: u64,
+    #[arg(long, default_value_t = 2385)]
+    pub seed: u64,
+    /// Worker threads (0: one per core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Steps after which a roll not at rest counts as unconverged.
+    #[arg(long, default_value_t = 2_000_000)]
+    pub max_steps: u64,
+    #[arg(long, default_value = "converge-out")]
+    pub out: PathBuf,
+    /// Print converge.json to stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct TradeoffArgs {
+    #[arg(long, default_value = "140x24x20", value_parser = parse_block)]
+    pub block: Block,
+    /// The methods' time steps (comma-separated).
+    #[arg(long, value_delimiter = ',', default_value = "1/100,1/250,1/1000", value_parser = parse_dt)]
+    pub dts: Vec<f64>,
+    /// The reference's time step (the faithful scene at the finest dt).
+    #[arg(long, default_value = "1/5000", value_parser = parse_dt)]
+    pub reference_dt: f64,
+    /// Rolls per method.
+    #[arg(long, default_value_t = 300)]
+    pub rolls: u64,
+    #[arg(long, default_value_t = 2385)]
+    pub seed: u64,
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    #[arg(long, default_value_t = 2_000_000)]
+    pub max_steps: u64,
+    #[arg(long, default_value = "tradeoff-out")]
+    pub out: PathBuf,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct StabilityArgs {
+    #[arg(long, value_delimiter = ',', default_value = "bullet,rapier", value_parser = parse_engine)]
+    pub engines: Vec<EngineKind>,
+    /// Time steps of the dt × restitution grid.
+    #[arg(long, value_delimiter = ',', default_value = "1/1000,1/240,1/60,1/30", value_parser = parse_dt)]
+    pub dts: Vec<f64>,
+    /// Restitutions of the grid (0 to 0.95).
+    #[arg(long, value_delimiter = ',', default_value = "0,0.5,0.8,0.95")]
+    pub restitutions: Vec<f64>,
+    /// Frictions of the friction line (0 to 1.5).
+    #[arg(long, value_delimiter = ',', default_value = "0,0.29,0.8,1.5")]
+    pub frictions: Vec<f64>,
+    /// Blocks of the aspect line: breadth/width up to 10, length/breadth down to 1.
+    #[arg(long, value_delimiter = ',', default_value = "140x24x20,140x40x20,140x100x20,200x200x20,24x24x20", value_parser = parse_block)]
+    pub blocks: Vec<Block>,
+    /// Rolls per cell.
+    #[arg(long, default_value_t = 30)]
+    pub rolls: u64,
+    #[arg(long, default_value_t = 2385)]
+    pub seed: u64,
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// The step cap: a roll still moving after it is unconverged.
+    #[arg(long, default_value_t = 20_000)]
+    pub max_steps: u64,
+    #[arg(long, default_value = "stability-out")]
+    pub out: PathBuf,
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn threads(t: usize) -> usize {
+    if t == 0 {
+        rayon::current_num_threads()
+    } else {
+        t
+    }
+}
+
+fn check_common(rolls: u64, max_steps: u64, t: usize, out: &Path, file: &str) -> Result<()> {
+    if rolls == 0 || rolls > 1_000_000_000 {
+        return Err(Error::Usage(format!("--rolls {rolls}: must be in 1..=1e9")));
+    }
+    if max_steps == 0 {
+        return Err(Error::Usage("--max-steps 0: need at least one step".into()));
+    }
+    if t > 1024 {
+        return Err(Error::Usage(format!("--threads {t}: at most 1024")));
+    }
+    std::fs::create_dir_all(out)
+        .map_err(|e| Error::Usage(format!("--out {}: cannot create it ({e})", out.display())))?;
+    super::check_writable(&out.join(file))
+}
+
+fn nonempty<T>(v: &[T], name: &str) -> Result<()> {
+    if v.is_empty() {
+        Err(Error::Usage(format!("{name}: give at least one value")))
+    } else {
+        Ok(())
+    }
+}
+
+fn to_json<T: serde::Serialize>(v: &T) -> Result<String> {
+    serde_json::to_string_pretty(v).map_err(|e| Error::Run(e.to_string()))
+}
+
+/// Writes the JSON and the report, prints one or the other.
+fn finish(out: &Path, file: &str, json: &str, report: &str, print_json: bool) -> Result<()> {
+    super::write_atomic(&out.join(file), json.as_bytes())?;
+    super::write_atomic(&out.join("report.md"), report.as_bytes())?;
+    if print_json {
+        println!("{json}");
+    } else {
+        println!("{report}");
+        eprintln!("wrote {}/{file}, report.md and figures", out.display());
+    }
+    Ok(())
+}
+
+pub fn converge(a: &ConvergeArgs) -> Result<()> {
+    nonempty(&a.blocks, "--blocks")?;
+    nonempty(&a.dts, "--dts")?;
+    nonempty(&a.engines, "--engines")?;
+    check_common(a.rolls, a.max_steps, a.threads, &a.out, "converge.json")?;
+    let cfg = converge::Config {
+        blocks: a.blocks.clone(),
+        dts: a.dts.clone(),
+        engines: a.engines.clone(),
+        rolls: a.rolls,
+        seed: a.seed,
+        threads: threads(a.threads),
+        max_steps: a.max_steps,
+    };
+    let quiet = a.json;
+    if !quiet {
+        eprintln!("{}", converge::header());
+    }
+    let res = converge::run(&cfg, &|l| {
+        if !quiet {
+            eprintln!("{l}")
+        }
+    })
+    .map_err(Error::Run)?;
+    let lines: Vec<fig::Line> = group(&res.cells, |c| {
+        format!("{} {} {}", c.block, c.engine, c.mode)
+    })
+    .into_iter()
+    .map(|(label, cells)| fig::Line {
+        label,
+        points: cells
+            .iter()
+            .map(|c| Point {
+                x: c.dt,
+                y: c.ratio,
+                y_err: c.ratio_err,
+            })
+            .collect(),
+    })
+    .collect();
+    fig::convergence(
+        &a.out,
+        "converge",
+        &format!("Ratio against dt ({} rolls per point)", a.rolls),
+        &lines,
+    )
+    .map_err(Error::Run)?;
+    let mut md = format!(
+        "# Convergence in dt\n\n{} rolls per cell, seed {}, rolls ended by {}.\n\n```\n{}\n",
+        res.rolls,
+        res.seed,
+        res.settle,
+        converge::header()
+    );
+    for c in &res.cells {
+        md += &converge::format_cell(c);
+        md.push('\n');
+    }
+    md += "```\n\n";
+    md += &format!("{}\n\n![ratio against dt](converge.svg)\n", res.verdict);
+    finish(&a.out, "converge.json", &to_json(&res)?, &md, a.json)
+}
+
+/// Items grouped by a key, in first-seen order.
+fn group<T>(items: &[T], key: impl Fn(&T) -> String) -> Vec<(String, Vec<&T>)> {
+    let mut out: Vec<(String, Vec<&T>)> = Vec::new();
+    for it in items {
+        let k = key(it);
+        match out.iter_mut().find(|(g, _)| *g == k) {
+            Some((_, v)) => v.push(it),
+            None => out.push((k, vec![it])),
+        }
+    }
+    out
+}
+
+pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
+    nonempty(&a.dts, "--dts")?;
+    if a.dts.iter().any(|&d| d <= a.reference_dt) {
+        return Err(Error::Usage(format!(
+            "--reference-dt {}: must be finer than every --dts",
+            dt_label(a.reference_dt)
+        )));
+    }
+    check_common(a.rolls, a.max_steps, a.threads, &a.out, "tradeoff.json")?;
+    let cfg = tradeoff::Config {
+        block: a.block,
+        dts: a.dts.clone(),
+        reference_dt: a.reference_dt,
+        rolls: a.rolls,
+        seed: a.seed,
+        threads: threads(a.threads),
+        max_steps: a.max_steps,
+    };
+    let quiet = a.json;
+    if !quiet {
+        eprintln!("{}", tradeoff::header());
+    }
+    let res = tradeoff::run(&cfg, &|l| {
+        if !quiet {
+            eprintln!("{l}")
+        }
+    })
+    .map_err(Error::Run)?;
+    let mut pts = Vec::new();
+    for m in &res.modes {
+        for r in &m.rows {
+            pts.push(fig::MethodPoint {
+                label: r.method.clone(),
+                cost: r.cpu_s_per_1000,
+                error: 100.0 * r.error.abs(),
+                error_err: 100.0 * r.error_err,
+                two_d: r.mode == "2d",
+                on_front: m.pareto_front.contains(&r.method),
+            });
+        }
+    }
+    fig::tradeoff(
+        &a.out,
+        "tradeoff",
+        &format!(
+            "{}: cost against error ({} rolls per method)",
+            res.block, res.rolls
+        ),
+        &pts,
+    )
+    .map_err(Error::Run)?;
+    let mut md = format!(
+        "# Accuracy against cost\n\n{}, {} rolls per method, seed {}; reference: Bullet, box floor, \
+         DicePhys's rule, every step stepped, dt {}.\n\n",
+        res.block,
+        res.rolls,
+        res.seed,
+        dt_label(res.reference_dt)
+    );
+    for m in &res.modes {
+        md += &format!(
+            "## {}\n\n```\n{}\n{}  (reference)\n",
+            m.mode,
+            tradeoff::header(),
+            tradeoff::format_row(&m.reference)
+        );
+        for r in &m.rows {
+            md += &tradeoff::format_row(r);
+            md.push('\n');
+        }
+        md += &format!(
+            "```\n\nPareto front (cheapest first): {}.\n\n{}\n\n",
+            m.pareto_front.join("; "),
+            m.note
+        );
+    }
+    md += "![cost against error](tradeoff.svg)\n";
+    finish(&a.out, "tradeoff.json", &to_json(&res)?, &md, a.json)
+}
+
+pub fn stability(a: &StabilityArgs) -> Result<()> {
+    nonempty(&a.engines, "--engines")?;
+    nonempty(&a.dts, "--dts")?;
+    nonempty(&a.restitutions, "--restitutions")?;
+    if let Some(e) = a
+        .restitutions
+        .iter()
+        .find(|e| !(e.is_finite() && (0.0..=1.0).contains(*e)))
+    {
+        return Err(Error::Usage(format!(
+            "--restitutions {e}: must be in [0, 1]"
+        )));
+    }
+    if let Some(m) = a.frictions.iter().find(|m| !(m.is_finite() && **m >= 0.0)) {
+        return Err(Error::Usage(format!(
+            "--frictions {m}: must be finite and >= 0"
+        )));
+    }
+    check_common(a.rolls, a.max_steps, a.threads, &a.out, "stability.json")?;
+    let cfg = stability::Config {
+        engines: a.engines.clone(),
+        dts: a.dts.clone(),
+        restitutions: a.restitutions.clone(),
+        frictions: a.frictions.clone(),
+        blocks: a.blocks.clone(),
+        rolls: a.rolls,
+        seed: a.seed,
+        threads: threads(a.threads),
+        max_steps: a.max_steps,
+    };
+    let quiet = a.json;
+    if !quiet {
+        eprintln!("{}", stability::header());
+    }
+    let res = stability::run(&cfg, &|l| {
+        if !quiet {
+            eprintln!("{l}")
+        }
+    })
+    .map_err(Error::Run)?;
+    let mut figures = Vec::new();
+    for kind in stability::KINDS {
+        let panels: Vec<fig::Panel> = group(
+            &res.cells
+                .iter()
+                .filter(|c| c.sweep == "dt_restitution")
+                .collect::<Vec<_>>(),
+            |c| format!("{} {}", c.engine, c.mode),
+        )
+        .into_iter()
+        .map(|(title, cells)| fig::Panel {
+            title,
+            x_desc: "dt, s".into(),
+            y_desc: "restitution e".into(),
+            x_labels: res.dts.iter().map(|&d| dt_label(d)).collect(),
+            y_labels: res.restitutions.iter().map(|e| e.to_string()).collect(),
+            values: res
+                .restitutions
+                .iter()
+                .map(|&e| {
+                    res.dts
+                        .iter()
+                        .map(|&d| {
+                            cells
+                                .iter()
+                                .find(|c| c.dt == d && c.restitution == e)
+                                .map_or(f64::NAN, |c| c.kind(kind))
+                        })
+                        .collect()
+                })
+                .collect(),
+        })
+        .collect();
+        let stem = format!("stability_{kind}");
+        fig::heatmap(
+            &a.out,
+            &stem,
+            &format!(
+                "Fraction of rolls {kind} ({} rolls per cell, μ 0.29, 140x24x20)",
+                res.rolls
+            ),
+            &panels,
+        )
+        .map_err(Error::Run)?;
+        figures.push(stem);
+    }
+    let mut md = format!(
+        "# Where methods fail\n\n{} rolls per cell, seed {}, cap {} steps, energy-gain tolerance \
+         {} % of the starting energy.\n\n```\n{}\n",
+        res.rolls,
+        res.seed,
+        res.max_steps,
+        100.0 * res.energy_gain_tolerance,
+        stability::header()
+    );
+    for c in &res.cells {
+        md += &stability::format_cell(c);
+        md.push('\n');
+    }
+    md += "```\n\n";
+    for f in &res.findings {
+        md += &format!("- {f}\n");
+    }
+    md.push('\n');
+    for f in &figures {
+        md += &format!("![{f}]({f}.svg)\n");
+    }
+    finish(&a.out, "stability.json", &to_json(&res)?, &md, a.json)
+}
