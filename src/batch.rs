@@ -26,10 +26,14 @@ pub struct Tally {
     pub steps: u64,
     /// Steps the engines took (fewer where free flight was coasted).
     pub engine_steps: u64,
-    /// Auditing the early stop: rolls the certificate fired on, how many of those settled on
-    /// another side than it named, and the steps at which it fired, summed.
+    /// Auditing the early stop: rolls the certificate fired on, how many of those came to rest
+    /// on another face than it named, how many the full settle left "unknown" (DicePhys's rest
+    /// rule stopping a rocking die at the turning point of a swing, still tilted: no face to
+    /// disagree with), and the steps at which it fired, summed.
     pub certified: u64,
     pub certified_wrong: u64,
+    #[serde(default)]
+    pub certified_unknown: u64,
     pub certified_steps: u64,
     /// Rolls in which the engine injected energy (`RollRecord::energy_gain`), whatever their
     /// fate.
@@ -65,11 +69,13 @@ impl Tally {
         if let Some((step, o)) = r.certified {
             self.certified += 1;
             self.certified_steps += step;
-            let wrong = match r.fate {
-                Fate::Settled(s) | Fate::Unconverged(s) => s != o,
-                Fate::Failed(_) => false,
-            };
-            self.certified_wrong += wrong as u64;
+            match r.fate {
+                Fate::Settled(Outcome::Unknown) | Fate::Unconverged(Outcome::Unknown) => {
+                    self.certified_unknown += 1
+                }
+                Fate::Settled(s) | Fate::Unconverged(s) => self.certified_wrong += (s != o) as u64,
+                Fate::Failed(_) => {}
+            }
         }
         match r.fate {
             Fate::Settled(o) => self.counts.add(o),
@@ -100,6 +106,7 @@ impl Tally {
         self.engine_steps += o.engine_steps;
         self.certified += o.certified;
         self.certified_wrong += o.certified_wrong;
+        self.certified_unknown += o.certified_unknown;
         self.certified_steps += o.certified_steps;
         self.energy_gain += o.energy_gain;
     }

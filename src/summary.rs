@@ -97,8 +97,11 @@ pub struct Audit {
     pub margin: f64,
     /// Rolls on which it fired before DicePhys's rule stopped them.
     pub certified: u64,
-    /// Of those, rolls whose final side differs from the one it named.
+    /// Of those, rolls that came to rest on another face than the one it named.
     pub wrong: u64,
+    /// Of those, rolls the full settle left "unknown" (stopped tilted, mid-rock).
+    #[serde(default)]
+    pub full_settle_unknown: u64,
     /// Mean step at which it fired, over the rolls it fired on.
     pub certified_steps_mean: f64,
     /// Mean steps of the full settle.
@@ -166,6 +169,7 @@ impl RunSummary {
                 margin: settle.margin,
                 certified: tally.certified,
                 wrong: tally.certified_wrong,
+                full_settle_unknown: tally.certified_unknown,
                 certified_steps_mean: tally.certified_steps as f64 / tally.certified.max(1) as f64,
                 full_steps_mean: tally.steps as f64 / tally.rolls.max(1) as f64,
             }),
@@ -233,9 +237,14 @@ impl RunSummary {
         );
         if let Some(a) = &self.audit {
             s += &format!(
-                "  audit of the early stop (margin {}): fired on {} rolls, wrong on {}; \
-                 mean step {:.0} against {:.0} for the full settle\n",
-                a.margin, a.certified, a.wrong, a.certified_steps_mean, a.full_steps_mean
+                "  audit of the early stop (margin {}): fired on {} rolls, wrong on {} (full settle \
+                 unknown on {}); mean step {:.0} against {:.0} for the full settle\n",
+                a.margin,
+                a.certified,
+                a.wrong,
+                a.full_settle_unknown,
+                a.certified_steps_mean,
+                a.full_steps_mean
             );
         }
         s
