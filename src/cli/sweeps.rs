@@ -117,6 +117,7 @@ fn check_common(rolls: u64, max_steps: u64, t: usize, out: &Path, file: &str) ->
     }
     std::fs::create_dir_all(out)
         .map_err(|e| Error::Usage(format!("--out {}: cannot create it ({e})", out.display())))?;
+    let _ = crate::sweeps::CHECKPOINT_DIR.set(out.join("checkpoint"));
     super::check_writable(&out.join(file))
 }
 

@@ -26,6 +26,7 @@ use crate::throws::{ThrowKind, ThrowRanges, Throws};
 pub const ONE_PERCENT: f64 = 0.01;
 
 /// One measured cell: the exact tally and the CPU seconds (all threads) it took.
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct Measured {
     pub tally: Tally,
     pub cpu_s: f64,
@@ -52,7 +53,37 @@ pub fn throws(seed: u64) -> Throws {
     Throws::new(ThrowKind::Keyed, seed, ThrowRanges::default(), 0)
 }
 
-/// Rolls throws 0..rolls; memory stays flat (chunked, records dropped).
+/// Where the sweeps keep their checkpoints (`--out/checkpoint`, set by the command line): a
+/// finished cell, with the CPU time it took, is not rolled again when the same command is run
+/// again after a crash or Ctrl-C. A cell is kept whole or not at all, so its cost stays true.
+pub static CHECKPOINT_DIR: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
+
+/// A cell's checkpoint directory, named by a hash of everything that defines it and holding
+/// that definition in `cell.json`; a directory holding another definition is emptied.
+fn cell_dir(
+    engine: EngineKind,
+    scene: &Scene,
+    throws_seed: &str,
+    settle: &Settle,
+    rolls: u64,
+) -> Option<std::path::PathBuf> {
+    use std::hash::{Hash, Hasher};
+    let root = CHECKPOINT_DIR.get()?;
+    let key = serde_json::to_string(&(engine, scene, throws_seed, settle, rolls)).ok()?;
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    key.hash(&mut h);
+    let dir = root.join(format!("{engine}-{:016x}", h.finish()));
+    let file = dir.join("cell.json");
+    if std::fs::read_to_string(&file).ok().as_deref() != Some(key.as_str()) {
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).ok()?;
+        checkpoint::write_atomic(&file, key.as_bytes()).ok()?;
+    }
+    Some(dir)
+}
+
+/// Rolls throws 0..rolls; memory stays flat (chunked, records dropped); a finished cell is
+/// kept under `CHECKPOINT_DIR` when set.
 pub fn measure(
     engine: EngineKind,
     scene: &Scene,
@@ -62,6 +93,18 @@ pub fn measure(
     threads: usize,
 ) -> Result<Measured, String> {
     let cpu = process_cpu_seconds();
+    let seed = match throws {
+        Throws::Keyed { seed, ranges } => format!("keyed {seed} {ranges:?}"),
+        Throws::Dicephys { throws } => format!("dicephys {}", throws.len()),
+    };
+    let kept = cell_dir(engine, scene, &seed, settle, rolls).map(|d| d.join("result.json"));
+    if let Some(m) = kept
+        .as_ref()
+        .and_then(|f| std::fs::read_to_string(f).ok())
+        .and_then(|t| serde_json::from_str::<Measured>(&t).ok())
+    {
+        return Ok(m);
+    }
     let run = checkpoint::run(
         engine,
         scene,
@@ -76,10 +119,16 @@ pub fn measure(
     if !run.complete {
         return Err("stopped before the end (Ctrl-C)".into());
     }
-    Ok(Measured {
+    let m = Measured {
         tally: run.tally,
         cpu_s: process_cpu_seconds() - cpu,
-    })
+    };
+    if let Some(f) = &kept {
+        if let Ok(json) = serde_json::to_string(&m) {
+            let _ = checkpoint::write_atomic(f, json.as_bytes());
+        }
+    }
+    Ok(m)
 }
 
 /// A ratio's relative departure from a reference, r/ref − 1, with its error (the two taken as
