@@ -160,16 +160,7 @@ pub fn converge(a: &ConvergeArgs) -> Result<()> {
         threads: threads(a.threads),
         max_steps: a.max_steps,
     };
-    let quiet = a.json;
-    if !quiet {
-        eprintln!("{}", converge::header());
-    }
-    let res = converge::run(&cfg, &|l| {
-        if !quiet {
-            eprintln!("{l}")
-        }
-    })
-    .map_err(Error::Run)?;
+    let res = logged(a.json, &converge::header(), |log| converge::run(&cfg, log))?;
     let lines: Vec<fig::Line> = group(&res.cells, |c| {
         format!("{} {} {}", c.block, c.engine, c.mode)
     })
@@ -240,16 +231,7 @@ pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
         threads: threads(a.threads),
         max_steps: a.max_steps,
     };
-    let quiet = a.json;
-    if !quiet {
-        eprintln!("{}", tradeoff::header());
-    }
-    let res = tradeoff::run(&cfg, &|l| {
-        if !quiet {
-            eprintln!("{l}")
-        }
-    })
-    .map_err(Error::Run)?;
+    let res = logged(a.json, &tradeoff::header(), |log| tradeoff::run(&cfg, log))?;
     let mut pts = Vec::new();
     for m in &res.modes {
         for r in &m.rows {
@@ -332,16 +314,9 @@ pub fn stability(a: &StabilityArgs) -> Result<()> {
         threads: threads(a.threads),
         max_steps: a.max_steps,
     };
-    let quiet = a.json;
-    if !quiet {
-        eprintln!("{}", stability::header());
-    }
-    let res = stability::run(&cfg, &|l| {
-        if !quiet {
-            eprintln!("{l}")
-        }
-    })
-    .map_err(Error::Run)?;
+    let res = logged(a.json, &stability::header(), |log| {
+        stability::run(&cfg, log)
+    })?;
     let mut figures = Vec::new();
     for kind in stability::KINDS {
         let panels: Vec<fig::Panel> = group(
@@ -410,4 +385,21 @@ pub fn stability(a: &StabilityArgs) -> Result<()> {
         md += &format!("![{f}]({f}.svg)\n");
     }
     finish(&a.out, "stability.json", &to_json(&res)?, &md, a.json)
+}
+
+/// Runs a sweep, logging its header and each cell to stderr unless the output is JSON.
+fn logged<T>(
+    quiet: bool,
+    header: &str,
+    run: impl FnOnce(&dyn Fn(&str)) -> std::result::Result<T, String>,
+) -> Result<T> {
+    if !quiet {
+        eprintln!("{header}");
+    }
+    run(&|l| {
+        if !quiet {
+            eprintln!("{l}")
+        }
+    })
+    .map_err(Error::Run)
 }
