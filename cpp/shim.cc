@@ -93,19 +93,23 @@ void BulletWorld::reset(const BodyStateFfi& start) {
   world_->addRigidBody(die_.get());
 }
 
-// Moves the die to a state mid-roll, keeping its contacts and timers: Rust uses it to jump
-// over a stretch of free flight it has integrated in closed form exactly as Bullet would.
+// Moves the die to a state at the end of a stretch of free flight that Rust integrated in
+// closed form exactly as Bullet would (flight.rs): started with no contact point held, and
+// kept only while the die moves faster than Bullet's sleeping thresholds. So the body is left
+// as such steps leave it: transform and velocities, the world inertia tensor for the new
+// orientation (setCenterOfMassTransform), and the deactivation timer reset.
 void BulletWorld::set_state(const BodyStateFfi& now) {
   if (!die_) throw std::logic_error("set_state before reset");
   btTransform at;
   at.setRotation(btQuaternion(now.rotation[0], now.rotation[1], now.rotation[2], now.rotation[3]));
   at.setOrigin(vec(now.position));
-  die_->setWorldTransform(at);
-  die_->setInterpolationWorldTransform(at);
   die_->setLinearVelocity(vec(now.linear_velocity));
   die_->setAngularVelocity(vec(now.angular_velocity));
-  die_->setInterpolationLinearVelocity(vec(now.linear_velocity));
-  die_->setInterpolationAngularVelocity(vec(now.angular_velocity));
+  // As a step ends (proceedToTransform), including the inverse inertia tensor in world axes,
+  // which the solver uses at the next contact.
+  die_->setCenterOfMassTransform(at);
+  die_->setDeactivationTime(0);
+  die_->setActivationState(ACTIVE_TAG);  // no effect under DISABLE_DEACTIVATION
 }
 
 // One fixed step per call, as DicePhys: stepSimulation(dt, 1, dt).
@@ -131,6 +135,16 @@ BodyStateFfi BulletWorld::state() const {
   out.angular_velocity = arr(die_->getAngularVelocity());
   out.sleeping = die_->getActivationState() == ISLAND_SLEEPING;
   return out;
+}
+
+// Contact points kept in the world's manifolds (the die's with the floor): after a step, those
+// found or kept on the state before it.
+std::uint32_t BulletWorld::contact_points() const {
+  std::uint32_t n = 0;
+  for (int i = 0; i < dispatcher_->getNumManifolds(); ++i) {
+    n += dispatcher_->getManifoldByIndexInternal(i)->getNumContacts();
+  }
+  return n;
 }
 
 std::unique_ptr<BulletWorld> new_world(const BulletScene& scene) {

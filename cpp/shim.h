@@ -31,6 +31,7 @@ class BulletWorld {
   void step();
   void step_n(std::uint32_t n);
   BodyStateFfi state() const;
+  std::uint32_t contact_points() const;
 
  private:
   // Declaration order is destruction order, reversed: the world goes first.

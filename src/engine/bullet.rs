@@ -53,6 +53,7 @@ mod ffi {
         fn step(self: Pin<&mut BulletWorld>) -> Result<()>;
         fn step_n(self: Pin<&mut BulletWorld>, n: u32) -> Result<()>;
         fn state(self: &BulletWorld) -> BodyStateFfi;
+        fn contact_points(self: &BulletWorld) -> u32;
         fn bullet_version() -> i32;
     }
 }
@@ -160,6 +161,10 @@ impl Engine for Bullet {
     /// Free flight is ballistic unless Bullet's implicit gyroscopic force turns ω.
     fn ballistic_flight(&self) -> bool {
         !self.gyroscopic
+    }
+
+    fn contact_free(&self) -> bool {
+        self.world.contact_points() == 0
     }
 
     fn step(&mut self) -> Result<(), String> {

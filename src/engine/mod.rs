@@ -47,11 +47,17 @@ impl BodyState {
 pub trait Engine: Send {
     /// Puts the die in its starting state, with nothing left over from an earlier throw.
     fn reset(&mut self, start: &BodyState) -> Result<(), String>;
-    /// Moves the die to `now` mid-roll (after a stretch of free flight integrated outside).
+    /// Moves the die to `now` mid-roll, at the end of a stretch of free flight integrated
+    /// outside (`flight::Flight`), leaving the body as the engine's own steps would have.
     fn set_state(&mut self, now: &BodyState) -> Result<(), String>;
     /// True if, out of contact, the engine moves the die exactly as `flight::Flight` does
     /// (gravity, symplectic Euler, constant angular velocity).
     fn ballistic_flight(&self) -> bool;
+    /// True if the engine keeps no contact point between the die and the floor now, so that
+    /// its next step from a state clear of the floor is free flight (`flight::Flight`).
+    fn contact_free(&self) -> bool {
+        false
+    }
     /// Advances the world by one fixed time step.
     fn step(&mut self) -> Result<(), String>;
     fn state(&self) -> BodyState;
