@@ -2,17 +2,16 @@
 
 use crate::block::Outcome;
 use crate::engine::BodyState;
-use nalgebra::Vector3;
+use nalgebra::{UnitQuaternion, Vector3};
 
 /// DicePhys's at-rest rule: over the last `window` steps, the vector sums of the linear and
 /// of the angular velocity are both shorter than `tolerance` (sums of vectors, not of
 /// lengths, so a die rocking back and forth also counts as at rest).
 #[derive(Clone, Debug)]
 pub struct RestDetector {
-    window: usize,
     tolerance: f64,
-    linear: Vec<Vector3<f64>>,
-    angular: Vec<Vector3<f64>>,
+    linear: [Vector3<f64>; REST_WINDOW],
+    angular: [Vector3<f64>; REST_WINDOW],
     seen: usize,
 }
 
@@ -21,17 +20,16 @@ pub const REST_TOLERANCE: f64 = 1e-4;
 
 impl Default for RestDetector {
     fn default() -> Self {
-        RestDetector::new(REST_WINDOW, REST_TOLERANCE)
+        RestDetector::new(REST_TOLERANCE)
     }
 }
 
 impl RestDetector {
-    pub fn new(window: usize, tolerance: f64) -> RestDetector {
+    pub fn new(tolerance: f64) -> RestDetector {
         RestDetector {
-            window,
             tolerance,
-            linear: vec![Vector3::zeros(); window],
-            angular: vec![Vector3::zeros(); window],
+            linear: [Vector3::zeros(); REST_WINDOW],
+            angular: [Vector3::zeros(); REST_WINDOW],
             seen: 0,
         }
     }
@@ -42,16 +40,19 @@ impl RestDetector {
 
     /// Records one step's state; true once the die is at rest.
     pub fn push(&mut self, s: &BodyState) -> bool {
-        let slot = self.seen % self.window;
+        let slot = self.seen % REST_WINDOW;
         self.linear[slot] = s.linear_velocity;
         self.angular[slot] = s.angular_velocity;
         self.seen += 1;
-        if self.seen < self.window {
+        if self.seen < REST_WINDOW {
             return false;
         }
         let v: Vector3<f64> = self.linear.iter().sum();
+        if v.norm() >= self.tolerance {
+            return false;
+        }
         let w: Vector3<f64> = self.angular.iter().sum();
-        v.norm() < self.tolerance && w.norm() < self.tolerance
+        w.norm() < self.tolerance
     }
 }
 
@@ -108,19 +109,31 @@ pub struct DieShape {
     pub gravity: f64,
     /// Rotation about z only (2D): region and barrier over the x and y axes.
     pub planar: bool,
+    /// Bᵢ: the lowest edge-balance height out of face region i (∞ for z in 2D).
+    pub barrier: Vector3<f64>,
 }
 
 impl DieShape {
     pub fn of(scene: &crate::scene::Scene) -> DieShape {
         let [a, b, c] = scene.body_sides();
         let m = scene.mass();
+        let half = Vector3::new(a, b, c) / 2.0;
+        let planar = scene.mode == crate::scene::Mode::TwoD;
+        let axes: &[usize] = if planar { &[0, 1] } else { &[0, 1, 2] };
+        let barrier = Vector3::from_fn(|i, _| {
+            axes.iter()
+                .filter(|&&j| j != i && axes.contains(&i))
+                .map(|&j| half[i].hypot(half[j]))
+                .fold(f64::INFINITY, f64::min)
+        });
         DieShape {
-            half: Vector3::new(a, b, c) / 2.0,
+            half,
             mass: m,
             // A box's principal moments about its centre: m/12 (b² + c²), etc.
             inertia: Vector3::new(b * b + c * c, a * a + c * c, a * a + b * b) * (m / 12.0),
             gravity: scene.gravity,
-            planar: scene.mode == crate::scene::Mode::TwoD,
+            planar,
+            barrier,
         }
     }
 
@@ -132,18 +145,27 @@ impl DieShape {
 
     /// Kinetic plus potential energy (floor top at y = 0).
     pub fn energy(&self, s: &BodyState) -> f64 {
-        let w = s.rotation.inverse() * s.angular_velocity;
+        let w = s.rotation.inverse_transform_vector(&s.angular_velocity);
         0.5 * self.mass * s.linear_velocity.norm_squared()
             + 0.5 * w.component_mul(&w).dot(&self.inertia)
             + self.mass * self.gravity * s.position.y
     }
 }
 
+/// The world's up direction in body axes, Rᵀ ŷ: the second row of the rotation matrix.
+pub fn up_in_body(q: &UnitQuaternion<f64>) -> Vector3<f64> {
+    let (w, x, y, z) = (q.w, q.i, q.j, q.k);
+    Vector3::new(
+        2.0 * (x * y + w * z),
+        1.0 - 2.0 * (x * x + z * z),
+        2.0 * (y * z - w * x),
+    )
+}
+
 /// Height above the floor of the lowest point of a box with half sides `half`:
 /// y − Σ hᵢ |(Rᵀ ŷ)ᵢ| (the support function in the downward direction).
 pub fn lowest_point(half: &Vector3<f64>, s: &BodyState) -> f64 {
-    let up = s.rotation.inverse() * Vector3::y();
-    s.position.y - up.abs().dot(half)
+    s.position.y - up_in_body(&s.rotation).abs().dot(half)
 }
 
 const SIDES: [Outcome; 3] = [Outcome::Breadth, Outcome::Width, Outcome::Length];
@@ -151,20 +173,21 @@ const SIDES: [Outcome; 3] = [Outcome::Breadth, Outcome::Width, Outcome::Length];
 impl Certificate {
     /// The outcome, if it is already certain.
     pub fn certain(&self, die: &DieShape, s: &BodyState) -> Option<Outcome> {
-        let down = s.rotation.inverse() * Vector3::new(0.0, -1.0, 0.0);
-        let axes: &[usize] = if die.planar { &[0, 1] } else { &[0, 1, 2] };
-        let i = *axes.iter().max_by(|&&p, &&q| {
-            (down[p].abs() / die.half[p]).total_cmp(&(down[q].abs() / die.half[q]))
-        })?;
-        let barrier = axes
-            .iter()
-            .filter(|&&j| j != i)
-            .map(|&j| die.half[i].hypot(die.half[j]))
-            .fold(f64::INFINITY, f64::min);
+        let up = up_in_body(&s.rotation);
+        let n = if die.planar { 2 } else { 3 };
+        // Region i: the axis whose face the downward ray leaves through, |gᵢ|/sᵢ largest.
+        let i = (0..n)
+            .max_by(|&p, &q| (up[p].abs() / die.half[p]).total_cmp(&(up[q].abs() / die.half[q])))?;
         let rest = die.half[i];
-        let mg = die.mass * die.gravity;
-        let excess = die.energy(s) / mg - rest;
-        (excess < (1.0 - self.margin) * (barrier - rest)).then_some(SIDES[i])
+        let allowed = (1.0 - self.margin) * (die.barrier[i] - rest);
+        // The height plus the translational energy's worth of height is a lower bound of E/mg:
+        // most states fail on it without the rotational energy being computed.
+        let g = die.gravity;
+        if s.position.y + 0.5 * s.linear_velocity.norm_squared() / g - rest >= allowed {
+            return None;
+        }
+        let excess = die.energy(s) / (die.mass * g) - rest;
+        (excess < allowed).then_some(SIDES[i])
     }
 }
 
