@@ -1,10 +1,20 @@
 //! Free flight in closed form. Between bounces the die only falls and turns; an engine spends
-//! hundreds of steps per roll on that. Out of reach of the floor, Bullet (without the
-//! gyroscopic term) and Rapier advance a body by symplectic Euler under gravity alone:
-//! v ← v + g·dt, x ← x + v·dt, and the orientation by the exponential map of the (constant)
-//! angular velocity, q ← exp(½ω·dt)·q. That is cheap to do here, so the roll can jump to the
-//! last step before the die comes within `clearance` of the floor, and hand the state back to
-//! the engine: the same trajectory to rounding, far fewer engine steps.
+//! hundreds of steps per roll on that. Out of contact, Bullet (without the gyroscopic term)
+//! advances a body by symplectic Euler under gravity alone: v ← v + g·dt, x ← x + v·dt, and
+//! the orientation by the exponential map of the (constant) angular velocity,
+//! q ← exp(½ω·dt)·q. That is cheap to do here, so the roll steps the die itself while it is
+//! out of contact and hands the state back to the engine when it lands: the same trajectory
+//! to rounding, far fewer engine steps.
+//!
+//! When is a Bullet step pure flight? Its collision pass runs on the state before the step.
+//! The box-box test (btBoxBoxDetector, a separating-axis test) makes a contact point only
+//! where the boxes overlap, and the points Bullet keeps from earlier steps are dropped once
+//! farther than the contact breaking threshold. So a step taken while Bullet holds no contact
+//! point (`Engine::contact_free`) from a state clear of the floor adds none: the flight may
+//! start there (`may_start`) and lasts for every step taken from a state clear of the floor
+//! (`next`). Bullet's sleeping timer is the one other thing such a step changes: it resets
+//! while the die moves faster than the sleeping thresholds, so flight is only taken at such
+//! speeds and the engine's `set_state` resets the timer, as those steps would have.
 
 use crate::engine::BodyState;
 use crate::scene::Scene;
@@ -13,29 +23,31 @@ use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 /// Bullet's clamp on the rotation per step (ANGULAR_MOTION_THRESHOLD = π/4).
 const MAX_ANGLE_PER_STEP: f64 = 0.25 * std::f64::consts::PI;
 
+/// A state is clear of the floor when its lowest point is this far above it. The box-box test
+/// needs only > 0; this allows for rounding in the 10 km floor box's coordinates.
+pub const CLEAR: f64 = 1e-6;
+
+/// Bullet's default sleeping thresholds (btRigidBodyConstructionInfo): a step resets the
+/// deactivation timer when |v| ≥ 0.8 m/s or |ω| ≥ 1 rad/s. Kept with 1 % to spare.
+const LINEAR_SLEEPING_THRESHOLD: f64 = 0.8 * 1.01;
+const ANGULAR_SLEEPING_THRESHOLD: f64 = 1.0 * 1.01;
+
 #[derive(Clone, Copy, Debug)]
 pub struct Flight {
     pub dt: f64,
     pub gravity: f64,
     pub half: Vector3<f64>,
-    /// The lowest point of the die must stay this far above the floor: beyond Bullet's
-    /// contact breaking threshold (0.02 m) and its AABB margins, so no contact can form.
-    pub clearance: f64,
 }
-
-pub const CLEARANCE: f64 = 0.05;
 
 impl Flight {
     pub fn of(scene: &Scene) -> Flight {
         let [a, b, c] = scene.body_sides();
-        let half = Vector3::new(a, b, c) / 2.0;
         Flight {
             dt: scene.dt,
             gravity: scene.gravity,
             // In 2D the box is 1 m deep but turns about z only, so its reach below the
             // centre comes from x and y alone; the support function below handles both.
-            half,
-            clearance: CLEARANCE,
+            half: Vector3::new(a, b, c) / 2.0,
         }
     }
 
@@ -44,8 +56,15 @@ impl Flight {
         crate::settle::lowest_point(&self.half, s)
     }
 
+    /// True if a flight may start from `s`, the state after the engine's last step: the die
+    /// is clear of the floor and the engine holds no contact point (`contact_free`, asked
+    /// only when the first holds).
+    pub fn may_start(&self, s: &BodyState, contact_free: impl FnOnce() -> bool) -> bool {
+        self.lowest_point(s) > CLEAR && contact_free()
+    }
+
     /// The rotation one step applies, as Bullet's `integrateTransform` builds it.
-    fn step_rotation(&self, w: &Vector3<f64>) -> UnitQuaternion<f64> {
+    pub fn step_rotation(&self, w: &Vector3<f64>) -> UnitQuaternion<f64> {
         let dt = self.dt;
         let mut angle = w.norm();
         if angle * dt > MAX_ANGLE_PER_STEP {
@@ -65,7 +84,7 @@ impl Flight {
         ))
     }
 
-    /// One engine step of free flight.
+    /// One engine step of free flight; `dq` is `step_rotation` of the angular velocity.
     pub fn step(&self, s: &BodyState, dq: &UnitQuaternion<f64>) -> BodyState {
         let mut v = s.linear_velocity;
         v.y -= self.gravity * self.dt;
@@ -78,18 +97,31 @@ impl Flight {
         }
     }
 
-    /// Advances free flight while the die stays clear of the floor, at most `max` steps;
-    /// returns the state and the number of steps taken (0 if it is not clear now).
+    /// The state one step after `s` if that step is pure flight (`s` clear of the floor, the
+    /// die fast enough that the step resets the sleeping timer); `None` if the engine must
+    /// take it.
+    pub fn next(&self, s: &BodyState, dq: &UnitQuaternion<f64>) -> Option<BodyState> {
+        if self.lowest_point(s) <= CLEAR {
+            return None;
+        }
+        let next = self.step(s, dq);
+        let awake = next.linear_velocity.norm() >= LINEAR_SLEEPING_THRESHOLD
+            || next.angular_velocity.norm() >= ANGULAR_SLEEPING_THRESHOLD;
+        // A non-finite state ends the roll as a failure in the roll's own check.
+        awake.then_some(next)
+    }
+
+    /// Advances free flight from `s` (which `may_start`), at most `max` steps; returns the
+    /// state and the number of steps taken.
     pub fn coast(&self, s: &BodyState, max: u64) -> (BodyState, u64) {
         let dq = self.step_rotation(&s.angular_velocity);
         let mut now = *s;
         let mut n = 0;
         while n < max {
-            let next = self.step(&now, &dq);
-            if self.lowest_point(&next) <= self.clearance || !next.is_finite() {
-                break;
+            match self.next(&now, &dq) {
+                Some(next) => now = next,
+                None => break,
             }
-            now = next;
             n += 1;
         }
         (now, n)
@@ -142,16 +174,87 @@ mod tests {
     }
 
     #[test]
-    fn a_die_near_the_floor_does_not_coast() {
+    fn a_flight_handed_back_at_the_floor_bounces_as_if_stepped() {
+        // Coast a tumbling die down to the floor, hand the state to Bullet, and let it bounce:
+        // the same to rounding as Bullet stepping all the way. This needs `set_state` to leave
+        // the body as a step does (the world inertia tensor for the new orientation) and the
+        // flight to end where Bullet's first contact forms.
+        for mode in [Mode::ThreeD, Mode::TwoD] {
+            let scene = Scene::paper("140x24x20".parse().unwrap(), mode);
+            let flight = Flight::of(&scene);
+            let start = BodyState {
+                position: Vector3::new(0.0, 0.2, 0.0),
+                // In 2D the 1 m deep box turns about z only.
+                rotation: if mode == Mode::TwoD {
+                    UnitQuaternion::from_euler_angles(0.0, 0.0, 0.2)
+                } else {
+                    UnitQuaternion::from_euler_angles(0.3, 0.0, 0.2)
+                },
+                linear_velocity: Vector3::new(0.1, 0.0, 0.0),
+                angular_velocity: if mode == Mode::TwoD {
+                    Vector3::new(0.0, 0.0, 40.0)
+                } else {
+                    Vector3::new(5.0, -3.0, 40.0)
+                },
+                sleeping: false,
+            };
+            let mut stepped = new_engine(EngineKind::Bullet, &scene).unwrap();
+            stepped.reset(&start).unwrap();
+            let mut flown = new_engine(EngineKind::Bullet, &scene).unwrap();
+            flown.reset(&start).unwrap();
+            assert!(flight.may_start(&start, || flown.contact_free()));
+            let (landing, n) = flight.coast(&start, 10_000);
+            assert!(
+                n > 100 && flight.lowest_point(&landing) <= CLEAR,
+                "{mode:?}"
+            );
+            flown.set_state(&landing).unwrap();
+            for _ in 0..n {
+                stepped.step().unwrap();
+            }
+            let mut bounced = false;
+            for _ in 0..60 {
+                stepped.step().unwrap();
+                flown.step().unwrap();
+                let (a, b) = (stepped.state(), flown.state());
+                bounced |= a.linear_velocity.y > 0.0;
+                assert!(
+                    (a.position - b.position).norm() < 1e-9
+                        && (a.linear_velocity - b.linear_velocity).norm() < 1e-7
+                        && (a.angular_velocity - b.angular_velocity).norm() < 1e-6
+                        && a.rotation.angle_to(&b.rotation) < 1e-9,
+                    "{mode:?}: {a:?} against {b:?}"
+                );
+            }
+            assert!(bounced, "{mode:?}: no bounce in the window");
+        }
+    }
+
+    #[test]
+    fn flight_starts_clear_of_the_floor_and_of_contacts() {
         let scene = Scene::paper("140x24x20".parse().unwrap(), Mode::ThreeD);
         let flight = Flight::of(&scene);
-        let s = BodyState {
-            position: Vector3::new(0.0, 0.04, 0.0),
+        // Flat on its 20 mm side: lowest point 10 mm below the centre.
+        let at = |y: f64, vy: f64| BodyState {
+            position: Vector3::new(0.0, y, 0.0),
             rotation: UnitQuaternion::identity(),
-            linear_velocity: Vector3::zeros(),
+            linear_velocity: Vector3::new(0.0, vy, 0.0),
             angular_velocity: Vector3::zeros(),
             sleeping: false,
         };
-        assert_eq!(flight.coast(&s, 100).1, 0);
+        assert!(!flight.may_start(&at(0.0305, -1.0), || false));
+        assert!(flight.may_start(&at(0.0105, -1.0), || true));
+        assert!(!flight.may_start(&at(0.0099, -1.0), || true));
+        // Falling at 1 m/s from 20.5 mm clear: the last step is taken from a clear state,
+        // so the flight ends just inside the floor, where the engine's contact takes over.
+        let (end, n) = flight.coast(&at(0.0305, -1.0), 1000);
+        assert!(n > 0 && flight.lowest_point(&end) <= CLEAR);
+        assert!(
+            flight.lowest_point(&end) > -0.002,
+            "{}",
+            flight.lowest_point(&end)
+        );
+        // Slower than the sleeping thresholds: the engine must step (its timer runs).
+        assert_eq!(flight.coast(&at(0.0305, 0.01), 1000).1, 0);
     }
 }

@@ -7,6 +7,7 @@ use crate::flight::Flight;
 use crate::scene::Scene;
 use crate::settle::{classify, Certificate, DieShape, RestDetector};
 use crate::throws::Throw;
+use nalgebra::UnitQuaternion;
 use serde::{Deserialize, Serialize};
 
 /// DicePhys's cap: a roll not at rest after this many steps is unconverged.
@@ -219,37 +220,52 @@ pub fn run_from(
     observe(0, &engine.state());
     let mut rest = RestDetector::default();
     let mut state = *start;
+    // In free flight (`flight::Flight`) the roll steps the die itself: `flying` holds the
+    // step's rotation, and the engine is behind until the state is handed back.
+    let mut flying: Option<UnitQuaternion<f64>> = None;
+    let mut behind = false;
     while end.steps < settle.max_steps {
+        let mut next = None;
         if let Some(f) = &flight {
-            if f.lowest_point(&state) > f.clearance {
-                let (coasted, n) = f.coast(&state, settle.max_steps - end.steps);
-                if n > 0 {
-                    if engine.set_state(&coasted).is_err() {
+            if flying.is_none() && f.may_start(&state, || engine.contact_free()) {
+                flying = Some(f.step_rotation(&state.angular_velocity));
+            }
+            if let Some(dq) = &flying {
+                next = f.next(&state, dq);
+                if next.is_none() {
+                    flying = None;
+                    if behind && engine.set_state(&state).is_err() {
                         return end;
                     }
-                    end.steps += n;
-                    state = coasted;
-                    energy.push(&die, &state);
-                    end.energy_gain = energy.gained;
-                    observe(end.steps, &state);
-                    rest.push(&state);
-                    continue;
+                    behind = false;
+                } else {
+                    behind = true;
                 }
             }
         }
-        if engine.step().is_err() {
-            return end;
-        }
+        let flown = next.is_some();
+        state = match next {
+            Some(s) => s,
+            None => {
+                if engine.step().is_err() {
+                    return end;
+                }
+                end.engine_steps += 1;
+                engine.state()
+            }
+        };
         end.steps += 1;
-        end.engine_steps += 1;
-        state = engine.state();
+        // Every step's state, flown or stepped, goes through the same checks, but for the
+        // energy watch: a flown step has no contact to gain energy at.
         observe(end.steps, &state);
         if let Some(f) = check(&state) {
             end.fate = Fate::Failed(f);
             return end;
         }
-        energy.push(&die, &state);
-        end.energy_gain = energy.gained;
+        if !flown {
+            energy.push(&die, &state);
+            end.energy_gain = energy.gained;
+        }
         if watch && end.certified.is_none() {
             if let Some(o) = certificate.certain(&die, &state) {
                 end.certified = Some((end.steps, o));

@@ -83,8 +83,8 @@ fn fast_flight_keeps_the_outcomes_of_stepped_flight() {
         let engine_steps: u64 = fast.iter().map(|r| r.engine_steps).sum();
         let steps: u64 = stepped.iter().map(|r| r.engine_steps).sum();
         assert!(
-            engine_steps * 10 < steps * 8,
-            "{mode:?}: fast flight saved under 20 % of steps"
+            engine_steps * 2 < steps,
+            "{mode:?}: fast flight saved under half the engine's steps"
         );
     }
 }
