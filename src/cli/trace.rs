@@ -27,6 +27,11 @@ pub struct TraceArgs {
     pub every: u64,
     #[arg(long, default_value_t = DEFAULT_MAX_STEPS)]
     pub max_steps: u64,
+    /// Free flight: stepped (every step by the engine) or fast (integrated in closed form where
+    /// the engine's flight is ballistic, as `roll` does by default; the flown steps are printed
+    /// too).
+    #[arg(long, default_value = "stepped", value_parser = ["stepped", "fast"])]
+    pub flight: String,
 }
 
 /// Kinetic (translational + rotational) and potential energy, J, with the floor at y = 0.
@@ -87,6 +92,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     };
     let settle = Settle {
         max_steps: a.max_steps,
+        fast_flight: a.flight == "fast",
         ..Settle::default()
     };
     let record = roll_observed(engine.as_mut(), &scene, &throw, &settle, |step, s| {
