@@ -43,6 +43,9 @@ fn bad_input_gets_one_line_and_exit_code_2() {
         &["roll", "--block", "20000x24x20"],
         &["paper", "--rolls", "0"],
         &["trace", "--block", "140x24x20", "--every", "0"],
+        &["trace", "--block", "140x24x20", "--flight", "warp"],
+        &["bench", "--rolls", "0"],
+        &["bench", "--repeat", "0"],
     ];
     for args in cases {
         let out = dicephys(args);

@@ -14,6 +14,10 @@ pub struct BenchArgs {
     /// Threads for the "all threads" measurements (0: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
+    /// Run each measurement this many times and keep the fastest (the outcomes are the same
+    /// every time); for a machine shared with other work.
+    #[arg(long, default_value_t = 1)]
+    pub repeat: u32,
     #[arg(long)]
     pub json: bool,
 }
@@ -21,6 +25,9 @@ pub struct BenchArgs {
 pub fn run(a: &BenchArgs) -> Result<()> {
     if a.rolls == 0 {
         return Err(Error::Usage("--rolls 0: need at least one roll".into()));
+    }
+    if a.repeat == 0 {
+        return Err(Error::Usage("--repeat 0: need at least one run".into()));
     }
     let threads = if a.threads == 0 {
         rayon::current_num_threads()
@@ -31,7 +38,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     if !quiet {
         println!("{}", bench::header());
     }
-    let b = bench::run(a.rolls, a.seed, threads, &|line| {
+    let b = bench::run(a.rolls, a.seed, threads, a.repeat, &|line| {
         if !quiet {
             println!("{line}");
         }
