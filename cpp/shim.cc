@@ -112,21 +112,29 @@ void BulletWorld::set_state(const BodyStateFfi& now) {
   die_->setActivationState(ACTIVE_TAG);  // no effect under DISABLE_DEACTIVATION
 }
 
-// One fixed step per call, as DicePhys: stepSimulation(dt, 1, dt).
-void BulletWorld::step() {
+// One fixed step per call, as DicePhys: stepSimulation(dt, 1, dt). Returns the state after
+// it, so that a step and its read cross the FFI once.
+BodyStateFfi BulletWorld::step() {
   if (!die_) throw std::logic_error("step before reset");
   world_->stepSimulation(dt_, 1, dt_);
+  return state();
 }
 
-// Steps n times without returning to Rust: used only to measure what the FFI costs.
+// The same n steps, each with its state read, without returning to Rust: used only to
+// measure what crossing the FFI once per step costs.
 void BulletWorld::step_n(std::uint32_t n) {
   if (!die_) throw std::logic_error("step before reset");
-  for (std::uint32_t i = 0; i < n; ++i) world_->stepSimulation(dt_, 1, dt_);
+  volatile double sink = 0;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    world_->stepSimulation(dt_, 1, dt_);
+    const BodyStateFfi s = state();
+    sink = sink + s.position[1] + s.rotation[3] + s.angular_velocity[2];
+  }
 }
 
 BodyStateFfi BulletWorld::state() const {
-  BodyStateFfi out{};
-  if (!die_) return out;
+  if (!die_) return BodyStateFfi{};
+  BodyStateFfi out;  // every field set below: no zeroing first (this runs every step)
   const btTransform& t = die_->getWorldTransform();
   const btQuaternion q = t.getRotation();
   out.position = arr(t.getOrigin());

@@ -28,7 +28,7 @@ class BulletWorld {
 
   void reset(const BodyStateFfi& start);
   void set_state(const BodyStateFfi& now);
-  void step();
+  BodyStateFfi step();
   void step_n(std::uint32_t n);
   BodyStateFfi state() const;
   std::uint32_t contact_points() const;

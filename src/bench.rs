@@ -116,7 +116,8 @@ pub struct FfiCost {
     /// Seconds, summed over 200 throws of the fastest of three runs per throw.
     pub rust_loop_s: f64,
     pub cpp_loop_s: f64,
-    /// (Rust loop − C++ loop) / C++ loop: what one cxx call (step + state read) per step costs.
+    /// (Rust loop − C++ loop) / C++ loop: what crossing into C++ once per step costs (both
+    /// loops step and read the state every step).
     pub overhead: f64,
 }
 
@@ -255,7 +256,7 @@ pub fn run(
     }
     let ffi = ffi_cost(&Scene::paper(block, Mode::ThreeD))?;
     log(&format!(
-        "FFI: {} steps (fastest of 3 per throw), Rust loop (one cxx call per step + a state read) {:.3} s, C++ loop {:.3} s: overhead {:+.1} %",
+        "FFI: {} steps (fastest of 3 per throw), Rust loop (one cxx call per step, returning the state) {:.3} s, C++ loop (the same steps and state reads) {:.3} s: overhead {:+.1} %",
         ffi.steps,
         ffi.rust_loop_s,
         ffi.cpp_loop_s,
@@ -306,8 +307,9 @@ pub fn run(
 }
 
 /// What one cxx call per step costs: the same 1,000-step stretch of the same throws, stepped
-/// from Rust (a call per step and a state read, as a roll does) and inside C++ alone,
-/// interleaved and repeated so that machine noise falls on both alike.
+/// from Rust (one call per step, which returns the state, as a roll does) and inside C++
+/// alone (the same steps and state reads), interleaved and repeated so that machine noise
+/// falls on both alike.
 pub fn ffi_cost(scene: &Scene) -> Result<FfiCost, String> {
     use crate::engine::Engine;
     let mut bullet = crate::engine::bullet::Bullet::new(scene)?;

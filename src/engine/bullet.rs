@@ -50,7 +50,7 @@ mod ffi {
         fn new_world(scene: &BulletScene) -> Result<UniquePtr<BulletWorld>>;
         fn reset(self: Pin<&mut BulletWorld>, start: &BodyStateFfi) -> Result<()>;
         fn set_state(self: Pin<&mut BulletWorld>, now: &BodyStateFfi) -> Result<()>;
-        fn step(self: Pin<&mut BulletWorld>) -> Result<()>;
+        fn step(self: Pin<&mut BulletWorld>) -> Result<BodyStateFfi>;
         fn step_n(self: Pin<&mut BulletWorld>, n: u32) -> Result<()>;
         fn state(self: &BulletWorld) -> BodyStateFfi;
         fn contact_points(self: &BulletWorld) -> u32;
@@ -96,6 +96,8 @@ unsafe impl Send for ffi::BulletWorld {}
 pub struct Bullet {
     world: UniquePtr<ffi::BulletWorld>,
     gyroscopic: bool,
+    /// The die's state as the world last reported it (after reset, set_state or a step).
+    now: ffi::BodyStateFfi,
 }
 
 impl Bullet {
@@ -119,9 +121,11 @@ impl Bullet {
             deactivation: true,
         };
         let world = ffi::new_world(&desc).map_err(|e| format!("bullet: {e}"))?;
+        let now = world.state();
         Ok(Bullet {
             world,
             gyroscopic: s.gyroscopic_implicit,
+            now,
         })
     }
 
@@ -148,14 +152,18 @@ impl Engine for Bullet {
         self.world
             .pin_mut()
             .reset(&to_ffi(start))
-            .map_err(|e| e.to_string())
+            .map_err(|e| e.to_string())?;
+        self.now = self.world.state();
+        Ok(())
     }
 
     fn set_state(&mut self, now: &BodyState) -> Result<(), String> {
         self.world
             .pin_mut()
             .set_state(&to_ffi(now))
-            .map_err(|e| e.to_string())
+            .map_err(|e| e.to_string())?;
+        self.now = self.world.state();
+        Ok(())
     }
 
     /// Free flight is ballistic unless Bullet's implicit gyroscopic force turns ω.
@@ -168,11 +176,12 @@ impl Engine for Bullet {
     }
 
     fn step(&mut self) -> Result<(), String> {
-        self.world.pin_mut().step().map_err(|e| e.to_string())
+        self.now = self.world.pin_mut().step().map_err(|e| e.to_string())?;
+        Ok(())
     }
 
     fn state(&self) -> BodyState {
-        let s = self.world.state();
+        let s = &self.now;
         let [x, y, z, w] = s.rotation;
         BodyState {
             position: Vector3::from(s.position),
