@@ -164,9 +164,10 @@ fn same_fraction(a: &[RollRecord], b: &[RollRecord]) -> f64 {
     same as f64 / a.len().max(1) as f64
 }
 
-/// Runs the benchmark; `log` gets a line per measurement as it finishes.
-/// Runs the benchmark: `rolls` throws per method, mode and thread count, each measurement
-/// repeated `repeat` times with the fastest kept.
+/// Runs the benchmark: `rolls` throws per method, mode and thread count; `log` gets a line per
+/// measurement. With `repeat` > 1, every method of a mode and thread count is run in turn,
+/// `repeat` rounds over, and each keeps its fastest run: a spell of load from elsewhere then
+/// falls on different methods in different rounds, not on one method's every run.
 pub fn run(
     rolls: u64,
     seed: u64,
@@ -177,6 +178,7 @@ pub fn run(
     let block = "140x24x20".parse().map_err(|e: String| e)?;
     let throws = Throws::new(ThrowKind::Keyed, seed, ThrowRanges::default(), 0);
     let base = Settle::default();
+    let methods = methods();
     let mut rows = Vec::new();
     for mode in [Mode::ThreeD, Mode::TwoD] {
         let mut thread_counts = vec![1];
@@ -184,32 +186,35 @@ pub fn run(
             thread_counts.push(all_threads);
         }
         for &threads in &thread_counts {
-            let mut faithful: Option<(Vec<RollRecord>, f64)> = None;
-            for m in methods() {
-                let mut scene = Scene::paper(block, mode);
-                scene.floor = m.floor;
-                let settle = m.settle(&base);
-                // The same throws `repeat` times (same outcomes: every run is reproducible);
-                // the fastest run's times count, so a moment's load elsewhere does not.
-                let (mut recs, mut wall_s, mut cpu_s) = (Vec::new(), f64::INFINITY, 0.0);
-                for _ in 0..repeat.max(1) {
+            // Per method: its records (the same every run: runs are reproducible) and its
+            // fastest run's wall and CPU seconds.
+            let mut best: Vec<(Vec<RollRecord>, f64, f64)> =
+                vec![(Vec::new(), f64::INFINITY, 0.0); methods.len()];
+            for _ in 0..repeat.max(1) {
+                for (m, best) in methods.iter().zip(best.iter_mut()) {
+                    let mut scene = Scene::paper(block, mode);
+                    scene.floor = m.floor;
                     let wall = Instant::now();
                     let cpu = process_cpu_seconds();
-                    recs = batch::run(
+                    let recs = batch::run(
                         m.engine,
                         &scene,
                         &throws,
-                        &settle,
+                        &m.settle(&base),
                         0..rolls,
                         threads,
                         &|_| {},
                     )?;
                     let (c, w) = (process_cpu_seconds() - cpu, wall.elapsed().as_secs_f64());
-                    if w < wall_s {
-                        (wall_s, cpu_s) = (w, c);
+                    if w < best.1 {
+                        *best = (recs, w, c);
                     }
                 }
-                let t = Tally::of(&recs);
+            }
+            let mut faithful: Option<(&[RollRecord], f64)> = None;
+            for (m, (recs, wall_s, cpu_s)) in methods.iter().zip(&best) {
+                let (wall_s, cpu_s) = (*wall_s, *cpu_s);
+                let t = Tally::of(recs);
                 let r = stats::ratio(t.counts.breadth, t.counts.width);
                 let rolls_per_s = rolls as f64 / wall_s;
                 let (speedup, z, same) = match &faithful {
@@ -220,7 +225,7 @@ pub fn run(
                         (
                             rolls_per_s / f_rps,
                             stats::z_score(r.value, r.err, fr.value, fr.err),
-                            same_fraction(f, &recs),
+                            same_fraction(f, recs),
                         )
                     }
                 };
@@ -270,13 +275,13 @@ pub fn run(
                     .filter(move |r| r.mode == mode.name() && r.threads == t)
             };
             let faithful_1 = of_mode(1).find(|r| r.method == "faithful")?.rolls_per_s;
-            let proven: Vec<String> = methods()
-                .into_iter()
+            let proven: Vec<&String> = methods
+                .iter()
                 .filter(|m| m.proven && m.engine == EngineKind::Bullet)
-                .map(|m| m.name)
+                .map(|m| &m.name)
                 .collect();
             let best = of_mode(all_threads.max(1))
-                .filter(|r| proven.contains(&r.method) && r.z_vs_faithful.abs() <= Z_BOUND)
+                .filter(|r| proven.contains(&&r.method) && r.z_vs_faithful.abs() <= Z_BOUND)
                 .max_by(|a, b| a.rolls_per_s.total_cmp(&b.rolls_per_s))?;
             Some(Verdict {
                 mode: mode.name().into(),
