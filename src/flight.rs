@@ -7,25 +7,32 @@
 //! to rounding, far fewer engine steps.
 //!
 //! When is a Bullet step pure flight? Its collision pass runs on the state before the step.
-//! The box-box test (btBoxBoxDetector, a separating-axis test) makes a contact point only
-//! where the boxes overlap, and the points Bullet keeps from earlier steps are dropped once
-//! farther than the contact breaking threshold. So a step taken while Bullet holds no contact
-//! point (`Engine::contact_free`) from a state clear of the floor adds none: the flight may
-//! start there (`may_start`) and lasts for every step taken from a state clear of the floor
-//! (`next`). Bullet's sleeping timer is the one other thing such a step changes: it resets
-//! while the die moves faster than the sleeping thresholds, so flight is only taken at such
-//! speeds and the engine's `set_state` resets the timer, as those steps would have.
+//! On DicePhys's box floor, the box-box test (btBoxBoxDetector, a separating-axis test) makes
+//! a contact point only where the boxes overlap, and the points Bullet keeps from earlier
+//! steps are dropped once farther than the contact breaking threshold. So a step taken while
+//! Bullet holds no contact point (`Engine::contact_free`) from a state clear of the floor
+//! adds none: the flight may start there (`may_start`) and lasts for every step taken from a
+//! state clear of the floor (`next`). The plane floor is different: Bullet's convex-plane
+//! test reports points up to the breaking threshold (≤ 2 cm) away, and again for the die
+//! turned by up to that much at its rim, so there "clear" means 5 cm up. Bullet's sleeping
+//! timer is the one other thing such a step changes: it resets while the die moves faster
+//! than the sleeping thresholds, so flight is only taken at such speeds and the engine's
+//! `set_state` resets the timer, as those steps would have.
 
 use crate::engine::BodyState;
-use crate::scene::Scene;
+use crate::scene::{Floor, Scene};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 /// Bullet's clamp on the rotation per step (ANGULAR_MOTION_THRESHOLD = π/4).
 const MAX_ANGLE_PER_STEP: f64 = 0.25 * std::f64::consts::PI;
 
-/// A state is clear of the floor when its lowest point is this far above it. The box-box test
-/// needs only > 0; this allows for rounding in the 10 km floor box's coordinates.
+/// On the box floor a state is clear of it when its lowest point is this far above it. The
+/// box-box test needs only > 0; this allows for rounding in the 10 km floor box's coordinates.
 pub const CLEAR: f64 = 1e-6;
+
+/// On the plane floor: beyond the breaking threshold (0.02 m at most) and the convex-plane
+/// test's perturbation (as much again), with room to spare.
+pub const CLEAR_OF_PLANE: f64 = 0.05;
 
 /// Bullet's default sleeping thresholds (btRigidBodyConstructionInfo): a step resets the
 /// deactivation timer when |v| ≥ 0.8 m/s or |ω| ≥ 1 rad/s. Kept with 1 % to spare.
@@ -37,6 +44,9 @@ pub struct Flight {
     pub dt: f64,
     pub gravity: f64,
     pub half: Vector3<f64>,
+    /// How far above the floor the die's lowest point must be for a step to be pure flight
+    /// (`CLEAR` or `CLEAR_OF_PLANE`).
+    pub clear: f64,
 }
 
 impl Flight {
@@ -48,6 +58,10 @@ impl Flight {
             // In 2D the box is 1 m deep but turns about z only, so its reach below the
             // centre comes from x and y alone; the support function below handles both.
             half: Vector3::new(a, b, c) / 2.0,
+            clear: match scene.floor {
+                Floor::Box => CLEAR,
+                Floor::Plane => CLEAR_OF_PLANE,
+            },
         }
     }
 
@@ -60,7 +74,7 @@ impl Flight {
     /// is clear of the floor and the engine holds no contact point (`contact_free`, asked
     /// only when the first holds).
     pub fn may_start(&self, s: &BodyState, contact_free: impl FnOnce() -> bool) -> bool {
-        self.lowest_point(s) > CLEAR && contact_free()
+        self.lowest_point(s) > self.clear && contact_free()
     }
 
     /// The rotation one step applies, as Bullet's `integrateTransform` builds it.
@@ -101,7 +115,7 @@ impl Flight {
     /// die fast enough that the step resets the sleeping timer); `None` if the engine must
     /// take it.
     pub fn next(&self, s: &BodyState, dq: &UnitQuaternion<f64>) -> Option<BodyState> {
-        if self.lowest_point(s) <= CLEAR {
+        if self.lowest_point(s) <= self.clear {
             return None;
         }
         let next = self.step(s, dq);
@@ -256,5 +270,12 @@ mod tests {
         );
         // Slower than the sleeping thresholds: the engine must step (its timer runs).
         assert_eq!(flight.coast(&at(0.0305, 0.01), 1000).1, 0);
+        // Over the plane floor, whose contacts reach up to it, the flight stays 5 cm clear.
+        let mut plane = scene.clone();
+        plane.floor = crate::scene::Floor::Plane;
+        let flight = Flight::of(&plane);
+        assert!(!flight.may_start(&at(0.0595, -1.0), || true));
+        let (end, n) = flight.coast(&at(0.2, -1.0), 1000);
+        assert!(n > 0 && (-0.005..=0.0).contains(&(flight.lowest_point(&end) - CLEAR_OF_PLANE)));
     }
 }

@@ -87,6 +87,33 @@ fn fast_flight_keeps_the_outcomes_of_stepped_flight() {
             "{mode:?}: fast flight saved under half the engine's steps"
         );
     }
+    // Over the plane floor, where Bullet's contacts reach out before the die arrives.
+    let mut scene = Scene::paper("140x24x20".parse().unwrap(), Mode::TwoD);
+    scene.floor = Floor::Plane;
+    let throws = Throws::new(ThrowKind::Keyed, 99, ThrowRanges::default(), 0);
+    let run = |fast_flight| {
+        let settle = Settle {
+            fast_flight,
+            ..Settle::default()
+        };
+        batch::run(
+            EngineKind::Bullet,
+            &scene,
+            &throws,
+            &settle,
+            0..400,
+            0,
+            &|_| {},
+        )
+        .unwrap()
+    };
+    let (stepped, fast) = (run(false), run(true));
+    let same = stepped
+        .iter()
+        .zip(&fast)
+        .filter(|(a, b)| a.fate == b.fate)
+        .count();
+    assert!(same >= 396, "plane floor: {same} of 400 identical");
 }
 
 #[test]
