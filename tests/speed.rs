@@ -2,12 +2,18 @@
 
 use dicephys::batch::{self, Tally};
 use dicephys::engine::EngineKind;
-use dicephys::roll::{Fate, Rule, Settle};
+use dicephys::roll::{Fate, RollRecord, Rule, Settle};
 use dicephys::scene::{Floor, Mode, Scene};
 use dicephys::throws::{ThrowKind, ThrowRanges, Throws};
 
-fn rolls(kind: EngineKind, mode: Mode, settle: Settle, n: u64) -> Vec<dicephys::roll::RollRecord> {
-    let scene = Scene::paper("140x24x20".parse().unwrap(), mode);
+/// `n` fixed throws of 140x24x20 on DicePhys's box floor.
+fn rolls(kind: EngineKind, mode: Mode, settle: Settle, n: u64) -> Vec<RollRecord> {
+    rolls_on(Floor::Box, kind, mode, settle, n)
+}
+
+fn rolls_on(floor: Floor, kind: EngineKind, mode: Mode, settle: Settle, n: u64) -> Vec<RollRecord> {
+    let mut scene = Scene::paper("140x24x20".parse().unwrap(), mode);
+    scene.floor = floor;
     let throws = Throws::new(ThrowKind::Keyed, 99, ThrowRanges::default(), 0);
     batch::run(kind, &scene, &throws, &settle, 0..n, 0, &|_| {}).unwrap()
 }
@@ -88,24 +94,12 @@ fn fast_flight_keeps_the_outcomes_of_stepped_flight() {
         );
     }
     // Over the plane floor, where Bullet's contacts reach out before the die arrives.
-    let mut scene = Scene::paper("140x24x20".parse().unwrap(), Mode::TwoD);
-    scene.floor = Floor::Plane;
-    let throws = Throws::new(ThrowKind::Keyed, 99, ThrowRanges::default(), 0);
     let run = |fast_flight| {
         let settle = Settle {
             fast_flight,
             ..Settle::default()
         };
-        batch::run(
-            EngineKind::Bullet,
-            &scene,
-            &throws,
-            &settle,
-            0..400,
-            0,
-            &|_| {},
-        )
-        .unwrap()
+        rolls_on(Floor::Plane, EngineKind::Bullet, Mode::TwoD, settle, 400)
     };
     let (stepped, fast) = (run(false), run(true));
     let same = stepped
@@ -125,24 +119,12 @@ fn the_plane_floor_is_not_the_box_floor() {
     // So the plane stays off by default and the benchmark marks it unproven. Fixed seed,
     // 1,500 throws: the two differ by more than 3 combined standard errors.
     let ratio = |floor| {
-        let mut scene = Scene::paper("140x24x20".parse().unwrap(), Mode::TwoD);
-        scene.floor = floor;
-        let throws = Throws::new(ThrowKind::Keyed, 99, ThrowRanges::default(), 0);
         let settle = Settle {
             rule: Rule::Certificate,
             fast_flight: true,
             ..Settle::default()
         };
-        let recs = batch::run(
-            EngineKind::Bullet,
-            &scene,
-            &throws,
-            &settle,
-            0..1500,
-            0,
-            &|_| {},
-        )
-        .unwrap();
+        let recs = rolls_on(floor, EngineKind::Bullet, Mode::TwoD, settle, 1500);
         let c = Tally::of(&recs).counts;
         dicephys::stats::ratio(c.breadth, c.width)
     };
