@@ -143,12 +143,21 @@ impl DieShape {
         lowest_point(&self.half, s)
     }
 
-    /// Kinetic plus potential energy (floor top at y = 0).
-    pub fn energy(&self, s: &BodyState) -> f64 {
+    /// Kinetic energy, translational plus rotational.
+    pub fn kinetic(&self, s: &BodyState) -> f64 {
         let w = s.rotation.inverse_transform_vector(&s.angular_velocity);
         0.5 * self.mass * s.linear_velocity.norm_squared()
             + 0.5 * w.component_mul(&w).dot(&self.inertia)
-            + self.mass * self.gravity * s.position.y
+    }
+
+    /// Potential energy, with the floor's top at y = 0.
+    pub fn potential(&self, s: &BodyState) -> f64 {
+        self.mass * self.gravity * s.position.y
+    }
+
+    /// Kinetic plus potential energy.
+    pub fn energy(&self, s: &BodyState) -> f64 {
+        self.kinetic(s) + self.potential(s)
     }
 }
 

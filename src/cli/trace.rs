@@ -4,7 +4,7 @@ use super::args::{parse_engine, SceneArgs, ThrowArgs};
 use crate::engine::{new_engine, BodyState, EngineKind};
 use crate::error::{Error, Result};
 use crate::roll::{roll_observed, Fate, Settle, DEFAULT_MAX_STEPS};
-use crate::scene::Scene;
+use crate::settle::DieShape;
 use crate::throws::Throws;
 use clap::Args;
 use std::io::Write;
@@ -34,20 +34,9 @@ pub struct TraceArgs {
     pub flight: String,
 }
 
-/// Kinetic (translational + rotational) and potential energy, J, with the floor at y = 0.
-pub fn energy(scene: &Scene, s: &BodyState) -> (f64, f64) {
-    let m = scene.mass();
-    let [a, b, c] = scene.body_sides();
-    // A box's principal moments about its centre: m/12 (b² + c²) etc.
-    let inertia = nalgebra::Vector3::new(b * b + c * c, a * a + c * c, a * a + b * b) * (m / 12.0);
-    let w_body = s.rotation.inverse() * s.angular_velocity;
-    let rot = 0.5 * w_body.component_mul(&w_body).dot(&inertia);
-    let kin = 0.5 * m * s.linear_velocity.norm_squared() + rot;
-    (kin, m * scene.gravity * s.position.y)
-}
-
 pub fn run(a: &TraceArgs) -> Result<()> {
     let scene = a.scene.scene()?;
+    let die = DieShape::of(&scene);
     let ranges = a.throw.ranges()?;
     if a.every == 0 || a.max_steps == 0 {
         return Err(Error::Usage(
@@ -66,7 +55,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     let mut last = None;
     let line = |step: u64, s: &BodyState| -> String {
         let q = s.rotation.quaternion();
-        let (k, p) = energy(&scene, s);
+        let (k, p) = (die.kinetic(s), die.potential(s));
         format!(
             "{},{:.6},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9e},{:.9e},{:.9e},{}",
             step,
