@@ -124,22 +124,6 @@ impl Flight {
         // A non-finite state ends the roll as a failure in the roll's own check.
         awake.then_some(next)
     }
-
-    /// Advances free flight from `s` (which `may_start`), at most `max` steps; returns the
-    /// state and the number of steps taken.
-    pub fn coast(&self, s: &BodyState, max: u64) -> (BodyState, u64) {
-        let dq = self.step_rotation(&s.angular_velocity);
-        let mut now = *s;
-        let mut n = 0;
-        while n < max {
-            match self.next(&now, &dq) {
-                Some(next) => now = next,
-                None => break,
-            }
-            n += 1;
-        }
-        (now, n)
-    }
 }
 
 #[cfg(test)]
@@ -147,6 +131,22 @@ mod tests {
     use super::*;
     use crate::engine::{new_engine, EngineKind};
     use crate::scene::Mode;
+
+    /// Free flight from `s` (which `may_start`) as the roll flies it, at most `max` steps;
+    /// the state and the number of steps taken.
+    fn coast(f: &Flight, s: &BodyState, max: u64) -> (BodyState, u64) {
+        let dq = f.step_rotation(&s.angular_velocity);
+        let mut now = *s;
+        let mut n = 0;
+        while n < max {
+            match f.next(&now, &dq) {
+                Some(next) => now = next,
+                None => break,
+            }
+            n += 1;
+        }
+        (now, n)
+    }
 
     #[test]
     fn coasting_matches_bullet_stepping() {
@@ -166,7 +166,7 @@ mod tests {
             };
             let mut e = new_engine(EngineKind::Bullet, &scene).unwrap();
             e.reset(&start).unwrap();
-            let (coasted, n) = flight.coast(&start, 200);
+            let (coasted, n) = coast(&flight, &start, 200);
             assert_eq!(n, 200);
             for _ in 0..n {
                 e.step().unwrap();
@@ -217,7 +217,7 @@ mod tests {
             let mut flown = new_engine(EngineKind::Bullet, &scene).unwrap();
             flown.reset(&start).unwrap();
             assert!(flight.may_start(&start, || flown.contact_free()));
-            let (landing, n) = flight.coast(&start, 10_000);
+            let (landing, n) = coast(&flight, &start, 10_000);
             assert!(
                 n > 100 && flight.lowest_point(&landing) <= CLEAR,
                 "{mode:?}"
@@ -261,7 +261,7 @@ mod tests {
         assert!(!flight.may_start(&at(0.0099, -1.0), || true));
         // Falling at 1 m/s from 20.5 mm clear: the last step is taken from a clear state,
         // so the flight ends just inside the floor, where the engine's contact takes over.
-        let (end, n) = flight.coast(&at(0.0305, -1.0), 1000);
+        let (end, n) = coast(&flight, &at(0.0305, -1.0), 1000);
         assert!(n > 0 && flight.lowest_point(&end) <= CLEAR);
         assert!(
             flight.lowest_point(&end) > -0.002,
@@ -269,13 +269,13 @@ mod tests {
             flight.lowest_point(&end)
         );
         // Slower than the sleeping thresholds: the engine must step (its timer runs).
-        assert_eq!(flight.coast(&at(0.0305, 0.01), 1000).1, 0);
+        assert_eq!(coast(&flight, &at(0.0305, 0.01), 1000).1, 0);
         // Over the plane floor, whose contacts reach up to it, the flight stays 5 cm clear.
         let mut plane = scene.clone();
         plane.floor = crate::scene::Floor::Plane;
         let flight = Flight::of(&plane);
         assert!(!flight.may_start(&at(0.0595, -1.0), || true));
-        let (end, n) = flight.coast(&at(0.2, -1.0), 1000);
+        let (end, n) = coast(&flight, &at(0.2, -1.0), 1000);
         assert!(n > 0 && (-0.005..=0.0).contains(&(flight.lowest_point(&end) - CLEAR_OF_PLANE)));
     }
 }
