@@ -49,10 +49,16 @@ pub trait Engine: Send {
     fn reset(&mut self, start: &BodyState) -> Result<(), String>;
     /// Moves the die to `now` mid-roll, at the end of a stretch of free flight integrated
     /// outside (`flight::Flight`), leaving the body as the engine's own steps would have.
-    fn set_state(&mut self, now: &BodyState) -> Result<(), String>;
+    /// Only engines with `ballistic_flight` are handed a flight.
+    fn set_state(&mut self, _now: &BodyState) -> Result<(), String> {
+        Err("this engine's free flight is not integrated outside it".into())
+    }
     /// True if, out of contact, the engine moves the die exactly as `flight::Flight` does
-    /// (gravity, symplectic Euler, constant angular velocity).
-    fn ballistic_flight(&self) -> bool;
+    /// (gravity, symplectic Euler, constant angular velocity): Bullet without its gyroscopic
+    /// term. Not Rapier, which keeps the gyroscopic term and integrates rotation to first order.
+    fn ballistic_flight(&self) -> bool {
+        false
+    }
     /// True if the engine keeps no contact point between the die and the floor now, so that
     /// its next step from a state clear of the floor is free flight (`flight::Flight`).
     fn contact_free(&self) -> bool {

@@ -110,21 +110,6 @@ impl Engine for Rapier2d {
         Ok(())
     }
 
-    fn set_state(&mut self, now: &BodyState) -> Result<(), String> {
-        let h = self.die.ok_or("rapier2d: set_state before reset")?;
-        let v = &now.linear_velocity;
-        let b = &mut self.world.bodies[h];
-        b.set_position(planar_pose(now), true);
-        b.set_linvel(Vector::new(v.x, v.y), true);
-        b.set_angvel(now.angular_velocity.z, true);
-        Ok(())
-    }
-
-    /// Rapier integrates rotation to first order, not as `flight::Flight`: never coast it.
-    fn ballistic_flight(&self) -> bool {
-        false
-    }
-
     fn step(&mut self) -> Result<(), String> {
         if self.die.is_none() {
             return Err("rapier2d: step before reset".into());

@@ -128,28 +128,6 @@ impl Engine for Rapier3d {
         Ok(())
     }
 
-    fn set_state(&mut self, now: &BodyState) -> Result<(), String> {
-        let h = self.die.ok_or("rapier: set_state before reset")?;
-        let q = now.rotation.quaternion();
-        let b = &mut self.world.bodies[h];
-        b.set_position(
-            Pose::from_parts(
-                from_na(&now.position),
-                Rotation::from_xyzw(q.i, q.j, q.k, q.w),
-            ),
-            true,
-        );
-        b.set_linvel(from_na(&now.linear_velocity), true);
-        b.set_angvel(from_na(&now.angular_velocity), true);
-        Ok(())
-    }
-
-    /// Rapier keeps gyroscopic forces on and integrates rotation to first order, so its free
-    /// flight is not `flight::Flight`'s: never coast it.
-    fn ballistic_flight(&self) -> bool {
-        false
-    }
-
     fn step(&mut self) -> Result<(), String> {
         if self.die.is_none() {
             return Err("rapier: step before reset".into());
