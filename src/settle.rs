@@ -137,12 +137,6 @@ impl DieShape {
         }
     }
 
-    /// Height of the die's lowest point above the floor's top: y − Σ hᵢ |(Rᵀ ŷ)ᵢ| (in 2D the
-    /// body turns about z only, so z adds nothing).
-    pub fn lowest_point(&self, s: &BodyState) -> f64 {
-        lowest_point(&self.half, s)
-    }
-
     /// Kinetic energy, translational plus rotational.
     pub fn kinetic(&self, s: &BodyState) -> f64 {
         let w = s.rotation.inverse_transform_vector(&s.angular_velocity);
@@ -172,7 +166,8 @@ pub fn up_in_body(q: &UnitQuaternion<f64>) -> Vector3<f64> {
 }
 
 /// Height above the floor of the lowest point of a box with half sides `half`:
-/// y − Σ hᵢ |(Rᵀ ŷ)ᵢ| (the support function in the downward direction).
+/// y − Σ hᵢ |(Rᵀ ŷ)ᵢ| (the support function in the downward direction; in 2D the body turns
+/// about z only, so z adds nothing).
 pub fn lowest_point(half: &Vector3<f64>, s: &BodyState) -> f64 {
     s.position.y - up_in_body(&s.rotation).abs().dot(half)
 }
