@@ -4,8 +4,8 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use dicephys::engine::bullet::Bullet;
 use dicephys::engine::{new_engine, Engine, EngineKind};
-use dicephys::scene::{Mode, Scene};
-use dicephys::throws::{keyed, ThrowRanges};
+use dicephys::model::scene::{Mode, Scene};
+use dicephys::model::throws::{keyed, ThrowRanges};
 use std::hint::black_box;
 
 /// 500 steps of one throw, from its start: flight, first bounces.

@@ -1,41 +1,60 @@
-//! The two kinds of error a command can end with, and their exit codes.
+//! The library's errors. Which exit code each becomes is the command line's business.
 
-use std::fmt;
+use std::path::{Path, PathBuf};
 
-#[derive(Debug)]
+/// What can go wrong in the library.
+#[derive(Debug, thiserror::Error)]
 pub enum Error {
-    /// Bad input: exit code 2, one line naming what is wrong.
-    Usage(String),
-    /// A failure while running (I/O, an engine that cannot start): exit code 1.
-    Run(String),
-    /// Stopped by Ctrl-C before the end, with what was done kept: exit code 130.
-    Interrupted(String),
+    /// A value refused before anything runs: out of range, malformed, or inconsistent.
+    #[error("{0}")]
+    Invalid(String),
+    /// Inputs that do not belong together: a checkpoint of another run, shards of two runs.
+    #[error("{0}")]
+    Mismatch(String),
+    /// Reading or writing a file.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the system said.
+        source: std::io::Error,
+    },
+    /// An engine could not be built, or failed outside a roll.
+    #[error("{0}")]
+    Engine(String),
+    /// Anything else that stops a run: encoding output, drawing a figure.
+    #[error("{0}")]
+    Failed(String),
 }
 
 impl Error {
-    pub fn exit_code(&self) -> i32 {
-        match self {
-            Error::Usage(_) => 2,
-            Error::Run(_) => 1,
-            Error::Interrupted(_) => 130,
+    /// An I/O error on `path`.
+    pub fn io(path: &Path, source: std::io::Error) -> Error {
+        Error::Io {
+            path: path.to_path_buf(),
+            source,
         }
     }
-}
 
-impl fmt::Display for Error {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Error::Usage(m) | Error::Run(m) | Error::Interrupted(m) => f.write_str(m),
-        }
+    /// True for errors in what was asked (bad values, mismatched inputs), not in running it.
+    pub fn is_input(&self) -> bool {
+        matches!(self, Error::Invalid(_) | Error::Mismatch(_))
     }
 }
 
-impl std::error::Error for Error {}
-
-impl From<std::io::Error> for Error {
-    fn from(e: std::io::Error) -> Error {
-        Error::Run(e.to_string())
-    }
-}
-
+/// The library's result type.
 pub type Result<T> = std::result::Result<T, Error>;
+
+/// Parses one of an enum's names (`strum`), or says which names there are:
+/// "unknown floor 'x' (known: box, plane)".
+pub fn parse_name<T>(what: &str, s: &str) -> Result<T>
+where
+    T: std::str::FromStr + strum::VariantNames,
+{
+    s.parse().map_err(|_| {
+        Error::Invalid(format!(
+            "unknown {what} '{s}' (known: {})",
+            T::VARIANTS.join(", ")
+        ))
+    })
+}

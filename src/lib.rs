@@ -4,30 +4,27 @@
 //! theory and measured data of G. A. T. Pender and M. Uhrin, "Predicting Non-Square 2D Dice
 //! Probabilities", Eur. J. Phys. 35 (2014), arXiv:1407.6307.
 //!
-//! Modules: `block` (the die and its sides' names), `scene` (what a throw happens in),
-//! `throws` (initial conditions, keyed or DicePhys's sequence), `engine` (Bullet, Rapier),
-//! `settle` (at rest, outcome), `theory` and `paper_data` (the paper's closed forms and table),
-//! `stats` (binomial errors, z, χ²), `figures` (the paper's figures as SVG and PNG),
-//! `roll` (one roll), `batch` (many, in parallel), `cli`.
+//! The library's dependencies run one way, from the model up to the studies:
+//!
+//! * [`model`]: the die (block, shape, state), the scene it is thrown in, the throws;
+//! * [`engine`]: Bullet and Rapier behind one trait;
+//! * [`sim`]: one roll: free flight, the rest rule, the exact early stop;
+//! * [`run`]: many rolls: the run's specification, batches, tallies, checkpoints, atomic output;
+//! * [`theory`]: the paper's closed forms, its experimental table, the statistics;
+//! * [`report`]: what a run or the paper's table says, as text, JSON, CSV and figures;
+//! * [`studies`]: the paper end to end, the bench, the convergence, trade-off and stability sweeps.
+//!
+//! The command line lives in the binary (`src/main.rs`, `src/cli/`), on top of all of these.
 
-pub mod batch;
-pub mod bench;
-pub mod block;
-pub mod checkpoint;
-pub mod cli;
-pub mod cputime;
+#![warn(missing_docs)]
+
 pub mod engine;
 pub mod error;
-pub mod figures;
-pub mod flight;
-pub mod glibc;
-pub mod paper;
-pub mod paper_data;
-pub mod roll;
-pub mod scene;
-pub mod settle;
-pub mod stats;
-pub mod summary;
-pub mod sweeps;
+pub mod model;
+pub mod report;
+pub mod run;
+pub mod sim;
+pub mod studies;
 pub mod theory;
-pub mod throws;
+
+pub use error::{Error, Result};

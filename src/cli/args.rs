@@ -1,19 +1,23 @@
-//! Command-line arguments shared by the commands that simulate.
+//! Command-line arguments shared by the commands that simulate. They only spell the library's
+//! types; every check of a value is the library's (`Scene::validate`, `RunSpec::validate`).
 
-use crate::block::Block;
-use crate::engine::EngineKind;
-use crate::error::{Error, Result};
-use crate::roll::{Rule, Settle, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
-use crate::scene::{Floor, Mode, Preset, Scene};
-use crate::throws::{Range, ThrowKind, ThrowRanges};
-use clap::Args;
+use super::error::{Error, Result};
+use clap::{Args, ValueEnum};
+use dicephys::engine::EngineKind;
+use dicephys::error::parse_name;
+use dicephys::model::block::Block;
+use dicephys::model::scene::{Floor, Mode, Preset, Scene};
+use dicephys::model::throws::{Range, ThrowKind, ThrowRanges};
+use dicephys::run::runner::MAX_THREADS;
+use dicephys::run::spec::{Shard, ThrowSpec};
+use dicephys::sim::roll::{RollConfig, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
 
 /// The scene: the block, the surface, the time step.
 #[derive(Args, Debug, Clone)]
 pub struct SceneArgs {
     /// The block, LENGTHxBREADTHxWIDTH in mm (the paper's order), e.g. 140x24x20.
     #[arg(long, value_parser = parse_block)]
-    pub block: Block,
+    pub block: Option<Block>,
     /// DicePhys's 2D mode: a 1 m deep box locked to the x-y plane.
     #[arg(long = "2d")]
     pub two_d: bool,
@@ -60,6 +64,24 @@ pub struct ThrowArgs {
     pub drop_height: Range,
 }
 
+/// What ends a roll, on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SettleArg {
+    /// The exact early stop: energy below the barrier out of the current face.
+    Certificate,
+    /// At rest by DicePhys's rule.
+    Dicephys,
+}
+
+/// How free flight is stepped, on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum FlightArg {
+    /// Integrated in closed form where the engine's flight is ballistic.
+    Fast,
+    /// Every step by the engine.
+    Stepped,
+}
+
 /// How many rolls, how.
 #[derive(Args, Debug, Clone)]
 pub struct RunArgs {
@@ -74,8 +96,8 @@ pub struct RunArgs {
     pub max_steps: u64,
     /// What ends a roll: certificate (the exact early stop: energy below the barrier out of
     /// the current face; the default) or dicephys (at rest by DicePhys's rule).
-    #[arg(long, default_value = "certificate", value_parser = ["dicephys", "certificate"])]
-    pub settle: String,
+    #[arg(long, value_enum, default_value = "certificate")]
+    pub settle: SettleArg,
     /// The certificate's reserve, a fraction of the barrier in [0, 1).
     #[arg(long, default_value_t = DEFAULT_MARGIN)]
     pub margin: f64,
@@ -85,145 +107,110 @@ pub struct RunArgs {
     pub audit: bool,
     /// Free flight: fast (integrated in closed form where the engine's flight is ballistic,
     /// the default) or stepped (every step by the engine).
-    #[arg(long, default_value = "fast", value_parser = ["fast", "stepped"])]
-    pub flight: String,
+    #[arg(long, value_enum, default_value = "fast")]
+    pub flight: FlightArg,
     /// DicePhys exactly as the paper ran it: --settle dicephys --flight stepped (with the
     /// defaults --floor box --preset dicephys281).
     #[arg(long)]
     pub faithful: bool,
 }
 
-pub fn parse_block(s: &str) -> std::result::Result<Block, String> {
+/// `--block` as clap reads it.
+pub fn parse_block(s: &str) -> std::result::Result<Block, dicephys::Error> {
     s.parse()
 }
-pub fn parse_range(s: &str) -> std::result::Result<Range, String> {
+/// `LO:HI` as clap reads it.
+pub fn parse_range(s: &str) -> std::result::Result<Range, dicephys::Error> {
     s.parse()
 }
-pub fn parse_preset(s: &str) -> std::result::Result<Preset, String> {
-    s.parse()
+/// `--preset` as clap reads it.
+pub fn parse_preset(s: &str) -> std::result::Result<Preset, dicephys::Error> {
+    parse_name("preset", s)
 }
-pub fn parse_floor(s: &str) -> std::result::Result<Floor, String> {
-    s.parse()
+/// `--floor` as clap reads it.
+pub fn parse_floor(s: &str) -> std::result::Result<Floor, dicephys::Error> {
+    parse_name("floor", s)
 }
-pub fn parse_throw_kind(s: &str) -> std::result::Result<ThrowKind, String> {
-    s.parse()
+/// `--throws` as clap reads it.
+pub fn parse_throw_kind(s: &str) -> std::result::Result<ThrowKind, dicephys::Error> {
+    parse_name("throw source", s)
 }
-pub fn parse_engine(s: &str) -> std::result::Result<EngineKind, String> {
-    s.parse()
+/// `--engine` as clap reads it.
+pub fn parse_engine(s: &str) -> std::result::Result<EngineKind, dicephys::Error> {
+    parse_name("engine", s)
 }
-
-fn usage(msg: String) -> Error {
-    Error::Usage(msg)
+/// `--shard K/N` as clap reads it.
+pub fn parse_shard(s: &str) -> std::result::Result<Shard, dicephys::Error> {
+    s.parse()
 }
 
 impl SceneArgs {
     /// The scene, with every value checked before anything runs.
     pub fn scene(&self) -> Result<Scene> {
+        let block = self
+            .block
+            .ok_or_else(|| Error::Usage("--block is required".into()))?;
         let mode = if self.two_d { Mode::TwoD } else { Mode::ThreeD };
-        if !(self.dt.is_finite() && self.dt > 0.0 && self.dt <= 0.1) {
-            return Err(usage(format!("--dt {}: must be in (0, 0.1] s", self.dt)));
-        }
-        if !(self.friction.is_finite() && self.friction >= 0.0) {
-            return Err(usage(format!(
-                "--friction {}: must be finite and >= 0",
-                self.friction
-            )));
-        }
-        let e_max = if self.allow_restitution_above_one {
-            10.0
-        } else {
-            1.0
-        };
-        if !(self.restitution.is_finite() && self.restitution >= 0.0 && self.restitution <= e_max) {
-            return Err(usage(format!(
-                "--restitution {}: must be in [0, 1] (above 1 only with --allow-restitution-above-one)",
-                self.restitution
-            )));
-        }
-        if !(self.density.is_finite() && self.density > 0.0 && self.density <= 1e5) {
-            return Err(usage(format!(
-                "--density {}: must be in (0, 100000] kg/m³",
-                self.density
-            )));
-        }
-        let mut scene = Scene::paper(self.block, mode);
+        let mut scene = Scene::paper(block, mode);
         scene.dt = self.dt;
         scene.friction = self.friction;
         scene.restitution = self.restitution;
         scene.density = self.density;
         scene.preset = self.preset;
         scene.floor = self.floor;
+        scene.validate(self.allow_restitution_above_one)?;
         Ok(scene)
     }
 }
 
 impl ThrowArgs {
-    pub fn ranges(&self) -> Result<ThrowRanges> {
-        if self.spin.lo < 0.0 {
-            return Err(usage(format!("--spin {}: must be >= 0 rad/s", self.spin)));
-        }
-        if self.drop_height.lo < 0.0 {
-            return Err(usage(format!(
-                "--drop-height {}: must be >= 0 m",
-                self.drop_height
-            )));
-        }
-        for (name, r, max) in [
-            ("--velocity", self.velocity, 100.0),
-            ("--spin", self.spin, 10_000.0),
-            ("--drop-height", self.drop_height, 100.0),
-        ] {
-            if r.lo.abs() > max || r.hi.abs() > max {
-                return Err(usage(format!(
-                    "{name} {r}: magnitudes above {max} are not accepted"
-                )));
-            }
-        }
-        if self.throws == ThrowKind::Dicephys && self.seed > u32::MAX as u64 {
-            return Err(usage(format!(
-                "--seed {}: the dicephys throw source takes a 32-bit seed (srand)",
-                self.seed
-            )));
-        }
-        Ok(ThrowRanges {
-            velocity: self.velocity,
-            spin: self.spin,
-            drop_height: self.drop_height,
-        })
+    /// The throws, checked.
+    pub fn spec(&self) -> Result<ThrowSpec> {
+        let spec = ThrowSpec {
+            kind: self.throws,
+            seed: self.seed,
+            ranges: ThrowRanges {
+                velocity: self.velocity,
+                spin: self.spin,
+                drop_height: self.drop_height,
+            },
+        };
+        spec.validate()?;
+        Ok(spec)
     }
 }
 
 impl RunArgs {
-    pub fn check(&self) -> Result<Settle> {
-        if self.rolls == 0 {
-            return Err(usage("--rolls 0: need at least one roll".into()));
-        }
-        if self.rolls > 1_000_000_000 {
-            return Err(usage(format!("--rolls {}: at most 1e9", self.rolls)));
-        }
-        if self.max_steps == 0 {
-            return Err(usage("--max-steps 0: need at least one step".into()));
-        }
-        if self.threads > 1024 {
-            return Err(usage(format!("--threads {}: at most 1024", self.threads)));
-        }
-        if !(self.margin.is_finite() && (0.0..1.0).contains(&self.margin)) {
-            return Err(usage(format!(
-                "--margin {}: must be in [0, 1)",
-                self.margin
-            )));
-        }
+    /// How each roll is carried out and ended, checked.
+    pub fn roll(&self) -> Result<RollConfig> {
         // An audit compares the certificate with the full settle, so it settles fully.
-        let rule = match self.settle.as_str() {
-            "certificate" if !self.faithful && !self.audit => Rule::Certificate,
+        let rule = match self.settle {
+            SettleArg::Certificate if !self.faithful && !self.audit => Rule::Certificate,
             _ => Rule::Dicephys,
         };
-        Ok(Settle {
+        let cfg = RollConfig {
             max_steps: self.max_steps,
             rule,
             margin: self.margin,
             audit: self.audit,
-            fast_flight: self.flight == "fast" && !self.faithful,
-        })
+            fast_flight: self.flight == FlightArg::Fast && !self.faithful,
+        };
+        cfg.validate()?;
+        Ok(cfg)
     }
+
+    /// The worker threads, checked (0: one per core).
+    pub fn threads(&self) -> Result<usize> {
+        threads(self.threads)
+    }
+}
+
+/// Checks `--threads` (0: one per core) and resolves it.
+pub fn threads(asked: usize) -> Result<usize> {
+    if asked > MAX_THREADS {
+        return Err(Error::Usage(format!(
+            "--threads {asked}: at most {MAX_THREADS}"
+        )));
+    }
+    Ok(dicephys::run::runner::threads(asked))
 }

@@ -1,8 +1,8 @@
 //! `dicephys bench`: speed of every engine and lever against the faithful configuration.
 
-use crate::bench;
-use crate::error::{Error, Result};
+use super::error::{Error, Result};
 use clap::Args;
+use dicephys::studies::bench;
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
@@ -29,11 +29,13 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     if a.repeat == 0 {
         return Err(Error::Usage("--repeat 0: need at least one run".into()));
     }
-    let threads = if a.threads == 0 {
-        rayon::current_num_threads()
-    } else {
-        a.threads
-    };
+    if a.rolls > 10_000_000 {
+        return Err(Error::Usage(format!(
+            "--rolls {}: at most 10000000",
+            a.rolls
+        )));
+    }
+    let threads = super::args::threads(a.threads)?;
     let quiet = a.json;
     if !quiet {
         println!("{}", bench::header());
@@ -42,8 +44,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         if !quiet {
             println!("{line}");
         }
-    })
-    .map_err(Error::Run)?;
+    })?;
     if a.json {
         println!(
             "{}",

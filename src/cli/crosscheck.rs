@@ -1,18 +1,19 @@
 //! `dicephys crosscheck`: the very same throws on several engines, side by side.
 
 use super::args::{parse_engine, RunArgs, SceneArgs, ThrowArgs};
-use crate::batch::{self, Tally};
-use crate::cputime::process_cpu_seconds;
-use crate::engine::EngineKind;
-use crate::error::{Error, Result};
-use crate::roll::{Fate, RollRecord};
-use crate::stats;
-use crate::summary::RunSummary;
-use crate::throws::Throws;
+use super::error::{Error, Result};
 use clap::Args;
+use dicephys::engine::EngineKind;
+use dicephys::report::summary::{Cost, RunSummary};
+use dicephys::run::cputime::process_cpu_seconds;
+use dicephys::run::runner::Runner;
+use dicephys::run::spec::RunSpec;
+use dicephys::run::tally::Agreement;
+use dicephys::theory::stats;
 use serde::Serialize;
 use std::time::Instant;
 
+/// `dicephys crosscheck`'s arguments.
 #[derive(Args, Debug)]
 pub struct CrosscheckArgs {
     /// Engines to compare (comma-separated); the first is the baseline.
@@ -24,6 +25,7 @@ pub struct CrosscheckArgs {
     pub throw: ThrowArgs,
     #[command(flatten)]
     pub run: RunArgs,
+    /// Print one JSON document instead of the human summary.
     #[arg(long)]
     pub json: bool,
 }
@@ -31,94 +33,89 @@ pub struct CrosscheckArgs {
 /// One engine against the baseline, on identical throws.
 #[derive(Clone, Debug, Serialize)]
 pub struct Versus {
-    pub engine: String,
-    pub baseline: String,
+    /// The engine compared.
+    pub engine: EngineKind,
+    /// The baseline engine.
+    pub baseline: EngineKind,
     /// (ratio − baseline ratio) / combined binomial error.
     pub z: f64,
-    /// Throws both engines settled: how many, and the fraction with the same outcome.
+    /// Throws both engines settled: how many, and the fraction of them with the same outcome.
     pub both_settled: u64,
+    /// Same outcome over the throws both settled.
     pub same_outcome_fraction: f64,
     /// This engine's CPU time per roll over the baseline's.
     pub cpu_ratio: f64,
 }
 
+/// The whole cross-check.
 #[derive(Clone, Debug, Serialize)]
 pub struct Crosscheck {
+    /// Each engine's run, baseline first.
     pub runs: Vec<RunSummary>,
+    /// Each other engine against the baseline.
     pub versus: Vec<Versus>,
 }
 
-fn same_outcomes(a: &[RollRecord], b: &[RollRecord]) -> (u64, f64) {
-    let mut both = 0u64;
-    let mut same = 0u64;
-    for (x, y) in a.iter().zip(b) {
-        if let (Fate::Settled(p), Fate::Settled(q)) = (x.fate, y.fate) {
-            both += 1;
-            same += (p == q) as u64;
-        }
-    }
-    (both, same as f64 / both.max(1) as f64)
-}
-
+/// Runs `dicephys crosscheck`.
 pub fn run(a: &CrosscheckArgs) -> Result<()> {
-    let scene = a.scene.scene()?;
-    let ranges = a.throw.ranges()?;
-    let settle = a.run.check()?;
     if a.engines.len() < 2 {
         return Err(Error::Usage(
             "--engines: name at least two engines to compare".into(),
         ));
     }
-    let threads = if a.run.threads == 0 {
-        rayon::current_num_threads()
-    } else {
-        a.run.threads
+    let base = RunSpec {
+        engine: a.engines[0],
+        scene: a.scene.scene()?,
+        throws: a.throw.spec()?,
+        roll: a.run.roll()?,
+        rolls: a.run.rolls,
+        shard: None,
     };
-    let throws = Throws::new(a.throw.throws, a.throw.seed, ranges, a.run.rolls);
+    base.validate(a.scene.allow_restitution_above_one)?;
+    let threads = a.run.threads()?;
+    let runner = Runner::new(threads, super::stop().clone());
     let mut runs = Vec::new();
     let mut records = Vec::new();
     for &engine in &a.engines {
+        let spec = RunSpec {
+            engine,
+            ..base.clone()
+        };
         let wall = Instant::now();
         let cpu = process_cpu_seconds();
-        let recs = batch::run(
-            engine,
-            &scene,
-            &throws,
-            &settle,
-            0..a.run.rolls,
+        let mut recs = Vec::new();
+        let done = runner.run(&spec, None, &mut |r| {
+            recs.extend_from_slice(r);
+            Ok(())
+        })?;
+        let cost = Cost {
+            wall_s: wall.elapsed().as_secs_f64(),
+            cpu_s: process_cpu_seconds() - cpu,
             threads,
-            &|_| {},
-        )
-        .map_err(Error::Run)?;
-        let tally = Tally::of(&recs);
-        runs.push(RunSummary::new(
-            engine,
-            &scene,
-            a.throw.seed,
-            a.throw.throws,
-            &ranges,
-            &settle,
-            &tally,
-            wall.elapsed().as_secs_f64(),
-            process_cpu_seconds() - cpu,
-            threads,
-        ));
+        };
+        if !done.complete {
+            return Err(Error::Interrupted(format!(
+                "interrupted during {engine} after {} of {} rolls; nothing compared",
+                done.tally.rolls, spec.rolls
+            )));
+        }
+        runs.push(RunSummary::new(&spec, &done.tally, cost));
         records.push(recs);
     }
     let versus: Vec<Versus> = (1..runs.len())
         .map(|i| {
-            let (both, frac) = same_outcomes(&records[0], &records[i]);
+            let agree = Agreement::of(&records[0], &records[i]);
             Versus {
-                engine: runs[i].engine.clone(),
-                baseline: runs[0].engine.clone(),
+                engine: runs[i].engine,
+                baseline: runs[0].engine,
                 z: stats::z_score(
                     runs[i].ratio,
                     runs[i].ratio_err,
                     runs[0].ratio,
                     runs[0].ratio_err,
                 ),
-                both_settled: both,
-                same_outcome_fraction: frac,
+                both_settled: agree.both_settled,
+                same_outcome_fraction: agree.of_settled(),
                 cpu_ratio: runs[i].cpu_ms_per_roll / runs[0].cpu_ms_per_roll,
             }
         })

@@ -1,16 +1,15 @@
 //! The command line: a thin layer over the library. Each subcommand has a module of its own.
 
-use crate::error::{Error, Result};
 use clap::{Parser, Subcommand};
-use std::path::Path;
+use dicephys::run::stop::Stop;
 
 pub mod args;
 pub mod bench;
 pub mod crosscheck;
+pub mod error;
 pub mod merge;
 pub mod paper;
 pub mod roll;
-pub mod runargs;
 pub mod sweeps;
 pub mod theory;
 pub mod trace;
@@ -51,25 +50,24 @@ pub enum Command {
     Trace(trace::TraceArgs),
 }
 
-/// Runs the command line; returns the process exit code (0 ok, 2 bad input, 1 failure).
+/// The process's stop flag, raised by Ctrl-C or SIGTERM.
+pub fn stop() -> &'static Stop {
+    static STOP: std::sync::OnceLock<Stop> = std::sync::OnceLock::new();
+    STOP.get_or_init(Stop::new)
+}
+
+/// Runs the command line; returns the process exit code (0 ok, 2 bad input, 1 failure, 130
+/// stopped early with what was done kept).
 pub fn main() -> i32 {
-    // Ctrl-C: the first asks long runs to stop cleanly between chunks (they keep their
-    // checkpoint and print a partial report); a second ends the process at once.
+    // Ctrl-C or SIGTERM: the first asks runs to stop before their next roll (they keep their
+    // checkpoint and report what was done, as partial); a second ends the process at once.
     let _ = ctrlc::set_handler(|| {
-        if crate::checkpoint::STOP.swap(true, std::sync::atomic::Ordering::SeqCst) {
+        if stop().request() {
             std::process::exit(130);
         }
-        eprintln!("dicephys: stopping after the current chunk (Ctrl-C again to quit now)");
+        eprintln!("dicephys: stopping after the rolls under way (Ctrl-C again to quit now)");
     });
-    let argv = match resume_argv(std::env::args().collect()) {
-        Ok(a) => a,
-        Err(e) => {
-            eprintln!("dicephys: {e}");
-            return e.exit_code();
-        }
-    };
-    let _ = runargs::EFFECTIVE.set(argv.clone());
-    let cli = match Cli::try_parse_from(argv) {
+    let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => return clap_error(e),
     };
@@ -130,81 +128,7 @@ fn clap_error(e: clap::Error) -> i32 {
     }
 }
 
-/// Fails early, before any simulation, if `path` cannot be written.
-pub fn check_writable(path: &Path) -> Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    if !dir.is_dir() {
-        return Err(Error::Usage(format!(
-            "{}: directory {} does not exist",
-            path.display(),
-            dir.display()
-        )));
-    }
-    let probe = dir.join(format!(".dicephys-probe-{}", std::process::id()));
-    std::fs::write(&probe, b"")
-        .map_err(|e| Error::Usage(format!("{}: cannot write there ({e})", path.display())))?;
-    let _ = std::fs::remove_file(probe);
-    Ok(())
-}
-
-/// Writes a whole file or nothing: a temporary file beside it, then a rename.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    crate::checkpoint::write_atomic(path, bytes)
-        .map_err(|e| Error::Run(format!("{}: {e}", path.display())))
-}
-
-/// `dicephys roll --resume DIR [--threads T] [--json]` becomes the stored run's own command
-/// line with `--checkpoint DIR`, so a resumed run is configured exactly as it started.
-fn resume_argv(argv: Vec<String>) -> Result<Vec<String>> {
-    let Some(pos) = argv
-        .iter()
-        .position(|a| a == "--resume" || a.starts_with("--resume="))
-    else {
-        return Ok(argv);
-    };
-    if argv.get(1).map(String::as_str) != Some("roll") {
-        return Err(Error::Usage(
-            "--resume: only `dicephys roll --resume DIR` resumes".into(),
-        ));
-    }
-    let dir = match argv[pos].split_once('=') {
-        Some((_, d)) => d.to_string(),
-        None => argv
-            .get(pos + 1)
-            .cloned()
-            .ok_or_else(|| Error::Usage("--resume: name the checkpoint directory".into()))?,
-    };
-    let file = Path::new(&dir).join("args.json");
-    let text = std::fs::read_to_string(&file).map_err(|e| {
-        Error::Usage(format!(
-            "--resume {dir}: no checkpoint there ({}: {e})",
-            file.display()
-        ))
-    })?;
-    let stored: Vec<String> = serde_json::from_str(&text).map_err(|e| {
-        Error::Usage(format!(
-            "--resume {dir}: {} is damaged ({e})",
-            file.display()
-        ))
-    })?;
-    let extra = runargs::without(&argv[2..], &[("--resume", true)]);
-    let allowed = runargs::without(
-        &extra,
-        &[("--threads", true), ("--json", false), ("--per-roll", true)],
-    );
-    if !allowed.is_empty() {
-        return Err(Error::Usage(format!(
-            "--resume takes only --threads, --json and --per-roll besides, not {}",
-            allowed.join(" ")
-        )));
-    }
-    let mut out = vec![argv[0].clone(), "roll".to_string()];
-    out.extend(stored);
-    out.extend(extra);
-    out.push("--checkpoint".into());
-    out.push(dir);
-    Ok(out)
+/// Checks an output path before anything runs (exit 2 if it cannot be written).
+pub fn output(path: &std::path::Path) -> error::Result<dicephys::run::io::Output> {
+    Ok(dicephys::run::io::Output::check(path)?)
 }

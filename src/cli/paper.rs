@@ -1,15 +1,18 @@
 //! `dicephys paper`: the main job. Reproduces the paper end to end and writes a report.
 
 use super::args::parse_engine;
-use crate::engine::EngineKind;
-use crate::error::{Error, Result};
-use crate::paper::{self, PaperConfig};
-use crate::roll::DEFAULT_MAX_STEPS;
+use super::error::{Error, Result};
 use clap::Args;
+use dicephys::engine::EngineKind;
+use dicephys::report::paper as report;
+use dicephys::run::runner::Runner;
+use dicephys::sim::roll::DEFAULT_MAX_STEPS;
+use dicephys::studies::paper::{self, PaperConfig};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
+/// `dicephys paper`'s arguments.
 #[derive(Args, Debug)]
 pub struct PaperArgs {
     /// Rolls per simulated cell (block × engine × 2D/3D); 100000 is the paper's own scale.
@@ -42,29 +45,8 @@ pub struct PaperArgs {
     pub json: bool,
 }
 
+/// Runs `dicephys paper`.
 pub fn run(a: &PaperArgs) -> Result<()> {
-    if a.rolls == 0 {
-        return Err(Error::Usage("--rolls 0: need at least one roll".into()));
-    }
-    if !(a.dt.is_finite() && a.dt > 0.0 && a.dt <= 0.1) {
-        return Err(Error::Usage(format!(
-            "--dt {}: must be in (0, 0.1] s",
-            a.dt
-        )));
-    }
-    if a.max_steps == 0 || a.engines.is_empty() {
-        return Err(Error::Usage(
-            "--max-steps and --engines must not be empty or 0".into(),
-        ));
-    }
-    std::fs::create_dir_all(&a.out)
-        .map_err(|e| Error::Usage(format!("--out {}: cannot create it ({e})", a.out.display())))?;
-    super::check_writable(&a.out.join("results.json"))?;
-    let threads = if a.threads == 0 {
-        rayon::current_num_threads()
-    } else {
-        a.threads
-    };
     let mut engines = a.engines.clone();
     engines.dedup();
     let cfg = PaperConfig {
@@ -72,10 +54,18 @@ pub fn run(a: &PaperArgs) -> Result<()> {
         seed: a.seed,
         engines,
         dt: a.dt,
-        threads,
         max_steps: a.max_steps,
         faithful: a.faithful,
     };
+    cfg.validate()?;
+    let threads = super::args::threads(a.threads)?;
+    std::fs::create_dir_all(&a.out)
+        .map_err(|e| Error::Usage(format!("--out {}: cannot create it ({e})", a.out.display())))?;
+    let outputs = [
+        super::output(&a.out.join("results.json"))?,
+        super::output(&a.out.join("results.csv"))?,
+        super::output(&a.out.join("report.md"))?,
+    ];
     let total = paper::total_rolls(&cfg)?;
     let bar = if a.json || !std::io::stderr().is_terminal() {
         ProgressBar::hidden()
@@ -90,37 +80,34 @@ pub fn run(a: &PaperArgs) -> Result<()> {
         b
     };
     let command_line = std::env::args().collect::<Vec<_>>().join(" ");
-    // Cells are rolled in checkpointed chunks under --out/checkpoint: the same command run
-    // again (after a crash or Ctrl-C) continues where it stopped.
+    // Cells are rolled in checkpointed chunks under --out/checkpoint, each cell's directory
+    // bound to its run's specification: the same command run again (after a crash or Ctrl-C)
+    // continues where it stopped.
     let ck = a.out.join("checkpoint");
-    let key = serde_json::to_string(&PaperConfig {
-        threads: 0,
-        ..cfg.clone()
-    })
-    .map_err(|e| Error::Run(e.to_string()))?;
-    let key_file = ck.join("config.json");
-    if std::fs::read_to_string(&key_file).ok().as_deref() != Some(key.as_str()) {
-        if ck.exists() {
-            eprintln!(
-                "dicephys: {} held another configuration; starting afresh",
-                ck.display()
-            );
-            std::fs::remove_dir_all(&ck)?;
-        }
-        std::fs::create_dir_all(&ck)?;
-        super::write_atomic(&key_file, key.as_bytes())?;
-    }
-    let res = paper::run(&cfg, command_line, Some(&ck), &|n| bar.set_position(n))?;
-    bar.finish_and_clear();
-    let figures = crate::paper::write_figures(&a.out, &res)?;
-    let json = serde_json::to_string_pretty(&res).map_err(|e| Error::Run(e.to_string()))?;
-    super::write_atomic(&a.out.join("results.json"), json.as_bytes())?;
-    super::write_atomic(
-        &a.out.join("results.csv"),
-        paper::results_csv(&res).as_bytes(),
+    let progress = |n| bar.set_position(n);
+    let runner = Runner::new(threads, super::stop().clone());
+    let res = paper::run(
+        &cfg,
+        command_line,
+        &runner.with_progress(&progress),
+        Some(&ck),
     )?;
-    let md = paper::report_markdown(&res, &figures);
-    super::write_atomic(&a.out.join("report.md"), md.as_bytes())?;
+    bar.finish_and_clear();
+    let md = report::report_markdown(&res, &["master_graph", "prob_2d", "len_graph", "dreidel"]);
+    if res.partial {
+        // A partial run leaves the last complete outputs alone: its report goes to stdout.
+        println!("{md}");
+        return Err(Error::Interrupted(format!(
+            "interrupted; {} kept what was rolled: run the same command to continue",
+            ck.display()
+        )));
+    }
+    let figures = report::write_figures(&a.out, &res)?;
+    let md = report::report_markdown(&res, &figures);
+    let json = serde_json::to_string_pretty(&res).map_err(|e| Error::Run(e.to_string()))?;
+    outputs[0].write(json.as_bytes())?;
+    outputs[1].write(report::results_csv(&res).as_bytes())?;
+    outputs[2].write(md.as_bytes())?;
     if a.json {
         println!("{json}");
     } else {

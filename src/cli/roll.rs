@@ -1,18 +1,42 @@
 //! `dicephys roll`: many throws of one block on one engine.
 
-use super::args::{parse_engine, RunArgs, SceneArgs, ThrowArgs};
-use crate::checkpoint;
-use crate::cputime::process_cpu_seconds;
-use crate::engine::EngineKind;
-use crate::error::{Error, Result};
-use crate::roll::{Fate, RollRecord};
-use crate::summary::{RunSummary, Shard};
-use crate::throws::Throws;
+use super::args::{parse_engine, parse_shard, RunArgs, SceneArgs, ThrowArgs};
+use super::error::{Error, Result};
 use clap::Args;
+use dicephys::engine::EngineKind;
+use dicephys::report::summary::{Cost, RunSummary};
+use dicephys::run::cputime::process_cpu_seconds;
+use dicephys::run::runner::{Checkpoint, Runner};
+use dicephys::run::spec::{RunSpec, Shard};
+use dicephys::sim::roll::{Fate, RollRecord};
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
+/// The options that define a run: `--resume` takes them from the checkpoint instead.
+const DEFINING: [&str; 19] = [
+    "engine",
+    "block",
+    "two_d",
+    "dt",
+    "friction",
+    "restitution",
+    "allow_restitution_above_one",
+    "density",
+    "preset",
+    "floor",
+    "seed",
+    "throws",
+    "velocity",
+    "spin",
+    "drop_height",
+    "rolls",
+    "max_steps",
+    "settle",
+    "shard",
+];
+
+/// `dicephys roll`'s arguments.
 #[derive(Args, Debug)]
 pub struct RollArgs {
     /// Physics engine: bullet, rapier (in 2D a true 2D body), rapier-locked (in 2D a locked 3D
@@ -33,10 +57,11 @@ pub struct RollArgs {
     pub per_roll: Option<PathBuf>,
     /// Keep a checkpoint here as the run goes (chunks of 1,000 rolls, written atomically);
     /// `dicephys roll --resume DIR` continues it, bit for bit.
-    #[arg(long, value_name = "DIR")]
+    #[arg(long, value_name = "DIR", conflicts_with = "resume")]
     pub checkpoint: Option<PathBuf>,
-    /// Continue the run checkpointed in DIR, with the configuration stored there.
-    #[arg(long, value_name = "DIR")]
+    /// Continue the run checkpointed in DIR, with the specification stored there (only
+    /// --threads, --json and --per-roll may be given beside it).
+    #[arg(long, value_name = "DIR", conflicts_with_all = DEFINING.iter().chain(&["margin", "audit", "flight", "faithful"]))]
     pub resume: Option<PathBuf>,
     /// Roll only throws with index ≡ K (mod N); `dicephys merge` combines the shards' --json
     /// outputs into the unsharded result.
@@ -44,93 +69,64 @@ pub struct RollArgs {
     pub shard: Option<Shard>,
 }
 
-fn parse_shard(s: &str) -> std::result::Result<Shard, String> {
-    s.parse()
+impl RollArgs {
+    /// The run's specification: from the command line, or from the checkpoint it resumes.
+    pub fn spec(&self) -> Result<RunSpec> {
+        if let Some(dir) = &self.resume {
+            return Checkpoint::spec_in(dir)
+                .map_err(|e| Error::Usage(format!("--resume {}: {e}", dir.display())));
+        }
+        let spec = RunSpec {
+            engine: self.engine,
+            scene: self.scene.scene()?,
+            throws: self.throw.spec()?,
+            roll: self.run.roll()?,
+            rolls: self.run.rolls,
+            shard: self.shard,
+        };
+        spec.validate(self.scene.allow_restitution_above_one)?;
+        Ok(spec)
+    }
 }
 
+/// Runs `dicephys roll`.
 pub fn run(a: &RollArgs) -> Result<()> {
-    let scene = a.scene.scene()?;
-    let ranges = a.throw.ranges()?;
-    let settle = a.run.check()?;
-    if let Some(p) = &a.per_roll {
-        super::check_writable(p)?;
-    }
-    let throws = Throws::new(a.throw.throws, a.throw.seed, ranges, a.run.rolls);
-    let threads = if a.run.threads == 0 {
-        rayon::current_num_threads()
-    } else {
-        a.run.threads
-    };
-    let indices = match a.shard {
-        Some(Shard { k, n }) => checkpoint::Indices {
-            k,
-            n,
-            end: a.run.rolls,
-        },
-        None => checkpoint::Indices::all(a.run.rolls),
-    };
-    let args = super::runargs::current();
-    if let Some(dir) = &a.checkpoint {
-        open_checkpoint(dir, &super::runargs::defining(&args))?;
-    }
-    // The per-roll CSV grows chunk by chunk in a temporary file, renamed into place at the end.
-    let mut csv = match &a.per_roll {
-        Some(p) => {
-            let tmp = p.with_extension(format!("tmp-{}", std::process::id()));
-            let mut f = std::io::BufWriter::new(
-                std::fs::File::create(&tmp)
-                    .map_err(|e| Error::Usage(format!("--per-roll {}: {e}", p.display())))?,
-            );
-            f.write_all(PER_ROLL_HEADER.as_bytes())?;
-            Some((tmp, f))
+    let spec = a.spec()?;
+    let threads = a.run.threads()?;
+    let per_roll = a.per_roll.as_deref().map(super::output).transpose()?;
+    let dir = a.resume.as_ref().or(a.checkpoint.as_ref());
+    let checkpoint = dir.map(|d| Checkpoint::open(d, &spec)).transpose()?;
+    // The per-roll CSV grows chunk by chunk in a temporary file, put in place at the end.
+    let mut csv = match &per_roll {
+        Some(out) => {
+            let mut w = out.writer()?;
+            w.write_all(PER_ROLL_HEADER.as_bytes())?;
+            Some(w)
         }
         None => None,
     };
-    let dt = scene.dt;
-    let mut sink = |recs: &[RollRecord]| -> std::result::Result<(), String> {
-        if let Some((_, f)) = csv.as_mut() {
+    let dt = spec.scene.dt;
+    let mut sink = |recs: &[RollRecord]| -> dicephys::Result<()> {
+        if let Some(f) = csv.as_mut() {
             f.write_all(per_roll_rows(recs, dt).as_bytes())
-                .map_err(|e| e.to_string())?;
+                .map_err(|e| dicephys::Error::Failed(format!("--per-roll: {e}")))?;
         }
         Ok(())
     };
     let wall = Instant::now();
     let cpu = process_cpu_seconds();
-    let done = checkpoint::run(
-        a.engine,
-        &scene,
-        &throws,
-        &settle,
-        indices,
+    let runner = Runner::new(threads, super::stop().clone());
+    let done = runner.run(&spec, checkpoint.as_ref(), &mut sink)?;
+    let cost = Cost {
+        wall_s: wall.elapsed().as_secs_f64(),
+        cpu_s: process_cpu_seconds() - cpu,
         threads,
-        a.checkpoint.as_deref(),
-        &|_| {},
-        &mut sink,
-    )
-    .map_err(Error::Run)?;
-    let cpu_s = process_cpu_seconds() - cpu;
-    let wall_s = wall.elapsed().as_secs_f64();
-    let tally = done.tally;
-    if let (Some((tmp, f)), Some(p)) = (csv, &a.per_roll) {
-        f.into_inner()
-            .map_err(|e| Error::Run(e.to_string()))?
-            .sync_all()?;
-        std::fs::rename(&tmp, p)?;
+    };
+    if let Some(w) = csv {
+        w.commit()?;
     }
-    let mut summary = RunSummary::new(
-        a.engine,
-        &scene,
-        a.throw.seed,
-        a.throw.throws,
-        &ranges,
-        &settle,
-        &tally,
-        wall_s,
-        cpu_s,
-        threads,
-    );
-    summary.args = super::runargs::defining_unsharded(&args);
-    summary.shard = a.shard;
+    let tally = done.tally;
+    let mut summary = RunSummary::new(&spec, &tally, cost);
     summary.partial = !done.complete;
     if a.json {
         println!(
@@ -141,44 +137,17 @@ pub fn run(a: &RollArgs) -> Result<()> {
         print!("{}", summary.human());
     }
     if !done.complete {
-        return Err(Error::Interrupted(match &a.checkpoint {
+        let total = spec.indices().len();
+        return Err(Error::Interrupted(match dir {
             Some(d) => format!(
-                "interrupted after {} of {} rolls; continue with: dicephys roll --resume {}",
+                "interrupted after {} of {total} rolls; continue with: dicephys roll --resume {}",
                 tally.rolls,
-                indices.len(),
                 d.display()
             ),
-            None => format!(
-                "interrupted after {} of {} rolls",
-                tally.rolls,
-                indices.len()
-            ),
+            None => format!("interrupted after {} of {total} rolls", tally.rolls),
         }));
     }
     Ok(())
-}
-
-/// Creates the checkpoint directory with the run's arguments in it, or checks that an existing
-/// one holds this very run.
-fn open_checkpoint(dir: &std::path::Path, args: &[String]) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| {
-        Error::Usage(format!(
-            "--checkpoint {}: cannot create it ({e})",
-            dir.display()
-        ))
-    })?;
-    let file = dir.join("args.json");
-    let want = serde_json::to_string(args).map_err(|e| Error::Run(e.to_string()))?;
-    match std::fs::read_to_string(&file) {
-        Ok(have) if have.trim() == want => Ok(()),
-        Ok(_) => Err(Error::Usage(format!(
-            "--checkpoint {}: it holds another run; resume that with --resume, or use a new directory",
-            dir.display()
-        ))),
-        Err(_) => super::write_atomic(&file, want.as_bytes()).map_err(|e| {
-            Error::Usage(format!("--checkpoint {}: cannot write there ({e})", dir.display()))
-        }),
-    }
 }
 
 /// The per-throw CSV's header.

@@ -1,14 +1,17 @@
-//! `dicephys converge`, `tradeoff` and `stability`: the sweeps (`crate::sweeps`), each writing
+//! `dicephys converge`, `tradeoff` and `stability`: the sweeps (`dicephys::studies::sweep`), each writing
 //! `<command>.json`, `report.md` and its figures into --out.
 
 use super::args::{parse_block, parse_engine};
-use crate::block::Block;
-use crate::engine::EngineKind;
-use crate::error::{Error, Result};
-use crate::figures::sweeps as fig;
-use crate::figures::Point;
-use crate::sweeps::{converge, dt_label, parse_dt, stability, tradeoff};
+use super::error::{Error, Result};
 use clap::Args;
+use dicephys::engine::EngineKind;
+use dicephys::model::block::Block;
+use dicephys::report::figures::sweeps as fig;
+use dicephys::report::figures::Point;
+use dicephys::run::runner::Runner;
+use dicephys::studies::stability::Sweep;
+use dicephys::studies::sweep::{dt_label, parse_dt, Study};
+use dicephys::studies::{converge, stability, tradeoff};
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
@@ -97,28 +100,30 @@ pub struct StabilityArgs {
     pub json: bool,
 }
 
-fn threads(t: usize) -> usize {
-    if t == 0 {
-        rayon::current_num_threads()
-    } else {
-        t
-    }
-}
-
-fn check_common(rolls: u64, max_steps: u64, t: usize, out: &Path, file: &str) -> Result<()> {
-    if rolls == 0 || rolls > 1_000_000_000 {
+/// Checks what every sweep takes, creates --out, and sets up how cells are run: on these
+/// threads, stopped by Ctrl-C, kept under --out/checkpoint.
+fn check_common(
+    rolls: u64,
+    max_steps: u64,
+    t: usize,
+    out: &Path,
+    file: &str,
+) -> Result<Study<'static>> {
+    if rolls == 0 || rolls > dicephys::run::spec::MAX_ROLLS {
         return Err(Error::Usage(format!("--rolls {rolls}: must be in 1..=1e9")));
     }
     if max_steps == 0 {
         return Err(Error::Usage("--max-steps 0: need at least one step".into()));
     }
-    if t > 1024 {
-        return Err(Error::Usage(format!("--threads {t}: at most 1024")));
-    }
+    let threads = super::args::threads(t)?;
     std::fs::create_dir_all(out)
         .map_err(|e| Error::Usage(format!("--out {}: cannot create it ({e})", out.display())))?;
-    let _ = crate::sweeps::CHECKPOINT_DIR.set(out.join("checkpoint"));
-    super::check_writable(&out.join(file))
+    super::output(&out.join(file))?;
+    super::output(&out.join("report.md"))?;
+    Ok(Study {
+        runner: Runner::new(threads, super::stop().clone()),
+        checkpoint: Some(out.join("checkpoint")),
+    })
 }
 
 fn nonempty<T>(v: &[T], name: &str) -> Result<()> {
@@ -135,8 +140,8 @@ fn to_json<T: serde::Serialize>(v: &T) -> Result<String> {
 
 /// Writes the JSON and the report, prints one or the other.
 fn finish(out: &Path, file: &str, json: &str, report: &str, print_json: bool) -> Result<()> {
-    super::write_atomic(&out.join(file), json.as_bytes())?;
-    super::write_atomic(&out.join("report.md"), report.as_bytes())?;
+    super::output(&out.join(file))?.write(json.as_bytes())?;
+    super::output(&out.join("report.md"))?.write(report.as_bytes())?;
     if print_json {
         println!("{json}");
     } else {
@@ -150,17 +155,18 @@ pub fn converge(a: &ConvergeArgs) -> Result<()> {
     nonempty(&a.blocks, "--blocks")?;
     nonempty(&a.dts, "--dts")?;
     nonempty(&a.engines, "--engines")?;
-    check_common(a.rolls, a.max_steps, a.threads, &a.out, "converge.json")?;
+    let study = check_common(a.rolls, a.max_steps, a.threads, &a.out, "converge.json")?;
     let cfg = converge::Config {
         blocks: a.blocks.clone(),
         dts: a.dts.clone(),
         engines: a.engines.clone(),
         rolls: a.rolls,
         seed: a.seed,
-        threads: threads(a.threads),
         max_steps: a.max_steps,
     };
-    let res = logged(a.json, &converge::header(), |log| converge::run(&cfg, log))?;
+    let res = logged(a.json, &converge::header(), |log| {
+        converge::run(&cfg, &study, log)
+    })?;
     let lines: Vec<fig::Line> = group(&res.cells, |c| {
         format!("{} {} {}", c.block, c.engine, c.mode)
     })
@@ -182,8 +188,7 @@ pub fn converge(a: &ConvergeArgs) -> Result<()> {
         "converge",
         &format!("Ratio against dt ({} rolls per point)", a.rolls),
         &lines,
-    )
-    .map_err(Error::Run)?;
+    )?;
     let mut md = format!(
         "# Convergence in dt\n\n{} rolls per cell, seed {}, rolls ended by {}.\n\n```\n{}\n",
         res.rolls,
@@ -221,17 +226,18 @@ pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
             dt_label(a.reference_dt)
         )));
     }
-    check_common(a.rolls, a.max_steps, a.threads, &a.out, "tradeoff.json")?;
+    let study = check_common(a.rolls, a.max_steps, a.threads, &a.out, "tradeoff.json")?;
     let cfg = tradeoff::Config {
         block: a.block,
         dts: a.dts.clone(),
         reference_dt: a.reference_dt,
         rolls: a.rolls,
         seed: a.seed,
-        threads: threads(a.threads),
         max_steps: a.max_steps,
     };
-    let res = logged(a.json, &tradeoff::header(), |log| tradeoff::run(&cfg, log))?;
+    let res = logged(a.json, &tradeoff::header(), |log| {
+        tradeoff::run(&cfg, &study, log)
+    })?;
     let mut pts = Vec::new();
     for m in &res.modes {
         for r in &m.rows {
@@ -240,7 +246,7 @@ pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
                 cost: r.cpu_s_per_1000,
                 error: 100.0 * r.error.abs(),
                 error_err: 100.0 * r.error_err,
-                two_d: r.mode == "2d",
+                two_d: r.mode == dicephys::model::scene::Mode::TwoD,
                 on_front: m.pareto_front.contains(&r.method),
             });
         }
@@ -253,8 +259,7 @@ pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
             res.block, res.rolls
         ),
         &pts,
-    )
-    .map_err(Error::Run)?;
+    )?;
     let mut md = format!(
         "# Accuracy against cost\n\n{}, {} rolls per method, seed {}; reference: Bullet, box floor, \
          DicePhys's rule, every step stepped, dt {}.\n\n",
@@ -302,7 +307,7 @@ pub fn stability(a: &StabilityArgs) -> Result<()> {
             "--frictions {m}: must be finite and >= 0"
         )));
     }
-    check_common(a.rolls, a.max_steps, a.threads, &a.out, "stability.json")?;
+    let study = check_common(a.rolls, a.max_steps, a.threads, &a.out, "stability.json")?;
     let cfg = stability::Config {
         engines: a.engines.clone(),
         dts: a.dts.clone(),
@@ -311,18 +316,17 @@ pub fn stability(a: &StabilityArgs) -> Result<()> {
         blocks: a.blocks.clone(),
         rolls: a.rolls,
         seed: a.seed,
-        threads: threads(a.threads),
         max_steps: a.max_steps,
     };
     let res = logged(a.json, &stability::header(), |log| {
-        stability::run(&cfg, log)
+        stability::run(&cfg, &study, log)
     })?;
     let mut figures = Vec::new();
     for kind in stability::KINDS {
         let panels: Vec<fig::Panel> = group(
             &res.cells
                 .iter()
-                .filter(|c| c.sweep == "dt_restitution")
+                .filter(|c| c.sweep == Sweep::DtRestitution)
                 .collect::<Vec<_>>(),
             |c| format!("{} {}", c.engine, c.mode),
         )
@@ -359,8 +363,7 @@ pub fn stability(a: &StabilityArgs) -> Result<()> {
                 res.rolls
             ),
             &panels,
-        )
-        .map_err(Error::Run)?;
+        )?;
         figures.push(stem);
     }
     let mut md = format!(
@@ -391,7 +394,7 @@ pub fn stability(a: &StabilityArgs) -> Result<()> {
 fn logged<T>(
     quiet: bool,
     header: &str,
-    run: impl FnOnce(&dyn Fn(&str)) -> std::result::Result<T, String>,
+    run: impl FnOnce(&dyn Fn(&str)) -> dicephys::Result<T>,
 ) -> Result<T> {
     if !quiet {
         eprintln!("{header}");
@@ -401,5 +404,5 @@ fn logged<T>(
             eprintln!("{l}")
         }
     })
-    .map_err(Error::Run)
+    .map_err(Error::from)
 }

@@ -1,14 +1,15 @@
 //! `dicephys trace`: one throw's trajectory as CSV, for looking at a single roll.
 
 use super::args::{parse_engine, SceneArgs, ThrowArgs};
-use crate::engine::{new_engine, BodyState, EngineKind};
-use crate::error::{Error, Result};
-use crate::roll::{roll_observed, Fate, Settle, DEFAULT_MAX_STEPS};
-use crate::settle::DieShape;
-use crate::throws::Throws;
+use super::error::{Error, Result};
 use clap::Args;
+use dicephys::engine::{new_engine, EngineKind};
+use dicephys::model::die::DieShape;
+use dicephys::model::state::BodyState;
+use dicephys::sim::roll::{roll_observed, Fate, RollConfig, DEFAULT_MAX_STEPS};
 use std::io::Write;
 
+/// `dicephys trace`'s arguments.
 #[derive(Args, Debug)]
 pub struct TraceArgs {
     /// Physics engine: bullet, rapier (in 2D a true 2D body), rapier-locked (in 2D a locked 3D
@@ -37,15 +38,19 @@ pub struct TraceArgs {
 pub fn run(a: &TraceArgs) -> Result<()> {
     let scene = a.scene.scene()?;
     let die = DieShape::of(&scene);
-    let ranges = a.throw.ranges()?;
+    let throw_spec = a.throw.spec()?;
     if a.every == 0 || a.max_steps == 0 {
         return Err(Error::Usage(
             "--every and --max-steps must be at least 1".into(),
         ));
     }
-    let throws = Throws::new(a.throw.throws, a.throw.seed, ranges, a.index + 1);
+    let n = a
+        .index
+        .checked_add(1)
+        .ok_or_else(|| Error::Usage(format!("--index {}: too large", a.index)))?;
+    let throws = throw_spec.source(n);
     let throw = throws.get(a.index);
-    let mut engine = new_engine(a.engine, &scene).map_err(Error::Run)?;
+    let mut engine = new_engine(a.engine, &scene)?;
     let out = std::io::stdout();
     let mut out = std::io::BufWriter::new(out.lock());
     let _ = writeln!(
@@ -79,10 +84,10 @@ pub fn run(a: &TraceArgs) -> Result<()> {
             s.sleeping as u8
         )
     };
-    let settle = Settle {
+    let settle = RollConfig {
         max_steps: a.max_steps,
         fast_flight: a.flight == "fast",
-        ..Settle::default()
+        ..RollConfig::default()
     };
     let record = roll_observed(engine.as_mut(), &scene, &throw, &settle, |step, s| {
         let l = line(step, s);

@@ -1,7 +1,7 @@
 //! Bullet (Debian's libbullet, double precision) through the C++ shim in `cpp/`.
 
 use super::{BodyState, Engine};
-use crate::scene::{Floor, Mode, Preset, Scene};
+use crate::model::scene::{Floor, Mode, Preset, Scene};
 use cxx::UniquePtr;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
@@ -101,7 +101,7 @@ pub struct Bullet {
 }
 
 impl Bullet {
-    pub fn new(scene: &Scene) -> Result<Bullet, String> {
+    pub fn new(scene: &Scene) -> crate::Result<Bullet> {
         let s = solver(scene.preset);
         let desc = ffi::BulletScene {
             sides: scene.body_sides(),
@@ -120,7 +120,8 @@ impl Bullet {
             solver_iterations: 10,
             deactivation: true,
         };
-        let world = ffi::new_world(&desc).map_err(|e| format!("bullet: {e}"))?;
+        let world =
+            ffi::new_world(&desc).map_err(|e| crate::Error::Engine(format!("bullet: {e}")))?;
         let now = world.state();
         Ok(Bullet {
             world,
@@ -131,8 +132,11 @@ impl Bullet {
 
     /// Steps `n` times inside C++ with no call back into Rust: the benchmark's baseline
     /// for what one FFI call per step costs.
-    pub fn step_n(&mut self, n: u32) -> Result<(), String> {
-        self.world.pin_mut().step_n(n).map_err(|e| e.to_string())
+    pub fn step_n(&mut self, n: u32) -> crate::Result<()> {
+        self.world
+            .pin_mut()
+            .step_n(n)
+            .map_err(|e| crate::Error::Engine(e.to_string()))
     }
 }
 
@@ -148,20 +152,20 @@ fn to_ffi(s: &BodyState) -> ffi::BodyStateFfi {
 }
 
 impl Engine for Bullet {
-    fn reset(&mut self, start: &BodyState) -> Result<(), String> {
+    fn reset(&mut self, start: &BodyState) -> crate::Result<()> {
         self.world
             .pin_mut()
             .reset(&to_ffi(start))
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| crate::Error::Engine(e.to_string()))?;
         self.now = self.world.state();
         Ok(())
     }
 
-    fn set_state(&mut self, now: &BodyState) -> Result<(), String> {
+    fn set_state(&mut self, now: &BodyState) -> crate::Result<()> {
         self.world
             .pin_mut()
             .set_state(&to_ffi(now))
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| crate::Error::Engine(e.to_string()))?;
         self.now = self.world.state();
         Ok(())
     }
@@ -175,8 +179,12 @@ impl Engine for Bullet {
         self.world.contact_points() == 0
     }
 
-    fn step(&mut self) -> Result<(), String> {
-        self.now = self.world.pin_mut().step().map_err(|e| e.to_string())?;
+    fn step(&mut self) -> crate::Result<()> {
+        self.now = self
+            .world
+            .pin_mut()
+            .step()
+            .map_err(|e| crate::Error::Engine(e.to_string()))?;
         Ok(())
     }
 

@@ -7,7 +7,7 @@
 //! crate reads: position (x, y, 0), rotation about z, velocity (vx, vy, 0), spin (0, 0, ω).
 
 use super::{BodyState, Engine};
-use crate::scene::{Floor, Mode, Scene};
+use crate::model::scene::{Floor, Mode, Scene};
 use nalgebra::{UnitQuaternion, Vector3};
 use rapier2d_f64::prelude::*;
 
@@ -18,12 +18,16 @@ pub struct Rapier2d {
 }
 
 impl Rapier2d {
-    pub fn new(scene: &Scene) -> Result<Rapier2d, String> {
+    pub fn new(scene: &Scene) -> crate::Result<Rapier2d> {
         if scene.mode != Mode::TwoD {
-            return Err("rapier2d: a 2D engine needs the 2D scene (--2d)".into());
+            return Err(crate::Error::Engine(
+                "rapier2d: a 2D engine needs the 2D scene (--2d)".into(),
+            ));
         }
         if !(scene.dt > 0.0 && scene.mass() > 0.0) {
-            return Err("rapier2d: bad scene (dt and mass must be positive)".into());
+            return Err(crate::Error::Engine(
+                "rapier2d: bad scene (dt and mass must be positive)".into(),
+            ));
         }
         let mut world = PhysicsWorld::new();
         world.gravity = Vector::new(0.0, -scene.gravity);
@@ -86,7 +90,7 @@ fn planar_pose(s: &BodyState) -> Pose {
 impl Engine for Rapier2d {
     /// As in 3D, a throw starts from a new body and collider. The start must lie in the
     /// plane: a rotation about z only, no z position or velocity, spin about z only.
-    fn reset(&mut self, start: &BodyState) -> Result<(), String> {
+    fn reset(&mut self, start: &BodyState) -> crate::Result<()> {
         let q = start.rotation.quaternion();
         if start.position.z != 0.0
             || start.linear_velocity.z != 0.0
@@ -95,7 +99,9 @@ impl Engine for Rapier2d {
             || q.i != 0.0
             || q.j != 0.0
         {
-            return Err("rapier2d: the start state is not in the x-y plane".into());
+            return Err(crate::Error::Engine(
+                "rapier2d: the start state is not in the x-y plane".into(),
+            ));
         }
         if let Some(h) = self.die.take() {
             self.world.remove_body(h);
@@ -110,14 +116,16 @@ impl Engine for Rapier2d {
         Ok(())
     }
 
-    fn step(&mut self) -> Result<(), String> {
+    fn step(&mut self) -> crate::Result<()> {
         if self.die.is_none() {
-            return Err("rapier2d: step before reset".into());
+            return Err(crate::Error::Engine("rapier2d: step before reset".into()));
         }
         self.world.step();
         // A quarantined body is reset to a finite pose at rest; report it (see rapier3d.rs).
         if !self.world.quarantine().is_empty() {
-            return Err("rapier2d: the die's state went non-finite (quarantined)".into());
+            return Err(crate::Error::Engine(
+                "rapier2d: the die's state went non-finite (quarantined)".into(),
+            ));
         }
         Ok(())
     }

@@ -5,7 +5,7 @@
 //! the components across, exactly.
 
 use super::{BodyState, Engine};
-use crate::scene::{Floor, Mode, Scene};
+use crate::model::scene::{Floor, Mode, Scene};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use rapier3d_f64::prelude::*;
 
@@ -24,9 +24,11 @@ pub struct Rapier3d {
 }
 
 impl Rapier3d {
-    pub fn new(scene: &Scene) -> Result<Rapier3d, String> {
+    pub fn new(scene: &Scene) -> crate::Result<Rapier3d> {
         if !(scene.dt > 0.0 && scene.mass() > 0.0) {
-            return Err("rapier: bad scene (dt and mass must be positive)".into());
+            return Err(crate::Error::Engine(
+                "rapier: bad scene (dt and mass must be positive)".into(),
+            ));
         }
         let mut world = PhysicsWorld::new();
         world.gravity = Vector::new(0.0, -scene.gravity, 0.0);
@@ -109,7 +111,7 @@ impl Engine for Rapier3d {
     /// contact pair (with its warm-start impulses), its island and its sleep timer. Verified
     /// in tests/rapier.rs: a throw after another on the same world goes step for step as on a
     /// fresh world.
-    fn reset(&mut self, start: &BodyState) -> Result<(), String> {
+    fn reset(&mut self, start: &BodyState) -> crate::Result<()> {
         if let Some(h) = self.die.take() {
             self.world.remove_body(h);
         }
@@ -128,15 +130,17 @@ impl Engine for Rapier3d {
         Ok(())
     }
 
-    fn step(&mut self) -> Result<(), String> {
+    fn step(&mut self) -> crate::Result<()> {
         if self.die.is_none() {
-            return Err("rapier: step before reset".into());
+            return Err(crate::Error::Engine("rapier: step before reset".into()));
         }
         self.world.step();
         // Rapier does not let a NaN through: it puts the body back at its last finite pose
         // with zero velocity and disables it, which would look like a die at rest. Report it.
         if !self.world.quarantine().is_empty() {
-            return Err("rapier: the die's state went non-finite (quarantined)".into());
+            return Err(crate::Error::Engine(
+                "rapier: the die's state went non-finite (quarantined)".into(),
+            ));
         }
         Ok(())
     }

@@ -67,18 +67,18 @@ impl MarkovChain {
     }
 
     /// The chain of figure (MarkovChainCompleate) for sides k, l > 0 and parameter
-    /// γ·½mg in (0, [`Self::max_gamma_half_mg`]]. Anything else is an `Error::Usage`.
+    /// γ·½mg in (0, [`Self::max_gamma_half_mg`]]. Anything else is an `Error::Invalid`.
     pub fn new(k: f64, l: f64, gamma_half_mg: f64) -> Result<MarkovChain> {
         for (name, v) in [("k", k), ("l", l)] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(Error::Usage(format!(
+                return Err(Error::Invalid(format!(
                     "Markov chain side {name} must be positive and finite, got {v}"
                 )));
             }
         }
         let max = Self::max_gamma_half_mg(k, l);
         if !(gamma_half_mg.is_finite() && gamma_half_mg > 0.0 && gamma_half_mg <= max) {
-            return Err(Error::Usage(format!(
+            return Err(Error::Invalid(format!(
                 "Markov chain gamma*(mg/2) must be in (0, {max}] for k = {k}, l = {l} \
                  (every arc a probability), got {gamma_half_mg}"
             )));
@@ -171,7 +171,7 @@ impl MarkovChain {
         let p = self.transition_matrix();
         let q: Matrix3<f64> = p.fixed_view::<3, 3>(0, 0).into_owned();
         (Matrix3::identity() - q).try_inverse().ok_or_else(|| {
-            Error::Run("Markov chain: I - Q is singular (no absorbing path)".to_string())
+            Error::Failed("Markov chain: I - Q is singular (no absorbing path)".to_string())
         })
     }
 
@@ -199,7 +199,7 @@ impl MarkovChain {
         for t in 0..T {
             let d: f64 = (t + 1..5).map(|j| w[(t, j)]).sum();
             if d.is_nan() || d <= 0.0 {
-                return Err(Error::Run(format!(
+                return Err(Error::Failed(format!(
                     "Markov chain: state {} cannot leave the transient states",
                     t + 1
                 )));
@@ -352,7 +352,7 @@ mod tests {
         let max = MarkovChain::max_gamma_half_mg(k, l);
         for g in [0.0, -1.0, max * (1.0 + 1e-9), f64::NAN, f64::INFINITY] {
             assert!(
-                matches!(MarkovChain::new(k, l, g), Err(Error::Usage(_))),
+                matches!(MarkovChain::new(k, l, g), Err(Error::Invalid(_))),
                 "{g}"
             );
         }

@@ -1,0 +1,9 @@
+//! What is thrown and where: the block and its sides, the die as a rigid body, its state, the
+//! scene (floor, surface, time step), and the throws' initial conditions.
+
+pub mod block;
+pub mod die;
+pub mod glibc;
+pub mod scene;
+pub mod state;
+pub mod throws;

@@ -1,0 +1,35 @@
+//! The die's state: where it is, how it is turned, how it moves.
+
+use nalgebra::{UnitQuaternion, Vector3};
+
+/// The die's state in world coordinates (y up, floor top at y = 0).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyState {
+    pub position: Vector3<f64>,
+    pub rotation: UnitQuaternion<f64>,
+    pub linear_velocity: Vector3<f64>,
+    pub angular_velocity: Vector3<f64>,
+    /// The engine has put the body to sleep (deactivated it).
+    pub sleeping: bool,
+}
+
+impl BodyState {
+    /// At rest at the origin, unrotated: the state of a world with no die in it yet.
+    pub fn at_origin() -> BodyState {
+        BodyState {
+            position: Vector3::zeros(),
+            rotation: UnitQuaternion::identity(),
+            linear_velocity: Vector3::zeros(),
+            angular_velocity: Vector3::zeros(),
+            sleeping: false,
+        }
+    }
+
+    pub fn is_finite(&self) -> bool {
+        let q = self.rotation.quaternion();
+        self.position.iter().all(|v| v.is_finite())
+            && [q.i, q.j, q.k, q.w].iter().all(|v| v.is_finite())
+            && self.linear_velocity.iter().all(|v| v.is_finite())
+            && self.angular_velocity.iter().all(|v| v.is_finite())
+    }
+}

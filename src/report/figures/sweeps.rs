@@ -1,0 +1,356 @@
+//! The sweeps' figures: the ratio against dt (`convergence`), cost against error with the
+//! Pareto front (`tradeoff`), and failure fractions as heat maps (`heatmap`). Log axes are drawn
+//! as log10 of the value with ticks labelled by the value itself.
+
+use super::*;
+
+/// One line of the convergence figure: points at x = dt.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Line {
+    pub label: String,
+    pub points: Vec<Point>,
+}
+
+/// One method of the trade-off figure.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MethodPoint {
+    pub label: String,
+    /// CPU seconds per 1,000 rolls.
+    pub cost: f64,
+    /// |departure| from the reference, per cent, and its error.
+    pub error: f64,
+    pub error_err: f64,
+    pub two_d: bool,
+    pub on_front: bool,
+}
+
+/// One heat map: `values[y][x]` in [0, 1] (NaN: no data).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Panel {
+    pub title: String,
+    pub x_desc: String,
+    pub y_desc: String,
+    pub x_labels: Vec<String>,
+    pub y_labels: Vec<String>,
+    pub values: Vec<Vec<f64>>,
+}
+
+const LINES: [RGBColor; 12] = [
+    RGBColor(0, 0, 139),
+    RGBColor(210, 0, 0),
+    RGBColor(0, 140, 0),
+    RGBColor(128, 0, 128),
+    RGBColor(230, 130, 0),
+    RGBColor(0, 150, 200),
+    RGBColor(160, 82, 45),
+    RGBColor(120, 120, 0),
+    RGBColor(200, 0, 200),
+    RGBColor(80, 140, 230),
+    RGBColor(0, 170, 120),
+    RGBColor(110, 110, 110),
+];
+
+/// `x` rounded to two significant figures.
+fn two_figures(x: f64) -> f64 {
+    if !(x.is_finite() && x > 0.0) {
+        return x;
+    }
+    let p = 10f64.powf(x.log10().floor() - 1.0);
+    (x / p).round() * p
+}
+
+/// A log10 tick for a time step: 1/N, N to two significant figures.
+fn log_tick_dt(v: &f64) -> String {
+    format!("1/{}", two_figures(10f64.powf(-*v)))
+}
+
+/// A log10 tick: the value to two significant figures.
+fn log_tick(v: &f64) -> String {
+    tick(&two_figures(10f64.powf(*v)))
+}
+
+/// `chart` with its own x tick labels.
+fn chart_x<'a, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
+    title: &str,
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+    x_desc: &str,
+    y_desc: &str,
+    x_fmt: &dyn Fn(&f64) -> String,
+) -> Result<Chart<'a, DB>, String> {
+    root.fill(&WHITE).map_err(plot_err)?;
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, (FONT, 24))
+        .margin(20)
+        .x_label_area_size(55)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x, y)
+        .map_err(plot_err)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .axis_desc_style((FONT, 20))
+        .label_style((FONT, 16))
+        .x_labels(7)
+        .x_label_formatter(x_fmt)
+        .y_label_formatter(&tick)
+        .light_line_style(RGBColor(243, 243, 243))
+        .bold_line_style(RGBColor(210, 210, 210))
+        .draw()
+        .map_err(plot_err)?;
+    Ok(chart)
+}
+
+struct Convergence<'a> {
+    title: &'a str,
+    lines: &'a [Line],
+}
+
+impl Figure for Convergence<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let mut xs = Span::new(f64::INFINITY, f64::NEG_INFINITY);
+        let mut ys = Span::new(f64::INFINITY, f64::NEG_INFINITY);
+        let lines: Vec<Line> = self
+            .lines
+            .iter()
+            .map(|l| Line {
+                label: l.label.clone(),
+                points: l
+                    .points
+                    .iter()
+                    .filter(|p| p.x > 0.0)
+                    .map(|p| Point {
+                        x: p.x.log10(),
+                        ..*p
+                    })
+                    .collect(),
+            })
+            .collect();
+        for p in lines.iter().flat_map(|l| &l.points) {
+            xs.add(p.x);
+            ys.add_point(p);
+        }
+        if !(xs.lo.is_finite() && ys.lo.is_finite()) {
+            xs = Span::new(-4.0, -1.0);
+            ys = Span::new(0.0, 1.0);
+        }
+        let mut chart = chart_x(
+            root,
+            self.title,
+            xs.padded(0.05, 0.05),
+            ys.padded(0.05, 0.35),
+            "time step dt, s (log scale)",
+            RATIO_DESC,
+            &log_tick_dt,
+        )?;
+        for (i, l) in lines.iter().enumerate() {
+            let marker = if l.label.contains(" 2d") {
+                Marker::Circle
+            } else {
+                Marker::Triangle
+            };
+            points(
+                &mut chart,
+                &l.points,
+                LINES[i % LINES.len()],
+                marker,
+                true,
+                &l.label,
+            )?;
+        }
+        legend(&mut chart, SeriesLabelPosition::UpperRight)
+    }
+}
+
+/// The ratio against dt, one line per block × engine × mode.
+pub fn convergence(dir: &Path, stem: &str, title: &str, lines: &[Line]) -> crate::Result<()> {
+    write_both(dir, stem, &Convergence { title, lines })
+}
+
+struct Tradeoff<'a> {
+    title: &'a str,
+    methods: &'a [MethodPoint],
+}
+
+impl Figure for Tradeoff<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let ok: Vec<&MethodPoint> = self
+            .methods
+            .iter()
+            .filter(|m| m.cost > 0.0 && m.cost.is_finite() && m.error.is_finite())
+            .collect();
+        let mut xs = Span::new(f64::INFINITY, f64::NEG_INFINITY);
+        let mut ys = Span::new(0.0, 1.0);
+        for m in &ok {
+            xs.add(m.cost.log10());
+            ys.add(m.error + bar(m.error_err));
+        }
+        if !xs.lo.is_finite() {
+            xs = Span::new(0.0, 1.0);
+        }
+        let mut chart = chart_x(
+            root,
+            self.title,
+            xs.padded(0.08, 0.08),
+            (0.0)..(ys.hi * 1.15),
+            "CPU seconds per 1,000 rolls (log scale)",
+            "|departure from the reference|, %",
+            &log_tick,
+        )?;
+        for (two_d, color, label) in [
+            (false, RGBColor(128, 0, 128), "3D methods"),
+            (true, RGBColor(0, 140, 120), "2D methods"),
+        ] {
+            let pts: Vec<Point> = ok
+                .iter()
+                .filter(|m| m.two_d == two_d)
+                .map(|m| Point {
+                    x: m.cost.log10(),
+                    y: m.error,
+                    y_err: m.error_err,
+                })
+                .collect();
+            let marker = if two_d {
+                Marker::Circle
+            } else {
+                Marker::Triangle
+            };
+            points(&mut chart, &pts, color, marker, false, label)?;
+            let mut front: Vec<&&MethodPoint> = ok
+                .iter()
+                .filter(|m| m.two_d == two_d && m.on_front)
+                .collect();
+            front.sort_by(|a, b| a.cost.total_cmp(&b.cost));
+            let line: Vec<(f64, f64)> = front.iter().map(|m| (m.cost.log10(), m.error)).collect();
+            solid(
+                &mut chart,
+                line,
+                color.stroke_width(2),
+                &format!("{label}: Pareto front"),
+            )?;
+            chart
+                .draw_series(front.iter().map(|m| {
+                    // The name beside its marker, a little up and to the right.
+                    EmptyElement::at((m.cost.log10(), m.error))
+                        + Text::new(
+                            m.label.clone(),
+                            (9, -16),
+                            (FONT, 13).into_font().color(&color),
+                        )
+                }))
+                .map_err(plot_err)?;
+        }
+        chart
+            .draw_series(DashedLineSeries::new(
+                vec![(xs.lo - 10.0, 1.0), (xs.hi + 10.0, 1.0)],
+                6,
+                5,
+                GREY.stroke_width(1),
+            ))
+            .map_err(plot_err)?;
+        legend(&mut chart, SeriesLabelPosition::UpperRight)
+    }
+}
+
+/// Cost against |error|, one marker per method, the Pareto fronts drawn and named; a dashed
+/// line at 1 %.
+pub fn tradeoff(dir: &Path, stem: &str, title: &str, methods: &[MethodPoint]) -> crate::Result<()> {
+    write_both(dir, stem, &Tradeoff { title, methods })
+}
+
+struct Heatmap<'a> {
+    title: &'a str,
+    panels: &'a [Panel],
+}
+
+/// White (0) to dark red (1).
+fn heat(v: f64) -> RGBColor {
+    if !v.is_finite() {
+        return RGBColor(220, 220, 220);
+    }
+    let v = v.clamp(0.0, 1.0);
+    let lerp = |a: f64, b: f64| (a + (b - a) * v).round() as u8;
+    RGBColor(lerp(255.0, 170.0), lerp(255.0, 0.0), lerp(255.0, 0.0))
+}
+
+impl Figure for Heatmap<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        root.fill(&WHITE).map_err(plot_err)?;
+        let root = root.titled(self.title, (FONT, 24)).map_err(plot_err)?;
+        let n = self.panels.len().max(1);
+        let cols = if n > 1 { 2 } else { 1 };
+        let rows = n.div_ceil(cols);
+        let areas = root.split_evenly((rows, cols));
+        for (p, area) in self.panels.iter().zip(areas.iter()) {
+            let nx = p.x_labels.len().max(1);
+            let ny = p.y_labels.len().max(1);
+            let xl = p.x_labels.clone();
+            let yl = p.y_labels.clone();
+            let fx = move |v: &f64| label_at(&xl, *v);
+            let fy = move |v: &f64| label_at(&yl, *v);
+            let mut chart = ChartBuilder::on(area)
+                .caption(&p.title, (FONT, 18))
+                .margin(12)
+                .x_label_area_size(45)
+                .y_label_area_size(60)
+                .build_cartesian_2d(0.0..nx as f64, 0.0..ny as f64)
+                .map_err(plot_err)?;
+            chart
+                .configure_mesh()
+                .disable_mesh()
+                .x_desc(p.x_desc.as_str())
+                .y_desc(p.y_desc.as_str())
+                .axis_desc_style((FONT, 15))
+                .label_style((FONT, 13))
+                .x_labels(nx * 2 + 1)
+                .y_labels(ny * 2 + 1)
+                .x_label_formatter(&fx)
+                .y_label_formatter(&fy)
+                .draw()
+                .map_err(plot_err)?;
+            for (j, row) in p.values.iter().enumerate() {
+                for (i, &v) in row.iter().enumerate() {
+                    let (x, y) = (i as f64, j as f64);
+                    chart
+                        .draw_series(std::iter::once(Rectangle::new(
+                            [(x, y), (x + 1.0, y + 1.0)],
+                            heat(v).filled(),
+                        )))
+                        .map_err(plot_err)?;
+                    let text = if v.is_finite() {
+                        format!("{:.0}%", 100.0 * v)
+                    } else {
+                        "–".into()
+                    };
+                    let color = if v > 0.5 { WHITE } else { BLACK };
+                    chart
+                        .draw_series(std::iter::once(Text::new(
+                            text,
+                            (x + 0.38, y + 0.55),
+                            (FONT, 14).into_font().color(&color),
+                        )))
+                        .map_err(plot_err)?;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The label of the cell whose centre is at `v` (ticks fall on centres and edges; edges get
+/// none).
+fn label_at(labels: &[String], v: f64) -> String {
+    let c = v - 0.5;
+    if (c - c.round()).abs() < 1e-6 && c >= 0.0 {
+        labels.get(c.round() as usize).cloned().unwrap_or_default()
+    } else {
+        String::new()
+    }
+}
+
+/// Heat maps of fractions, one panel per engine × mode (or whatever the caller groups).
+pub fn heatmap(dir: &Path, stem: &str, title: &str, panels: &[Panel]) -> crate::Result<()> {
+    write_both(dir, stem, &Heatmap { title, panels })
+}

@@ -1,0 +1,7 @@
+//! What results say: a run's summary, the theory and the paper's table as reports, the paper's
+//! Markdown and CSV, and the figures.
+
+pub mod figures;
+pub mod paper;
+pub mod summary;
+pub mod table;

@@ -1,0 +1,334 @@
+//! The paper's report: its results as data, `report.md`, `results.csv` and the figures.
+
+use crate::engine::EngineKind;
+use crate::error::Result;
+use crate::model::scene::{Mode, Preset};
+use crate::report::summary::RunSummary;
+use crate::report::table::TableReport;
+use crate::theory::stats::Ratio;
+use serde::Serialize;
+
+/// One simulated cell: a block of the table, an engine, 2D or 3D.
+#[derive(Clone, Debug, Serialize)]
+pub struct SimCell {
+    pub row: usize,
+    pub label: String,
+    pub engine: EngineKind,
+    pub mode: Mode,
+    /// Stopped before all its rolls were made: the counts cover the rolls made.
+    pub partial: bool,
+    pub ratio: Ratio,
+    /// (simulation − experiment) / combined error.
+    pub z_experiment: f64,
+    /// (simulation − theory) / combined error.
+    pub z_theory: f64,
+    pub run: RunSummary,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Provenance {
+    pub command_line: String,
+    pub dicephys_version: String,
+    pub engines: Vec<String>,
+    /// The engines' short names, as in `simulations[].engine`.
+    pub engines_short: Vec<EngineKind>,
+    pub preset: Preset,
+    pub dt: f64,
+    pub seed: u64,
+    pub rolls_per_cell: u64,
+    pub date_utc: String,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct PaperResults {
+    /// Stopped by Ctrl-C: only the cells in `simulations` were (wholly or partly) rolled.
+    pub partial: bool,
+    pub provenance: Provenance,
+    pub table: TableReport,
+    pub simulations: Vec<SimCell>,
+    pub wall_s: f64,
+    pub cpu_s: f64,
+    /// Surfaces whose μ and e the paper did not measure: not simulated, and why.
+    pub not_simulated: String,
+}
+
+/// The current UTC date and time, ISO 8601, from the system clock.
+pub fn utc_now() -> String {
+    let f = time::macros::format_description!("[year]-[month]-[day]T[hour]:[minute]:[second]Z");
+    time::OffsetDateTime::now_utc()
+        .format(&f)
+        .unwrap_or_else(|_| "unknown".into())
+}
+
+fn fmt_z(z: f64) -> String {
+    if z.is_finite() {
+        format!("{z:+.1}")
+    } else {
+        "–".into()
+    }
+}
+
+/// The cell for (row, engine, mode), if simulated.
+pub fn cell<'a>(
+    res: &'a PaperResults,
+    row: usize,
+    engine: EngineKind,
+    mode: Mode,
+) -> Option<&'a SimCell> {
+    res.simulations
+        .iter()
+        .find(|c| c.row == row && c.engine == engine && c.mode == mode)
+}
+
+/// report.md: the table formatted like the paper's, the simulation columns, and a reading.
+pub fn report_markdown(res: &PaperResults, figures: &[&str]) -> String {
+    let p = &res.provenance;
+    let engines: Vec<EngineKind> = {
+        let mut v: Vec<EngineKind> = res.simulations.iter().map(|c| c.engine).collect();
+        v.dedup();
+        let mut seen = Vec::new();
+        for e in v {
+            if !seen.contains(&e) {
+                seen.push(e);
+            }
+        }
+        seen
+    };
+    let mut s = String::new();
+    s += "# Pender & Uhrin (2014) reproduced by dicephys\n\n";
+    if res.partial {
+        s += "**PARTIAL**: stopped before every cell was simulated; run the same command again \
+              to continue from the checkpoint.\n\n";
+    }
+    s += &format!(
+        "Command: `{}`  \nDate: {}  \ndicephys {}; engines: {}; preset {}; dt {} s; seed {}; \
+         {} rolls per simulated cell (keyed throws, the paper's ranges); wall {:.0} s, CPU {:.0} s.\n\n",
+        p.command_line,
+        p.date_utc,
+        p.dicephys_version,
+        p.engines.join(", "),
+        p.preset,
+        p.dt,
+        p.seed,
+        p.rolls_per_cell,
+        res.wall_s,
+        res.cpu_s
+    );
+    // Statistical resolution bought by this many rolls.
+    let errs: Vec<f64> = res.simulations.iter().map(|c| c.ratio.err).collect();
+    if !errs.is_empty() {
+        let lo = errs.iter().cloned().fold(f64::INFINITY, f64::min);
+        let hi = errs.iter().cloned().fold(0.0, f64::max);
+        s += &format!(
+            "Statistical resolution: a simulated ratio's binomial error is {lo:.4}–{hi:.4} at \
+             {} rolls (it falls as 1/√rolls; `--rolls 100000` is the paper's own scale).\n\n",
+            p.rolls_per_cell
+        );
+    }
+    s += "## The paper's table, with our simulations\n\n";
+    s += "Ratio = N(breadth vertical)/N(width vertical). Theory: eq. (MasterEqu), ± from the \
+          printed side errors. Measured: the paper's counts, ± binomial. No bounce: eq. (InElasK). \
+          Simulated cells: ratio ± binomial error, then z against experiment / against theory.\n\n";
+    let mut head = String::from(
+        "| row | L × B × W (mm) | R | theory | surface | throws | L | B | W | measured | z | no bounce |",
+    );
+    let mut rule = String::from("|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for e in &engines {
+        for m in ["3D", "2D"] {
+            head += &format!(" {e} {m} (z exp / z th) |");
+            rule += "---|";
+        }
+    }
+    s += &head;
+    s += "\n";
+    s += &rule;
+    s += "\n";
+    for r in &res.table.rows {
+        s += &format!(
+            "| {}{} | {}×{}×{} | {:.3} ± {:.3} | {:.3} ± {:.3} | {} | {} | {} | {} | {} | {:.3} ± {:.3} | {} | {:.3} |",
+            r.row,
+            if r.simulated { "*" } else { "" },
+            r.length_mm,
+            r.breadth_mm,
+            r.width_mm,
+            r.r.value,
+            r.r.err,
+            r.theory_ratio.value,
+            r.theory_ratio.err,
+            r.surface.name(),
+            r.throws,
+            r.length_vertical,
+            r.breadth_vertical,
+            r.width_vertical,
+            r.measured_ratio.value,
+            r.measured_ratio.err,
+            fmt_z(r.z),
+            r.no_bounce_ratio
+        );
+        for e in &engines {
+            for m in [Mode::ThreeD, Mode::TwoD] {
+                match cell(res, r.row, *e, m) {
+                    Some(c) => {
+                        s += &format!(
+                            " {:.4} ± {:.4} ({} / {}) |",
+                            c.ratio.value,
+                            c.ratio.err,
+                            fmt_z(c.z_experiment),
+                            fmt_z(c.z_theory)
+                        )
+                    }
+                    None => s += " |",
+                }
+            }
+        }
+        s += "\n";
+    }
+    s += "\n\\* simulated (printed blocks on MDF, μ = 0.29, e = 0.5).\n\n";
+    s += &format!("Not simulated: {}\n\n", res.not_simulated);
+    if !res.table.discrepancies.is_empty() {
+        s += "Data check: ";
+        let d: Vec<String> = res
+            .table
+            .discrepancies
+            .iter()
+            .map(|f| f.message.clone())
+            .collect();
+        s += &d.join("; ");
+        s += ".\n\n";
+    }
+    s += "## Reading\n\n";
+    for e in &engines {
+        for (m, name) in [("3d", "3D"), ("2d", "2D")] {
+            let cells: Vec<&SimCell> = res
+                .simulations
+                .iter()
+                .filter(|c| c.engine == *e && c.mode.name() == m)
+                .collect();
+            if cells.is_empty() {
+                continue;
+            }
+            let within = |k: f64| cells.iter().filter(|c| c.z_experiment.abs() <= k).count();
+            let outside: Vec<String> = cells
+                .iter()
+                .filter(|c| c.z_experiment.abs() > 1.0)
+                .map(|c| format!("{} ({})", c.label, fmt_z(c.z_experiment)))
+                .collect();
+            s += &format!(
+                "- {e} {name}: {} of {} blocks within 1 experimental standard error (combined), \
+                 {} within 2{}.\n",
+                within(1.0),
+                cells.len(),
+                within(2.0),
+                if outside.is_empty() {
+                    String::new()
+                } else {
+                    format!("; outside 1σ: {}", outside.join(", "))
+                }
+            );
+        }
+    }
+    s +=
+        "\nThe paper: all its 3D simulations agree with experiment within error; its 2D line lies \
+          outside two of the five experimental error bars.\n\n";
+    if !figures.is_empty() {
+        s += "## Figures\n\n";
+        for f in figures {
+            s += &format!("![{f}]({f}.svg)\n\n");
+        }
+    }
+    s
+}
+
+/// results.csv: one row per simulated cell.
+pub fn results_csv(res: &PaperResults) -> String {
+    let mut s = String::from(
+        "row,block,engine,mode,rolls,breadth,width,length,unknown,unconverged,failed,ratio,ratio_err,\
+         measured_ratio,measured_err,theory_ratio,theory_err,z_experiment,z_theory,steps_mean,cpu_ms_per_roll\n",
+    );
+    for c in &res.simulations {
+        let t = res.table.rows.iter().find(|r| r.row == c.row);
+        let (mr, me, tr, te) = t
+            .map(|t| {
+                (
+                    t.measured_ratio.value,
+                    t.measured_ratio.err,
+                    t.theory_ratio.value,
+                    t.theory_ratio.err,
+                )
+            })
+            .unwrap_or((f64::NAN, f64::NAN, f64::NAN, f64::NAN));
+        let k = &c.run.counts;
+        s += &format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.3},{:.3},{:.1},{:.4}\n",
+            c.row,
+            c.label.split(' ').next().unwrap_or(""),
+            c.engine,
+            c.mode,
+            c.run.rolls,
+            k.breadth,
+            k.width,
+            k.length,
+            k.unknown,
+            c.run.unconverged,
+            c.run.failed_total,
+            c.ratio.value,
+            c.ratio.err,
+            mr,
+            me,
+            tr,
+            te,
+            c.z_experiment,
+            c.z_theory,
+            c.run.steps_mean,
+            c.run.cpu_ms_per_roll
+        );
+    }
+    s
+}
+
+/// The paper's figures, drawn from the results; returns their names (each has .svg and .png).
+pub fn write_figures(dir: &std::path::Path, res: &PaperResults) -> Result<Vec<&'static str>> {
+    use crate::report::figures::{self, Point, SimSeries};
+    let mut sims = Vec::new();
+    for engine in &res.provenance.engines_short {
+        for (mode, name) in [("2d", "2D"), ("3d", "3D")] {
+            let mut points: Vec<Point> = res
+                .simulations
+                .iter()
+                .filter(|c| c.engine == *engine && c.mode.name() == mode)
+                .filter_map(|c| {
+                    let row = res.table.rows.iter().find(|r| r.row == c.row)?;
+                    Some(Point {
+                        x: row.r.value,
+                        y: c.ratio.value,
+                        y_err: c.ratio.err,
+                    })
+                })
+                .collect();
+            points.sort_by(|a, b| a.x.total_cmp(&b.x));
+            sims.push(SimSeries {
+                label: format!("{} {name} simulation", engine_label(*engine)),
+                two_d: mode == "2d",
+                points,
+            });
+        }
+    }
+    figures::master_graph(
+        dir,
+        "master_graph",
+        &figures::paper_experiment_points(),
+        &sims,
+    )?;
+    figures::prob_2d(dir, "prob_2d")?;
+    figures::len_graph(dir, "len_graph", &figures::paper_length_groups())?;
+    figures::dreidel(dir, "dreidel", 0.1)?;
+    Ok(vec!["master_graph", "prob_2d", "len_graph", "dreidel"])
+}
+
+fn engine_label(engine: EngineKind) -> &'static str {
+    match engine {
+        EngineKind::Bullet => "Bullet",
+        EngineKind::Rapier => "Rapier",
+        EngineKind::RapierLocked => "Rapier (locked 3D)",
+    }
+}

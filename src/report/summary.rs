@@ -1,0 +1,352 @@
+//! A run's result as it is reported: configuration, exact counts, the ratio with its error,
+//! the theory beside it, and what it cost.
+
+use crate::engine::EngineKind;
+use crate::model::scene::{Floor, Mode, Preset};
+use crate::model::throws::{ThrowKind, ThrowRanges};
+use crate::run::spec::RunSpec;
+use crate::run::tally::{Counts, Tally};
+use crate::sim::roll::{Failure, Rule};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// What a run cost, and on how many threads.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Cost {
+    /// Wall-clock seconds.
+    pub wall_s: f64,
+    /// Process CPU seconds, all threads.
+    pub cpu_s: f64,
+    /// Worker threads.
+    pub threads: usize,
+}
+
+/// A run's report: its specification spelled out, its counts, ratio, theory and cost. The
+/// `--json` of `roll`, and each cell of `paper` and `crosscheck`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RunSummary {
+    /// The engine.
+    pub engine: EngineKind,
+    /// The engine's name and version, for provenance.
+    pub engine_version: String,
+    /// Bullet's solver settings.
+    pub preset: Preset,
+    /// Length, breadth, width in mm.
+    pub block_mm: [f64; 3],
+    /// 2D or 3D.
+    pub mode: Mode,
+    /// Rolls made.
+    pub rolls: u64,
+    /// The throws' seed.
+    pub seed: u64,
+    /// The throws' source.
+    pub throws: ThrowKind,
+    /// The throws' ranges.
+    pub ranges: ThrowRanges,
+    /// Time step, s.
+    pub dt: f64,
+    /// The contact's μ.
+    pub friction: f64,
+    /// The contact's e.
+    pub restitution: f64,
+    /// The die's density, kg/m³.
+    pub density: f64,
+    /// Box or plane.
+    pub floor: Floor,
+    /// The step cap.
+    pub max_steps: u64,
+    /// What ended each roll: DicePhys's rest rule or the energy certificate.
+    pub settle: Rule,
+    /// Settled rolls by the side vertical.
+    pub counts: Counts,
+    /// Rolls not at rest at the step cap.
+    pub unconverged: u64,
+    /// Failed rolls by why.
+    pub failed: BTreeMap<Failure, u64>,
+    /// Failed rolls in all.
+    pub failed_total: u64,
+    /// Rolls in which the engine injected energy: kinetic + potential rose above its lowest
+    /// value so far by more than `energy_gain_tolerance` of the starting energy. A flag on
+    /// rolls of any fate, not a failure.
+    #[serde(default)]
+    pub energy_gain: u64,
+    /// The energy-gain flag's tolerance, a fraction of the starting energy.
+    #[serde(default)]
+    pub energy_gain_tolerance: f64,
+    /// N(breadth vertical) / N(width vertical), the paper's ratio.
+    pub ratio: f64,
+    /// The paper's binomial error of the ratio.
+    pub ratio_err: f64,
+    /// The 2D theory's ratio (eq. MasterEqu) for this block.
+    pub theory_ratio: f64,
+    /// (ratio − theory) / ratio_err.
+    pub z_theory: f64,
+    /// Steps simulated over all rolls.
+    pub steps_total: u64,
+    /// Steps simulated per roll.
+    pub steps_mean: f64,
+    /// Steps the engine took per roll (below steps_mean where free flight was coasted).
+    pub engine_steps_mean: f64,
+    /// Free flight integrated in closed form.
+    pub fast_flight: bool,
+    /// Wall-clock seconds.
+    pub wall_s: f64,
+    /// Process CPU seconds, all threads (summed over a resumed run's segments).
+    pub cpu_s: f64,
+    /// CPU milliseconds per roll.
+    pub cpu_ms_per_roll: f64,
+    /// Worker threads.
+    pub threads: usize,
+    /// This program's version.
+    pub dicephys_version: String,
+    /// The run's specification: what `--resume` continues and `merge` compares.
+    pub spec: RunSpec,
+    /// Stopped before all rolls were made (Ctrl-C): the counts cover `rolls` only.
+    pub partial: bool,
+    /// The exact integer tally, for `merge`.
+    pub tally: Tally,
+    /// Present when auditing the early stop (`--audit`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub audit: Option<Audit>,
+}
+
+/// How the energy certificate would have done on these rolls.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Audit {
+    /// The certificate's margin.
+    pub margin: f64,
+    /// Rolls on which it fired before DicePhys's rule stopped them.
+    pub certified: u64,
+    /// Of those, rolls that came to rest on another face than the one it named.
+    pub wrong: u64,
+    /// Of those, rolls the full settle left "unknown" (stopped tilted, mid-rock).
+    #[serde(default)]
+    pub full_settle_unknown: u64,
+    /// Mean step at which it fired, over the rolls it fired on.
+    pub certified_steps_mean: f64,
+    /// Mean steps of the full settle.
+    pub full_steps_mean: f64,
+}
+
+impl RunSummary {
+    /// The report of a run of `spec` that made the rolls in `tally`.
+    pub fn new(spec: &RunSpec, tally: &Tally, cost: Cost) -> RunSummary {
+        let (scene, settle) = (&spec.scene, &spec.roll);
+        let Cost {
+            wall_s,
+            cpu_s,
+            threads,
+        } = cost;
+        let r = crate::theory::stats::ratio(tally.counts.breadth, tally.counts.width);
+        let (ratio, ratio_err) = (r.value, r.err);
+        let theory_ratio = crate::theory::ratio_from_r(scene.block.r());
+        RunSummary {
+            engine: spec.engine,
+            engine_version: spec.engine.version(),
+            preset: scene.preset,
+            block_mm: scene.block.mm(),
+            mode: scene.mode,
+            rolls: tally.rolls,
+            seed: spec.throws.seed,
+            throws: spec.throws.kind,
+            ranges: spec.throws.ranges,
+            dt: scene.dt,
+            friction: scene.friction,
+            restitution: scene.restitution,
+            density: scene.density,
+            floor: scene.floor,
+            max_steps: settle.max_steps,
+            settle: settle.rule,
+            counts: tally.counts.clone(),
+            unconverged: tally.unconverged,
+            failed: tally.failed.clone(),
+            failed_total: tally.failed_total(),
+            energy_gain: tally.energy_gain,
+            energy_gain_tolerance: crate::sim::roll::ENERGY_GAIN_TOLERANCE,
+            ratio,
+            ratio_err,
+            theory_ratio,
+            z_theory: (ratio - theory_ratio) / ratio_err,
+            steps_total: tally.steps,
+            steps_mean: tally.steps as f64 / tally.rolls.max(1) as f64,
+            engine_steps_mean: tally.engine_steps as f64 / tally.rolls.max(1) as f64,
+            fast_flight: settle.fast_flight,
+            wall_s,
+            cpu_s,
+            cpu_ms_per_roll: 1000.0 * cpu_s / tally.rolls.max(1) as f64,
+            threads,
+            dicephys_version: env!("CARGO_PKG_VERSION").into(),
+            spec: spec.clone(),
+            partial: false,
+            tally: tally.clone(),
+            audit: settle.audit.then(|| Audit {
+                margin: settle.margin,
+                certified: tally.certified,
+                wrong: tally.certified_wrong,
+                full_settle_unknown: tally.certified_unknown,
+                certified_steps_mean: tally.certified_steps as f64 / tally.certified.max(1) as f64,
+                full_steps_mean: tally.steps as f64 / tally.rolls.max(1) as f64,
+            }),
+        }
+    }
+
+    /// The human summary: counts, the ratio with its error, theory and σ, failures, cost.
+    pub fn human(&self) -> String {
+        let c = &self.counts;
+        let mut s = String::new();
+        if self.partial {
+            s += "PARTIAL: stopped before all rolls were made; the counts cover these rolls only\n";
+        }
+        s += &format!(
+            "{} {} {} mm, {} rolls, {} throws seed {}, dt {} s, μ {}, e {}, preset {}, floor {}\n",
+            self.engine,
+            self.mode,
+            crate::model::block::Block::from_mm(
+                self.block_mm[0],
+                self.block_mm[1],
+                self.block_mm[2]
+            )
+            .map(|b| b.to_string())
+            .unwrap_or_default(),
+            self.rolls,
+            self.throws.name(),
+            self.seed,
+            self.dt,
+            self.friction,
+            self.restitution,
+            self.preset,
+            self.floor
+        );
+        s += &format!(
+            "  breadth vertical {:>8}   width vertical {:>8}   length vertical {:>6}   unknown {:>6}\n",
+            c.breadth, c.width, c.length, c.unknown
+        );
+        s += &format!(
+            "  ratio breadth/width  {:.4} ± {:.4}   theory {:.4}   ({:+.1} σ)\n",
+            self.ratio, self.ratio_err, self.theory_ratio, self.z_theory
+        );
+        let failed: Vec<String> = self
+            .failed
+            .iter()
+            .map(|(k, v)| format!("{k} {v}"))
+            .collect();
+        s += &format!(
+            "  unconverged {} (cap {} steps)   failed {}{}   energy gain {} (> {} % of the start)\n",
+            self.unconverged,
+            self.max_steps,
+            self.failed_total,
+            if failed.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", failed.join(", "))
+            },
+            self.energy_gain,
+            100.0 * self.energy_gain_tolerance
+        );
+        s += &format!(
+            "  steps/roll {:.0} ({:.0} by the engine)   wall {:.2} s   CPU {:.2} s ({:.3} ms/roll, {} threads)   {}\n",
+            self.steps_mean,
+            self.engine_steps_mean,
+            self.wall_s,
+            self.cpu_s,
+            self.cpu_ms_per_roll,
+            self.threads,
+            self.engine_version
+        );
+        if let Some(a) = &self.audit {
+            s += &format!(
+                "  audit of the early stop (margin {}): fired on {} rolls, wrong on {} (full settle \
+                 unknown on {}); mean step {:.0} against {:.0} for the full settle\n",
+                a.margin,
+                a.certified,
+                a.wrong,
+                a.full_settle_unknown,
+                a.certified_steps_mean,
+                a.full_steps_mean
+            );
+        }
+        s
+    }
+}
+
+/// What `merge` reads of a shard's `roll --json`: its specification, exact tally and cost
+/// (the derived numbers, which may be null where NaN, are recomputed).
+#[derive(Clone, Debug, Deserialize)]
+pub struct ShardResult {
+    /// The shard's run.
+    pub spec: RunSpec,
+    /// Its exact counts.
+    pub tally: Tally,
+    /// Interrupted before its end.
+    pub partial: bool,
+    /// Wall-clock seconds.
+    pub wall_s: f64,
+    /// CPU seconds.
+    pub cpu_s: f64,
+    /// Worker threads.
+    pub threads: usize,
+}
+
+impl RunSummary {
+    /// Combines the shards of one run into the unsharded run's summary: the same exact counts.
+    /// Refuses shards of different runs (compared by specification, however their command
+    /// lines were spelled), partial, missing or repeated shards, and tallies that do not add up.
+    pub fn merge(parts: &[ShardResult]) -> crate::Result<RunSummary> {
+        use crate::Error::Mismatch;
+        let first = parts
+            .first()
+            .ok_or_else(|| Mismatch("merge: no shards".into()))?;
+        let whole = first.spec.unsharded();
+        let n = first.spec.shard.map_or(1, |s| s.n);
+        let mut seen = vec![false; n.min(1 << 20) as usize];
+        let mut tally = Tally::default();
+        let (mut wall, mut cpu) = (0.0f64, 0.0f64);
+        for p in parts {
+            if p.spec.unsharded() != whole {
+                return Err(Mismatch("merge: shards of different runs".into()));
+            }
+            if p.partial {
+                return Err(Mismatch(
+                    "merge: a shard is partial (interrupted); resume it first".into(),
+                ));
+            }
+            let s = p
+                .spec
+                .shard
+                .ok_or_else(|| Mismatch("merge: an input is not a shard (no --shard)".into()))?;
+            s.validate()?;
+            p.tally.check()?;
+            if s.n != n || seen.get(s.k as usize).copied().unwrap_or(true) {
+                return Err(Mismatch(format!(
+                    "merge: shard {}/{} is repeated or of another split",
+                    s.k, s.n
+                )));
+            }
+            if p.tally.rolls != p.spec.indices().len() {
+                return Err(Mismatch(format!(
+                    "merge: shard {}/{} counts {} rolls, not its {}",
+                    s.k,
+                    s.n,
+                    p.tally.rolls,
+                    p.spec.indices().len()
+                )));
+            }
+            seen[s.k as usize] = true;
+            tally.merge(&p.tally);
+            wall += p.wall_s;
+            cpu += p.cpu_s;
+        }
+        if let Some(k) = seen.iter().position(|&x| !x) {
+            return Err(Mismatch(format!("merge: shard {k}/{n} is missing")));
+        }
+        Ok(RunSummary::new(
+            &whole,
+            &tally,
+            Cost {
+                wall_s: wall,
+                cpu_s: cpu,
+                threads: first.threads,
+            },
+        ))
+    }
+}

@@ -1,0 +1,10 @@
+//! Many rolls: a run's specification, parallel batches and their exact tally, the chunked
+//! runner with its checkpoints, stop requests, and atomic output.
+
+pub mod batch;
+pub mod cputime;
+pub mod io;
+pub mod runner;
+pub mod spec;
+pub mod stop;
+pub mod tally;

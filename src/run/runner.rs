@@ -1,0 +1,294 @@
+//! Never lose a run. A run is rolled in chunks; with a checkpoint directory each finished
+//! chunk's records are written there atomically, bound to the run by its specification's key,
+//! so a run killed at any moment resumes from its last whole chunk, and a chunk of another run
+//! is never counted. Every throw is a pure function of (specification, index), so the resumed
+//! result is bit-identical to an uninterrupted one. A stop request is honoured before every
+//! roll: what was rolled is kept.
+
+use crate::error::{Error, Result};
+use crate::run::batch;
+use crate::run::io::write_atomic;
+use crate::run::spec::RunSpec;
+use crate::run::stop::Stop;
+use crate::run::tally::Tally;
+use crate::sim::roll::RollRecord;
+use serde::{Deserialize, Serialize};
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+/// Rolls per chunk: a chunk file per 1,000 rolls costs nothing.
+pub const CHUNK: u64 = 1000;
+
+/// How runs are carried out: threads, stop requests, progress. Nothing here changes a result.
+#[derive(Clone)]
+pub struct Runner<'a> {
+    /// Worker threads, at least 1.
+    pub threads: usize,
+    /// Checked before every roll.
+    pub stop: Stop,
+    /// Called with the rolls finished so far in the current run, from any thread.
+    pub progress: &'a (dyn Fn(u64) + Sync),
+}
+
+/// Worker threads: 0 means one per core.
+pub fn threads(asked: usize) -> usize {
+    if asked == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        asked
+    }
+}
+
+/// The most worker threads a run takes.
+pub const MAX_THREADS: usize = 1024;
+
+/// The outcome of a run: the exact tally of the rolls made, and whether all were.
+#[derive(Clone, Debug)]
+pub struct Chunked {
+    /// The rolls made (or read back from the checkpoint).
+    pub tally: Tally,
+    /// False if a stop request ended the run early.
+    pub complete: bool,
+    /// Rolls read back from the checkpoint rather than rolled now.
+    pub resumed: u64,
+}
+
+/// One chunk file: the run's key and the chunk's records.
+#[derive(Serialize, Deserialize)]
+struct ChunkFile {
+    key: String,
+    records: Vec<RollRecord>,
+}
+
+impl<'a> Runner<'a> {
+    /// A runner on `threads` threads (0: one per core), no progress shown.
+    pub fn new(threads_asked: usize, stop: Stop) -> Runner<'static> {
+        Runner {
+            threads: threads(threads_asked),
+            stop,
+            progress: &|_| {},
+        }
+    }
+
+    /// The same runner, reporting progress to `progress`.
+    pub fn with_progress<'b>(&self, progress: &'b (dyn Fn(u64) + Sync)) -> Runner<'b> {
+        Runner {
+            threads: self.threads,
+            stop: self.stop.clone(),
+            progress,
+        }
+    }
+
+    /// Rolls the run's throws chunk by chunk, reading finished chunks from `checkpoint` and
+    /// writing new ones there; each chunk's records go to `sink` in index order and are then
+    /// dropped, so memory stays flat however many rolls. Ends early (complete = false) on a
+    /// stop request, with every roll made so far counted.
+    pub fn run(
+        &self,
+        spec: &RunSpec,
+        checkpoint: Option<&Checkpoint>,
+        sink: &mut dyn FnMut(&[RollRecord]) -> Result<()>,
+    ) -> Result<Chunked> {
+        let indices = spec.indices();
+        let throws = spec.throws.source(spec.rolls);
+        let key = spec.key();
+        let mut tally = Tally::default();
+        let mut resumed = 0;
+        for c in 0..indices.len().div_ceil(CHUNK) {
+            let chunk = indices.chunk(c, CHUNK);
+            let path = checkpoint.map(|d| d.chunk_path(chunk[0], chunk.len()));
+            if let Some(p) = path.as_ref().filter(|p| p.exists()) {
+                let recs = read_chunk(p, &key, &chunk)?;
+                resumed += recs.len() as u64;
+                recs.iter().for_each(|r| tally.add(r));
+                sink(&recs)?;
+                (self.progress)(tally.rolls);
+                continue;
+            }
+            if self.stop.requested() {
+                return Ok(Chunked {
+                    tally,
+                    complete: false,
+                    resumed,
+                });
+            }
+            let base = tally.rolls;
+            let job = batch::Job {
+                engine: spec.engine,
+                scene: &spec.scene,
+                throws: &throws,
+                cfg: &spec.roll,
+            };
+            let recs = batch::run_indices(&job, &chunk, self.threads, &self.stop, &|n| {
+                (self.progress)(base + n)
+            })?;
+            let whole = recs.len() == chunk.len();
+            if let (Some(p), true) = (&path, whole) {
+                let file = ChunkFile {
+                    key: key.clone(),
+                    records: recs,
+                };
+                let json =
+                    serde_json::to_string(&file).map_err(|e| Error::Failed(e.to_string()))?;
+                write_atomic(p, json.as_bytes())?;
+                file.records.iter().for_each(|r| tally.add(r));
+                sink(&file.records)?;
+            } else {
+                recs.iter().for_each(|r| tally.add(r));
+                sink(&recs)?;
+            }
+            if !whole {
+                return Ok(Chunked {
+                    tally,
+                    complete: false,
+                    resumed,
+                });
+            }
+        }
+        Ok(Chunked {
+            tally,
+            complete: true,
+            resumed,
+        })
+    }
+}
+
+fn read_chunk(p: &Path, key: &str, chunk: &[u64]) -> Result<Vec<RollRecord>> {
+    let text = std::fs::read_to_string(p).map_err(|e| Error::io(p, e))?;
+    let file: ChunkFile = serde_json::from_str(&text)
+        .map_err(|e| Error::Mismatch(format!("{}: not a chunk of this run ({e})", p.display())))?;
+    if file.key != key {
+        return Err(Error::Mismatch(format!(
+            "{}: a chunk of another run (key {}, this run's {key})",
+            p.display(),
+            file.key
+        )));
+    }
+    let ok = file.records.len() == chunk.len()
+        && file
+            .records
+            .iter()
+            .zip(chunk)
+            .all(|(r, &i)| r.throw.index == i);
+    if !ok {
+        return Err(Error::Mismatch(format!(
+            "{}: its throws are not this chunk's",
+            p.display()
+        )));
+    }
+    Ok(file.records)
+}
+
+/// A checkpoint directory, held by one run at a time: `spec.json` names the run, `lock` its
+/// holder while it runs, and `chunk-*.json` its finished chunks.
+#[derive(Debug)]
+pub struct Checkpoint {
+    /// The directory.
+    pub dir: PathBuf,
+    /// Held (an advisory lock the system drops when the process ends, however it ends).
+    _lock: File,
+}
+
+/// A checkpoint's `spec.json`.
+#[derive(Serialize, Deserialize)]
+struct Stored {
+    key: String,
+    spec: RunSpec,
+}
+
+impl Checkpoint {
+    /// Opens `dir` for `spec`: creates it with the specification in it, or checks that it
+    /// holds this very run; and takes its lock, or says who holds it.
+    pub fn open(dir: &Path, spec: &RunSpec) -> Result<Checkpoint> {
+        std::fs::create_dir_all(dir).map_err(|e| {
+            Error::Invalid(format!(
+                "checkpoint {}: cannot create it ({e})",
+                dir.display()
+            ))
+        })?;
+        let lock = lock(dir)?;
+        match Checkpoint::spec_in(dir) {
+            Ok(stored) if stored == *spec => {}
+            Ok(_) => {
+                return Err(Error::Mismatch(format!(
+                    "checkpoint {}: it holds another run; resume that with --resume, or use a new directory",
+                    dir.display()
+                )))
+            }
+            Err(_) if !dir.join("spec.json").exists() => {
+                let stored = Stored {
+                    key: spec.key(),
+                    spec: spec.clone(),
+                };
+                let json = serde_json::to_string_pretty(&stored)
+                    .map_err(|e| Error::Failed(e.to_string()))?;
+                write_atomic(&dir.join("spec.json"), json.as_bytes())?;
+            }
+            Err(e) => return Err(e),
+        }
+        Ok(Checkpoint {
+            dir: dir.to_path_buf(),
+            _lock: lock,
+        })
+    }
+
+    /// Opens `dir` for `spec`, emptying it first if it holds another run (the sweeps' cells,
+    /// whose directories are named by their key and rewritten freely).
+    pub fn open_fresh(dir: &Path, spec: &RunSpec) -> Result<Checkpoint> {
+        if Checkpoint::spec_in(dir).is_ok_and(|s| s != *spec) {
+            std::fs::remove_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+        }
+        Checkpoint::open(dir, spec)
+    }
+
+    /// The run specification stored in `dir`.
+    pub fn spec_in(dir: &Path) -> Result<RunSpec> {
+        let file = dir.join("spec.json");
+        let text = std::fs::read_to_string(&file).map_err(|e| {
+            Error::Invalid(format!(
+                "{}: no checkpoint there ({}: {e})",
+                dir.display(),
+                file.display()
+            ))
+        })?;
+        let stored: Stored = serde_json::from_str(&text)
+            .map_err(|e| Error::Invalid(format!("{} is damaged ({e})", file.display())))?;
+        Ok(stored.spec)
+    }
+
+    fn chunk_path(&self, first: u64, len: usize) -> PathBuf {
+        self.dir.join(format!("chunk-{first:012}-{len}.json"))
+    }
+}
+
+/// Takes the directory's lock file, writing this process's id into it; if another process
+/// holds it, says which.
+fn lock(dir: &Path) -> Result<File> {
+    use std::io::{Read, Seek, Write};
+    let path = dir.join("lock");
+    let mut f = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(&path)
+        .map_err(|e| Error::io(&path, e))?;
+    match f.try_lock() {
+        Ok(()) => {
+            f.set_len(0).map_err(|e| Error::io(&path, e))?;
+            f.rewind().map_err(|e| Error::io(&path, e))?;
+            writeln!(f, "pid {}", std::process::id()).map_err(|e| Error::io(&path, e))?;
+            Ok(f)
+        }
+        Err(std::fs::TryLockError::WouldBlock) => {
+            let mut holder = String::new();
+            let _ = f.read_to_string(&mut holder);
+            Err(Error::Mismatch(format!(
+                "checkpoint {}: in use by another run ({})",
+                dir.display(),
+                holder.trim()
+            )))
+        }
+        Err(std::fs::TryLockError::Error(e)) => Err(Error::io(&path, e)),
+    }
+}

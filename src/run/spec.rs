@@ -1,0 +1,202 @@
+//! A run's specification: everything that decides its result, and nothing that does not
+//! (threads, output paths). It is stored with a checkpoint and in every `--json` output;
+//! `--resume` reads it back, `merge` compares it, and its key binds a checkpoint's chunks to
+//! the run that wrote them.
+
+use crate::engine::EngineKind;
+use crate::error::{Error, Result};
+use crate::model::scene::Scene;
+use crate::model::throws::{ThrowKind, ThrowRanges, Throws};
+use crate::sim::roll::RollConfig;
+use serde::{Deserialize, Serialize};
+
+/// The most rolls one run takes.
+pub const MAX_ROLLS: u64 = 1_000_000_000;
+
+/// Where a run's throws come from.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ThrowSpec {
+    /// Keyed by (seed, index), or DicePhys's sequence.
+    pub kind: ThrowKind,
+    /// The seed (a 32-bit `srand` seed for DicePhys's sequence).
+    pub seed: u64,
+    /// The ranges each throw's numbers are drawn from.
+    pub ranges: ThrowRanges,
+}
+
+impl ThrowSpec {
+    /// Keyed throws from the paper's ranges.
+    pub fn keyed(seed: u64) -> ThrowSpec {
+        ThrowSpec {
+            kind: ThrowKind::Keyed,
+            seed,
+            ranges: ThrowRanges::default(),
+        }
+    }
+
+    /// Checks the ranges and the seed.
+    pub fn validate(&self) -> Result<()> {
+        self.ranges.validate()?;
+        if self.kind == ThrowKind::Dicephys && self.seed > u32::MAX as u64 {
+            return Err(Error::Invalid(format!(
+                "--seed {}: the dicephys throw source takes a 32-bit seed (srand)",
+                self.seed
+            )));
+        }
+        Ok(())
+    }
+
+    /// The throw source, able to give throws `0..n`.
+    pub fn source(&self, n: u64) -> Throws {
+        Throws::new(self.kind, self.seed, self.ranges, n)
+    }
+}
+
+/// A share of a run's throws: indices i with i mod n = k.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    /// This share, 0 ≤ k < n.
+    pub k: u64,
+    /// How many shares.
+    pub n: u64,
+}
+
+impl Shard {
+    /// Checks 0 ≤ k < n.
+    pub fn validate(&self) -> Result<()> {
+        if self.n == 0 || self.k >= self.n {
+            return Err(Error::Invalid(format!(
+                "shard {}/{} is not K/N with 0 <= K < N",
+                self.k, self.n
+            )));
+        }
+        Ok(())
+    }
+}
+
+impl std::str::FromStr for Shard {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Shard> {
+        let bad = || Error::Invalid(format!("shard '{s}' is not K/N with 0 <= K < N"));
+        let (k, n) = s.split_once('/').ok_or_else(bad)?;
+        let shard = Shard {
+            k: k.parse().map_err(|_| bad())?,
+            n: n.parse().map_err(|_| bad())?,
+        };
+        shard.validate().map_err(|_| bad())?;
+        Ok(shard)
+    }
+}
+
+/// Everything that decides a run's result.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunSpec {
+    /// The engine.
+    pub engine: EngineKind,
+    /// The scene: block, surface, time step, 2D or 3D.
+    pub scene: Scene,
+    /// The throws.
+    pub throws: ThrowSpec,
+    /// How each roll is carried out and ended.
+    pub roll: RollConfig,
+    /// Throws 0..rolls (of which a shard takes its share).
+    pub rolls: u64,
+    /// This run's share of the throws, or all of them.
+    pub shard: Option<Shard>,
+}
+
+impl RunSpec {
+    /// Checks every value before anything runs. A restitution above 1 passes only when the
+    /// caller allows it (an engine-stability study).
+    pub fn validate(&self, allow_restitution_above_one: bool) -> Result<()> {
+        self.scene.validate(allow_restitution_above_one)?;
+        self.throws.validate()?;
+        self.roll.validate()?;
+        if self.rolls == 0 {
+            return Err(Error::Invalid("--rolls 0: need at least one roll".into()));
+        }
+        if self.rolls > MAX_ROLLS {
+            return Err(Error::Invalid(format!(
+                "--rolls {}: at most {MAX_ROLLS}",
+                self.rolls
+            )));
+        }
+        if let Some(s) = self.shard {
+            s.validate()?;
+        }
+        Ok(())
+    }
+
+    /// The throw indices this run rolls.
+    pub fn indices(&self) -> Indices {
+        match self.shard {
+            Some(Shard { k, n }) => Indices {
+                k,
+                n,
+                end: self.rolls,
+            },
+            None => Indices::all(self.rolls),
+        }
+    }
+
+    /// The same run without its shard: equal for every shard of one run.
+    pub fn unsharded(&self) -> RunSpec {
+        RunSpec {
+            shard: None,
+            ..self.clone()
+        }
+    }
+
+    /// A short, stable key of the whole specification (64-bit FNV-1a of its JSON, in hex):
+    /// written into each checkpoint chunk, so that a chunk of another run is never counted.
+    /// JSON of this struct is stable: fields in declaration order, floats round-tripped.
+    pub fn key(&self) -> String {
+        let json = serde_json::to_vec(self).unwrap_or_default();
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for b in json {
+            h ^= b as u64;
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        format!("{h:016x}")
+    }
+}
+
+/// The throws of a run or of one shard: indices k, k + n, k + 2n, … below `end`, generated
+/// chunk by chunk so that a run of any size holds one chunk's indices at a time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Indices {
+    /// The first index.
+    pub k: u64,
+    /// The stride.
+    pub n: u64,
+    /// One past the last index of the whole run.
+    pub end: u64,
+}
+
+impl Indices {
+    /// Every index below `end`.
+    pub fn all(end: u64) -> Indices {
+        Indices { k: 0, n: 1, end }
+    }
+
+    /// How many indices.
+    pub fn len(&self) -> u64 {
+        if self.k >= self.end {
+            0
+        } else {
+            (self.end - self.k).div_ceil(self.n)
+        }
+    }
+
+    /// True if there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The `c`-th run of at most `size` indices.
+    pub fn chunk(&self, c: u64, size: u64) -> Vec<u64> {
+        let first = c.saturating_mul(size);
+        let last = first.saturating_add(size).min(self.len());
+        (first..last).map(|j| self.k + j * self.n).collect()
+    }
+}

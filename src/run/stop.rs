@@ -1,0 +1,27 @@
+//! A request to stop a run early (Ctrl-C, SIGTERM), passed to whatever runs rolls. It is
+//! checked before every roll, so it is honoured within one roll's time however slow the
+//! rolls; what was rolled is kept and reported as partial.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+/// A shared stop flag: cheap to clone, set from a signal handler, read by the workers.
+#[derive(Clone, Debug, Default)]
+pub struct Stop(Arc<AtomicBool>);
+
+impl Stop {
+    /// A flag not yet raised.
+    pub fn new() -> Stop {
+        Stop::default()
+    }
+
+    /// Raises the flag; returns whether it was already raised.
+    pub fn request(&self) -> bool {
+        self.0.swap(true, Ordering::SeqCst)
+    }
+
+    /// True once a stop was requested.
+    pub fn requested(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+}

@@ -1,0 +1,186 @@
+//! Exact integer counts over a set of rolls: the same whatever the thread count, order, shard
+//! or resumed segment they were rolled in.
+
+use crate::model::block::Outcome;
+use crate::sim::roll::{Failure, Fate, RollRecord};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Exact counts over a set of rolls.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Tally {
+    /// Settled rolls by the side standing vertical.
+    pub counts: Counts,
+    /// Rolls not at rest at the step cap.
+    pub unconverged: u64,
+    /// Failed rolls by why they failed.
+    pub failed: BTreeMap<Failure, u64>,
+    /// Rolls counted.
+    pub rolls: u64,
+    /// Steps simulated over all rolls.
+    pub steps: u64,
+    /// Steps the engines took (fewer where free flight was coasted).
+    pub engine_steps: u64,
+    /// Auditing the early stop: rolls the certificate fired on, how many of those came to rest
+    /// on another face than it named, how many the full settle left "unknown" (DicePhys's rest
+    /// rule stopping a rocking die at the turning point of a swing, still tilted: no face to
+    /// disagree with), and the steps at which it fired, summed.
+    pub certified: u64,
+    pub certified_wrong: u64,
+    #[serde(default)]
+    pub certified_unknown: u64,
+    pub certified_steps: u64,
+    /// Rolls in which the engine injected energy (`RollRecord::energy_gain`), whatever their
+    /// fate.
+    #[serde(default)]
+    pub energy_gain: u64,
+}
+
+/// Settled rolls by the side standing vertical.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Counts {
+    /// Breadth vertical.
+    pub breadth: u64,
+    /// Width vertical.
+    pub width: u64,
+    /// Length vertical (standing on its end).
+    pub length: u64,
+    /// No side vertical (at rest on an edge, or leaning).
+    pub unknown: u64,
+}
+
+impl Counts {
+    /// Counts one outcome.
+    pub fn add(&mut self, o: Outcome) {
+        match o {
+            Outcome::Breadth => self.breadth += 1,
+            Outcome::Width => self.width += 1,
+            Outcome::Length => self.length += 1,
+            Outcome::Unknown => self.unknown += 1,
+        }
+    }
+}
+
+impl Tally {
+    /// Counts one roll.
+    pub fn add(&mut self, r: &RollRecord) {
+        self.rolls += 1;
+        self.steps += r.steps;
+        self.engine_steps += r.engine_steps;
+        self.energy_gain += r.energy_gain as u64;
+        if let Some((step, o)) = r.certified {
+            self.certified += 1;
+            self.certified_steps += step;
+            match r.fate {
+                Fate::Settled(Outcome::Unknown) | Fate::Unconverged(Outcome::Unknown) => {
+                    self.certified_unknown += 1
+                }
+                Fate::Settled(s) | Fate::Unconverged(s) => self.certified_wrong += (s != o) as u64,
+                Fate::Failed(_) => {}
+            }
+        }
+        match r.fate {
+            Fate::Settled(o) => self.counts.add(o),
+            Fate::Unconverged(_) => self.unconverged += 1,
+            Fate::Failed(f) => *self.failed.entry(f).or_insert(0) += 1,
+        }
+    }
+
+    /// Checks that the counts add up: every roll settled, unconverged or failed, and the
+    /// audit's counts within the rolls. A tally read from a file must pass this.
+    pub fn check(&self) -> crate::Result<()> {
+        let c = &self.counts;
+        let ended = [c.breadth, c.width, c.length, c.unknown, self.unconverged]
+            .into_iter()
+            .chain(self.failed.values().copied())
+            .try_fold(0u64, u64::checked_add);
+        let fine = ended == Some(self.rolls)
+            && self.certified <= self.rolls
+            && self.certified_wrong + self.certified_unknown <= self.certified
+            && self.energy_gain <= self.rolls;
+        if fine {
+            Ok(())
+        } else {
+            Err(crate::Error::Mismatch(format!(
+                "a tally whose counts do not add up to its {} rolls",
+                self.rolls
+            )))
+        }
+    }
+
+    /// Rolls that failed, for any reason.
+    pub fn failed_total(&self) -> u64 {
+        self.failed.values().sum()
+    }
+
+    /// Rolls that failed for this reason.
+    pub fn failed_of(&self, f: Failure) -> u64 {
+        self.failed.get(&f).copied().unwrap_or(0)
+    }
+
+    /// Adds another tally's counts (of other rolls) to this one.
+    pub fn merge(&mut self, o: &Tally) {
+        self.counts.breadth += o.counts.breadth;
+        self.counts.width += o.counts.width;
+        self.counts.length += o.counts.length;
+        self.counts.unknown += o.counts.unknown;
+        self.unconverged += o.unconverged;
+        for (k, v) in &o.failed {
+            *self.failed.entry(*k).or_insert(0) += v;
+        }
+        self.rolls += o.rolls;
+        self.steps += o.steps;
+        self.engine_steps += o.engine_steps;
+        self.certified += o.certified;
+        self.certified_wrong += o.certified_wrong;
+        self.certified_unknown += o.certified_unknown;
+        self.certified_steps += o.certified_steps;
+        self.energy_gain += o.energy_gain;
+    }
+
+    /// The tally of these records.
+    pub fn of(records: &[RollRecord]) -> Tally {
+        let mut t = Tally::default();
+        for r in records {
+            t.add(r);
+        }
+        t
+    }
+}
+
+/// How two runs of the same throws agree, throw for throw. "Same outcome" means both rolls
+/// settled, on the same side; a roll that did not settle agrees with nothing.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Agreement {
+    /// Throws compared.
+    pub rolls: u64,
+    /// Throws both runs settled.
+    pub both_settled: u64,
+    /// Throws both runs settled on the same side.
+    pub same: u64,
+}
+
+impl Agreement {
+    /// Compares records of the same throws, in the same order.
+    pub fn of(a: &[RollRecord], b: &[RollRecord]) -> Agreement {
+        let mut g = Agreement::default();
+        for (x, y) in a.iter().zip(b) {
+            g.rolls += 1;
+            if let (Fate::Settled(p), Fate::Settled(q)) = (x.fate, y.fate) {
+                g.both_settled += 1;
+                g.same += (p == q) as u64;
+            }
+        }
+        g
+    }
+
+    /// Same outcome, as a fraction of all throws compared.
+    pub fn of_rolls(&self) -> f64 {
+        self.same as f64 / self.rolls.max(1) as f64
+    }
+
+    /// Same outcome, as a fraction of the throws both settled.
+    pub fn of_settled(&self) -> f64 {
+        self.same as f64 / self.both_settled.max(1) as f64
+    }
+}

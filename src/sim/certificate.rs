@@ -1,0 +1,106 @@
+//! The exact early stop: once the die's energy is below the barrier out of its face region,
+//! its outcome can no longer change.
+
+use crate::model::block::Outcome;
+use crate::model::die::{up_in_body, DieShape};
+use crate::model::state::BodyState;
+
+/// The paper's "static" states made exact: once the die's mechanical energy is below the
+/// lowest barrier out of the face region it is in, its outcome can no longer change.
+///
+/// Let g be the downward unit vertical in body coordinates and s = (a, b, c)/2 the box's half
+/// sides. A box touching the floor with down-direction g has its centre at height
+/// h(g) = Σ sᵢ|gᵢ| (the support function), and never lower: y ≥ h(g) while it is above the
+/// floor. Call "region i" the directions g whose downward ray from the centre leaves the box
+/// through a face normal to axis i (|gᵢ|/sᵢ largest). On the boundary between region i and
+/// region j the ray hits an edge, and h there is at least the edge-balance height
+/// B_ij = √(sᵢ² + sⱼ²) (a linear function on a circle arc takes its least value at an end;
+/// the other end, a vertex, is higher). So with E = ½mv² + ½ω·Iω + mgy below mg·Bᵢ, where
+/// Bᵢ = min over j≠i of B_ij, h(g) ≤ y ≤ E/mg < Bᵢ for ever (energy never rises), g cannot
+/// leave region i, and the die comes to rest on face i: axis i vertical. In 2D (rotation about
+/// z only) the same holds with j ranging over x and y alone: the paper's E_Trans (eq. Etrans)
+/// is mg·B for the one edge of the cross-section.
+///
+/// Engines inject a little energy at contacts and let the die sink into the floor, so the
+/// test keeps a margin: the die's energy above its resting height on face i must be below
+/// (1 − margin) of the barrier above that height.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Certificate {
+    /// Fraction of the barrier kept in reserve, in [0, 1).
+    pub margin: f64,
+}
+const SIDES: [Outcome; 3] = [Outcome::Breadth, Outcome::Width, Outcome::Length];
+
+impl Certificate {
+    /// The outcome, if it is already certain.
+    pub fn certain(&self, die: &DieShape, s: &BodyState) -> Option<Outcome> {
+        let up = up_in_body(&s.rotation);
+        let n = if die.planar { 2 } else { 3 };
+        // Region i: the axis whose face the downward ray leaves through, |gᵢ|/sᵢ largest.
+        let i = (0..n)
+            .max_by(|&p, &q| (up[p].abs() / die.half[p]).total_cmp(&(up[q].abs() / die.half[q])))?;
+        let rest = die.half[i];
+        let allowed = (1.0 - self.margin) * (die.barrier[i] - rest);
+        // The height plus the translational energy's worth of height is a lower bound of E/mg:
+        // most states fail on it without the rotational energy being computed.
+        let g = die.gravity;
+        if s.position.y + 0.5 * s.linear_velocity.norm_squared() / g - rest >= allowed {
+            return None;
+        }
+        let excess = die.energy(s) / (die.mass * g) - rest;
+        (excess < allowed).then_some(SIDES[i])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::scene::{Mode, Scene};
+    use nalgebra::{UnitQuaternion, Vector3};
+
+    fn state(y: f64, rot: UnitQuaternion<f64>, v: f64, w: f64) -> BodyState {
+        BodyState {
+            position: Vector3::new(0.0, y, 0.0),
+            rotation: rot,
+            linear_velocity: Vector3::new(v, 0.0, 0.0),
+            angular_velocity: Vector3::new(0.0, 0.0, w),
+            sleeping: false,
+        }
+    }
+
+    #[test]
+    fn a_die_at_rest_is_certain_and_a_flying_one_is_not() {
+        let scene = Scene::paper("140x24x20".parse().unwrap(), Mode::ThreeD);
+        let die = DieShape::of(&scene);
+        let c = Certificate { margin: 0.1 };
+        let id = UnitQuaternion::identity();
+        assert_eq!(
+            c.certain(&die, &state(0.010, id, 0.0, 0.0)),
+            Some(Outcome::Width)
+        );
+        let on_side = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 1.5);
+        assert_eq!(
+            c.certain(&die, &state(0.012, on_side, 0.0, 0.0)),
+            Some(Outcome::Breadth)
+        );
+        // Dropped from 0.3 m: far above every barrier.
+        assert_eq!(c.certain(&die, &state(0.3, id, 0.0, 0.0)), None);
+        // On the floor but spinning fast enough to tip over.
+        assert_eq!(c.certain(&die, &state(0.010, id, 0.0, 60.0)), None);
+    }
+
+    #[test]
+    fn the_barrier_is_the_edge_balance_height() {
+        // 2D, width face down (identity): barrier ½√(b² + w²) above the floor.
+        let scene = Scene::paper("140x24x20".parse().unwrap(), Mode::TwoD);
+        let die = DieShape::of(&scene);
+        let c = Certificate { margin: 0.0 };
+        let id = UnitQuaternion::identity();
+        let b = 0.5 * (0.024f64).hypot(0.020);
+        assert_eq!(
+            c.certain(&die, &state(b - 1e-6, id, 0.0, 0.0)),
+            Some(Outcome::Width)
+        );
+        assert_eq!(c.certain(&die, &state(b + 1e-6, id, 0.0, 0.0)), None);
+    }
+}

@@ -1,0 +1,281 @@
+//! Free flight in closed form. Between bounces the die only falls and turns; an engine spends
+//! hundreds of steps per roll on that. Out of contact, Bullet (without the gyroscopic term)
+//! advances a body by symplectic Euler under gravity alone: v ← v + g·dt, x ← x + v·dt, and
+//! the orientation by the exponential map of the (constant) angular velocity,
+//! q ← exp(½ω·dt)·q. That is cheap to do here, so the roll steps the die itself while it is
+//! out of contact and hands the state back to the engine when it lands: the same trajectory
+//! to rounding, far fewer engine steps.
+//!
+//! When is a Bullet step pure flight? Its collision pass runs on the state before the step.
+//! On DicePhys's box floor, the box-box test (btBoxBoxDetector, a separating-axis test) makes
+//! a contact point only where the boxes overlap, and the points Bullet keeps from earlier
+//! steps are dropped once farther than the contact breaking threshold. So a step taken while
+//! Bullet holds no contact point (`Engine::contact_free`) from a state clear of the floor
+//! adds none: the flight may start there (`may_start`) and lasts for every step taken from a
+//! state clear of the floor (`next`). The plane floor is different: Bullet's convex-plane
+//! test reports points up to the breaking threshold (≤ 2 cm) away, and again for the die
+//! turned by up to that much at its rim, so there "clear" means 5 cm up. Bullet's sleeping
+//! timer is the one other thing such a step changes: it resets while the die moves faster
+//! than the sleeping thresholds, so flight is only taken at such speeds and the engine's
+//! `set_state` resets the timer, as those steps would have.
+
+use crate::model::scene::{Floor, Scene};
+use crate::model::state::BodyState;
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+
+/// Bullet's clamp on the rotation per step (ANGULAR_MOTION_THRESHOLD = π/4).
+const MAX_ANGLE_PER_STEP: f64 = 0.25 * std::f64::consts::PI;
+
+/// On the box floor a state is clear of it when its lowest point is this far above it. The
+/// box-box test needs only > 0; this allows for rounding in the 10 km floor box's coordinates.
+pub const CLEAR: f64 = 1e-6;
+
+/// On the plane floor: beyond the breaking threshold (0.02 m at most) and the convex-plane
+/// test's perturbation (as much again), with room to spare.
+pub const CLEAR_OF_PLANE: f64 = 0.05;
+
+/// Bullet's default sleeping thresholds (btRigidBodyConstructionInfo): a step resets the
+/// deactivation timer when |v| ≥ 0.8 m/s or |ω| ≥ 1 rad/s. Kept with 1 % to spare.
+const LINEAR_SLEEPING_THRESHOLD: f64 = 0.8 * 1.01;
+const ANGULAR_SLEEPING_THRESHOLD: f64 = 1.0 * 1.01;
+
+#[derive(Clone, Copy, Debug)]
+pub struct Flight {
+    pub dt: f64,
+    pub gravity: f64,
+    pub half: Vector3<f64>,
+    /// How far above the floor the die's lowest point must be for a step to be pure flight
+    /// (`CLEAR` or `CLEAR_OF_PLANE`).
+    pub clear: f64,
+}
+
+impl Flight {
+    pub fn of(scene: &Scene) -> Flight {
+        let [a, b, c] = scene.body_sides();
+        Flight {
+            dt: scene.dt,
+            gravity: scene.gravity,
+            // In 2D the box is 1 m deep but turns about z only, so its reach below the
+            // centre comes from x and y alone; the support function below handles both.
+            half: Vector3::new(a, b, c) / 2.0,
+            clear: match scene.floor {
+                Floor::Box => CLEAR,
+                Floor::Plane => CLEAR_OF_PLANE,
+            },
+        }
+    }
+
+    /// Height of the die's lowest point above the floor: y − Σ hᵢ |(Rᵀ ŷ)ᵢ|.
+    pub fn lowest_point(&self, s: &BodyState) -> f64 {
+        crate::model::die::lowest_point(&self.half, s)
+    }
+
+    /// True if a flight may start from `s`, the state after the engine's last step: the die
+    /// is clear of the floor and the engine holds no contact point (`contact_free`, asked
+    /// only when the first holds).
+    pub fn may_start(&self, s: &BodyState, contact_free: impl FnOnce() -> bool) -> bool {
+        self.lowest_point(s) > self.clear && contact_free()
+    }
+
+    /// The rotation one step applies, as Bullet's `integrateTransform` builds it.
+    pub fn step_rotation(&self, w: &Vector3<f64>) -> UnitQuaternion<f64> {
+        let dt = self.dt;
+        let mut angle = w.norm();
+        if angle * dt > MAX_ANGLE_PER_STEP {
+            angle = MAX_ANGLE_PER_STEP / dt;
+        }
+        let axis = if angle < 0.001 {
+            // Taylor expansion of sin(½θ dt)/θ, as Bullet.
+            w * (0.5 * dt - dt * dt * dt * 0.020833333333 * angle * angle)
+        } else {
+            w * ((0.5 * angle * dt).sin() / angle)
+        };
+        UnitQuaternion::new_normalize(Quaternion::new(
+            (0.5 * angle * dt).cos(),
+            axis.x,
+            axis.y,
+            axis.z,
+        ))
+    }
+
+    /// One engine step of free flight; `dq` is `step_rotation` of the angular velocity.
+    pub fn step(&self, s: &BodyState, dq: &UnitQuaternion<f64>) -> BodyState {
+        let mut v = s.linear_velocity;
+        v.y -= self.gravity * self.dt;
+        BodyState {
+            position: s.position + v * self.dt,
+            rotation: UnitQuaternion::new_normalize(dq.into_inner() * s.rotation.into_inner()),
+            linear_velocity: v,
+            angular_velocity: s.angular_velocity,
+            sleeping: false,
+        }
+    }
+
+    /// The state one step after `s` if that step is pure flight (`s` clear of the floor, the
+    /// die fast enough that the step resets the sleeping timer); `None` if the engine must
+    /// take it.
+    pub fn next(&self, s: &BodyState, dq: &UnitQuaternion<f64>) -> Option<BodyState> {
+        if self.lowest_point(s) <= self.clear {
+            return None;
+        }
+        let next = self.step(s, dq);
+        let awake = next.linear_velocity.norm() >= LINEAR_SLEEPING_THRESHOLD
+            || next.angular_velocity.norm() >= ANGULAR_SLEEPING_THRESHOLD;
+        // A non-finite state ends the roll as a failure in the roll's own check.
+        awake.then_some(next)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::{new_engine, EngineKind};
+    use crate::model::scene::Mode;
+
+    /// Free flight from `s` (which `may_start`) as the roll flies it, at most `max` steps;
+    /// the state and the number of steps taken.
+    fn coast(f: &Flight, s: &BodyState, max: u64) -> (BodyState, u64) {
+        let dq = f.step_rotation(&s.angular_velocity);
+        let mut now = *s;
+        let mut n = 0;
+        while n < max {
+            match f.next(&now, &dq) {
+                Some(next) => now = next,
+                None => break,
+            }
+            n += 1;
+        }
+        (now, n)
+    }
+
+    #[test]
+    fn coasting_matches_bullet_stepping() {
+        for mode in [Mode::ThreeD, Mode::TwoD] {
+            let scene = Scene::paper("140x24x20".parse().unwrap(), mode);
+            let flight = Flight::of(&scene);
+            let start = BodyState {
+                position: Vector3::new(0.0, 0.5, 0.0),
+                rotation: UnitQuaternion::from_euler_angles(0.3, 0.0, 0.2),
+                linear_velocity: Vector3::new(0.1, 1.0, 0.0),
+                angular_velocity: if mode == Mode::TwoD {
+                    Vector3::new(0.0, 0.0, 120.0)
+                } else {
+                    Vector3::new(5.0, -3.0, 120.0)
+                },
+                sleeping: false,
+            };
+            let mut e = new_engine(EngineKind::Bullet, &scene).unwrap();
+            e.reset(&start).unwrap();
+            let (coasted, n) = coast(&flight, &start, 200);
+            assert_eq!(n, 200);
+            for _ in 0..n {
+                e.step().unwrap();
+            }
+            let stepped = e.state();
+            assert!(
+                (coasted.position - stepped.position).norm() < 1e-9,
+                "{mode:?} position"
+            );
+            assert!(
+                (coasted.linear_velocity - stepped.linear_velocity).norm() < 1e-9,
+                "{mode:?} velocity"
+            );
+            assert!(
+                coasted.rotation.angle_to(&stepped.rotation) < 1e-9,
+                "{mode:?} rotation"
+            );
+        }
+    }
+
+    #[test]
+    fn a_flight_handed_back_at_the_floor_bounces_as_if_stepped() {
+        // Coast a tumbling die down to the floor, hand the state to Bullet, and let it bounce:
+        // the same to rounding as Bullet stepping all the way. This needs `set_state` to leave
+        // the body as a step does (the world inertia tensor for the new orientation) and the
+        // flight to end where Bullet's first contact forms.
+        for mode in [Mode::ThreeD, Mode::TwoD] {
+            let scene = Scene::paper("140x24x20".parse().unwrap(), mode);
+            let flight = Flight::of(&scene);
+            let start = BodyState {
+                position: Vector3::new(0.0, 0.2, 0.0),
+                // In 2D the 1 m deep box turns about z only.
+                rotation: if mode == Mode::TwoD {
+                    UnitQuaternion::from_euler_angles(0.0, 0.0, 0.2)
+                } else {
+                    UnitQuaternion::from_euler_angles(0.3, 0.0, 0.2)
+                },
+                linear_velocity: Vector3::new(0.1, 0.0, 0.0),
+                angular_velocity: if mode == Mode::TwoD {
+                    Vector3::new(0.0, 0.0, 40.0)
+                } else {
+                    Vector3::new(5.0, -3.0, 40.0)
+                },
+                sleeping: false,
+            };
+            let mut stepped = new_engine(EngineKind::Bullet, &scene).unwrap();
+            stepped.reset(&start).unwrap();
+            let mut flown = new_engine(EngineKind::Bullet, &scene).unwrap();
+            flown.reset(&start).unwrap();
+            assert!(flight.may_start(&start, || flown.contact_free()));
+            let (landing, n) = coast(&flight, &start, 10_000);
+            assert!(
+                n > 100 && flight.lowest_point(&landing) <= CLEAR,
+                "{mode:?}"
+            );
+            flown.set_state(&landing).unwrap();
+            for _ in 0..n {
+                stepped.step().unwrap();
+            }
+            let mut bounced = false;
+            for _ in 0..60 {
+                stepped.step().unwrap();
+                flown.step().unwrap();
+                let (a, b) = (stepped.state(), flown.state());
+                bounced |= a.linear_velocity.y > 0.0;
+                assert!(
+                    (a.position - b.position).norm() < 1e-9
+                        && (a.linear_velocity - b.linear_velocity).norm() < 1e-7
+                        && (a.angular_velocity - b.angular_velocity).norm() < 1e-6
+                        && a.rotation.angle_to(&b.rotation) < 1e-9,
+                    "{mode:?}: {a:?} against {b:?}"
+                );
+            }
+            assert!(bounced, "{mode:?}: no bounce in the window");
+        }
+    }
+
+    #[test]
+    fn flight_starts_clear_of_the_floor_and_of_contacts() {
+        let scene = Scene::paper("140x24x20".parse().unwrap(), Mode::ThreeD);
+        let flight = Flight::of(&scene);
+        // Flat on its 20 mm side: lowest point 10 mm below the centre.
+        let at = |y: f64, vy: f64| BodyState {
+            position: Vector3::new(0.0, y, 0.0),
+            rotation: UnitQuaternion::identity(),
+            linear_velocity: Vector3::new(0.0, vy, 0.0),
+            angular_velocity: Vector3::zeros(),
+            sleeping: false,
+        };
+        assert!(!flight.may_start(&at(0.0305, -1.0), || false));
+        assert!(flight.may_start(&at(0.0105, -1.0), || true));
+        assert!(!flight.may_start(&at(0.0099, -1.0), || true));
+        // Falling at 1 m/s from 20.5 mm clear: the last step is taken from a clear state,
+        // so the flight ends just inside the floor, where the engine's contact takes over.
+        let (end, n) = coast(&flight, &at(0.0305, -1.0), 1000);
+        assert!(n > 0 && flight.lowest_point(&end) <= CLEAR);
+        assert!(
+            flight.lowest_point(&end) > -0.002,
+            "{}",
+            flight.lowest_point(&end)
+        );
+        // Slower than the sleeping thresholds: the engine must step (its timer runs).
+        assert_eq!(coast(&flight, &at(0.0305, 0.01), 1000).1, 0);
+        // Over the plane floor, whose contacts reach up to it, the flight stays 5 cm clear.
+        let mut plane = scene.clone();
+        plane.floor = crate::model::scene::Floor::Plane;
+        let flight = Flight::of(&plane);
+        assert!(!flight.may_start(&at(0.0595, -1.0), || true));
+        let (end, n) = coast(&flight, &at(0.2, -1.0), 1000);
+        assert!(n > 0 && (-0.005..=0.0).contains(&(flight.lowest_point(&end) - CLEAR_OF_PLANE)));
+    }
+}

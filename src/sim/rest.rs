@@ -1,0 +1,75 @@
+//! When a roll is over, and how it came out: DicePhys's at-rest rule and its outcome test.
+
+use crate::model::block::Outcome;
+use crate::model::state::BodyState;
+use nalgebra::Vector3;
+
+/// DicePhys's at-rest rule: over the last `window` steps, the vector sums of the linear and
+/// of the angular velocity are both shorter than `tolerance` (sums of vectors, not of
+/// lengths, so a die rocking back and forth also counts as at rest).
+#[derive(Clone, Debug)]
+pub struct RestDetector {
+    tolerance: f64,
+    linear: [Vector3<f64>; REST_WINDOW],
+    angular: [Vector3<f64>; REST_WINDOW],
+    seen: usize,
+}
+
+pub const REST_WINDOW: usize = 10;
+pub const REST_TOLERANCE: f64 = 1e-4;
+
+impl Default for RestDetector {
+    fn default() -> Self {
+        RestDetector::new(REST_TOLERANCE)
+    }
+}
+
+impl RestDetector {
+    pub fn new(tolerance: f64) -> RestDetector {
+        RestDetector {
+            tolerance,
+            linear: [Vector3::zeros(); REST_WINDOW],
+            angular: [Vector3::zeros(); REST_WINDOW],
+            seen: 0,
+        }
+    }
+
+    pub fn clear(&mut self) {
+        self.seen = 0;
+    }
+
+    /// Records one step's state; true once the die is at rest.
+    pub fn push(&mut self, s: &BodyState) -> bool {
+        let slot = self.seen % REST_WINDOW;
+        self.linear[slot] = s.linear_velocity;
+        self.angular[slot] = s.angular_velocity;
+        self.seen += 1;
+        if self.seen < REST_WINDOW {
+            return false;
+        }
+        let v: Vector3<f64> = self.linear.iter().sum();
+        if v.norm() >= self.tolerance {
+            return false;
+        }
+        let w: Vector3<f64> = self.angular.iter().sum();
+        w.norm() < self.tolerance
+    }
+}
+
+/// DicePhys's tolerance on a vertical axis: |cos| within 1e-4 of 1.
+pub const VERTICAL_TOLERANCE: f64 = 1e-4;
+
+/// The side standing vertical: the body axis (x = breadth, y = width, z = length, tested in
+/// that order, as DicePhys) whose direction is vertical within the tolerance; else unknown.
+pub fn classify(s: &BodyState) -> Outcome {
+    let up = Vector3::y();
+    let sides = [Outcome::Breadth, Outcome::Width, Outcome::Length];
+    for (axis, side) in [Vector3::x(), Vector3::y(), Vector3::z()].iter().zip(sides) {
+        let dir = (s.rotation * axis).normalize();
+        let dot = up.dot(&dir).abs();
+        if dot > 1.0 - VERTICAL_TOLERANCE && dot < 1.0 + VERTICAL_TOLERANCE {
+            return side;
+        }
+    }
+    Outcome::Unknown
+}

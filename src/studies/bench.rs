@@ -1,0 +1,382 @@
+//! `dicephys bench`: the standard workload (140x24x20, 3D and 2D, dt = 1 ms, the paper's throw
+//! ranges, a fixed seed) for each engine and each speed lever, on 1 thread and on all, against
+//! the faithful configuration (Bullet, DicePhys's rest rule, box floor, dicephys281) measured
+//! in the same run. Speed is reported as ratios measured side by side: this machine is noisy.
+
+use crate::engine::EngineKind;
+use crate::model::scene::{Floor, Mode, Scene};
+use crate::model::throws::{ThrowKind, ThrowRanges, Throws};
+use crate::run::batch;
+use crate::run::cputime::{peak_rss_bytes, process_cpu_seconds};
+use crate::run::tally::{Agreement, Tally};
+use crate::sim::roll::{RollConfig, RollRecord, Rule};
+use crate::theory::stats;
+use serde::Serialize;
+use std::time::Instant;
+
+/// DicePhys 2.81's CPU time per 3D roll of 140x24x20 on this kind of machine, one core
+/// (shared/reference/dicephys-2.81.md): the yardstick for "ten times DicePhys".
+pub const DICEPHYS_MS_PER_ROLL_3D: f64 = 4.22;
+pub const DICEPHYS_MS_PER_ROLL_2D: f64 = 2.50;
+
+/// One way of rolling: an engine and the levers it uses.
+#[derive(Clone, Debug, Serialize)]
+pub struct Method {
+    pub name: String,
+    pub engine: EngineKind,
+    pub floor: Floor,
+    pub rule: Rule,
+    pub fast_flight: bool,
+    /// Shown by a cross-check at >= 20,000 rolls not to change the result (README, Speed);
+    /// only such methods can be the benchmark's verdict.
+    pub proven: bool,
+}
+
+impl Method {
+    pub fn new(
+        name: &str,
+        engine: EngineKind,
+        floor: Floor,
+        rule: Rule,
+        fast_flight: bool,
+    ) -> Method {
+        Method {
+            name: name.into(),
+            engine,
+            floor,
+            rule,
+            fast_flight,
+            // The plane floor changes the contact and so the result (measured: README).
+            proven: floor == Floor::Box,
+        }
+    }
+
+    pub fn faithful() -> Method {
+        Method::new(
+            "faithful",
+            EngineKind::Bullet,
+            Floor::Box,
+            Rule::Dicephys,
+            false,
+        )
+    }
+
+    pub fn settle(&self, base: &RollConfig) -> RollConfig {
+        RollConfig {
+            rule: self.rule,
+            fast_flight: self.fast_flight,
+            ..*base
+        }
+    }
+}
+
+/// The methods the benchmark compares: each lever on its own, then together.
+pub fn methods() -> Vec<Method> {
+    use EngineKind::*;
+    use Floor::*;
+    use Rule::*;
+    vec![
+        Method::faithful(),
+        Method::new("early stop", Bullet, Box, Certificate, false),
+        Method::new("fast flight", Bullet, Box, Dicephys, true),
+        Method::new("plane floor", Bullet, Plane, Dicephys, false),
+        Method::new("early stop + flight", Bullet, Box, Certificate, true),
+        Method::new("all + plane floor", Bullet, Plane, Certificate, true),
+        Method::new("rapier", Rapier, Box, Dicephys, false),
+        Method::new("rapier early stop", Rapier, Box, Certificate, false),
+    ]
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchRow {
+    pub method: String,
+    pub engine: String,
+    pub mode: String,
+    pub threads: usize,
+    pub rolls: u64,
+    pub rolls_per_s: f64,
+    pub cpu_ms_per_roll: f64,
+    pub us_per_engine_step: f64,
+    pub steps_per_roll: f64,
+    pub engine_steps_per_roll: f64,
+    /// Rolls per second over the faithful method's, same mode and threads, same run.
+    pub speedup: f64,
+    /// Rolls per second over DicePhys 2.81's on one core (reference timing, not this run).
+    pub vs_dicephys: f64,
+    pub ratio: f64,
+    pub ratio_err: f64,
+    /// (ratio − faithful ratio) / combined error, on the same throws.
+    pub z_vs_faithful: f64,
+    /// Fraction of throws with the same outcome as the faithful method.
+    pub same_outcome: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct FfiCost {
+    pub steps: u64,
+    /// Seconds, summed over 200 throws of the fastest of three runs per throw.
+    pub rust_loop_s: f64,
+    pub cpp_loop_s: f64,
+    /// (Rust loop − C++ loop) / C++ loop: what crossing into C++ once per step costs (both
+    /// loops step and read the state every step).
+    pub overhead: f64,
+}
+
+/// Per mode: the fastest proven Bullet method whose ratio stays within the accuracy bound of
+/// the faithful one's (|z| ≤ `Z_BOUND` on the same throws), on all threads.
+#[derive(Clone, Debug, Serialize)]
+pub struct Verdict {
+    pub mode: String,
+    pub method: String,
+    pub threads: usize,
+    pub rolls_per_s: f64,
+    /// Over the faithful method on the same number of threads.
+    pub speedup: f64,
+    /// Over the faithful method on one thread (DicePhys is single-threaded).
+    pub speedup_vs_faithful_1_thread: f64,
+    pub vs_dicephys: f64,
+    pub z_vs_faithful: f64,
+}
+
+/// The accuracy bound: a method's ratio within this many combined standard errors of the
+/// faithful method's, on the same throws.
+pub const Z_BOUND: f64 = 2.0;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Bench {
+    pub rows: Vec<BenchRow>,
+    pub verdicts: Vec<Verdict>,
+    pub ffi: FfiCost,
+    pub peak_rss_mb: f64,
+    pub seed: u64,
+    /// Runs per measurement; the fastest counts.
+    pub repeat: u32,
+}
+
+/// Runs the benchmark: `rolls` throws per method, mode and thread count; `log` gets a line per
+/// measurement. With `repeat` > 1, every method of a mode and thread count is run in turn,
+/// `repeat` rounds over, and each keeps its fastest run: a spell of load from elsewhere then
+/// falls on different methods in different rounds, not on one method's every run.
+pub fn run(
+    rolls: u64,
+    seed: u64,
+    all_threads: usize,
+    repeat: u32,
+    log: &dyn Fn(&str),
+) -> crate::Result<Bench> {
+    let block: crate::model::block::Block = "140x24x20".parse()?;
+    let throws = Throws::new(ThrowKind::Keyed, seed, ThrowRanges::default(), 0);
+    let base = RollConfig::default();
+    let methods = methods();
+    let mut rows = Vec::new();
+    for mode in [Mode::ThreeD, Mode::TwoD] {
+        let mut thread_counts = vec![1];
+        if all_threads > 1 {
+            thread_counts.push(all_threads);
+        }
+        for &threads in &thread_counts {
+            // Per method: its records (the same every run: runs are reproducible) and its
+            // fastest run's wall and CPU seconds.
+            let mut best: Vec<(Vec<RollRecord>, f64, f64)> =
+                vec![(Vec::new(), f64::INFINITY, 0.0); methods.len()];
+            for _ in 0..repeat.max(1) {
+                for (m, best) in methods.iter().zip(best.iter_mut()) {
+                    let mut scene = Scene::paper(block, mode);
+                    scene.floor = m.floor;
+                    let wall = Instant::now();
+                    let cpu = process_cpu_seconds();
+                    let recs = batch::run(
+                        m.engine,
+                        &scene,
+                        &throws,
+                        &m.settle(&base),
+                        0..rolls,
+                        threads,
+                        &|_| {},
+                    )?;
+                    let (c, w) = (process_cpu_seconds() - cpu, wall.elapsed().as_secs_f64());
+                    if w < best.1 {
+                        *best = (recs, w, c);
+                    }
+                }
+            }
+            let mut faithful: Option<(&[RollRecord], f64)> = None;
+            for (m, (recs, wall_s, cpu_s)) in methods.iter().zip(&best) {
+                let (wall_s, cpu_s) = (*wall_s, *cpu_s);
+                let t = Tally::of(recs);
+                let r = stats::ratio(t.counts.breadth, t.counts.width);
+                let rolls_per_s = rolls as f64 / wall_s;
+                let (speedup, z, same) = match &faithful {
+                    None => (1.0, 0.0, 1.0),
+                    Some((f, f_rps)) => {
+                        let ft = Tally::of(f);
+                        let fr = stats::ratio(ft.counts.breadth, ft.counts.width);
+                        (
+                            rolls_per_s / f_rps,
+                            stats::z_score(r.value, r.err, fr.value, fr.err),
+                            Agreement::of(f, recs).of_rolls(),
+                        )
+                    }
+                };
+                let dicephys_ms = match mode {
+                    Mode::ThreeD => DICEPHYS_MS_PER_ROLL_3D,
+                    Mode::TwoD => DICEPHYS_MS_PER_ROLL_2D,
+                };
+                let row = BenchRow {
+                    method: m.name.clone(),
+                    engine: m.engine.name().into(),
+                    mode: mode.name().into(),
+                    threads,
+                    rolls,
+                    rolls_per_s,
+                    cpu_ms_per_roll: 1000.0 * cpu_s / rolls as f64,
+                    us_per_engine_step: 1e6 * cpu_s / t.engine_steps.max(1) as f64,
+                    steps_per_roll: t.steps as f64 / rolls as f64,
+                    engine_steps_per_roll: t.engine_steps as f64 / rolls as f64,
+                    speedup,
+                    vs_dicephys: rolls_per_s * dicephys_ms / 1000.0,
+                    ratio: r.value,
+                    ratio_err: r.err,
+                    z_vs_faithful: z,
+                    same_outcome: same,
+                };
+                log(&format_row(&row));
+                if faithful.is_none() {
+                    faithful = Some((recs, rolls_per_s));
+                }
+                rows.push(row);
+            }
+        }
+    }
+    let ffi = ffi_cost(&Scene::paper(block, Mode::ThreeD))?;
+    log(&format!(
+        "FFI: {} steps (fastest of 3 per throw), Rust loop (one cxx call per step, returning the state) {:.3} s, C++ loop (the same steps and state reads) {:.3} s: overhead {:+.1} %",
+        ffi.steps,
+        ffi.rust_loop_s,
+        ffi.cpp_loop_s,
+        100.0 * ffi.overhead
+    ));
+    let verdicts: Vec<Verdict> = [Mode::ThreeD, Mode::TwoD]
+        .iter()
+        .filter_map(|mode| {
+            let of_mode = |t: usize| {
+                rows.iter()
+                    .filter(move |r| r.mode == mode.name() && r.threads == t)
+            };
+            let faithful_1 = of_mode(1).find(|r| r.method == "faithful")?.rolls_per_s;
+            let proven: Vec<&String> = methods
+                .iter()
+                .filter(|m| m.proven && m.engine == EngineKind::Bullet)
+                .map(|m| &m.name)
+                .collect();
+            let best = of_mode(all_threads.max(1))
+                .filter(|r| proven.contains(&&r.method) && r.z_vs_faithful.abs() <= Z_BOUND)
+                .max_by(|a, b| a.rolls_per_s.total_cmp(&b.rolls_per_s))?;
+            Some(Verdict {
+                mode: mode.name().into(),
+                method: best.method.clone(),
+                threads: best.threads,
+                rolls_per_s: best.rolls_per_s,
+                speedup: best.speedup,
+                speedup_vs_faithful_1_thread: best.rolls_per_s / faithful_1,
+                vs_dicephys: best.vs_dicephys,
+                z_vs_faithful: best.z_vs_faithful,
+            })
+        })
+        .collect();
+    for v in &verdicts {
+        log(&format!(
+            "fastest within |z| <= {Z_BOUND} of faithful, {}: {} on {} threads, {:.0} rolls/s: {:.2}x faithful on {} threads, {:.2}x faithful on 1 thread, {:.1}x DicePhys",
+            v.mode, v.method, v.threads, v.rolls_per_s, v.speedup, v.threads, v.speedup_vs_faithful_1_thread, v.vs_dicephys
+        ));
+    }
+    Ok(Bench {
+        rows,
+        verdicts,
+        ffi,
+        peak_rss_mb: peak_rss_bytes() as f64 / 1e6,
+        seed,
+        repeat: repeat.max(1),
+    })
+}
+
+/// What one cxx call per step costs: the same 1,000-step stretch of the same throws, stepped
+/// from Rust (one call per step, which returns the state, as a roll does) and inside C++
+/// alone (the same steps and state reads), interleaved and repeated so that machine noise
+/// falls on both alike.
+pub fn ffi_cost(scene: &Scene) -> crate::Result<FfiCost> {
+    use crate::engine::Engine;
+    let mut bullet = crate::engine::bullet::Bullet::new(scene)?;
+    let throws = Throws::new(ThrowKind::Keyed, 1, ThrowRanges::default(), 0);
+    let n = 1000u32;
+    let (mut rust_s, mut cpp_s) = (0.0, 0.0);
+    let mut sink = 0.0;
+    // Per throw, the two loops side by side, three times each; the fastest of each three
+    // counts, so that a moment's load on this shared machine does not.
+    for i in 0..200u64 {
+        let start = throws.get(i).start(scene);
+        let (mut rust_best, mut cpp_best) = (f64::INFINITY, f64::INFINITY);
+        for _ in 0..3 {
+            bullet.reset(&start)?;
+            let t = Instant::now();
+            for _ in 0..n {
+                bullet.step()?;
+                sink += bullet.state().position.y;
+            }
+            rust_best = rust_best.min(t.elapsed().as_secs_f64());
+            bullet.reset(&start)?;
+            let t = Instant::now();
+            bullet.step_n(n)?;
+            sink += bullet.state().position.y;
+            cpp_best = cpp_best.min(t.elapsed().as_secs_f64());
+        }
+        rust_s += rust_best;
+        cpp_s += cpp_best;
+    }
+    std::hint::black_box(sink);
+    Ok(FfiCost {
+        steps: 200 * n as u64,
+        rust_loop_s: rust_s,
+        cpp_loop_s: cpp_s,
+        overhead: rust_s / cpp_s - 1.0,
+    })
+}
+
+pub fn header() -> String {
+    format!(
+        "{:<20} {:>4} {:>3} {:>9} {:>8} {:>8} {:>7} {:>7} {:>8} {:>8} {:>15} {:>6} {:>6}",
+        "method",
+        "mode",
+        "thr",
+        "rolls/s",
+        "ms/roll",
+        "µs/step",
+        "steps",
+        "engine",
+        "speedup",
+        "×DicePhys",
+        "ratio",
+        "z",
+        "same"
+    )
+}
+
+pub fn format_row(r: &BenchRow) -> String {
+    format!(
+        "{:<20} {:>4} {:>3} {:>9.0} {:>8.3} {:>8.2} {:>7.0} {:>7.0} {:>7.2}x {:>8.1}x {:>7.4} ± {:.4} {:>+6.1} {:>5.1}%",
+        r.method,
+        r.mode,
+        r.threads,
+        r.rolls_per_s,
+        r.cpu_ms_per_roll,
+        r.us_per_engine_step,
+        r.steps_per_roll,
+        r.engine_steps_per_roll,
+        r.speedup,
+        r.vs_dicephys,
+        r.ratio,
+        r.ratio_err,
+        r.z_vs_faithful,
+        100.0 * r.same_outcome
+    )
+}

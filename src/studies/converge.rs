@@ -1,0 +1,261 @@
+//! `dicephys converge`: the paper's convergence test. For each block, engine and 2D/3D the
+//! ratio at every dt, and its relative departure from the finest dt's. The paper claims that
+//! dt = 0.001 s is within 1 % of dt = 0.0001 s; here that is tested as 0.001 s against the
+//! finest dt of the run, and the verdict says whether the data can resolve 1 % at all.
+//!
+//! Rolls end by DicePhys's own rule with every step stepped (no early stop, no closed-form
+//! flight): this is a study of the integrator, so nothing else may change with dt.
+
+use super::sweep::{cell_spec, departure, dt_label, measure, rolls_to_resolve, Study, ONE_PERCENT};
+use crate::engine::EngineKind;
+use crate::error::{Error, Result};
+use crate::model::block::Block;
+use crate::model::scene::{Mode, Scene};
+use crate::sim::roll::{RollConfig, Rule};
+use serde::Serialize;
+
+pub struct Config {
+    pub blocks: Vec<Block>,
+    pub dts: Vec<f64>,
+    pub engines: Vec<EngineKind>,
+    pub rolls: u64,
+    pub seed: u64,
+    pub max_steps: u64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Cell {
+    pub block: String,
+    pub engine: String,
+    pub mode: String,
+    pub dt: f64,
+    pub rolls: u64,
+    pub ratio: f64,
+    pub ratio_err: f64,
+    pub steps_per_roll: f64,
+    pub cpu_s_per_roll: f64,
+    pub unconverged: u64,
+    pub failed: u64,
+    pub energy_gain: u64,
+    /// ratio / ratio at the finest dt − 1, and its error.
+    pub departure: f64,
+    pub departure_err: f64,
+}
+
+/// The paper's claim for one block × engine × mode.
+#[derive(Clone, Debug, Serialize)]
+pub struct Claim {
+    pub block: String,
+    pub engine: String,
+    pub mode: String,
+    pub dt: f64,
+    pub dt_finest: f64,
+    pub departure: f64,
+    pub departure_err: f64,
+    /// 2σ of the departure is at most 1 %.
+    pub resolved: bool,
+    /// Resolved and |departure| ≤ 1 %.
+    pub within_one_percent: Option<bool>,
+    /// Rolls per cell for 2σ = 1 %.
+    pub rolls_needed: Option<u64>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Converge {
+    pub settle: String,
+    pub rolls: u64,
+    pub seed: u64,
+    pub dts: Vec<f64>,
+    pub max_steps: u64,
+    pub cells: Vec<Cell>,
+    pub claims: Vec<Claim>,
+    /// Every claim resolved.
+    pub resolved: bool,
+    /// Plain words: does the run resolve the paper's claim, and if not, what would.
+    pub verdict: String,
+}
+
+/// The dt the paper's claim is about.
+pub const CLAIM_DT: f64 = 0.001;
+
+/// Runs the convergence test, logging each cell as it is measured.
+pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Converge> {
+    let settle = RollConfig {
+        max_steps: cfg.max_steps,
+        rule: Rule::Dicephys,
+        fast_flight: false,
+        ..RollConfig::default()
+    };
+    let mut dts = cfg.dts.clone();
+    dts.sort_by(|a, b| b.total_cmp(a));
+    dts.dedup();
+    let finest = *dts
+        .last()
+        .ok_or_else(|| Error::Invalid("no dt given".into()))?;
+    let mut cells = Vec::new();
+    let mut claims = Vec::new();
+    for block in &cfg.blocks {
+        for &engine in &cfg.engines {
+            for mode in [Mode::ThreeD, Mode::TwoD] {
+                let mut row = Vec::new();
+                for &dt in &dts {
+                    let mut scene = Scene::paper(*block, mode);
+                    scene.dt = dt;
+                    let m = measure(
+                        &cell_spec(engine, scene, settle, cfg.seed, cfg.rolls),
+                        study,
+                    )?;
+                    row.push((dt, m));
+                }
+                let reference = row
+                    .last()
+                    .map(|(_, m)| m.ratio())
+                    .ok_or_else(|| Error::Invalid("no dt given".into()))?;
+                for (dt, m) in &row {
+                    let r = m.ratio();
+                    let (d, d_err) = departure(r, reference);
+                    let cell = Cell {
+                        block: block.to_string(),
+                        engine: engine.name().into(),
+                        mode: mode.name().into(),
+                        dt: *dt,
+                        rolls: m.tally.rolls,
+                        ratio: r.value,
+                        ratio_err: r.err,
+                        steps_per_roll: m.steps_per_roll(),
+                        cpu_s_per_roll: m.cpu_s_per_roll(),
+                        unconverged: m.tally.unconverged,
+                        failed: m.tally.failed_total(),
+                        energy_gain: m.tally.energy_gain,
+                        departure: d,
+                        departure_err: d_err,
+                    };
+                    log(&format_cell(&cell));
+                    if (dt - CLAIM_DT).abs() < 1e-12 && *dt > finest {
+                        let resolved = 2.0 * d_err <= ONE_PERCENT;
+                        claims.push(Claim {
+                            block: cell.block.clone(),
+                            engine: cell.engine.clone(),
+                            mode: cell.mode.clone(),
+                            dt: *dt,
+                            dt_finest: finest,
+                            departure: d,
+                            departure_err: d_err,
+                            resolved,
+                            within_one_percent: resolved.then_some(d.abs() <= ONE_PERCENT),
+                            rolls_needed: rolls_to_resolve(d_err, cfg.rolls),
+                        });
+                    }
+                    cells.push(cell);
+                }
+            }
+        }
+    }
+    let resolved = !claims.is_empty() && claims.iter().all(|c| c.resolved);
+    let verdict = verdict(&claims, finest, cfg.rolls);
+    Ok(Converge {
+        settle: "dicephys rest rule, every step stepped (faithful)".into(),
+        rolls: cfg.rolls,
+        seed: cfg.seed,
+        dts,
+        max_steps: cfg.max_steps,
+        cells,
+        claims,
+        resolved,
+        verdict,
+    })
+}
+
+fn verdict(claims: &[Claim], finest: f64, rolls: u64) -> String {
+    if claims.is_empty() {
+        return format!(
+            "The paper's claim (dt = 0.001 s within 1 % of 0.0001 s) is not tested: the run \
+             needs dt = 1/1000 and a finer dt (finest here {}).",
+            dt_label(finest)
+        );
+    }
+    let vs = if (finest - 1e-4).abs() < 1e-12 {
+        "0.0001 s, as the paper".to_string()
+    } else {
+        format!(
+            "the finest dt here, {} s (the paper: 0.0001 s)",
+            dt_label(finest)
+        )
+    };
+    let unresolved: Vec<&Claim> = claims.iter().filter(|c| !c.resolved).collect();
+    if unresolved.is_empty() {
+        let fails: Vec<String> = claims
+            .iter()
+            .filter(|c| c.within_one_percent == Some(false))
+            .map(|c| format!("{} {} {}", c.block, c.engine, c.mode))
+            .collect();
+        if fails.is_empty() {
+            format!("Resolved: dt = 0.001 s is within 1 % of {vs} in every cell (2σ ≤ 1 %).")
+        } else {
+            format!(
+                "Resolved: dt = 0.001 s departs by more than 1 % from {vs} for {}.",
+                fails.join(", ")
+            )
+        }
+    } else {
+        let need = |c: &&&Claim| c.rolls_needed.unwrap_or(u64::MAX);
+        let name = |c: &Claim| format!("{} {} {}", c.block, c.engine, c.mode);
+        let (Some(least), Some(most)) = (
+            unresolved.iter().min_by_key(need),
+            unresolved.iter().max_by_key(need),
+        ) else {
+            return String::new();
+        };
+        format!(
+            "Not resolved: with {rolls} rolls per cell the departure of dt = 0.001 s from {vs} is \
+             known only to ±{:.0} % to ±{:.0} % (2σ), so 1 % cannot be told from 0 ({} of {} \
+             cells unresolved). Resolving it needs about {} rolls per cell for {} and {} for {} \
+             (small ratios need the most).",
+            100.0 * 2.0 * least.departure_err,
+            100.0 * 2.0 * most.departure_err,
+            unresolved.len(),
+            claims.len(),
+            least.rolls_needed.unwrap_or(0),
+            name(least),
+            most.rolls_needed
+                .map_or("unknown".into(), |n| n.to_string()),
+            name(most),
+        )
+    }
+}
+
+pub fn header() -> String {
+    format!(
+        "{:<10} {:<13} {:>4} {:>8} {:>17} {:>8} {:>10} {:>18} {:>6} {:>6} {:>5}",
+        "block",
+        "engine",
+        "mode",
+        "dt",
+        "ratio",
+        "steps",
+        "CPU s/roll",
+        "vs finest dt",
+        "unconv",
+        "failed",
+        "gain"
+    )
+}
+
+pub fn format_cell(c: &Cell) -> String {
+    format!(
+        "{:<10} {:<13} {:>4} {:>8} {:>8.4} ± {:.4} {:>8.0} {:>10.5} {:>+7.1} ± {:>4.1} % {:>6} {:>6} {:>5}",
+        c.block,
+        c.engine,
+        c.mode,
+        dt_label(c.dt),
+        c.ratio,
+        c.ratio_err,
+        c.steps_per_roll,
+        c.cpu_s_per_roll,
+        100.0 * c.departure,
+        100.0 * c.departure_err,
+        c.unconverged,
+        c.failed,
+        c.energy_gain
+    )
+}

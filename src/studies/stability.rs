@@ -1,0 +1,287 @@
+//! `dicephys stability`: where engines break. Around the paper's scene (140x24x20, μ = 0.29,
+//! e = 0.5, dt = 1 ms) one grid over the two most telling axes, dt × restitution, and two
+//! lines, friction and the block's aspect ratio, per engine, 2D and 3D. Per cell the fractions
+//! of rolls that end unconverged at the step cap, unknown (resting on an edge), failed
+//! non-finite, tunnelled through the floor, and that gained energy (`roll::EnergyWatch`).
+//! Rolls end by DicePhys's rule, every step stepped, capped at `max_steps`.
+
+use super::sweep::{cell_spec, measure, Study};
+use crate::engine::EngineKind;
+use crate::error::Result;
+use crate::model::block::Block;
+use crate::model::scene::{Mode, Scene};
+use crate::sim::roll::{Failure, RollConfig, Rule};
+use serde::Serialize;
+
+pub struct Config {
+    pub engines: Vec<EngineKind>,
+    pub dts: Vec<f64>,
+    pub restitutions: Vec<f64>,
+    pub frictions: Vec<f64>,
+    pub blocks: Vec<Block>,
+    pub rolls: u64,
+    pub seed: u64,
+    pub max_steps: u64,
+}
+
+/// The failure kinds, in the order of the figures and tables.
+pub const KINDS: [&str; 5] = [
+    "unconverged",
+    "unknown",
+    "non_finite",
+    "tunnelled",
+    "energy_gain",
+];
+
+/// Which sweep a cell belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, strum::Display, strum::IntoStaticStr)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum Sweep {
+    /// The grid of time step against restitution.
+    DtRestitution,
+    /// The line over friction.
+    Friction,
+    /// The line over the block's aspect ratios.
+    Aspect,
+}
+
+/// One measured cell.
+#[derive(Clone, Debug, Serialize)]
+pub struct Cell {
+    /// The grid or line the cell is on.
+    pub sweep: Sweep,
+    /// The engine.
+    pub engine: EngineKind,
+    /// 2D or 3D.
+    pub mode: Mode,
+    pub block: String,
+    /// breadth/width and length/breadth.
+    pub breadth_over_width: f64,
+    pub length_over_breadth: f64,
+    pub dt: f64,
+    pub restitution: f64,
+    pub friction: f64,
+    pub rolls: u64,
+    pub unconverged: f64,
+    pub unknown: f64,
+    pub non_finite: f64,
+    pub tunnelled: f64,
+    pub engine_error: f64,
+    pub energy_gain: f64,
+    pub ratio: f64,
+    pub ratio_err: f64,
+    pub steps_per_roll: f64,
+}
+
+impl Cell {
+    pub fn kind(&self, k: &str) -> f64 {
+        match k {
+            "unconverged" => self.unconverged,
+            "unknown" => self.unknown,
+            "non_finite" => self.non_finite,
+            "tunnelled" => self.tunnelled,
+            "energy_gain" => self.energy_gain,
+            _ => f64::NAN,
+        }
+    }
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Stability {
+    pub rolls: u64,
+    pub seed: u64,
+    pub max_steps: u64,
+    pub energy_gain_tolerance: f64,
+    pub dts: Vec<f64>,
+    pub restitutions: Vec<f64>,
+    pub frictions: Vec<f64>,
+    pub blocks: Vec<String>,
+    pub cells: Vec<Cell>,
+    /// One sentence per failure kind: where it happens most.
+    pub findings: Vec<String>,
+}
+
+/// The paper's block and contact, the centre of every line.
+fn base_block() -> Block {
+    Block::from_mm(140.0, 24.0, 20.0).expect("a valid block")
+}
+
+/// The paper's scene for `block` with the step and the contact's e and μ set.
+fn scene(block: Block, mode: Mode, dt: f64, e: f64, mu: f64) -> Scene {
+    let mut scene = Scene::paper(block, mode);
+    scene.dt = dt;
+    scene.restitution = e;
+    scene.friction = mu;
+    scene
+}
+
+fn cell(
+    cfg: &Config,
+    study: &Study,
+    sweep: Sweep,
+    engine: EngineKind,
+    scene: Scene,
+) -> Result<Cell> {
+    let (block, mode, dt, e, mu) = (
+        scene.block,
+        scene.mode,
+        scene.dt,
+        scene.restitution,
+        scene.friction,
+    );
+    let settle = RollConfig {
+        max_steps: cfg.max_steps,
+        rule: Rule::Dicephys,
+        fast_flight: false,
+        ..RollConfig::default()
+    };
+    let m = measure(
+        &cell_spec(engine, scene, settle, cfg.seed, cfg.rolls),
+        study,
+    )?;
+    let r = m.ratio();
+    let t = &m.tally;
+    Ok(Cell {
+        sweep,
+        engine,
+        mode,
+        block: block.to_string(),
+        breadth_over_width: block.breadth / block.width,
+        length_over_breadth: block.length / block.breadth,
+        dt,
+        restitution: e,
+        friction: mu,
+        rolls: t.rolls,
+        unconverged: m.frac(t.unconverged),
+        unknown: m.frac(t.counts.unknown),
+        non_finite: m.frac(t.failed_of(Failure::NonFinite)),
+        tunnelled: m.frac(t.failed_of(Failure::Tunnelled)),
+        engine_error: m.frac(t.failed_of(Failure::Engine)),
+        energy_gain: m.frac(t.energy_gain),
+        ratio: r.value,
+        ratio_err: r.err,
+        steps_per_roll: m.steps_per_roll(),
+    })
+}
+
+/// Measures every cell, logging each as it is measured.
+pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Stability> {
+    let (dt0, e0, mu0) = (0.001, 0.5, 0.29);
+    let mut cells = Vec::new();
+    let mut push = |c: Cell| {
+        log(&format_cell(&c));
+        cells.push(c);
+    };
+    for &engine in &cfg.engines {
+        for mode in [Mode::ThreeD, Mode::TwoD] {
+            for &dt in &cfg.dts {
+                for &e in &cfg.restitutions {
+                    let s = scene(base_block(), mode, dt, e, mu0);
+                    push(cell(cfg, study, Sweep::DtRestitution, engine, s)?);
+                }
+            }
+            for &mu in &cfg.frictions {
+                let s = scene(base_block(), mode, dt0, e0, mu);
+                push(cell(cfg, study, Sweep::Friction, engine, s)?);
+            }
+            for &b in &cfg.blocks {
+                let s = scene(b, mode, dt0, e0, mu0);
+                push(cell(cfg, study, Sweep::Aspect, engine, s)?);
+            }
+        }
+    }
+    let findings = findings(&cells);
+    Ok(Stability {
+        rolls: cfg.rolls,
+        seed: cfg.seed,
+        max_steps: cfg.max_steps,
+        energy_gain_tolerance: crate::sim::roll::ENERGY_GAIN_TOLERANCE,
+        dts: cfg.dts.clone(),
+        restitutions: cfg.restitutions.clone(),
+        frictions: cfg.frictions.clone(),
+        blocks: cfg.blocks.iter().map(|b| b.to_string()).collect(),
+        cells,
+        findings,
+    })
+}
+
+fn describe(c: &Cell) -> String {
+    match c.sweep {
+        Sweep::Friction => format!("{} {} μ {}", c.engine, c.mode, c.friction),
+        Sweep::Aspect => format!("{} {} block {}", c.engine, c.mode, c.block),
+        _ => format!(
+            "{} {} dt {} e {}",
+            c.engine,
+            c.mode,
+            super::sweep::dt_label(c.dt),
+            c.restitution
+        ),
+    }
+}
+
+/// Per failure kind: how many cells show it, and the worst.
+fn findings(cells: &[Cell]) -> Vec<String> {
+    KINDS
+        .iter()
+        .map(|&k| {
+            let hit: Vec<&Cell> = cells.iter().filter(|c| c.kind(k) > 0.0).collect();
+            match hit.iter().max_by(|a, b| a.kind(k).total_cmp(&b.kind(k))) {
+                None => format!("{k}: none in any of {} cells.", cells.len()),
+                Some(w) => {
+                    let mut names: Vec<String> = hit.iter().take(6).map(|c| describe(c)).collect();
+                    if hit.len() > 6 {
+                        names.push("…".into());
+                    }
+                    format!(
+                        "{k}: in {} of {} cells, worst {:.0} % ({}); cells: {}.",
+                        hit.len(),
+                        cells.len(),
+                        100.0 * w.kind(k),
+                        describe(w),
+                        names.join("; ")
+                    )
+                }
+            }
+        })
+        .collect()
+}
+
+pub fn header() -> String {
+    format!(
+        "{:<15} {:<13} {:>4} {:<11} {:>8} {:>5} {:>5} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7}",
+        "sweep",
+        "engine",
+        "mode",
+        "block",
+        "dt",
+        "e",
+        "μ",
+        "unconv",
+        "unknown",
+        "nonfin",
+        "tunnel",
+        "gain",
+        "steps"
+    )
+}
+
+pub fn format_cell(c: &Cell) -> String {
+    let pc = |v: f64| format!("{:.0}%", 100.0 * v);
+    format!(
+        "{:<15} {:<13} {:>4} {:<11} {:>8} {:>5} {:>5} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7.0}",
+        c.sweep,
+        c.engine,
+        c.mode,
+        c.block,
+        super::sweep::dt_label(c.dt),
+        c.restitution,
+        c.friction,
+        pc(c.unconverged),
+        pc(c.unknown),
+        pc(c.non_finite),
+        pc(c.tunnelled),
+        pc(c.energy_gain),
+        c.steps_per_roll
+    )
+}

@@ -1,0 +1,217 @@
+//! Integration tests against the real Bullet, through the real shim. Run optimised
+//! (`cargo test --release`): each rolls thousands of real throws.
+
+use dicephys::engine::{new_engine, EngineKind};
+use dicephys::model::block::{Block, Outcome};
+use dicephys::model::scene::{Mode, Scene};
+use dicephys::model::state::BodyState;
+use dicephys::model::throws::{ThrowKind, ThrowRanges, Throws};
+use dicephys::run::batch;
+use dicephys::run::tally::Tally;
+use dicephys::sim::roll::{roll, run_from, Fate, RollConfig};
+use nalgebra::{UnitQuaternion, Vector3};
+use std::f64::consts::FRAC_PI_2;
+
+fn block() -> Block {
+    "140x24x20".parse().unwrap()
+}
+
+/// A die set down at rest, a hair above the floor, with `up` (a body axis) vertical.
+fn at_rest(rotation: UnitQuaternion<f64>, half_height: f64) -> BodyState {
+    BodyState {
+        position: Vector3::new(0.0, half_height + 1e-4, 0.0),
+        rotation,
+        linear_velocity: Vector3::zeros(),
+        angular_velocity: Vector3::zeros(),
+        sleeping: false,
+    }
+}
+
+fn settle_at_rest(
+    engine: EngineKind,
+    mode: Mode,
+    rotation: UnitQuaternion<f64>,
+    half: f64,
+) -> Fate {
+    let scene = Scene::paper(block(), mode);
+    let mut e = new_engine(engine, &scene).unwrap();
+    let end = run_from(
+        e.as_mut(),
+        &scene,
+        &at_rest(rotation, half),
+        &RollConfig {
+            max_steps: 20_000,
+            ..RollConfig::default()
+        },
+        |_, _| {},
+    );
+    end.fate
+}
+
+#[test]
+fn a_box_at_rest_on_each_face_classifies_right() {
+    let b = block();
+    // Body x = breadth, y = width, z = length. Identity: width vertical.
+    let cases_3d = [
+        (UnitQuaternion::identity(), b.width / 2.0, Outcome::Width),
+        (
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), FRAC_PI_2),
+            b.breadth / 2.0,
+            Outcome::Breadth,
+        ),
+        (
+            UnitQuaternion::from_axis_angle(&Vector3::x_axis(), FRAC_PI_2),
+            b.length / 2.0,
+            Outcome::Length,
+        ),
+    ];
+    for (rot, half, want) in cases_3d {
+        assert_eq!(
+            settle_at_rest(EngineKind::Bullet, Mode::ThreeD, rot, half),
+            Fate::Settled(want),
+            "3D, {want:?} vertical"
+        );
+    }
+    for (rot, half, want) in &cases_3d[..2] {
+        assert_eq!(
+            settle_at_rest(EngineKind::Bullet, Mode::TwoD, *rot, *half),
+            Fate::Settled(*want),
+            "2D, {want:?} vertical"
+        );
+    }
+}
+
+#[test]
+fn same_seed_same_counts_for_any_thread_count() {
+    let scene = Scene::paper(block(), Mode::ThreeD);
+    let throws = Throws::new(ThrowKind::Keyed, 11, ThrowRanges::default(), 0);
+    let settle = RollConfig::default();
+    let one = batch::run(
+        EngineKind::Bullet,
+        &scene,
+        &throws,
+        &settle,
+        0..300,
+        1,
+        &|_| {},
+    )
+    .unwrap();
+    let two = batch::run(
+        EngineKind::Bullet,
+        &scene,
+        &throws,
+        &settle,
+        0..300,
+        2,
+        &|_| {},
+    )
+    .unwrap();
+    assert_eq!(one, two, "records differ between 1 and 2 threads");
+    assert_eq!(Tally::of(&one), Tally::of(&two));
+}
+
+#[test]
+fn a_throw_rolls_the_same_alone_and_inside_a_batch() {
+    let scene = Scene::paper(block(), Mode::ThreeD);
+    let throws = Throws::new(ThrowKind::Keyed, 5, ThrowRanges::default(), 0);
+    let settle = RollConfig::default();
+    let batch = batch::run(
+        EngineKind::Bullet,
+        &scene,
+        &throws,
+        &settle,
+        0..40,
+        2,
+        &|_| {},
+    )
+    .unwrap();
+    for i in [0u64, 17, 39] {
+        let mut fresh = new_engine(EngineKind::Bullet, &scene).unwrap();
+        let alone = roll(fresh.as_mut(), &scene, &throws.get(i), &settle);
+        assert_eq!(alone, batch[i as usize], "throw {i}");
+    }
+}
+
+/// The reference: DicePhys 2.81's outcome for each of its first 2,000 throws.
+fn reference(file: &str) -> Vec<String> {
+    let path = format!("{}/tests/data/{file}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).unwrap();
+    text.lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap().to_string())
+        .collect()
+}
+
+fn match_dicephys(mode: Mode, block: &str, file: &str) -> f64 {
+    let want = reference(file);
+    let scene = Scene::paper(block.parse().unwrap(), mode);
+    let n = want.len() as u64;
+    let throws = Throws::new(ThrowKind::Dicephys, 2385, ThrowRanges::default(), n);
+    let got = batch::run(
+        EngineKind::Bullet,
+        &scene,
+        &throws,
+        &RollConfig::default(),
+        0..n,
+        0,
+        &|_| {},
+    )
+    .unwrap();
+    let same = got
+        .iter()
+        .zip(&want)
+        .filter(|(r, w)| matches!(r.fate, Fate::Settled(o) if o.name() == w.as_str()))
+        .count();
+    same as f64 / n as f64
+}
+
+#[test]
+fn matches_dicephys_throw_for_throw_3d() {
+    // DicePhys's own source rebuilt on Bullet 3.24 gets 99.95 %; the issue asks >= 99.5 %.
+    let f = match_dicephys(
+        Mode::ThreeD,
+        "140x24x20",
+        "dicephys-2.81-per-roll-3d-140x24x20.csv",
+    );
+    assert!(f >= 0.995, "3D: {:.2} % identical outcomes", 100.0 * f);
+}
+
+#[test]
+fn matches_dicephys_throw_for_throw_2d() {
+    let f = match_dicephys(
+        Mode::TwoD,
+        "140x22x13",
+        "dicephys-2.81-per-roll-2d-140x22x13.csv",
+    );
+    assert!(f >= 0.995, "2D: {:.2} % identical outcomes", 100.0 * f);
+}
+
+#[test]
+fn keyed_throws_agree_with_dicephys_ratio_within_3_sigma() {
+    // Reference: DicePhys 2.81, 3D 140x24x20, 40,000 rolls: 14163 / 25837 = 0.5482 ± 0.0057.
+    // Independent keyed throws, fixed seed; tolerance 3 combined standard errors.
+    let scene = Scene::paper(block(), Mode::ThreeD);
+    let throws = Throws::new(ThrowKind::Keyed, 20_141_407, ThrowRanges::default(), 0);
+    let recs = batch::run(
+        EngineKind::Bullet,
+        &scene,
+        &throws,
+        &RollConfig::default(),
+        0..3000,
+        0,
+        &|_| {},
+    )
+    .unwrap();
+    let t = Tally::of(&recs);
+    let ours = dicephys::theory::stats::ratio(t.counts.breadth, t.counts.width);
+    let theirs = dicephys::theory::stats::ratio(14163, 25837);
+    let z = dicephys::theory::stats::z_score(ours.value, ours.err, theirs.value, theirs.err);
+    assert!(
+        z.abs() < 3.0,
+        "ratio {:.4} ± {:.4} is {z:.2} σ from DicePhys's {:.4}",
+        ours.value,
+        ours.err,
+        theirs.value
+    );
+    assert_eq!(t.failed_total() + t.unconverged, 0);
+}

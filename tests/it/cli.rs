@@ -1,0 +1,195 @@
+//! The command line as a user meets it: the built binary, its exit codes, its outputs.
+
+fn dicephys(args: &[&str]) -> std::process::Output {
+    super::helpers::bin()
+        .args(args)
+        .output()
+        .expect("run dicephys")
+}
+
+fn json(out: &std::process::Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON document")
+}
+
+#[test]
+fn bad_input_gets_one_line_and_exit_code_2() {
+    let cases: &[&[&str]] = &[
+        &["roll", "--block", "0x24x20"],
+        &["roll", "--block", "abc"],
+        &["roll", "--block", "140x24x20", "--rolls", "0"],
+        &["roll", "--block", "140x24x20", "--dt", "0"],
+        &["roll", "--block", "140x24x20", "--dt", "0.5"],
+        &["roll", "--block", "140x24x20", "--dt", "nan"],
+        &["roll", "--block", "140x24x20", "--friction", "-1"],
+        &["roll", "--block", "140x24x20", "--restitution", "1.5"],
+        &["roll", "--block", "140x24x20", "--spin", "160:31"],
+        &["roll", "--block", "140x24x20", "--engine", "havok"],
+        &["roll", "--block", "140x24x20", "--preset", "bullet2"],
+        &["roll", "--block", "140x24x20", "--throws", "random"],
+        &[
+            "roll",
+            "--block",
+            "140x24x20",
+            "--per-roll",
+            "/nonexistent/dir/x.csv",
+        ],
+        &["roll", "--block", "20000x24x20"],
+        &["paper", "--rolls", "0"],
+        &["trace", "--block", "140x24x20", "--every", "0"],
+        &["trace", "--block", "140x24x20", "--flight", "warp"],
+        &["bench", "--rolls", "0"],
+        &["bench", "--repeat", "0"],
+    ];
+    for args in cases {
+        let out = dicephys(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(out.stdout.is_empty(), "{args:?} printed to stdout");
+    }
+}
+
+#[test]
+fn roll_json_has_the_documented_fields_and_ignores_thread_count() {
+    let base = [
+        "roll",
+        "--block",
+        "140x22x13",
+        "--2d",
+        "--rolls",
+        "200",
+        "--seed",
+        "9",
+        "--json",
+    ];
+    let one = json(&dicephys(&[&base[..], &["--threads", "1"]].concat()));
+    let two = json(&dicephys(&[&base[..], &["--threads", "2"]].concat()));
+    for f in [
+        "engine",
+        "preset",
+        "block_mm",
+        "mode",
+        "rolls",
+        "seed",
+        "dt",
+        "counts",
+        "unconverged",
+        "failed",
+        "ratio",
+        "ratio_err",
+        "theory_ratio",
+        "steps_mean",
+        "wall_s",
+        "cpu_s",
+        "engine_version",
+    ] {
+        assert!(one.get(f).is_some(), "missing {f}");
+    }
+    assert_eq!(one["counts"], two["counts"]);
+    assert_eq!(one["steps_total"], two["steps_total"]);
+    assert_eq!(one["rolls"], 200);
+    assert_eq!(one["mode"], "2d");
+}
+
+#[test]
+fn per_roll_csv_has_a_row_per_throw() {
+    let path = std::env::temp_dir().join(format!("dicephys-per-roll-{}.csv", std::process::id()));
+    let p = path.to_str().unwrap();
+    let out = dicephys(&[
+        "roll",
+        "--block",
+        "140x24x20",
+        "--rolls",
+        "50",
+        "--per-roll",
+        p,
+    ]);
+    assert!(out.status.success());
+    let text = std::fs::read_to_string(&path).unwrap();
+    let _ = std::fs::remove_file(&path);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 51);
+    assert!(
+        lines[0].starts_with("index,drop_height_m,velocity_m_s,spin_rad_s,status,outcome,steps")
+    );
+    assert!(lines[1].starts_with("0,"));
+}
+
+#[test]
+fn trace_prints_a_trajectory() {
+    let out = dicephys(&[
+        "trace",
+        "--block",
+        "140x24x20",
+        "--index",
+        "3",
+        "--every",
+        "100",
+    ]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.starts_with("step,time_s,x,y,z,"));
+    assert!(text.lines().count() > 5);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("settled"));
+}
+
+#[test]
+fn a_tiny_paper_run_is_complete_and_repeatable() {
+    let dir = std::env::temp_dir().join(format!("dicephys-paper-{}", std::process::id()));
+    let d = dir.to_str().unwrap();
+    let run = || {
+        let out = dicephys(&["paper", "--rolls", "40", "--seed", "3", "--out", d]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = std::fs::read_to_string(dir.join("results.json")).unwrap();
+        serde_json::from_str::<serde_json::Value>(&text).unwrap()
+    };
+    let a = run();
+    let b = run();
+    let rows = a["table"]["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 19, "every table row");
+    let sims = a["simulations"].as_array().unwrap();
+    assert!(sims.len() >= 10, "five blocks, 3D and 2D, per engine");
+    for (x, y) in sims.iter().zip(b["simulations"].as_array().unwrap()) {
+        assert_eq!(x["run"]["counts"], y["run"]["counts"]);
+        assert_eq!(x["ratio"], y["ratio"]);
+    }
+    assert!(dir.join("report.md").exists());
+    for (fig, series) in [
+        (
+            "master_graph",
+            &[
+                "theory",
+                "no bounce",
+                "printed on MDF",
+                "Bullet 2D simulation",
+                "Bullet 3D simulation",
+            ][..],
+        ),
+        ("prob_2d", &["theory"][..]),
+        ("len_graph", &["printed 24x20 on MDF"][..]),
+        ("dreidel", &["first order"][..]),
+    ] {
+        let svg = std::fs::read_to_string(dir.join(format!("{fig}.svg"))).unwrap();
+        assert!(
+            svg.trim_start().starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
+            "{fig}.svg"
+        );
+        assert_eq!(svg.matches("<svg").count(), svg.matches("</svg>").count());
+        for name in series {
+            assert!(svg.contains(name), "{fig}.svg lacks the series '{name}'");
+        }
+        let png = std::fs::read(dir.join(format!("{fig}.png"))).unwrap();
+        assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "{fig}.png");
+    }
+    assert!(dir.join("results.csv").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

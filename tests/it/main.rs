@@ -1,0 +1,13 @@
+//! The integration tests, one binary (it links once): real Bullet through the shim, real
+//! Rapier, and the `dicephys` binary as a user runs it.
+
+mod helpers;
+
+mod bullet;
+mod cli;
+mod fuzz;
+mod rapier;
+mod reliability;
+mod speed;
+mod sweeps;
+mod theory_cli;

@@ -1,0 +1,269 @@
+//! Rapier behind the engine interface: real Rapier, no mocks. A die laid on each face stays on
+//! it, a reused world forgets its last throw, a batch is the same for any thread count.
+
+use dicephys::engine::rapier2d::Rapier2d;
+use dicephys::engine::rapier3d::Rapier3d;
+use dicephys::engine::{new_engine, Engine, EngineKind};
+use dicephys::model::block::{Block, Outcome};
+use dicephys::model::scene::{Mode, Scene};
+use dicephys::model::state::BodyState;
+use dicephys::model::throws::{ThrowKind, ThrowRanges, Throws};
+use dicephys::run::batch;
+use dicephys::sim::roll::{roll, roll_observed, Fate, RollConfig, RollRecord};
+use nalgebra::{UnitQuaternion, Vector3};
+use std::f64::consts::FRAC_PI_2;
+
+fn scene(mode: Mode) -> Scene {
+    Scene::paper("140x24x20".parse::<Block>().unwrap(), mode)
+}
+
+fn throws() -> Throws {
+    Throws::new(ThrowKind::Keyed, 1, ThrowRanges::default(), 0)
+}
+
+/// Enough for any roll here to settle; bounds a test's time if one does not.
+const CAP: RollConfig = RollConfig {
+    max_steps: 20_000,
+    rule: dicephys::sim::roll::Rule::Dicephys,
+    margin: dicephys::sim::roll::DEFAULT_MARGIN,
+    audit: false,
+    fast_flight: false,
+};
+
+/// An engine whose every throw starts from one given state instead of the throw's: so that
+/// `roll::roll` itself (rest rule, failure checks, outcome) runs a die laid on a face.
+struct StartAt {
+    inner: Box<dyn Engine>,
+    start: BodyState,
+}
+
+impl Engine for StartAt {
+    fn reset(&mut self, _: &BodyState) -> dicephys::Result<()> {
+        self.inner.reset(&self.start)
+    }
+    fn set_state(&mut self, now: &BodyState) -> dicephys::Result<()> {
+        self.inner.set_state(now)
+    }
+    fn ballistic_flight(&self) -> bool {
+        self.inner.ballistic_flight()
+    }
+    fn step(&mut self) -> dicephys::Result<()> {
+        self.inner.step()
+    }
+    fn state(&self) -> BodyState {
+        self.inner.state()
+    }
+}
+
+/// At rest, a hair (1 µm) above the floor, with `rotation` and the side `vertical` upright.
+fn laid(rotation: UnitQuaternion<f64>, vertical: f64) -> BodyState {
+    BodyState {
+        position: Vector3::new(0.0, 0.5 * vertical + 1e-6, 0.0),
+        rotation,
+        linear_velocity: Vector3::zeros(),
+        angular_velocity: Vector3::zeros(),
+        sleeping: false,
+    }
+}
+
+fn roll_from(kind: EngineKind, scene: &Scene, start: BodyState) -> RollRecord {
+    let mut e = StartAt {
+        inner: new_engine(kind, scene).unwrap(),
+        start,
+    };
+    roll(&mut e, scene, &throws().get(0), &CAP)
+}
+
+fn assert_settles_on(kind: EngineKind, scene: &Scene, start: BodyState, want: Outcome) {
+    let r = roll_from(kind, scene, start);
+    assert_eq!(
+        r.fate,
+        Fate::Settled(want),
+        "{kind} {}: {want:?} vertical, after {} steps",
+        scene.mode.name(),
+        r.steps
+    );
+}
+
+// Body x = breadth, y = width, z = length; world y is up.
+fn breadth_up() -> UnitQuaternion<f64> {
+    UnitQuaternion::from_axis_angle(&Vector3::z_axis(), FRAC_PI_2)
+}
+fn length_up() -> UnitQuaternion<f64> {
+    UnitQuaternion::from_axis_angle(&Vector3::x_axis(), -FRAC_PI_2)
+}
+
+#[test]
+fn a_3d_box_laid_on_each_face_rests_on_it() {
+    let s = scene(Mode::ThreeD);
+    let b = s.block;
+    for kind in [EngineKind::Rapier, EngineKind::RapierLocked] {
+        assert_settles_on(kind, &s, laid(breadth_up(), b.breadth), Outcome::Breadth);
+        assert_settles_on(
+            kind,
+            &s,
+            laid(UnitQuaternion::identity(), b.width),
+            Outcome::Width,
+        );
+        assert_settles_on(kind, &s, laid(length_up(), b.length), Outcome::Length);
+    }
+}
+
+#[test]
+fn a_2d_box_laid_on_each_side_rests_on_it() {
+    let s = scene(Mode::TwoD);
+    let b = s.block;
+    for kind in [EngineKind::Rapier, EngineKind::RapierLocked] {
+        assert_settles_on(kind, &s, laid(breadth_up(), b.breadth), Outcome::Breadth);
+        assert_settles_on(
+            kind,
+            &s,
+            laid(UnitQuaternion::identity(), b.width),
+            Outcome::Width,
+        );
+    }
+}
+
+#[test]
+fn a_throw_that_starts_just_above_the_floor_rolls_to_width_vertical() {
+    // Throw::start puts the centre at the longest side plus the drop height: a negative drop
+    // height lays the (unrotated) block on its length x breadth face.
+    for mode in [Mode::ThreeD, Mode::TwoD] {
+        let s = scene(mode);
+        let mut t = throws().get(0);
+        t.drop_height = 0.5 * s.block.width + 1e-6 - s.drop_base();
+        t.velocity = 0.0;
+        t.spin = 0.0;
+        for kind in [EngineKind::Rapier, EngineKind::RapierLocked] {
+            let mut e = new_engine(kind, &s).unwrap();
+            let r = roll(e.as_mut(), &s, &t, &CAP);
+            assert_eq!(r.fate, Fate::Settled(Outcome::Width), "{kind} {mode:?}");
+        }
+    }
+}
+
+#[test]
+fn the_die_has_the_scenes_mass_and_inertia() {
+    let rest = laid(UnitQuaternion::identity(), 0.02);
+    for mode in [Mode::ThreeD, Mode::TwoD] {
+        let s = scene(mode);
+        let mut e = Rapier3d::new(&s).unwrap();
+        e.reset(&rest).unwrap();
+        let m = e.die_mass().unwrap();
+        assert!(
+            (m - s.mass()).abs() <= 1e-15 * s.mass(),
+            "{m} vs {}",
+            s.mass()
+        );
+    }
+    let s = scene(Mode::TwoD);
+    let mut e = Rapier2d::new(&s).unwrap();
+    e.reset(&rest).unwrap();
+    let (m, i) = e.die_mass_inertia().unwrap();
+    let (b, w) = (s.block.breadth, s.block.width);
+    let want_i = s.mass() / 12.0 * (b * b + w * w);
+    assert!(
+        (m - s.mass()).abs() <= 1e-15 * s.mass(),
+        "{m} vs {}",
+        s.mass()
+    );
+    assert!((i - want_i).abs() <= 1e-15 * want_i, "{i} vs {want_i}");
+}
+
+#[test]
+fn rapier2d_refuses_a_3d_scene_and_a_start_off_the_plane() {
+    assert!(Rapier2d::new(&scene(Mode::ThreeD)).is_err());
+    let mut e = Rapier2d::new(&scene(Mode::TwoD)).unwrap();
+    assert!(e.reset(&laid(length_up(), 0.14)).is_err());
+    assert!(e.reset(&laid(breadth_up(), 0.024)).is_ok());
+}
+
+/// Every state of a roll, and its record.
+fn trajectory(e: &mut dyn Engine, s: &Scene, index: u64) -> (RollRecord, Vec<BodyState>) {
+    let mut states = Vec::new();
+    let t = throws().get(index);
+    let r = roll_observed(e, s, &t, &CAP, |_, st| states.push(*st));
+    (r, states)
+}
+
+#[test]
+fn a_reused_world_forgets_the_last_throw() {
+    for (kind, mode) in [
+        (EngineKind::Rapier, Mode::ThreeD),
+        (EngineKind::Rapier, Mode::TwoD),
+        (EngineKind::RapierLocked, Mode::TwoD),
+    ] {
+        let s = scene(mode);
+        let mut fresh = new_engine(kind, &s).unwrap();
+        let alone = trajectory(fresh.as_mut(), &s, 3);
+
+        let mut reused = new_engine(kind, &s).unwrap();
+        for i in 0..3 {
+            trajectory(reused.as_mut(), &s, i);
+        }
+        let after = trajectory(reused.as_mut(), &s, 3);
+        assert_eq!(alone.0, after.0, "{kind} {mode:?}: records differ");
+        assert!(
+            alone.1 == after.1,
+            "{kind} {mode:?}: the trajectories differ (bit for bit)"
+        );
+    }
+}
+
+#[test]
+fn a_batch_is_the_same_on_one_thread_and_two() {
+    for mode in [Mode::ThreeD, Mode::TwoD] {
+        let s = scene(mode);
+        let run = |threads| {
+            batch::run(
+                EngineKind::Rapier,
+                &s,
+                &throws(),
+                &CAP,
+                0..200,
+                threads,
+                &|_| {},
+            )
+            .unwrap()
+        };
+        let one = run(1);
+        assert_eq!(one.len(), 200);
+        assert_eq!(one, run(2), "{mode:?}");
+    }
+}
+
+/// Lying on its length x breadth face, pushed along x at 0.5 m/s: with μ = 0.29 friction
+/// stops it in 0.5 / (μ g) ≈ 0.18 s.
+fn slides_to_a_stop(kind: EngineKind, mode: Mode) -> bool {
+    let s = scene(mode);
+    let mut start = laid(UnitQuaternion::identity(), s.block.width);
+    start.linear_velocity.x = 0.5;
+    let mut e = new_engine(kind, &s).unwrap();
+    e.reset(&start).unwrap();
+    for _ in 0..1000 {
+        e.step().unwrap();
+    }
+    e.state().linear_velocity.x.abs() < 1e-3
+}
+
+#[test]
+fn friction_stops_a_sliding_box() {
+    for (kind, mode) in [
+        (EngineKind::Bullet, Mode::ThreeD),
+        (EngineKind::Bullet, Mode::TwoD),
+        (EngineKind::Rapier, Mode::ThreeD),
+        (EngineKind::Rapier, Mode::TwoD),
+    ] {
+        assert!(slides_to_a_stop(kind, mode), "{kind} {mode:?}");
+    }
+}
+
+/// Rapier 0.36.1 solves a contact's two friction directions together, dividing by the
+/// determinant of their 2x2 effective-mass matrix. On a body with a locked translation, one
+/// tangent (z) has no effective mass, the determinant is 0, and Rapier's safe inverse makes
+/// the whole friction impulse 0: a body with z translation locked slides without friction.
+/// So `rapier-locked` locks only the rotations about x and y; this checks friction works.
+#[test]
+fn friction_stops_a_sliding_locked_3d_box() {
+    assert!(slides_to_a_stop(EngineKind::RapierLocked, Mode::TwoD));
+}

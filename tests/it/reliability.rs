@@ -1,0 +1,198 @@
+//! Reliability: a killed run resumes bit for bit, shards merge into the whole, Ctrl-C stops
+//! cleanly, a non-finite roll is counted as failed.
+
+use dicephys::engine::{new_engine, EngineKind};
+use dicephys::model::scene::{Mode, Scene};
+use dicephys::model::state::BodyState;
+use dicephys::sim::roll::{run_from, Failure, Fate, RollConfig};
+use nalgebra::{UnitQuaternion, Vector3};
+use std::process::Stdio;
+use std::time::Duration;
+
+use super::helpers::bin;
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("dicephys-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn json(out: &std::process::Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+const RUN: [&str; 8] = [
+    "roll",
+    "--block",
+    "140x22x13",
+    "--2d",
+    "--rolls",
+    "4000",
+    "--seed",
+    "77",
+];
+
+#[test]
+fn a_run_killed_with_sigkill_resumes_bit_for_bit() {
+    let whole = json(&bin().args(RUN).arg("--json").output().unwrap());
+    let dir = tmp("killed");
+    let mut child = bin()
+        .args(RUN)
+        .args(["--json", "--checkpoint", dir.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Wait for at least one finished chunk, then SIGKILL (Child::kill sends SIGKILL).
+    let chunk_written = || {
+        std::fs::read_dir(&dir)
+            .map(|d| {
+                d.flatten()
+                    .any(|e| e.file_name().to_string_lossy().starts_with("chunk-"))
+            })
+            .unwrap_or(false)
+    };
+    for _ in 0..600 {
+        if chunk_written() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(chunk_written(), "no chunk was checkpointed before the kill");
+    let resumed = json(
+        &bin()
+            .args(["roll", "--json", "--resume", dir.to_str().unwrap()])
+            .output()
+            .unwrap(),
+    );
+    assert_eq!(
+        whole["tally"], resumed["tally"],
+        "resumed run differs from the uninterrupted one"
+    );
+    assert_eq!(whole["counts"], resumed["counts"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn shards_merged_equal_the_whole() {
+    let whole = json(&bin().args(RUN).arg("--json").output().unwrap());
+    let dir = tmp("shards");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut files = Vec::new();
+    for k in 0..3 {
+        let out = bin()
+            .args(RUN)
+            .args(["--json", "--shard", &format!("{k}/3")])
+            .output()
+            .unwrap();
+        assert!(out.status.success());
+        let f = dir.join(format!("s{k}.json"));
+        std::fs::write(&f, &out.stdout).unwrap();
+        files.push(f);
+    }
+    let merged = json(
+        &bin()
+            .arg("merge")
+            .args(&files)
+            .arg("--json")
+            .output()
+            .unwrap(),
+    );
+    assert_eq!(whole["tally"], merged["tally"]);
+    assert_eq!(whole["ratio"], merged["ratio"]);
+    // A missing shard, or a shard of another run, is refused.
+    let out = bin().arg("merge").args(&files[..2]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let other = bin()
+        .args([
+            "roll",
+            "--block",
+            "140x24x20",
+            "--rolls",
+            "30",
+            "--json",
+            "--shard",
+            "2/3",
+        ])
+        .output()
+        .unwrap();
+    let f = dir.join("other.json");
+    std::fs::write(&f, &other.stdout).unwrap();
+    let out = bin()
+        .arg("merge")
+        .args(&files[..2])
+        .arg(&f)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn ctrl_c_stops_cleanly_with_a_resumable_checkpoint_and_a_partial_report() {
+    let dir = tmp("sigint");
+    let child = bin()
+        .args([
+            "roll",
+            "--block",
+            "140x24x20",
+            "--rolls",
+            "200000",
+            "--seed",
+            "3",
+        ])
+        .args(["--json", "--checkpoint", dir.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let partial: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(partial["partial"], true);
+    assert!(partial["rolls"].as_u64().unwrap() < 200000);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--resume"));
+    assert!(dir.join("spec.json").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_roll_forced_non_finite_is_counted_as_failed() {
+    let scene = Scene::paper("140x24x20".parse().unwrap(), Mode::ThreeD);
+    let mut e = new_engine(EngineKind::Bullet, &scene).unwrap();
+    let start = BodyState {
+        position: Vector3::new(0.0, 0.3, 0.0),
+        rotation: UnitQuaternion::identity(),
+        linear_velocity: Vector3::new(f64::NAN, 0.0, 0.0),
+        angular_velocity: Vector3::new(0.0, 0.0, 50.0),
+        sleeping: false,
+    };
+    let end = run_from(
+        e.as_mut(),
+        &scene,
+        &start,
+        &RollConfig::default(),
+        |_, _| {},
+    );
+    assert_eq!(end.fate, Fate::Failed(Failure::NonFinite));
+    // The world is still usable for the next throw.
+    let ok = BodyState {
+        linear_velocity: Vector3::zeros(),
+        ..start
+    };
+    let end = run_from(e.as_mut(), &scene, &ok, &RollConfig::default(), |_, _| {});
+    assert!(matches!(end.fate, Fate::Settled(_)));
+}
