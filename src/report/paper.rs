@@ -69,12 +69,7 @@ fn fmt_z(z: f64) -> String {
 }
 
 /// The cell for (row, engine, mode), if simulated.
-pub fn cell<'a>(
-    res: &'a PaperResults,
-    row: usize,
-    engine: EngineKind,
-    mode: Mode,
-) -> Option<&'a SimCell> {
+pub fn cell(res: &PaperResults, row: usize, engine: EngineKind, mode: Mode) -> Option<&SimCell> {
     res.simulations
         .iter()
         .find(|c| c.row == row && c.engine == engine && c.mode == mode)
