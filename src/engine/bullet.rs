@@ -93,6 +93,7 @@ fn solver(preset: Preset) -> Solver {
 // move to another thread; it is never used from two at once (it is not Sync).
 unsafe impl Send for ffi::BulletWorld {}
 
+/// The Bullet engine: one Bullet world with one die in it, through the C++ shim.
 pub struct Bullet {
     world: UniquePtr<ffi::BulletWorld>,
     gyroscopic: bool,
@@ -101,6 +102,7 @@ pub struct Bullet {
 }
 
 impl Bullet {
+    /// A fresh Bullet world for the scene, its solver set by the scene's preset.
     pub fn new(scene: &Scene) -> crate::Result<Bullet> {
         let s = solver(scene.preset);
         let desc = ffi::BulletScene {

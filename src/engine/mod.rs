@@ -35,6 +35,7 @@ pub trait Engine: Send {
     }
     /// Advances the world by one fixed time step.
     fn step(&mut self) -> Result<()>;
+    /// The die's state now, as the engine last left it.
     fn state(&self) -> BodyState;
 }
 

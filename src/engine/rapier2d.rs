@@ -11,6 +11,7 @@ use crate::model::scene::{Floor, Mode, Scene};
 use nalgebra::{UnitQuaternion, Vector3};
 use rapier2d_f64::prelude::*;
 
+/// Rapier's 2D engine: a breadth × width box in the x-y plane, for the 2D scene only.
 pub struct Rapier2d {
     world: PhysicsWorld,
     die: Option<RigidBodyHandle>,
@@ -18,6 +19,7 @@ pub struct Rapier2d {
 }
 
 impl Rapier2d {
+    /// A fresh 2D world for the scene; refuses a 3D scene, and a non-positive time step or mass.
     pub fn new(scene: &Scene) -> crate::Result<Rapier2d> {
         if scene.mode != Mode::TwoD {
             return Err(crate::Error::Engine(

@@ -14,6 +14,7 @@ pub fn version() -> &'static str {
     rapier3d_f64::VERSION
 }
 
+/// Rapier's 3D engine: a free 3D die, or in 2D DicePhys's locked 3D body.
 pub struct Rapier3d {
     /// Rapier's bundle of one world: pipeline, islands, broad and narrow phase, bodies,
     /// colliders, integration parameters and gravity.
@@ -24,6 +25,7 @@ pub struct Rapier3d {
 }
 
 impl Rapier3d {
+    /// A fresh world for the scene; refuses a non-positive time step or mass.
     pub fn new(scene: &Scene) -> crate::Result<Rapier3d> {
         if !(scene.dt > 0.0 && scene.mass() > 0.0) {
             return Err(crate::Error::Engine(

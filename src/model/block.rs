@@ -145,6 +145,7 @@ pub enum Outcome {
 }
 
 impl Outcome {
+    /// Every outcome: breadth, width, length, unknown.
     pub const ALL: [Outcome; 4] = [
         Outcome::Breadth,
         Outcome::Width,
@@ -152,6 +153,7 @@ impl Outcome {
         Outcome::Unknown,
     ];
 
+    /// The outcome's name in reports: "breadth", "width", "length" or "unknown".
     pub fn name(self) -> &'static str {
         match self {
             Outcome::Breadth => "breadth",

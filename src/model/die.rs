@@ -8,10 +8,14 @@ use nalgebra::{UnitQuaternion, Vector3};
 /// The die as the roll, the energy watch and the certificate see it.
 #[derive(Clone, Copy, Debug)]
 pub struct DieShape {
+    /// Half the sides along body x, y, z (breadth, width, length; in 2D, z is half the 1 m
+    /// depth), m.
     pub half: Vector3<f64>,
+    /// Mass, kg.
     pub mass: f64,
     /// Principal moments of inertia about the body axes.
     pub inertia: Vector3<f64>,
+    /// Gravity's magnitude, m/s², along −y.
     pub gravity: f64,
     /// Rotation about z only (2D): region and barrier over the x and y axes.
     pub planar: bool,
@@ -20,6 +24,8 @@ pub struct DieShape {
 }
 
 impl DieShape {
+    /// The die of a scene: half sides, mass, inertia and barriers from its block, density
+    /// and mode.
     pub fn of(scene: &Scene) -> DieShape {
         let [a, b, c] = scene.body_sides();
         let m = scene.mass();

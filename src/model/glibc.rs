@@ -4,8 +4,10 @@
 //! r[i] = r[i−3] + r[i−31] (mod 2³²), seeded by the Park–Miller LCG r[i] = 16807·r[i−1]
 //! mod (2³¹ − 1), with the first 310 outputs thrown away; each output is r[i] >> 1.
 
+/// glibc's `RAND_MAX`, the largest value `rand()` returns (2³¹ − 1).
 pub const RAND_MAX: i32 = 2_147_483_647;
 
+/// glibc's `rand()` generator (TYPE_3), with its own state in place of the C library's global one.
 #[derive(Clone, Debug)]
 pub struct GlibcRand {
     r: [u32; 34],

@@ -5,9 +5,13 @@ use nalgebra::{UnitQuaternion, Vector3};
 /// The die's state in world coordinates (y up, floor top at y = 0).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BodyState {
+    /// The centre of mass, m.
     pub position: Vector3<f64>,
+    /// The orientation, body axes to world axes.
     pub rotation: UnitQuaternion<f64>,
+    /// The centre's velocity, m/s.
     pub linear_velocity: Vector3<f64>,
+    /// The angular velocity in world axes, rad/s.
     pub angular_velocity: Vector3<f64>,
     /// The engine has put the body to sleep (deactivated it).
     pub sleeping: bool,
@@ -25,6 +29,7 @@ impl BodyState {
         }
     }
 
+    /// True if every component of position, rotation and velocities is finite.
     pub fn is_finite(&self) -> bool {
         let q = self.rotation.quaternion();
         self.position.iter().all(|v| v.is_finite())

@@ -20,11 +20,14 @@ use std::str::FromStr;
 /// A closed interval `lo..=hi` to draw uniformly from; `lo == hi` fixes the value.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Range {
+    /// The lower end.
     pub lo: f64,
+    /// The upper end.
     pub hi: f64,
 }
 
 impl Range {
+    /// The interval `lo..=hi`, unchecked (parsing refuses high to low).
     pub fn new(lo: f64, hi: f64) -> Range {
         Range { lo, hi }
     }
@@ -127,8 +130,11 @@ impl Default for ThrowRanges {
 /// One throw's drawn numbers.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Throw {
+    /// The throw's index in the run, from 0.
     pub index: u64,
+    /// Height added to the longest side for the centre's start, m.
     pub drop_height: f64,
+    /// Linear velocity along x, m/s.
     pub velocity: f64,
     /// The spin's z component as the engine receives it (rad/s).
     pub spin: f64,
@@ -182,12 +188,16 @@ impl ThrowKind {
 /// Where throws come from.
 #[derive(Clone, Debug)]
 pub enum Throws {
+    /// Each throw a pure function of (seed, index): ChaCha8 seeded by `seed`, on stream `index`.
     Keyed {
+        /// The run's seed.
         seed: u64,
+        /// The ranges every throw is drawn from.
         ranges: ThrowRanges,
     },
     /// DicePhys's sequence, throws 0..n drawn up front.
     Dicephys {
+        /// Throws `0..n`, indexed by throw.
         throws: Vec<Throw>,
     },
 }
@@ -203,6 +213,7 @@ impl Throws {
         }
     }
 
+    /// Throw `index`; a `Dicephys` source panics past the `n` it drew.
     pub fn get(&self, index: u64) -> Throw {
         match self {
             Throws::Keyed { seed, ranges } => keyed(*seed, ranges, index),

@@ -11,42 +11,63 @@ use serde::Serialize;
 /// One simulated cell: a block of the table, an engine, 2D or 3D.
 #[derive(Clone, Debug, Serialize)]
 pub struct SimCell {
+    /// The row of the paper's table, 1-based.
     pub row: usize,
+    /// e.g. `140x24x20 MDF`.
     pub label: String,
+    /// The engine that rolled it.
     pub engine: EngineKind,
+    /// 2D or 3D.
     pub mode: Mode,
     /// Stopped before all its rolls were made: the counts cover the rolls made.
     pub partial: bool,
+    /// Simulated N(breadth vertical)/N(width vertical) ± binomial error.
     pub ratio: Ratio,
     /// (simulation − experiment) / combined error.
     pub z_experiment: f64,
     /// (simulation − theory) / combined error.
     pub z_theory: f64,
+    /// The cell's run in full: specification, counts and cost.
     pub run: RunSummary,
 }
 
+/// Where a paper run's results come from: command, versions, settings, date.
 #[derive(Clone, Debug, Serialize)]
 pub struct Provenance {
+    /// The command line as typed.
     pub command_line: String,
+    /// This program's version.
     pub dicephys_version: String,
+    /// Each engine's name and version.
     pub engines: Vec<String>,
     /// The engines' short names, as in `simulations[].engine`.
     pub engines_short: Vec<EngineKind>,
+    /// Bullet's solver settings (always `dicephys281`, as the paper ran it).
     pub preset: Preset,
+    /// The time step, s.
     pub dt: f64,
+    /// The throws' seed (keyed throws).
     pub seed: u64,
+    /// Rolls per simulated cell.
     pub rolls_per_cell: u64,
+    /// When the run ended, UTC, ISO 8601.
     pub date_utc: String,
 }
 
+/// `dicephys paper`'s results: the table beside the theory, and the simulated cells.
 #[derive(Clone, Debug, Serialize)]
 pub struct PaperResults {
     /// Stopped by Ctrl-C: only the cells in `simulations` were (wholly or partly) rolled.
     pub partial: bool,
+    /// Where the results come from.
     pub provenance: Provenance,
+    /// The paper's table beside the theory, with the data check and χ² per set.
     pub table: TableReport,
+    /// The cells simulated, row by row, each engine, 3D then 2D.
     pub simulations: Vec<SimCell>,
+    /// Wall-clock seconds for the whole run.
     pub wall_s: f64,
+    /// Process CPU seconds for the whole run, all threads.
     pub cpu_s: f64,
     /// Surfaces whose μ and e the paper did not measure: not simulated, and why.
     pub not_simulated: String,

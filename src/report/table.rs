@@ -18,8 +18,11 @@ use crate::theory::{self, propagation};
 /// The block's sides, mm.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct SidesMm {
+    /// Length, mm.
     pub length_mm: f64,
+    /// Breadth, mm.
     pub breadth_mm: f64,
+    /// Width, mm.
     pub width_mm: f64,
 }
 
@@ -28,7 +31,9 @@ pub struct SidesMm {
 pub struct Theory2d {
     /// P(breadth vertical)/P(width vertical) ± propagated error.
     pub ratio: Ratio,
+    /// P(breadth vertical), equation (rattoprob).
     pub p_breadth_vertical: f64,
+    /// P(width vertical), equation (rattoprob).
     pub p_width_vertical: f64,
     /// Propagated error of either probability (they sum to 1).
     pub p_err: f64,
@@ -37,28 +42,39 @@ pub struct Theory2d {
 /// The 2D no-bounce (Simpson) model: (InElasK).
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct NoBounce2d {
+    /// The no-bounce ratio P(breadth vertical)/P(width vertical).
     pub ratio: f64,
+    /// P(breadth vertical) = (2/π) arctan R.
     pub p_breadth_vertical: f64,
+    /// P(width vertical) = (2/π) arctan(1/R).
     pub p_width_vertical: f64,
 }
 
 /// The 3D Simpson model, per face pair.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct Simpson3d {
+    /// P(breadth vertical): resting on either length × width face.
     pub p_breadth_vertical: f64,
+    /// P(width vertical): resting on either length × breadth face.
     pub p_width_vertical: f64,
+    /// P(length vertical): standing on either end.
     pub p_length_vertical: f64,
 }
 
 /// Everything `theory --block` reports.
 #[derive(Clone, Debug, Serialize)]
 pub struct BlockReport {
+    /// The block's sides.
     pub block: SidesMm,
+    /// The ± on breadth and width, mm, propagated into R and the 2D theory.
     pub tolerance_mm: f64,
     /// R = width/breadth ± propagated error.
     pub r: Ratio,
+    /// The 2D theory, (MasterEqu) and (rattoprob).
     pub theory_2d: Theory2d,
+    /// The 2D no-bounce model, (InElasK).
     pub no_bounce_2d: NoBounce2d,
+    /// The 3D Simpson model.
     pub simpson_3d: Simpson3d,
 }
 
@@ -119,6 +135,7 @@ fn pm(v: Ratio) -> String {
     format!("{:.d$} ± {:.d$}", v.value, v.err)
 }
 
+/// Writes a `BlockReport` as aligned text, one quantity a line.
 pub fn write_block(out: &mut impl Write, r: &BlockReport) -> std::io::Result<()> {
     let b = &r.block;
     let sides = Block::from_mm(b.length_mm, b.breadth_mm, b.width_mm)
@@ -196,34 +213,56 @@ pub fn write_block(out: &mut impl Write, r: &BlockReport) -> std::io::Result<()>
 /// The printed numbers of a row that the check recomputes.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct PrintedColumns {
+    /// Printed R.
     pub r: PrintedNumber,
+    /// Printed error on R.
     pub r_err: PrintedNumber,
+    /// Printed prediction of (MasterEqu).
     pub predicted_ratio: PrintedNumber,
+    /// Printed error on the prediction.
     pub predicted_ratio_err: PrintedNumber,
+    /// Printed measured ratio N(breadth vertical)/N(width vertical).
     pub ratio: PrintedNumber,
+    /// Printed binomial error on the measured ratio.
     pub ratio_err: PrintedNumber,
 }
 
 /// One row of the paper's table beside the theory.
 #[derive(Clone, Debug, Serialize)]
 pub struct TableRow {
+    /// The row, 1-based, in the paper's order.
     pub row: usize,
     /// e.g. `140x24x20 MDF`.
     pub label: String,
+    /// Length, mm.
     pub length_mm: f64,
+    /// ± on the length, mm.
     pub length_err_mm: f64,
+    /// Breadth, mm.
     pub breadth_mm: f64,
+    /// ± on the breadth, mm.
     pub breadth_err_mm: f64,
+    /// Width, mm.
     pub width_mm: f64,
+    /// ± on the width, mm.
     pub width_err_mm: f64,
+    /// The block's material.
     pub block: Material,
+    /// The surface it was thrown onto.
     pub surface: Surface,
+    /// The data set (the row's colour).
     pub set: Set,
+    /// An uncoloured row: the same cross-section as the set's row above, another length.
     pub extra_length: bool,
+    /// One of the five rows the paper simulated.
     pub simulated: bool,
+    /// Throws counted.
     pub throws: u64,
+    /// Throws that ended length vertical.
     pub length_vertical: u64,
+    /// Throws that ended breadth vertical.
     pub breadth_vertical: u64,
+    /// Throws that ended width vertical.
     pub width_vertical: u64,
     /// R from the dimensions, ± propagated from the row's side errors.
     pub r: Ratio,
@@ -235,17 +274,24 @@ pub struct TableRow {
     pub z: f64,
     /// (InElasK) ratio at R.
     pub no_bounce_ratio: f64,
+    /// The row's printed numbers that the data check recomputes.
     pub printed: PrintedColumns,
 }
 
 /// A finding of the data check.
 #[derive(Clone, Debug, Serialize)]
 pub struct Finding {
+    /// The row, 1-based.
     pub row: usize,
+    /// e.g. `140x24x20 MDF`.
     pub label: String,
+    /// The CSV column of the printed number, e.g. `ratio_err`.
     pub field: &'static str,
+    /// The number as printed.
     pub printed: PrintedNumber,
+    /// What the row's own data give for it.
     pub recomputed: f64,
+    /// One line saying so (`Discrepancy::describe`).
     pub message: String,
 }
 
@@ -265,10 +311,15 @@ impl From<&Discrepancy> for Finding {
 /// χ² of one data set's measured ratios against the theory.
 #[derive(Clone, Debug, Serialize)]
 pub struct SetChiSquare {
+    /// The data set.
     pub set: Set,
+    /// Its rows, 1-based.
     pub rows: Vec<usize>,
+    /// χ², the sum of z² over the rows used.
     pub chi2: f64,
+    /// Degrees of freedom: the rows used (no fitted parameter).
     pub dof: usize,
+    /// Rows left out because their z was not finite.
     pub skipped: usize,
     /// P(χ² at least this large | theory right).
     pub p_value: f64,
@@ -277,10 +328,15 @@ pub struct SetChiSquare {
 /// Everything `theory --table` reports.
 #[derive(Clone, Debug, Serialize)]
 pub struct TableReport {
+    /// Where the table comes from: the paper and its table's title.
     pub source: &'static str,
+    /// Every row of the paper's table, in its order.
     pub rows: Vec<TableRow>,
+    /// Printed numbers the row's own data do not give.
     pub discrepancies: Vec<Finding>,
+    /// Printed errors rounded up rather than to nearest: accepted, listed.
     pub errors_rounded_up: Vec<Finding>,
+    /// χ² of the measured ratios against the theory, one per set.
     pub chi_square: Vec<SetChiSquare>,
 }
 
@@ -364,6 +420,7 @@ pub fn table_report() -> Result<TableReport> {
     })
 }
 
+/// Writes a `TableReport` as text: the rows beside the theory, the data check, χ² per set.
 pub fn write_table(out: &mut impl Write, t: &TableReport) -> std::io::Result<()> {
     writeln!(out, "{}", t.source)?;
     writeln!(

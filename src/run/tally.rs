@@ -21,14 +21,15 @@ pub struct Tally {
     pub steps: u64,
     /// Steps the engines took (fewer where free flight was coasted).
     pub engine_steps: u64,
-    /// Auditing the early stop: rolls the certificate fired on, how many of those came to rest
-    /// on another face than it named, how many the full settle left "unknown" (DicePhys's rest
-    /// rule stopping a rocking die at the turning point of a swing, still tilted: no face to
-    /// disagree with), and the steps at which it fired, summed.
+    /// Auditing the early stop: rolls the certificate fired on.
     pub certified: u64,
+    /// Of those, rolls that ended on another face than it named (at rest, or at the step cap).
     pub certified_wrong: u64,
+    /// Of those, rolls the full settle left "unknown" (DicePhys's rest rule stopping a rocking
+    /// die at the turning point of a swing, still tilted: no face to disagree with).
     #[serde(default)]
     pub certified_unknown: u64,
+    /// The steps at which the certificate fired, summed over those rolls.
     pub certified_steps: u64,
     /// Rolls in which the engine injected energy (`RollRecord::energy_gain`), whatever their
     /// fate.

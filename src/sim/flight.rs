@@ -39,10 +39,14 @@ pub const CLEAR_OF_PLANE: f64 = 0.05;
 const LINEAR_SLEEPING_THRESHOLD: f64 = 0.8 * 1.01;
 const ANGULAR_SLEEPING_THRESHOLD: f64 = 1.0 * 1.01;
 
+/// Free flight as Bullet integrates it out of contact: what a flown step needs of the scene.
 #[derive(Clone, Copy, Debug)]
 pub struct Flight {
+    /// The time step, s.
     pub dt: f64,
+    /// Gravity's magnitude, m/s², along −y.
     pub gravity: f64,
+    /// Half the sides along body x, y, z, m.
     pub half: Vector3<f64>,
     /// How far above the floor the die's lowest point must be for a step to be pure flight
     /// (`CLEAR` or `CLEAR_OF_PLANE`).
@@ -50,6 +54,8 @@ pub struct Flight {
 }
 
 impl Flight {
+    /// The flight of a scene's die: its time step, gravity, half sides, and the clearance its
+    /// floor needs.
     pub fn of(scene: &Scene) -> Flight {
         let [a, b, c] = scene.body_sides();
         Flight {

@@ -15,7 +15,9 @@ pub struct RestDetector {
     seen: usize,
 }
 
+/// Steps the at-rest rule sums over (DicePhys: 10).
 pub const REST_WINDOW: usize = 10;
+/// DicePhys's bound on both velocity sums, m/s and rad/s.
 pub const REST_TOLERANCE: f64 = 1e-4;
 
 impl Default for RestDetector {
@@ -25,6 +27,7 @@ impl Default for RestDetector {
 }
 
 impl RestDetector {
+    /// A detector with `tolerance` as the bound on both sums, nothing seen yet.
     pub fn new(tolerance: f64) -> RestDetector {
         RestDetector {
             tolerance,
@@ -34,6 +37,7 @@ impl RestDetector {
         }
     }
 
+    /// Forgets the steps seen, to start over.
     pub fn clear(&mut self) {
         self.seen = 0;
     }

@@ -67,13 +67,18 @@ pub enum Fate {
     Settled(Outcome),
     /// Still moving at the step cap; the side vertical at that moment, for the record only.
     Unconverged(Outcome),
+    /// The roll failed, and why.
     Failed(Failure),
 }
 
+/// One roll: its throw, how it ended, and how many steps it took.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RollRecord {
+    /// The throw rolled.
     pub throw: Throw,
+    /// How the roll ended.
     pub fate: Fate,
+    /// Simulated steps, flown or by the engine (time = steps × dt).
     pub steps: u64,
     /// Steps the engine itself took (fewer than `steps` where free flight was coasted).
     pub engine_steps: u64,
@@ -88,6 +93,7 @@ pub struct RollRecord {
 }
 
 impl RollRecord {
+    /// The roll's simulated time, s, at time step `dt` (s).
     pub fn sim_time(&self, dt: f64) -> f64 {
         self.steps as f64 * dt
     }
@@ -123,6 +129,7 @@ pub enum Rule {
 pub struct RollConfig {
     /// A roll not at rest after this many steps is unconverged.
     pub max_steps: u64,
+    /// The rule that ends the roll.
     pub rule: Rule,
     /// The certificate's reserve, a fraction of the barrier (`sim::certificate::Certificate`).
     pub margin: f64,
@@ -202,10 +209,12 @@ pub fn check(s: &BodyState) -> Option<Failure> {
 pub struct EnergyWatch {
     lowest: f64,
     allowance: f64,
+    /// True once the energy has risen above its lowest value so far by more than the allowance.
     pub gained: bool,
 }
 
 impl EnergyWatch {
+    /// A watch from `start`'s energy; the allowance is `ENERGY_GAIN_TOLERANCE` of it.
     pub fn new(die: &DieShape, start: &BodyState) -> EnergyWatch {
         let e0 = die.energy(start);
         EnergyWatch {
@@ -215,6 +224,7 @@ impl EnergyWatch {
         }
     }
 
+    /// Takes one state's energy: flags a gain, keeps the lowest value so far.
     pub fn push(&mut self, die: &DieShape, s: &BodyState) {
         let e = die.energy(s);
         if e > self.lowest + self.allowance {
@@ -246,11 +256,14 @@ pub fn roll_observed(
 /// How a roll from a start state ended.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct End {
+    /// How the roll ended.
     pub fate: Fate,
     /// Simulated steps (time = steps × dt).
     pub steps: u64,
     /// Steps the engine took.
     pub engine_steps: u64,
+    /// With an audit or the certificate rule: the first step at which the energy certificate
+    /// held, and the outcome it certified.
     pub certified: Option<(u64, Outcome)>,
     /// See `RollRecord::energy_gain`.
     pub energy_gain: bool,
@@ -348,6 +361,7 @@ pub fn run_from(
     end
 }
 
+/// Rolls one throw to its end (`roll_observed`, watching nothing).
 pub fn roll(engine: &mut dyn Engine, scene: &Scene, throw: &Throw, cfg: &RollConfig) -> RollRecord {
     roll_observed(engine, scene, throw, cfg, |_, _| {})
 }

@@ -17,15 +17,21 @@ use std::time::Instant;
 /// DicePhys 2.81's CPU time per 3D roll of 140x24x20 on this kind of machine, one core
 /// (shared/reference/dicephys-2.81.md): the yardstick for "ten times DicePhys".
 pub const DICEPHYS_MS_PER_ROLL_3D: f64 = 4.22;
+/// The same for a 2D roll, ms.
 pub const DICEPHYS_MS_PER_ROLL_2D: f64 = 2.50;
 
 /// One way of rolling: an engine and the levers it uses.
 #[derive(Clone, Debug, Serialize)]
 pub struct Method {
+    /// The method's name in the log and the report.
     pub name: String,
+    /// The engine that rolls.
     pub engine: EngineKind,
+    /// The floor: DicePhys's box, or the plane.
     pub floor: Floor,
+    /// The rule that ends a roll.
     pub rule: Rule,
+    /// Free flight integrated in closed form.
     pub fast_flight: bool,
     /// Shown by a cross-check at >= 20,000 rolls not to change the result (README, Speed);
     /// only such methods can be the benchmark's verdict.
@@ -33,6 +39,7 @@ pub struct Method {
 }
 
 impl Method {
+    /// A method from its levers; proven if it keeps the box floor.
     pub fn new(
         name: &str,
         engine: EngineKind,
@@ -51,6 +58,7 @@ impl Method {
         }
     }
 
+    /// The baseline: Bullet, box floor, DicePhys's rest rule, every step by the engine.
     pub fn faithful() -> Method {
         Method::new(
             "faithful",
@@ -61,6 +69,7 @@ impl Method {
         )
     }
 
+    /// `base` with this method's rule and free flight.
     pub fn settle(&self, base: &RollConfig) -> RollConfig {
         RollConfig {
             rule: self.rule,
@@ -87,23 +96,36 @@ pub fn methods() -> Vec<Method> {
     ]
 }
 
+/// One measurement: a method, a mode and a thread count, its speed and its result.
 #[derive(Clone, Debug, Serialize)]
 pub struct BenchRow {
+    /// The method's name.
     pub method: String,
+    /// The engine's name.
     pub engine: String,
+    /// "3d" or "2d".
     pub mode: String,
+    /// Worker threads.
     pub threads: usize,
+    /// Rolls made.
     pub rolls: u64,
+    /// Rolls per wall-clock second (the fastest run of the repeats).
     pub rolls_per_s: f64,
+    /// Process CPU milliseconds per roll, all threads.
     pub cpu_ms_per_roll: f64,
+    /// Process CPU microseconds per step the engine took.
     pub us_per_engine_step: f64,
+    /// Simulated steps per roll.
     pub steps_per_roll: f64,
+    /// Steps the engine took per roll (fewer where free flight was coasted).
     pub engine_steps_per_roll: f64,
     /// Rolls per second over the faithful method's, same mode and threads, same run.
     pub speedup: f64,
     /// Rolls per second over DicePhys 2.81's on one core (reference timing, not this run).
     pub vs_dicephys: f64,
+    /// N(breadth vertical)/N(width vertical) over the rolls.
     pub ratio: f64,
+    /// Its binomial error.
     pub ratio_err: f64,
     /// (ratio − faithful ratio) / combined error, on the same throws.
     pub z_vs_faithful: f64,
@@ -111,11 +133,14 @@ pub struct BenchRow {
     pub same_outcome: f64,
 }
 
+/// What crossing into C++ once per step costs (`ffi_cost`).
 #[derive(Clone, Debug, Serialize)]
 pub struct FfiCost {
+    /// Steps in each loop, over all throws (200 × 1,000).
     pub steps: u64,
     /// Seconds, summed over 200 throws of the fastest of three runs per throw.
     pub rust_loop_s: f64,
+    /// The same for the loop inside C++ (`Bullet::step_n`), s.
     pub cpp_loop_s: f64,
     /// (Rust loop − C++ loop) / C++ loop: what crossing into C++ once per step costs (both
     /// loops step and read the state every step).
@@ -126,15 +151,21 @@ pub struct FfiCost {
 /// the faithful one's (|z| ≤ `Z_BOUND` on the same throws), on all threads.
 #[derive(Clone, Debug, Serialize)]
 pub struct Verdict {
+    /// "3d" or "2d".
     pub mode: String,
+    /// The method's name.
     pub method: String,
+    /// Worker threads (all).
     pub threads: usize,
+    /// Rolls per wall-clock second.
     pub rolls_per_s: f64,
     /// Over the faithful method on the same number of threads.
     pub speedup: f64,
     /// Over the faithful method on one thread (DicePhys is single-threaded).
     pub speedup_vs_faithful_1_thread: f64,
+    /// Rolls per second over DicePhys 2.81's on one core (reference timing, not this run).
     pub vs_dicephys: f64,
+    /// (ratio − faithful ratio) / combined error, on the same throws.
     pub z_vs_faithful: f64,
 }
 
@@ -142,12 +173,18 @@ pub struct Verdict {
 /// faithful method's, on the same throws.
 pub const Z_BOUND: f64 = 2.0;
 
+/// The benchmark's results: every measurement, the verdicts, the FFI cost.
 #[derive(Clone, Debug, Serialize)]
 pub struct Bench {
+    /// Every measurement, in the order run.
     pub rows: Vec<BenchRow>,
+    /// Per mode, the fastest proven method within the accuracy bound; a mode with none is left out.
     pub verdicts: Vec<Verdict>,
+    /// What one cxx call per step costs.
     pub ffi: FfiCost,
+    /// Peak resident set size of the process, MB (10⁶ bytes).
     pub peak_rss_mb: f64,
+    /// The throws' seed (keyed throws).
     pub seed: u64,
     /// Runs per measurement; the fastest counts.
     pub repeat: u32,
@@ -342,6 +379,7 @@ pub fn ffi_cost(scene: &Scene) -> crate::Result<FfiCost> {
     })
 }
 
+/// The column heads of the log's measurement lines (`format_row`).
 pub fn header() -> String {
     format!(
         "{:<20} {:>4} {:>3} {:>9} {:>8} {:>8} {:>7} {:>7} {:>8} {:>8} {:>15} {:>6} {:>6}",
@@ -361,6 +399,7 @@ pub fn header() -> String {
     )
 }
 
+/// One measurement as a line of the log, under `header`.
 pub fn format_row(r: &BenchRow) -> String {
     format!(
         "{:<20} {:>4} {:>3} {:>9.0} {:>8.3} {:>8.2} {:>7.0} {:>7.0} {:>7.2}x {:>8.1}x {:>7.4} ± {:.4} {:>+6.1} {:>5.1}%",

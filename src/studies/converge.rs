@@ -14,43 +14,71 @@ use crate::model::scene::{Mode, Scene};
 use crate::sim::roll::{RollConfig, Rule};
 use serde::Serialize;
 
+/// What the convergence test runs.
 pub struct Config {
+    /// The blocks.
     pub blocks: Vec<Block>,
+    /// The time steps, s (`run` sorts them coarse to fine, without repeats).
     pub dts: Vec<f64>,
+    /// The engines.
     pub engines: Vec<EngineKind>,
+    /// Rolls per cell.
     pub rolls: u64,
+    /// The throws' seed (keyed throws, the same in every cell).
     pub seed: u64,
+    /// The step cap per roll.
     pub max_steps: u64,
 }
 
+/// One cell: a block, an engine, 2D or 3D, a dt.
 #[derive(Clone, Debug, Serialize)]
 pub struct Cell {
+    /// The block, `LxBxW` in mm.
     pub block: String,
+    /// The engine's name.
     pub engine: String,
+    /// "3d" or "2d".
     pub mode: String,
+    /// The time step, s.
     pub dt: f64,
+    /// Rolls made.
     pub rolls: u64,
+    /// N(breadth vertical)/N(width vertical).
     pub ratio: f64,
+    /// Its binomial error.
     pub ratio_err: f64,
+    /// Simulated steps per roll.
     pub steps_per_roll: f64,
+    /// Process CPU seconds per roll, all threads.
     pub cpu_s_per_roll: f64,
+    /// Rolls not at rest at the step cap.
     pub unconverged: u64,
+    /// Rolls that failed, for any reason.
     pub failed: u64,
+    /// Rolls in which the engine injected energy.
     pub energy_gain: u64,
-    /// ratio / ratio at the finest dt − 1, and its error.
+    /// ratio / ratio at the finest dt − 1.
     pub departure: f64,
+    /// Its error.
     pub departure_err: f64,
 }
 
 /// The paper's claim for one block × engine × mode.
 #[derive(Clone, Debug, Serialize)]
 pub struct Claim {
+    /// The block, `LxBxW` in mm.
     pub block: String,
+    /// The engine's name.
     pub engine: String,
+    /// "3d" or "2d".
     pub mode: String,
+    /// The dt the claim is about (`CLAIM_DT`), s.
     pub dt: f64,
+    /// The finest dt of the run, the reference, s.
     pub dt_finest: f64,
+    /// The ratio at `dt` over the ratio at `dt_finest`, − 1.
     pub departure: f64,
+    /// Its error.
     pub departure_err: f64,
     /// 2σ of the departure is at most 1 %.
     pub resolved: bool,
@@ -60,14 +88,22 @@ pub struct Claim {
     pub rolls_needed: Option<u64>,
 }
 
+/// The convergence test's results.
 #[derive(Clone, Debug, Serialize)]
 pub struct Converge {
+    /// How rolls end, in words.
     pub settle: String,
+    /// Rolls per cell.
     pub rolls: u64,
+    /// The throws' seed.
     pub seed: u64,
+    /// The time steps run, coarse to fine, s.
     pub dts: Vec<f64>,
+    /// The step cap per roll.
     pub max_steps: u64,
+    /// Every cell: by block, engine, 3D then 2D, then dt.
     pub cells: Vec<Cell>,
+    /// The paper's claim per block × engine × mode; none without dt = 0.001 s and a finer one.
     pub claims: Vec<Claim>,
     /// Every claim resolved.
     pub resolved: bool,
@@ -224,6 +260,7 @@ fn verdict(claims: &[Claim], finest: f64, rolls: u64) -> String {
     }
 }
 
+/// The column heads of the log's cell lines (`format_cell`).
 pub fn header() -> String {
     format!(
         "{:<10} {:<13} {:>4} {:>8} {:>17} {:>8} {:>10} {:>18} {:>6} {:>6} {:>5}",
@@ -241,6 +278,7 @@ pub fn header() -> String {
     )
 }
 
+/// One cell as a line of the log, under `header`.
 pub fn format_cell(c: &Cell) -> String {
     format!(
         "{:<10} {:<13} {:>4} {:>8} {:>8.4} ± {:.4} {:>8.0} {:>10.5} {:>+7.1} ± {:>4.1} % {:>6} {:>6} {:>5}",

@@ -22,10 +22,15 @@ use std::time::Instant;
 /// What to simulate.
 #[derive(Clone, Debug, Serialize)]
 pub struct PaperConfig {
+    /// Rolls per cell.
     pub rolls: u64,
+    /// The throws' seed (keyed throws, the same in every cell).
     pub seed: u64,
+    /// The engines, each run in 3D and 2D.
     pub engines: Vec<EngineKind>,
+    /// The time step, s.
     pub dt: f64,
+    /// The step cap per roll.
     pub max_steps: u64,
     /// DicePhys's rest rule and stepped flight, instead of the early stop and fast flight.
     pub faithful: bool,
@@ -85,7 +90,8 @@ pub fn total_rolls(cfg: &PaperConfig) -> Result<u64> {
     Ok(simulated_rows(&table).len() as u64 * cfg.engines.len() as u64 * 2 * cfg.rolls)
 }
 
-/// Runs every simulated cell. `progress` gets the rolls finished so far.
+/// Runs every simulated cell. The runner's `progress` gets the rolls finished so far, over all
+/// cells.
 pub fn run(
     cfg: &PaperConfig,
     command_line: String,

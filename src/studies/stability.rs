@@ -13,14 +13,23 @@ use crate::model::scene::{Mode, Scene};
 use crate::sim::roll::{Failure, RollConfig, Rule};
 use serde::Serialize;
 
+/// What the stability sweeps run.
 pub struct Config {
+    /// The engines.
     pub engines: Vec<EngineKind>,
+    /// The grid's time steps, s.
     pub dts: Vec<f64>,
+    /// The grid's restitutions e.
     pub restitutions: Vec<f64>,
+    /// The friction line's μ (at dt = 1 ms, e = 0.5).
     pub frictions: Vec<f64>,
+    /// The aspect line's blocks (at dt = 1 ms, e = 0.5, μ = 0.29).
     pub blocks: Vec<Block>,
+    /// Rolls per cell.
     pub rolls: u64,
+    /// The throws' seed (keyed throws, the same in every cell).
     pub seed: u64,
+    /// The step cap per roll.
     pub max_steps: u64,
 }
 
@@ -55,26 +64,42 @@ pub struct Cell {
     pub engine: EngineKind,
     /// 2D or 3D.
     pub mode: Mode,
+    /// The block, `LxBxW` in mm.
     pub block: String,
-    /// breadth/width and length/breadth.
+    /// breadth/width.
     pub breadth_over_width: f64,
+    /// length/breadth.
     pub length_over_breadth: f64,
+    /// The time step, s.
     pub dt: f64,
+    /// The contact's restitution e.
     pub restitution: f64,
+    /// The contact's friction μ.
     pub friction: f64,
+    /// Rolls made.
     pub rolls: u64,
+    /// Fraction of rolls not at rest at the step cap.
     pub unconverged: f64,
+    /// Fraction of rolls at rest with no side vertical.
     pub unknown: f64,
+    /// Fraction of rolls failed non-finite.
     pub non_finite: f64,
+    /// Fraction of rolls failed tunnelled through the floor.
     pub tunnelled: f64,
+    /// Fraction of rolls failed by an engine error.
     pub engine_error: f64,
+    /// Fraction of rolls in which the engine injected energy.
     pub energy_gain: f64,
+    /// N(breadth vertical)/N(width vertical).
     pub ratio: f64,
+    /// Its binomial error.
     pub ratio_err: f64,
+    /// Simulated steps per roll.
     pub steps_per_roll: f64,
 }
 
 impl Cell {
+    /// The fraction of failure kind `k` (one of `KINDS`); NaN for any other name.
     pub fn kind(&self, k: &str) -> f64 {
         match k {
             "unconverged" => self.unconverged,
@@ -87,16 +112,26 @@ impl Cell {
     }
 }
 
+/// The stability sweeps' results.
 #[derive(Clone, Debug, Serialize)]
 pub struct Stability {
+    /// Rolls per cell.
     pub rolls: u64,
+    /// The throws' seed.
     pub seed: u64,
+    /// The step cap per roll.
     pub max_steps: u64,
+    /// The energy gain flagged, a fraction of the starting energy (`ENERGY_GAIN_TOLERANCE`).
     pub energy_gain_tolerance: f64,
+    /// The grid's time steps, s.
     pub dts: Vec<f64>,
+    /// The grid's restitutions.
     pub restitutions: Vec<f64>,
+    /// The friction line's μ.
     pub frictions: Vec<f64>,
+    /// The aspect line's blocks, `LxBxW` in mm.
     pub blocks: Vec<String>,
+    /// Every cell: per engine, 3D then 2D, the grid, then the friction line, then the aspect line.
     pub cells: Vec<Cell>,
     /// One sentence per failure kind: where it happens most.
     pub findings: Vec<String>,
@@ -247,6 +282,7 @@ fn findings(cells: &[Cell]) -> Vec<String> {
         .collect()
 }
 
+/// The column heads of the log's cell lines (`format_cell`).
 pub fn header() -> String {
     format!(
         "{:<15} {:<13} {:>4} {:<11} {:>8} {:>5} {:>5} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7}",
@@ -266,6 +302,7 @@ pub fn header() -> String {
     )
 }
 
+/// One cell as a line of the log, under `header`.
 pub fn format_cell(c: &Cell) -> String {
     let pc = |v: f64| format!("{:.0}%", 100.0 * v);
     format!(

@@ -27,17 +27,22 @@ pub const ONE_PERCENT: f64 = 0.01;
 /// One measured cell: the exact tally and the CPU seconds (all threads) it took.
 #[derive(serde::Serialize, serde::Deserialize)]
 pub struct Measured {
+    /// The cell's exact counts.
     pub tally: Tally,
+    /// Process CPU seconds the cell took, all threads.
     pub cpu_s: f64,
 }
 
 impl Measured {
+    /// N(breadth vertical)/N(width vertical) ± binomial error.
     pub fn ratio(&self) -> stats::Ratio {
         stats::ratio(self.tally.counts.breadth, self.tally.counts.width)
     }
+    /// Process CPU seconds per roll.
     pub fn cpu_s_per_roll(&self) -> f64 {
         self.cpu_s / self.tally.rolls.max(1) as f64
     }
+    /// Simulated steps per roll.
     pub fn steps_per_roll(&self) -> f64 {
         self.tally.steps as f64 / self.tally.rolls.max(1) as f64
     }

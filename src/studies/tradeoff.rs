@@ -13,59 +13,93 @@ use crate::model::scene::{Floor, Mode, Scene};
 use crate::sim::roll::{RollConfig, Rule};
 use serde::Serialize;
 
+/// What the trade-off study runs.
 pub struct Config {
+    /// The block.
     pub block: Block,
+    /// The methods' time steps, s.
     pub dts: Vec<f64>,
     /// The reference's dt (finer than every method's).
     pub reference_dt: f64,
+    /// Rolls per method.
     pub rolls: u64,
+    /// The throws' seed (keyed throws, the same for every method).
     pub seed: u64,
+    /// The step cap per roll.
     pub max_steps: u64,
 }
 
+/// One method's measurement (or the reference's).
 #[derive(Clone, Debug, Serialize)]
 pub struct Row {
+    /// The method's name: engine, mode, dt, rule, floor.
     pub method: String,
+    /// The engine.
     pub engine: EngineKind,
+    /// 2D or 3D.
     pub mode: Mode,
+    /// The time step, s.
     pub dt: f64,
     /// `faithful` (DicePhys's rule, stepped flight) or `fast` (early stop + closed-form flight).
     pub rule: String,
+    /// The floor: DicePhys's box, or the plane.
     pub floor: Floor,
+    /// Rolls made.
     pub rolls: u64,
+    /// N(breadth vertical)/N(width vertical).
     pub ratio: f64,
+    /// Its binomial error.
     pub ratio_err: f64,
+    /// Process CPU seconds per 1,000 rolls, all threads.
     pub cpu_s_per_1000: f64,
+    /// Simulated steps per roll.
     pub steps_per_roll: f64,
-    /// Relative departure from the reference, its error, and in standard errors.
+    /// Relative departure from the reference, ratio/reference − 1 (a fraction).
     pub error: f64,
+    /// Its error.
     pub error_err: f64,
+    /// The departure in standard errors, `error / error_err` (0 unless that error is positive).
     pub error_sigma: f64,
+    /// Rolls not at rest at the step cap.
     pub unconverged: u64,
+    /// Rolls that failed, for any reason.
     pub failed: u64,
+    /// Rolls in which the engine injected energy.
     pub energy_gain: u64,
+    /// This row is the reference (its departure 0).
     pub reference: bool,
 }
 
+/// One mode's methods against its reference, its Pareto front and its verdict.
 #[derive(Clone, Debug, Serialize)]
 pub struct ModeResult {
+    /// 2D or 3D.
     pub mode: Mode,
+    /// The reference: Bullet, box floor, DicePhys's rule, stepped, at the reference dt.
     pub reference: Row,
+    /// Every method, in the order run.
     pub rows: Vec<Row>,
     /// Methods no other is both cheaper and closer to the reference than, cheapest first
     /// (among methods failing or unconverged on at most 1 % of rolls).
     pub pareto_front: Vec<String>,
     /// The cheapest method whose departure is within 1 % at 2σ (|error| + 2σ ≤ 1 %), if any.
     pub cheapest_within_one_percent: Option<String>,
+    /// Plain words: the cheapest method within 1 %, or how many rolls would resolve 1 %.
     pub note: String,
 }
 
+/// The trade-off study's results.
 #[derive(Clone, Debug, Serialize)]
 pub struct Tradeoff {
+    /// The block, `LxBxW` in mm.
     pub block: String,
+    /// Rolls per method.
     pub rolls: u64,
+    /// The throws' seed.
     pub seed: u64,
+    /// The reference's time step, s.
     pub reference_dt: f64,
+    /// 3D, then 2D.
     pub modes: Vec<ModeResult>,
 }
 
@@ -262,6 +296,7 @@ pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Tradeoff> 
     })
 }
 
+/// The column heads of the log's method lines (`format_row`).
 pub fn header() -> String {
     format!(
         "{:<38} {:>17} {:>12} {:>8} {:>18} {:>6} {:>6}",
@@ -269,6 +304,7 @@ pub fn header() -> String {
     )
 }
 
+/// One method as a line of the log, under `header`.
 pub fn format_row(r: &Row) -> String {
     format!(
         "{:<38} {:>8.4} ± {:.4} {:>12.3} {:>8.0} {:>+7.1} ± {:>4.1} % {:>+6.1} {:>6}",

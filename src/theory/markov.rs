@@ -25,11 +25,15 @@ use std::f64::consts::FRAC_2_PI;
 
 use crate::error::{Error, Result};
 
-/// Index of each state in the matrices and vectors (the paper's number − 1).
+/// Index of Initial (state 1) in the matrices and vectors; every index is the paper's number − 1.
 pub const INITIAL: usize = 0;
+/// Index of K-dynamic (state 2).
 pub const K_DYNAMIC: usize = 1;
+/// Index of L-dynamic (state 3).
 pub const L_DYNAMIC: usize = 2;
+/// Index of K-static (state 4): at rest on side k.
 pub const K_STATIC: usize = 3;
+/// Index of L-static (state 5): at rest on side l.
 pub const L_STATIC: usize = 4;
 
 /// The chain for a 2D block with sides k and l.
@@ -108,14 +112,17 @@ impl MarkovChain {
         })
     }
 
+    /// Side k, on which the block rests in state K.
     pub fn k(&self) -> f64 {
         self.k
     }
 
+    /// Side l, on which the block rests in state L.
     pub fn l(&self) -> f64 {
         self.l
     }
 
+    /// The parameter γ·½mg, 1/length (the unit of k and l).
     pub fn gamma_half_mg(&self) -> f64 {
         self.gamma_half_mg
     }

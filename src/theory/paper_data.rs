@@ -59,7 +59,9 @@ pub const COLUMNS: [&str; 22] = [
 /// A number as printed in the paper: its value and its number of decimals.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct PrintedNumber {
+    /// The value.
     pub value: f64,
+    /// Digits printed after the decimal point.
     pub decimals: u32,
 }
 
@@ -100,6 +102,7 @@ impl fmt::Display for PrintedNumber {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Material {
+    /// Pine.
     Pine,
     /// 3D printed polylactide.
     Printed,
@@ -109,10 +112,15 @@ pub enum Material {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Surface {
+    /// Carpet (pine blocks).
     Carpet,
+    /// A thin towel (pine blocks).
     ThinTowel,
+    /// A towel on a rug (pine blocks).
     TowelRug,
+    /// Medium-density fibreboard (printed blocks; the surface the paper simulated).
     Mdf,
+    /// Tough carpet (printed blocks).
     ToughCarpet,
 }
 
@@ -172,12 +180,14 @@ impl Surface {
 }
 
 impl Set {
+    /// Every set, in the paper's order.
     pub const ALL: [Set; 3] = [Set::Pine, Set::Mdf, Set::Carpet];
 
     fn parse(s: &str) -> Option<Set> {
         Set::ALL.into_iter().find(|v| v.name() == s)
     }
 
+    /// The set's name in the CSV: "pine", "mdf" or "carpet".
     pub fn name(self) -> &'static str {
         match self {
             Set::Pine => "pine",
@@ -192,29 +202,45 @@ impl Set {
 pub struct PaperRow {
     /// 1-based, in the paper's order.
     pub row: usize,
+    /// Printed length, mm.
     pub length_mm: PrintedNumber,
+    /// Printed ± on the length, mm.
     pub length_err_mm: PrintedNumber,
+    /// Printed breadth, mm.
     pub breadth_mm: PrintedNumber,
+    /// Printed ± on the breadth, mm.
     pub breadth_err_mm: PrintedNumber,
+    /// Printed width, mm.
     pub width_mm: PrintedNumber,
+    /// Printed ± on the width, mm.
     pub width_err_mm: PrintedNumber,
     /// Printed R = width/breadth.
     pub r: PrintedNumber,
+    /// Printed error on R.
     pub r_err: PrintedNumber,
     /// Printed prediction of (MasterEqu).
     pub predicted_ratio: PrintedNumber,
+    /// Printed error on the prediction.
     pub predicted_ratio_err: PrintedNumber,
+    /// The block's material.
     pub block: Material,
+    /// The surface it was thrown onto.
     pub surface: Surface,
+    /// The data set (the row's colour).
     pub set: Set,
     /// An uncoloured row: the same cross-section as the set's row above, another length.
     pub extra_length: bool,
+    /// Throws counted.
     pub throws: u64,
+    /// Throws that ended length vertical (a blank in the paper is 0).
     pub length_vertical: u64,
+    /// Throws that ended breadth vertical.
     pub breadth_vertical: u64,
+    /// Throws that ended width vertical.
     pub width_vertical: u64,
     /// Printed measured ratio N(breadth vertical)/N(width vertical).
     pub ratio: PrintedNumber,
+    /// Printed binomial error on the measured ratio.
     pub ratio_err: PrintedNumber,
     /// One of the five rows the paper simulated (red, printed on MDF, length 140).
     pub simulated: bool,
@@ -260,13 +286,16 @@ impl PaperRow {
 /// A printed number and what the row's own data give for it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Discrepancy {
+    /// The row, 1-based, in the paper's order.
     pub row: usize,
     /// e.g. `140x24x20 MDF`.
     pub label: String,
     /// The CSV column: `throws`, `ratio`, `ratio_err`, `r`, `r_err`, `predicted_ratio`,
     /// `predicted_ratio_err`.
     pub field: &'static str,
+    /// The number as printed.
     pub printed: PrintedNumber,
+    /// What the row's own data give for it.
     pub recomputed: f64,
 }
 
@@ -294,6 +323,7 @@ impl Discrepancy {
 /// The loaded table and what the check found.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PaperTable {
+    /// Every row, in the paper's order, as printed.
     pub rows: Vec<PaperRow>,
     /// Printed numbers the row's own data do not give (see the module's rule).
     pub discrepancies: Vec<Discrepancy>,

@@ -31,9 +31,13 @@ pub fn d_ratio_d_r(r: f64) -> f64 {
 /// R and the predicted ratio, each with its propagated one-standard-error uncertainty.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Propagated {
+    /// R = width/breadth.
     pub r: f64,
+    /// σ_R, propagated from the sides' errors.
     pub r_err: f64,
+    /// The predicted ratio P(breadth vertical)/P(width vertical) of (MasterEqu).
     pub ratio: f64,
+    /// Its error, |d ratio/dR| σ_R.
     pub ratio_err: f64,
 }
 

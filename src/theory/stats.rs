@@ -17,7 +17,9 @@ use serde::Serialize;
 /// A ratio with its one-standard-error binomial error.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Ratio {
+    /// The ratio.
     pub value: f64,
+    /// Its binomial standard error.
     pub err: f64,
 }
 
@@ -44,7 +46,9 @@ pub const Z95: f64 = 1.959_963_984_540_054;
 /// A proportion k/n with its binomial error and Wilson 95 % score interval.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Proportion {
+    /// The count of the outcome.
     pub k: u64,
+    /// The number of trials.
     pub n: u64,
     /// k/n.
     pub value: f64,
@@ -113,9 +117,13 @@ pub fn z_score(a: f64, a_err: f64, b: f64, b_err: f64) -> f64 {
 /// One comparison for χ²: a measurement and a prediction, each with its error.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Comparison {
+    /// The measured value.
     pub measured: f64,
+    /// Its standard error.
     pub measured_err: f64,
+    /// The predicted value.
     pub predicted: f64,
+    /// Its standard error.
     pub predicted_err: f64,
 }
 
@@ -134,6 +142,7 @@ impl Comparison {
 /// χ² = Σ z² over comparisons, with its degrees of freedom.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct ChiSquare {
+    /// χ², the sum of z² over the comparisons used.
     pub chi2: f64,
     /// Number of comparisons used: the prediction has no fitted parameter, so every comparison
     /// is one degree of freedom.

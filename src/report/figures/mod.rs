@@ -30,8 +30,11 @@ pub mod sweeps;
 /// One plotted value with its one-standard-error bar (`y_err` 0, negative or non-finite: no bar).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Point {
+    /// Abscissa.
     pub x: f64,
+    /// Ordinate.
     pub y: f64,
+    /// One standard error on `y`.
     pub y_err: f64,
 }
 
@@ -40,9 +43,13 @@ pub struct Point {
 /// (printed blocks on tough carpet); any other name is drawn in grey under its own label.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ExpPoint {
+    /// R = width/breadth.
     pub r: f64,
+    /// Measured ratio N(breadth vertical)/N(width vertical).
     pub ratio: f64,
+    /// Its binomial error.
     pub err: f64,
+    /// The data set: "pine", "mdf", "carpet", or another name.
     pub set: String,
 }
 
@@ -50,15 +57,20 @@ pub struct ExpPoint {
 /// series as separate triangles.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SimSeries {
+    /// The series' name in the legend.
     pub label: String,
+    /// A 2D simulation (connected circles), else 3D (separate triangles).
     pub two_d: bool,
+    /// The ratio at each R.
     pub points: Vec<Point>,
 }
 
 /// Blocks of one cross-section measured at several lengths (`x` = length in mm).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LenGroup {
+    /// The group's name in the legend, e.g. "printed 24x20 on MDF".
     pub label: String,
+    /// The measured ratio at each length (`x`, mm).
     pub points: Vec<Point>,
 }
 

@@ -7,31 +7,43 @@ use super::*;
 /// One line of the convergence figure: points at x = dt.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Line {
+    /// The line's name in the legend; one containing " 2d" is drawn with circles, else triangles.
     pub label: String,
+    /// The ratio at each time step (`x` = dt, s).
     pub points: Vec<Point>,
 }
 
 /// One method of the trade-off figure.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MethodPoint {
+    /// The method's name, beside its marker if on the front.
     pub label: String,
     /// CPU seconds per 1,000 rolls.
     pub cost: f64,
-    /// |departure| from the reference, per cent, and its error.
+    /// |departure| from the reference, per cent.
     pub error: f64,
+    /// Its one-standard-error bar, per cent.
     pub error_err: f64,
+    /// A 2D method (circle), else 3D (triangle).
     pub two_d: bool,
+    /// On its mode's Pareto front: joined by the front's line and named beside its marker.
     pub on_front: bool,
 }
 
 /// One heat map: `values[y][x]` in [0, 1] (NaN: no data).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Panel {
+    /// The panel's caption.
     pub title: String,
+    /// The x axis's title.
     pub x_desc: String,
+    /// The y axis's title.
     pub y_desc: String,
+    /// The columns' labels, one per x cell.
     pub x_labels: Vec<String>,
+    /// The rows' labels, one per y cell.
     pub y_labels: Vec<String>,
+    /// The fractions, `values[y][x]`, in [0, 1]; NaN: no data.
     pub values: Vec<Vec<f64>>,
 }
 
