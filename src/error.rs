@@ -22,6 +22,9 @@ pub enum Error {
     /// An engine could not be built, or failed outside a roll.
     #[error("{0}")]
     Engine(String),
+    /// A stop was requested (Ctrl-C, SIGTERM) before the work was done; what was done is kept.
+    #[error("stopped before the end")]
+    Stopped,
     /// Anything else that stops a run: encoding output, drawing a figure.
     #[error("{0}")]
     Failed(String),

@@ -1,6 +1,7 @@
 //! `dicephys bench`: speed of every engine and lever against the faithful configuration.
 
 use super::error::{Error, Result};
+use super::outln;
 use clap::Args;
 use dicephys::studies::bench;
 
@@ -38,20 +39,22 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let threads = super::args::threads(a.threads)?;
     let quiet = a.json;
     if !quiet {
-        println!("{}", bench::header());
+        outln!("{}", bench::header());
     }
+    // A progress line that cannot be written (a closed pipe) is dropped; the result is
+    // written, or its failure reported, at the end.
     let b = bench::run(a.rolls, a.seed, threads, a.repeat, &|line| {
         if !quiet {
-            println!("{line}");
+            let _ = super::stdout(&format!("{line}\n"));
         }
     })?;
     if a.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&b).map_err(|e| Error::Run(e.to_string()))?
         );
     } else {
-        println!("peak RSS {:.1} MB", b.peak_rss_mb);
+        outln!("peak RSS {:.1} MB", b.peak_rss_mb);
     }
     Ok(())
 }

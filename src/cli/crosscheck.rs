@@ -2,6 +2,7 @@
 
 use super::args::{parse_engine, RunArgs, SceneArgs, ThrowArgs};
 use super::error::{Error, Result};
+use super::{out, outln};
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::report::summary::{Cost, RunSummary};
@@ -122,16 +123,16 @@ pub fn run(a: &CrosscheckArgs) -> Result<()> {
         .collect();
     let out = Crosscheck { runs, versus };
     if a.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&out).map_err(|e| Error::Run(e.to_string()))?
         );
     } else {
         for r in &out.runs {
-            print!("{}", r.human());
+            out!("{}", r.human());
         }
         for v in &out.versus {
-            println!(
+            outln!(
                 "{} vs {}: {:+.1} σ apart; same outcome on {:.1} % of the {} throws both settled; CPU per roll {:.2}x",
                 v.engine,
                 v.baseline,

@@ -11,6 +11,8 @@ pub enum Error {
     Run(String),
     /// Stopped by Ctrl-C or SIGTERM before the end, with what was done kept: exit code 130.
     Interrupted(String),
+    /// Standard output was closed by its reader (`| head -1`): the command ends quietly.
+    Closed,
 }
 
 impl Error {
@@ -20,6 +22,7 @@ impl Error {
             Error::Usage(_) => 2,
             Error::Run(_) => 1,
             Error::Interrupted(_) => 130,
+            Error::Closed => 0,
         }
     }
 }
@@ -28,13 +31,18 @@ impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Error::Usage(m) | Error::Run(m) | Error::Interrupted(m) => f.write_str(m),
+            Error::Closed => f.write_str("standard output closed"),
         }
     }
 }
 
 impl From<dicephys::Error> for Error {
     fn from(e: dicephys::Error) -> Error {
-        if e.is_input() {
+        if matches!(e, dicephys::Error::Stopped) {
+            Error::Interrupted(
+                "interrupted; the finished work is kept: run the same command to continue".into(),
+            )
+        } else if e.is_input() {
             Error::Usage(e.to_string())
         } else {
             Error::Run(e.to_string())
@@ -44,7 +52,11 @@ impl From<dicephys::Error> for Error {
 
 impl From<std::io::Error> for Error {
     fn from(e: std::io::Error) -> Error {
-        Error::Run(e.to_string())
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            Error::Closed
+        } else {
+            Error::Run(format!("standard output: {e}"))
+        }
     }
 }
 

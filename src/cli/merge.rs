@@ -2,6 +2,7 @@
 //! the unsharded run: the same exact counts, because every throw depends only on its index.
 
 use super::error::{Error, Result};
+use super::{out, outln};
 use clap::Args;
 use dicephys::report::summary::{RunSummary, ShardResult};
 use std::path::PathBuf;
@@ -33,12 +34,12 @@ pub fn run(a: &MergeArgs) -> Result<()> {
     }
     let out = RunSummary::merge(&parts)?;
     if a.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&out).map_err(|e| Error::Run(e.to_string()))?
         );
     } else {
-        print!("{}", out.human());
+        out!("{}", out.human());
     }
     Ok(())
 }

@@ -2,6 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use dicephys::run::stop::Stop;
+use error::Error;
 
 pub mod args;
 pub mod bench;
@@ -84,7 +85,7 @@ pub fn main() -> i32 {
         Command::Trace(a) => trace::run(&a),
     };
     match result {
-        Ok(()) => 0,
+        Ok(()) | Err(Error::Closed) => 0,
         Err(e) => {
             eprintln!("dicephys: {e}");
             e.exit_code()
@@ -127,6 +128,30 @@ fn clap_error(e: clap::Error) -> i32 {
         }
     }
 }
+
+/// Writes `text` to stdout and flushes it. A closed pipe (`| head -1`) ends the command
+/// quietly; any other failure (a full disk) is an error, never a panic.
+pub fn stdout(text: &str) -> error::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())?;
+    out.flush()?;
+    Ok(())
+}
+
+/// `println!` to [`stdout`], returning its error.
+macro_rules! outln {
+    ($($t:tt)*) => {
+        $crate::cli::stdout(&format!("{}\n", format_args!($($t)*)))?
+    };
+}
+/// `print!` to [`stdout`], returning its error.
+macro_rules! out {
+    ($($t:tt)*) => {
+        $crate::cli::stdout(&format!($($t)*))?
+    };
+}
+pub(crate) use {out, outln};
 
 /// Checks an output path before anything runs (exit 2 if it cannot be written).
 pub fn output(path: &std::path::Path) -> error::Result<dicephys::run::io::Output> {

@@ -2,6 +2,7 @@
 
 use super::args::parse_engine;
 use super::error::{Error, Result};
+use super::outln;
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::report::paper as report;
@@ -96,7 +97,7 @@ pub fn run(a: &PaperArgs) -> Result<()> {
     let md = report::report_markdown(&res, &["master_graph", "prob_2d", "len_graph", "dreidel"]);
     if res.partial {
         // A partial run leaves the last complete outputs alone: its report goes to stdout.
-        println!("{md}");
+        outln!("{md}");
         return Err(Error::Interrupted(format!(
             "interrupted; {} kept what was rolled: run the same command to continue",
             ck.display()
@@ -106,12 +107,12 @@ pub fn run(a: &PaperArgs) -> Result<()> {
     let md = report::report_markdown(&res, &figures);
     let json = serde_json::to_string_pretty(&res).map_err(|e| Error::Run(e.to_string()))?;
     outputs[0].write(json.as_bytes())?;
-    outputs[1].write(report::results_csv(&res).as_bytes())?;
+    outputs[1].write(report::results_csv(&res)?.as_bytes())?;
     outputs[2].write(md.as_bytes())?;
     if a.json {
-        println!("{json}");
+        outln!("{json}");
     } else {
-        println!("{md}");
+        outln!("{md}");
         eprintln!(
             "wrote {}/report.md, results.json, results.csv and figures",
             a.out.display()

@@ -2,14 +2,15 @@
 
 use super::args::{parse_engine, parse_shard, RunArgs, SceneArgs, ThrowArgs};
 use super::error::{Error, Result};
+use super::{out, outln};
 use clap::Args;
 use dicephys::engine::EngineKind;
+use dicephys::report::per_roll::PerRoll;
 use dicephys::report::summary::{Cost, RunSummary};
 use dicephys::run::cputime::process_cpu_seconds;
 use dicephys::run::runner::{Checkpoint, Runner};
 use dicephys::run::spec::{RunSpec, Shard};
-use dicephys::sim::roll::{Fate, RollRecord};
-use std::io::Write;
+use dicephys::sim::roll::RollRecord;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -98,43 +99,38 @@ pub fn run(a: &RollArgs) -> Result<()> {
     let checkpoint = dir.map(|d| Checkpoint::open(d, &spec)).transpose()?;
     // The per-roll CSV grows chunk by chunk in a temporary file, put in place at the end.
     let mut csv = match &per_roll {
-        Some(out) => {
-            let mut w = out.writer()?;
-            w.write_all(PER_ROLL_HEADER.as_bytes())?;
-            Some(w)
-        }
+        Some(out) => Some(PerRoll::new(out.writer()?, spec.scene.dt)?),
         None => None,
     };
-    let dt = spec.scene.dt;
     let mut sink = |recs: &[RollRecord]| -> dicephys::Result<()> {
-        if let Some(f) = csv.as_mut() {
-            f.write_all(per_roll_rows(recs, dt).as_bytes())
-                .map_err(|e| dicephys::Error::Failed(format!("--per-roll: {e}")))?;
+        match csv.as_mut() {
+            Some(c) => c.write(recs),
+            None => Ok(()),
         }
-        Ok(())
     };
     let wall = Instant::now();
     let cpu = process_cpu_seconds();
     let runner = Runner::new(threads, super::stop().clone());
     let done = runner.run(&spec, checkpoint.as_ref(), &mut sink)?;
+    // A resumed run's cost is the sum over its segments: the resumed chunks carry theirs.
     let cost = Cost {
-        wall_s: wall.elapsed().as_secs_f64(),
-        cpu_s: process_cpu_seconds() - cpu,
+        wall_s: wall.elapsed().as_secs_f64() + done.resumed_wall_s,
+        cpu_s: process_cpu_seconds() - cpu + done.resumed_cpu_s,
         threads,
     };
-    if let Some(w) = csv {
-        w.commit()?;
+    if let Some(c) = csv {
+        c.finish()?.commit()?;
     }
     let tally = done.tally;
     let mut summary = RunSummary::new(&spec, &tally, cost);
     summary.partial = !done.complete;
     if a.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&summary).map_err(|e| Error::Run(e.to_string()))?
         );
     } else {
-        print!("{}", summary.human());
+        out!("{}", summary.human());
     }
     if !done.complete {
         let total = spec.indices().len();
@@ -148,33 +144,4 @@ pub fn run(a: &RollArgs) -> Result<()> {
         }));
     }
     Ok(())
-}
-
-/// The per-throw CSV's header.
-pub const PER_ROLL_HEADER: &str =
-    "index,drop_height_m,velocity_m_s,spin_rad_s,status,outcome,steps,sim_time_s\n";
-
-/// Per-throw CSV rows: index, initial conditions, status, outcome, steps, simulated time.
-pub fn per_roll_rows(records: &[RollRecord], dt: f64) -> String {
-    let mut s = String::new();
-    for r in records {
-        let (status, outcome) = match r.fate {
-            Fate::Settled(o) => ("settled", o.name()),
-            Fate::Unconverged(o) => ("unconverged", o.name()),
-            Fate::Failed(f) => (f.name(), ""),
-        };
-        let t = &r.throw;
-        s += &format!(
-            "{},{:?},{:?},{:?},{},{},{},{:?}\n",
-            t.index,
-            t.drop_height,
-            t.velocity,
-            t.spin,
-            status,
-            outcome,
-            r.steps,
-            r.sim_time(dt)
-        );
-    }
-    s
 }

@@ -3,6 +3,7 @@
 
 use super::args::{parse_block, parse_engine};
 use super::error::{Error, Result};
+use super::outln;
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::model::block::Block;
@@ -143,9 +144,9 @@ fn finish(out: &Path, file: &str, json: &str, report: &str, print_json: bool) ->
     super::output(&out.join(file))?.write(json.as_bytes())?;
     super::output(&out.join("report.md"))?.write(report.as_bytes())?;
     if print_json {
-        println!("{json}");
+        outln!("{json}");
     } else {
-        println!("{report}");
+        outln!("{report}");
         eprintln!("wrote {}/{file}, report.md and figures", out.display());
     }
     Ok(())

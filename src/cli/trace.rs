@@ -53,10 +53,13 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     let mut engine = new_engine(a.engine, &scene)?;
     let out = std::io::stdout();
     let mut out = std::io::BufWriter::new(out.lock());
-    let _ = writeln!(
+    writeln!(
         out,
         "step,time_s,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,kinetic_j,potential_j,total_j,sleeping"
-    );
+    )?;
+    // The first failed write is kept and returned after the roll (a roll cannot be stopped
+    // from its observer); later lines are not attempted.
+    let mut failed: Option<std::io::Error> = None;
     let mut last = None;
     let line = |step: u64, s: &BodyState| -> String {
         let q = s.rotation.quaternion();
@@ -92,16 +95,21 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     let record = roll_observed(engine.as_mut(), &scene, &throw, &settle, |step, s| {
         let l = line(step, s);
         if step % a.every == 0 {
-            let _ = writeln!(out, "{l}");
+            if failed.is_none() {
+                failed = writeln!(out, "{l}").err();
+            }
             last = None;
         } else {
             last = Some(l);
         }
     });
-    if let Some(l) = last {
-        let _ = writeln!(out, "{l}");
+    if let Some(e) = failed {
+        return Err(e.into());
     }
-    let _ = out.flush();
+    if let Some(l) = last {
+        writeln!(out, "{l}")?;
+    }
+    out.flush()?;
     let fate = match record.fate {
         Fate::Settled(o) => format!("settled, {} vertical", o.name()),
         Fate::Unconverged(o) => format!("unconverged ({} vertical at the cap)", o.name()),

@@ -1,8 +1,8 @@
 //! glibc's `rand()`, bit for bit: the generator DicePhys draws its throws from.
 //!
 //! glibc's default `random()` state is TYPE_3: an additive lagged-Fibonacci generator
-//! r[i] = r[i−3] + r[i−31] (mod 2³²), seeded by the Park–Miller LCG r[i] = 16807·r[i−1]
-//! mod (2³¹ − 1), with the first 310 outputs thrown away; each output is r[i] >> 1.
+//! `r[i] = r[i−3] + r[i−31] (mod 2³²)`, seeded by the Park–Miller LCG `r[i] = 16807·r[i−1]
+//! mod (2³¹ − 1)`, with the first 310 outputs thrown away; each output is `r[i] >> 1`.
 
 /// glibc's `RAND_MAX`, the largest value `rand()` returns (2³¹ − 1).
 pub const RAND_MAX: i32 = 2_147_483_647;

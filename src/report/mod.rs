@@ -3,5 +3,6 @@
 
 pub mod figures;
 pub mod paper;
+pub mod per_roll;
 pub mod summary;
 pub mod table;

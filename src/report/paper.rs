@@ -1,7 +1,7 @@
 //! The paper's report: its results as data, `report.md`, `results.csv` and the figures.
 
 use crate::engine::EngineKind;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::scene::{Mode, Preset};
 use crate::report::summary::RunSummary;
 use crate::report::table::TableReport;
@@ -256,11 +256,33 @@ pub fn report_markdown(res: &PaperResults, figures: &[&str]) -> String {
 }
 
 /// results.csv: one row per simulated cell.
-pub fn results_csv(res: &PaperResults) -> String {
-    let mut s = String::from(
-        "row,block,engine,mode,rolls,breadth,width,length,unknown,unconverged,failed,ratio,ratio_err,\
-         measured_ratio,measured_err,theory_ratio,theory_err,z_experiment,z_theory,steps_mean,cpu_ms_per_roll\n",
-    );
+pub fn results_csv(res: &PaperResults) -> Result<String> {
+    /// One simulated cell; decimals fixed per column.
+    #[derive(Serialize)]
+    struct Row<'a> {
+        row: usize,
+        block: &'a str,
+        engine: EngineKind,
+        mode: Mode,
+        rolls: u64,
+        breadth: u64,
+        width: u64,
+        length: u64,
+        unknown: u64,
+        unconverged: u64,
+        failed: u64,
+        ratio: String,
+        ratio_err: String,
+        measured_ratio: String,
+        measured_err: String,
+        theory_ratio: String,
+        theory_err: String,
+        z_experiment: String,
+        z_theory: String,
+        steps_mean: String,
+        cpu_ms_per_roll: String,
+    }
+    let mut csv = csv::Writer::from_writer(Vec::new());
     for c in &res.simulations {
         let t = res.table.rows.iter().find(|r| r.row == c.row);
         let (mr, me, tr, te) = t
@@ -274,32 +296,37 @@ pub fn results_csv(res: &PaperResults) -> String {
             })
             .unwrap_or((f64::NAN, f64::NAN, f64::NAN, f64::NAN));
         let k = &c.run.counts;
-        s += &format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.3},{:.3},{:.1},{:.4}\n",
-            c.row,
-            c.label.split(' ').next().unwrap_or(""),
-            c.engine,
-            c.mode,
-            c.run.rolls,
-            k.breadth,
-            k.width,
-            k.length,
-            k.unknown,
-            c.run.unconverged,
-            c.run.failed_total,
-            c.ratio.value,
-            c.ratio.err,
-            mr,
-            me,
-            tr,
-            te,
-            c.z_experiment,
-            c.z_theory,
-            c.run.steps_mean,
-            c.run.cpu_ms_per_roll
-        );
+        let f6 = |v: f64| format!("{v:.6}");
+        let row = Row {
+            row: c.row,
+            block: c.label.split(' ').next().unwrap_or(""),
+            engine: c.engine,
+            mode: c.mode,
+            rolls: c.run.rolls,
+            breadth: k.breadth,
+            width: k.width,
+            length: k.length,
+            unknown: k.unknown,
+            unconverged: c.run.unconverged,
+            failed: c.run.failed_total,
+            ratio: f6(c.ratio.value),
+            ratio_err: f6(c.ratio.err),
+            measured_ratio: f6(mr),
+            measured_err: f6(me),
+            theory_ratio: f6(tr),
+            theory_err: f6(te),
+            z_experiment: format!("{:.3}", c.z_experiment),
+            z_theory: format!("{:.3}", c.z_theory),
+            steps_mean: format!("{:.1}", c.run.steps_mean),
+            cpu_ms_per_roll: format!("{:.4}", c.run.cpu_ms_per_roll),
+        };
+        csv.serialize(row)
+            .map_err(|e| Error::Failed(format!("results.csv: {e}")))?;
     }
-    s
+    let bytes = csv
+        .into_inner()
+        .map_err(|e| Error::Failed(format!("results.csv: {}", e.error())))?;
+    String::from_utf8(bytes).map_err(|e| Error::Failed(format!("results.csv: {e}")))
 }
 
 /// The paper's figures, drawn from the results; returns their names (each has .svg and .png).

@@ -7,6 +7,7 @@
 
 use crate::error::{Error, Result};
 use crate::run::batch;
+use crate::run::cputime::process_cpu_seconds;
 use crate::run::io::write_atomic;
 use crate::run::spec::RunSpec;
 use crate::run::stop::Stop;
@@ -51,12 +52,19 @@ pub struct Chunked {
     pub complete: bool,
     /// Rolls read back from the checkpoint rather than rolled now.
     pub resumed: u64,
+    /// CPU seconds the resumed rolls took when they were rolled (stored with their chunks), so
+    /// that a resumed run's cost is the sum over its segments.
+    pub resumed_cpu_s: f64,
+    /// Wall-clock seconds the resumed rolls took when they were rolled.
+    pub resumed_wall_s: f64,
 }
 
-/// One chunk file: the run's key and the chunk's records.
+/// One chunk file: the run's key, what the chunk cost, and its records.
 #[derive(Serialize, Deserialize)]
 struct ChunkFile {
     key: String,
+    cpu_s: f64,
+    wall_s: f64,
     records: Vec<RollRecord>,
 }
 
@@ -92,27 +100,31 @@ impl<'a> Runner<'a> {
         let indices = spec.indices();
         let throws = spec.throws.source(spec.rolls);
         let key = spec.key();
-        let mut tally = Tally::default();
-        let mut resumed = 0;
+        let mut done = Chunked {
+            tally: Tally::default(),
+            complete: false,
+            resumed: 0,
+            resumed_cpu_s: 0.0,
+            resumed_wall_s: 0.0,
+        };
         for c in 0..indices.len().div_ceil(CHUNK) {
             let chunk = indices.chunk(c, CHUNK);
             let path = checkpoint.map(|d| d.chunk_path(chunk[0], chunk.len()));
             if let Some(p) = path.as_ref().filter(|p| p.exists()) {
-                let recs = read_chunk(p, &key, &chunk)?;
-                resumed += recs.len() as u64;
-                recs.iter().for_each(|r| tally.add(r));
-                sink(&recs)?;
-                (self.progress)(tally.rolls);
+                let file = read_chunk(p, &key, &chunk)?;
+                done.resumed += file.records.len() as u64;
+                done.resumed_cpu_s += file.cpu_s;
+                done.resumed_wall_s += file.wall_s;
+                file.records.iter().for_each(|r| done.tally.add(r));
+                sink(&file.records)?;
+                (self.progress)(done.tally.rolls);
                 continue;
             }
             if self.stop.requested() {
-                return Ok(Chunked {
-                    tally,
-                    complete: false,
-                    resumed,
-                });
+                return Ok(done);
             }
-            let base = tally.rolls;
+            let base = done.tally.rolls;
+            let (cpu, wall) = (process_cpu_seconds(), std::time::Instant::now());
             let job = batch::Job {
                 engine: spec.engine,
                 scene: &spec.scene,
@@ -126,34 +138,29 @@ impl<'a> Runner<'a> {
             if let (Some(p), true) = (&path, whole) {
                 let file = ChunkFile {
                     key: key.clone(),
+                    cpu_s: process_cpu_seconds() - cpu,
+                    wall_s: wall.elapsed().as_secs_f64(),
                     records: recs,
                 };
                 let json =
                     serde_json::to_string(&file).map_err(|e| Error::Failed(e.to_string()))?;
                 write_atomic(p, json.as_bytes())?;
-                file.records.iter().for_each(|r| tally.add(r));
+                file.records.iter().for_each(|r| done.tally.add(r));
                 sink(&file.records)?;
             } else {
-                recs.iter().for_each(|r| tally.add(r));
+                recs.iter().for_each(|r| done.tally.add(r));
                 sink(&recs)?;
             }
             if !whole {
-                return Ok(Chunked {
-                    tally,
-                    complete: false,
-                    resumed,
-                });
+                return Ok(done);
             }
         }
-        Ok(Chunked {
-            tally,
-            complete: true,
-            resumed,
-        })
+        done.complete = true;
+        Ok(done)
     }
 }
 
-fn read_chunk(p: &Path, key: &str, chunk: &[u64]) -> Result<Vec<RollRecord>> {
+fn read_chunk(p: &Path, key: &str, chunk: &[u64]) -> Result<ChunkFile> {
     let text = std::fs::read_to_string(p).map_err(|e| Error::io(p, e))?;
     let file: ChunkFile = serde_json::from_str(&text)
         .map_err(|e| Error::Mismatch(format!("{}: not a chunk of this run ({e})", p.display())))?;
@@ -176,7 +183,7 @@ fn read_chunk(p: &Path, key: &str, chunk: &[u64]) -> Result<Vec<RollRecord>> {
             p.display()
         )));
     }
-    Ok(file.records)
+    Ok(file)
 }
 
 /// A checkpoint directory, held by one run at a time: `spec.json` names the run, `lock` its

@@ -82,8 +82,9 @@ pub struct RollRecord {
     pub steps: u64,
     /// Steps the engine itself took (fewer than `steps` where free flight was coasted).
     pub engine_steps: u64,
-    /// With `RollConfig::audit`: the first step at which the energy certificate held, and the
-    /// outcome it certified.
+    /// With `RollConfig::audit` or the certificate rule: the first step at which the energy
+    /// certificate held, and the outcome it certified (under the certificate rule, the step
+    /// the roll ended).
     pub certified: Option<(u64, Outcome)>,
     /// The engine injected energy: the die's kinetic + potential energy rose above its lowest
     /// value so far by more than `ENERGY_GAIN_TOLERANCE` of its starting energy. A flag, not a

@@ -145,8 +145,8 @@ pub fn run(
                     &spec,
                     &tally,
                     Cost {
-                        wall_s: cell_wall.elapsed().as_secs_f64(),
-                        cpu_s: process_cpu_seconds() - cell_cpu,
+                        wall_s: cell_wall.elapsed().as_secs_f64() + done.resumed_wall_s,
+                        cpu_s: process_cpu_seconds() - cell_cpu + done.resumed_cpu_s,
                         threads: runner.threads,
                     },
                 );

@@ -1,10 +1,10 @@
 //! Accuracy against cost, and where methods fail: three sweeps over the same roll code.
 //!
-//! * [`converge`]: the paper's convergence test (its appendix): the ratio against dt for
+//! * [`converge`](super::converge): the paper's convergence test (its appendix): the ratio against dt for
 //!   several blocks, engines, 2D and 3D, and whether dt = 0.001 s is within 1 % of the finest;
-//! * [`tradeoff`]: CPU cost against departure from the reference (the finest-dt faithful
+//! * [`tradeoff`](super::tradeoff): CPU cost against departure from the reference (the finest-dt faithful
 //!   result) across methods, and the Pareto front;
-//! * [`stability`]: the fractions of rolls that end unconverged, unknown, non-finite or
+//! * [`stability`](super::stability): the fractions of rolls that end unconverged, unknown, non-finite or
 //!   tunnelled, or that gain energy, across dt, restitution, friction and aspect ratio.
 //!
 //! Every cell rolls the same keyed throws (seed, index), so cells differ only in the method.
@@ -104,11 +104,11 @@ pub fn measure(spec: &RunSpec, study: &Study) -> Result<Measured> {
     };
     let run = study.runner.run(spec, ck.as_ref(), &mut |_| Ok(()))?;
     if !run.complete {
-        return Err(Error::Failed("stopped before the end".into()));
+        return Err(Error::Stopped);
     }
     let m = Measured {
         tally: run.tally,
-        cpu_s: process_cpu_seconds() - cpu,
+        cpu_s: process_cpu_seconds() - cpu + run.resumed_cpu_s,
     };
     if let Some(f) = &kept {
         let json = serde_json::to_string(&m).map_err(|e| Error::Failed(e.to_string()))?;

@@ -6,6 +6,7 @@ mod helpers;
 mod bullet;
 mod cli;
 mod fuzz;
+mod redteam;
 mod rapier;
 mod reliability;
 mod speed;

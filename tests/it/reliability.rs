@@ -196,3 +196,118 @@ fn a_roll_forced_non_finite_is_counted_as_failed() {
     let end = run_from(e.as_mut(), &scene, &ok, &RollConfig::default(), |_, _| {});
     assert!(matches!(end.fate, Fate::Settled(_)));
 }
+
+#[test]
+fn shards_of_one_run_merge_however_their_flags_are_spelled() {
+    let whole = json(&bin().args(RUN).arg("--json").output().unwrap());
+    let dir = tmp("spelled");
+    std::fs::create_dir_all(&dir).unwrap();
+    // One run, three spellings: `--flag=value`, flags reordered, an explicit default.
+    let spellings: [&[&str]; 3] = [
+        &[
+            "roll",
+            "--block=140x22x13",
+            "--2d",
+            "--rolls=4000",
+            "--seed=77",
+        ],
+        &[
+            "roll",
+            "--seed",
+            "77",
+            "--rolls",
+            "4000",
+            "--2d",
+            "--block",
+            "140x22x13",
+        ],
+        &[
+            "roll",
+            "--block",
+            "140x22x13",
+            "--2d",
+            "--rolls",
+            "4000",
+            "--seed",
+            "77",
+            "--dt",
+            "0.001",
+            "--engine",
+            "bullet",
+            "--threads",
+            "1",
+        ],
+    ];
+    let mut files = Vec::new();
+    for (k, args) in spellings.iter().enumerate() {
+        let out = bin()
+            .args(*args)
+            .args(["--json", "--shard", &format!("{k}/3")])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let f = dir.join(format!("s{k}.json"));
+        std::fs::write(&f, &out.stdout).unwrap();
+        files.push(f);
+    }
+    let merged = json(
+        &bin()
+            .arg("merge")
+            .args(&files)
+            .arg("--json")
+            .output()
+            .unwrap(),
+    );
+    assert_eq!(whole["tally"], merged["tally"]);
+    assert_eq!(whole["spec"], merged["spec"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_checkpoint_directory_holds_one_run() {
+    let dir = tmp("one-run");
+    let d = dir.to_str().unwrap();
+    let roll = |seed: &str| {
+        bin()
+            .args([
+                "roll",
+                "--block",
+                "140x24x20",
+                "--rolls",
+                "50",
+                "--seed",
+                seed,
+            ])
+            .args(["--json", "--checkpoint", d])
+            .output()
+            .unwrap()
+    };
+    assert!(roll("1").status.success());
+    // Another run on the same directory is refused before it rolls anything.
+    let out = roll("2");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("another run"));
+    // A chunk of another run (its key differs) is refused, not counted.
+    let spec = std::fs::read_to_string(dir.join("spec.json")).unwrap();
+    std::fs::write(
+        dir.join("spec.json"),
+        spec.replace("\"seed\": 1", "\"seed\": 3"),
+    )
+    .unwrap();
+    let out = bin()
+        .args(["roll", "--json", "--resume", d])
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("another run"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
