@@ -6,3 +6,4 @@ pub mod paper;
 pub mod per_roll;
 pub mod summary;
 pub mod table;
+pub mod text;

@@ -6,6 +6,7 @@
 use crate::engine::EngineKind;
 use crate::model::scene::{Floor, Mode, Scene};
 use crate::model::throws::{ThrowKind, ThrowRanges, Throws};
+use crate::report::text::{left, right, Columns};
 use crate::run::batch;
 use crate::run::cputime::{peak_rss_bytes, process_cpu_seconds};
 use crate::run::tally::{Agreement, Tally};
@@ -381,41 +382,41 @@ pub fn ffi_cost(scene: &Scene) -> crate::Result<FfiCost> {
 
 /// The column heads of the log's measurement lines (`format_row`).
 pub fn header() -> String {
-    format!(
-        "{:<20} {:>4} {:>3} {:>9} {:>8} {:>8} {:>7} {:>7} {:>8} {:>8} {:>15} {:>6} {:>6}",
-        "method",
-        "mode",
-        "thr",
-        "rolls/s",
-        "ms/roll",
-        "µs/step",
-        "steps",
-        "engine",
-        "speedup",
-        "×DicePhys",
-        "ratio",
-        "z",
-        "same"
-    )
+    TABLE.header()
 }
 
 /// One measurement as a line of the log, under `header`.
 pub fn format_row(r: &BenchRow) -> String {
-    format!(
-        "{:<20} {:>4} {:>3} {:>9.0} {:>8.3} {:>8.2} {:>7.0} {:>7.0} {:>7.2}x {:>8.1}x {:>7.4} ± {:.4} {:>+6.1} {:>5.1}%",
-        r.method,
-        r.mode,
-        r.threads,
-        r.rolls_per_s,
-        r.cpu_ms_per_roll,
-        r.us_per_engine_step,
-        r.steps_per_roll,
-        r.engine_steps_per_roll,
-        r.speedup,
-        r.vs_dicephys,
-        r.ratio,
-        r.ratio_err,
-        r.z_vs_faithful,
-        100.0 * r.same_outcome
-    )
+    TABLE.row(&[
+        r.method.clone(),
+        r.mode.to_string(),
+        r.threads.to_string(),
+        format!("{:.0}", r.rolls_per_s),
+        format!("{:.3}", r.cpu_ms_per_roll),
+        format!("{:.2}", r.us_per_engine_step),
+        format!("{:.0}", r.steps_per_roll),
+        format!("{:.0}", r.engine_steps_per_roll),
+        format!("{:.2}x", r.speedup),
+        format!("{:.1}x", r.vs_dicephys),
+        format!("{:.4} ± {:.4}", r.ratio, r.ratio_err),
+        format!("{:+.1}", r.z_vs_faithful),
+        format!("{:.1}%", 100.0 * r.same_outcome),
+    ])
 }
+
+/// The columns of the bench's table.
+const TABLE: Columns = Columns(&[
+    left("method", 20),
+    right("mode", 4),
+    right("thr", 3),
+    right("rolls/s", 9),
+    right("ms/roll", 8),
+    right("µs/step", 8),
+    right("steps", 7),
+    right("engine", 7),
+    right("speedup", 8),
+    right("×DicePhys", 9),
+    right("ratio", 16),
+    right("z", 6),
+    right("same", 6),
+]);

@@ -11,6 +11,7 @@ use crate::engine::EngineKind;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::scene::{Mode, Scene};
+use crate::report::text::{left, right, Columns};
 use crate::sim::roll::{RollConfig, Rule};
 use serde::Serialize;
 
@@ -262,38 +263,41 @@ fn verdict(claims: &[Claim], finest: f64, rolls: u64) -> String {
 
 /// The column heads of the log's cell lines (`format_cell`).
 pub fn header() -> String {
-    format!(
-        "{:<10} {:<13} {:>4} {:>8} {:>17} {:>8} {:>10} {:>18} {:>6} {:>6} {:>5}",
-        "block",
-        "engine",
-        "mode",
-        "dt",
-        "ratio",
-        "steps",
-        "CPU s/roll",
-        "vs finest dt",
-        "unconv",
-        "failed",
-        "gain"
-    )
+    TABLE.header()
 }
 
 /// One cell as a line of the log, under `header`.
 pub fn format_cell(c: &Cell) -> String {
-    format!(
-        "{:<10} {:<13} {:>4} {:>8} {:>8.4} ± {:.4} {:>8.0} {:>10.5} {:>+7.1} ± {:>4.1} % {:>6} {:>6} {:>5}",
-        c.block,
-        c.engine,
-        c.mode,
+    TABLE.row(&[
+        c.block.clone(),
+        c.engine.to_string(),
+        c.mode.to_string(),
         dt_label(c.dt),
-        c.ratio,
-        c.ratio_err,
-        c.steps_per_roll,
-        c.cpu_s_per_roll,
-        100.0 * c.departure,
-        100.0 * c.departure_err,
-        c.unconverged,
-        c.failed,
-        c.energy_gain
-    )
+        format!("{:.4} ± {:.4}", c.ratio, c.ratio_err),
+        format!("{:.0}", c.steps_per_roll),
+        format!("{:.5}", c.cpu_s_per_roll),
+        format!(
+            "{:+.1} ± {:.1} %",
+            100.0 * c.departure,
+            100.0 * c.departure_err
+        ),
+        c.unconverged.to_string(),
+        c.failed.to_string(),
+        c.energy_gain.to_string(),
+    ])
 }
+
+/// The columns of the log and of report.md.
+const TABLE: Columns = Columns(&[
+    left("block", 10),
+    left("engine", 13),
+    right("mode", 4),
+    right("dt", 8),
+    right("ratio", 17),
+    right("steps", 8),
+    right("CPU s/roll", 10),
+    right("vs finest dt", 18),
+    right("unconv", 6),
+    right("failed", 6),
+    right("gain", 5),
+]);

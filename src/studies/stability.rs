@@ -10,6 +10,7 @@ use crate::engine::EngineKind;
 use crate::error::Result;
 use crate::model::block::Block;
 use crate::model::scene::{Mode, Scene};
+use crate::report::text::{left, right, Columns};
 use crate::sim::roll::{Failure, RollConfig, Rule};
 use serde::Serialize;
 
@@ -284,41 +285,42 @@ fn findings(cells: &[Cell]) -> Vec<String> {
 
 /// The column heads of the log's cell lines (`format_cell`).
 pub fn header() -> String {
-    format!(
-        "{:<15} {:<13} {:>4} {:<11} {:>8} {:>5} {:>5} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7}",
-        "sweep",
-        "engine",
-        "mode",
-        "block",
-        "dt",
-        "e",
-        "μ",
-        "unconv",
-        "unknown",
-        "nonfin",
-        "tunnel",
-        "gain",
-        "steps"
-    )
+    TABLE.header()
 }
 
 /// One cell as a line of the log, under `header`.
 pub fn format_cell(c: &Cell) -> String {
     let pc = |v: f64| format!("{:.0}%", 100.0 * v);
-    format!(
-        "{:<15} {:<13} {:>4} {:<11} {:>8} {:>5} {:>5} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7.0}",
-        c.sweep,
-        c.engine,
-        c.mode,
-        c.block,
+    TABLE.row(&[
+        c.sweep.to_string(),
+        c.engine.to_string(),
+        c.mode.to_string(),
+        c.block.clone(),
         super::sweep::dt_label(c.dt),
-        c.restitution,
-        c.friction,
+        c.restitution.to_string(),
+        c.friction.to_string(),
         pc(c.unconverged),
         pc(c.unknown),
         pc(c.non_finite),
         pc(c.tunnelled),
         pc(c.energy_gain),
-        c.steps_per_roll
-    )
+        format!("{:.0}", c.steps_per_roll),
+    ])
 }
+
+/// The columns of the log and of report.md.
+const TABLE: Columns = Columns(&[
+    left("sweep", 15),
+    left("engine", 13),
+    right("mode", 4),
+    left("block", 11),
+    right("dt", 8),
+    right("e", 5),
+    right("μ", 5),
+    right("unconv", 7),
+    right("unknown", 7),
+    right("nonfin", 7),
+    right("tunnel", 7),
+    right("gain", 7),
+    right("steps", 7),
+]);

@@ -10,6 +10,7 @@ use crate::engine::EngineKind;
 use crate::error::Result;
 use crate::model::block::Block;
 use crate::model::scene::{Floor, Mode, Scene};
+use crate::report::text::{left, right, Columns};
 use crate::sim::roll::{RollConfig, Rule};
 use serde::Serialize;
 
@@ -298,24 +299,29 @@ pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Tradeoff> 
 
 /// The column heads of the log's method lines (`format_row`).
 pub fn header() -> String {
-    format!(
-        "{:<38} {:>17} {:>12} {:>8} {:>18} {:>6} {:>6}",
-        "method", "ratio", "CPU s/1000", "steps", "error", "σ", "failed"
-    )
+    TABLE.header()
 }
 
 /// One method as a line of the log, under `header`.
 pub fn format_row(r: &Row) -> String {
-    format!(
-        "{:<38} {:>8.4} ± {:.4} {:>12.3} {:>8.0} {:>+7.1} ± {:>4.1} % {:>+6.1} {:>6}",
-        r.method,
-        r.ratio,
-        r.ratio_err,
-        r.cpu_s_per_1000,
-        r.steps_per_roll,
-        100.0 * r.error,
-        100.0 * r.error_err,
-        r.error_sigma,
-        r.failed + r.unconverged
-    )
+    TABLE.row(&[
+        r.method.clone(),
+        format!("{:.4} ± {:.4}", r.ratio, r.ratio_err),
+        format!("{:.3}", r.cpu_s_per_1000),
+        format!("{:.0}", r.steps_per_roll),
+        format!("{:+.1} ± {:.1} %", 100.0 * r.error, 100.0 * r.error_err),
+        format!("{:+.1}", r.error_sigma),
+        (r.failed + r.unconverged).to_string(),
+    ])
 }
+
+/// The columns of the log and of report.md.
+const TABLE: Columns = Columns(&[
+    left("method", 38),
+    right("ratio", 17),
+    right("CPU s/1000", 12),
+    right("steps", 8),
+    right("error", 18),
+    right("σ", 6),
+    right("failed", 6),
+]);

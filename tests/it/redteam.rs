@@ -49,7 +49,11 @@ fn per_roll_onto_a_symlink_writes_its_target_and_keeps_the_link() {
         .file_type()
         .is_symlink());
     let text = std::fs::read_to_string(&target).unwrap();
-    assert_eq!(text.lines().count(), 21, "header and 20 rows in the link's target");
+    assert_eq!(
+        text.lines().count(),
+        21,
+        "header and 20 rows in the link's target"
+    );
     no_temp_files(&d);
 }
 
@@ -98,13 +102,23 @@ fn merge_reads_shards_whose_ratio_is_not_a_number() {
     let d = scratch("nan");
     // 4 rolls in 4 shards: a shard with no width outcome has no ratio (null in JSON).
     let files: Vec<PathBuf> = (0..4).map(|k| shard(&["--rolls", "4"], k, 4, &d)).collect();
-    let out = bin().arg("merge").args(&files).arg("--json").output().unwrap();
+    let out = bin()
+        .arg("merge")
+        .args(&files)
+        .arg("--json")
+        .output()
+        .unwrap();
     assert!(out.status.success(), "{}", stderr(&out));
     // Shards whose every roll is unconverged (a cap of 1 step).
     let files: Vec<PathBuf> = (0..2)
         .map(|k| shard(&["--rolls", "6", "--max-steps", "1"], k, 2, &d))
         .collect();
-    let out = bin().arg("merge").args(&files).arg("--json").output().unwrap();
+    let out = bin()
+        .arg("merge")
+        .args(&files)
+        .arg("--json")
+        .output()
+        .unwrap();
     assert!(out.status.success(), "{}", stderr(&out));
 }
 
@@ -147,11 +161,19 @@ fn sigterm_stops_a_roll_like_ctrl_c() {
     let d = scratch("sigterm");
     let ck = d.join("ck");
     let out = interrupted(
-        &["roll", "--block", "140x24x20", "--rolls", "300000", "--json", "--checkpoint"]
-            .iter()
-            .copied()
-            .chain([ck.to_str().unwrap()])
-            .collect::<Vec<_>>(),
+        &[
+            "roll",
+            "--block",
+            "140x24x20",
+            "--rolls",
+            "300000",
+            "--json",
+            "--checkpoint",
+        ]
+        .iter()
+        .copied()
+        .chain([ck.to_str().unwrap()])
+        .collect::<Vec<_>>(),
         libc::SIGTERM,
         1500,
     );
@@ -166,8 +188,17 @@ fn a_slow_run_stops_within_a_roll_not_a_chunk() {
     // At dt = 1e-5 s a faithful 3D roll takes ~150,000 steps: a chunk takes minutes.
     let out = interrupted(
         &[
-            "roll", "--block", "140x24x20", "--rolls", "1000", "--dt", "0.00001", "--faithful",
-            "--threads", "1", "--json",
+            "roll",
+            "--block",
+            "140x24x20",
+            "--rolls",
+            "1000",
+            "--dt",
+            "0.00001",
+            "--faithful",
+            "--threads",
+            "1",
+            "--json",
         ],
         libc::SIGINT,
         1500,
@@ -197,7 +228,15 @@ fn paper_interrupted_leaves_the_complete_outputs_alone() {
     let before = std::fs::read(d.join("results.json")).unwrap();
     let png = std::fs::read(d.join("prob_2d.png")).unwrap();
     let out = interrupted(
-        &["paper", "--rolls", "300000", "--engines", "bullet", "--out", o],
+        &[
+            "paper",
+            "--rolls",
+            "300000",
+            "--engines",
+            "bullet",
+            "--out",
+            o,
+        ],
         libc::SIGINT,
         1500,
     );
@@ -212,8 +251,17 @@ fn a_sweep_stops_with_exit_130() {
     let d = scratch("sweep");
     let out = interrupted(
         &[
-            "converge", "--blocks", "140x24x20", "--dts", "1/1000", "--engines", "bullet",
-            "--rolls", "300000", "--out", d.to_str().unwrap(),
+            "converge",
+            "--blocks",
+            "140x24x20",
+            "--dts",
+            "1/1000",
+            "--engines",
+            "bullet",
+            "--rolls",
+            "300000",
+            "--out",
+            d.to_str().unwrap(),
         ],
         libc::SIGINT,
         1500,
@@ -225,7 +273,10 @@ fn a_sweep_stops_with_exit_130() {
 
 #[test]
 fn a_full_stdout_is_an_error_not_a_panic() {
-    let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
     for args in [
         &["roll", "--block", "140x24x20", "--rolls", "10", "--json"][..],
         &["trace", "--block", "140x24x20", "--max-steps", "50"][..],
@@ -237,7 +288,12 @@ fn a_full_stdout_is_an_error_not_a_panic() {
             .output()
             .unwrap();
         assert_eq!(out.status.code(), Some(1), "{args:?}: {}", stderr(&out));
-        assert_eq!(stderr(&out).trim_end().lines().count(), 1, "{args:?}: {}", stderr(&out));
+        assert_eq!(
+            stderr(&out).trim_end().lines().count(),
+            1,
+            "{args:?}: {}",
+            stderr(&out)
+        );
     }
 }
 
@@ -260,7 +316,15 @@ fn a_closed_pipe_ends_quietly() {
 #[test]
 fn inputs_at_the_edges_get_one_line_and_exit_2() {
     for args in [
-        &["trace", "--block", "140x24x20", "--throws", "dicephys", "--index", "18446744073709551615"][..],
+        &[
+            "trace",
+            "--block",
+            "140x24x20",
+            "--throws",
+            "dicephys",
+            "--index",
+            "18446744073709551615",
+        ][..],
         &["bench", "--rolls", "18446744073709551615"][..],
         &["roll", "--block", "1e-300x1e-300x1e-300", "--rolls", "10"][..],
         &["paper", "--threads", "5000", "--rolls", "10"][..],
@@ -268,7 +332,12 @@ fn inputs_at_the_edges_get_one_line_and_exit_2() {
     ] {
         let out = bin().args(args).output().unwrap();
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
-        assert_eq!(stderr(&out).trim_end().lines().count(), 1, "{args:?}: {}", stderr(&out));
+        assert_eq!(
+            stderr(&out).trim_end().lines().count(),
+            1,
+            "{args:?}: {}",
+            stderr(&out)
+        );
     }
 }
 
@@ -277,7 +346,16 @@ fn inputs_at_the_edges_get_one_line_and_exit_2() {
 #[test]
 fn a_resumed_run_writes_the_same_per_roll_rows_and_counts_its_whole_cost() {
     let d = scratch("resume");
-    let args = ["roll", "--block", "140x22x13", "--2d", "--rolls", "3000", "--seed", "5"];
+    let args = [
+        "roll",
+        "--block",
+        "140x22x13",
+        "--2d",
+        "--rolls",
+        "3000",
+        "--seed",
+        "5",
+    ];
     let whole_csv = d.join("whole.csv");
     let whole = bin()
         .args(args)
@@ -295,7 +373,11 @@ fn a_resumed_run_writes_the_same_per_roll_rows_and_counts_its_whole_cost() {
         libc::SIGKILL,
         600,
     );
-    assert_ne!(first.status.code(), Some(0), "finished before the kill: make it longer");
+    assert_ne!(
+        first.status.code(),
+        Some(0),
+        "finished before the kill: make it longer"
+    );
     let resumed_csv = d.join("resumed.csv");
     let resumed = bin()
         .args(["roll", "--json", "--resume", ck.to_str().unwrap()])
@@ -313,5 +395,8 @@ fn a_resumed_run_writes_the_same_per_roll_rows_and_counts_its_whole_cost() {
     assert_eq!(w["tally"], r["tally"]);
     // The resumed run's cost includes the chunks rolled before the kill.
     let (wc, rc) = (w["cpu_s"].as_f64().unwrap(), r["cpu_s"].as_f64().unwrap());
-    assert!(rc > 0.5 * wc, "resumed cost {rc} s against {wc} s uninterrupted");
+    assert!(
+        rc > 0.5 * wc,
+        "resumed cost {rc} s against {wc} s uninterrupted"
+    );
 }
