@@ -107,7 +107,8 @@ pub fn run(
     let throws = Throws::new(ThrowKind::Keyed, cfg.seed, ranges, 0);
     let settle = Settle {
         max_steps: cfg.max_steps,
-        rule: if cfg.faithful {
+        // The early stop only where it is audited exact (`roll::EARLY_STOP_MAX_DT`).
+        rule: if cfg.faithful || !crate::roll::early_stop_exact(cfg.dt) {
             Rule::Dicephys
         } else {
             Rule::Certificate

@@ -100,8 +100,14 @@ pub struct Scene {
     pub dt: f64,
     pub preset: Preset,
     pub floor: Floor,
+    /// The box floor's thickness, m: DicePhys's is 100 m (`DICEPHYS_FLOOR_THICKNESS`), which
+    /// nothing gets through; a table top (2 cm) lets a die at a coarse step pass through it.
+    pub floor_thickness: f64,
     pub gravity: f64,
 }
+
+/// DicePhys's floor box is 100 m thick, its top face at y = 0.
+pub const DICEPHYS_FLOOR_THICKNESS: f64 = 100.0;
 
 impl Scene {
     /// The paper's MDF scene (μ = 0.29, e = 0.5, dt = 1 ms) for a block.
@@ -117,6 +123,7 @@ impl Scene {
             dt: 0.001,
             preset: Preset::Dicephys281,
             floor: Floor::Box,
+            floor_thickness: DICEPHYS_FLOOR_THICKNESS,
             gravity: GRAVITY,
         }
     }
@@ -137,6 +144,15 @@ impl Scene {
         match self.mode {
             Mode::ThreeD => b.breadth * b.width * b.length * self.density,
             Mode::TwoD => b.breadth * b.width * self.density,
+        }
+    }
+
+    /// Height of the floor's bottom face: the die is through the floor once wholly below it
+    /// (−∞ for the plane, which is a half-space).
+    pub fn floor_bottom(&self) -> f64 {
+        match self.floor {
+            Floor::Box => -self.floor_thickness,
+            Floor::Plane => f64::NEG_INFINITY,
         }
     }
 

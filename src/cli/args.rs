@@ -38,6 +38,10 @@ pub struct SceneArgs {
     /// The floor: box (DicePhys's 10 km static box) or plane.
     #[arg(long, default_value = "box", value_parser = parse_floor)]
     pub floor: Floor,
+    /// The box floor's thickness, m (DicePhys's: 100). A table top (0.02) is thin enough for
+    /// a die to pass through at a coarse step: a real tunnel, counted as failed.
+    #[arg(long, value_name = "M", allow_hyphen_values = true)]
+    pub floor_thickness: Option<f64>,
 }
 
 /// Where the throws come from.
@@ -73,9 +77,10 @@ pub struct RunArgs {
     #[arg(long, default_value_t = DEFAULT_MAX_STEPS)]
     pub max_steps: u64,
     /// What ends a roll: certificate (the exact early stop: energy below the barrier out of
-    /// the current face; the default) or dicephys (at rest by DicePhys's rule).
-    #[arg(long, default_value = "certificate", value_parser = ["dicephys", "certificate"])]
-    pub settle: String,
+    /// the current face) or dicephys (at rest by DicePhys's rule). Default: certificate at
+    /// dt <= 1/250 s, where it is audited exact; dicephys at coarser steps.
+    #[arg(long, value_parser = ["dicephys", "certificate"])]
+    pub settle: Option<String>,
     /// The certificate's reserve, a fraction of the barrier in [0, 1).
     #[arg(long, default_value_t = DEFAULT_MARGIN)]
     pub margin: f64,
@@ -153,6 +158,19 @@ impl SceneArgs {
         scene.density = self.density;
         scene.preset = self.preset;
         scene.floor = self.floor;
+        if let Some(t) = self.floor_thickness {
+            if self.floor == Floor::Plane {
+                return Err(usage(
+                    "--floor-thickness: the plane floor is a half-space; use --floor box".into(),
+                ));
+            }
+            if !(0.001..=crate::scene::DICEPHYS_FLOOR_THICKNESS).contains(&t) {
+                return Err(usage(format!(
+                    "--floor-thickness {t}: must be in [0.001, 100] m"
+                )));
+            }
+            scene.floor_thickness = t;
+        }
         Ok(scene)
     }
 }
@@ -194,7 +212,14 @@ impl ThrowArgs {
 }
 
 impl RunArgs {
+    /// Checks the values; the settling as at the paper's dt, 1 ms (`check_at` for a scene's).
     pub fn check(&self) -> Result<Settle> {
+        self.check_at(0.001)
+    }
+
+    /// Checks the values; the settling for a scene with time step `dt` (the early stop by
+    /// default only where it is exact, `roll::EARLY_STOP_MAX_DT`).
+    pub fn check_at(&self, dt: f64) -> Result<Settle> {
         if self.rolls == 0 {
             return Err(usage("--rolls 0: need at least one roll".into()));
         }
@@ -214,9 +239,14 @@ impl RunArgs {
             )));
         }
         // An audit compares the certificate with the full settle, so it settles fully.
-        let rule = match self.settle.as_str() {
-            "certificate" if !self.faithful && !self.audit => Rule::Certificate,
-            _ => Rule::Dicephys,
+        let certificate = match self.settle.as_deref() {
+            Some(s) => s == "certificate",
+            None => crate::roll::early_stop_exact(dt),
+        };
+        let rule = if certificate && !self.faithful && !self.audit {
+            Rule::Certificate
+        } else {
+            Rule::Dicephys
         };
         Ok(Settle {
             max_steps: self.max_steps,

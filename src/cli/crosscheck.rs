@@ -63,7 +63,7 @@ fn same_outcomes(a: &[RollRecord], b: &[RollRecord]) -> (u64, f64) {
 pub fn run(a: &CrosscheckArgs) -> Result<()> {
     let scene = a.scene.scene()?;
     let ranges = a.throw.ranges()?;
-    let settle = a.run.check()?;
+    let settle = a.run.check_at(scene.dt)?;
     if a.engines.len() < 2 {
         return Err(Error::Usage(
             "--engines: name at least two engines to compare".into(),

@@ -69,7 +69,7 @@ pub fn merge(parts: &[RunSummary]) -> Result<RunSummary> {
         .map_err(|e| Error::Usage(format!("merge: the shards' arguments do not parse ({e})")))?
         .roll;
     let scene = r.scene.scene()?;
-    let settle = r.run.check()?;
+    let settle = r.run.check_at(scene.dt)?;
     let mut out = RunSummary::new(
         r.engine,
         &scene,

@@ -51,7 +51,7 @@ fn parse_shard(s: &str) -> std::result::Result<Shard, String> {
 pub fn run(a: &RollArgs) -> Result<()> {
     let scene = a.scene.scene()?;
     let ranges = a.throw.ranges()?;
-    let settle = a.run.check()?;
+    let settle = a.run.check_at(scene.dt)?;
     if let Some(p) = &a.per_roll {
         super::check_writable(p)?;
     }
@@ -183,9 +183,12 @@ fn open_checkpoint(dir: &std::path::Path, args: &[String]) -> Result<()> {
 
 /// The per-throw CSV's header.
 pub const PER_ROLL_HEADER: &str =
-    "index,drop_height_m,velocity_m_s,spin_rad_s,status,outcome,steps,sim_time_s\n";
+    "index,drop_height_m,velocity_m_s,spin_rad_s,status,outcome,steps,sim_time_s,energy_gain,dip_steps,longest_dip_steps,penetration_m\n";
 
-/// Per-throw CSV rows: index, initial conditions, status, outcome, steps, simulated time.
+/// Per-throw CSV rows: index, initial conditions, status, outcome, steps, simulated time; then
+/// the flags: energy gain (0/1), the steps at whose end the die's centre was below the
+/// floor's top face, the longest run of them, and the deepest any point of the die went
+/// below that face, m (`roll::Dip`).
 pub fn per_roll_rows(records: &[RollRecord], dt: f64) -> String {
     let mut s = String::new();
     for r in records {
@@ -196,7 +199,7 @@ pub fn per_roll_rows(records: &[RollRecord], dt: f64) -> String {
         };
         let t = &r.throw;
         s += &format!(
-            "{},{:?},{:?},{:?},{},{},{},{:?}\n",
+            "{},{:?},{:?},{:?},{},{},{},{:?},{},{},{},{:?}\n",
             t.index,
             t.drop_height,
             t.velocity,
@@ -204,7 +207,11 @@ pub fn per_roll_rows(records: &[RollRecord], dt: f64) -> String {
             status,
             outcome,
             r.steps,
-            r.sim_time(dt)
+            r.sim_time(dt),
+            r.energy_gain as u8,
+            r.dip.steps,
+            r.dip.longest,
+            r.dip.penetration
         );
     }
     s

@@ -29,7 +29,8 @@ pub struct Row {
     pub engine: String,
     pub mode: String,
     pub dt: f64,
-    /// `faithful` (DicePhys's rule, stepped flight) or `fast` (early stop + closed-form flight).
+    /// `faithful` (DicePhys's rule, stepped flight) or `fast` (the defaults: closed-form flight,
+    /// and the early stop where it is exact, dt <= 1/250).
     pub rule: String,
     pub floor: String,
     pub rolls: u64,
@@ -130,7 +131,8 @@ fn roll_method(
     scene.floor = m.floor;
     let settle = Settle {
         max_steps: cfg.max_steps,
-        rule: if m.faithful {
+        // `fast` is the defaults: the early stop only where it is audited exact.
+        rule: if m.faithful || !crate::roll::early_stop_exact(m.dt) {
             Rule::Dicephys
         } else {
             Rule::Certificate
