@@ -45,6 +45,9 @@ pub struct Row {
     pub unconverged: u64,
     pub failed: u64,
     pub energy_gain: u64,
+    /// Rolls whose die's centre went under the floor's top face at a step (not failures).
+    #[serde(default)]
+    pub dipped: u64,
     pub reference: bool,
 }
 
@@ -181,6 +184,7 @@ fn roll_method(
         unconverged: res.tally.unconverged,
         failed: res.tally.failed_total(),
         energy_gain: res.tally.energy_gain,
+        dipped: res.tally.dipped,
         reference: reference.is_none(),
     })
 }
@@ -268,14 +272,14 @@ pub fn run(cfg: &Config, log: &dyn Fn(&str)) -> Result<Tradeoff, String> {
 
 pub fn header() -> String {
     format!(
-        "{:<38} {:>17} {:>12} {:>8} {:>18} {:>6} {:>6}",
-        "method", "ratio", "CPU s/1000", "steps", "error", "σ", "failed"
+        "{:<38} {:>17} {:>12} {:>8} {:>18} {:>6} {:>6} {:>6}",
+        "method", "ratio", "CPU s/1000", "steps", "error", "σ", "failed", "dipped"
     )
 }
 
 pub fn format_row(r: &Row) -> String {
     format!(
-        "{:<38} {:>8.4} ± {:.4} {:>12.3} {:>8.0} {:>+7.1} ± {:>4.1} % {:>+6.1} {:>6}",
+        "{:<38} {:>8.4} ± {:.4} {:>12.3} {:>8.0} {:>+7.1} ± {:>4.1} % {:>+6.1} {:>6} {:>6}",
         r.method,
         r.ratio,
         r.ratio_err,
@@ -284,6 +288,7 @@ pub fn format_row(r: &Row) -> String {
         100.0 * r.error,
         100.0 * r.error_err,
         r.error_sigma,
-        r.failed + r.unconverged
+        r.failed + r.unconverged,
+        r.dipped
     )
 }
