@@ -152,8 +152,9 @@ pub fn check(s: &BodyState, die: &DieShape, dip: &Dip, floor_bottom: f64) -> Opt
 /// Bullet's split impulse takes a fifth of the penetration a step while gravity pulls the die
 /// back by g·dt² (1.1 cm a step at 1/30 s), so a thin block landing flat at a coarse step can
 /// sit with its centre under the top face for a while and still come out. Measured (README,
-/// "Failures"): the longest dip that recovered was 13 steps at dt = 1/60 and 39 at 1/30
-/// (Bullet, e = 0, 140x30x10); Rapier's, 8. One that did not lasted 19,912 steps, to the cap.
+/// "Coarse time steps"): the longest dip that recovered was 19 steps at dt = 1/60 and 39 at 1/30
+/// (Bullet, e = 0, 140x30x10), 74 in a 5 m/s drop at dt = 0.1; Rapier's, 8. One that did not
+/// lasted 19,912 steps, to the cap.
 /// A die that stays under longer than this is held inside the floor or falling beneath it.
 pub const MAX_DIP_STEPS: u64 = 100;
 
@@ -201,7 +202,7 @@ impl Dip {
     ///
     /// Wholly below the *top* face is not enough: at dt = 1/60 a thin block landing flat
     /// falls 4-5 cm in one step, ends it entirely inside DicePhys's box floor, and Bullet
-    /// pushes it back out (8,947 of 20,000 rolls of 140x27x13 in 2D; README, "Failures").
+    /// pushes it back out (8,947 of 20,000 rolls of 140x27x13 in 2D; README, "Coarse time steps").
     /// A die at rest with its centre below the top face is a failure too (`run_from`).
     pub fn through(&self, die: &DieShape, s: &BodyState, floor_bottom: f64) -> bool {
         let reach = s.position.y - crate::settle::lowest_point(&die.half, s);
