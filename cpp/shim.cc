@@ -43,8 +43,10 @@ BulletWorld::BulletWorld(const BulletScene& s)
   if (s.plane_floor) {
     floor_shape_ = std::make_unique<btStaticPlaneShape>(btVector3(0, 1, 0), 0);
   } else {
-    floor_shape_ = std::make_unique<btBoxShape>(btVector3(5000., 50., 5000.));
-    floor_at.setOrigin(btVector3(0, -50, 0));
+    // 10 km square; 100 m thick as DicePhys's, or as thin as a table top.
+    const double half = 0.5 * s.floor_thickness;
+    floor_shape_ = std::make_unique<btBoxShape>(btVector3(5000., half, 5000.));
+    floor_at.setOrigin(btVector3(0, -half, 0));
   }
   btRigidBody::btRigidBodyConstructionInfo floor_info(0.0, nullptr, floor_shape_.get());
   floor_info.m_startWorldTransform = floor_at;

@@ -10,7 +10,7 @@ use dicephys::model::scene::{Floor, Mode, Preset, Scene};
 use dicephys::model::throws::{Range, ThrowKind, ThrowRanges};
 use dicephys::run::runner::MAX_THREADS;
 use dicephys::run::spec::{Shard, ThrowSpec};
-use dicephys::sim::roll::{RollConfig, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
+use dicephys::sim::roll::{early_stop_exact, RollConfig, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
 
 /// The scene: the block, the surface, the time step.
 #[derive(Args, Debug, Clone)]
@@ -42,6 +42,10 @@ pub struct SceneArgs {
     /// The floor: box (DicePhys's 10 km static box) or plane.
     #[arg(long, default_value = "box", value_parser = parse_floor)]
     pub floor: Floor,
+    /// The box floor's thickness, m (DicePhys's: 100). A table top (0.02) is thin enough for
+    /// a die to pass through at a coarse step: a real tunnel, counted as failed.
+    #[arg(long, value_name = "M", allow_hyphen_values = true)]
+    pub floor_thickness: Option<f64>,
 }
 
 /// Where the throws come from.
@@ -95,9 +99,10 @@ pub struct RunArgs {
     #[arg(long, default_value_t = DEFAULT_MAX_STEPS)]
     pub max_steps: u64,
     /// What ends a roll: certificate (the exact early stop: energy below the barrier out of
-    /// the current face; the default) or dicephys (at rest by DicePhys's rule).
-    #[arg(long, value_enum, default_value = "certificate")]
-    pub settle: SettleArg,
+    /// the current face) or dicephys (at rest by DicePhys's rule). Default: certificate at
+    /// dt <= 1/250 s, where it is audited exact; dicephys at coarser steps.
+    #[arg(long, value_enum)]
+    pub settle: Option<SettleArg>,
     /// The certificate's reserve, a fraction of the barrier in [0, 1).
     #[arg(long, default_value_t = DEFAULT_MARGIN)]
     pub margin: f64,
@@ -158,6 +163,14 @@ impl SceneArgs {
         scene.density = self.density;
         scene.preset = self.preset;
         scene.floor = self.floor;
+        if let Some(t) = self.floor_thickness {
+            if self.floor == Floor::Plane {
+                return Err(Error::Usage(
+                    "--floor-thickness: the plane floor is a half-space; use --floor box".into(),
+                ));
+            }
+            scene.floor_thickness = t;
+        }
         scene.validate(self.allow_restitution_above_one)?;
         Ok(scene)
     }
@@ -181,12 +194,18 @@ impl ThrowArgs {
 }
 
 impl RunArgs {
-    /// How each roll is carried out and ended, checked.
-    pub fn roll(&self) -> Result<RollConfig> {
+    /// How each roll is carried out and ended, checked, for a scene with time step `dt`: the
+    /// early stop by default only where it is exact (`roll::EARLY_STOP_MAX_DT`).
+    pub fn roll(&self, dt: f64) -> Result<RollConfig> {
         // An audit compares the certificate with the full settle, so it settles fully.
-        let rule = match self.settle {
-            SettleArg::Certificate if !self.faithful && !self.audit => Rule::Certificate,
-            _ => Rule::Dicephys,
+        let certificate = match self.settle {
+            Some(s) => s == SettleArg::Certificate,
+            None => early_stop_exact(dt),
+        };
+        let rule = if certificate && !self.faithful && !self.audit {
+            Rule::Certificate
+        } else {
+            Rule::Dicephys
         };
         let cfg = RollConfig {
             max_steps: self.max_steps,

@@ -64,11 +64,12 @@ pub fn run(a: &CrosscheckArgs) -> Result<()> {
             "--engines: name at least two engines to compare".into(),
         ));
     }
+    let scene = a.scene.scene()?;
     let base = RunSpec {
         engine: a.engines[0],
-        scene: a.scene.scene()?,
+        roll: a.run.roll(scene.dt)?,
+        scene,
         throws: a.throw.spec()?,
-        roll: a.run.roll()?,
         rolls: a.run.rolls,
         shard: None,
     };

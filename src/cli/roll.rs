@@ -77,11 +77,12 @@ impl RollArgs {
             return Checkpoint::spec_in(dir)
                 .map_err(|e| Error::Usage(format!("--resume {}: {e}", dir.display())));
         }
+        let scene = self.scene.scene()?;
         let spec = RunSpec {
             engine: self.engine,
-            scene: self.scene.scene()?,
+            roll: self.run.roll(scene.dt)?,
+            scene,
             throws: self.throw.spec()?,
-            roll: self.run.roll()?,
             rolls: self.run.rolls,
             shard: self.shard,
         };

@@ -20,6 +20,8 @@ mod ffi {
         floor_restitution: f64,
         /// A static plane instead of DicePhys's 10 km box.
         plane_floor: bool,
+        /// The box floor's thickness, m (DicePhys: 100).
+        floor_thickness: f64,
         gravity: f64,
         dt: f64,
         /// Bullet 2.83+'s per-body implicit gyroscopic force (2.81: off).
@@ -114,6 +116,7 @@ impl Bullet {
             floor_friction: scene.floor_friction,
             floor_restitution: scene.floor_restitution,
             plane_floor: scene.floor == Floor::Plane,
+            floor_thickness: scene.floor_thickness,
             gravity: scene.gravity,
             dt: scene.dt,
             gyroscopic_implicit: s.gyroscopic_implicit,

@@ -39,9 +39,8 @@ impl Rapier2d {
 
         // Friction and restitution multiply, as in Bullet (see rapier3d.rs).
         let floor = match scene.floor {
-            Floor::Box => {
-                ColliderBuilder::cuboid(5000.0, 50.0).translation(Vector::new(0.0, -50.0))
-            }
+            Floor::Box => ColliderBuilder::cuboid(5000.0, 0.5 * scene.floor_thickness)
+                .translation(Vector::new(0.0, -0.5 * scene.floor_thickness)),
             Floor::Plane => ColliderBuilder::new(SharedShape::halfspace(Vector::Y)),
         };
         world.insert_collider(

@@ -44,8 +44,9 @@ impl Rapier3d {
         // contact's μ and e are the die's. Both colliders say Multiply, so no rule outranks it.
         let floor = match scene.floor {
             // DicePhys's static 10000 x 100 x 10000 m box, top face at y = 0.
-            Floor::Box => ColliderBuilder::cuboid(5000.0, 50.0, 5000.0)
-                .translation(Vector::new(0.0, -50.0, 0.0)),
+            // (`--floor-thickness` makes it thinner.)
+            Floor::Box => ColliderBuilder::cuboid(5000.0, 0.5 * scene.floor_thickness, 5000.0)
+                .translation(Vector::new(0.0, -0.5 * scene.floor_thickness, 0.0)),
             Floor::Plane => ColliderBuilder::new(SharedShape::halfspace(Vector::Y)),
         };
         world.insert_collider(

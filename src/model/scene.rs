@@ -127,9 +127,15 @@ pub struct Scene {
     pub preset: Preset,
     /// Box or plane.
     pub floor: Floor,
+    /// The box floor's thickness, m: DicePhys's is 100 m (`DICEPHYS_FLOOR_THICKNESS`), which
+    /// nothing gets through; a table top (2 cm) lets a die at a coarse step pass through it.
+    pub floor_thickness: f64,
     /// m/s², along −y.
     pub gravity: f64,
 }
+
+/// DicePhys's floor box is 100 m thick, its top face at y = 0.
+pub const DICEPHYS_FLOOR_THICKNESS: f64 = 100.0;
 
 impl Scene {
     /// Checks every value before anything runs. A restitution above 1 is not physics; it is
@@ -156,6 +162,14 @@ impl Scene {
                 self.restitution
             ));
         }
+        if !(self.floor_thickness.is_finite()
+            && (0.001..=DICEPHYS_FLOOR_THICKNESS).contains(&self.floor_thickness))
+        {
+            return bad(format!(
+                "--floor-thickness {}: must be in [0.001, 100] m",
+                self.floor_thickness
+            ));
+        }
         if !(self.density.is_finite() && self.density > 0.0 && self.density <= 1e5) {
             return bad(format!(
                 "--density {}: must be in (0, 100000] kg/m³",
@@ -178,6 +192,7 @@ impl Scene {
             dt: 0.001,
             preset: Preset::Dicephys281,
             floor: Floor::Box,
+            floor_thickness: DICEPHYS_FLOOR_THICKNESS,
             gravity: GRAVITY,
         }
     }
@@ -198,6 +213,15 @@ impl Scene {
         match self.mode {
             Mode::ThreeD => b.breadth * b.width * b.length * self.density,
             Mode::TwoD => b.breadth * b.width * self.density,
+        }
+    }
+
+    /// Height of the floor's bottom face: the die is through the floor once wholly below it
+    /// (−∞ for the plane, which is a half-space).
+    pub fn floor_bottom(&self) -> f64 {
+        match self.floor {
+            Floor::Box => -self.floor_thickness,
+            Floor::Plane => f64::NEG_INFINITY,
         }
     }
 

@@ -23,6 +23,15 @@ struct Row<'a> {
     steps: u64,
     #[serde(serialize_with = "shortest")]
     sim_time_s: f64,
+    /// The energy-gain flag, 0 or 1.
+    energy_gain: u8,
+    /// Steps at whose end the die's centre was below the floor's top face.
+    dip_steps: u64,
+    /// The longest run of such steps.
+    longest_dip_steps: u64,
+    /// The deepest any point of the die went below that face, m (`roll::Dip`).
+    #[serde(serialize_with = "shortest")]
+    penetration_m: f64,
 }
 
 /// A float as Rust writes it (`{:?}`: the shortest text that reads back to the same double,
@@ -33,7 +42,7 @@ fn shortest<S: serde::Serializer>(v: &f64, s: S) -> std::result::Result<S::Ok, S
 }
 
 /// The columns, as the header names them.
-pub const COLUMNS: [&str; 8] = [
+pub const COLUMNS: [&str; 12] = [
     "index",
     "drop_height_m",
     "velocity_m_s",
@@ -42,6 +51,10 @@ pub const COLUMNS: [&str; 8] = [
     "outcome",
     "steps",
     "sim_time_s",
+    "energy_gain",
+    "dip_steps",
+    "longest_dip_steps",
+    "penetration_m",
 ];
 
 /// A per-roll CSV being written.
@@ -83,6 +96,10 @@ impl<W: Write> PerRoll<W> {
                     outcome,
                     steps: r.steps,
                     sim_time_s: r.sim_time(self.dt),
+                    energy_gain: r.energy_gain as u8,
+                    dip_steps: r.dip.steps,
+                    longest_dip_steps: r.dip.longest,
+                    penetration_m: r.dip.penetration,
                 })
                 .map_err(failed)?;
         }

@@ -73,6 +73,17 @@ pub struct RunSummary {
     /// The energy-gain flag's tolerance, a fraction of the starting energy.
     #[serde(default)]
     pub energy_gain_tolerance: f64,
+    /// Rolls whose die's centre went below the floor's top face at some step, whatever their
+    /// fate: a flag, not a failure (`roll::Dip`).
+    #[serde(default)]
+    pub dipped: u64,
+    /// The deepest any point of a die went below the floor's top face, over all rolls, m.
+    #[serde(default)]
+    pub deepest_dip_m: f64,
+    /// A centre below the top face for more steps in a row than this is a die through the
+    /// floor (`roll::MAX_DIP_STEPS`).
+    #[serde(default)]
+    pub max_dip_steps: u64,
     /// N(breadth vertical) / N(width vertical), the paper's ratio.
     pub ratio: f64,
     /// The paper's binomial error of the ratio.
@@ -163,6 +174,9 @@ impl RunSummary {
             failed_total: tally.failed_total(),
             energy_gain: tally.energy_gain,
             energy_gain_tolerance: crate::sim::roll::ENERGY_GAIN_TOLERANCE,
+            dipped: tally.dipped,
+            deepest_dip_m: tally.deepest_dip_m(),
+            max_dip_steps: crate::sim::roll::MAX_DIP_STEPS,
             ratio,
             ratio_err,
             theory_ratio,
@@ -242,6 +256,11 @@ impl RunSummary {
             },
             self.energy_gain,
             100.0 * self.energy_gain_tolerance
+        );
+        s += &format!(
+            "  dipped {} (centre below the floor's top face at a step; not a failure)   deepest {:.1} mm into the floor\n",
+            self.dipped,
+            1000.0 * self.deepest_dip_m
         );
         s += &format!(
             "  steps/roll {:.0} ({:.0} by the engine)   wall {:.2} s   CPU {:.2} s ({:.3} ms/roll, {} threads)   {}\n",

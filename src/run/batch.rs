@@ -139,6 +139,7 @@ fn roll_one(
         engine_steps: 0,
         certified: None,
         energy_gain: false,
+        dip: Default::default(),
     };
     let Some(w) = world.as_mut() else {
         return failed;

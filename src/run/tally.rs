@@ -35,6 +35,14 @@ pub struct Tally {
     /// fate.
     #[serde(default)]
     pub energy_gain: u64,
+    /// Rolls whose die's centre went below the floor's top face at some step (`roll::Dip`),
+    /// whatever their fate. A flag, like the energy gain.
+    #[serde(default)]
+    pub dipped: u64,
+    /// The deepest any point of a die went below the floor's top face, over all rolls, in
+    /// nanometres, rounded up (an integer, so that tallies merge exactly, by the maximum).
+    #[serde(default)]
+    pub deepest_dip_nm: u64,
 }
 
 /// Settled rolls by the side standing vertical.
@@ -69,6 +77,8 @@ impl Tally {
         self.steps += r.steps;
         self.engine_steps += r.engine_steps;
         self.energy_gain += r.energy_gain as u64;
+        self.dipped += r.dip.dipped() as u64;
+        self.deepest_dip_nm = self.deepest_dip_nm.max(nanometres(r.dip.penetration));
         if let Some((step, o)) = r.certified {
             self.certified += 1;
             self.certified_steps += step;
@@ -98,7 +108,8 @@ impl Tally {
         let fine = ended == Some(self.rolls)
             && self.certified <= self.rolls
             && self.certified_wrong + self.certified_unknown <= self.certified
-            && self.energy_gain <= self.rolls;
+            && self.energy_gain <= self.rolls
+            && self.dipped <= self.rolls;
         if fine {
             Ok(())
         } else {
@@ -137,6 +148,13 @@ impl Tally {
         self.certified_unknown += o.certified_unknown;
         self.certified_steps += o.certified_steps;
         self.energy_gain += o.energy_gain;
+        self.dipped += o.dipped;
+        self.deepest_dip_nm = self.deepest_dip_nm.max(o.deepest_dip_nm);
+    }
+
+    /// `deepest_dip_nm` in metres.
+    pub fn deepest_dip_m(&self) -> f64 {
+        self.deepest_dip_nm as f64 * 1e-9
     }
 
     /// The tally of these records.
@@ -146,6 +164,16 @@ impl Tally {
             t.add(r);
         }
         t
+    }
+}
+
+/// A depth in whole nanometres, rounded up (0 for none; a NaN never reaches here, as a
+/// non-finite state fails the roll before its depth is recorded).
+fn nanometres(m: f64) -> u64 {
+    if m > 0.0 {
+        (m * 1e9).ceil().min(u64::MAX as f64) as u64
+    } else {
+        0
     }
 }
 

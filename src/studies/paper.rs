@@ -13,7 +13,7 @@ use crate::report::table::{table_report, TableReport};
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::runner::{Checkpoint, Runner};
 use crate::run::spec::{RunSpec, ThrowSpec};
-use crate::sim::roll::RollConfig;
+use crate::sim::roll::{early_stop_exact, RollConfig, Rule};
 use crate::theory::stats;
 use serde::Serialize;
 use std::path::Path;
@@ -72,13 +72,22 @@ impl PaperConfig {
     }
 
     /// How each roll is carried out and ended.
+    /// The early stop only where it is audited exact (`roll::EARLY_STOP_MAX_DT`).
     pub fn roll(&self) -> RollConfig {
+        let fast = RollConfig {
+            rule: if early_stop_exact(self.dt) {
+                Rule::Certificate
+            } else {
+                Rule::Dicephys
+            },
+            ..RollConfig::fast()
+        };
         RollConfig {
             max_steps: self.max_steps,
             ..if self.faithful {
                 RollConfig::faithful()
             } else {
-                RollConfig::fast()
+                fast
             }
         }
     }

@@ -2,8 +2,11 @@
 //! e = 0.5, dt = 1 ms) one grid over the two most telling axes, dt × restitution, and two
 //! lines, friction and the block's aspect ratio, per engine, 2D and 3D. Per cell the fractions
 //! of rolls that end unconverged at the step cap, unknown (resting on an edge), failed
-//! non-finite, tunnelled through the floor, and that gained energy (`roll::EnergyWatch`).
-//! Rolls end by DicePhys's rule, every step stepped, capped at `max_steps`.
+//! non-finite, tunnelled through the floor (`roll::Dip::through`), and, as flags, that gained
+//! energy (`roll::EnergyWatch`) or dipped into the floor and came back (`roll::Dip`). Rolls
+//! end by DicePhys's rule, every step stepped, capped at `max_steps`. Each fraction carries
+//! its binomial standard error (`Cell::err`); the default rolls per cell make a 0 mean below
+//! 1 % at 95 %.
 
 use super::sweep::{cell_spec, measure, Study};
 use crate::engine::EngineKind;
@@ -32,15 +35,19 @@ pub struct Config {
     pub seed: u64,
     /// The step cap per roll.
     pub max_steps: u64,
+    /// The box floor's thickness, m: DicePhys's 100 m, or a table top (2 cm) that a die can
+    /// really pass through.
+    pub floor_thickness: f64,
 }
 
 /// The failure kinds, in the order of the figures and tables.
-pub const KINDS: [&str; 5] = [
+pub const KINDS: [&str; 6] = [
     "unconverged",
     "unknown",
     "non_finite",
     "tunnelled",
     "energy_gain",
+    "dipped",
 ];
 
 /// Which sweep a cell belongs to.
@@ -91,6 +98,15 @@ pub struct Cell {
     pub engine_error: f64,
     /// Fraction of rolls in which the engine injected energy.
     pub energy_gain: f64,
+    /// Rolls whose centre went under the floor's top face at a step (a flag, not a failure).
+    #[serde(default)]
+    pub dipped: f64,
+    /// The largest binomial standard error of this cell's fractions, √(f(1−f)/rolls).
+    #[serde(default)]
+    pub fraction_err_max: f64,
+    /// A fraction measured as 0 is below this at 95 % confidence: 1 − 0.05^(1/rolls).
+    #[serde(default)]
+    pub zero_below_95: f64,
     /// N(breadth vertical)/N(width vertical).
     pub ratio: f64,
     /// Its binomial error.
@@ -108,9 +124,25 @@ impl Cell {
             "non_finite" => self.non_finite,
             "tunnelled" => self.tunnelled,
             "energy_gain" => self.energy_gain,
+            "dipped" => self.dipped,
             _ => f64::NAN,
         }
     }
+
+    /// The binomial standard error of a fraction `f` of this cell's rolls.
+    pub fn err(&self, f: f64) -> f64 {
+        fraction_err(f, self.rolls)
+    }
+}
+
+/// √(f(1−f)/n): the standard error of a fraction of n rolls.
+pub fn fraction_err(f: f64, n: u64) -> f64 {
+    (f * (1.0 - f) / n.max(1) as f64).sqrt()
+}
+
+/// The 95 % upper bound of a fraction seen 0 times in n rolls: 1 − 0.05^(1/n) (≈ 3/n).
+pub fn zero_below_95(n: u64) -> f64 {
+    1.0 - 0.05f64.powf(1.0 / n.max(1) as f64)
 }
 
 /// The stability sweeps' results.
@@ -124,6 +156,13 @@ pub struct Stability {
     pub max_steps: u64,
     /// The energy gain flagged, a fraction of the starting energy (`ENERGY_GAIN_TOLERANCE`).
     pub energy_gain_tolerance: f64,
+    /// The box floor's thickness, m (DicePhys's: 100).
+    pub floor_thickness: f64,
+    /// Per cell: a fraction's standard error is at most 0.5/√rolls; a 0 is below
+    /// `zero_below_95` at 95 %.
+    pub fraction_err_max: f64,
+    /// A fraction measured as 0 is below this at 95 % confidence.
+    pub zero_below_95: f64,
     /// The grid's time steps, s.
     pub dts: Vec<f64>,
     /// The grid's restitutions.
@@ -166,6 +205,8 @@ fn cell(
         scene.restitution,
         scene.friction,
     );
+    let mut scene = scene;
+    scene.floor_thickness = cfg.floor_thickness;
     let settle = RollConfig {
         max_steps: cfg.max_steps,
         rule: Rule::Dicephys,
@@ -178,7 +219,7 @@ fn cell(
     )?;
     let r = m.ratio();
     let t = &m.tally;
-    Ok(Cell {
+    let mut c = Cell {
         sweep,
         engine,
         mode,
@@ -195,10 +236,15 @@ fn cell(
         tunnelled: m.frac(t.failed_of(Failure::Tunnelled)),
         engine_error: m.frac(t.failed_of(Failure::Engine)),
         energy_gain: m.frac(t.energy_gain),
+        dipped: m.frac(t.dipped),
+        fraction_err_max: 0.0,
+        zero_below_95: zero_below_95(t.rolls),
         ratio: r.value,
         ratio_err: r.err,
         steps_per_roll: m.steps_per_roll(),
-    })
+    };
+    c.fraction_err_max = KINDS.iter().map(|k| c.err(c.kind(k))).fold(0.0, f64::max);
+    Ok(c)
 }
 
 /// Measures every cell, logging each as it is measured.
@@ -233,6 +279,9 @@ pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Stability>
         seed: cfg.seed,
         max_steps: cfg.max_steps,
         energy_gain_tolerance: crate::sim::roll::ENERGY_GAIN_TOLERANCE,
+        floor_thickness: cfg.floor_thickness,
+        fraction_err_max: 0.5 / (cfg.rolls.max(1) as f64).sqrt(),
+        zero_below_95: zero_below_95(cfg.rolls),
         dts: cfg.dts.clone(),
         restitutions: cfg.restitutions.clone(),
         frictions: cfg.frictions.clone(),
@@ -270,10 +319,11 @@ fn findings(cells: &[Cell]) -> Vec<String> {
                         names.push("…".into());
                     }
                     format!(
-                        "{k}: in {} of {} cells, worst {:.0} % ({}); cells: {}.",
+                        "{k}: in {} of {} cells, worst {:.1} ± {:.1} % ({}); cells: {}.",
                         hit.len(),
                         cells.len(),
                         100.0 * w.kind(k),
+                        100.0 * w.err(w.kind(k)),
                         describe(w),
                         names.join("; ")
                     )
@@ -290,7 +340,7 @@ pub fn header() -> String {
 
 /// One cell as a line of the log, under `header`.
 pub fn format_cell(c: &Cell) -> String {
-    let pc = |v: f64| format!("{:.0}%", 100.0 * v);
+    let pc = |v: f64| format!("{:.1}%", 100.0 * v);
     TABLE.row(&[
         c.sweep.to_string(),
         c.engine.to_string(),
@@ -304,6 +354,8 @@ pub fn format_cell(c: &Cell) -> String {
         pc(c.non_finite),
         pc(c.tunnelled),
         pc(c.energy_gain),
+        pc(c.dipped),
+        pc(c.fraction_err_max),
         format!("{:.0}", c.steps_per_roll),
     ])
 }
@@ -322,5 +374,7 @@ const TABLE: Columns = Columns(&[
     right("nonfin", 7),
     right("tunnel", 7),
     right("gain", 7),
+    right("dipped", 7),
+    right("±max", 6),
     right("steps", 7),
 ]);

@@ -5,6 +5,7 @@ mod helpers;
 
 mod bullet;
 mod cli;
+mod coarse;
 mod fuzz;
 mod rapier;
 mod redteam;
