@@ -81,7 +81,7 @@ fn an_output_that_is_a_directory_is_refused_before_anything_runs() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert_eq!(stderr(&out).trim_end().lines().count(), 1);
     assert!(out.stdout.is_empty(), "it ran before refusing");
-    no_temp_files(d.parent().unwrap_or(Path::new("/tmp")));
+    no_temp_files(&d);
 }
 
 // 2. merge reads its own output.
