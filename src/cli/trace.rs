@@ -1,6 +1,6 @@
 //! `dicephys trace`: one throw's trajectory as CSV, for looking at a single roll.
 
-use super::args::{parse_engine, SceneArgs, ThrowArgs};
+use super::args::{parse_engine, FlightArg, SceneArgs, ThrowArgs};
 use super::error::{Error, Result};
 use clap::Args;
 use dicephys::engine::{new_engine, EngineKind};
@@ -31,8 +31,8 @@ pub struct TraceArgs {
     /// Free flight: stepped (every step by the engine) or fast (integrated in closed form where
     /// the engine's flight is ballistic, as `roll` does by default; the flown steps are printed
     /// too).
-    #[arg(long, default_value = "stepped", value_parser = ["stepped", "fast"])]
-    pub flight: String,
+    #[arg(long, value_enum, default_value = "stepped")]
+    pub flight: FlightArg,
 }
 
 pub fn run(a: &TraceArgs) -> Result<()> {
@@ -89,7 +89,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     };
     let settle = RollConfig {
         max_steps: a.max_steps,
-        fast_flight: a.flight == "fast",
+        fast_flight: a.flight == FlightArg::Fast,
         ..RollConfig::default()
     };
     let record = roll_observed(engine.as_mut(), &scene, &throw, &settle, |step, s| {

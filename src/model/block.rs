@@ -131,8 +131,22 @@ fn fmt_mm(v: f64) -> String {
 }
 
 /// The side of the block that stands vertical when it comes to rest.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, PartialOrd, Ord)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    Hash,
+    Serialize,
+    Deserialize,
+    PartialOrd,
+    Ord,
+    strum::Display,
+    strum::IntoStaticStr,
+)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
 pub enum Outcome {
     /// The breadth stands upright: the block lies on a length × width face.
     Breadth,
@@ -155,12 +169,7 @@ impl Outcome {
 
     /// The outcome's name in reports: "breadth", "width", "length" or "unknown".
     pub fn name(self) -> &'static str {
-        match self {
-            Outcome::Breadth => "breadth",
-            Outcome::Width => "width",
-            Outcome::Length => "length",
-            Outcome::Unknown => "unknown",
-        }
+        self.into()
     }
 }
 

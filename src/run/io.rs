@@ -46,11 +46,11 @@ impl Output {
         match std::fs::metadata(&target) {
             Ok(m) if m.is_dir() => return Err(bad("is a directory".into())),
             Ok(m) if !m.is_file() => {
-                // A device or a FIFO: it must open for writing.
-                std::fs::OpenOptions::new()
-                    .write(true)
-                    .open(&target)
-                    .map_err(|e| bad(format!("cannot write there ({e})")))?;
+                // A device or a FIFO: it must be writable. Not opened to find out: opening a
+                // FIFO waits for its reader, and closing it again ends the reader's input.
+                if !writable(&target) {
+                    return Err(bad("cannot write there (permission denied)".into()));
+                }
                 return Ok(Output {
                     path: path.to_path_buf(),
                     target,
@@ -172,6 +172,16 @@ fn sync_dir(dir: &Path) {
     if let Ok(d) = File::open(dir) {
         let _ = d.sync_all();
     }
+}
+
+/// access(2) with W_OK: may this process write to `path`?
+fn writable(path: &Path) -> bool {
+    use std::os::unix::ffi::OsStrExt;
+    let Ok(c) = std::ffi::CString::new(path.as_os_str().as_bytes()) else {
+        return false;
+    };
+    // SAFETY: `c` is a valid NUL-terminated path that outlives the call.
+    unsafe { libc::access(c.as_ptr(), libc::W_OK) == 0 }
 }
 
 fn parent(path: &Path) -> &Path {

@@ -99,7 +99,7 @@ impl fmt::Display for PrintedNumber {
 }
 
 /// The block's material.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, strum::EnumString, strum::IntoStaticStr)]
 #[serde(rename_all = "snake_case")]
 pub enum Material {
     /// Pine.
@@ -109,24 +109,40 @@ pub enum Material {
 }
 
 /// The surface the block was thrown onto.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, strum::EnumString, strum::IntoStaticStr)]
 #[serde(rename_all = "snake_case")]
 pub enum Surface {
     /// Carpet (pine blocks).
     Carpet,
     /// A thin towel (pine blocks).
+    #[strum(serialize = "Thin Towel")]
     ThinTowel,
     /// A towel on a rug (pine blocks).
+    #[strum(serialize = "Towel+Rug")]
     TowelRug,
     /// Medium-density fibreboard (printed blocks; the surface the paper simulated).
+    #[strum(serialize = "MDF")]
     Mdf,
     /// Tough carpet (printed blocks).
+    #[strum(serialize = "Tough Carpet")]
     ToughCarpet,
 }
 
 /// The paper's three data sets, by colour in its table and figure (MasterGraph2).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, PartialOrd, Ord)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    Serialize,
+    PartialOrd,
+    Ord,
+    strum::EnumString,
+    strum::IntoStaticStr,
+)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
 pub enum Set {
     /// RawSienna: pine blocks on carpet and towelling.
     Pine,
@@ -137,45 +153,16 @@ pub enum Set {
 }
 
 impl Material {
-    fn parse(s: &str) -> Option<Material> {
-        match s {
-            "Pine" => Some(Material::Pine),
-            "Printed" => Some(Material::Printed),
-            _ => None,
-        }
-    }
-
     /// The name the paper prints.
     pub fn name(self) -> &'static str {
-        match self {
-            Material::Pine => "Pine",
-            Material::Printed => "Printed",
-        }
+        self.into()
     }
 }
 
 impl Surface {
-    fn parse(s: &str) -> Option<Surface> {
-        [
-            Surface::Carpet,
-            Surface::ThinTowel,
-            Surface::TowelRug,
-            Surface::Mdf,
-            Surface::ToughCarpet,
-        ]
-        .into_iter()
-        .find(|v| v.name() == s)
-    }
-
     /// The name the paper prints.
     pub fn name(self) -> &'static str {
-        match self {
-            Surface::Carpet => "Carpet",
-            Surface::ThinTowel => "Thin Towel",
-            Surface::TowelRug => "Towel+Rug",
-            Surface::Mdf => "MDF",
-            Surface::ToughCarpet => "Tough Carpet",
-        }
+        self.into()
     }
 }
 
@@ -183,17 +170,9 @@ impl Set {
     /// Every set, in the paper's order.
     pub const ALL: [Set; 3] = [Set::Pine, Set::Mdf, Set::Carpet];
 
-    fn parse(s: &str) -> Option<Set> {
-        Set::ALL.into_iter().find(|v| v.name() == s)
-    }
-
     /// The set's name in the CSV: "pine", "mdf" or "carpet".
     pub fn name(self) -> &'static str {
-        match self {
-            Set::Pine => "pine",
-            Set::Mdf => "mdf",
-            Set::Carpet => "carpet",
-        }
+        self.into()
     }
 }
 
@@ -415,15 +394,21 @@ pub fn parse(text: &str) -> Result<PaperTable> {
             r_err: num("r_err", &rec.r_err)?,
             predicted_ratio: num("predicted_ratio", &rec.predicted_ratio)?,
             predicted_ratio_err: num("predicted_ratio_err", &rec.predicted_ratio_err)?,
-            block: Material::parse(&rec.block)
+            block: rec
+                .block
+                .parse::<Material>()
+                .ok()
                 .ok_or_else(|| bad(ln, format!("block '{}' is not Pine/Printed", rec.block)))?,
-            surface: Surface::parse(&rec.surface).ok_or_else(|| {
+            surface: rec.surface.parse::<Surface>().ok().ok_or_else(|| {
                 bad(
                     ln,
                     format!("surface '{}' is not one of the paper's", rec.surface),
                 )
             })?,
-            set: Set::parse(&rec.set)
+            set: rec
+                .set
+                .parse::<Set>()
+                .ok()
                 .ok_or_else(|| bad(ln, format!("set '{}' is not pine/mdf/carpet", rec.set)))?,
             extra_length: rec.extra_length,
             throws: rec.throws,

@@ -68,6 +68,15 @@ fn per_roll_onto_a_fifo_streams_into_it_and_leaves_it_a_fifo() {
         std::thread::spawn(move || std::fs::read_to_string(fifo).unwrap())
     };
     let out = roll(&["--rolls", "20", "--per-roll", fifo.to_str().unwrap()]);
+    // Should dicephys never have opened the FIFO, its reader would wait for ever: open and
+    // close it once without blocking, which ends a waiting reader and does nothing otherwise.
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        let _ = std::fs::OpenOptions::new()
+            .write(true)
+            .custom_flags(libc::O_NONBLOCK)
+            .open(&fifo);
+    }
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(reader.join().unwrap().lines().count(), 21);
     use std::os::unix::fs::FileTypeExt;
