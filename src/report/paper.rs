@@ -331,7 +331,7 @@ pub fn results_csv(res: &PaperResults) -> Result<String> {
 
 /// The paper's figures, drawn from the results; returns their names (each has .svg and .png).
 pub fn write_figures(dir: &std::path::Path, res: &PaperResults) -> Result<Vec<&'static str>> {
-    use crate::report::figures::{self, Point, SimSeries};
+    use crate::report::figures::{paper as figures, Point, SimSeries};
     let mut sims = Vec::new();
     for engine in &res.provenance.engines_short {
         for (mode, name) in [("2d", "2D"), ("3d", "3D")] {
