@@ -263,13 +263,14 @@ impl RunSummary {
             1000.0 * self.deepest_dip_m
         );
         s += &format!(
-            "  steps/roll {:.0} ({:.0} by the engine)   wall {:.2} s   CPU {:.2} s ({:.3} ms/roll, {} threads)   {}\n",
+            "  steps/roll {:.0} ({:.0} by the engine)   wall {:.2} s   CPU {:.2} s ({:.3} ms/roll, {} thread{})   {}\n",
             self.steps_mean,
             self.engine_steps_mean,
             self.wall_s,
             self.cpu_s,
             self.cpu_ms_per_roll,
             self.threads,
+            if self.threads == 1 { "" } else { "s" },
             self.engine_version
         );
         if let Some(a) = &self.audit {
