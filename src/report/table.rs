@@ -6,6 +6,7 @@ use std::io::Write;
 
 use crate::error::Result;
 use crate::model::block::Block;
+use crate::theory::markov::MarkovChain;
 use crate::theory::paper_data::{
     self, Discrepancy, Material, PaperRow, PrintedNumber, Set, Surface,
 };
@@ -61,6 +62,21 @@ pub struct Simpson3d {
     pub p_length_vertical: f64,
 }
 
+/// The five-state Markov chain of figure (MarkovChainCompleate), with k = breadth and
+/// l = width, absorbed exactly: its P(L)/P(K) is (MasterEquM1), the same as (MasterEqu)
+/// whatever the settling rate γ in its valid range.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Markov2d {
+    /// The γ·½mg used, 1/m: half the largest valid value for this block.
+    pub gamma_half_mg: f64,
+    /// P(K): ending in K-static.
+    pub p_k: f64,
+    /// P(L): ending in L-static.
+    pub p_l: f64,
+    /// P(L)/P(K), to set beside `theory_2d.ratio`.
+    pub ratio: f64,
+}
+
 /// Everything `theory --block` reports.
 #[derive(Clone, Debug, Serialize)]
 pub struct BlockReport {
@@ -76,6 +92,9 @@ pub struct BlockReport {
     pub no_bounce_2d: NoBounce2d,
     /// The 3D Simpson model.
     pub simpson_3d: Simpson3d,
+    /// The 2D Markov chain the theory is derived from, absorbed exactly (absent if the
+    /// chain cannot be built for these sides).
+    pub markov_2d: Option<Markov2d>,
 }
 
 /// The predictions for one block, with side uncertainty `tolerance_mm` on breadth and width.
@@ -87,6 +106,19 @@ pub fn block_report(block: &Block, tolerance_mm: f64) -> BlockReport {
     let p_err = p.ratio_err / (1.0 + p.ratio).powi(2);
     let nb = theory::no_bounce_2d(p.r);
     let (simpson, _) = theory::simpson_3d(block);
+    let markov_2d = {
+        let (k, l) = (block.breadth, block.width);
+        let g = 0.5 * MarkovChain::max_gamma_half_mg(k, l);
+        MarkovChain::new(k, l, g)
+            .and_then(|c| c.absorption())
+            .ok()
+            .map(|a| Markov2d {
+                gamma_half_mg: g,
+                p_k: a.p_k,
+                p_l: a.p_l,
+                ratio: a.ratio(),
+            })
+    };
     BlockReport {
         block: SidesMm {
             length_mm,
@@ -117,6 +149,7 @@ pub fn block_report(block: &Block, tolerance_mm: f64) -> BlockReport {
             p_width_vertical: simpson.width_vertical,
             p_length_vertical: simpson.length_vertical,
         },
+        markov_2d,
     }
 }
 
@@ -145,7 +178,7 @@ pub fn write_block(out: &mut impl Write, r: &BlockReport) -> std::io::Result<()>
     let nb = &r.no_bounce_2d;
     let s = &r.simpson_3d;
     let pd = decimals(t.p_breadth_vertical).max(4);
-    let rows: Vec<(String, String)> = vec![
+    let mut rows: Vec<(String, String)> = vec![
         (
             "block (L x B x W)".into(),
             format!("{sides} mm, sides ± {} mm", r.tolerance_mm),
@@ -192,6 +225,16 @@ pub fn write_block(out: &mut impl Write, r: &BlockReport) -> std::io::Result<()>
             ),
         ),
     ];
+    if let Some(m) = &r.markov_2d {
+        rows.push((
+            "2D Markov chain (MasterEquM1)".into(),
+            format!("γ·½mg = {:.4} /m, absorbed exactly", m.gamma_half_mg),
+        ));
+        rows.push((
+            "  ratio P(L)/P(K)".into(),
+            format!("{:.*}", decimals(m.ratio).max(4), m.ratio),
+        ));
+    }
     let w = rows
         .iter()
         .map(|(k, _)| k.chars().count())

@@ -177,3 +177,18 @@ fn bad_input_is_one_line_and_exit_2() {
         assert!(o.stdout.is_empty(), "{args:?}");
     }
 }
+
+#[test]
+fn the_markov_chain_absorbs_to_the_theory_ratio() {
+    for block in ["140x24x20", "140x30x10", "100x50x49"] {
+        let v = json(&["theory", "--block", block, "--json"]);
+        let chain = num(&v, &["markov_2d", "ratio"]);
+        let theory = num(&v, &["theory_2d", "ratio", "value"]);
+        assert!(
+            (chain - theory).abs() < 1e-12,
+            "{block}: {chain} vs {theory}"
+        );
+        let p = num(&v, &["markov_2d", "p_k"]) + num(&v, &["markov_2d", "p_l"]);
+        assert!((p - 1.0).abs() < 1e-12, "{block}: P(K) + P(L) = {p}");
+    }
+}
