@@ -15,7 +15,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 /// The options that define a run: `--resume` takes them from the checkpoint instead.
-const DEFINING: [&str; 19] = [
+const DEFINING: [&str; 20] = [
+    "floor_thickness",
     "engine",
     "block",
     "two_d",
