@@ -241,8 +241,11 @@ impl Checkpoint {
 
     /// Opens `dir` for `spec`, emptying it first if it holds another run (the sweeps' cells,
     /// whose directories are named by their key and rewritten freely).
+    /// A directory without a readable `spec.json` (an older version's, or damaged) is emptied
+    /// too.
     pub fn open_fresh(dir: &Path, spec: &RunSpec) -> Result<Checkpoint> {
-        if Checkpoint::spec_in(dir).is_ok_and(|s| s != *spec) {
+        let ours = Checkpoint::spec_in(dir).is_ok_and(|s| s == *spec);
+        if !ours && dir.exists() {
             std::fs::remove_dir_all(dir).map_err(|e| Error::io(dir, e))?;
         }
         Checkpoint::open(dir, spec)
