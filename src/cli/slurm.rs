@@ -21,7 +21,7 @@ pub struct SlurmArgs {
 #[derive(Subcommand, Debug)]
 pub enum SlurmCommand {
     /// `roll` as a job array: task K of N rolls shard K/N; the finishing job merges them.
-    Roll(SlurmRollArgs),
+    Roll(Box<SlurmRollArgs>),
     /// The finishing job: check that every task's result is there, merge, write DIR/result.*.
     Finish(FinishArgs),
 }

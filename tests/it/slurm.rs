@@ -40,12 +40,9 @@ fn run_for(cmd: &mut Command, limit: Duration) -> Option<String> {
 /// Some(guard) when a cluster answers; None (with the reason printed) when the test is skipped.
 fn cluster(test: &str) -> Option<std::sync::MutexGuard<'static, ()>> {
     let guard = CLUSTER.lock().unwrap_or_else(|e| e.into_inner());
-    if run_for(
-        Command::new("sbatch").arg("--version"),
-        Duration::from_secs(10),
-    )
-    .is_none()
-    {
+    let on_path = std::env::var_os("PATH")
+        .is_some_and(|p| std::env::split_paths(&p).any(|d| d.join("sbatch").is_file()));
+    if !on_path {
         eprintln!("{test}: skipped: no sbatch here (apt-get install slurm-wlm munge)");
         return None;
     }
