@@ -11,6 +11,7 @@ pub mod error;
 pub mod merge;
 pub mod paper;
 pub mod roll;
+pub mod slurm;
 pub mod sweeps;
 pub mod theory;
 pub mod trace;
@@ -47,6 +48,8 @@ pub enum Command {
     Theory(theory::TheoryArgs),
     /// Roll one block many times on one engine: counts, ratio, theory, cost.
     Roll(roll::RollArgs),
+    /// A run as a Slurm job array and a finishing job that merges it into the one-machine result.
+    Slurm(slurm::SlurmArgs),
     /// One throw's trajectory as CSV (step, time, position, orientation, velocities, energy).
     Trace(trace::TraceArgs),
 }
@@ -82,6 +85,7 @@ pub fn main() -> i32 {
         Command::Paper(a) => paper::run(&a),
         Command::Theory(a) => theory::run(&a),
         Command::Roll(a) => roll::run(&a),
+        Command::Slurm(a) => slurm::run(&a),
         Command::Trace(a) => trace::run(&a),
     };
     match result {

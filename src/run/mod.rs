@@ -1,10 +1,11 @@
 //! Many rolls: a run's specification, parallel batches and their exact tally, the chunked
-//! runner with its checkpoints, stop requests, and atomic output.
+//! runner with its checkpoints, stop requests, atomic output, and Slurm job arrays.
 
 pub mod batch;
 pub mod cputime;
 pub mod io;
 pub mod runner;
+pub mod slurm;
 pub mod spec;
 pub mod stop;
 pub mod tally;

@@ -10,6 +10,7 @@ mod fuzz;
 mod rapier;
 mod redteam;
 mod reliability;
+mod slurm;
 mod speed;
 mod sweeps;
 mod theory_cli;

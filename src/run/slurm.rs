@@ -1,0 +1,249 @@
+//! A run as a Slurm job array. Task K of N rolls its shard (`--shard K/N`) into its own
+//! checkpoint directory on the shared file system, then writes its `--json` result; a finishing
+//! job, started after every task has ended, checks that all N results are there and whole and
+//! merges them into exactly the one-machine result.
+//!
+//! Everything a task needs is on disk before anything is submitted: `DIR/slurm.json` (the
+//! [`Plan`]) and one checkpoint per task, `DIR/shard-K/spec.json`, holding that task's
+//! [`RunSpec`]. A task runs `dicephys roll --resume DIR/shard-K`, so a task that is requeued
+//! or resubmitted continues from its last whole chunk, and no command line is ever re-parsed.
+//!
+//! This module writes the scripts; it never calls the scheduler.
+
+use crate::error::{Error, Result};
+use crate::run::spec::{RunSpec, Shard};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The most tasks of one array (Slurm's own default `MaxArraySize` is 1001).
+pub const MAX_TASKS: u64 = 100_000;
+
+/// What a Slurm run does, stored as `DIR/slurm.json`: the finishing job reads it back.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "command", rename_all = "snake_case")]
+pub enum Plan {
+    /// `dicephys roll`, its throws split into `tasks` shards.
+    Roll {
+        /// The whole run (no shard).
+        spec: RunSpec,
+        /// Array tasks, one shard each.
+        tasks: u64,
+    },
+}
+
+impl Plan {
+    /// The array's tasks.
+    pub fn tasks(&self) -> u64 {
+        match self {
+            Plan::Roll { tasks, .. } => *tasks,
+        }
+    }
+
+    /// The command it runs, for job names and messages.
+    pub fn command(&self) -> &'static str {
+        match self {
+            Plan::Roll { .. } => "roll",
+        }
+    }
+
+    /// Task `k`'s share of a `roll`: the same run with shard k/N.
+    pub fn shard_spec(spec: &RunSpec, k: u64, tasks: u64) -> RunSpec {
+        RunSpec {
+            shard: Some(Shard { k, n: tasks }),
+            ..spec.unsharded()
+        }
+    }
+
+    /// Checks the number of tasks against the work.
+    pub fn validate(&self) -> Result<()> {
+        let n = self.tasks();
+        if n == 0 || n > MAX_TASKS {
+            return Err(Error::Invalid(format!(
+                "--tasks {n}: need 1 to {MAX_TASKS} tasks"
+            )));
+        }
+        match self {
+            Plan::Roll { spec, .. } if n > spec.rolls => Err(Error::Invalid(format!(
+                "--tasks {n}: more tasks than the run's {} rolls",
+                spec.rolls
+            ))),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Where the pieces of a Slurm run live under its directory.
+#[derive(Clone, Debug)]
+pub struct Layout {
+    /// The run's directory (absolute: the scripts run on other nodes).
+    pub dir: PathBuf,
+}
+
+impl Layout {
+    /// The plan, `slurm.json`.
+    pub fn plan(&self) -> PathBuf {
+        self.dir.join("slurm.json")
+    }
+    /// Task k's checkpoint directory.
+    pub fn checkpoint(&self, k: u64) -> PathBuf {
+        self.dir.join(format!("shard-{k}"))
+    }
+    /// Task k's result (`roll --json`), written whole when the task ends.
+    pub fn shard_result(&self, k: u64) -> PathBuf {
+        self.dir.join(format!("shard-{k}.json"))
+    }
+    /// The job-array script.
+    pub fn array_script(&self) -> PathBuf {
+        self.dir.join("array.sh")
+    }
+    /// The finishing job's script.
+    pub fn finish_script(&self) -> PathBuf {
+        self.dir.join("finish.sh")
+    }
+    /// The jobs' logs.
+    pub fn logs(&self) -> PathBuf {
+        self.dir.join("logs")
+    }
+    /// The merged result, as `roll --json` prints it.
+    pub fn result_json(&self) -> PathBuf {
+        self.dir.join("result.json")
+    }
+    /// The merged result, as `roll` prints it.
+    pub fn result_text(&self) -> PathBuf {
+        self.dir.join("result.txt")
+    }
+}
+
+/// The scheduler options every job of the run gets.
+#[derive(Clone, Debug, Default)]
+pub struct Options {
+    /// `--partition`.
+    pub partition: Option<String>,
+    /// `--time` (each task's limit; the finishing job's too).
+    pub time: Option<String>,
+    /// `--account`.
+    pub account: Option<String>,
+    /// CPUs per array task (its `--threads`).
+    pub cpus: usize,
+}
+
+impl Options {
+    /// Refuses values that cannot go on an `#SBATCH` line.
+    pub fn validate(&self) -> Result<()> {
+        for (name, v) in [
+            ("partition", &self.partition),
+            ("time", &self.time),
+            ("account", &self.account),
+        ] {
+            if let Some(v) = v {
+                if v.is_empty() || v.chars().any(|c| c.is_whitespace() || c.is_control()) {
+                    return Err(Error::Invalid(format!(
+                        "--{name} '{v}': one word without spaces"
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn lines(&self) -> String {
+        let mut s = String::new();
+        for (name, v) in [
+            ("partition", &self.partition),
+            ("time", &self.time),
+            ("account", &self.account),
+        ] {
+            if let Some(v) = v {
+                s += &format!("#SBATCH --{name}={v}\n");
+            }
+        }
+        s
+    }
+}
+
+/// Quotes a word for the shell (POSIX single quotes).
+pub fn quote(s: &str) -> String {
+    if !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "/._-+=:,@".contains(c))
+    {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+fn path_str(p: &Path) -> Result<&str> {
+    p.to_str()
+        .ok_or_else(|| Error::Invalid(format!("{}: not a UTF-8 path", p.display())))
+}
+
+/// The job-array script: task K rolls (or resumes) its shard from `DIR/shard-K` and puts its
+/// `--json` result at `DIR/shard-K.json` by a rename, so that the file is whole or absent. A
+/// task whose result is already there does nothing (a harmless rerun). `--requeue` lets the
+/// scheduler requeue a task on a lost node; `--open-mode=append` keeps each attempt's log.
+pub fn array_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Result<String> {
+    let dir = path_str(&lay.dir)?;
+    let bin = path_str(bin)?;
+    let n = plan.tasks();
+    let logs = lay.logs();
+    let logs = path_str(&logs)?;
+    let body = match plan {
+        Plan::Roll { .. } => format!(
+            "ckpt={d}/shard-$k\n\
+             out={d}/shard-$k.json\n\
+             if [ -s \"$out\" ]; then\n  echo \"task $k: $out is there already\"\n  exit 0\nfi\n\
+             tmp={d}/.shard-$k.json.$SLURM_JOB_ID\n\
+             {b} roll --resume \"$ckpt\" --threads {t} --json >\"$tmp\"\n\
+             rc=$?\n\
+             if [ $rc -ne 0 ]; then\n  rm -f \"$tmp\"\n  echo \"task $k: dicephys exited $rc; its checkpoint $ckpt is kept\" >&2\n  exit $rc\nfi\n\
+             mv -f \"$tmp\" \"$out\"\n",
+            d = quote(dir),
+            b = quote(bin),
+            t = opt.cpus,
+        ),
+    };
+    Ok(format!(
+        "#!/bin/bash\n\
+         # dicephys {cmd}: task K of {n} (K = $SLURM_ARRAY_TASK_ID). Written by `dicephys slurm`.\n\
+         #SBATCH --job-name=dicephys-{cmd}\n\
+         #SBATCH --array=0-{last}\n\
+         #SBATCH --cpus-per-task={cpus}\n\
+         #SBATCH --requeue\n\
+         #SBATCH --open-mode=append\n\
+         #SBATCH --output={logs}/task-%a.out\n\
+         {extra}\
+         k=${{SLURM_ARRAY_TASK_ID:?not a Slurm array task}}\n\
+         echo \"task $k: job ${{SLURM_JOB_ID:-?}} on $(hostname), attempt $((${{SLURM_RESTART_COUNT:-0}} + 1))\"\n\
+         {body}",
+        cmd = plan.command(),
+        last = n - 1,
+        cpus = opt.cpus,
+        logs = quote(logs),
+        extra = opt.lines(),
+    ))
+}
+
+/// The finishing job's script: `dicephys slurm finish DIR`, which refuses an incomplete run,
+/// naming the missing tasks, and otherwise writes the merged result (again, if rerun).
+pub fn finish_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Result<String> {
+    let dir = path_str(&lay.dir)?;
+    let logs = lay.logs();
+    let logs = path_str(&logs)?;
+    Ok(format!(
+        "#!/bin/bash\n\
+         # dicephys {cmd}: merge the {n} tasks' results. Written by `dicephys slurm`.\n\
+         #SBATCH --job-name=dicephys-{cmd}-finish\n\
+         #SBATCH --cpus-per-task=1\n\
+         #SBATCH --open-mode=append\n\
+         #SBATCH --output={logs}/finish.out\n\
+         {extra}\
+         exec {b} slurm finish {d}\n",
+        cmd = plan.command(),
+        n = plan.tasks(),
+        logs = quote(logs),
+        extra = opt.lines(),
+        b = quote(path_str(bin)?),
+        d = quote(dir),
+    ))
+}

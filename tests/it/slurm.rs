@@ -1,0 +1,272 @@
+//! `dicephys slurm` against a real scheduler: the one-node cluster of
+//! `scripts/slurm-local.sh start` (`.ci/run` starts it). Without `sbatch`, or with no cluster
+//! answering, each test says why on stderr and passes without running.
+
+use super::helpers::bin;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+/// The cluster has two cores: one Slurm test at a time.
+static CLUSTER: Mutex<()> = Mutex::new(());
+
+/// Runs a command with a time limit; its stdout if it succeeded.
+fn run_for(cmd: &mut Command, limit: Duration) -> Option<String> {
+    let mut child = cmd
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .ok()?;
+    let start = Instant::now();
+    loop {
+        match child.try_wait() {
+            Ok(Some(status)) => {
+                let out = child.wait_with_output().ok()?;
+                return status
+                    .success()
+                    .then(|| String::from_utf8_lossy(&out.stdout).into_owned());
+            }
+            Ok(None) if start.elapsed() < limit => std::thread::sleep(Duration::from_millis(100)),
+            _ => {
+                let _ = child.kill();
+                let _ = child.wait();
+                return None;
+            }
+        }
+    }
+}
+
+/// Some(guard) when a cluster answers; None (with the reason printed) when the test is skipped.
+fn cluster(test: &str) -> Option<std::sync::MutexGuard<'static, ()>> {
+    let guard = CLUSTER.lock().unwrap_or_else(|e| e.into_inner());
+    let on_path = std::env::var_os("PATH")
+        .is_some_and(|p| std::env::split_paths(&p).any(|d| d.join("sbatch").is_file()));
+    if !on_path {
+        eprintln!("{test}: skipped: no sbatch here (apt-get install slurm-wlm munge)");
+        return None;
+    }
+    match run_for(
+        Command::new("sinfo").args(["-h", "-o", "%t"]),
+        Duration::from_secs(15),
+    ) {
+        Some(states) if !states.trim().is_empty() => Some(guard),
+        _ => {
+            eprintln!("{test}: skipped: no Slurm cluster answers (scripts/slurm-local.sh start)");
+            None
+        }
+    }
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("dicephys-slurm-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn json(out: &std::process::Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// `dicephys slurm roll RUN --tasks N --dir D --submit`: the array's and the finisher's ids.
+fn submit(run: &[&str], tasks: u64, dir: &Path) -> (String, String) {
+    let out = bin()
+        .args(["slurm", "roll"])
+        .args(run)
+        .args(["--tasks", &tasks.to_string(), "--dir"])
+        .arg(dir)
+        .arg("--submit")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "slurm roll --submit: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    // "array job A (N tasks), finishing job F"
+    let line = text.lines().next().unwrap_or("");
+    let words: Vec<&str> = line.split_whitespace().collect();
+    assert!(
+        words.len() == 8 && words[0] == "array" && words[5] == "finishing",
+        "unexpected: {text}"
+    );
+    (words[2].to_string(), words[7].to_string())
+}
+
+/// What the scheduler says about these jobs, and the logs, for a failure message.
+fn diagnose(jobs: &[&str], dir: &Path) -> String {
+    let sh = |args: &[&str]| {
+        Command::new(args[0])
+            .args(&args[1..])
+            .output()
+            .map(|o| String::from_utf8_lossy(&o.stdout).into_owned())
+            .unwrap_or_default()
+    };
+    let mut s = sh(&["squeue"]);
+    for j in jobs {
+        s += &sh(&["scontrol", "show", "job", j]);
+    }
+    if let Ok(d) = std::fs::read_dir(dir.join("logs")) {
+        for e in d.flatten() {
+            s += &format!(
+                "--- {}\n{}",
+                e.path().display(),
+                std::fs::read_to_string(e.path()).unwrap_or_default()
+            );
+        }
+    }
+    s
+}
+
+/// Waits until none of `jobs` is queued or running.
+fn wait_gone(jobs: &[&str], dir: &Path, limit: Duration) {
+    let start = Instant::now();
+    let list = jobs.join(",");
+    loop {
+        let q = Command::new("squeue")
+            .args(["-h", "-o", "%i %t", "-j", &list])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&q.stdout);
+        if q.status.success() && text.trim().is_empty() {
+            return;
+        }
+        assert!(
+            start.elapsed() < limit,
+            "jobs {list} still queued after {limit:?}:\n{}",
+            diagnose(jobs, dir)
+        );
+        std::thread::sleep(Duration::from_millis(500));
+    }
+}
+
+fn result(dir: &Path, jobs: &[&str]) -> serde_json::Value {
+    let text = std::fs::read_to_string(dir.join("result.json"))
+        .unwrap_or_else(|e| panic!("no result.json ({e}):\n{}", diagnose(jobs, dir)));
+    serde_json::from_str(&text).unwrap()
+}
+
+const SMALL: [&str; 6] = ["--block", "140x24x20", "--rolls", "2000", "--threads", "1"];
+
+#[test]
+fn a_four_task_roll_through_slurm_merges_to_the_one_machine_counts() {
+    let Some(_cluster) = cluster("slurm roll") else {
+        return;
+    };
+    let dir = tmp("roll");
+    let (array, fin) = submit(&SMALL, 4, &dir);
+    let whole = json(
+        &bin()
+            .arg("roll")
+            .args(SMALL)
+            .arg("--json")
+            .output()
+            .unwrap(),
+    );
+    wait_gone(&[&array, &fin], &dir, Duration::from_secs(90));
+    let merged = result(&dir, &[&array, &fin]);
+    assert_eq!(merged["tally"], whole["tally"]);
+    assert_eq!(merged["counts"], whole["counts"]);
+    assert_eq!(merged["spec"], whole["spec"]);
+    // The finishing step is harmless to rerun: the same counts again.
+    let again = bin().args(["slurm", "finish"]).arg(&dir).output().unwrap();
+    assert!(again.status.success());
+    assert_eq!(result(&dir, &[])["tally"], whole["tally"]);
+    // With a task's result gone it refuses, naming the task.
+    std::fs::remove_file(dir.join("shard-2.json")).unwrap();
+    let out = bin().args(["slurm", "finish"]).arg(&dir).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("have not finished: 2 ") && err.contains("--array=2"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_task_cancelled_mid_run_and_requeued_resumes_and_the_counts_still_match() {
+    let Some(_cluster) = cluster("slurm roll, a task cancelled") else {
+        return;
+    };
+    // DicePhys's rule with every step stepped: ~2 ms a roll, so a task of 1,500 rolls runs
+    // a few seconds and checkpoints its first 1,000 before it ends.
+    let run = [
+        "--block",
+        "140x24x20",
+        "--rolls",
+        "6000",
+        "--faithful",
+        "--threads",
+        "1",
+    ];
+    let dir = tmp("requeue");
+    let (array, fin) = submit(&run, 4, &dir);
+    let reference = bin()
+        .arg("roll")
+        .args(run)
+        .arg("--json")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Cancel task 0 once its first chunk is checkpointed and before it has finished.
+    let chunk = || {
+        std::fs::read_dir(dir.join("shard-0"))
+            .map(|d| {
+                d.flatten()
+                    .any(|e| e.file_name().to_string_lossy().starts_with("chunk-"))
+            })
+            .unwrap_or(false)
+    };
+    let start = Instant::now();
+    while !chunk() {
+        assert!(
+            start.elapsed() < Duration::from_secs(90),
+            "task 0 checkpointed nothing in 90 s:\n{}",
+            diagnose(&[&array, &fin], &dir)
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let task = format!("{array}_0");
+    assert!(
+        !dir.join("shard-0.json").exists(),
+        "task 0 ended before it could be cancelled"
+    );
+    let ok = Command::new("scancel").arg(&task).status().unwrap();
+    assert!(ok.success(), "scancel {task}");
+    // Requeue it (the scheduler may take a moment to record the cancel).
+    let start = Instant::now();
+    loop {
+        let out = Command::new("scontrol")
+            .args(["requeue", &task])
+            .output()
+            .unwrap();
+        if out.status.success() {
+            break;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(30),
+            "scontrol requeue {task}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        std::thread::sleep(Duration::from_millis(500));
+    }
+    wait_gone(&[&array, &fin], &dir, Duration::from_secs(150));
+    let whole = json(&reference.wait_with_output().unwrap());
+    let merged = result(&dir, &[&array, &fin]);
+    assert_eq!(merged["tally"], whole["tally"]);
+    assert_eq!(merged["counts"], whole["counts"]);
+    let log = std::fs::read_to_string(dir.join("logs/task-0.out")).unwrap();
+    assert!(
+        log.contains("attempt 2"),
+        "task 0 was not run again:\n{log}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
