@@ -15,7 +15,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 /// The options that define a run: `--resume` takes them from the checkpoint instead.
-const DEFINING: [&str; 19] = [
+const DEFINING: [&str; 23] = [
     "engine",
     "block",
     "two_d",
@@ -35,6 +35,10 @@ const DEFINING: [&str; 19] = [
     "max_steps",
     "settle",
     "shard",
+    "linear_damping",
+    "angular_damping",
+    "no_sleep",
+    "style",
 ];
 
 /// `dicephys roll`'s arguments.
