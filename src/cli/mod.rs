@@ -14,6 +14,7 @@ pub mod roll;
 pub mod sweeps;
 pub mod theory;
 pub mod trace;
+pub mod validate;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -49,6 +50,9 @@ pub enum Command {
     Roll(roll::RollArgs),
     /// One throw's trajectory as CSV (step, time, position, orientation, velocities, energy).
     Trace(trace::TraceArgs),
+    /// The engines against the limits known in closed form: no bounce (2D), solid angles (3D),
+    /// free flight, and the trend towards the paper's theory.
+    Validate(validate::ValidateArgs),
 }
 
 /// The process's stop flag, raised by Ctrl-C or SIGTERM.
@@ -83,6 +87,7 @@ pub fn main() -> i32 {
         Command::Theory(a) => theory::run(&a),
         Command::Roll(a) => roll::run(&a),
         Command::Trace(a) => trace::run(&a),
+        Command::Validate(a) => validate::run(&a),
     };
     match result {
         Ok(()) | Err(Error::Closed) => 0,

@@ -26,6 +26,7 @@ use crate::theory::paper_data::{self, PaperRow};
 use crate::theory::{self, dreidel as dr};
 
 pub mod sweeps;
+pub mod validate;
 
 /// One plotted value with its one-standard-error bar (`y_err` 0, negative or non-finite: no bar).
 #[derive(Clone, Copy, Debug, PartialEq)]
