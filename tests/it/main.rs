@@ -13,3 +13,4 @@ mod reliability;
 mod speed;
 mod sweeps;
 mod theory_cli;
+mod validate;
