@@ -60,9 +60,12 @@ pub const LIMIT_DAMPING: f64 = MAX_DAMPING;
 /// The limit cases' friction μ: high, so that the die pivots on its corner rather than slides.
 pub const LIMIT_FRICTION: f64 = 1.0;
 
-/// The limit cases' step cap: 10 s. A die released at rest is at rest well within 2 s; one
-/// still moving after 10 s creeps or rocks on a face.
-pub const LIMIT_MAX_STEPS: u64 = 10_000;
+/// The limit cases' step cap: 5 s of 1 ms steps. A die released at rest comes to rest within
+/// 2 s (Rapier's slowest of 1,000 rolls: 1.6 s), or never: Bullet lets 26-28 % of 3D dice creep
+/// on their face past 20 s with sleeping off, of which about 2 % meet the rest rule between 5
+/// and 20 s; counted at the cap on the face region they are certified in, they land where
+/// they would have, at a quarter of the cost.
+pub const LIMIT_MAX_STEPS: u64 = 5_000;
 
 /// A conserved quantity passes if it drifts by at most this fraction over the flight at
 /// dt = 1 ms and its drift falls as dt does.
@@ -604,7 +607,7 @@ pub fn rolls_to_resolve(p: f64, n: u64, resolve: f64) -> Option<u64> {
 }
 
 /// What a limit cell's dice did besides coming to rest on a face, for its rows' notes.
-fn cell_note(c: &LimitCell) -> String {
+fn cell_note(c: &LimitCell, max_steps: u64) -> String {
     let mut v = vec![format!(
         "{} of {} on the face they started over",
         c.ended_where_started, c.ended_on_a_face
@@ -614,7 +617,7 @@ fn cell_note(c: &LimitCell) -> String {
         v.push(format!(
             "{moving} of {} still moving on a face at the {} s cap (counted on it)",
             c.tally.rolls,
-            LIMIT_MAX_STEPS as f64 * 0.001
+            max_steps as f64 * 0.001
         ));
     }
     if c.unknown > 0 {
@@ -684,7 +687,7 @@ pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Validation
                     p,
                     (f.breadth, f.total()),
                 );
-                r.note = cell_note(c);
+                r.note = cell_note(c, cfg.max_steps);
                 if case == Case::Momentum2d {
                     let same = format!(
                         "same face as over-damped for {:.1} % of throws",
@@ -726,7 +729,7 @@ pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Validation
                     want,
                     (f.of(o), f.total()),
                 );
-                r.note = cell_note(&c);
+                r.note = cell_note(&c, cfg.max_steps);
                 push(r, &mut rows);
             }
             cells.push(c);
@@ -808,10 +811,18 @@ pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Validation
                     z,
                     verdict: Verdict::Curve,
                     note: format!(
-                        "{:.0} % of the way from (MasterEqu) {t:.3} to no bounce {nb:.3}{}",
+                        "{:.0} % of the way from (MasterEqu) {t:.3} to no bounce {nb:.3}{}{}",
                         100.0 * point.towards_no_bounce,
                         if m.tally.unconverged > 0 {
                             format!("; {} unconverged", m.tally.unconverged)
+                        } else {
+                            String::new()
+                        },
+                        if m.tally.energy_gain > 0 {
+                            format!(
+                                "; {} of {} rolls gained energy",
+                                m.tally.energy_gain, m.tally.rolls
+                            )
                         } else {
                             String::new()
                         }
@@ -922,11 +933,10 @@ fn flight_rows(cfg: &Config, integrator: Integrator, runs: &[FlightRun]) -> Vec<
         let note = if exact {
             "conserved to rounding at every dt".to_string()
         } else if !integrator.gyroscopic() && quantity.starts_with("angular") {
-            format!(
-                "no gyroscopic term: ω is held constant in world axes, so the die turns about a \
-                 fixed axis and L turns with it at every dt (order {p:.1}); exact only for a spin \
-                 about a principal axis, as in the paper's throw"
-            )
+            "no gyroscopic term: ω is held constant in world axes, so the die turns about a \
+             fixed axis and L turns with it, the same at every dt (it does not fall with dt); \
+             exact only for a spin about a principal axis, as in the paper's throw"
+                .to_string()
         } else {
             format!("max over {} s; order {p:.2} in dt", cfg.flight_time)
         };
