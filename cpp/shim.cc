@@ -21,7 +21,9 @@ BulletWorld::BulletWorld(const BulletScene& s)
       die_restitution_(s.die_restitution),
       planar_(s.planar),
       gyroscopic_(s.gyroscopic_implicit),
-      deactivation_(s.deactivation) {
+      deactivation_(s.deactivation),
+      linear_damping_(s.linear_damping),
+      angular_damping_(s.angular_damping) {
   config_ = std::make_unique<btDefaultCollisionConfiguration>();
   dispatcher_ = std::make_unique<btCollisionDispatcher>(config_.get());
   // Two bodies: the simplest broadphase does (the pair is the same; measured identical).
@@ -92,6 +94,11 @@ void BulletWorld::reset(const BodyStateFfi& start) {
     die_->setAngularFactor(btVector3(0, 0, 1));
   }
   if (!deactivation_) die_->setActivationState(DISABLE_DEACTIVATION);
+  // DicePhys: none (0, 0), as a new body has. Bullet scales the velocities by (1 - d)^dt once a
+  // step, before the contacts are solved.
+  if (linear_damping_ != 0 || angular_damping_ != 0) {
+    die_->setDamping(linear_damping_, angular_damping_);
+  }
   world_->addRigidBody(die_.get());
 }
 

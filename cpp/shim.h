@@ -51,6 +51,8 @@ class BulletWorld {
   bool planar_;
   bool gyroscopic_;
   bool deactivation_;
+  double linear_damping_;
+  double angular_damping_;
 };
 
 std::unique_ptr<BulletWorld> new_world(const BulletScene& scene);

@@ -7,7 +7,7 @@ use dicephys::engine::EngineKind;
 use dicephys::error::parse_name;
 use dicephys::model::block::Block;
 use dicephys::model::scene::{Floor, Mode, Preset, Scene};
-use dicephys::model::throws::{Range, ThrowKind, ThrowRanges};
+use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
 use dicephys::run::runner::MAX_THREADS;
 use dicephys::run::spec::{Shard, ThrowSpec};
 use dicephys::sim::roll::{early_stop_exact, RollConfig, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
@@ -46,6 +46,16 @@ pub struct SceneArgs {
     /// a die to pass through at a coarse step: a real tunnel, counted as failed.
     #[arg(long, value_name = "M", allow_hyphen_values = true)]
     pub floor_thickness: Option<f64>,
+    /// Linear damping, a rate in 1/s (velocity ∝ e^(−λt) out of contact; 0 to 30; DicePhys: 0).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub linear_damping: f64,
+    /// Angular damping, a rate in 1/s (0 to 30; DicePhys: 0).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub angular_damping: f64,
+    /// Never let the engine put the die to sleep (for slow, over-damped rolls, which it would
+    /// freeze mid-fall).
+    #[arg(long)]
+    pub no_sleep: bool,
 }
 
 /// Where the throws come from.
@@ -66,6 +76,12 @@ pub struct ThrowArgs {
     /// Drop height added to the longest side, m: LO:HI, or one number.
     #[arg(long, default_value = "0.2:0.4", value_parser = parse_range, allow_hyphen_values = true)]
     pub drop_height: Range,
+    /// How the die is thrown: paper (length along z, spin about it, velocity along x), tumble
+    /// (random orientation, spin axis uniform on the sphere, velocity in a random horizontal
+    /// direction; the ranges give the magnitudes) or rest (released at rest in a random
+    /// orientation, its lowest corner touching the floor; no range is used).
+    #[arg(long = "throw", default_value = "paper", value_parser = parse_throw_style)]
+    pub style: ThrowStyle,
 }
 
 /// What ends a roll, on the command line.
@@ -140,6 +156,10 @@ pub fn parse_floor(s: &str) -> std::result::Result<Floor, dicephys::Error> {
 pub fn parse_throw_kind(s: &str) -> std::result::Result<ThrowKind, dicephys::Error> {
     parse_name("throw source", s)
 }
+/// `--throw` as clap reads it.
+pub fn parse_throw_style(s: &str) -> std::result::Result<ThrowStyle, dicephys::Error> {
+    parse_name("throw style", s)
+}
 /// `--engine` as clap reads it.
 pub fn parse_engine(s: &str) -> std::result::Result<EngineKind, dicephys::Error> {
     parse_name("engine", s)
@@ -163,6 +183,9 @@ impl SceneArgs {
         scene.density = self.density;
         scene.preset = self.preset;
         scene.floor = self.floor;
+        scene.linear_damping = self.linear_damping;
+        scene.angular_damping = self.angular_damping;
+        scene.sleeping = !self.no_sleep;
         if let Some(t) = self.floor_thickness {
             if self.floor == Floor::Plane {
                 return Err(Error::Usage(
@@ -187,6 +210,7 @@ impl ThrowArgs {
                 spin: self.spin,
                 drop_height: self.drop_height,
             },
+            style: self.style,
         };
         spec.validate()?;
         Ok(spec)

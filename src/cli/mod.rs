@@ -15,6 +15,7 @@ pub mod slurm;
 pub mod sweeps;
 pub mod theory;
 pub mod trace;
+pub mod validate;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -52,6 +53,9 @@ pub enum Command {
     Slurm(slurm::SlurmArgs),
     /// One throw's trajectory as CSV (step, time, position, orientation, velocities, energy).
     Trace(trace::TraceArgs),
+    /// The engines against the limits known in closed form: no bounce (2D), solid angles (3D),
+    /// free flight, and the trend towards the paper's theory.
+    Validate(validate::ValidateArgs),
 }
 
 /// The process's stop flag, raised by Ctrl-C or SIGTERM.
@@ -87,6 +91,7 @@ pub fn main() -> i32 {
         Command::Roll(a) => roll::run(&a),
         Command::Slurm(a) => slurm::run(&a),
         Command::Trace(a) => trace::run(&a),
+        Command::Validate(a) => validate::run(&a),
     };
     match result {
         Ok(()) | Err(Error::Closed) => 0,

@@ -15,7 +15,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 /// The options that define a run: `--resume` takes them from the checkpoint instead.
-const DEFINING: [&str; 20] = [
+const DEFINING: [&str; 24] = [
     "floor_thickness",
     "engine",
     "block",
@@ -36,6 +36,10 @@ const DEFINING: [&str; 20] = [
     "max_steps",
     "settle",
     "shard",
+    "linear_damping",
+    "angular_damping",
+    "no_sleep",
+    "style",
 ];
 
 /// `dicephys roll`'s arguments.

@@ -108,7 +108,7 @@ pub struct StabilityArgs {
 
 /// Checks what every sweep takes, creates --out, and sets up how cells are run: on these
 /// threads, stopped by Ctrl-C, kept under --out/checkpoint.
-fn check_common(
+pub(super) fn check_common(
     rolls: u64,
     max_steps: u64,
     t: usize,
@@ -140,12 +140,18 @@ fn nonempty<T>(v: &[T], name: &str) -> Result<()> {
     }
 }
 
-fn to_json<T: serde::Serialize>(v: &T) -> Result<String> {
+pub(super) fn to_json<T: serde::Serialize>(v: &T) -> Result<String> {
     serde_json::to_string_pretty(v).map_err(|e| Error::Run(e.to_string()))
 }
 
 /// Writes the JSON and the report, prints one or the other.
-fn finish(out: &Path, file: &str, json: &str, report: &str, print_json: bool) -> Result<()> {
+pub(super) fn finish(
+    out: &Path,
+    file: &str,
+    json: &str,
+    report: &str,
+    print_json: bool,
+) -> Result<()> {
     super::output(&out.join(file))?.write(json.as_bytes())?;
     super::output(&out.join("report.md"))?.write(report.as_bytes())?;
     if print_json {
@@ -422,7 +428,7 @@ fn floor_note(thickness: f64) -> String {
 }
 
 /// Runs a sweep, logging its header and each cell to stderr unless the output is JSON.
-fn logged<T>(
+pub(super) fn logged<T>(
     quiet: bool,
     header: &str,
     run: impl FnOnce(&dyn Fn(&str)) -> dicephys::Result<T>,

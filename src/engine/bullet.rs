@@ -32,6 +32,10 @@ mod ffi {
         solver_iterations: i32,
         /// Bullet's sleeping (deactivation) at its defaults, or never.
         deactivation: bool,
+        /// `btRigidBody::setDamping(linear, angular)`: d in [0, 1], the velocity scaled by
+        /// (1 − d)^dt each step (`Scene::bullet_damping`); DicePhys: 0, 0.
+        linear_damping: f64,
+        angular_damping: f64,
     }
 
     /// The die's state: position, orientation (x, y, z, w), velocities, and whether Bullet
@@ -99,6 +103,8 @@ unsafe impl Send for ffi::BulletWorld {}
 pub struct Bullet {
     world: UniquePtr<ffi::BulletWorld>,
     gyroscopic: bool,
+    /// Damping slows the die in flight too, so its flight is not ballistic.
+    damped: bool,
     /// The die's state as the world last reported it (after reset, set_state or a step).
     now: ffi::BodyStateFfi,
 }
@@ -107,6 +113,7 @@ impl Bullet {
     /// A fresh Bullet world for the scene, its solver set by the scene's preset.
     pub fn new(scene: &Scene) -> crate::Result<Bullet> {
         let s = solver(scene.preset);
+        let (linear_damping, angular_damping) = scene.bullet_damping();
         let desc = ffi::BulletScene {
             sides: scene.body_sides(),
             mass: scene.mass(),
@@ -123,7 +130,9 @@ impl Bullet {
             restitution_velocity_threshold: s.restitution_velocity_threshold,
             split_impulse: true,
             solver_iterations: 10,
-            deactivation: true,
+            deactivation: scene.sleeping,
+            linear_damping,
+            angular_damping,
         };
         let world =
             ffi::new_world(&desc).map_err(|e| crate::Error::Engine(format!("bullet: {e}")))?;
@@ -131,6 +140,7 @@ impl Bullet {
         Ok(Bullet {
             world,
             gyroscopic: s.gyroscopic_implicit,
+            damped: scene.damped(),
             now,
         })
     }
@@ -175,9 +185,10 @@ impl Engine for Bullet {
         Ok(())
     }
 
-    /// Free flight is ballistic unless Bullet's implicit gyroscopic force turns ω.
+    /// Free flight is ballistic unless Bullet's implicit gyroscopic force turns ω or damping
+    /// slows the die.
     fn ballistic_flight(&self) -> bool {
-        !self.gyroscopic
+        !self.gyroscopic && !self.damped
     }
 
     fn contact_free(&self) -> bool {

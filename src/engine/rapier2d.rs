@@ -16,6 +16,10 @@ pub struct Rapier2d {
     world: PhysicsWorld,
     die: Option<RigidBodyHandle>,
     die_collider: ColliderBuilder,
+    /// Rapier's (linear, angular) damping coefficients (`Scene::rapier_damping`).
+    damping: (f64, f64),
+    /// The die may sleep (`Scene::sleeping`).
+    can_sleep: bool,
 }
 
 impl Rapier2d {
@@ -66,6 +70,8 @@ impl Rapier2d {
             world,
             die: None,
             die_collider,
+            damping: scene.rapier_damping(),
+            can_sleep: scene.sleeping,
         })
     }
 
@@ -111,7 +117,10 @@ impl Engine for Rapier2d {
         let body = RigidBodyBuilder::dynamic()
             .pose(planar_pose(start))
             .linvel(Vector::new(v.x, v.y))
-            .angvel(start.angular_velocity.z);
+            .angvel(start.angular_velocity.z)
+            .linear_damping(self.damping.0)
+            .angular_damping(self.damping.1)
+            .can_sleep(self.can_sleep);
         let (h, _) = self.world.insert(body, self.die_collider.clone());
         self.die = Some(h);
         Ok(())

@@ -14,6 +14,12 @@ pub fn version() -> &'static str {
     rapier3d_f64::VERSION
 }
 
+/// Rapier's solver substeps per step (its `num_solver_iterations`, left at the default): each
+/// integrates the velocities and positions once, so free flight is symplectic Euler at dt/n.
+pub fn substeps() -> usize {
+    IntegrationParameters::default().num_solver_iterations
+}
+
 /// Rapier's 3D engine: a free 3D die, or in 2D DicePhys's locked 3D body.
 pub struct Rapier3d {
     /// Rapier's bundle of one world: pipeline, islands, broad and narrow phase, bodies,
@@ -22,6 +28,10 @@ pub struct Rapier3d {
     die: Option<RigidBodyHandle>,
     die_collider: ColliderBuilder,
     locked: LockedAxes,
+    /// Rapier's (linear, angular) damping coefficients (`Scene::rapier_damping`).
+    damping: (f64, f64),
+    /// The die may sleep (`Scene::sleeping`).
+    can_sleep: bool,
 }
 
 impl Rapier3d {
@@ -80,6 +90,8 @@ impl Rapier3d {
             die: None,
             die_collider,
             locked,
+            damping: scene.rapier_damping(),
+            can_sleep: scene.sleeping,
         })
     }
 
@@ -127,7 +139,10 @@ impl Engine for Rapier3d {
             .pose(pose)
             .linvel(from_na(&start.linear_velocity))
             .angvel(from_na(&start.angular_velocity))
-            .locked_axes(self.locked);
+            .locked_axes(self.locked)
+            .linear_damping(self.damping.0)
+            .angular_damping(self.damping.1)
+            .can_sleep(self.can_sleep);
         let (h, _) = self.world.insert(body, self.die_collider.clone());
         self.die = Some(h);
         Ok(())

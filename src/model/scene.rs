@@ -132,7 +132,40 @@ pub struct Scene {
     pub floor_thickness: f64,
     /// m/s², along −y.
     pub gravity: f64,
+    /// Linear damping, a rate in 1/s: out of contact the die's velocity decays as e^(−λt).
+    /// DicePhys: 0 (none). How each engine applies it: [`Scene::bullet_damping`],
+    /// [`Scene::rapier_damping`]. Written into a specification only when not 0, so that a
+    /// default run's specification, and the key its checkpoints carry, are unchanged.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub linear_damping: f64,
+    /// Angular damping, a rate in 1/s, as `linear_damping` but for the angular velocity.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub angular_damping: f64,
+    /// The engine may put a die that has slowed down to sleep (Bullet's deactivation after
+    /// 2 s under 0.8 m/s and 1 rad/s, Rapier's after 0.5 s under its thresholds), as DicePhys
+    /// let Bullet do. False: never, for a die that moves slowly for long (an over-damped roll,
+    /// which sleeping would freeze mid-fall). Written into a specification only when false.
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    pub sleeping: bool,
 }
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
+fn is_true(v: &bool) -> bool {
+    *v
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// The largest damping rate accepted, 1/s. Bullet takes damping as d in [0, 1] and scales the
+/// velocity by (1 − d)^dt each step, so a rate λ is d = 1 − e^(−λ); above about 36/s, 1 − d
+/// rounds to 0 in double precision and Bullet would zero the velocity every step instead. At
+/// 30/s, 1 − d = 9.4e-14 is held to 6e-4 of itself: the rate to 2e-5.
+pub const MAX_DAMPING: f64 = 30.0;
 
 /// DicePhys's floor box is 100 m thick, its top face at y = 0.
 pub const DICEPHYS_FLOOR_THICKNESS: f64 = 100.0;
@@ -176,6 +209,16 @@ impl Scene {
                 self.density
             ));
         }
+        for (name, v) in [
+            ("--linear-damping", self.linear_damping),
+            ("--angular-damping", self.angular_damping),
+        ] {
+            if !(v.is_finite() && (0.0..=MAX_DAMPING).contains(&v)) {
+                return bad(format!(
+                    "{name} {v}: must be in [0, {MAX_DAMPING}] 1/s (Bullet cannot hold a faster rate)"
+                ));
+            }
+        }
         Ok(())
     }
 
@@ -194,7 +237,31 @@ impl Scene {
             floor: Floor::Box,
             floor_thickness: DICEPHYS_FLOOR_THICKNESS,
             gravity: GRAVITY,
+            linear_damping: 0.0,
+            angular_damping: 0.0,
+            sleeping: true,
         }
+    }
+
+    /// True if the die's velocities are damped (either rate above 0).
+    pub fn damped(&self) -> bool {
+        self.linear_damping > 0.0 || self.angular_damping > 0.0
+    }
+
+    /// The damping as Bullet takes it (`btRigidBody::setDamping`), (linear, angular):
+    /// d = 1 − e^(−λ), so that Bullet's factor per step, (1 − d)^dt, is e^(−λ dt). Bullet
+    /// applies it once a step, before the contacts are solved.
+    pub fn bullet_damping(&self) -> (f64, f64) {
+        let d = |rate: f64| -(-rate).exp_m1();
+        (d(self.linear_damping), d(self.angular_damping))
+    }
+
+    /// The damping as Rapier takes it (`RigidBodyBuilder::linear_damping`), (linear,
+    /// angular): c = (e^(λ dt) − 1)/dt, so that Rapier's factor per step, 1/(1 + c·dt), is
+    /// e^(−λ dt), as Bullet's. Rapier applies it once a step, after the contacts are solved.
+    pub fn rapier_damping(&self) -> (f64, f64) {
+        let c = |rate: f64| (rate * self.dt).exp_m1() / self.dt;
+        (c(self.linear_damping), c(self.angular_damping))
     }
 
     /// Full sides along the body's x, y, z axes (breadth, width, length); in 2D the depth
@@ -232,5 +299,47 @@ impl Scene {
             Mode::ThreeD => b.width.max(b.breadth).max(b.length),
             Mode::TwoD => b.width.max(b.breadth),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn damping_is_the_same_rate_in_both_engines() {
+        let mut s = Scene::paper("140x24x20".parse().unwrap(), Mode::ThreeD);
+        assert_eq!(s.bullet_damping(), (0.0, 0.0));
+        assert_eq!(s.rapier_damping(), (0.0, 0.0));
+        for rate in [0.5, 5.0, MAX_DAMPING] {
+            s.linear_damping = rate;
+            s.angular_damping = rate;
+            let want = (-rate * s.dt).exp();
+            let (d, _) = s.bullet_damping();
+            let (c, _) = s.rapier_damping();
+            // Bullet: v ← v (1 − d)^dt; Rapier: v ← v / (1 + c dt).
+            assert!(((1.0 - d).powf(s.dt) / want - 1.0).abs() < 1e-4, "{rate}");
+            assert!(
+                ((1.0 / (1.0 + c * s.dt)) / want - 1.0).abs() < 1e-12,
+                "{rate}"
+            );
+        }
+        s.validate(false).unwrap();
+        for bad in [-1.0, MAX_DAMPING * 1.01, f64::NAN, f64::INFINITY] {
+            s.linear_damping = bad;
+            assert!(matches!(s.validate(false), Err(Error::Invalid(_))), "{bad}");
+        }
+    }
+
+    #[test]
+    fn a_default_scene_serialises_as_before() {
+        let s = Scene::paper("140x24x20".parse().unwrap(), Mode::ThreeD);
+        let json = serde_json::to_string(&s).unwrap();
+        assert!(
+            !json.contains("damping") && !json.contains("sleeping"),
+            "{json}"
+        );
+        let back: Scene = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, s);
     }
 }

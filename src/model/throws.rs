@@ -6,11 +6,17 @@
 //!   gives the same throws.
 //! - `dicephys`: the exact sequence DicePhys draws from glibc's `rand()` after `srand(seed)`,
 //!   drawn up front, so that dicephys can be compared with DicePhys throw for throw.
+//!
+//! And in one of three styles ([`ThrowStyle`]): the paper's (the default: length along z, spin
+//! about it, velocity along x), a tumble (any orientation, any spin axis, any horizontal
+//! direction), or a release at rest touching the floor (the quasi-static limit). The tumble
+//! and the rest draw their directions from the same keyed stream, so they too are a pure
+//! function of (seed, index).
 
 use crate::model::glibc::GlibcRand;
-use crate::model::scene::Scene;
+use crate::model::scene::{Mode, Scene};
 use crate::model::state::BodyState;
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -127,29 +133,156 @@ impl Default for ThrowRanges {
     }
 }
 
+/// How a die is thrown.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    Serialize,
+    Deserialize,
+    strum::Display,
+    strum::EnumString,
+    strum::IntoStaticStr,
+    strum::VariantNames,
+)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum ThrowStyle {
+    /// The paper's: identity orientation (length along z), velocity along x, spin about z.
+    #[default]
+    Paper,
+    /// Any cuboid, any way: a uniformly random orientation (Haar measure), a spin axis
+    /// uniform on the sphere with its magnitude from the spin range, and the velocity from
+    /// the velocity range along a uniformly random horizontal direction. In 2D: a uniform
+    /// angle about z, spin ± about z, velocity ± along x.
+    Tumble,
+    /// Released at rest in a uniformly random orientation (in 2D, angle about z) with its
+    /// lowest corner just touching the floor: the quasi-static limit. No range is used.
+    Rest,
+}
+
+impl ThrowStyle {
+    /// "paper", "tumble" or "rest".
+    pub fn name(self) -> &'static str {
+        self.into()
+    }
+
+    /// True for the paper's style (the default, left out of a specification's JSON).
+    pub fn is_paper(&self) -> bool {
+        *self == ThrowStyle::Paper
+    }
+}
+
+/// The directions a tumble or a rest throw draws, beyond the paper's numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Turn {
+    /// The starting orientation, body to world, as a unit quaternion [w, i, j, k]: uniform on
+    /// the rotations (Haar measure), by Shoemake's method from three uniform deviates.
+    pub rotation: [f64; 4],
+    /// The spin axis in world axes, uniform on the unit sphere (zero at rest).
+    pub spin_axis: [f64; 3],
+    /// The horizontal velocity's direction, radians from +x towards +z, uniform (0 at rest).
+    pub heading: f64,
+}
+
+impl Turn {
+    /// The orientation in 3D, or in 2D its angle about z: the azimuth of the rotated body x
+    /// axis in the x-y plane, uniform on [0, 2π) when the rotation is Haar-uniform (the rotated
+    /// x axis is uniform on the sphere, and so its azimuth about z).
+    pub fn orientation(&self, mode: Mode) -> UnitQuaternion<f64> {
+        let [w, i, j, k] = self.rotation;
+        let q = UnitQuaternion::new_normalize(Quaternion::new(w, i, j, k));
+        match mode {
+            Mode::ThreeD => q,
+            Mode::TwoD => {
+                let x = q * Vector3::x();
+                UnitQuaternion::from_axis_angle(&Vector3::z_axis(), x.y.atan2(x.x))
+            }
+        }
+    }
+}
+
 /// One throw's drawn numbers.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Throw {
     /// The throw's index in the run, from 0.
     pub index: u64,
-    /// Height added to the longest side for the centre's start, m.
+    /// Height added to the longest side for the centre's start, m (0 at rest).
     pub drop_height: f64,
-    /// Linear velocity along x, m/s.
+    /// Linear velocity along x (a tumble: along its heading), m/s.
     pub velocity: f64,
-    /// The spin's z component as the engine receives it (rad/s).
+    /// The spin's z component as the engine receives it (a tumble: its magnitude), rad/s.
     pub spin: f64,
+    /// How the die is thrown; the paper's is left out of the JSON (so a chunk of paper throws
+    /// reads and writes as before).
+    #[serde(default, skip_serializing_if = "ThrowStyle::is_paper")]
+    pub style: ThrowStyle,
+    /// A tumble's or a rest's directions; none for the paper's throw.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub turn: Option<Turn>,
 }
 
 impl Throw {
-    /// The die's starting state: identity orientation (length along z), centre at
-    /// (0, longest side + drop height, 0), velocity (v, 0, 0), spin (0, 0, ω).
+    /// The die's starting state.
+    ///
+    /// - Paper: identity orientation (length along z), centre at (0, longest side + drop
+    ///   height, 0), velocity (v, 0, 0), spin (0, 0, ω).
+    /// - Tumble: the turn's orientation, the same centre (the longest side is more than the
+    ///   half diagonal, so the die starts clear of the floor however it is turned), velocity
+    ///   v (cos h, 0, sin h), spin ω times the turn's axis. In 2D: the angle about z, velocity
+    ///   (±v, 0, 0) by the sign of cos h, spin (0, 0, ±ω) by the sign of the axis's z.
+    /// - Rest: the turn's orientation, at rest, its centre at the height where its lowest
+    ///   corner (in 2D, edge) touches the floor's top face.
     pub fn start(&self, scene: &Scene) -> BodyState {
-        BodyState {
+        let paper = BodyState {
             position: Vector3::new(0.0, scene.drop_base() + self.drop_height, 0.0),
             rotation: UnitQuaternion::identity(),
             linear_velocity: Vector3::new(self.velocity, 0.0, 0.0),
             angular_velocity: Vector3::new(0.0, 0.0, self.spin),
             sleeping: false,
+        };
+        let Some(turn) = self.turn.filter(|_| !self.style.is_paper()) else {
+            return paper;
+        };
+        let rotation = turn.orientation(scene.mode);
+        let [sx, sy, sz] = turn.spin_axis;
+        let sign = |v: f64| if v < 0.0 { -1.0 } else { 1.0 };
+        match (self.style, scene.mode) {
+            (ThrowStyle::Paper, _) => paper,
+            (ThrowStyle::Tumble, Mode::ThreeD) => BodyState {
+                rotation,
+                linear_velocity: self.velocity
+                    * Vector3::new(turn.heading.cos(), 0.0, turn.heading.sin()),
+                angular_velocity: self.spin * Vector3::new(sx, sy, sz),
+                ..paper
+            },
+            (ThrowStyle::Tumble, Mode::TwoD) => BodyState {
+                rotation,
+                linear_velocity: Vector3::new(sign(turn.heading.cos()) * self.velocity, 0.0, 0.0),
+                angular_velocity: Vector3::new(0.0, 0.0, sign(sz) * self.spin),
+                ..paper
+            },
+            (ThrowStyle::Rest, _) => {
+                let [a, b, c] = scene.body_sides();
+                let half = Vector3::new(a, b, c) / 2.0;
+                let at_zero = BodyState {
+                    position: Vector3::zeros(),
+                    rotation,
+                    linear_velocity: Vector3::zeros(),
+                    angular_velocity: Vector3::zeros(),
+                    sleeping: false,
+                };
+                // In 2D the rotation is about z only, so the 1 m depth adds nothing here.
+                let touching = -crate::model::die::lowest_point(&half, &at_zero);
+                BodyState {
+                    position: Vector3::new(0.0, touching, 0.0),
+                    ..at_zero
+                }
+            }
         }
     }
 }
@@ -194,6 +327,8 @@ pub enum Throws {
         seed: u64,
         /// The ranges every throw is drawn from.
         ranges: ThrowRanges,
+        /// How each die is thrown.
+        style: ThrowStyle,
     },
     /// DicePhys's sequence. It is sequential, so the generator's state is kept at every
     /// `DICEPHYS_MARK`-th throw (drawn up front, 152 bytes each: 15 MB for 10⁸ throws) and a
@@ -210,10 +345,26 @@ pub enum Throws {
 pub const DICEPHYS_MARK: u64 = 1024;
 
 impl Throws {
-    /// A throw source that can give throws `0..n`.
+    /// A throw source of the paper's throws that can give throws `0..n`.
     pub fn new(kind: ThrowKind, seed: u64, ranges: ThrowRanges, n: u64) -> Throws {
+        Throws::styled(kind, ThrowStyle::Paper, seed, ranges, n)
+    }
+
+    /// A throw source that can give throws `0..n` thrown in `style`. DicePhys's sequence has
+    /// the paper's throw only (`ThrowSpec::validate` refuses another style with it).
+    pub fn styled(
+        kind: ThrowKind,
+        style: ThrowStyle,
+        seed: u64,
+        ranges: ThrowRanges,
+        n: u64,
+    ) -> Throws {
         match kind {
-            ThrowKind::Keyed => Throws::Keyed { seed, ranges },
+            ThrowKind::Keyed => Throws::Keyed {
+                seed,
+                ranges,
+                style,
+            },
             ThrowKind::Dicephys => {
                 let mut g = GlibcRand::new(seed as u32);
                 g.uniform(0.0, 1.0);
@@ -232,7 +383,11 @@ impl Throws {
     /// Throw `index`; a `Dicephys` source panics past the `n` it was made for.
     pub fn get(&self, index: u64) -> Throw {
         match self {
-            Throws::Keyed { seed, ranges } => keyed(*seed, ranges, index),
+            Throws::Keyed {
+                seed,
+                ranges,
+                style,
+            } => keyed_styled(*style, *seed, ranges, index),
             Throws::Dicephys { ranges, marks } => {
                 let first = index - index % DICEPHYS_MARK;
                 let mut g = marks[(index / DICEPHYS_MARK) as usize].clone();
@@ -245,19 +400,73 @@ impl Throws {
     }
 }
 
-/// Throw `index` of the keyed source: ChaCha8 seeded by `seed`, on stream `index`.
+/// Throw `index` of the keyed source, the paper's throw: ChaCha8 seeded by `seed`, on stream
+/// `index`.
 pub fn keyed(seed: u64, ranges: &ThrowRanges, index: u64) -> Throw {
+    keyed_styled(ThrowStyle::Paper, seed, ranges, index)
+}
+
+/// Throw `index` of the keyed source in `style`: ChaCha8 seeded by `seed`, on stream `index`.
+/// The paper's throw draws drop height, velocity and spin, in that order; a tumble draws the
+/// same three, then its orientation (three deviates), spin axis (two) and heading (one); a
+/// rest draws only its orientation.
+pub fn keyed_styled(style: ThrowStyle, seed: u64, ranges: &ThrowRanges, index: u64) -> Throw {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(index);
-    let drop_height = ranges.drop_height.draw(rng.random::<f64>());
-    let velocity = ranges.velocity.draw(rng.random::<f64>());
-    let spin = ranges.spin.draw(rng.random::<f64>());
-    Throw {
-        index,
-        drop_height,
-        velocity,
-        spin,
+    let mut u = || rng.random::<f64>();
+    match style {
+        ThrowStyle::Paper | ThrowStyle::Tumble => {
+            let drop_height = ranges.drop_height.draw(u());
+            let velocity = ranges.velocity.draw(u());
+            let spin = ranges.spin.draw(u());
+            let turn = (style == ThrowStyle::Tumble).then(|| Turn {
+                rotation: haar_quaternion(u(), u(), u()),
+                spin_axis: unit_vector(u(), u()),
+                heading: std::f64::consts::TAU * u(),
+            });
+            Throw {
+                index,
+                drop_height,
+                velocity,
+                spin,
+                style,
+                turn,
+            }
+        }
+        ThrowStyle::Rest => Throw {
+            index,
+            drop_height: 0.0,
+            velocity: 0.0,
+            spin: 0.0,
+            style,
+            turn: Some(Turn {
+                rotation: haar_quaternion(u(), u(), u()),
+                spin_axis: [0.0; 3],
+                heading: 0.0,
+            }),
+        },
     }
+}
+
+/// A unit quaternion [w, i, j, k] uniform on the rotations (Haar measure) from three
+/// independent uniform deviates in [0, 1), by Shoemake's method ("Uniform random rotations",
+/// Graphics Gems III, 1992): (√(1−u₁) sin 2πu₂, √(1−u₁) cos 2πu₂, √u₁ sin 2πu₃, √u₁ cos 2πu₃)
+/// is uniform on the unit 3-sphere, and so its rotation on SO(3).
+pub fn haar_quaternion(u1: f64, u2: f64, u3: f64) -> [f64; 4] {
+    use std::f64::consts::TAU;
+    let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+    let (s2, c2) = (TAU * u2).sin_cos();
+    let (s3, c3) = (TAU * u3).sin_cos();
+    [b * c3, a * s2, a * c2, b * s3]
+}
+
+/// A unit vector uniform on the sphere from two uniform deviates in [0, 1) (Archimedes: z
+/// uniform in [−1, 1], azimuth uniform).
+pub fn unit_vector(u1: f64, u2: f64) -> [f64; 3] {
+    let z = 2.0 * u1 - 1.0;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let (s, c) = (std::f64::consts::TAU * u2).sin_cos();
+    [r * c, r * s, z]
 }
 
 /// DicePhys's throws 0..n: `srand(seed)`, one discarded draw, then per roll, in this order,
@@ -284,6 +493,8 @@ fn dicephys_next(g: &mut GlibcRand, ranges: &ThrowRanges, index: u64) -> Throw {
         drop_height,
         velocity,
         spin: unit * magnitude,
+        style: ThrowStyle::Paper,
+        turn: None,
     }
 }
 
@@ -340,6 +551,99 @@ mod tests {
             n - 1,
         ] {
             assert_eq!(source.get(i), all[i as usize], "throw {i}");
+        }
+    }
+
+    #[test]
+    fn paper_throws_are_unchanged_by_the_styles() {
+        // The paper's throw draws exactly what it drew before the styles: three deviates.
+        let r = ThrowRanges::default();
+        let t = keyed(7, &r, 3);
+        assert_eq!(t, keyed_styled(ThrowStyle::Paper, 7, &r, 3));
+        assert!(t.turn.is_none());
+        let json = serde_json::to_string(&t).unwrap();
+        assert!(!json.contains("style") && !json.contains("turn"), "{json}");
+        // A tumble shares the paper's first three numbers, then draws its directions.
+        let u = keyed_styled(ThrowStyle::Tumble, 7, &r, 3);
+        assert_eq!(
+            (u.drop_height, u.velocity, u.spin),
+            (t.drop_height, t.velocity, t.spin)
+        );
+        assert_eq!(u, keyed_styled(ThrowStyle::Tumble, 7, &r, 3));
+        let back: Throw = serde_json::from_str(&serde_json::to_string(&u).unwrap()).unwrap();
+        assert_eq!(back, u);
+    }
+
+    #[test]
+    fn haar_rotations_are_uniform() {
+        // Under the Haar measure every rotated axis is uniform on the sphere: its components'
+        // squares average 1/3, |cos| to the vertical averages 1/2; and the quaternion's
+        // components' squares average 1/4. 20,000 draws: standard errors about 0.002.
+        let n = 20_000;
+        let r = ThrowRanges::default();
+        let (mut sq, mut cos, mut w2) = (Vector3::zeros(), 0.0, 0.0);
+        for i in 0..n {
+            let t = keyed_styled(ThrowStyle::Rest, 11, &r, i);
+            let turn = t.turn.unwrap();
+            let q = turn.orientation(Mode::ThreeD);
+            let x = q * Vector3::x();
+            sq += x.component_mul(&x);
+            cos += (q * Vector3::z()).y.abs();
+            w2 += turn.rotation[0].powi(2);
+        }
+        let nf = n as f64;
+        for v in (sq / nf).iter() {
+            assert!((v - 1.0 / 3.0).abs() < 0.01, "{v}");
+        }
+        assert!((cos / nf - 0.5).abs() < 0.01, "{}", cos / nf);
+        assert!((w2 / nf - 0.25).abs() < 0.01, "{}", w2 / nf);
+        for u in [0.0, 0.3, 0.999] {
+            let q = haar_quaternion(u, 0.7, 0.1);
+            assert!((q.iter().map(|c| c * c).sum::<f64>() - 1.0).abs() < 1e-15);
+            let a = unit_vector(u, 0.4);
+            assert!((a.iter().map(|c| c * c).sum::<f64>() - 1.0).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn a_rest_throw_touches_the_floor_at_rest() {
+        for mode in [Mode::ThreeD, Mode::TwoD] {
+            let scene = Scene::paper("40x30x20".parse().unwrap(), mode);
+            let half = Vector3::from(scene.body_sides()) / 2.0;
+            for i in 0..100 {
+                let t = keyed_styled(ThrowStyle::Rest, 5, &ThrowRanges::default(), i);
+                let s = t.start(&scene);
+                assert!(crate::model::die::lowest_point(&half, &s).abs() < 1e-15);
+                assert_eq!(s.linear_velocity, Vector3::zeros());
+                assert_eq!(s.angular_velocity, Vector3::zeros());
+                if mode == Mode::TwoD {
+                    let q = s.rotation.quaternion();
+                    assert_eq!((q.i, q.j), (0.0, 0.0));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_tumble_starts_clear_of_the_floor_with_its_drawn_motion() {
+        let r = ThrowRanges::default();
+        for mode in [Mode::ThreeD, Mode::TwoD] {
+            let scene = Scene::paper("140x24x20".parse().unwrap(), mode);
+            let half = Vector3::from(scene.body_sides()) / 2.0;
+            for i in 0..200 {
+                let t = keyed_styled(ThrowStyle::Tumble, 9, &r, i);
+                let s = t.start(&scene);
+                assert!(crate::model::die::lowest_point(&half, &s) > 0.0);
+                assert!((s.angular_velocity.norm() - t.spin).abs() < 1e-9 * t.spin);
+                assert!((s.linear_velocity.norm() - t.velocity.abs()).abs() < 1e-12);
+                assert_eq!(s.linear_velocity.y, 0.0);
+                if mode == Mode::TwoD {
+                    let q = s.rotation.quaternion();
+                    assert_eq!((q.i, q.j), (0.0, 0.0));
+                    assert_eq!(s.linear_velocity.z, 0.0);
+                    assert_eq!((s.angular_velocity.x, s.angular_velocity.y), (0.0, 0.0));
+                }
+            }
         }
     }
 }

@@ -212,6 +212,7 @@ pub fn report_markdown(res: &PaperResults, figures: &[&str]) -> String {
         s += &d.join("; ");
         s += ".\n\n";
     }
+    s += &crate::report::outcomes::paper_markdown(res);
     s += "## Reading\n\n";
     for e in &engines {
         for (m, name) in [("3d", "3D"), ("2d", "2D")] {

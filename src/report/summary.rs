@@ -90,6 +90,10 @@ pub struct RunSummary {
     pub ratio_err: f64,
     /// The 2D theory's ratio (eq. MasterEqu) for this block.
     pub theory_ratio: f64,
+    /// In 3D: P(breadth vertical), P(width vertical), P(length vertical), each ± its binomial
+    /// error, beside the solid-angle prediction (absent in 2D, or with no die on a face).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub outcomes: Option<crate::report::outcomes::Outcomes3d>,
     /// (ratio − theory) / ratio_err.
     pub z_theory: f64,
     /// Steps simulated over all rolls.
@@ -180,6 +184,12 @@ impl RunSummary {
             ratio,
             ratio_err,
             theory_ratio,
+            outcomes: match scene.mode {
+                Mode::ThreeD => {
+                    crate::report::outcomes::Outcomes3d::of(&scene.block, &tally.counts)
+                }
+                Mode::TwoD => None,
+            },
             z_theory: (ratio - theory_ratio) / ratio_err,
             steps_total: tally.steps,
             steps_mean: tally.steps as f64 / tally.rolls.max(1) as f64,
@@ -231,6 +241,24 @@ impl RunSummary {
             self.preset,
             self.floor
         );
+        // What is not DicePhys's: the throw style, damping, no sleeping.
+        let (scene, style) = (&self.spec.scene, self.spec.throws.style);
+        let mut extra = Vec::new();
+        if !style.is_paper() {
+            extra.push(format!("throw {style}"));
+        }
+        if scene.damped() {
+            extra.push(format!(
+                "damping {} (linear), {} (angular) 1/s",
+                scene.linear_damping, scene.angular_damping
+            ));
+        }
+        if !scene.sleeping {
+            extra.push("never asleep".into());
+        }
+        if !extra.is_empty() {
+            s += &format!("  {}\n", extra.join(", "));
+        }
         s += &format!(
             "  breadth vertical {:>8}   width vertical {:>8}   length vertical {:>6}   unknown {:>6}\n",
             c.breadth, c.width, c.length, c.unknown
@@ -239,6 +267,9 @@ impl RunSummary {
             "  ratio breadth/width  {:.4} ± {:.4}   theory {:.4}   ({:+.1} σ)\n",
             self.ratio, self.ratio_err, self.theory_ratio, self.z_theory
         );
+        if let Some(o) = &self.outcomes {
+            s += &format!("  {}\n", o.line());
+        }
         let failed: Vec<String> = self
             .failed
             .iter()

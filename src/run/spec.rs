@@ -6,7 +6,7 @@
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
 use crate::model::scene::Scene;
-use crate::model::throws::{ThrowKind, ThrowRanges, Throws};
+use crate::model::throws::{ThrowKind, ThrowRanges, ThrowStyle, Throws};
 use crate::sim::roll::RollConfig;
 use serde::{Deserialize, Serialize};
 
@@ -22,6 +22,10 @@ pub struct ThrowSpec {
     pub seed: u64,
     /// The ranges each throw's numbers are drawn from.
     pub ranges: ThrowRanges,
+    /// How each die is thrown: the paper's (left out of the JSON, so that a paper run's
+    /// specification and its key are as before), a tumble, or at rest.
+    #[serde(default, skip_serializing_if = "ThrowStyle::is_paper")]
+    pub style: ThrowStyle,
 }
 
 impl ThrowSpec {
@@ -31,12 +35,27 @@ impl ThrowSpec {
             kind: ThrowKind::Keyed,
             seed,
             ranges: ThrowRanges::default(),
+            style: ThrowStyle::Paper,
         }
     }
 
-    /// Checks the ranges and the seed.
+    /// Keyed throws from the paper's ranges, thrown in `style`.
+    pub fn keyed_style(seed: u64, style: ThrowStyle) -> ThrowSpec {
+        ThrowSpec {
+            style,
+            ..ThrowSpec::keyed(seed)
+        }
+    }
+
+    /// Checks the ranges, the seed, and that DicePhys's sequence is thrown the paper's way.
     pub fn validate(&self) -> Result<()> {
         self.ranges.validate()?;
+        if self.kind == ThrowKind::Dicephys && !self.style.is_paper() {
+            return Err(Error::Invalid(format!(
+                "--throw {}: the dicephys throw source draws the paper's throw only; use --throws keyed",
+                self.style
+            )));
+        }
         if self.kind == ThrowKind::Dicephys && self.seed > u32::MAX as u64 {
             return Err(Error::Invalid(format!(
                 "--seed {}: the dicephys throw source takes a 32-bit seed (srand)",
@@ -48,7 +67,7 @@ impl ThrowSpec {
 
     /// The throw source, able to give throws `0..n`.
     pub fn source(&self, n: u64) -> Throws {
-        Throws::new(self.kind, self.seed, self.ranges, n)
+        Throws::styled(self.kind, self.style, self.seed, self.ranges, n)
     }
 }
 

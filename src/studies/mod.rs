@@ -7,3 +7,4 @@ pub mod paper;
 pub mod stability;
 pub mod sweep;
 pub mod tradeoff;
+pub mod validate;

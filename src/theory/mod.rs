@@ -305,4 +305,29 @@ mod tests {
         assert!((p.breadth_vertical - two.breadth_vertical).abs() < 1e-3);
         assert!(p.length_vertical < 1e-3);
     }
+
+    #[test]
+    fn the_solid_angle_formula_is_simpsons() {
+        // The validation's P(i) = (2/π) arctan(w_j w_k / (w_i |w|)), w the sides and i the
+        // vertical one, is twice Simpson's one-face probability: simpson_3d is it, normalised.
+        for dims in [
+            (20.0, 20.0, 20.0),
+            (40.0, 20.0, 20.0),
+            (30.0, 20.0, 10.0),
+            (140.0, 24.0, 20.0),
+        ] {
+            let b = Block::from_mm(dims.0, dims.1, dims.2).unwrap();
+            let (l, br, w) = (b.length, b.breadth, b.width);
+            let norm = (l * l + br * br + w * w).sqrt();
+            let p = |wi: f64, wj: f64, wk: f64| FRAC_2_PI * (wj * wk / (wi * norm)).atan();
+            let (s, _) = simpson_3d(&b);
+            assert!((p(br, l, w) - s.breadth_vertical).abs() < 1e-14, "{dims:?}");
+            assert!((p(w, l, br) - s.width_vertical).abs() < 1e-14, "{dims:?}");
+            assert!((p(l, br, w) - s.length_vertical).abs() < 1e-14, "{dims:?}");
+            let total = p(br, l, w) + p(w, l, br) + p(l, br, w);
+            assert!((total - 1.0).abs() < 1e-14, "{dims:?}: {total}");
+        }
+        let cube = Block::from_mm(20.0, 20.0, 20.0).unwrap();
+        assert!((simpson_3d(&cube).0.length_vertical - 1.0 / 3.0).abs() < 1e-15);
+    }
 }

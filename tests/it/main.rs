@@ -14,3 +14,4 @@ mod slurm;
 mod speed;
 mod sweeps;
 mod theory_cli;
+mod validate;

@@ -361,7 +361,7 @@ fn a_resumed_run_writes_the_same_per_roll_rows_and_counts_its_whole_cost() {
         "140x22x13",
         "--2d",
         "--rolls",
-        "3000",
+        "8000",
         "--seed",
         "5",
     ];
@@ -373,20 +373,33 @@ fn a_resumed_run_writes_the_same_per_roll_rows_and_counts_its_whole_cost() {
         .unwrap();
     assert!(whole.status.success());
     let ck = d.join("ck");
-    let first = interrupted(
-        &args
-            .iter()
-            .copied()
-            .chain(["--json", "--checkpoint", ck.to_str().unwrap()])
-            .collect::<Vec<_>>(),
-        libc::SIGKILL,
-        600,
-    );
-    assert_ne!(
-        first.status.code(),
-        Some(0),
-        "finished before the kill: make it longer"
-    );
+    // Killed with SIGKILL once its first chunk is on disk: well before its end, whatever the
+    // machine's speed.
+    let mut child = bin()
+        .args(args)
+        .args(["--json", "--checkpoint", ck.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let chunk_written = || {
+        std::fs::read_dir(&ck)
+            .map(|d| {
+                d.flatten()
+                    .any(|e| e.file_name().to_string_lossy().starts_with("chunk-"))
+            })
+            .unwrap_or(false)
+    };
+    for _ in 0..1200 {
+        if chunk_written() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    child.kill().unwrap();
+    let status = child.wait().unwrap();
+    assert!(chunk_written(), "no chunk was checkpointed before the kill");
+    assert_ne!(status.code(), Some(0), "finished before the kill");
     let resumed_csv = d.join("resumed.csv");
     let resumed = bin()
         .args(["roll", "--json", "--resume", ck.to_str().unwrap()])

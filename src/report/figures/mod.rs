@@ -19,6 +19,7 @@ use plotters::prelude::*;
 
 pub mod paper;
 pub mod sweeps;
+pub mod validate;
 
 /// One plotted value with its one-standard-error bar (`y_err` 0, negative or non-finite: no bar).
 #[derive(Clone, Copy, Debug, PartialEq)]
