@@ -62,9 +62,9 @@ pub const LIMIT_FRICTION: f64 = 1.0;
 
 /// The limit cases' step cap: 5 s of 1 ms steps. A die released at rest comes to rest within
 /// 2 s (Rapier's slowest of 1,000 rolls: 1.6 s), or never: Bullet lets 26-28 % of 3D dice creep
-/// on their face past 20 s with sleeping off, of which about 2 % meet the rest rule between 5
-/// and 20 s; counted at the cap on the face region they are certified in, they land where
-/// they would have, at a quarter of the cost.
+/// on their face past 20 s with sleeping off, and 0.1-1.7 % of rolls meet the rest rule only
+/// between 5 and 20 s; counted at the cap on the face region they are certified in, they land
+/// where they would have, at a quarter of the cost.
 pub const LIMIT_MAX_STEPS: u64 = 5_000;
 
 /// A conserved quantity passes if it drifts by at most this fraction over the flight at
