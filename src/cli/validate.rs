@@ -11,7 +11,7 @@ use dicephys::model::block::Block;
 use dicephys::report::figures::validate as fig;
 use dicephys::report::figures::Point;
 use dicephys::studies::sweep::parse_dt;
-use dicephys::studies::validate::{self as v, Case, Row, Validation, Verdict};
+use dicephys::studies::validate::{self as v, Case, Row, Validation};
 use std::path::PathBuf;
 
 /// `dicephys validate`'s arguments.
@@ -255,61 +255,6 @@ fn figures(out: &std::path::Path, res: &Validation) -> Result<Vec<&'static str>>
     Ok(stems)
 }
 
-fn md_num(v: f64) -> String {
-    if !v.is_finite() {
-        "–".into()
-    } else if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e4) {
-        format!("{v:.2e}")
-    } else {
-        format!("{v:.4}")
-    }
-}
-
-/// The Markdown table of the rows, as the README quotes it.
-pub fn markdown_table(res: &Validation) -> String {
-    let mut s = String::from(
-        "| case | engine | subject | quantity | closed form | measured ± err | n | z | verdict | note |\n\
-         |---|---|---|---|---|---|---|---|---|---|\n",
-    );
-    for r in &res.rows {
-        let measured = if r.err.is_finite() {
-            format!("{} ± {:.4}", md_num(r.measured), r.err)
-        } else {
-            md_num(r.measured)
-        };
-        let z = if r.z.is_finite() {
-            format!("{:+.1}", r.z)
-        } else {
-            "–".into()
-        };
-        let mut note = r.note.clone();
-        if let Some(n) = r.rolls_to_resolve {
-            if !note.is_empty() {
-                note += "; ";
-            }
-            note += &format!("{n} rolls would resolve ±{}", res.config.resolve);
-        }
-        let verdict = match r.verdict {
-            Verdict::Fail => "**fail**".to_string(),
-            v => v.to_string(),
-        };
-        s += &format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
-            r.case,
-            r.engine,
-            r.subject,
-            r.quantity,
-            md_num(r.closed_form),
-            measured,
-            r.n,
-            z,
-            verdict,
-            note
-        );
-    }
-    s
-}
-
 fn report(res: &Validation, figures: &[&str]) -> String {
     let c = &res.config;
     let mut md = format!(
@@ -339,7 +284,7 @@ fn report(res: &Validation, figures: &[&str]) -> String {
         res.wall_s,
         res.cpu_s
     );
-    md += &markdown_table(res);
+    md += &v::markdown_table(res);
     md += "\n## Findings\n\n";
     for f in &res.findings {
         md += &format!("- {f}\n");

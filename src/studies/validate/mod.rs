@@ -1124,6 +1124,51 @@ fn num(v: f64) -> String {
     }
 }
 
+/// The Markdown table of the rows, as the README quotes it.
+pub fn markdown_table(res: &Validation) -> String {
+    let mut s = String::from(
+        "| case | engine | subject | quantity | closed form | measured ± err | n | z | verdict | note |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in &res.rows {
+        let measured = if r.err.is_finite() {
+            format!("{} ± {:.4}", num(r.measured), r.err)
+        } else {
+            num(r.measured)
+        };
+        let z = if r.z.is_finite() {
+            format!("{:+.1}", r.z)
+        } else {
+            "–".into()
+        };
+        let mut note = r.note.clone();
+        if let Some(n) = r.rolls_to_resolve {
+            if !note.is_empty() {
+                note += "; ";
+            }
+            note += &format!("{n} rolls would resolve ±{}", res.config.resolve);
+        }
+        let verdict = match r.verdict {
+            Verdict::Fail => "**fail**".to_string(),
+            v => v.to_string(),
+        };
+        s += &format!(
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            r.case,
+            r.engine,
+            r.subject,
+            r.quantity,
+            num(r.closed_form),
+            measured,
+            r.n,
+            z,
+            verdict,
+            note
+        );
+    }
+    s
+}
+
 /// One row as text; its note, and the rolls that would resolve it, after it.
 pub fn format_row(r: &Row) -> String {
     let measured = if r.err.is_finite() {
