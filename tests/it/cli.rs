@@ -1,20 +1,6 @@
 //! The command line as a user meets it: the built binary, its exit codes, its outputs.
 
-fn dicephys(args: &[&str]) -> std::process::Output {
-    super::helpers::bin()
-        .args(args)
-        .output()
-        .expect("run dicephys")
-}
-
-fn json(out: &std::process::Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("one JSON document")
-}
+use super::helpers::{dicephys, json};
 
 #[test]
 fn bad_input_gets_one_line_and_exit_code_2() {

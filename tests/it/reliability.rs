@@ -1,6 +1,7 @@
 //! Reliability: a killed run resumes bit for bit, shards merge into the whole, Ctrl-C stops
 //! cleanly, a non-finite roll is counted as failed.
 
+use super::helpers::json;
 use dicephys::engine::{new_engine, EngineKind};
 use dicephys::model::scene::{Mode, Scene};
 use dicephys::model::state::BodyState;
@@ -15,15 +16,6 @@ fn tmp(name: &str) -> std::path::PathBuf {
     let d = std::env::temp_dir().join(format!("dicephys-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     d
-}
-
-fn json(out: &std::process::Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
 }
 
 const RUN: [&str; 8] = [

@@ -5,6 +5,7 @@
 //! command's own verdict is 3; the seeds are fixed, so these are exact regressions, and 4
 //! leaves room for an engine upgrade's rounding to move a few dice).
 
+use super::helpers::{dicephys, json};
 use dicephys::engine::{new_engine, EngineKind};
 use dicephys::model::block::{Block, Outcome};
 use dicephys::model::scene::{Mode, Scene};
@@ -196,22 +197,6 @@ fn damping_slows_both_engines_by_the_same_rate_in_flight() {
             s.angular_velocity.z
         );
     }
-}
-
-fn dicephys(args: &[&str]) -> std::process::Output {
-    super::helpers::bin()
-        .args(args)
-        .output()
-        .expect("run dicephys")
-}
-
-fn json(out: &std::process::Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("one JSON document")
 }
 
 fn out_dir(name: &str) -> std::path::PathBuf {
