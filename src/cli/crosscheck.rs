@@ -7,11 +7,11 @@ use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::report::summary::{Cost, RunSummary};
 use dicephys::run::cputime::process_cpu_seconds;
-use dicephys::run::runner::Runner;
 use dicephys::run::spec::RunSpec;
 use dicephys::run::tally::Agreement;
 use dicephys::theory::stats;
 use serde::Serialize;
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// `dicephys crosscheck`'s arguments.
@@ -26,6 +26,10 @@ pub struct CrosscheckArgs {
     pub throw: ThrowArgs,
     #[command(flatten)]
     pub run: RunArgs,
+    /// Keep each engine's rolls here as they are made (a directory per engine, in chunks of
+    /// 1,000 rolls): the same command run again continues where it stopped.
+    #[arg(long, value_name = "DIR")]
+    pub checkpoint: Option<PathBuf>,
     /// Print one JSON document instead of the human summary.
     #[arg(long)]
     pub json: bool,
@@ -75,7 +79,7 @@ pub fn run(a: &CrosscheckArgs) -> Result<()> {
     };
     base.validate(a.scene.allow_restitution_above_one)?;
     let threads = a.run.threads()?;
-    let runner = Runner::new(threads, super::stop().clone());
+    let runner = super::runner(threads);
     let mut runs = Vec::new();
     let mut records = Vec::new();
     for &engine in &a.engines {
@@ -86,7 +90,12 @@ pub fn run(a: &CrosscheckArgs) -> Result<()> {
         let wall = Instant::now();
         let cpu = process_cpu_seconds();
         let mut recs = Vec::new();
-        let done = runner.run(&spec, None, &mut |r| {
+        let ck = a
+            .checkpoint
+            .as_ref()
+            .map(|d| runner.open_cell(&d.join(format!("{engine}-{}", spec.key())), &spec))
+            .transpose()?;
+        let done = runner.run(&spec, ck.as_ref(), &mut |r| {
             recs.extend_from_slice(r);
             Ok(())
         })?;
@@ -103,6 +112,10 @@ pub fn run(a: &CrosscheckArgs) -> Result<()> {
         }
         runs.push(RunSummary::new(&spec, &done.tally, cost));
         records.push(recs);
+    }
+    if super::is_task() {
+        // A cluster task's share: its chunks are kept for the finishing job; nothing to compare.
+        return Ok(());
     }
     let versus: Vec<Versus> = (1..runs.len())
         .map(|i| {

@@ -1,6 +1,7 @@
 //! The command line: a thin layer over the library. Each subcommand has a module of its own.
 
 use clap::{Parser, Subcommand};
+use dicephys::run::runner::{Chunks, Runner};
 use dicephys::run::stop::Stop;
 use error::Error;
 
@@ -64,6 +65,25 @@ pub fn stop() -> &'static Stop {
     STOP.get_or_init(Stop::new)
 }
 
+/// Which chunks this process rolls: all, unless `dicephys slurm task` or `slurm finish` set it,
+/// once, before running the command they run.
+pub fn chunks() -> &'static std::sync::OnceLock<Chunks> {
+    static CHUNKS: std::sync::OnceLock<Chunks> = std::sync::OnceLock::new();
+    &CHUNKS
+}
+
+/// The runner every command rolls with: these threads, stopped by Ctrl-C or SIGTERM, rolling
+/// the chunks [`chunks`] gives it.
+pub fn runner(threads: usize) -> Runner<'static> {
+    Runner::new(threads, stop().clone()).with_chunks(chunks().get().cloned().unwrap_or_default())
+}
+
+/// True in a cluster task, whose results are its share only: it keeps its chunks and reports
+/// nothing.
+pub fn is_task() -> bool {
+    chunks().get().is_some_and(Chunks::is_task)
+}
+
 /// Runs the command line; returns the process exit code (0 ok, 2 bad input, 1 failure, 130
 /// stopped early with what was done kept).
 pub fn main() -> i32 {
@@ -79,7 +99,19 @@ pub fn main() -> i32 {
         Ok(cli) => cli,
         Err(e) => return clap_error(e),
     };
-    let result = match cli.command {
+    let result = dispatch(cli.command);
+    match result {
+        Ok(()) | Err(Error::Closed) => 0,
+        Err(e) => {
+            eprintln!("dicephys: {e}");
+            e.exit_code()
+        }
+    }
+}
+
+/// Runs one command.
+pub fn dispatch(command: Command) -> error::Result<()> {
+    match command {
         Command::Bench(a) => bench::run(&a),
         Command::Converge(a) => sweeps::converge(&a),
         Command::Crosscheck(a) => crosscheck::run(&a),
@@ -92,13 +124,6 @@ pub fn main() -> i32 {
         Command::Slurm(a) => slurm::run(&a),
         Command::Trace(a) => trace::run(&a),
         Command::Validate(a) => validate::run(&a),
-    };
-    match result {
-        Ok(()) | Err(Error::Closed) => 0,
-        Err(e) => {
-            eprintln!("dicephys: {e}");
-            e.exit_code()
-        }
     }
 }
 

@@ -6,7 +6,6 @@ use super::outln;
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::report::paper as report;
-use dicephys::run::runner::Runner;
 use dicephys::sim::roll::DEFAULT_MAX_STEPS;
 use dicephys::studies::paper::{self, PaperConfig};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -86,7 +85,7 @@ pub fn run(a: &PaperArgs) -> Result<()> {
     // continues where it stopped.
     let ck = a.out.join("checkpoint");
     let progress = |n| bar.set_position(n);
-    let runner = Runner::new(threads, super::stop().clone());
+    let runner = super::runner(threads);
     let res = paper::run(
         &cfg,
         command_line,
@@ -94,6 +93,10 @@ pub fn run(a: &PaperArgs) -> Result<()> {
         Some(&ck),
     )?;
     bar.finish_and_clear();
+    if super::is_task() {
+        // A cluster task's share: its chunks are kept for the finishing job; nothing to report.
+        return Ok(());
+    }
     let md = report::report_markdown(&res, &["master_graph", "prob_2d", "len_graph", "dreidel"]);
     if res.partial {
         // A partial run leaves the last complete outputs alone: its report goes to stdout.

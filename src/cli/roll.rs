@@ -8,7 +8,7 @@ use dicephys::engine::EngineKind;
 use dicephys::report::per_roll::PerRoll;
 use dicephys::report::summary::{Cost, RunSummary};
 use dicephys::run::cputime::process_cpu_seconds;
-use dicephys::run::runner::{Checkpoint, Runner};
+use dicephys::run::runner::Checkpoint;
 use dicephys::run::spec::{RunSpec, Shard};
 use dicephys::sim::roll::RollRecord;
 use std::path::PathBuf;
@@ -116,7 +116,7 @@ pub fn run(a: &RollArgs) -> Result<()> {
     };
     let wall = Instant::now();
     let cpu = process_cpu_seconds();
-    let runner = Runner::new(threads, super::stop().clone());
+    let runner = super::runner(threads);
     let done = runner.run(&spec, checkpoint.as_ref(), &mut sink)?;
     // A resumed run's cost is the sum over its segments: the resumed chunks carry theirs.
     let cost = Cost {

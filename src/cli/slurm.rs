@@ -1,12 +1,19 @@
 //! `dicephys slurm`: a run as a Slurm job array and a finishing job that merges it exactly
 //! (the scripts: `dicephys::run::slurm`), and `dicephys slurm finish DIR`, the finishing step.
+//! `roll` is split into shards of its throws; the studies (`paper`, `crosscheck`, `converge`,
+//! `tradeoff`, `stability`) chunk by chunk, each task running the command itself with its
+//! share (`dicephys slurm task DIR K`), and the finishing job running it once more.
 
+use super::crosscheck::CrosscheckArgs;
 use super::error::{Error, Result};
 use super::outln;
+use super::paper::PaperArgs;
 use super::roll::RollArgs;
-use clap::{Args, Subcommand};
+use super::sweeps::{ConvergeArgs, StabilityArgs, TradeoffArgs};
+use super::{Cli, Command};
+use clap::{Args, Parser, Subcommand};
 use dicephys::report::summary::{RunSummary, ShardResult};
-use dicephys::run::runner::Checkpoint;
+use dicephys::run::runner::{Checkpoint, Chunks};
 use dicephys::run::slurm::{self, Layout, Options, Plan};
 use std::path::{Path, PathBuf};
 
@@ -22,8 +29,41 @@ pub struct SlurmArgs {
 pub enum SlurmCommand {
     /// `roll` as a job array: task K of N rolls shard K/N; the finishing job merges them.
     Roll(Box<SlurmRollArgs>),
-    /// The finishing job: check that every task's result is there, merge, write DIR/result.*.
+    /// `paper` as a job array: the tasks share the cells' chunks; the finishing job writes
+    /// the report into --dir.
+    Paper(Box<SlurmStudyArgs<PaperArgs>>),
+    /// `crosscheck` as a job array; the finishing job's comparison is DIR/result.txt.
+    Crosscheck(Box<SlurmStudyArgs<CrosscheckArgs>>),
+    /// `converge` as a job array; the finishing job writes the study into --dir.
+    Converge(Box<SlurmStudyArgs<ConvergeArgs>>),
+    /// `tradeoff` as a job array; the finishing job writes the study into --dir.
+    Tradeoff(Box<SlurmStudyArgs<TradeoffArgs>>),
+    /// `stability` as a job array; the finishing job writes the study into --dir.
+    Stability(Box<SlurmStudyArgs<StabilityArgs>>),
+    /// The finishing job: check that every task has finished, then merge (roll) or assemble
+    /// (the studies) into DIR.
     Finish(FinishArgs),
+    /// One array task of a study: its share of the chunks (run by the array script).
+    #[command(hide = true)]
+    Task(TaskArgs),
+}
+
+/// `dicephys slurm <study>`'s arguments: the study's and the job's.
+#[derive(Args, Debug)]
+pub struct SlurmStudyArgs<T: Args> {
+    #[command(flatten)]
+    pub study: T,
+    #[command(flatten)]
+    pub job: JobArgs,
+}
+
+/// `dicephys slurm task`'s arguments.
+#[derive(Args, Debug)]
+pub struct TaskArgs {
+    /// The run's directory.
+    pub dir: PathBuf,
+    /// This task, 0 ≤ K < the run's tasks.
+    pub k: u64,
 }
 
 /// The scheduler's side: how many tasks, where, which queue.
@@ -73,8 +113,151 @@ pub struct FinishArgs {
 pub fn run(a: &SlurmArgs) -> Result<()> {
     match &a.command {
         SlurmCommand::Roll(r) => roll(r),
+        SlurmCommand::Paper(a) => study(&a.job),
+        SlurmCommand::Crosscheck(a) => study(&a.job),
+        SlurmCommand::Converge(a) => study(&a.job),
+        SlurmCommand::Tradeoff(a) => study(&a.job),
+        SlurmCommand::Stability(a) => study(&a.job),
         SlurmCommand::Finish(f) => finish(&f.dir),
+        SlurmCommand::Task(t) => task(&t.dir, t.k),
     }
+}
+
+/// The scheduler's options, which `dicephys slurm` takes and the study does not.
+const JOB_OPTIONS: [&str; 6] = [
+    "--tasks",
+    "--dir",
+    "--partition",
+    "--time",
+    "--account",
+    "--bin",
+];
+
+/// The study's own command line, from this process's: the words after `slurm`, without the
+/// scheduler's options (clap has parsed them all already).
+fn study_args() -> Vec<String> {
+    let argv: Vec<String> = std::env::args().collect();
+    let start = argv
+        .iter()
+        .position(|w| w == "slurm")
+        .map_or(argv.len(), |i| i + 1);
+    let mut args = Vec::new();
+    let mut words = argv[start..].iter();
+    while let Some(w) = words.next() {
+        if w == "--submit" {
+            continue;
+        }
+        if JOB_OPTIONS.contains(&w.as_str()) {
+            words.next();
+            continue;
+        }
+        if JOB_OPTIONS.iter().any(|o| w.starts_with(&format!("{o}="))) {
+            continue;
+        }
+        args.push(w.clone());
+    }
+    args
+}
+
+/// Parses a study's command line again (as a task or the finishing job does).
+fn parse_study(args: &[String]) -> Result<Command> {
+    let cli =
+        Cli::try_parse_from(std::iter::once("dicephys".to_string()).chain(args.iter().cloned()))
+            .map_err(|e| {
+                Error::Usage(format!(
+                    "slurm: the stored command line does not parse: {}",
+                    e.kind()
+                ))
+            })?;
+    Ok(cli.command)
+}
+
+/// Points a study at the run's directory and its threads: its outputs (and checkpoints) go to
+/// DIR, on every task and in the finishing job alike.
+fn place(cmd: &mut Command, lay: &Layout, threads: usize) -> Result<()> {
+    match cmd {
+        Command::Paper(a) => (a.out, a.threads) = (lay.dir.clone(), threads),
+        Command::Converge(a) => (a.out, a.threads) = (lay.dir.clone(), threads),
+        Command::Tradeoff(a) => (a.out, a.threads) = (lay.dir.clone(), threads),
+        Command::Stability(a) => (a.out, a.threads) = (lay.dir.clone(), threads),
+        Command::Crosscheck(a) => (a.checkpoint, a.run.threads) = (Some(lay.cells()), threads),
+        _ => return Err(Error::Usage("slurm: not a study this runs".into())),
+    }
+    Ok(())
+}
+
+/// The threads the study asked for (0: one per core).
+fn threads_of(cmd: &Command) -> usize {
+    match cmd {
+        Command::Paper(a) => a.threads,
+        Command::Converge(a) => a.threads,
+        Command::Tradeoff(a) => a.threads,
+        Command::Stability(a) => a.threads,
+        Command::Crosscheck(a) => a.run.threads,
+        _ => 1,
+    }
+}
+
+fn study(job: &JobArgs) -> Result<()> {
+    let args = study_args();
+    let name = args.first().cloned().unwrap_or_default();
+    for w in &args {
+        for (flag, why) in [
+            ("--out", "the study writes its outputs into --dir"),
+            ("--checkpoint", "the tasks keep their chunks under --dir"),
+        ] {
+            if w == flag || w.starts_with(&format!("{flag}=")) {
+                return Err(Error::Usage(format!("slurm {name}: {flag}: {why}")));
+            }
+        }
+    }
+    let cmd = parse_study(&args)?;
+    // A cluster task takes the threads it asks for; "one per core" means one.
+    let threads = threads_of(&cmd).max(1);
+    super::args::threads(threads)?;
+    let plan = Plan::Study {
+        args,
+        threads,
+        tasks: job.tasks,
+    };
+    let (lay, opt, bin) = prepare(&plan, job, threads)?;
+    std::fs::create_dir_all(lay.tasks())
+        .map_err(|e| Error::Run(format!("{}: {e}", lay.tasks().display())))?;
+    emit(&plan, &lay, &opt, &bin, job.submit)
+}
+
+/// One array task of a study: the command with this task's share of the chunks, then its mark.
+fn task(dir: &Path, k: u64) -> Result<()> {
+    let lay = Layout {
+        dir: dir.to_path_buf(),
+    };
+    let Plan::Study {
+        args,
+        threads,
+        tasks,
+    } = read_plan(&lay)?
+    else {
+        return Err(Error::Usage(format!(
+            "slurm task: {} is not a study's run",
+            dir.display()
+        )));
+    };
+    if k >= tasks {
+        return Err(Error::Usage(format!(
+            "slurm task {k}: the run has tasks 0 to {}",
+            tasks - 1
+        )));
+    }
+    let mut cmd = parse_study(&args)?;
+    place(&mut cmd, &lay, threads)?;
+    let _ = super::chunks().set(Chunks::task(k, tasks));
+    super::dispatch(cmd)?;
+    super::output(&lay.task_done(k))?.write(format!("task {k} of {tasks}\n").as_bytes())?;
+    eprintln!(
+        "task {k}: its share is rolled ({})",
+        lay.task_done(k).display()
+    );
+    Ok(())
 }
 
 fn roll(a: &SlurmRollArgs) -> Result<()> {
@@ -100,7 +283,7 @@ fn roll(a: &SlurmRollArgs) -> Result<()> {
     }
     let spec = r.spec()?;
     let plan = Plan::Roll {
-        spec: spec.clone(),
+        spec: Box::new(spec.clone()),
         tasks: a.job.tasks,
     };
     let threads = r.run.threads.max(1);
@@ -198,7 +381,7 @@ fn emit(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path, submit: bool) -> R
             "#   sbatch --dependency=afterany:${{jid%%;*}} {}",
             slurm::quote(&f.to_string_lossy())
         );
-        outln!("# result: {}", lay.result_json().display());
+        outln!("# result: {}", result_of(plan, lay));
         return Ok(());
     }
     let array_id = sbatch(&[a.as_os_str()])?;
@@ -208,9 +391,22 @@ fn emit(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path, submit: bool) -> R
         "array job {array_id} ({} tasks), finishing job {fin_id}",
         plan.tasks()
     );
-    outln!("result: {}", lay.result_json().display());
+    outln!("result: {}", result_of(plan, lay));
     outln!("logs: {}", lay.logs().display());
     Ok(())
+}
+
+/// Where the finishing job puts the result, for the user.
+fn result_of(plan: &Plan, lay: &Layout) -> String {
+    match plan {
+        Plan::Roll { .. } => lay.result_json().display().to_string(),
+        Plan::Study { .. } => format!(
+            "{} (the {} outputs; its printed report in {})",
+            lay.dir.display(),
+            plan.command(),
+            lay.stdout().display()
+        ),
+    }
 }
 
 /// Runs `sbatch --parsable ARGS` and returns the job id it prints.
@@ -247,6 +443,24 @@ fn finish(dir: &Path) -> Result<()> {
     };
     let plan = read_plan(&lay)?;
     match &plan {
+        Plan::Study {
+            args,
+            threads,
+            tasks,
+        } => {
+            let missing: Vec<String> = (0..*tasks)
+                .filter(|&k| !lay.task_done(k).exists())
+                .map(|k| k.to_string())
+                .collect();
+            if !missing.is_empty() {
+                return Err(not_finished(&lay, *tasks, &missing, "no mark in tasks/"));
+            }
+            let mut cmd = parse_study(args)?;
+            place(&mut cmd, &lay, *threads)?;
+            // Every chunk is on disk: the study reads them all and rolls none.
+            let _ = super::chunks().set(Chunks::Assemble);
+            super::dispatch(cmd)?;
+        }
         Plan::Roll { spec, tasks } => {
             let mut parts = Vec::new();
             let mut missing = Vec::new();
@@ -262,17 +476,7 @@ fn finish(dir: &Path) -> Result<()> {
                 }
             }
             if !missing.is_empty() {
-                return Err(Error::Run(format!(
-                    "slurm finish: {} of {tasks} tasks have not finished: {} ({}); \
-                     rerun them with `sbatch --array={} {}` (each resumes from its checkpoint), \
-                     then `sbatch {}`",
-                    missing.len(),
-                    missing.join(", "),
-                    why.join("; "),
-                    missing.join(","),
-                    lay.array_script().display(),
-                    lay.finish_script().display()
-                )));
+                return Err(not_finished(&lay, *tasks, &missing, &why.join("; ")));
             }
             let merged = RunSummary::merge(&parts)?;
             let json =
@@ -292,6 +496,20 @@ fn finish(dir: &Path) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The finishing job's refusal: which tasks have not finished, and how to finish them.
+fn not_finished(lay: &Layout, tasks: u64, missing: &[String], why: &str) -> Error {
+    Error::Run(format!(
+        "slurm finish: {} of {tasks} tasks have not finished: {} ({why}); \
+         rerun them with `sbatch --array={} {}` (each resumes from its checkpoint), \
+         then `sbatch {}`",
+        missing.len(),
+        missing.join(", "),
+        missing.join(","),
+        lay.array_script().display(),
+        lay.finish_script().display()
+    ))
 }
 
 /// One task's result, if it is there, whole, and of this task.

@@ -9,7 +9,6 @@ use dicephys::engine::EngineKind;
 use dicephys::model::block::Block;
 use dicephys::report::figures::sweeps as fig;
 use dicephys::report::figures::Point;
-use dicephys::run::runner::Runner;
 use dicephys::studies::stability::Sweep;
 use dicephys::studies::sweep::{dt_label, parse_dt, Study};
 use dicephys::studies::{converge, stability, tradeoff};
@@ -127,7 +126,7 @@ pub(super) fn check_common(
     super::output(&out.join(file))?;
     super::output(&out.join("report.md"))?;
     Ok(Study {
-        runner: Runner::new(threads, super::stop().clone()),
+        runner: super::runner(threads),
         checkpoint: Some(out.join("checkpoint")),
     })
 }
@@ -176,9 +175,12 @@ pub fn converge(a: &ConvergeArgs) -> Result<()> {
         seed: a.seed,
         max_steps: a.max_steps,
     };
-    let res = logged(a.json, &converge::header(), |log| {
+    let Some(res) = logged(a.json, &converge::header(), |log| {
         converge::run(&cfg, &study, log)
-    })?;
+    })?
+    else {
+        return Ok(());
+    };
     let lines: Vec<fig::Line> = group(&res.cells, |c| {
         format!("{} {} {}", c.block, c.engine, c.mode)
     })
@@ -247,9 +249,12 @@ pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
         seed: a.seed,
         max_steps: a.max_steps,
     };
-    let res = logged(a.json, &tradeoff::header(), |log| {
+    let Some(res) = logged(a.json, &tradeoff::header(), |log| {
         tradeoff::run(&cfg, &study, log)
-    })?;
+    })?
+    else {
+        return Ok(());
+    };
     let mut pts = Vec::new();
     for m in &res.modes {
         for r in &m.rows {
@@ -337,9 +342,12 @@ pub fn stability(a: &StabilityArgs) -> Result<()> {
         max_steps: a.max_steps,
         floor_thickness: a.floor_thickness,
     };
-    let res = logged(a.json, &stability::header(), |log| {
+    let Some(res) = logged(a.json, &stability::header(), |log| {
         stability::run(&cfg, &study, log)
-    })?;
+    })?
+    else {
+        return Ok(());
+    };
     let mut figures = Vec::new();
     for kind in stability::KINDS {
         let panels: Vec<fig::Panel> = group(
@@ -427,19 +435,23 @@ fn floor_note(thickness: f64) -> String {
     }
 }
 
-/// Runs a sweep, logging its header and each cell to stderr unless the output is JSON.
+/// Runs a sweep, logging its header and each cell to stderr unless the output is JSON. In a
+/// cluster task it runs silently and gives None: the task's share is for the finishing job to
+/// assemble, not to report.
 pub(super) fn logged<T>(
     quiet: bool,
     header: &str,
     run: impl FnOnce(&dyn Fn(&str)) -> dicephys::Result<T>,
-) -> Result<T> {
+) -> Result<Option<T>> {
+    let task = super::is_task();
+    let quiet = quiet || task;
     if !quiet {
         eprintln!("{header}");
     }
-    run(&|l| {
+    let res = run(&|l| {
         if !quiet {
             eprintln!("{l}")
         }
-    })
-    .map_err(Error::from)
+    })?;
+    Ok((!task).then_some(res))
 }

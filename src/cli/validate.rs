@@ -86,7 +86,9 @@ pub fn run(a: &ValidateArgs) -> Result<()> {
     };
     cfg.validate()?;
     let study = check_common(a.rolls, cfg.max_steps, a.threads, &a.out, "validate.json")?;
-    let res = logged(a.json, &v::header(), |log| v::run(&cfg, &study, log))?;
+    let Some(res) = logged(a.json, &v::header(), |log| v::run(&cfg, &study, log))? else {
+        return Ok(());
+    };
     let figures = figures(&a.out, &res)?;
     finish(
         &a.out,

@@ -16,6 +16,8 @@ use crate::sim::roll::RollRecord;
 use serde::{Deserialize, Serialize};
 use std::fs::File;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 
 /// Rolls per chunk: a chunk file per 1,000 rolls costs nothing.
 pub const CHUNK: u64 = 1000;
@@ -29,6 +31,57 @@ pub struct Runner<'a> {
     pub stop: Stop,
     /// Called with the rolls finished so far in the current run, from any thread.
     pub progress: &'a (dyn Fn(u64) + Sync),
+    /// Which chunks this process rolls: all of them, except on a cluster.
+    pub chunks: Chunks,
+}
+
+/// Which of its runs' chunks a process rolls. On one machine, all. On a cluster, a study of
+/// several cells (`paper`, the sweeps, `crosscheck`) is split chunk by chunk among the tasks of
+/// a job array, all writing into the same checkpoint directories; the finishing job then runs
+/// the study once more and finds every chunk there, so its counts are those of one machine.
+#[derive(Clone, Debug, Default)]
+pub enum Chunks {
+    /// Roll every chunk not already in the checkpoint.
+    #[default]
+    All,
+    /// Task `k` of `n`: of the chunks this process meets, counted over all its runs in the
+    /// order it meets them (a study's order does not depend on its results), the j-th is its
+    /// own when j mod n = k; it rolls those and passes over the rest. Its tallies are partial,
+    /// for the finishing job to assemble, never to report.
+    Task {
+        /// This task, 0 ≤ k < n.
+        k: u64,
+        /// How many tasks.
+        n: u64,
+        /// Chunks met so far.
+        met: Arc<AtomicU64>,
+    },
+    /// Roll nothing: every chunk must be in the checkpoint already (the finishing job).
+    Assemble,
+}
+
+impl Chunks {
+    /// Task `k` of `n`.
+    pub fn task(k: u64, n: u64) -> Chunks {
+        Chunks::Task {
+            k,
+            n,
+            met: Arc::new(AtomicU64::new(0)),
+        }
+    }
+
+    /// Whether this process takes the next chunk it meets.
+    fn take_next(&self) -> bool {
+        match self {
+            Chunks::Task { k, n, met } => met.fetch_add(1, Ordering::Relaxed) % n == *k,
+            _ => true,
+        }
+    }
+
+    /// True for a task's share: its tallies are partial by design.
+    pub fn is_task(&self) -> bool {
+        matches!(self, Chunks::Task { .. })
+    }
 }
 
 /// Worker threads: 0 means one per core.
@@ -75,6 +128,22 @@ impl<'a> Runner<'a> {
             threads: threads(threads_asked),
             stop,
             progress: &|_| {},
+            chunks: Chunks::All,
+        }
+    }
+
+    /// The same runner, rolling only the chunks `chunks` gives it.
+    pub fn with_chunks(self, chunks: Chunks) -> Runner<'a> {
+        Runner { chunks, ..self }
+    }
+
+    /// Opens a cell's checkpoint directory for `spec` (see [`Checkpoint::open_fresh`]). A
+    /// task of a cluster run shares the directory with the other tasks: it takes a lock of its
+    /// own, and refuses, rather than empties, a directory holding another run.
+    pub fn open_cell(&self, dir: &Path, spec: &RunSpec) -> Result<Checkpoint> {
+        match &self.chunks {
+            Chunks::Task { k, .. } => Checkpoint::open_as(dir, spec, &format!("lock-task-{k}")),
+            _ => Checkpoint::open_fresh(dir, spec),
         }
     }
 
@@ -84,13 +153,16 @@ impl<'a> Runner<'a> {
             threads: self.threads,
             stop: self.stop.clone(),
             progress,
+            chunks: self.chunks.clone(),
         }
     }
 
     /// Rolls the run's throws chunk by chunk, reading finished chunks from `checkpoint` and
     /// writing new ones there; each chunk's records go to `sink` in index order and are then
     /// dropped, so memory stays flat however many rolls. Ends early (complete = false) on a
-    /// stop request, with every roll made so far counted.
+    /// stop request, with every roll made so far counted. A cluster task passes over the
+    /// chunks that are not its own (and is complete when its own are done); the finishing
+    /// job rolls nothing, and a chunk missing from the checkpoint is an error for it.
     pub fn run(
         &self,
         spec: &RunSpec,
@@ -110,6 +182,9 @@ impl<'a> Runner<'a> {
         for c in 0..indices.len().div_ceil(CHUNK) {
             let chunk = indices.chunk(c, CHUNK);
             let path = checkpoint.map(|d| d.chunk_path(chunk[0], chunk.len()));
+            if !self.chunks.take_next() {
+                continue;
+            }
             if let Some(p) = path.as_ref().filter(|p| p.exists()) {
                 let file = read_chunk(p, &key, &chunk)?;
                 done.resumed += file.records.len() as u64;
@@ -119,6 +194,15 @@ impl<'a> Runner<'a> {
                 sink(&file.records)?;
                 (self.progress)(done.tally.rolls);
                 continue;
+            }
+            if let Chunks::Assemble = self.chunks {
+                let first = chunk[0];
+                return Err(Error::Failed(format!(
+                    "{}: throws {first}.. ({} of them) were never rolled; the task that rolls \
+                     them has not finished",
+                    path.map_or_else(|| "no checkpoint".into(), |p| p.display().to_string()),
+                    chunk.len()
+                )));
             }
             if self.stop.requested() {
                 return Ok(done);
@@ -207,31 +291,37 @@ impl Checkpoint {
     /// Opens `dir` for `spec`: creates it with the specification in it, or checks that it
     /// holds this very run; and takes its lock, or says who holds it.
     pub fn open(dir: &Path, spec: &RunSpec) -> Result<Checkpoint> {
+        Checkpoint::open_as(dir, spec, "lock")
+    }
+
+    /// [`Checkpoint::open`] with the lock file `lock_name`: the tasks of a cluster run each
+    /// hold their own on a directory they share, writing chunks no other task writes.
+    fn open_as(dir: &Path, spec: &RunSpec, lock_name: &str) -> Result<Checkpoint> {
         std::fs::create_dir_all(dir).map_err(|e| {
             Error::Invalid(format!(
                 "checkpoint {}: cannot create it ({e})",
                 dir.display()
             ))
         })?;
-        let lock = lock(dir)?;
-        match Checkpoint::spec_in(dir) {
-            Ok(stored) if stored == *spec => {}
-            Ok(_) => {
-                return Err(Error::Mismatch(format!(
-                    "checkpoint {}: it holds another run; resume that with --resume, or use a new directory",
-                    dir.display()
-                )))
-            }
-            Err(_) if !dir.join("spec.json").exists() => {
-                let stored = Stored {
-                    key: spec.key(),
-                    spec: spec.clone(),
-                };
-                let json = serde_json::to_string_pretty(&stored)
-                    .map_err(|e| Error::Failed(e.to_string()))?;
-                write_atomic(&dir.join("spec.json"), json.as_bytes())?;
-            }
-            Err(e) => return Err(e),
+        let lock = lock(&dir.join(lock_name))?;
+        // Written when absent, then read back: tasks of a cluster run that open a new cell at
+        // the same moment each write the same whole file (an atomic rename), and the one
+        // read back decides.
+        let file = dir.join("spec.json");
+        if !file.exists() {
+            let stored = Stored {
+                key: spec.key(),
+                spec: spec.clone(),
+            };
+            let json =
+                serde_json::to_string_pretty(&stored).map_err(|e| Error::Failed(e.to_string()))?;
+            write_atomic(&file, json.as_bytes())?;
+        }
+        if Checkpoint::spec_in(dir)? != *spec {
+            return Err(Error::Mismatch(format!(
+                "checkpoint {}: it holds another run; resume that with --resume, or use a new directory",
+                dir.display()
+            )));
         }
         Ok(Checkpoint {
             dir: dir.to_path_buf(),
@@ -273,21 +363,21 @@ impl Checkpoint {
 
 /// Takes the directory's lock file, writing this process's id into it; if another process
 /// holds it, says which.
-fn lock(dir: &Path) -> Result<File> {
+fn lock(path: &Path) -> Result<File> {
     use std::io::{Read, Seek, Write};
-    let path = dir.join("lock");
+    let dir = path.parent().unwrap_or(Path::new("."));
     let mut f = std::fs::OpenOptions::new()
         .read(true)
         .write(true)
         .create(true)
         .truncate(false)
-        .open(&path)
-        .map_err(|e| Error::io(&path, e))?;
+        .open(path)
+        .map_err(|e| Error::io(path, e))?;
     match f.try_lock() {
         Ok(()) => {
-            f.set_len(0).map_err(|e| Error::io(&path, e))?;
-            f.rewind().map_err(|e| Error::io(&path, e))?;
-            writeln!(f, "pid {}", std::process::id()).map_err(|e| Error::io(&path, e))?;
+            f.set_len(0).map_err(|e| Error::io(path, e))?;
+            f.rewind().map_err(|e| Error::io(path, e))?;
+            writeln!(f, "pid {}", std::process::id()).map_err(|e| Error::io(path, e))?;
             Ok(f)
         }
         Err(std::fs::TryLockError::WouldBlock) => {
@@ -299,6 +389,6 @@ fn lock(dir: &Path) -> Result<File> {
                 holder.trim()
             )))
         }
-        Err(std::fs::TryLockError::Error(e)) => Err(Error::io(&path, e)),
+        Err(std::fs::TryLockError::Error(e)) => Err(Error::io(path, e)),
     }
 }

@@ -8,6 +8,12 @@
 //! [`RunSpec`]. A task runs `dicephys roll --resume DIR/shard-K`, so a task that is requeued
 //! or resubmitted continues from its last whole chunk, and no command line is ever re-parsed.
 //!
+//! A study of several cells (`paper`, `crosscheck`, `converge`, `tradeoff`, `stability`) is
+//! split chunk by chunk instead ([`crate::run::runner::Chunks`]): task K runs the command with
+//! its share of the chunks, into the checkpoint directories under `DIR` that all tasks share,
+//! and marks itself done in `DIR/tasks/`; the finishing job runs the very command once more,
+//! rolling nothing, and writes its outputs into `DIR` exactly as one machine would.
+//!
 //! This module writes the scripts; it never calls the scheduler.
 
 use crate::error::{Error, Result};
@@ -25,8 +31,19 @@ pub enum Plan {
     /// `dicephys roll`, its throws split into `tasks` shards.
     Roll {
         /// The whole run (no shard).
-        spec: RunSpec,
+        spec: Box<RunSpec>,
         /// Array tasks, one shard each.
+        tasks: u64,
+    },
+    /// A study of several cells: `dicephys ARGS`, its chunks shared among the tasks.
+    Study {
+        /// The command line after `dicephys`, as given (without the scheduler's options);
+        /// the tasks and the finishing job parse it again, then write into the run's
+        /// directory and take `threads` threads.
+        args: Vec<String>,
+        /// Threads per task (each task's `--cpus-per-task`).
+        threads: usize,
+        /// Array tasks.
         tasks: u64,
     },
 }
@@ -35,14 +52,15 @@ impl Plan {
     /// The array's tasks.
     pub fn tasks(&self) -> u64 {
         match self {
-            Plan::Roll { tasks, .. } => *tasks,
+            Plan::Roll { tasks, .. } | Plan::Study { tasks, .. } => *tasks,
         }
     }
 
     /// The command it runs, for job names and messages.
-    pub fn command(&self) -> &'static str {
+    pub fn command(&self) -> &str {
         match self {
             Plan::Roll { .. } => "roll",
+            Plan::Study { args, .. } => args.first().map_or("study", String::as_str),
         }
     }
 
@@ -99,6 +117,23 @@ impl Layout {
     /// The finishing job's script.
     pub fn finish_script(&self) -> PathBuf {
         self.dir.join("finish.sh")
+    }
+    /// Where the tasks of a study mark themselves done.
+    pub fn tasks(&self) -> PathBuf {
+        self.dir.join("tasks")
+    }
+    /// Task k's mark: written when its share of a study is rolled.
+    pub fn task_done(&self, k: u64) -> PathBuf {
+        self.tasks().join(format!("task-{k}.done"))
+    }
+    /// The checkpoint directory of a study's cells (`crosscheck --checkpoint`; the other
+    /// studies keep theirs under their `--out`, which is the run's directory).
+    pub fn cells(&self) -> PathBuf {
+        self.dir.join("checkpoint")
+    }
+    /// What the finishing job of a study printed (the command's standard output).
+    pub fn stdout(&self) -> PathBuf {
+        self.dir.join("result.txt")
     }
     /// The jobs' logs.
     pub fn logs(&self) -> PathBuf {
@@ -202,6 +237,13 @@ pub fn array_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Res
             b = quote(bin),
             t = opt.cpus,
         ),
+        Plan::Study { .. } => format!(
+            "done={d}/tasks/task-$k.done\n\
+             if [ -e \"$done\" ]; then\n  echo \"task $k: done already ($done)\"\n  exit 0\nfi\n\
+             exec {b} slurm task {d} \"$k\"\n",
+            d = quote(dir),
+            b = quote(bin),
+        ),
     };
     Ok(format!(
         "#!/bin/bash\n\
@@ -227,7 +269,8 @@ pub fn array_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Res
 /// The finishing job's script: `dicephys slurm finish DIR`, which refuses an incomplete run,
 /// naming the missing tasks, and otherwise writes the merged result (again, if rerun).
 pub fn finish_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Result<String> {
-    let dir = path_str(&lay.dir)?;
+    let d = quote(path_str(&lay.dir)?);
+    let b = quote(path_str(bin)?);
     let logs = lay.logs();
     let logs = path_str(&logs)?;
     Ok(format!(
@@ -238,12 +281,24 @@ pub fn finish_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Re
          #SBATCH --open-mode=append\n\
          #SBATCH --output={logs}/finish.out\n\
          {extra}\
-         exec {b} slurm finish {d}\n",
+         {run}",
+        run = match plan {
+            Plan::Roll { .. } => format!("exec {b} slurm finish {d}\n"),
+            // The study's report is its standard output: kept whole in DIR/result.txt.
+            Plan::Study { .. } => format!(
+                "tmp={d}/.result.txt.${{SLURM_JOB_ID:-$$}}\n\
+                 {b} slurm finish {d} >\"$tmp\"\n\
+                 rc=$?\n\
+                 if [ $rc -ne 0 ]; then\n  rm -f \"$tmp\"\n  exit $rc\nfi\n\
+                 mv -f \"$tmp\" {d}/result.txt\n\
+                 echo \"dicephys {cmd}: {n} tasks assembled into {d}\"\n",
+                cmd = plan.command(),
+                n = plan.tasks(),
+            ),
+        },
         cmd = plan.command(),
         n = plan.tasks(),
         logs = quote(logs),
         extra = opt.lines(),
-        b = quote(path_str(bin)?),
-        d = quote(dir),
     ))
 }

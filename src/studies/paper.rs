@@ -11,7 +11,7 @@ use crate::report::paper::{PaperResults, Provenance, SimCell};
 use crate::report::summary::{Cost, RunSummary};
 use crate::report::table::{table_report, TableReport};
 use crate::run::cputime::process_cpu_seconds;
-use crate::run::runner::{Checkpoint, Runner};
+use crate::run::runner::Runner;
 use crate::run::spec::{RunSpec, ThrowSpec};
 use crate::sim::roll::{early_stop_exact, RollConfig, Rule};
 use crate::theory::stats;
@@ -134,13 +134,14 @@ pub fn run(
                     rolls: cfg.rolls,
                     shard: None,
                 };
-                let ck = match checkpoint_dir {
-                    Some(d) => Some(Checkpoint::open_fresh(
-                        &d.join(format!("row{row}-{engine}-{}", mode.name())),
-                        &spec,
-                    )?),
-                    None => None,
-                };
+                let ck =
+                    match checkpoint_dir {
+                        Some(d) => Some(runner.open_cell(
+                            &d.join(format!("row{row}-{engine}-{}", mode.name())),
+                            &spec,
+                        )?),
+                        None => None,
+                    };
                 let progress = |n| (runner.progress)(base + n);
                 let done = runner
                     .with_progress(&progress)

@@ -14,7 +14,7 @@ use crate::error::{Error, Result};
 use crate::model::scene::Scene;
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::io::write_atomic;
-use crate::run::runner::{Checkpoint, Runner};
+use crate::run::runner::Runner;
 use crate::run::spec::{RunSpec, ThrowSpec};
 use crate::run::tally::Tally;
 use crate::sim::roll::RollConfig;
@@ -90,7 +90,12 @@ pub fn measure(spec: &RunSpec, study: &Study) -> Result<Measured> {
         .checkpoint
         .as_ref()
         .map(|root| root.join(format!("{}-{}", spec.engine, spec.key())));
-    let kept = dir.as_ref().map(|d| d.join("result.json"));
+    // A cluster task's tally is its share only: it neither reads nor keeps a cell's result.
+    let task = study.runner.chunks.is_task();
+    let kept = dir
+        .as_ref()
+        .filter(|_| !task)
+        .map(|d| d.join("result.json"));
     if let Some(m) = kept
         .as_ref()
         .and_then(|f| std::fs::read_to_string(f).ok())
@@ -99,7 +104,7 @@ pub fn measure(spec: &RunSpec, study: &Study) -> Result<Measured> {
         return Ok(m);
     }
     let ck = match &dir {
-        Some(d) => Some(Checkpoint::open_fresh(d, spec)?),
+        Some(d) => Some(study.runner.open_cell(d, spec)?),
         None => None,
     };
     let run = study.runner.run(spec, ck.as_ref(), &mut |_| Ok(()))?;

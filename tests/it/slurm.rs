@@ -65,10 +65,10 @@ fn tmp(name: &str) -> PathBuf {
     d
 }
 
-/// `dicephys slurm roll RUN --tasks N --dir D --submit`: the array's and the finisher's ids.
-fn submit(run: &[&str], tasks: u64, dir: &Path) -> (String, String) {
+/// `dicephys slurm COMMAND RUN --tasks N --dir D --submit`: the array's and the finisher's ids.
+fn submit(command: &str, run: &[&str], tasks: u64, dir: &Path) -> (String, String) {
     let out = bin()
-        .args(["slurm", "roll"])
+        .args(["slurm", command])
         .args(run)
         .args(["--tasks", &tasks.to_string(), "--dir"])
         .arg(dir)
@@ -77,7 +77,7 @@ fn submit(run: &[&str], tasks: u64, dir: &Path) -> (String, String) {
         .unwrap();
     assert!(
         out.status.success(),
-        "slurm roll --submit: {}",
+        "slurm {command} --submit: {}",
         String::from_utf8_lossy(&out.stderr)
     );
     let text = String::from_utf8_lossy(&out.stdout);
@@ -152,7 +152,7 @@ fn a_four_task_roll_through_slurm_merges_to_the_one_machine_counts() {
         return;
     };
     let dir = tmp("roll");
-    let (array, fin) = submit(&SMALL, 4, &dir);
+    let (array, fin) = submit("roll", &SMALL, 4, &dir);
     let whole = json(
         &bin()
             .arg("roll")
@@ -199,7 +199,7 @@ fn a_task_cancelled_mid_run_and_requeued_resumes_and_the_counts_still_match() {
         "1",
     ];
     let dir = tmp("requeue");
-    let (array, fin) = submit(&run, 4, &dir);
+    let (array, fin) = submit("roll", &run, 4, &dir);
     let reference = bin()
         .arg("roll")
         .args(run)
@@ -260,5 +260,106 @@ fn a_task_cancelled_mid_run_and_requeued_resumes_and_the_counts_still_match() {
         log.contains("attempt 2"),
         "task 0 was not run again:\n{log}"
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A results.csv without its last column, the CPU time per roll (the only column that is
+/// measured rather than counted).
+fn counted(csv: &Path) -> Vec<String> {
+    std::fs::read_to_string(csv)
+        .unwrap_or_else(|e| panic!("{}: {e}", csv.display()))
+        .lines()
+        .map(|l| l.rsplit_once(',').map_or(l, |(head, _)| head).to_string())
+        .collect()
+}
+
+#[test]
+fn paper_through_slurm_writes_the_one_machine_results() {
+    let Some(_cluster) = cluster("slurm paper") else {
+        return;
+    };
+    let dir = tmp("paper");
+    let run = ["--rolls", "2000", "--threads", "1"];
+    let (array, fin) = submit("paper", &run, 4, &dir);
+    let one = tmp("paper-one");
+    let status = bin()
+        .arg("paper")
+        .args(run)
+        .arg("--out")
+        .arg(&one)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success());
+    wait_gone(&[&array, &fin], &dir, Duration::from_secs(600));
+    assert!(
+        dir.join("results.csv").exists() && dir.join("result.txt").exists(),
+        "no results:\n{}",
+        diagnose(&[&array, &fin], &dir)
+    );
+    let (a, b) = (
+        counted(&one.join("results.csv")),
+        counted(&dir.join("results.csv")),
+    );
+    assert_eq!(a.len(), 21, "20 cells and a header");
+    assert_eq!(
+        a, b,
+        "the cluster's counts, ratios and z are the one machine's"
+    );
+    let report = std::fs::read_to_string(dir.join("result.txt")).unwrap();
+    assert!(report.contains("140x24x20"), "{report}");
+    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&one);
+}
+
+/// The study path without a scheduler: the scripts written, each task run by hand as the array
+/// would (`slurm task DIR K`), then the finishing step; its comparison is the one machine's.
+#[test]
+fn a_crosscheck_split_by_hand_into_tasks_assembles_to_the_one_machine_comparison() {
+    let dir = tmp("by-hand");
+    let run = [
+        "crosscheck",
+        "--block",
+        "140x22x13",
+        "--rolls",
+        "2500",
+        "--json",
+    ];
+    let slurm = |args: &[&str]| bin().arg("slurm").args(args).output().unwrap();
+    let d = dir.to_str().unwrap();
+    let out = slurm(&[&run[..], &["--tasks", "3", "--dir", d]].concat());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("slurm task"));
+    // Before any task has run, the finishing step names all three.
+    let early = slurm(&["finish", d]);
+    assert_eq!(early.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&early.stderr).contains("have not finished: 0, 1, 2 "));
+    for k in ["0", "1", "2"] {
+        let t = slurm(&["task", d, k]);
+        assert!(
+            t.status.success(),
+            "task {k}: {}",
+            String::from_utf8_lossy(&t.stderr)
+        );
+        assert!(t.stdout.is_empty(), "a task reports nothing");
+    }
+    let assembled = json(&slurm(&["finish", d]));
+    let whole = json(&bin().args(run).output().unwrap());
+    assert_eq!(assembled["runs"][0]["tally"], whole["runs"][0]["tally"]);
+    assert_eq!(assembled["runs"][1]["tally"], whole["runs"][1]["tally"]);
+    assert_eq!(assembled["versus"][0]["z"], whole["versus"][0]["z"]);
+    assert_eq!(
+        assembled["versus"][0]["same_outcome_fraction"],
+        whole["versus"][0]["same_outcome_fraction"]
+    );
+    // A task out of range, and a study's own output flag, are refused as bad input.
+    assert_eq!(slurm(&["task", d, "3"]).status.code(), Some(2));
+    let own = slurm(&["paper", "--out", "x", "--tasks", "2", "--dir", d]);
+    assert_eq!(own.status.code(), Some(2));
     let _ = std::fs::remove_dir_all(&dir);
 }
