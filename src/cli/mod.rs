@@ -78,10 +78,10 @@ pub fn runner(threads: usize) -> Runner<'static> {
     Runner::new(threads, stop().clone()).with_chunks(chunks().get().cloned().unwrap_or_default())
 }
 
-/// True in a cluster task, whose results are its share only: it keeps its chunks and reports
-/// nothing.
+/// True in a cluster task, whose results are its share only (it keeps its chunks and reports
+/// nothing), and in a dry run.
 pub fn is_task() -> bool {
-    chunks().get().is_some_and(Chunks::is_task)
+    chunks().get().is_some_and(Chunks::is_partial)
 }
 
 /// Runs the command line; returns the process exit code (0 ok, 2 bad input, 1 failure, 130

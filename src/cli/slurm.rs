@@ -211,19 +211,32 @@ fn study(job: &JobArgs) -> Result<()> {
             }
         }
     }
-    let cmd = parse_study(&args)?;
+    let mut cmd = parse_study(&args)?;
     // A cluster task takes the threads it asks for; "one per core" means one.
     let threads = threads_of(&cmd).max(1);
     super::args::threads(threads)?;
-    let plan = Plan::Study {
-        args,
-        threads,
-        tasks: job.tasks,
-    };
-    let (lay, opt, bin) = prepare(&plan, job, threads)?;
+    let plan = plan_of(&args, threads, job);
+    // Bad input is refused here, before anything is submitted or stored: the study runs dry,
+    // checking its arguments and stopping at its first cell.
+    let (lay, opt, bin) = prepare(&plan, job, threads, |lay| {
+        place(&mut cmd, lay, threads)?;
+        let _ = super::chunks().set(Chunks::DryRun);
+        match super::dispatch(cmd) {
+            Ok(()) | Err(Error::Interrupted(_)) => Ok(()),
+            Err(e) => Err(e),
+        }
+    })?;
     std::fs::create_dir_all(lay.tasks())
         .map_err(|e| Error::Run(format!("{}: {e}", lay.tasks().display())))?;
     emit(&plan, &lay, &opt, &bin, job.submit)
+}
+
+fn plan_of(args: &[String], threads: usize, job: &JobArgs) -> Plan {
+    Plan::Study {
+        args: args.to_vec(),
+        threads,
+        tasks: job.tasks,
+    }
 }
 
 /// One array task of a study: the command with this task's share of the chunks, then its mark.
@@ -288,16 +301,21 @@ fn roll(a: &SlurmRollArgs) -> Result<()> {
     };
     let threads = r.run.threads.max(1);
     super::args::threads(threads)?;
-    let (lay, opt, bin) = prepare(&plan, &a.job, threads)?;
+    let (lay, opt, bin) = prepare(&plan, &a.job, threads, |_| Ok(()))?;
     for k in 0..a.job.tasks {
         Checkpoint::open(&lay.checkpoint(k), &Plan::shard_spec(&spec, k, a.job.tasks))?;
     }
     emit(&plan, &lay, &opt, &bin, a.job.submit)
 }
 
-/// Checks the job options, makes the directory and stores the plan in it (or checks that it
-/// holds this very plan).
-fn prepare(plan: &Plan, job: &JobArgs, cpus: usize) -> Result<(Layout, Options, PathBuf)> {
+/// Checks the job options, makes the directory, runs `check` on it, and stores the plan in it
+/// (or checks that it holds this very plan).
+fn prepare(
+    plan: &Plan,
+    job: &JobArgs,
+    cpus: usize,
+    check: impl FnOnce(&Layout) -> Result<()>,
+) -> Result<(Layout, Options, PathBuf)> {
     plan.validate()?;
     let opt = Options {
         partition: job.partition.clone(),
@@ -329,6 +347,7 @@ fn prepare(plan: &Plan, job: &JobArgs, cpus: usize) -> Result<(Layout, Options, 
         .canonicalize()
         .map_err(|e| Error::Usage(format!("--dir {}: {e}", job.dir.display())))?;
     let lay = Layout { dir };
+    check(&lay)?;
     match read_plan(&lay) {
         Ok(stored) if stored == *plan => {}
         Ok(_) => {

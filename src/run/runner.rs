@@ -58,6 +58,9 @@ pub enum Chunks {
     },
     /// Roll nothing: every chunk must be in the checkpoint already (the finishing job).
     Assemble,
+    /// Roll and read nothing: every run ends at once, incomplete. A study run so checks its
+    /// arguments and stops at its first cell (`dicephys slurm` does this before submitting).
+    DryRun,
 }
 
 impl Chunks {
@@ -78,9 +81,10 @@ impl Chunks {
         }
     }
 
-    /// True for a task's share: its tallies are partial by design.
-    pub fn is_task(&self) -> bool {
-        matches!(self, Chunks::Task { .. })
+    /// True for a task's share or a dry run: their tallies are partial by design, for no
+    /// report.
+    pub fn is_partial(&self) -> bool {
+        matches!(self, Chunks::Task { .. } | Chunks::DryRun)
     }
 }
 
@@ -179,6 +183,9 @@ impl<'a> Runner<'a> {
             resumed_cpu_s: 0.0,
             resumed_wall_s: 0.0,
         };
+        if let Chunks::DryRun = self.chunks {
+            return Ok(done);
+        }
         for c in 0..indices.len().div_ceil(CHUNK) {
             let chunk = indices.chunk(c, CHUNK);
             let path = checkpoint.map(|d| d.chunk_path(chunk[0], chunk.len()));

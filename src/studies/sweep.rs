@@ -91,7 +91,7 @@ pub fn measure(spec: &RunSpec, study: &Study) -> Result<Measured> {
         .as_ref()
         .map(|root| root.join(format!("{}-{}", spec.engine, spec.key())));
     // A cluster task's tally is its share only: it neither reads nor keeps a cell's result.
-    let task = study.runner.chunks.is_task();
+    let task = study.runner.chunks.is_partial();
     let kept = dir
         .as_ref()
         .filter(|_| !task)

@@ -357,9 +357,38 @@ fn a_crosscheck_split_by_hand_into_tasks_assembles_to_the_one_machine_comparison
         assembled["versus"][0]["same_outcome_fraction"],
         whole["versus"][0]["same_outcome_fraction"]
     );
+    // A chunk lost after its task was marked done: the finishing step refuses, rolling nothing.
+    let cell = std::fs::read_dir(dir.join("checkpoint"))
+        .unwrap()
+        .flatten()
+        .next()
+        .unwrap()
+        .path();
+    let chunk = cell.join("chunk-000000001000-1000.json");
+    std::fs::rename(&chunk, dir.join("lost.json")).unwrap();
+    let lost = slurm(&["finish", d]);
+    assert_eq!(lost.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&lost.stderr).contains("were never rolled"));
+    std::fs::rename(dir.join("lost.json"), &chunk).unwrap();
     // A task out of range, and a study's own output flag, are refused as bad input.
     assert_eq!(slurm(&["task", d, "3"]).status.code(), Some(2));
     let own = slurm(&["paper", "--out", "x", "--tasks", "2", "--dir", d]);
     assert_eq!(own.status.code(), Some(2));
+    // A study's bad input is refused before anything is stored or submitted (a dry run).
+    let bad = tmp("by-hand-bad");
+    let b = bad.to_str().unwrap();
+    let out = slurm(&[
+        "tradeoff",
+        "--reference-dt",
+        "1/100",
+        "--tasks",
+        "2",
+        "--dir",
+        b,
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--reference-dt"));
+    assert!(!bad.join("slurm.json").exists());
+    let _ = std::fs::remove_dir_all(&bad);
     let _ = std::fs::remove_dir_all(&dir);
 }
