@@ -84,6 +84,13 @@ pub fn is_task() -> bool {
     chunks().get().is_some_and(Chunks::is_partial)
 }
 
+/// The command line a report names as its own: this process's, or, in a cluster run's
+/// finishing job, the study's as it was submitted.
+pub fn command_line() -> &'static std::sync::OnceLock<String> {
+    static LINE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    &LINE
+}
+
 /// Runs the command line; returns the process exit code (0 ok, 2 bad input, 1 failure, 130
 /// stopped early with what was done kept).
 pub fn main() -> i32 {

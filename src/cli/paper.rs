@@ -79,7 +79,9 @@ pub fn run(a: &PaperArgs) -> Result<()> {
         );
         b
     };
-    let command_line = std::env::args().collect::<Vec<_>>().join(" ");
+    let command_line = super::command_line()
+        .get_or_init(|| std::env::args().collect::<Vec<_>>().join(" "))
+        .clone();
     // Cells are rolled in checkpointed chunks under --out/checkpoint, each cell's directory
     // bound to its run's specification: the same command run again (after a crash or Ctrl-C)
     // continues where it stopped.

@@ -478,6 +478,11 @@ fn finish(dir: &Path) -> Result<()> {
             place(&mut cmd, &lay, *threads)?;
             // Every chunk is on disk: the study reads them all and rolls none.
             let _ = super::chunks().set(Chunks::Assemble);
+            let _ = super::command_line().set(format!(
+                "dicephys {} (through Slurm: {tasks} tasks, {})",
+                args.join(" "),
+                lay.dir.display()
+            ));
             super::dispatch(cmd)?;
         }
         Plan::Roll { spec, tasks } => {

@@ -65,9 +65,10 @@ pub struct PaperResults {
     pub table: TableReport,
     /// The cells simulated, row by row, each engine, 3D then 2D.
     pub simulations: Vec<SimCell>,
-    /// Wall-clock seconds for the whole run.
+    /// Wall-clock seconds the cells took, summed (with a resumed cell's earlier segments; on
+    /// a cluster, over every task).
     pub wall_s: f64,
-    /// Process CPU seconds for the whole run, all threads.
+    /// CPU seconds the cells took, all threads, summed likewise.
     pub cpu_s: f64,
     /// Surfaces whose μ and e the paper did not measure: not simulated, and why.
     pub not_simulated: String,
