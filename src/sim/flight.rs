@@ -291,6 +291,41 @@ mod tests {
     }
 
     #[test]
+    fn a_jump_reaches_the_states_of_the_walk_bit_for_bit() {
+        let scene = Scene::paper("140x24x20".parse().unwrap(), Mode::ThreeD);
+        let f = Flight::of(&scene);
+        let start = BodyState {
+            position: Vector3::new(0.0, 0.4, 0.0),
+            rotation: UnitQuaternion::from_euler_angles(0.3, 0.1, 0.2),
+            linear_velocity: Vector3::new(0.1, 0.5, 0.0),
+            angular_velocity: Vector3::new(5.0, -3.0, 120.0),
+            sleeping: false,
+        };
+        let dq = f.step_rotation(&start.angular_velocity);
+        let (walked, n) = coast(&f, &start, 10_000);
+        let mut jumped = start;
+        let mut seen = 0;
+        let k = f.jump(&mut jumped, &dq, 10_000, |_| true, |_| seen += 1);
+        // The jump stops one step short of the walk: the landing step is the walk's.
+        assert_eq!((k, seen), (n - 1, n - 1));
+        assert_eq!(f.next(&jumped, &dq), Some(walked));
+        // A check that could fire stops the jump where it could, and a cap is a cap.
+        let mut s = start;
+        assert_eq!(f.jump(&mut s, &dq, 10_000, |s| s.position.y > 0.3, |_| {}), {
+            let (_, m) = coast(&f, &start, 10_000);
+            let mut t = start;
+            (0..m).take_while(|_| {
+                t = f.next(&t, &dq).unwrap();
+                t.position.y > 0.3
+            })
+            .count() as u64
+        });
+        let mut s = start;
+        assert_eq!(f.jump(&mut s, &dq, 7, |_| true, |_| {}), 7);
+        assert_eq!(s, coast(&f, &start, 7).0);
+    }
+
+    #[test]
     fn flight_starts_clear_of_the_floor_and_of_contacts() {
         let scene = Scene::paper("140x24x20".parse().unwrap(), Mode::ThreeD);
         let flight = Flight::of(&scene);
