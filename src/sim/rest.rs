@@ -53,6 +53,12 @@ impl RestDetector {
         self.seen += 1;
     }
 
+    /// Counts `n` steps as seen without recording them: for steps that `record` calls for
+    /// the window's last ten states will overwrite (`flight::Flight::jump`).
+    pub fn skip(&mut self, n: u64) {
+        self.seen += n as usize;
+    }
+
     /// Records one step's state; true once the die is at rest.
     pub fn push(&mut self, s: &BodyState) -> bool {
         self.record(s);

@@ -339,6 +339,25 @@ fn record_of(throw: &Throw, end: End) -> RollRecord {
     }
 }
 
+/// How many steps of free flight from `s` the certificate cannot fire on: its energy height
+/// (E/mg) is above `ceiling` (`Certificate::energy_ceiling`) and falls by exactly ½g·dt² a
+/// step in flight (symplectic Euler: ½(v − g dt)² − ½v² + g(v − g dt)dt = −½g²dt², per unit
+/// mass, over g), while the bound `DieShape::energy_height_at_least` keeps its rotational
+/// part constant. Room is left for rounding.
+fn quiet_steps(die: &DieShape, s: &BodyState, ceiling: f64, f: &Flight) -> u64 {
+    if ceiling == f64::NEG_INFINITY {
+        return u64::MAX;
+    }
+    let above = die.energy_height_at_least(s) - ceiling;
+    let per_step = 0.5 * f.gravity * f.dt * f.dt * (1.0 + 1e-6) + 1e-15;
+    if above > 0.0 {
+        // Steps 1..=k are above the ceiling while above − k·per_step > 0.
+        ((above / per_step).floor() as u64).saturating_sub(1)
+    } else {
+        0
+    }
+}
+
 /// How a roll from a start state ended.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct End {
@@ -427,12 +446,9 @@ fn run(
                 // those steps are jumped, the rest rule's window kept filled, and the walk
                 // takes over where a check could fire or the die reaches the floor.
                 if jump && flown_in_a_row >= REST_WINDOW as u64 {
-                    let quiet = |s: &BodyState| {
-                        s.is_finite() && die.energy_height_at_least(s) > ceiling
-                    };
-                    let n = f.jump(&mut state, dq, cfg.max_steps - end.steps, quiet, |s| {
-                        rest.record(s)
-                    });
+                    let quiet = quiet_steps(&die, &state, ceiling, f);
+                    let max = quiet.min(cfg.max_steps - end.steps);
+                    let n = f.jump(&mut state, dq, max, &mut rest);
                     if n > 0 {
                         end.steps += n;
                         flown_in_a_row += n;
