@@ -155,7 +155,13 @@ fn jumped_flight_rolls_every_throw_as_walked_flight() {
         fast_flight: true,
         ..RollConfig::default()
     };
-    for block in ["140x24x20", "140x22x13", "140x27x13", "140x29x11", "140x30x10"] {
+    for block in [
+        "140x24x20",
+        "140x22x13",
+        "140x27x13",
+        "140x29x11",
+        "140x30x10",
+    ] {
         for mode in [Mode::ThreeD, Mode::TwoD] {
             let scene = Scene::paper(block.parse().unwrap(), mode);
             let mut e = new_engine(EngineKind::Bullet, &scene).unwrap();
@@ -164,7 +170,11 @@ fn jumped_flight_rolls_every_throw_as_walked_flight() {
                     let t = throws.get(i);
                     let jumped = roll(e.as_mut(), &scene, &t, &cfg);
                     let walked = roll_observed(e.as_mut(), &scene, &t, &cfg, |_, _| {});
-                    assert_eq!(jumped, walked, "{block} {mode:?} throw {i} ({:?})", cfg.rule);
+                    assert_eq!(
+                        jumped, walked,
+                        "{block} {mode:?} throw {i} ({:?})",
+                        cfg.rule
+                    );
                 }
             }
         }
