@@ -524,7 +524,8 @@ fn run(
     end
 }
 
-/// Rolls one throw to its end (`roll_observed`, watching nothing).
+/// Rolls one throw to its end: `roll_observed` watching nothing, with free flight jumped
+/// where no check can fire (`Flight::jump`), which leaves the record bit for bit the same.
 pub fn roll(engine: &mut dyn Engine, scene: &Scene, throw: &Throw, cfg: &RollConfig) -> RollRecord {
     let end = run(engine, scene, &throw.start(scene), cfg, |_, _| {}, true);
     record_of(throw, end)
