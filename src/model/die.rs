@@ -65,6 +65,17 @@ impl DieShape {
     pub fn energy(&self, s: &BodyState) -> f64 {
         self.kinetic(s) + self.potential(s)
     }
+
+    /// A lower bound of energy / (mg), the height the die's energy would lift it to, cheaper
+    /// than `energy`: the rotational energy ½ωᵀIω is at least ½ I_min |ω|². Less than the
+    /// exact value by far more than rounding (1e-9 m is taken off for it).
+    pub fn energy_height_at_least(&self, s: &BodyState) -> f64 {
+        let i_min = self.inertia.min();
+        s.position.y
+            + 0.5 * s.linear_velocity.norm_squared() / self.gravity
+            + 0.5 * i_min * s.angular_velocity.norm_squared() / (self.mass * self.gravity)
+            - 1e-9
+    }
 }
 
 /// The world's up direction in body axes, Rᵀ ŷ: the second row of the rotation matrix.

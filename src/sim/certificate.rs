@@ -32,6 +32,17 @@ pub struct Certificate {
 const SIDES: [Outcome; 3] = [Outcome::Breadth, Outcome::Width, Outcome::Length];
 
 impl Certificate {
+    /// The height E/(mg) must be below for the certificate to hold in any face region: the
+    /// largest over regions i of rest height + (1 − margin) × (barrier − rest height). A state
+    /// whose energy is above it (`DieShape::energy_height_at_least`) is never certain, so
+    /// the check can be skipped there (`flight::Flight::jump`).
+    pub fn energy_ceiling(&self, die: &DieShape) -> f64 {
+        let n = if die.planar { 2 } else { 3 };
+        (0..n)
+            .map(|i| die.half[i] + (1.0 - self.margin) * (die.barrier[i] - die.half[i]))
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
     /// The outcome, if it is already certain.
     pub fn certain(&self, die: &DieShape, s: &BodyState) -> Option<Outcome> {
         let up = up_in_body(&s.rotation);

@@ -21,6 +21,7 @@
 
 use crate::model::scene::{Floor, Scene};
 use crate::model::state::BodyState;
+use crate::sim::rest::{RestDetector, REST_WINDOW};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 /// Bullet's clamp on the rotation per step (ANGULAR_MOTION_THRESHOLD = π/4).
@@ -115,6 +116,70 @@ impl Flight {
             angular_velocity: s.angular_velocity,
             sleeping: false,
         }
+    }
+
+    /// Free flight jumped: takes the steps `next` would take from `s`, at most `max`, while
+    /// each one is pure flight and reaches a state clear of the floor; the rest rule's window
+    /// (`rest`) is left as if each state had been pushed to it (the rule is not asked).
+    /// Returns how many steps were taken and leaves `s` at the last state reached. The caller
+    /// bounds `max` by what its checks allow (`roll::run`): here nothing is checked.
+    ///
+    /// Each step is `step` itself, so the states are bit for bit those of walking the flight
+    /// with `next`: a closed form (x₀ + v₀t − ½gt², exp(½ωt)q₀) would differ from the
+    /// stepped recurrence by rounding, and a die landing 1e-15 m elsewhere can tip the other
+    /// way. What jumping saves is everything else a walked step costs (the rest rule's sums,
+    /// the certificate, the dip and failure checks), and most of the lowest-point tests: a
+    /// state whose centre is higher than the box's farthest reach above the clearance is
+    /// clear whatever its orientation.
+    pub fn jump(
+        &self,
+        s: &mut BodyState,
+        dq: &UnitQuaternion<f64>,
+        max: u64,
+        rest: &mut RestDetector,
+    ) -> u64 {
+        if max == 0 || self.lowest_point(s) <= self.clear {
+            return 0;
+        }
+        // ω is constant in flight, so whether it keeps the die awake is decided once (the
+        // same norm of the same vector that `next` takes).
+        let spinning = s.angular_velocity.norm() >= ANGULAR_SLEEPING_THRESHOLD;
+        // How far below its centre the die can reach: |h| in any orientation; in 2D (turning
+        // about z, which keeps the quaternion's i and j exactly 0) the cross-section's
+        // half diagonal. With room for rounding.
+        let (q, d) = (s.rotation.quaternion(), dq.quaternion());
+        let planar = q.i == 0.0 && q.j == 0.0 && d.i == 0.0 && d.j == 0.0;
+        let reach = if planar {
+            self.half.x.hypot(self.half.y)
+        } else {
+            self.half.norm()
+        } * (1.0 + 1e-9);
+        // Flight changes only the vertical velocity (x, z and ω are copied), so the last
+        // states' velocities are kept as that one number.
+        let mut vy = [0.0; REST_WINDOW];
+        let mut n = 0u64;
+        while n < max {
+            let next = self.step(s, dq);
+            if !(spinning || next.linear_velocity.norm() >= LINEAR_SLEEPING_THRESHOLD) {
+                break;
+            }
+            // The step that lands is left to the walk, with every check a landing can fire.
+            if next.position.y - reach <= self.clear && self.lowest_point(&next) <= self.clear {
+                break;
+            }
+            *s = next;
+            vy[(n % REST_WINDOW as u64) as usize] = s.linear_velocity.y;
+            n += 1;
+        }
+        // The window keeps the last ten: the earlier states only move its count on.
+        let first = n.saturating_sub(REST_WINDOW as u64);
+        rest.skip(first);
+        let mut at = *s;
+        for k in first..n {
+            at.linear_velocity.y = vy[(k % REST_WINDOW as u64) as usize];
+            rest.record(&at);
+        }
+        n
     }
 
     /// The state one step after `s` if that step is pure flight (`s` clear of the floor, the
@@ -247,6 +312,49 @@ mod tests {
                 );
             }
             assert!(bounced, "{mode:?}: no bounce in the window");
+        }
+    }
+
+    #[test]
+    fn a_jump_reaches_the_states_of_the_walk_bit_for_bit() {
+        for mode in [Mode::ThreeD, Mode::TwoD] {
+            let scene = Scene::paper("140x24x20".parse().unwrap(), mode);
+            let f = Flight::of(&scene);
+            let start = BodyState {
+                position: Vector3::new(0.0, 0.4, 0.0),
+                rotation: if mode == Mode::TwoD {
+                    UnitQuaternion::from_euler_angles(0.0, 0.0, 0.2)
+                } else {
+                    UnitQuaternion::from_euler_angles(0.3, 0.1, 0.2)
+                },
+                linear_velocity: Vector3::new(0.1, 0.5, 0.0),
+                angular_velocity: if mode == Mode::TwoD {
+                    Vector3::new(0.0, 0.0, 120.0)
+                } else {
+                    Vector3::new(5.0, -3.0, 120.0)
+                },
+                sleeping: false,
+            };
+            let dq = f.step_rotation(&start.angular_velocity);
+            let (walked, n) = coast(&f, &start, 10_000);
+            let mut jumped = start;
+            let mut rest = RestDetector::default();
+            let k = f.jump(&mut jumped, &dq, 10_000, &mut rest);
+            // The jump stops one step short of the walk: the landing step is the walk's.
+            assert_eq!(k, n - 1, "{mode:?}");
+            assert_eq!(f.next(&jumped, &dq), Some(walked), "{mode:?}");
+            // It leaves the rest rule's window as pushing every state would.
+            let mut pushed = RestDetector::default();
+            let mut t = start;
+            for _ in 0..k {
+                t = f.next(&t, &dq).unwrap();
+                pushed.push(&t);
+            }
+            assert_eq!(format!("{rest:?}"), format!("{pushed:?}"), "{mode:?}");
+            // A cap is a cap.
+            let mut s = start;
+            assert_eq!(f.jump(&mut s, &dq, 7, &mut RestDetector::default()), 7);
+            assert_eq!(s, coast(&f, &start, 7).0);
         }
     }
 

@@ -42,12 +42,26 @@ impl RestDetector {
         self.seen = 0;
     }
 
-    /// Records one step's state; true once the die is at rest.
-    pub fn push(&mut self, s: &BodyState) -> bool {
+    /// Records one step's state without asking whether the die is at rest: for a step at
+    /// which the rule is known not to fire (`flight::Flight::jump`). The window then holds
+    /// the same velocities in the same slots as if `push` had been called, so the next
+    /// `push` sums them in the same order.
+    pub fn record(&mut self, s: &BodyState) {
         let slot = self.seen % REST_WINDOW;
         self.linear[slot] = s.linear_velocity;
         self.angular[slot] = s.angular_velocity;
         self.seen += 1;
+    }
+
+    /// Counts `n` steps as seen without recording them: for steps that `record` calls for
+    /// the window's last ten states will overwrite (`flight::Flight::jump`).
+    pub fn skip(&mut self, n: u64) {
+        self.seen += n as usize;
+    }
+
+    /// Records one step's state; true once the die is at rest.
+    pub fn push(&mut self, s: &BodyState) -> bool {
+        self.record(s);
         if self.seen < REST_WINDOW {
             return false;
         }

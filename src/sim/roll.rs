@@ -9,7 +9,7 @@ use crate::model::state::BodyState;
 use crate::model::throws::Throw;
 use crate::sim::certificate::Certificate;
 use crate::sim::flight::Flight;
-use crate::sim::rest::{classify, RestDetector};
+use crate::sim::rest::{classify, RestDetector, REST_WINDOW};
 use nalgebra::UnitQuaternion;
 use serde::{Deserialize, Serialize};
 
@@ -313,7 +313,8 @@ impl EnergyWatch {
     }
 }
 
-/// Rolls one throw to its end. `observe` sees every step's state (for `trace`).
+/// Rolls one throw to its end. `observe` sees every step's state (for `trace`), so free flight
+/// is walked step by step, never jumped (`Flight::jump`); the roll is the same either way.
 pub fn roll_observed(
     engine: &mut dyn Engine,
     scene: &Scene,
@@ -321,7 +322,12 @@ pub fn roll_observed(
     cfg: &RollConfig,
     observe: impl FnMut(u64, &BodyState),
 ) -> RollRecord {
-    let end = run_from(engine, scene, &throw.start(scene), cfg, observe);
+    let end = run(engine, scene, &throw.start(scene), cfg, observe, false);
+    record_of(throw, end)
+}
+
+/// A roll's record: its throw and how it ended.
+fn record_of(throw: &Throw, end: End) -> RollRecord {
     RollRecord {
         throw: *throw,
         fate: end.fate,
@@ -330,6 +336,25 @@ pub fn roll_observed(
         certified: end.certified,
         energy_gain: end.energy_gain,
         dip: end.dip,
+    }
+}
+
+/// How many steps of free flight from `s` the certificate cannot fire on: its energy height
+/// (E/mg) is above `ceiling` (`Certificate::energy_ceiling`) and falls by exactly ½g·dt² a
+/// step in flight (symplectic Euler: ½(v − g dt)² − ½v² + g(v − g dt)dt = −½g²dt², per unit
+/// mass, over g), while the bound `DieShape::energy_height_at_least` keeps its rotational
+/// part constant. Room is left for rounding.
+fn quiet_steps(die: &DieShape, s: &BodyState, ceiling: f64, f: &Flight) -> u64 {
+    if ceiling == f64::NEG_INFINITY {
+        return u64::MAX;
+    }
+    let above = die.energy_height_at_least(s) - ceiling;
+    let per_step = 0.5 * f.gravity * f.dt * f.dt * (1.0 + 1e-6) + 1e-15;
+    if above > 0.0 {
+        // Steps 1..=k are above the ceiling while above − k·per_step > 0.
+        ((above / per_step).floor() as u64).saturating_sub(1)
+    } else {
+        0
     }
 }
 
@@ -352,13 +377,26 @@ pub struct End {
 }
 
 /// Steps the die from `start` until it is at rest (or certain), reaches the step cap, or
-/// fails.
+/// fails. `observe` sees every step's state.
 pub fn run_from(
     engine: &mut dyn Engine,
     scene: &Scene,
     start: &BodyState,
     cfg: &RollConfig,
+    observe: impl FnMut(u64, &BodyState),
+) -> End {
+    run(engine, scene, start, cfg, observe, false)
+}
+
+/// `run_from`; with `jump`, stretches of free flight on which no check can fire are jumped
+/// (`Flight::jump`) and `observe` does not see their states.
+fn run(
+    engine: &mut dyn Engine,
+    scene: &Scene,
+    start: &BodyState,
+    cfg: &RollConfig,
     mut observe: impl FnMut(u64, &BodyState),
+    jump: bool,
 ) -> End {
     let die = DieShape::of(scene);
     let certificate = Certificate { margin: cfg.margin };
@@ -385,6 +423,14 @@ pub fn run_from(
     // step's rotation, and the engine is behind until the state is handed back.
     let mut flying: Option<UnitQuaternion<f64>> = None;
     let mut behind = false;
+    // Flown steps in a row so far, and what a jumped state must be above for the certificate
+    // to be out of reach (when it is checked at all).
+    let mut flown_in_a_row = 0u64;
+    let ceiling = if watch {
+        certificate.energy_ceiling(&die)
+    } else {
+        f64::NEG_INFINITY
+    };
     while end.steps < cfg.max_steps {
         let mut next = None;
         if let Some(f) = &flight {
@@ -392,6 +438,29 @@ pub fn run_from(
                 flying = Some(f.step_rotation(&state.angular_velocity));
             }
             if let Some(dq) = &flying {
+                // Once the rest rule's window holds flown steps only it cannot fire in flight
+                // (every flown step keeps the die awake: its ω is the same every step, or its
+                // speed is above 0.8 m/s with the vertical velocity of one sign, so neither
+                // sum of ten is near 0). The certificate cannot fire while the energy is
+                // above its ceiling, and a state clear of the floor fails no check. So
+                // those steps are jumped, the rest rule's window kept filled, and the walk
+                // takes over where a check could fire or the die reaches the floor.
+                if jump && flown_in_a_row >= REST_WINDOW as u64 {
+                    let quiet = quiet_steps(&die, &state, ceiling, f);
+                    let max = quiet.min(cfg.max_steps - end.steps);
+                    let n = f.jump(&mut state, dq, max, &mut rest);
+                    if n > 0 {
+                        end.steps += n;
+                        flown_in_a_row += n;
+                        // What the jumped states did to the dip record: the centre above the
+                        // floor ends any run of dips (their depths, negative, change nothing).
+                        end.dip.push(&die, &state);
+                        behind = true;
+                        if end.steps >= cfg.max_steps {
+                            break;
+                        }
+                    }
+                }
                 next = f.next(&state, dq);
                 if next.is_none() {
                     flying = None;
@@ -405,6 +474,7 @@ pub fn run_from(
             }
         }
         let flown = next.is_some();
+        flown_in_a_row = if flown { flown_in_a_row + 1 } else { 0 };
         state = match next {
             Some(s) => s,
             None => {
@@ -454,7 +524,9 @@ pub fn run_from(
     end
 }
 
-/// Rolls one throw to its end (`roll_observed`, watching nothing).
+/// Rolls one throw to its end: `roll_observed` watching nothing, with free flight jumped
+/// where no check can fire (`Flight::jump`), which leaves the record bit for bit the same.
 pub fn roll(engine: &mut dyn Engine, scene: &Scene, throw: &Throw, cfg: &RollConfig) -> RollRecord {
-    roll_observed(engine, scene, throw, cfg, |_, _| {})
+    let end = run(engine, scene, &throw.start(scene), cfg, |_, _| {}, true);
+    record_of(throw, end)
 }

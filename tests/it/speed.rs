@@ -139,3 +139,44 @@ fn the_plane_floor_is_not_the_box_floor() {
     let z = dicephys::theory::stats::z_score(p.value, p.err, b.value, b.err);
     assert!(z > 3.0, "box {b:?}, plane {p:?}: z = {z:.1}");
 }
+
+#[test]
+fn jumped_flight_rolls_every_throw_as_walked_flight() {
+    // `roll` jumps the stretches of free flight where no check can fire; `roll_observed`
+    // (which must show every state) walks them step by step, as the fast defaults did before
+    // jumping. Every record must be the same bit for bit: outcome, steps, engine steps, the
+    // certified step, the flags and the dips. 500 keyed throws of each MDF block, 3D and 2D,
+    // under the fast defaults and under DicePhys's rule with fast flight (where the
+    // certificate is not watched and the jumps run longer).
+    use dicephys::engine::new_engine;
+    use dicephys::sim::roll::{roll, roll_observed};
+    let throws = Throws::new(ThrowKind::Keyed, 10, ThrowRanges::default(), 0);
+    let flight_only = RollConfig {
+        fast_flight: true,
+        ..RollConfig::default()
+    };
+    for block in [
+        "140x24x20",
+        "140x22x13",
+        "140x27x13",
+        "140x29x11",
+        "140x30x10",
+    ] {
+        for mode in [Mode::ThreeD, Mode::TwoD] {
+            let scene = Scene::paper(block.parse().unwrap(), mode);
+            let mut e = new_engine(EngineKind::Bullet, &scene).unwrap();
+            for (cfg, n) in [(RollConfig::fast(), 500), (flight_only, 50)] {
+                for i in 0..n {
+                    let t = throws.get(i);
+                    let jumped = roll(e.as_mut(), &scene, &t, &cfg);
+                    let walked = roll_observed(e.as_mut(), &scene, &t, &cfg, |_, _| {});
+                    assert_eq!(
+                        jumped, walked,
+                        "{block} {mode:?} throw {i} ({:?})",
+                        cfg.rule
+                    );
+                }
+            }
+        }
+    }
+}
