@@ -260,7 +260,14 @@ impl Stream {
         }
         self.outcomes.extend(outcomes);
         self.tally.merge(&tally);
-        self.cpu_s += process_cpu_seconds() - cpu + run.resumed_cpu_s;
+        // A chunk read back costs what it cost when rolled (stored with it), not the reading.
+        let rolled_now = run.tally.rolls > run.resumed;
+        self.cpu_s += run.resumed_cpu_s
+            + if rolled_now {
+                process_cpu_seconds() - cpu
+            } else {
+                0.0
+            };
         Ok(())
     }
 
