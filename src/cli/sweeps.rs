@@ -343,7 +343,7 @@ pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
             dt_label(a.reference_dt)
         )));
     }
-    if ladder.iter().any(|&d| d == a.reference_dt) {
+    if ladder.contains(&a.reference_dt) {
         return Err(Error::Usage(
             "--ladder: the reference's dt is not a rung".into(),
         ));

@@ -98,7 +98,10 @@ fn log_tick(v: &f64) -> String {
     tick(&two_figures(10f64.powf(*v)))
 }
 
-/// `chart` with its own x tick labels.
+/// A tick label formatter.
+type Ticks<'a> = &'a dyn Fn(&f64) -> String;
+
+/// `chart` with its own tick labels, x and y.
 fn chart_x<'a, DB: DrawingBackend>(
     root: &'a DrawingArea<DB, Shift>,
     title: &str,
@@ -106,8 +109,7 @@ fn chart_x<'a, DB: DrawingBackend>(
     y: std::ops::Range<f64>,
     x_desc: &str,
     y_desc: &str,
-    x_fmt: &dyn Fn(&f64) -> String,
-    y_fmt: &dyn Fn(&f64) -> String,
+    (x_fmt, y_fmt): (Ticks, Ticks),
 ) -> Result<Chart<'a, DB>, String> {
     root.fill(&WHITE).map_err(plot_err)?;
     let mut chart = ChartBuilder::on(root)
@@ -173,8 +175,7 @@ impl Figure for Convergence<'_> {
             ys.padded(0.05, 0.35),
             "time step dt, s (log scale)",
             RATIO_DESC,
-            &log_tick_dt,
-            &tick,
+            (&log_tick_dt, &tick),
         )?;
         for (i, l) in lines.iter().enumerate() {
             let marker = if l.label.contains(" 2d") {
@@ -243,8 +244,7 @@ impl Figure for Tradeoff<'_> {
             ys.padded(0.02, 0.25),
             "CPU seconds per 1,000 rolls (log scale)",
             "|departure from the reference|, % (log scale), 2σ bars",
-            &log_tick,
-            &log_tick,
+            (&log_tick, &log_tick),
         )?;
         for b in self.bands {
             let color = match b.two_d {
