@@ -266,9 +266,17 @@ pub fn converge(a: &ConvergeArgs) -> Result<()> {
             return Err(Error::Usage(format!("{name} {v}: CPU seconds, above 0")));
         }
     }
+    let bar = cpu_bar(a.json || a.precision.is_none());
+    let progress = |done: f64, total: f64| {
+        bar.set_length((1000.0 * total) as u64);
+        bar.set_position((1000.0 * done.min(total)) as u64);
+    };
     let res = logged(a.json, &converge::header(), |log| {
-        converge::run(&cfg, &study, log)
-    })?;
+        let log = |l: &str| bar.suspend(|| log(l));
+        converge::run(&cfg, &study, &log, &progress)
+    });
+    bar.finish_and_clear();
+    let res = res?;
     let lines: Vec<fig::Line> = group(&res.cells, |c| {
         format!("{} {} {}", c.block, c.engine, c.mode)
     })

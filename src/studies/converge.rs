@@ -135,7 +135,12 @@ pub struct Converge {
 pub const CLAIM_DT: f64 = 0.001;
 
 /// Runs the convergence test, logging each cell as it is measured.
-pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Converge> {
+pub fn run(
+    cfg: &Config,
+    study: &Study,
+    log: &dyn Fn(&str),
+    progress: super::tradeoff::Progress,
+) -> Result<Converge> {
     let mut dts = cfg.dts.clone();
     dts.sort_by(|a, b| b.total_cmp(a));
     dts.dedup();
@@ -143,7 +148,7 @@ pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Converge> 
         .last()
         .ok_or_else(|| Error::Invalid("no dt given".into()))?;
     if let Some(p) = cfg.precision {
-        return run_resolved(cfg, p, &dts, study, log);
+        return run_resolved(cfg, p, &dts, study, log, progress);
     }
     let settle = settle(cfg, finest);
     let mut cells = Vec::new();
@@ -259,6 +264,7 @@ fn run_resolved(
     dts: &[f64],
     study: &Study,
     log: &dyn Fn(&str),
+    progress: super::tradeoff::Progress,
 ) -> Result<Converge> {
     let finest = *dts
         .last()
@@ -288,27 +294,39 @@ fn run_resolved(
             spent += s.cpu_s;
         }
     }
-    {
+    let total = {
         let plan: Vec<Vec<&Stream>> = groups
             .iter()
             .map(|g| g.3.iter().map(|(_, s)| s).collect())
             .collect();
+        let total = plan_cpu(&plan, precision, Some((cfg.budget_s.1, cfg.budget_s.0)));
         log(&format!(
-            "plan: the pilot took {spent:.0} CPU s; ±{:.2} % (2σ) takes about {:.0} CPU s more \
-             within the budgets, {:.0} without; ±1 % {:.0} CPU s",
+            "plan: the pilot took {spent:.0} CPU s; ±{:.2} % (2σ) takes about {total:.0} CPU s \
+             more within the budgets, {:.0} without; ±1 % {:.0} CPU s",
             100.0 * precision,
-            plan_cpu(&plan, precision, Some((cfg.budget_s.1, cfg.budget_s.0))),
             plan_cpu(&plan, precision, None),
             plan_cpu(&plan, ONE_PERCENT, None),
         ));
-    }
+        total
+    };
+    let mut done = 0.0;
+    progress(0.0, total);
     let mut cells = Vec::new();
     let mut claims = Vec::new();
     for (block, engine, mode, mut streams) in groups {
         let (reference, rest) = streams.split_first_mut().expect("a dt is given");
-        resolve_reference(&mut reference.1, precision, cfg.budget_s.1, study, &|_| {})?;
+        let before = reference.1.cpu_s;
+        let base = done;
+        resolve_reference(&mut reference.1, precision, cfg.budget_s.1, study, &|c| {
+            progress(base + c, total)
+        })?;
+        done += reference.1.cpu_s - before;
         for (_, s) in rest.iter_mut() {
-            resolve_departure(s, &reference.1, precision, cfg.budget_s.0, study, &|_| {})?;
+            let (base, before) = (done, s.cpu_s);
+            resolve_departure(s, &reference.1, precision, cfg.budget_s.0, study, &|c| {
+                progress(base + c, total)
+            })?;
+            done += s.cpu_s - before;
         }
         // Coarse to fine, as without --precision.
         for (dt, s) in streams.iter().rev() {
