@@ -90,7 +90,18 @@ fn converge_at_tiny_size() {
     assert_eq!(claims.len(), 2);
     assert_eq!(v["resolved"], false);
     assert!(claims[0]["rolls_needed"].as_u64().unwrap() > 20);
-    assert!(v["verdict"].as_str().unwrap().starts_with("Not resolved"));
+    let verdict = v["verdict"].as_str().unwrap();
+    assert!(
+        verdict.starts_with("Not resolved") || verdict.starts_with("Decided"),
+        "{verdict}"
+    );
+    // The claim at 2σ: yes inside ±1 % once 2σ ≤ 1 %, no once the interval clears ±1 %.
+    use dicephys::studies::converge::decide;
+    assert_eq!(decide(0.005, 0.002), Some(true));
+    assert_eq!(decide(-0.02, 0.004), Some(false));
+    assert_eq!(decide(0.2, 0.05), Some(false));
+    assert_eq!(decide(0.005, 0.01), None);
+    assert_eq!(decide(0.03, 0.015), None);
     svg(&dir, "converge");
     assert!(dir.join("converge.json").exists() && dir.join("report.md").exists());
 }
@@ -281,7 +292,18 @@ fn converge_with_a_precision_rolls_each_claim_in_rounds() {
             );
         }
     }
-    assert!(v["verdict"].as_str().unwrap().starts_with("Not resolved"));
+    let verdict = v["verdict"].as_str().unwrap();
+    assert!(
+        verdict.starts_with("Not resolved") || verdict.starts_with("Decided"),
+        "{verdict}"
+    );
+    // The claim at 2σ: yes inside ±1 % once 2σ ≤ 1 %, no once the interval clears ±1 %.
+    use dicephys::studies::converge::decide;
+    assert_eq!(decide(0.005, 0.002), Some(true));
+    assert_eq!(decide(-0.02, 0.004), Some(false));
+    assert_eq!(decide(0.2, 0.05), Some(false));
+    assert_eq!(decide(0.005, 0.01), None);
+    assert_eq!(decide(0.03, 0.015), None);
 }
 
 #[test]
