@@ -241,7 +241,8 @@ impl Figure for Tradeoff<'_> {
             root,
             self.title,
             x.clone(),
-            ys.padded(0.02, 0.25),
+            // Headroom above the points for the legend.
+            ys.padded(0.02, 0.9),
             "CPU seconds per 1,000 rolls (log scale)",
             "|departure from the reference|, % (log scale), 2σ bars",
             (&log_tick, &log_tick),
@@ -335,7 +336,7 @@ impl Figure for Tradeoff<'_> {
                                         pct(self.precision),
                                         m.label
                                     ),
-                                    (9, -16),
+                                    (9, if two_d { -18 } else { 8 }), // 2D above, 3D below: they may sit close
                                     (FONT, 14).into_font().color(&color),
                                 )
                         }),
@@ -343,11 +344,8 @@ impl Figure for Tradeoff<'_> {
                 .map_err(plot_err)?;
         }
         chart
-            .draw_series(std::iter::once(Circle::new(
-                (x.start - 10.0, 0.0),
-                5,
-                GREY.stroke_width(1),
-            )))
+            // No marker: a legend entry only.
+            .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
             .map_err(plot_err)?
             .label("unresolved (grey, hollow): off the front")
             .legend(|(x, y)| Circle::new((x + 12, y), 5, GREY.stroke_width(1)));
@@ -357,7 +355,7 @@ impl Figure for Tradeoff<'_> {
             GREY.stroke_width(1),
             &format!("the precision, {}", pct(self.precision)),
         )?;
-        legend(&mut chart, SeriesLabelPosition::LowerRight)
+        legend(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }
 
