@@ -212,6 +212,28 @@ fn study(job: &JobArgs) -> Result<()> {
         }
     }
     let mut cmd = parse_study(&args)?;
+    // A precision run decides each round from all the rolls so far, which no task sees whole.
+    match &cmd {
+        Command::Tradeoff(t) if t.preroll.is_none() => {
+            return Err(Error::Usage(
+                "slurm tradeoff: give --preroll ROLLS: its rounds are decided from every roll \
+                 so far, which no task sees, so the tasks roll the first ROLLS throws of every \
+                 stream ahead and the finishing job runs the study, reading them back and \
+                 rolling on itself where a method needs more (`tradeoff --plan` prints the rolls \
+                 each needs)"
+                    .into(),
+            ))
+        }
+        Command::Converge(c) if c.precision.is_some() => {
+            return Err(Error::Usage(
+                "slurm converge: --precision decides each cell's rounds from all its rolls, \
+                 which no task sees; give --rolls N (a --precision run prints the rolls each \
+                 cell needs)"
+                    .into(),
+            ))
+        }
+        _ => {}
+    }
     // A cluster task takes the threads it asks for; "one per core" means one.
     let threads = threads_of(&cmd).max(1);
     super::args::threads(threads)?;
@@ -476,8 +498,17 @@ fn finish(dir: &Path) -> Result<()> {
             }
             let mut cmd = parse_study(args)?;
             place(&mut cmd, &lay, *threads)?;
-            // Every chunk is on disk: the study reads them all and rolls none.
-            let _ = super::chunks().set(Chunks::Assemble);
+            let chunks = match &mut cmd {
+                // The tasks rolled ahead; the study itself runs here, reading their chunks
+                // back and rolling on where a method needs more.
+                Command::Tradeoff(t) => {
+                    t.preroll = None;
+                    Chunks::All
+                }
+                // Every chunk is on disk: the study reads them all and rolls none.
+                _ => Chunks::Assemble,
+            };
+            let _ = super::chunks().set(chunks);
             let _ = super::command_line().set(format!(
                 "dicephys {} (through Slurm: {tasks} tasks, {})",
                 args.join(" "),

@@ -36,6 +36,20 @@ pub struct ConvergeArgs {
     /// Steps after which a roll not at rest counts as unconverged.
     #[arg(long, default_value_t = 2_000_000)]
     pub max_steps: u64,
+    /// Precision as the input, per cent at 2σ ("1" or "1%"): every cell rolled in rounds of one
+    /// keyed stream until its departure from the finest dt is resolved to it (--rolls ignored).
+    #[arg(long, value_parser = parse_percent)]
+    pub precision: Option<f64>,
+    /// With --precision: CPU seconds a cell may spend.
+    #[arg(long, default_value_t = 600.0)]
+    pub budget: f64,
+    /// With --precision: CPU seconds the finest dt's cell may spend.
+    #[arg(long, default_value_t = 1800.0)]
+    pub reference_budget: f64,
+    /// Roll with the exact levers (closed-form flight; the early stop at dt <= 1/250 s), shown
+    /// exact at fine steps by `tradeoff`'s levers row, instead of every step stepped.
+    #[arg(long)]
+    pub fast: bool,
     #[arg(long, default_value = "converge-out")]
     pub out: PathBuf,
     /// Print converge.json to stdout instead of the table.
@@ -47,15 +61,28 @@ pub struct ConvergeArgs {
 pub struct TradeoffArgs {
     #[arg(long, default_value = "140x24x20", value_parser = parse_block)]
     pub block: Block,
-    /// The methods' time steps (comma-separated).
+    /// Bullet's time steps (comma-separated).
     #[arg(long, value_delimiter = ',', default_value = "1/100,1/250,1/1000", value_parser = parse_dt)]
     pub dts: Vec<f64>,
-    /// The reference's time step (the faithful scene at the finest dt).
+    /// Rapier's time steps (comma-separated).
+    #[arg(long, value_delimiter = ',', default_value = "1/250,1/1000", value_parser = parse_dt)]
+    pub rapier_dts: Vec<f64>,
+    /// The reference's time step (Bullet, box floor, the exact levers).
     #[arg(long, default_value = "1/5000", value_parser = parse_dt)]
     pub reference_dt: f64,
-    /// Rolls per method.
-    #[arg(long, default_value_t = 300)]
-    pub rolls: u64,
+    /// The reference's ladder: other fine steps rolled like the reference, each a departure
+    /// from it (comma-separated; "none" for none).
+    #[arg(long, value_delimiter = ',', default_value = DEFAULT_LADDER, value_parser = parse_dt_or_none)]
+    pub ladder: Vec<Option<f64>>,
+    /// The 2σ half-width asked of every departure, in per cent of the ratio ("1" or "1%").
+    #[arg(long, default_value = DEFAULT_PRECISION, value_parser = parse_percent)]
+    pub precision: f64,
+    /// CPU seconds a method may spend before it is left unresolved.
+    #[arg(long, default_value_t = 600.0)]
+    pub budget: f64,
+    /// CPU seconds the reference (each mode's) may spend.
+    #[arg(long, default_value_t = 1800.0)]
+    pub reference_budget: f64,
     #[arg(long, default_value_t = 2385)]
     pub seed: u64,
     #[arg(long, default_value_t = 0)]
@@ -64,8 +91,65 @@ pub struct TradeoffArgs {
     pub max_steps: u64,
     #[arg(long, default_value = "tradeoff-out")]
     pub out: PathBuf,
+    /// Roll the pilot (a chunk of every method, kept), print the plan (the CPU the precision
+    /// asked costs, and the precision an hour buys) and stop.
+    #[arg(long)]
+    pub plan: bool,
+    /// Roll the first ROLLS throws (in whole 1,000s) of every stream (methods, reference, its
+    /// ladder and checks) into --out/checkpoint and stop, deciding nothing: what the tasks of
+    /// `dicephys slurm tradeoff` do, before its finishing job runs the study, reading them back.
+    #[arg(long, value_name = "ROLLS")]
+    pub preroll: Option<u64>,
     #[arg(long)]
     pub json: bool,
+}
+
+/// `tradeoff`'s default precision, per cent at 2σ: what about 60 minutes on 2 cores buys at
+/// the defaults (README, Speed against accuracy).
+pub const DEFAULT_PRECISION: &str = "2";
+
+/// `tradeoff`'s default ladder under the reference.
+pub const DEFAULT_LADDER: &str = "1/2000,1/10000";
+
+/// A precision in per cent, "1" or "1%", as a fraction in (0, 100 %).
+pub(super) fn parse_percent(s: &str) -> std::result::Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .trim_end_matches('%')
+        .trim()
+        .parse()
+        .map_err(|_| format!("bad precision '{s}': give per cent, e.g. 1 or 1%"))?;
+    if v.is_finite() && v > 0.0 && v < 100.0 {
+        Ok(v / 100.0)
+    } else {
+        Err(format!("precision '{s}': must be in (0, 100) %"))
+    }
+}
+
+fn parse_dt_or_none(s: &str) -> std::result::Result<Option<f64>, String> {
+    if s.trim() == "none" {
+        Ok(None)
+    } else {
+        parse_dt(s).map(Some).map_err(|e| e.to_string())
+    }
+}
+
+/// A progress bar on stderr in estimated CPU seconds (so its ETA weighs dear and cheap rolls
+/// right), hidden for --json or when stderr is not a terminal.
+pub(super) fn cpu_bar(quiet: bool) -> indicatif::ProgressBar {
+    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+    use std::io::IsTerminal;
+    if quiet || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::with_draw_target(Some(1), ProgressDrawTarget::stderr());
+    b.set_style(
+        ProgressStyle::with_template(
+            "{elapsed_precise} [{wide_bar}] {percent}% of the planned CPU, ETA {eta}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    b
 }
 
 #[derive(Args, Debug)]
@@ -174,11 +258,29 @@ pub fn converge(a: &ConvergeArgs) -> Result<()> {
         rolls: a.rolls,
         seed: a.seed,
         max_steps: a.max_steps,
+        precision: a.precision,
+        budget_s: (a.budget, a.reference_budget),
+        fast: a.fast,
     };
-    let Some(res) = logged(a.json, &converge::header(), |log| {
-        converge::run(&cfg, &study, log)
-    })?
-    else {
+    for (v, name) in [
+        (a.budget, "--budget"),
+        (a.reference_budget, "--reference-budget"),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(Error::Usage(format!("{name} {v}: CPU seconds, above 0")));
+        }
+    }
+    let bar = cpu_bar(a.json || a.precision.is_none());
+    let progress = |done: f64, total: f64| {
+        bar.set_length((1000.0 * total) as u64);
+        bar.set_position((1000.0 * done.min(total)) as u64);
+    };
+    let res = logged(a.json, &converge::header(), |log| {
+        let log = |l: &str| bar.suspend(|| log(l));
+        converge::run(&cfg, &study, &log, &progress)
+    });
+    bar.finish_and_clear();
+    let Some(res) = res? else {
         return Ok(());
     };
     let lines: Vec<fig::Line> = group(&res.cells, |c| {
@@ -200,12 +302,25 @@ pub fn converge(a: &ConvergeArgs) -> Result<()> {
     fig::convergence(
         &a.out,
         "converge",
-        &format!("Ratio against dt ({} rolls per point)", a.rolls),
+        &match a.precision {
+            Some(p) => format!(
+                "Ratio against dt (each departure resolved to ±{:.2} % at 2σ, or marked)",
+                100.0 * p
+            ),
+            None => format!("Ratio against dt ({} rolls per point)", a.rolls),
+        },
         &lines,
     )?;
     let mut md = format!(
-        "# Convergence in dt\n\n{} rolls per cell, seed {}, rolls ended by {}.\n\n```\n{}\n",
-        res.rolls,
+        "# Convergence in dt\n\n{}, seed {}, rolls ended by {}.\n\n```\n{}\n",
+        match a.precision {
+            Some(p) => format!(
+                "Every cell rolled until 2σ of its departure from the finest dt is at most {:.2} % \
+                 or its budget spent",
+                100.0 * p
+            ),
+            None => format!("{} rolls per cell", res.rolls),
+        },
         res.seed,
         res.settle,
         converge::header()
@@ -234,37 +349,126 @@ fn group<T>(items: &[T], key: impl Fn(&T) -> String) -> Vec<(String, Vec<&T>)> {
 
 pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
     nonempty(&a.dts, "--dts")?;
-    if a.dts.iter().any(|&d| d <= a.reference_dt) {
+    let ladder: Vec<f64> = a.ladder.iter().flatten().copied().collect();
+    let mut all_dts = a.dts.iter().chain(&a.rapier_dts);
+    if all_dts.any(|&d| d <= a.reference_dt) {
         return Err(Error::Usage(format!(
-            "--reference-dt {}: must be finer than every --dts",
+            "--reference-dt {}: must be finer than every --dts and --rapier-dts",
             dt_label(a.reference_dt)
         )));
     }
-    let study = check_common(a.rolls, a.max_steps, a.threads, &a.out, "tradeoff.json")?;
+    if ladder.contains(&a.reference_dt) {
+        return Err(Error::Usage(
+            "--ladder: the reference's dt is not a rung".into(),
+        ));
+    }
+    for (v, name) in [
+        (a.budget, "--budget"),
+        (a.reference_budget, "--reference-budget"),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(Error::Usage(format!("{name} {v}: CPU seconds, above 0")));
+        }
+    }
+    let study = check_common(1, a.max_steps, a.threads, &a.out, "tradeoff.json")?;
     let cfg = tradeoff::Config {
         block: a.block,
         dts: a.dts.clone(),
+        rapier_dts: a.rapier_dts.clone(),
         reference_dt: a.reference_dt,
-        rolls: a.rolls,
+        ladder,
+        precision: a.precision,
+        budget_s: a.budget,
+        reference_budget_s: a.reference_budget,
         seed: a.seed,
         max_steps: a.max_steps,
+        plan_only: a.plan,
+        preroll_chunks: a.preroll.map(|r| r.div_ceil(dicephys::run::runner::CHUNK)),
     };
-    let Some(res) = logged(a.json, &tradeoff::header(), |log| {
-        tradeoff::run(&cfg, &study, log)
-    })?
-    else {
+    if a.preroll == Some(0) {
+        return Err(Error::Usage("--preroll 0: give at least 1 roll".into()));
+    }
+    let bar = cpu_bar(a.json);
+    let progress = |done: f64, total: f64| {
+        bar.set_length((1000.0 * total) as u64);
+        bar.set_position((1000.0 * done.min(total)) as u64);
+    };
+    let res = logged(a.json, &tradeoff::header(), |log| {
+        let log = |l: &str| bar.suspend(|| log(l));
+        tradeoff::run(&cfg, &study, &log, &progress)
+    });
+    bar.finish_and_clear();
+    let Some(res) = res? else {
         return Ok(());
     };
+    if a.plan {
+        if a.json {
+            outln!("{}", to_json(&res)?);
+        }
+        return Ok(());
+    }
+    if let Some(r) = a.preroll {
+        eprintln!(
+            "rolled the first {r} throws of every stream into {}/checkpoint ({:.0} CPU s); \
+             the same command without --preroll reads them back",
+            a.out.display(),
+            res.cpu_s
+        );
+        return Ok(());
+    }
     let mut pts = Vec::new();
+    let mut bands = Vec::new();
+    if let Some(row) = dicephys::theory::paper_data::load().ok().and_then(|t| {
+        t.rows
+            .into_iter()
+            .find(|r| r.simulated && r.block_dims().ok() == Some(a.block))
+    }) {
+        let m = row.measured_ratio();
+        let rel = 200.0 * m.err / m.value;
+        bands.push(fig::Band {
+            label: format!("the paper's experiment, {}: ±{rel:.1} % (2σ)", row.label()),
+            lo: 0.0,
+            hi: rel,
+            two_d: None,
+        });
+    }
     for m in &res.modes {
+        let two_d = m.mode == dicephys::model::scene::Mode::TwoD;
         for r in &m.rows {
             pts.push(fig::MethodPoint {
                 label: r.method.clone(),
                 cost: r.cpu_s_per_1000,
                 error: 100.0 * r.error.abs(),
                 error_err: 100.0 * r.error_err,
-                two_d: r.mode == dicephys::model::scene::Mode::TwoD,
+                two_d,
+                resolved: r.resolved,
                 on_front: m.pareto_front.contains(&r.method),
+                cheapest: m.cheapest_within.as_ref() == Some(&r.method),
+            });
+        }
+        // Rapier's converged departure: its box floor, exact levers, at its finest step.
+        if let Some(r) = m
+            .rows
+            .iter()
+            .filter(|r| {
+                r.engine == EngineKind::Rapier
+                    && r.rule == "fast"
+                    && r.floor == dicephys::model::scene::Floor::Box
+            })
+            .min_by(|x, y| x.dt.total_cmp(&y.dt))
+        {
+            let (d, e) = (100.0 * r.error.abs(), 200.0 * r.error_err);
+            bands.push(fig::Band {
+                label: format!(
+                    "Rapier {} {} against Bullet: {:+.1} ± {:.1} % (2σ)",
+                    m.mode.name(),
+                    dt_label(r.dt),
+                    100.0 * r.error,
+                    e
+                ),
+                lo: d - e,
+                hi: d + e,
+                two_d: Some(two_d),
             });
         }
     }
@@ -272,18 +476,29 @@ pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
         &a.out,
         "tradeoff",
         &format!(
-            "{}: cost against error ({} rolls per method)",
-            res.block, res.rolls
+            "{}: cost against departure from Bullet at {} (±{} % at 2σ asked)",
+            res.block,
+            dt_label(res.reference_dt),
+            100.0 * res.precision
         ),
         &pts,
+        &bands,
+        100.0 * res.precision,
     )?;
     let mut md = format!(
-        "# Accuracy against cost\n\n{}, {} rolls per method, seed {}; reference: Bullet, box floor, \
-         DicePhys's rule, every step stepped, dt {}.\n\n",
+        "# Accuracy against cost\n\n{}, seed {}; every departure rolled until 2σ ≤ {:.2} % or \
+         {:.0} CPU s spent; reference: Bullet, box floor, the exact levers (early stop, fast \
+         flight), dt {}, to 2σ ≤ {:.2} % of its own. Planned after the pilot: {:.0} CPU s; \
+         spent on rolls: {:.0} CPU s. At ±1 % the plan is {:.0} CPU s.\n\n",
         res.block,
-        res.rolls,
         res.seed,
-        dt_label(res.reference_dt)
+        100.0 * res.precision,
+        res.budget_s,
+        dt_label(res.reference_dt),
+        50.0 * res.precision,
+        res.planned_cpu_s,
+        res.cpu_s,
+        res.planned_cpu_s_at_one_percent
     );
     for m in &res.modes {
         md += &format!(
@@ -292,17 +507,20 @@ pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
             tradeoff::header(),
             tradeoff::format_row(&m.reference)
         );
+        for r in &m.checks {
+            md += &format!("{}  ({:?})\n", tradeoff::format_row(r), r.role);
+        }
         for r in &m.rows {
             md += &tradeoff::format_row(r);
             md.push('\n');
         }
         md += &format!(
-            "```\n\nPareto front (cheapest first): {}.\n\n{}\n\n",
+            "```\n\nPareto front over resolved methods (cheapest first): {}.\n\n{}\n\n",
             m.pareto_front.join("; "),
             m.note
         );
     }
-    md += "![cost against error](tradeoff.svg)\n";
+    md += "![cost against departure](tradeoff.svg)\n";
     finish(&a.out, "tradeoff.json", &to_json(&res)?, &md, a.json)
 }
 

@@ -173,8 +173,26 @@ impl<'a> Runner<'a> {
         checkpoint: Option<&Checkpoint>,
         sink: &mut dyn FnMut(&[RollRecord]) -> Result<()>,
     ) -> Result<Chunked> {
+        let all = 0..spec.indices().len().div_ceil(CHUNK);
+        self.run_chunks(spec, checkpoint, all, sink)
+    }
+
+    /// `run`, over the chunks `chunks` only (chunk c holds the run's throws c·CHUNK onwards):
+    /// a run whose `rolls` is a large fixed cap is then one keyed throw stream, rolled a
+    /// prefix at a time into one checkpoint whose key does not change as the prefix grows
+    /// (`studies::sweep::Stream`). `complete` means every chunk in `chunks` was rolled.
+    pub fn run_chunks(
+        &self,
+        spec: &RunSpec,
+        checkpoint: Option<&Checkpoint>,
+        chunks: std::ops::Range<u64>,
+        sink: &mut dyn FnMut(&[RollRecord]) -> Result<()>,
+    ) -> Result<Chunked> {
         let indices = spec.indices();
-        let throws = spec.throws.source(spec.rolls);
+        let end = chunks.end.min(indices.len().div_ceil(CHUNK));
+        let throws = spec
+            .throws
+            .source(spec.rolls.min(end.saturating_mul(CHUNK) * indices.n.max(1)));
         let key = spec.key();
         let mut done = Chunked {
             tally: Tally::default(),
@@ -186,7 +204,7 @@ impl<'a> Runner<'a> {
         if let Chunks::DryRun = self.chunks {
             return Ok(done);
         }
-        for c in 0..indices.len().div_ceil(CHUNK) {
+        for c in chunks.start..end {
             let chunk = indices.chunk(c, CHUNK);
             let path = checkpoint.map(|d| d.chunk_path(chunk[0], chunk.len()));
             if !self.chunks.take_next() {

@@ -277,7 +277,7 @@ pub fn finish_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Re
         "#!/bin/bash\n\
          # dicephys {cmd}: merge the {n} tasks' results. Written by `dicephys slurm`.\n\
          #SBATCH --job-name=dicephys-{cmd}-finish\n\
-         #SBATCH --cpus-per-task=1\n\
+         #SBATCH --cpus-per-task={cpus}\n\
          #SBATCH --open-mode=append\n\
          #SBATCH --output={logs}/finish.out\n\
          {extra}\
@@ -300,5 +300,10 @@ pub fn finish_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Re
         n = plan.tasks(),
         logs = quote(logs),
         extra = opt.lines(),
+        cpus = match plan {
+            // The finishing job of `tradeoff` may roll on; the others only read and write.
+            Plan::Study { threads, .. } => *threads,
+            Plan::Roll { .. } => 1,
+        },
     ))
 }

@@ -6,7 +6,10 @@
 //! Rolls end by DicePhys's own rule with every step stepped (no early stop, no closed-form
 //! flight): this is a study of the integrator, so nothing else may change with dt.
 
-use super::sweep::{cell_spec, departure, dt_label, measure, rolls_to_resolve, Study, ONE_PERCENT};
+use super::sweep::{
+    cell_spec, departure, dt_label, measure, paired_departure, plan_cpu, resolve_departure,
+    resolve_reference, rolls_for_ratio, rolls_to_resolve, Departure, Stream, Study, ONE_PERCENT,
+};
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
@@ -29,6 +32,15 @@ pub struct Config {
     pub seed: u64,
     /// The step cap per roll.
     pub max_steps: u64,
+    /// Precision as the input: every cell's departure from the finest dt rolled in rounds of
+    /// one keyed stream until its 2σ is at most this (a fraction), the finest to half of it;
+    /// `rolls` is then ignored.
+    pub precision: Option<f64>,
+    /// With `precision`: CPU seconds a cell may spend, and the finest dt's cell.
+    pub budget_s: (f64, f64),
+    /// Roll with the exact levers (early stop, closed-form flight) instead of DicePhys's rule
+    /// with every step stepped.
+    pub fast: bool,
 }
 
 /// One cell: a block, an engine, 2D or 3D, a dt.
@@ -60,8 +72,12 @@ pub struct Cell {
     pub energy_gain: u64,
     /// ratio / ratio at the finest dt − 1.
     pub departure: f64,
-    /// Its error.
+    /// Its error (with `--precision`: paired on the shared throws).
     pub departure_err: f64,
+    /// With `--precision`: 2σ of the departure (of the finest dt: of its own ratio, to half
+    /// the precision) is within the precision.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub resolved: Option<bool>,
 }
 
 /// The paper's claim for one block × engine × mode.
@@ -83,10 +99,14 @@ pub struct Claim {
     pub departure_err: f64,
     /// 2σ of the departure is at most 1 %.
     pub resolved: bool,
-    /// Resolved and |departure| ≤ 1 %.
+    /// The claim decided at 2σ (`decide`): yes if resolved and |departure| ≤ 1 %; no if
+    /// resolved and beyond 1 %, or if even |departure| − 2σ > 1 %; else open.
     pub within_one_percent: Option<bool>,
-    /// Rolls per cell for 2σ = 1 %.
+    /// Rolls per cell for 2σ = 1 % (with `--precision`: both cells at that count, on the
+    /// same throws).
     pub rolls_needed: Option<u64>,
+    /// Rolls at `dt` and at `dt_finest` (equal without `--precision`).
+    pub rolls: (u64, u64),
 }
 
 /// The convergence test's results.
@@ -116,19 +136,22 @@ pub struct Converge {
 pub const CLAIM_DT: f64 = 0.001;
 
 /// Runs the convergence test, logging each cell as it is measured.
-pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Converge> {
-    let settle = RollConfig {
-        max_steps: cfg.max_steps,
-        rule: Rule::Dicephys,
-        fast_flight: false,
-        ..RollConfig::default()
-    };
+pub fn run(
+    cfg: &Config,
+    study: &Study,
+    log: &dyn Fn(&str),
+    progress: super::tradeoff::Progress,
+) -> Result<Converge> {
     let mut dts = cfg.dts.clone();
     dts.sort_by(|a, b| b.total_cmp(a));
     dts.dedup();
     let finest = *dts
         .last()
         .ok_or_else(|| Error::Invalid("no dt given".into()))?;
+    if let Some(p) = cfg.precision {
+        return run_resolved(cfg, p, &dts, study, log, progress);
+    }
+    let settle = settle(cfg, finest);
     let mut cells = Vec::new();
     let mut claims = Vec::new();
     for block in &cfg.blocks {
@@ -166,6 +189,7 @@ pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Converge> 
                         energy_gain: m.tally.energy_gain,
                         departure: d,
                         departure_err: d_err,
+                        resolved: None,
                     };
                     log(&format_cell(&cell));
                     if (dt - CLAIM_DT).abs() < 1e-12 && *dt > finest {
@@ -179,8 +203,9 @@ pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Converge> 
                             departure: d,
                             departure_err: d_err,
                             resolved,
-                            within_one_percent: resolved.then_some(d.abs() <= ONE_PERCENT),
+                            within_one_percent: decide(d, d_err),
                             rolls_needed: rolls_to_resolve(d_err, cfg.rolls),
+                            rolls: (cfg.rolls, cfg.rolls),
                         });
                     }
                     cells.push(cell);
@@ -189,9 +214,13 @@ pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Converge> 
         }
     }
     let resolved = !claims.is_empty() && claims.iter().all(|c| c.resolved);
-    let verdict = verdict(&claims, finest, cfg.rolls);
+    let verdict = verdict(
+        &claims,
+        finest,
+        &format!("with {} rolls per cell", cfg.rolls),
+    );
     Ok(Converge {
-        settle: "dicephys rest rule, every step stepped (faithful)".into(),
+        settle: settle_words(cfg),
         rolls: cfg.rolls,
         seed: cfg.seed,
         dts,
@@ -203,7 +232,180 @@ pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Converge> 
     })
 }
 
-fn verdict(claims: &[Claim], finest: f64, rolls: u64) -> String {
+/// How rolls end: DicePhys's rule, every step stepped; or, with `fast`, the exact levers
+/// (at every dt of a convergence test the early stop is exact only at dt <= 1/250 s, so it
+/// is used there only, as in `roll`).
+fn settle(cfg: &Config, dt: f64) -> RollConfig {
+    RollConfig {
+        max_steps: cfg.max_steps,
+        rule: if cfg.fast && crate::sim::roll::early_stop_exact(dt) {
+            Rule::Certificate
+        } else {
+            Rule::Dicephys
+        },
+        fast_flight: cfg.fast,
+        ..RollConfig::default()
+    }
+}
+
+fn settle_words(cfg: &Config) -> String {
+    if cfg.fast {
+        "the exact levers: closed-form flight, the early stop at dt <= 1/250 s (else DicePhys's rule)".into()
+    } else {
+        "dicephys rest rule, every step stepped (faithful)".into()
+    }
+}
+
+/// The convergence test with precision as the input: per block × engine × mode, the finest
+/// dt's stream to 2σ ≤ precision/2 of its own ratio, then every other dt's departure from it
+/// to 2σ ≤ precision, in rounds of one keyed stream each, within the budgets.
+fn run_resolved(
+    cfg: &Config,
+    precision: f64,
+    dts: &[f64],
+    study: &Study,
+    log: &dyn Fn(&str),
+    progress: super::tradeoff::Progress,
+) -> Result<Converge> {
+    let finest = *dts
+        .last()
+        .ok_or_else(|| Error::Invalid("no dt given".into()))?;
+    let mut groups = Vec::new();
+    for block in &cfg.blocks {
+        for &engine in &cfg.engines {
+            for mode in [Mode::ThreeD, Mode::TwoD] {
+                // The finest dt first: the group's reference.
+                let streams: Vec<(f64, Stream)> = dts
+                    .iter()
+                    .rev()
+                    .map(|&dt| {
+                        let mut scene = Scene::paper(*block, mode);
+                        scene.dt = dt;
+                        (dt, Stream::new(engine, scene, settle(cfg, dt), cfg.seed))
+                    })
+                    .collect();
+                groups.push((*block, engine, mode, streams));
+            }
+        }
+    }
+    let mut spent = 0.0;
+    for g in groups.iter_mut() {
+        for (_, s) in g.3.iter_mut() {
+            s.extend(1, study, &|_| {})?;
+            spent += s.cpu_s;
+        }
+    }
+    let total = {
+        let plan: Vec<Vec<&Stream>> = groups
+            .iter()
+            .map(|g| g.3.iter().map(|(_, s)| s).collect())
+            .collect();
+        let total = plan_cpu(&plan, precision, Some((cfg.budget_s.1, cfg.budget_s.0)));
+        log(&format!(
+            "plan: the pilot took {spent:.0} CPU s; ±{:.2} % (2σ) takes about {total:.0} CPU s \
+             more within the budgets, {:.0} without; ±1 % {:.0} CPU s",
+            100.0 * precision,
+            plan_cpu(&plan, precision, None),
+            plan_cpu(&plan, ONE_PERCENT, None),
+        ));
+        total
+    };
+    let mut done = 0.0;
+    progress(0.0, total);
+    let mut cells = Vec::new();
+    let mut claims = Vec::new();
+    for (block, engine, mode, mut streams) in groups {
+        let (reference, rest) = streams.split_first_mut().expect("a dt is given");
+        let before = reference.1.cpu_s;
+        let base = done;
+        resolve_reference(&mut reference.1, precision, cfg.budget_s.1, study, &|c| {
+            progress(base + c, total)
+        })?;
+        done += reference.1.cpu_s - before;
+        for (_, s) in rest.iter_mut() {
+            let (base, before) = (done, s.cpu_s);
+            resolve_departure(s, &reference.1, precision, cfg.budget_s.0, study, &|c| {
+                progress(base + c, total)
+            })?;
+            done += s.cpu_s - before;
+        }
+        // Coarse to fine, as without --precision.
+        for (dt, s) in streams.iter().rev() {
+            let is_ref = *dt == finest;
+            let d = if is_ref {
+                Departure::zero()
+            } else {
+                paired_departure(s, &streams[0].1)
+            };
+            let m = s.measured();
+            let r = m.ratio();
+            let resolved = if is_ref {
+                rolls_for_ratio(s, 0.5 * precision).is_some_and(|n| n <= s.rolls())
+            } else {
+                2.0 * d.err <= precision
+            };
+            let cell = Cell {
+                block: block.to_string(),
+                engine: engine.name().into(),
+                mode: mode.name().into(),
+                dt: *dt,
+                rolls: m.tally.rolls,
+                ratio: r.value,
+                ratio_err: r.err,
+                steps_per_roll: m.steps_per_roll(),
+                cpu_s_per_roll: m.cpu_s_per_roll(),
+                unconverged: m.tally.unconverged,
+                failed: m.tally.failed_total(),
+                energy_gain: m.tally.energy_gain,
+                departure: d.value,
+                departure_err: d.err,
+                resolved: Some(resolved),
+            };
+            log(&format_cell(&cell));
+            if (dt - CLAIM_DT).abs() < 1e-12 && *dt > finest {
+                let ok = 2.0 * d.err <= ONE_PERCENT;
+                claims.push(Claim {
+                    block: cell.block.clone(),
+                    engine: cell.engine.clone(),
+                    mode: cell.mode.clone(),
+                    dt: *dt,
+                    dt_finest: finest,
+                    departure: d.value,
+                    departure_err: d.err,
+                    resolved: ok,
+                    within_one_percent: decide(d.value, d.err),
+                    rolls_needed: d.rolls_both(ONE_PERCENT),
+                    rolls: (s.rolls(), streams[0].1.rolls()),
+                });
+            }
+            cells.push(cell);
+        }
+    }
+    let resolved = !claims.is_empty() && claims.iter().all(|c| c.resolved);
+    let verdict = verdict(
+        &claims,
+        finest,
+        &format!(
+            "rolled to ±{:.2} % (2σ) within the budgets ({} and {} CPU s a cell)",
+            100.0 * precision,
+            cfg.budget_s.0,
+            cfg.budget_s.1
+        ),
+    );
+    Ok(Converge {
+        settle: settle_words(cfg),
+        rolls: cfg.rolls,
+        seed: cfg.seed,
+        dts: dts.to_vec(),
+        max_steps: cfg.max_steps,
+        cells,
+        claims,
+        resolved,
+        verdict,
+    })
+}
+
+fn verdict(claims: &[Claim], finest: f64, how: &str) -> String {
     if claims.is_empty() {
         return format!(
             "The paper's claim (dt = 0.001 s within 1 % of 0.0001 s) is not tested: the run \
@@ -219,38 +421,58 @@ fn verdict(claims: &[Claim], finest: f64, rolls: u64) -> String {
             dt_label(finest)
         )
     };
+    let name = |c: &Claim| format!("{} {} {}", c.block, c.engine, c.mode);
     let unresolved: Vec<&Claim> = claims.iter().filter(|c| !c.resolved).collect();
+    // A departure whose 2σ interval lies wholly beyond ±1 % decides "no" before 2σ ≤ 1 %.
+    let no: Vec<String> = claims
+        .iter()
+        .filter(|c| c.within_one_percent == Some(false))
+        .map(|c| {
+            format!(
+                "{} ({:+.1} ± {:.1} %)",
+                name(c),
+                100.0 * c.departure,
+                200.0 * c.departure_err
+            )
+        })
+        .collect();
+    let beyond = if no.is_empty() {
+        String::new()
+    } else {
+        format!(
+            " dt = 0.001 s departs by more than 1 % from {vs} (2σ) for {}.",
+            no.join(", ")
+        )
+    };
     if unresolved.is_empty() {
-        let fails: Vec<String> = claims
-            .iter()
-            .filter(|c| c.within_one_percent == Some(false))
-            .map(|c| format!("{} {} {}", c.block, c.engine, c.mode))
-            .collect();
-        if fails.is_empty() {
+        if no.is_empty() {
             format!("Resolved: dt = 0.001 s is within 1 % of {vs} in every cell (2σ ≤ 1 %).")
         } else {
-            format!(
-                "Resolved: dt = 0.001 s departs by more than 1 % from {vs} for {}.",
-                fails.join(", ")
-            )
+            format!("Resolved:{beyond}")
         }
     } else {
         let need = |c: &&&Claim| c.rolls_needed.unwrap_or(u64::MAX);
-        let name = |c: &Claim| format!("{} {} {}", c.block, c.engine, c.mode);
+        let open: Vec<&&Claim> = unresolved
+            .iter()
+            .filter(|c| c.within_one_percent.is_none())
+            .collect();
+        if open.is_empty() {
+            return format!("Decided at 2σ, not within 1 %:{beyond}");
+        }
         let (Some(least), Some(most)) = (
-            unresolved.iter().min_by_key(need),
-            unresolved.iter().max_by_key(need),
+            open.iter().copied().min_by_key(need),
+            open.iter().copied().max_by_key(need),
         ) else {
             return String::new();
         };
         format!(
-            "Not resolved: with {rolls} rolls per cell the departure of dt = 0.001 s from {vs} is \
+            "Not resolved: {how}, the departure of dt = 0.001 s from {vs} is \
              known only to ±{:.0} % to ±{:.0} % (2σ), so 1 % cannot be told from 0 ({} of {} \
-             cells unresolved). Resolving it needs about {} rolls per cell for {} and {} for {} \
-             (small ratios need the most).",
+             cells open). Resolving it needs about {} rolls per cell for {} and {} for {} \
+             (small ratios need the most).{beyond}",
             100.0 * 2.0 * least.departure_err,
             100.0 * 2.0 * most.departure_err,
-            unresolved.len(),
+            open.len(),
             claims.len(),
             least.rolls_needed.unwrap_or(0),
             name(least),
@@ -301,3 +523,18 @@ const TABLE: Columns = Columns(&[
     right("failed", 6),
     right("gain", 5),
 ]);
+
+/// The paper's claim for one departure d ± err (1σ), at 2σ: `Some(true)` if 2σ ≤ 1 % and
+/// |d| ≤ 1 %; `Some(false)` if 2σ ≤ 1 % and |d| > 1 %, or if |d| − 2σ > 1 % (the interval
+/// lies wholly beyond ±1 %); `None` while the interval straddles the line.
+pub fn decide(d: f64, err: f64) -> Option<bool> {
+    if !(d.is_finite() && err.is_finite()) {
+        None
+    } else if 2.0 * err <= ONE_PERCENT {
+        Some(d.abs() <= ONE_PERCENT)
+    } else if d.abs() - 2.0 * err > ONE_PERCENT {
+        Some(false)
+    } else {
+        None
+    }
+}

@@ -11,13 +11,14 @@
 
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
+use crate::model::block::Outcome;
 use crate::model::scene::Scene;
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::io::write_atomic;
-use crate::run::runner::Runner;
+use crate::run::runner::{Runner, CHUNK};
 use crate::run::spec::{RunSpec, ThrowSpec};
 use crate::run::tally::Tally;
-use crate::sim::roll::RollConfig;
+use crate::sim::roll::{Fate, RollConfig, RollRecord};
 use crate::theory::stats;
 use std::path::PathBuf;
 
@@ -165,4 +166,396 @@ pub fn dt_label(dt: f64) -> String {
     } else {
         format!("{dt}")
     }
+}
+
+/// The `rolls` of a stream's specification: a fixed cap, never rolled whole. A method's rolls
+/// are a prefix of this one keyed throw stream, so its checkpoint's key stays the same however
+/// many rounds are added, and a cluster could roll chunks ahead of the rounds.
+pub const STREAM_ROLLS: u64 = crate::run::spec::MAX_ROLLS;
+
+/// A roll's outcome as the ratio sees it: 1 breadth vertical, 2 width vertical, 0 anything
+/// else (length vertical, unknown, unconverged, failed).
+fn class(r: &RollRecord) -> u8 {
+    match r.fate {
+        Fate::Settled(Outcome::Breadth) => 1,
+        Fate::Settled(Outcome::Width) => 2,
+        _ => 0,
+    }
+}
+
+/// One method's rolls: the first `rolls()` throws of its keyed stream, with each throw's
+/// outcome (for the paired error of a departure), the exact tally and the CPU seconds they
+/// took (read back with the chunks on a resumed run, so costs stay true).
+pub struct Stream {
+    /// The specification, its `rolls` the cap `STREAM_ROLLS`.
+    pub spec: RunSpec,
+    /// Each throw's `class`, in index order.
+    pub outcomes: Vec<u8>,
+    /// The exact counts of the rolls made.
+    pub tally: Tally,
+    /// Process CPU seconds they took, all threads.
+    pub cpu_s: f64,
+}
+
+impl Stream {
+    /// The stream of `rolls: STREAM_ROLLS` keyed throws of this method; nothing rolled yet.
+    pub fn new(engine: EngineKind, scene: Scene, roll: RollConfig, seed: u64) -> Stream {
+        Stream {
+            spec: cell_spec(engine, scene, roll, seed, STREAM_ROLLS),
+            outcomes: Vec::new(),
+            tally: Tally::default(),
+            cpu_s: 0.0,
+        }
+    }
+
+    /// Rolls made.
+    pub fn rolls(&self) -> u64 {
+        self.outcomes.len() as u64
+    }
+
+    /// The cell's measurement so far.
+    pub fn measured(&self) -> Measured {
+        Measured {
+            tally: self.tally.clone(),
+            cpu_s: self.cpu_s,
+        }
+    }
+
+    /// CPU seconds per roll so far (NaN before any roll).
+    pub fn cpu_s_per_roll(&self) -> f64 {
+        self.cpu_s / self.rolls() as f64
+    }
+
+    /// Rolls the stream on to its first `chunks` chunks (a no-op if it has them), reading
+    /// chunks already in the study's checkpoint back instead of rolling them. `progress`
+    /// hears the rolls made in this call. A stop request is `Error::Stopped`; every whole
+    /// chunk rolled is kept for the next run.
+    pub fn extend(
+        &mut self,
+        chunks: u64,
+        study: &Study,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<()> {
+        let have = self.rolls() / CHUNK;
+        if chunks <= have {
+            return Ok(());
+        }
+        let ck = match &study.checkpoint {
+            Some(root) => {
+                let dir = root.join(format!("{}-{}", self.spec.engine, self.spec.key()));
+                Some(study.runner.open_cell(&dir, &self.spec)?)
+            }
+            None => None,
+        };
+        let cpu = process_cpu_seconds();
+        let mut outcomes = Vec::new();
+        let mut tally = Tally::default();
+        let run = study.runner.with_progress(progress).run_chunks(
+            &self.spec,
+            ck.as_ref(),
+            have..chunks,
+            &mut |recs| {
+                outcomes.extend(recs.iter().map(class));
+                recs.iter().for_each(|r| tally.add(r));
+                Ok(())
+            },
+        )?;
+        if !run.complete {
+            return Err(Error::Stopped);
+        }
+        self.outcomes.extend(outcomes);
+        self.tally.merge(&tally);
+        // A chunk read back costs what it cost when rolled (stored with it), not the reading.
+        let rolled_now = run.tally.rolls > run.resumed;
+        self.cpu_s += run.resumed_cpu_s
+            + if rolled_now {
+                process_cpu_seconds() - cpu
+            } else {
+                0.0
+            };
+        Ok(())
+    }
+
+    /// The ratio's per-throw influence on ln(ratio): a_i = [breadth]/p_b − [width]/p_w, whose
+    /// mean is 0 and whose variance, 1/p_b + 1/p_w, over N rolls is the ratio's relative
+    /// variance (err/ratio)². `None` while either outcome is missing.
+    fn influence(&self) -> Option<[f64; 3]> {
+        let n = self.rolls() as f64;
+        let (b, w) = (
+            self.tally.counts.breadth as f64,
+            self.tally.counts.width as f64,
+        );
+        (b > 0.0 && w > 0.0).then(|| [0.0, n / b, -n / w])
+    }
+}
+
+/// A departure r_m/r_ref − 1 of one stream from another, with the ingredients of its error
+/// so that the error at other roll counts can be predicted.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct Departure {
+    /// r_m/r_ref − 1.
+    pub value: f64,
+    /// Its standard error, paired: the two share their first throws, and where they end alike
+    /// the noise cancels.
+    pub err: f64,
+    /// The error as if the two were independent (`departure`), for comparison.
+    pub err_unpaired: f64,
+    /// Fraction of the shared throws with the same outcome class (breadth, width, other).
+    pub agreement: f64,
+    /// Per-throw variance of ln r_m's influence, 1/p_b + 1/p_w.
+    var_m: f64,
+    /// The same for the reference.
+    var_r: f64,
+    /// Covariance of the two influences over the shared throws.
+    cov: f64,
+}
+
+impl Departure {
+    /// The standard error of the departure with `nm` rolls of the method and `nr` of the
+    /// reference (the first min(nm, nr) shared): ln q = mean(a) over nm − mean(c) over nr,
+    /// so var = V_m/nm + V_r/nr − 2·cov·min/(nm·nr), times q² for the relative departure.
+    pub fn err_at(&self, nm: u64, nr: u64) -> f64 {
+        let (m, r) = (nm as f64, nr as f64);
+        let var = self.var_m / m + self.var_r / r - 2.0 * self.cov * m.min(r) / (m * r);
+        (1.0 + self.value) * var.max(0.0).sqrt()
+    }
+}
+
+/// The departure of `m` from `reference` on the same keyed throws, with its paired error
+/// (delta method on ln of each ratio; the covariance from the throws both rolled).
+pub fn paired_departure(m: &Stream, reference: &Stream) -> Departure {
+    let nan = Departure {
+        value: f64::NAN,
+        err: f64::NAN,
+        err_unpaired: f64::NAN,
+        agreement: f64::NAN,
+        var_m: f64::NAN,
+        var_r: f64::NAN,
+        cov: f64::NAN,
+    };
+    let (Some(a), Some(c)) = (m.influence(), reference.influence()) else {
+        return nan;
+    };
+    let n = m.outcomes.len().min(reference.outcomes.len());
+    if n == 0 {
+        return nan;
+    }
+    let (mut sa, mut sc, mut sac, mut same) = (0.0, 0.0, 0.0, 0u64);
+    for (&x, &y) in m.outcomes[..n].iter().zip(&reference.outcomes[..n]) {
+        let (ai, ci) = (a[x as usize], c[y as usize]);
+        sa += ai;
+        sc += ci;
+        sac += ai * ci;
+        same += (x == y) as u64;
+    }
+    let nf = n as f64;
+    let cov = sac / nf - (sa / nf) * (sc / nf);
+    let (rm, rr) = (m.measured().ratio(), reference.measured().ratio());
+    let (value, err_unpaired) = departure(rm, rr);
+    let mut d = Departure {
+        value,
+        err: f64::NAN,
+        err_unpaired,
+        agreement: same as f64 / nf,
+        var_m: a[1] * a[1] * m.tally.counts.breadth as f64 / m.rolls() as f64
+            + a[2] * a[2] * m.tally.counts.width as f64 / m.rolls() as f64,
+        var_r: c[1] * c[1] * reference.tally.counts.breadth as f64 / reference.rolls() as f64
+            + c[2] * c[2] * reference.tally.counts.width as f64 / reference.rolls() as f64,
+        cov,
+    };
+    d.err = d.err_at(m.rolls(), reference.rolls());
+    d
+}
+
+/// The chunks a method needs for 2σ of its departure to be at most `precision`, with the
+/// reference at `nr` rolls; `None` if none up to `max_chunks` would do.
+pub fn chunks_to_resolve(d: &Departure, nr: u64, precision: f64, max_chunks: u64) -> Option<u64> {
+    if !d.err.is_finite() {
+        return None;
+    }
+    // err_at falls as nm grows, so the first chunk count that resolves is found by bisection.
+    let ok = |k: u64| 2.0 * d.err_at(k * CHUNK, nr) <= precision;
+    if !ok(max_chunks.max(1)) {
+        return None;
+    }
+    let (mut lo, mut hi) = (0u64, max_chunks.max(1));
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if ok(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(hi)
+}
+
+/// Rolls for 2σ of a ratio's own relative error to be at most `precision` (its influence
+/// variance from the rolls so far); `None` before both outcomes are seen.
+pub fn rolls_for_ratio(s: &Stream, precision: f64) -> Option<u64> {
+    let c = s.influence()?;
+    let n = s.rolls() as f64;
+    let var = c[1] * c[1] * s.tally.counts.breadth as f64 / n
+        + c[2] * c[2] * s.tally.counts.width as f64 / n;
+    Some((var / (0.5 * precision).powi(2)).ceil() as u64)
+}
+
+impl Departure {
+    /// The reference's departure from itself.
+    pub fn zero() -> Departure {
+        Departure {
+            value: 0.0,
+            err: 0.0,
+            err_unpaired: 0.0,
+            agreement: 1.0,
+            var_m: 0.0,
+            var_r: 0.0,
+            cov: 0.0,
+        }
+    }
+}
+
+/// The chunks a stream may roll in `budget_s` CPU seconds, at its cost so far (at least the
+/// chunks it has).
+pub fn max_chunks(s: &Stream, budget_s: f64) -> u64 {
+    let per_chunk = s.cpu_s_per_roll() * CHUNK as f64;
+    if per_chunk.is_finite() && per_chunk > 0.0 {
+        ((budget_s / per_chunk).floor() as u64).max(s.rolls() / CHUNK)
+    } else {
+        s.rolls() / CHUNK
+    }
+}
+
+/// The chunks a reference is planned to: 2σ of its own ratio at most half the precision, so
+/// that its noise takes at most a quarter of each departure's variance.
+pub fn reference_chunks(s: &Stream, precision: f64) -> Option<u64> {
+    rolls_for_ratio(s, 0.5 * precision).map(|n| n.div_ceil(CHUNK).max(1))
+}
+
+/// Rolls a reference in rounds until 2σ of its ratio is at most precision/2 or its budget is
+/// spent. `progress` hears the CPU seconds spent so far (estimated).
+pub fn resolve_reference(
+    s: &mut Stream,
+    precision: f64,
+    budget_s: f64,
+    study: &Study,
+    progress: &(dyn Fn(f64) + Sync),
+) -> Result<()> {
+    let cap = max_chunks(s, budget_s);
+    let mut spent = 0.0;
+    loop {
+        let want = reference_chunks(s, precision).unwrap_or(cap).min(cap);
+        let have = s.rolls() / CHUNK;
+        if want <= have {
+            return Ok(());
+        }
+        spent = round(s, want, study, spent, progress)?;
+    }
+}
+
+/// Extends `s` to `chunks`, telling `progress` the CPU seconds spent so far in this
+/// resolution (estimated at the stream's cost per roll); returns the new total.
+fn round(
+    s: &mut Stream,
+    chunks: u64,
+    study: &Study,
+    spent: f64,
+    progress: &(dyn Fn(f64) + Sync),
+) -> Result<f64> {
+    let (have, per) = (s.rolls(), s.cpu_s_per_roll());
+    s.extend(chunks, study, &|n| progress(spent + n as f64 * per))?;
+    let spent = spent + (s.rolls() - have) as f64 * per;
+    progress(spent);
+    Ok(spent)
+}
+
+/// Rolls a method in rounds of its keyed stream until 2σ of its departure from `reference` is
+/// at most `precision`; it stops, unresolved, as soon as the rolls that would resolve it (at
+/// its measured variance and cost) exceed its budget: rolling on to the budget would not
+/// resolve it, and the rolls it needs are reported instead. `progress` hears the rolls made
+/// the CPU seconds spent so far (estimated).
+pub fn resolve_departure(
+    s: &mut Stream,
+    reference: &Stream,
+    precision: f64,
+    budget_s: f64,
+    study: &Study,
+    progress: &(dyn Fn(f64) + Sync),
+) -> Result<()> {
+    let cap = max_chunks(s, budget_s);
+    let mut spent = 0.0;
+    loop {
+        let d = paired_departure(s, reference);
+        let have = s.rolls() / CHUNK;
+        if 2.0 * d.err <= precision {
+            return Ok(());
+        }
+        let Some(k) = chunks_to_resolve(&d, reference.rolls(), precision, cap) else {
+            return Ok(());
+        };
+        // A round adds at least a chunk: the estimate may say "resolved" just short of it.
+        let k = k.max(have + 1);
+        if k > cap {
+            return Ok(());
+        }
+        spent = round(s, k, study, spent, progress)?;
+    }
+}
+
+impl Departure {
+    /// Rolls of both streams (the same number, sharing their throws) for 2σ of the departure
+    /// to be at most `precision`, at the variances measured; `None` if not measured.
+    pub fn rolls_both(&self, precision: f64) -> Option<u64> {
+        let var = (1.0 + self.value).powi(2) * (self.var_m + self.var_r - 2.0 * self.cov);
+        (var.is_finite() && var >= 0.0)
+            .then(|| ((var / (0.5 * precision).powi(2)).ceil() as u64).max(1))
+    }
+}
+
+/// The most chunks one stream is ever planned to (`STREAM_ROLLS`).
+pub const NO_BUDGET: u64 = STREAM_ROLLS / CHUNK;
+
+/// The CPU seconds still to spend, at the streams' measured costs and variances, for every
+/// group (its reference first, then the streams compared with it) to be resolved to
+/// `precision` by `resolve_reference` and `resolve_departure`; with `budgets` (reference's,
+/// each other's, CPU s) as they would cut it, without them in full.
+pub fn plan_cpu(groups: &[Vec<&Stream>], precision: f64, budgets: Option<(f64, f64)>) -> f64 {
+    let mut cpu = 0.0;
+    for g in groups {
+        let Some((reference, rest)) = g.split_first() else {
+            continue;
+        };
+        let cap = budgets.map_or(NO_BUDGET, |(b, _)| max_chunks(reference, b));
+        let kr = reference_chunks(reference, precision)
+            .unwrap_or(cap)
+            .min(cap)
+            .max(reference.rolls() / CHUNK);
+        cpu += kr as f64 * CHUNK as f64 * reference.cpu_s_per_roll() - reference.cpu_s;
+        for s in rest {
+            let cap = budgets.map_or(NO_BUDGET, |(_, b)| max_chunks(s, b));
+            let d = paired_departure(s, reference);
+            // Past its budget a method stops at once (`resolve_departure`).
+            let k = chunks_to_resolve(&d, kr * CHUNK, precision, cap)
+                .unwrap_or(if budgets.is_some() { 0 } else { cap })
+                .max(s.rolls() / CHUNK);
+            cpu += k as f64 * CHUNK as f64 * s.cpu_s_per_roll() - s.cpu_s;
+        }
+    }
+    cpu.max(0.0)
+}
+
+/// The precision an hour of `threads` buys with `spent` CPU seconds already spent: the plan
+/// (no budgets) falls as 1/precision², so bisect on its log.
+pub fn precision_in_an_hour(groups: &[Vec<&Stream>], threads: usize, spent: f64) -> f64 {
+    let hour = 3600.0 * threads as f64 - spent;
+    let (mut lo, mut hi) = (1e-4f64, 0.5f64);
+    for _ in 0..40 {
+        let mid = (lo * hi).sqrt();
+        if plan_cpu(groups, mid, None) > hour {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi
 }

@@ -1,16 +1,28 @@
-//! `dicephys tradeoff`: accuracy against cost. A method is an engine, a time step, a settling
-//! rule (DicePhys's rest rule with every step stepped, or the exact early stop with closed-form
-//! flight) and a scene variant (box floor or plane; in 2D also Rapier's locked 3D body against
-//! its true 2D one). Cost: CPU seconds per 1,000 rolls. Accuracy: the ratio's departure from
-//! the reference, the faithful scene (Bullet, box floor, DicePhys's rule, stepped) at the finest
-//! dt, in standard errors and per cent. Each mode (2D, 3D) has its own reference and front.
+//! `dicephys tradeoff`: accuracy against cost, resolved. A method is an engine, a time step, a
+//! settling rule (DicePhys's rest rule with every step stepped, or the exact early stop with
+//! closed-form flight) and a scene variant (box floor or plane; in 2D also Rapier's locked 3D
+//! body against its true 2D one). Cost: CPU seconds per 1,000 rolls. Accuracy: the ratio's
+//! departure from the reference, Bullet's converged answer (box floor, the exact levers, at the
+//! finest dt), each mode (2D, 3D) its own.
+//!
+//! Precision is the input, rolls the output: every method rolls the same keyed throw stream
+//! (`sweep::Stream`) in rounds until 2σ of its departure is at most the precision, or its CPU
+//! budget is spent; the reference first, to 2σ ≤ precision/2 so that its own noise takes at
+//! most a quarter of each departure's variance. A departure's error is paired: the method
+//! and the reference share their first throws, and where they end alike (the same dt, another
+//! rule) the noise cancels; at another dt or engine the outcomes decorrelate (measured: about
+//! 54 % agreement, what chance gives) and the pairing changes nothing.
 
-use super::sweep::{cell_spec, departure, dt_label, measure, rolls_to_resolve, Study, ONE_PERCENT};
+use super::sweep::{
+    chunks_to_resolve, dt_label, paired_departure, plan_cpu, precision_in_an_hour,
+    resolve_departure, resolve_reference, rolls_for_ratio, Departure, Stream, Study, NO_BUDGET,
+};
 use crate::engine::EngineKind;
 use crate::error::Result;
 use crate::model::block::Block;
 use crate::model::scene::{Floor, Mode, Scene};
 use crate::report::text::{left, right, Columns};
+use crate::run::runner::CHUNK;
 use crate::sim::roll::{RollConfig, Rule};
 use serde::Serialize;
 
@@ -18,16 +30,48 @@ use serde::Serialize;
 pub struct Config {
     /// The block.
     pub block: Block,
-    /// The methods' time steps, s.
+    /// Bullet's time steps, s.
     pub dts: Vec<f64>,
+    /// Rapier's time steps, s.
+    pub rapier_dts: Vec<f64>,
     /// The reference's dt (finer than every method's).
     pub reference_dt: f64,
-    /// Rolls per method.
-    pub rolls: u64,
-    /// The throws' seed (keyed throws, the same for every method).
+    /// The reference's ladder: Bullet with the exact levers at these other fine steps, each a
+    /// departure from the reference that shows it converged (or not).
+    pub ladder: Vec<f64>,
+    /// The 2σ half-width asked of every departure, a fraction of the ratio.
+    pub precision: f64,
+    /// CPU seconds a method may spend.
+    pub budget_s: f64,
+    /// CPU seconds the reference (each mode's) may spend.
+    pub reference_budget_s: f64,
+    /// The throws' seed (keyed throws, the same stream for every method).
     pub seed: u64,
     /// The step cap per roll.
     pub max_steps: u64,
+    /// Stop after the pilot and the plan (no methods in the result).
+    pub plan_only: bool,
+    /// Roll this many chunks of every stream and stop, deciding nothing (no methods in the
+    /// result): a cluster's tasks roll ahead so, and the study run after reads them back.
+    pub preroll_chunks: Option<u64>,
+}
+
+/// Chunks every stream rolls first, to measure its cost and its variance.
+pub const PILOT_CHUNKS: u64 = 1;
+
+/// What a row is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Role {
+    /// A method on the chart.
+    Method,
+    /// The reference itself.
+    Reference,
+    /// A rung of the reference's ladder (another fine step, the same levers).
+    Ladder,
+    /// The reference's scene rolled faithfully (DicePhys's rule, stepped): shows the levers
+    /// exact at the reference's step.
+    Levers,
 }
 
 /// One method's measurement (or the reference's).
@@ -35,6 +79,8 @@ pub struct Config {
 pub struct Row {
     /// The method's name: engine, mode, dt, rule, floor.
     pub method: String,
+    /// What the row is.
+    pub role: Role,
     /// The engine.
     pub engine: EngineKind,
     /// 2D or 3D.
@@ -46,7 +92,7 @@ pub struct Row {
     pub rule: String,
     /// The floor: DicePhys's box, or the plane.
     pub floor: Floor,
-    /// Rolls made.
+    /// Rolls made: the first `rolls` throws of the keyed stream.
     pub rolls: u64,
     /// N(breadth vertical)/N(width vertical).
     pub ratio: f64,
@@ -58,10 +104,18 @@ pub struct Row {
     pub steps_per_roll: f64,
     /// Relative departure from the reference, ratio/reference − 1 (a fraction).
     pub error: f64,
-    /// Its error.
+    /// Its standard error, paired on the shared throws.
     pub error_err: f64,
+    /// The same error had the throws been independent.
+    pub error_err_unpaired: f64,
+    /// The fraction of shared throws ending alike (breadth, width, other) with the reference.
+    pub agreement: f64,
     /// The departure in standard errors, `error / error_err` (0 unless that error is positive).
     pub error_sigma: f64,
+    /// 2σ of the departure (for the reference: of its own ratio) is at most the precision.
+    pub resolved: bool,
+    /// Unresolved: the rolls that would resolve it (the reference as rolled), if any would.
+    pub rolls_needed: Option<u64>,
     /// Rolls not at rest at the step cap.
     pub unconverged: u64,
     /// Rolls that failed, for any reason.
@@ -80,16 +134,18 @@ pub struct Row {
 pub struct ModeResult {
     /// 2D or 3D.
     pub mode: Mode,
-    /// The reference: Bullet, box floor, DicePhys's rule, stepped, at the reference dt.
+    /// The reference: Bullet, box floor, the exact levers, at the reference dt.
     pub reference: Row,
+    /// The reference's scene rolled faithfully, and the ladder's rungs.
+    pub checks: Vec<Row>,
     /// Every method, in the order run.
     pub rows: Vec<Row>,
-    /// Methods no other is both cheaper and closer to the reference than, cheapest first
-    /// (among methods failing or unconverged on at most 1 % of rolls).
+    /// Resolved methods no other resolved one is both cheaper and closer to the reference
+    /// than, cheapest first (among methods failing or unconverged on at most 1 % of rolls).
     pub pareto_front: Vec<String>,
-    /// The cheapest method whose departure is within 1 % at 2σ (|error| + 2σ ≤ 1 %), if any.
-    pub cheapest_within_one_percent: Option<String>,
-    /// Plain words: the cheapest method within 1 %, or how many rolls would resolve 1 %.
+    /// The cheapest resolved method whose |departure| is at most the precision, if any.
+    pub cheapest_within: Option<String>,
+    /// Plain words: the cheapest method within the precision, and what is unresolved.
     pub note: String,
 }
 
@@ -98,17 +154,30 @@ pub struct ModeResult {
 pub struct Tradeoff {
     /// The block, `LxBxW` in mm.
     pub block: String,
-    /// Rolls per method.
-    pub rolls: u64,
+    /// The 2σ half-width asked of every departure, a fraction.
+    pub precision: f64,
+    /// CPU seconds a method may spend.
+    pub budget_s: f64,
     /// The throws' seed.
     pub seed: u64,
     /// The reference's time step, s.
     pub reference_dt: f64,
+    /// After the pilot: the CPU seconds the whole run was planned to take.
+    pub planned_cpu_s: f64,
+    /// The same plan at 1 % (no budget): what resolving the paper's 1 % costs.
+    pub planned_cpu_s_at_one_percent: f64,
+    /// The precision the whole run (pilot included, no budget) would reach in an hour of
+    /// all this run's threads, from the pilot's costs and variances.
+    pub precision_in_an_hour: f64,
+    /// CPU seconds the rolls took (read back with their chunks on a resumed run).
+    pub cpu_s: f64,
     /// 3D, then 2D.
     pub modes: Vec<ModeResult>,
 }
 
+#[derive(Clone, Copy)]
 struct Method {
+    role: Role,
     engine: EngineKind,
     dt: f64,
     faithful: bool,
@@ -129,23 +198,52 @@ impl Method {
             }
         )
     }
+
+    fn stream(&self, cfg: &Config, mode: Mode) -> Stream {
+        let mut scene = Scene::paper(cfg.block, mode);
+        scene.dt = self.dt;
+        scene.floor = self.floor;
+        let settle = RollConfig {
+            max_steps: cfg.max_steps,
+            // `fast` is the defaults: the early stop only where it is audited exact.
+            rule: if self.faithful || !crate::sim::roll::early_stop_exact(self.dt) {
+                Rule::Dicephys
+            } else {
+                Rule::Certificate
+            },
+            fast_flight: !self.faithful,
+            ..RollConfig::default()
+        };
+        Stream::new(self.engine, scene, settle, cfg.seed)
+    }
 }
 
-fn methods(mode: Mode, dts: &[f64]) -> Vec<Method> {
-    let engines: &[EngineKind] = match mode {
-        Mode::ThreeD => &[EngineKind::Bullet, EngineKind::Rapier],
-        Mode::TwoD => &[
-            EngineKind::Bullet,
-            EngineKind::Rapier,
-            EngineKind::RapierLocked,
-        ],
+/// Every stream of a mode: the reference first, then its checks, then the methods.
+fn methods(cfg: &Config, mode: Mode) -> Vec<Method> {
+    let bullet = |role, dt, faithful| Method {
+        role,
+        engine: EngineKind::Bullet,
+        dt,
+        faithful,
+        floor: Floor::Box,
     };
-    let mut out = Vec::new();
-    for &engine in engines {
+    let mut out = vec![
+        bullet(Role::Reference, cfg.reference_dt, false),
+        bullet(Role::Levers, cfg.reference_dt, true),
+    ];
+    out.extend(cfg.ladder.iter().map(|&dt| bullet(Role::Ladder, dt, false)));
+    let rapier: &[EngineKind] = match mode {
+        Mode::ThreeD => &[EngineKind::Rapier],
+        Mode::TwoD => &[EngineKind::Rapier, EngineKind::RapierLocked],
+    };
+    let engines = std::iter::once((EngineKind::Bullet, &cfg.dts))
+        .chain(rapier.iter().map(|&e| (e, &cfg.rapier_dts)));
+    for (engine, dts) in engines {
         for &dt in dts {
             for faithful in [true, false] {
                 for floor in [Floor::Box, Floor::Plane] {
                     out.push(Method {
+                        role: Role::Method,
                         engine,
                         dt,
                         faithful,
@@ -158,79 +256,18 @@ fn methods(mode: Mode, dts: &[f64]) -> Vec<Method> {
     out
 }
 
-fn roll_method(
-    cfg: &Config,
-    study: &Study,
-    mode: Mode,
-    m: &Method,
-    reference: Option<&Row>,
-) -> Result<Row> {
-    let mut scene = Scene::paper(cfg.block, mode);
-    scene.dt = m.dt;
-    scene.floor = m.floor;
-    let settle = RollConfig {
-        max_steps: cfg.max_steps,
-        // `fast` is the defaults: the early stop only where it is audited exact.
-        rule: if m.faithful || !crate::sim::roll::early_stop_exact(m.dt) {
-            Rule::Dicephys
-        } else {
-            Rule::Certificate
-        },
-        fast_flight: !m.faithful,
-        ..RollConfig::default()
-    };
-    let res = measure(
-        &cell_spec(m.engine, scene, settle, cfg.seed, cfg.rolls),
-        study,
-    )?;
-    let r = res.ratio();
-    let (error, error_err) = match reference {
-        Some(rf) => departure(
-            r,
-            crate::theory::stats::Ratio {
-                value: rf.ratio,
-                err: rf.ratio_err,
-            },
-        ),
-        None => (0.0, 0.0),
-    };
-    Ok(Row {
-        method: m.name(mode),
-        engine: m.engine,
-        mode,
-        dt: m.dt,
-        rule: if m.faithful { "faithful" } else { "fast" }.into(),
-        floor: m.floor,
-        rolls: res.tally.rolls,
-        ratio: r.value,
-        ratio_err: r.err,
-        cpu_s_per_1000: 1000.0 * res.cpu_s_per_roll(),
-        steps_per_roll: res.steps_per_roll(),
-        error,
-        error_err,
-        error_sigma: if error_err > 0.0 {
-            error / error_err
-        } else {
-            0.0
-        },
-        unconverged: res.tally.unconverged,
-        failed: res.tally.failed_total(),
-        energy_gain: res.tally.energy_gain,
-        dipped: res.tally.dipped,
-        reference: reference.is_none(),
-    })
-}
-
 /// A method that fails (non-finite, tunnelled, engine error) or does not settle on more than
 /// this fraction of its rolls is not a candidate, however close its ratio from the rest.
 pub const MAX_BAD_FRACTION: f64 = 0.01;
 
 fn eligible(r: &Row) -> bool {
-    r.error.is_finite() && ((r.failed + r.unconverged) as f64) <= MAX_BAD_FRACTION * r.rolls as f64
+    r.resolved
+        && r.error.is_finite()
+        && ((r.failed + r.unconverged) as f64) <= MAX_BAD_FRACTION * r.rolls as f64
 }
 
-/// The Pareto front in cost and |error| over eligible methods: sorted by cost, each method
-/// closer to the reference than every cheaper one.
+/// The Pareto front in cost and |error| over eligible (resolved) methods: sorted by cost, each
+/// method closer to the reference than every cheaper one.
 pub fn pareto(rows: &[Row]) -> Vec<String> {
     let mut sorted: Vec<&Row> = rows.iter().filter(|r| eligible(r)).collect();
     sorted.sort_by(|a, b| a.cpu_s_per_1000.total_cmp(&b.cpu_s_per_1000));
@@ -245,62 +282,245 @@ pub fn pareto(rows: &[Row]) -> Vec<String> {
     front
 }
 
-/// Measures every method against the reference, logging each as it is measured.
-pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Tradeoff> {
-    let mut modes = Vec::new();
-    for mode in [Mode::ThreeD, Mode::TwoD] {
-        let faithful = Method {
-            engine: EngineKind::Bullet,
-            dt: cfg.reference_dt,
-            faithful: true,
-            floor: Floor::Box,
-        };
-        let reference = roll_method(cfg, study, mode, &faithful, None)?;
-        log(&format_row(&reference));
-        let mut rows = Vec::new();
-        for m in methods(mode, &cfg.dts) {
-            let row = roll_method(cfg, study, mode, &m, Some(&reference))?;
-            log(&format_row(&row));
-            rows.push(row);
+/// Progress: estimated CPU seconds done and planned in all.
+pub type Progress<'a> = &'a (dyn Fn(f64, f64) + Sync);
+
+/// Measures every method against its reference to the precision asked, logging the plan and
+/// each method as it is resolved, reporting progress in estimated CPU seconds.
+pub fn run(
+    cfg: &Config,
+    study: &Study,
+    log: &dyn Fn(&str),
+    progress: Progress,
+) -> Result<Tradeoff> {
+    let modes = [Mode::ThreeD, Mode::TwoD];
+    let mut all: Vec<(Mode, Vec<(Method, Stream)>)> = modes
+        .iter()
+        .map(|&mode| {
+            let v = methods(cfg, mode)
+                .into_iter()
+                .map(|m| (m, m.stream(cfg, mode)))
+                .collect();
+            (mode, v)
+        })
+        .collect();
+    let empty = |cpu_s| Tradeoff {
+        block: cfg.block.to_string(),
+        precision: cfg.precision,
+        budget_s: cfg.budget_s,
+        seed: cfg.seed,
+        reference_dt: cfg.reference_dt,
+        planned_cpu_s: 0.0,
+        planned_cpu_s_at_one_percent: 0.0,
+        precision_in_an_hour: f64::NAN,
+        cpu_s,
+        modes: Vec::new(),
+    };
+    // Rolling ahead: the same chunks whatever the results, so a cluster's tasks, each seeing
+    // only its share, agree on which chunk is whose.
+    if let Some(k) = cfg.preroll_chunks {
+        let mut cpu = 0.0;
+        for (_, streams) in all.iter_mut() {
+            for (_, s) in streams.iter_mut() {
+                s.extend(k, study, &|_| {})?;
+                cpu += s.cpu_s;
+            }
         }
+        return Ok(empty(cpu));
+    }
+    // The pilot: a chunk of every stream, its cost and its variance.
+    let mut done_cpu = 0.0;
+    for (_, streams) in all.iter_mut() {
+        for (_, s) in streams.iter_mut() {
+            s.extend(PILOT_CHUNKS, study, &|_| {})?;
+            done_cpu += s.cpu_s;
+        }
+    }
+    let groups: Vec<Vec<&Stream>> = all
+        .iter()
+        .map(|(_, v)| v.iter().map(|(_, s)| s).collect())
+        .collect();
+    let budgets = (cfg.reference_budget_s, cfg.budget_s);
+    let planned = plan_cpu(&groups, cfg.precision, Some(budgets));
+    let at_one = plan_cpu(&groups, 0.01, None);
+    let in_an_hour = precision_in_an_hour(&groups, study.runner.threads, done_cpu);
+    log(&format!(
+        "plan: the pilot took {:.0} CPU s; at ±{:.2} % (2σ, budgets as given) the rest takes \
+         about {:.0} CPU s ({:.1} min on {} threads); ±1 % would take {:.0} CPU s ({:.1} h); \
+         an hour on {} threads buys ±{:.2} %",
+        done_cpu,
+        100.0 * cfg.precision,
+        planned,
+        planned / 60.0 / study.runner.threads as f64,
+        study.runner.threads,
+        at_one,
+        at_one / 3600.0 / study.runner.threads as f64,
+        study.runner.threads,
+        100.0 * in_an_hour
+    ));
+    if cfg.plan_only {
+        return Ok(Tradeoff {
+            planned_cpu_s: planned,
+            planned_cpu_s_at_one_percent: at_one,
+            precision_in_an_hour: in_an_hour,
+            ..empty(done_cpu)
+        });
+    }
+    // Progress counts the planned rolls only (the pilot is done), so that the bar's rate, and
+    // its ETA, are this run's.
+    let (pilot, total) = (done_cpu, planned);
+    progress(0.0, total);
+    let mut out_modes = Vec::new();
+    for (mode, mut streams) in all {
+        // The reference, to 2σ ≤ precision/2, in rounds; then every method.
+        let (rm, rest) = streams.split_first_mut().expect("the reference is first");
+        let reference = &mut rm.1;
+        let (base, before) = (done_cpu, reference.cpu_s);
+        resolve_reference(
+            reference,
+            cfg.precision,
+            cfg.reference_budget_s,
+            study,
+            &|c| progress(base + c - pilot, total),
+        )?;
+        done_cpu += reference.cpu_s - before;
+        let mut rows = Vec::new();
+        let mut checks = Vec::new();
+        for (m, s) in rest.iter_mut() {
+            let (base, before) = (done_cpu, s.cpu_s);
+            resolve_departure(s, reference, cfg.precision, cfg.budget_s, study, &|c| {
+                progress(base + c - pilot, total)
+            })?;
+            done_cpu += s.cpu_s - before;
+            let row = row(cfg, mode, m, s, Some(reference));
+            log(&format_row(&row));
+            if m.role == Role::Method {
+                rows.push(row);
+            } else {
+                checks.push(row);
+            }
+        }
+        let reference_row = row(cfg, mode, &rm.0, reference, None);
+        log(&format!("{}  (reference)", format_row(&reference_row)));
         let pareto_front = pareto(&rows);
         let mut by_cost: Vec<&Row> = rows.iter().collect();
         by_cost.sort_by(|a, b| a.cpu_s_per_1000.total_cmp(&b.cpu_s_per_1000));
         let cheapest = by_cost
             .iter()
-            .find(|r| eligible(r) && r.error.abs() + 2.0 * r.error_err <= ONE_PERCENT)
+            .find(|r| eligible(r) && r.error.abs() <= cfg.precision)
             .map(|r| r.method.clone());
-        let typical = rows
-            .iter()
-            .map(|r| r.error_err)
-            .filter(|e| e.is_finite())
-            .fold(f64::INFINITY, f64::min);
-        let note = match &cheapest {
-            Some(m) => format!("{m} is the cheapest method within 1 % of the reference (2σ)."),
-            None => format!(
-                "None is resolvable within 1 % at {} rolls: the smallest error of a departure is \
-                 ±{:.1} % (1σ); about {} rolls per method would make 2σ = 1 %.",
-                cfg.rolls,
-                100.0 * typical,
-                rolls_to_resolve(typical, cfg.rolls).unwrap_or(0)
-            ),
-        };
-        modes.push(ModeResult {
+        let note = note(cfg, &reference_row, &rows, &cheapest);
+        out_modes.push(ModeResult {
             mode,
-            reference,
+            reference: reference_row,
+            checks,
             rows,
             pareto_front,
-            cheapest_within_one_percent: cheapest,
+            cheapest_within: cheapest,
             note,
         });
     }
+    progress(total, total);
+    let cpu_s = out_modes
+        .iter()
+        .flat_map(|m| {
+            m.rows
+                .iter()
+                .chain(&m.checks)
+                .chain(std::iter::once(&m.reference))
+        })
+        .map(|r| r.cpu_s_per_1000 * r.rolls as f64 / 1000.0)
+        .sum();
     Ok(Tradeoff {
         block: cfg.block.to_string(),
-        rolls: cfg.rolls,
+        precision: cfg.precision,
+        budget_s: cfg.budget_s,
         seed: cfg.seed,
         reference_dt: cfg.reference_dt,
-        modes,
+        planned_cpu_s: planned,
+        planned_cpu_s_at_one_percent: at_one,
+        precision_in_an_hour: in_an_hour,
+        cpu_s,
+        modes: out_modes,
     })
+}
+
+fn row(cfg: &Config, mode: Mode, m: &Method, s: &Stream, reference: Option<&Stream>) -> Row {
+    let res = s.measured();
+    let r = res.ratio();
+    let d = match reference {
+        Some(rf) => paired_departure(s, rf),
+        None => Departure::zero(),
+    };
+    let (resolved, rolls_needed) = match reference {
+        Some(rf) => (
+            2.0 * d.err <= cfg.precision,
+            chunks_to_resolve(&d, rf.rolls(), cfg.precision, NO_BUDGET).map(|k| k * CHUNK),
+        ),
+        None => {
+            let need = rolls_for_ratio(s, 0.5 * cfg.precision);
+            (need.is_some_and(|n| n <= s.rolls()), need)
+        }
+    };
+    Row {
+        method: m.name(mode),
+        role: m.role,
+        engine: m.engine,
+        mode,
+        dt: m.dt,
+        rule: if m.faithful { "faithful" } else { "fast" }.into(),
+        floor: m.floor,
+        rolls: res.tally.rolls,
+        ratio: r.value,
+        ratio_err: r.err,
+        cpu_s_per_1000: 1000.0 * res.cpu_s_per_roll(),
+        steps_per_roll: res.steps_per_roll(),
+        error: d.value,
+        error_err: d.err,
+        error_err_unpaired: d.err_unpaired,
+        agreement: d.agreement,
+        error_sigma: if d.err > 0.0 { d.value / d.err } else { 0.0 },
+        resolved,
+        rolls_needed: (!resolved).then_some(rolls_needed).flatten(),
+        unconverged: res.tally.unconverged,
+        failed: res.tally.failed_total(),
+        energy_gain: res.tally.energy_gain,
+        dipped: res.tally.dipped,
+        reference: reference.is_none(),
+    }
+}
+
+fn note(cfg: &Config, reference: &Row, rows: &[Row], cheapest: &Option<String>) -> String {
+    let p = 100.0 * cfg.precision;
+    let mut s = match cheapest {
+        Some(m) => format!(
+            "{m} is the cheapest method within ±{p:.2} % of the reference (resolved at 2σ)."
+        ),
+        None => format!("No resolved method is within {p:.2} % of the reference."),
+    };
+    if !reference.resolved {
+        s += &format!(
+            " The reference is not resolved to ±{:.2} % (2σ) within its budget: it needs about {} rolls.",
+            p / 2.0,
+            reference.rolls_needed.unwrap_or(0)
+        );
+    }
+    let open: Vec<String> = rows
+        .iter()
+        .filter(|r| !r.resolved)
+        .map(|r| match r.rolls_needed {
+            Some(n) => format!("{} (needs about {n} rolls)", r.method),
+            None => format!("{} (not with this reference)", r.method),
+        })
+        .collect();
+    if !open.is_empty() {
+        s += &format!(
+            " Unresolved within the budget ({:.0} CPU s a method), off the front: {}.",
+            cfg.budget_s,
+            open.join("; ")
+        );
+    }
+    s
 }
 
 /// The column heads of the log's method lines (`format_row`).
@@ -312,11 +532,13 @@ pub fn header() -> String {
 pub fn format_row(r: &Row) -> String {
     TABLE.row(&[
         r.method.clone(),
+        r.rolls.to_string(),
         format!("{:.4} ± {:.4}", r.ratio, r.ratio_err),
         format!("{:.3}", r.cpu_s_per_1000),
         format!("{:.0}", r.steps_per_roll),
-        format!("{:+.1} ± {:.1} %", 100.0 * r.error, 100.0 * r.error_err),
-        format!("{:+.1}", r.error_sigma),
+        format!("{:+.2} ± {:.2} %", 100.0 * r.error, 100.0 * r.error_err),
+        if r.resolved { "yes" } else { "no" }.into(),
+        format!("{:.3}", r.agreement),
         (r.failed + r.unconverged).to_string(),
         r.dipped.to_string(),
     ])
@@ -325,11 +547,13 @@ pub fn format_row(r: &Row) -> String {
 /// The columns of the log and of report.md.
 const TABLE: Columns = Columns(&[
     left("method", 38),
+    right("rolls", 8),
     right("ratio", 17),
-    right("CPU s/1000", 12),
-    right("steps", 8),
-    right("error", 18),
-    right("σ", 6),
+    right("CPU s/1000", 11),
+    right("steps", 7),
+    right("departure ±1σ", 18),
+    right("res.", 4),
+    right("agree", 6),
     right("failed", 6),
     right("dipped", 6),
 ]);

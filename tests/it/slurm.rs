@@ -392,3 +392,69 @@ fn a_crosscheck_split_by_hand_into_tasks_assembles_to_the_one_machine_comparison
     let _ = std::fs::remove_dir_all(&bad);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `tradeoff` decides its rounds from all the rolls so far, which no task sees: its tasks roll
+/// ahead (`--preroll`) and the finishing job runs the study itself, reading their chunks back.
+/// Its rows are the one machine's, roll for roll.
+#[test]
+fn a_tradeoff_rolled_ahead_by_tasks_finishes_as_on_one_machine() {
+    let dir = tmp("tradeoff");
+    let d = dir.to_str().unwrap();
+    let study = [
+        "--precision",
+        "20",
+        "--dts",
+        "1/250",
+        "--rapier-dts",
+        "1/250",
+        "--reference-dt",
+        "1/1000",
+        "--ladder",
+        "1/2000",
+        "--json",
+    ];
+    let slurm = |args: &[&str]| bin().arg("slurm").args(args).output().unwrap();
+    // Without --preroll it is refused, saying why.
+    let plain = slurm(&[&["tradeoff"], &study[..], &["--tasks", "2", "--dir", d]].concat());
+    assert_eq!(plain.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&plain.stderr).contains("--preroll"));
+    let ahead = [
+        &["tradeoff"],
+        &study[..],
+        &["--preroll", "2000", "--tasks", "2", "--dir", d],
+    ];
+    assert!(slurm(&ahead.concat()).status.success());
+    for k in ["0", "1"] {
+        assert!(slurm(&["task", d, k]).status.success(), "task {k}");
+    }
+    let finished = json(&slurm(&["finish", d]));
+    let one = tmp("tradeoff-one");
+    let whole = json(
+        &bin()
+            .arg("tradeoff")
+            .args(study)
+            .arg("--out")
+            .arg(&one)
+            .output()
+            .unwrap(),
+    );
+    let rows = |v: &serde_json::Value| -> Vec<(String, serde_json::Value, serde_json::Value)> {
+        v["modes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|m| m["rows"].as_array().unwrap().clone())
+            .map(|r| {
+                (
+                    r["method"].to_string(),
+                    r["rolls"].clone(),
+                    r["ratio"].clone(),
+                )
+            })
+            .collect()
+    };
+    assert!(!rows(&whole).is_empty());
+    assert_eq!(rows(&finished), rows(&whole));
+    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&one);
+}
