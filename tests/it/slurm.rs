@@ -381,6 +381,8 @@ fn a_crosscheck_split_by_hand_into_tasks_assembles_to_the_one_machine_comparison
         "tradeoff",
         "--reference-dt",
         "1/100",
+        "--preroll",
+        "1000",
         "--tasks",
         "2",
         "--dir",
