@@ -80,6 +80,38 @@ pub struct Cell {
     pub resolved: Option<bool>,
 }
 
+impl Cell {
+    /// A cell from its measurement and its departure (value, error) from the finest dt.
+    fn of(
+        block: &Block,
+        engine: EngineKind,
+        mode: Mode,
+        dt: f64,
+        m: &super::sweep::Measured,
+        (departure, departure_err): (f64, f64),
+        resolved: Option<bool>,
+    ) -> Cell {
+        let r = m.ratio();
+        Cell {
+            block: block.to_string(),
+            engine: engine.name().into(),
+            mode: mode.name().into(),
+            dt,
+            rolls: m.tally.rolls,
+            ratio: r.value,
+            ratio_err: r.err,
+            steps_per_roll: m.steps_per_roll(),
+            cpu_s_per_roll: m.cpu_s_per_roll(),
+            unconverged: m.tally.unconverged,
+            failed: m.tally.failed_total(),
+            energy_gain: m.tally.energy_gain,
+            departure,
+            departure_err,
+            resolved,
+        }
+    }
+}
+
 /// The paper's claim for one block × engine × mode.
 #[derive(Clone, Debug, Serialize)]
 pub struct Claim {
@@ -174,23 +206,7 @@ pub fn run(
                 for (dt, m) in &row {
                     let r = m.ratio();
                     let (d, d_err) = departure(r, reference);
-                    let cell = Cell {
-                        block: block.to_string(),
-                        engine: engine.name().into(),
-                        mode: mode.name().into(),
-                        dt: *dt,
-                        rolls: m.tally.rolls,
-                        ratio: r.value,
-                        ratio_err: r.err,
-                        steps_per_roll: m.steps_per_roll(),
-                        cpu_s_per_roll: m.cpu_s_per_roll(),
-                        unconverged: m.tally.unconverged,
-                        failed: m.tally.failed_total(),
-                        energy_gain: m.tally.energy_gain,
-                        departure: d,
-                        departure_err: d_err,
-                        resolved: None,
-                    };
+                    let cell = Cell::of(block, engine, mode, *dt, m, (d, d_err), None);
                     log(&format_cell(&cell));
                     if (dt - CLAIM_DT).abs() < 1e-12 && *dt > finest {
                         let resolved = 2.0 * d_err <= ONE_PERCENT;
@@ -338,29 +354,20 @@ fn run_resolved(
                 paired_departure(s, &streams[0].1)
             };
             let m = s.measured();
-            let r = m.ratio();
             let resolved = if is_ref {
                 rolls_for_ratio(s, 0.5 * precision).is_some_and(|n| n <= s.rolls())
             } else {
                 2.0 * d.err <= precision
             };
-            let cell = Cell {
-                block: block.to_string(),
-                engine: engine.name().into(),
-                mode: mode.name().into(),
-                dt: *dt,
-                rolls: m.tally.rolls,
-                ratio: r.value,
-                ratio_err: r.err,
-                steps_per_roll: m.steps_per_roll(),
-                cpu_s_per_roll: m.cpu_s_per_roll(),
-                unconverged: m.tally.unconverged,
-                failed: m.tally.failed_total(),
-                energy_gain: m.tally.energy_gain,
-                departure: d.value,
-                departure_err: d.err,
-                resolved: Some(resolved),
-            };
+            let cell = Cell::of(
+                &block,
+                engine,
+                mode,
+                *dt,
+                &m,
+                (d.value, d.err),
+                Some(resolved),
+            );
             log(&format_cell(&cell));
             if (dt - CLAIM_DT).abs() < 1e-12 && *dt > finest {
                 let ok = 2.0 * d.err <= ONE_PERCENT;
