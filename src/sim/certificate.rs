@@ -4,6 +4,7 @@
 use crate::model::block::Outcome;
 use crate::model::die::{up_in_body, DieShape};
 use crate::model::state::BodyState;
+use nalgebra::Vector3;
 
 /// The paper's "static" states made exact: once the die's mechanical energy is below the
 /// lowest barrier out of the face region it is in, its outcome can no longer change.
@@ -31,6 +32,15 @@ pub struct Certificate {
 }
 const SIDES: [Outcome; 3] = [Outcome::Breadth, Outcome::Width, Outcome::Length];
 
+/// The face region the die is in, given the world's up direction in body axes: the axis i
+/// whose face the downward ray from the centre leaves through, |gᵢ|/sᵢ largest (in 2D, x or y).
+pub fn face_region(die: &DieShape, up: &Vector3<f64>) -> usize {
+    let n = if die.planar { 2 } else { 3 };
+    (0..n)
+        .max_by(|&p, &q| (up[p].abs() / die.half[p]).total_cmp(&(up[q].abs() / die.half[q])))
+        .unwrap_or(0)
+}
+
 impl Certificate {
     /// The height E/(mg) must be below for the certificate to hold in any face region: the
     /// largest over regions i of rest height + (1 − margin) × (barrier − rest height). A state
@@ -46,10 +56,7 @@ impl Certificate {
     /// The outcome, if it is already certain.
     pub fn certain(&self, die: &DieShape, s: &BodyState) -> Option<Outcome> {
         let up = up_in_body(&s.rotation);
-        let n = if die.planar { 2 } else { 3 };
-        // Region i: the axis whose face the downward ray leaves through, |gᵢ|/sᵢ largest.
-        let i = (0..n)
-            .max_by(|&p, &q| (up[p].abs() / die.half[p]).total_cmp(&(up[q].abs() / die.half[q])))?;
+        let i = face_region(die, &up);
         let rest = die.half[i];
         let allowed = (1.0 - self.margin) * (die.barrier[i] - rest);
         // The height plus the translational energy's worth of height is a lower bound of E/mg:
