@@ -13,16 +13,31 @@ namespace {
 btVector3 vec(const std::array<double, 3>& a) { return btVector3(a[0], a[1], a[2]); }
 std::array<double, 3> arr(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
 
-// Bullet's world, with one of its steps' parts done without the work that changes nothing
-// here. Every step, btDiscreteDynamicsWorld::predictUnconstraintMotion damps each body,
-// v *= pow(1 - d, dt), and predicts its transform for the swept bounding box. With no damping
-// (DicePhys's: d = 0) that is v *= pow(1, dt) = 1 exactly, two calls to pow for nothing, so
-// it is left out there; a body with damping is damped as Bullet does.
+// Bullet's world, with two of a step's parts done without the work that changes nothing
+// here (each the base class's code, less that work):
+// - predictUnconstraintMotion damps each body, v *= pow(1 - d, dt), and predicts its
+//   transform for the swept bounding box. With no damping (DicePhys's: d = 0) that is
+//   v *= pow(1, dt) = 1 exactly, so it is left out there; a body with damping is damped as
+//   Bullet does. The prediction is left out with the swept box (m_useContinuous, below).
+// - createPredictiveContacts predicts every body's transform once more, to compare its
+//   motion with the body's CCD threshold; but it acts on that only with m_useContinuous.
+//   Without it, what is left is what the base class does whatever the motion.
 class DiceWorld : public btDiscreteDynamicsWorld {
  public:
   using btDiscreteDynamicsWorld::btDiscreteDynamicsWorld;
 
  protected:
+  void createPredictiveContacts(btScalar dt) override {
+    if (getDispatchInfo().m_useContinuous) {
+      btDiscreteDynamicsWorld::createPredictiveContacts(dt);
+      return;
+    }
+    releasePredictiveContacts();
+    for (int i = 0; i < m_nonStaticRigidBodies.size(); i++) {
+      m_nonStaticRigidBodies[i]->setHitFraction(1.f);
+    }
+  }
+
   void predictUnconstraintMotion(btScalar dt) override {
     for (int i = 0; i < m_nonStaticRigidBodies.size(); i++) {
       btRigidBody* body = m_nonStaticRigidBodies[i];
