@@ -1,5 +1,6 @@
 #include "dicephys/cpp/shim.h"
 
+#include <BulletCollision/CollisionDispatch/btSimulationIslandManager.h>
 #include <btBulletDynamicsCommon.h>
 
 #include <cmath>
@@ -27,6 +28,82 @@ class DiceWorld : public btDiscreteDynamicsWorld {
   using btDiscreteDynamicsWorld::btDiscreteDynamicsWorld;
 
  protected:
+  // One dynamic body, not kinematic; every other object static; no joints, no predictive
+  // contacts; islands split (Bullet's default).
+  bool one_die() const {
+    if (m_nonStaticRigidBodies.size() != 1 || m_nonStaticRigidBodies[0]->isKinematicObject() ||
+        m_constraints.size() != 0 || m_predictiveManifolds.size() != 0 ||
+        !m_islandManager->getSplitIslands()) {
+      return false;
+    }
+    const btCollisionObjectArray& objects = getCollisionObjectArray();
+    for (int i = 0; i < objects.size(); i++) {
+      if (objects[i] != m_nonStaticRigidBodies[0] && !objects[i]->isStaticObject()) return false;
+    }
+    return true;
+  }
+
+  // A world of one die and static floors: the die's island is the die alone. Bullet finds
+  // that every step with a union-find over every object and a sort of the manifolds by
+  // island (btSimulationIslandManager), then hands the island to the solver. Here it is
+  // done directly, with the same effects: each object's island tag, companion id and hit
+  // fraction; the die put to sleep when it does not keep its island awake; and the same one
+  // call to the solver, with the same bodies and manifolds (none while the island sleeps).
+  // Any other world goes through Bullet's own.
+  void calculateSimulationIslands() override {
+    if (!one_die()) {
+      btDiscreteDynamicsWorld::calculateSimulationIslands();
+      return;
+    }
+    // btSimulationIslandManager::updateActivationState, then storeIslandActivationState.
+    btCollisionObjectArray& objects = getCollisionObjectArray();
+    for (int i = 0; i < objects.size(); i++) {
+      btCollisionObject* o = objects[i];
+      o->setHitFraction(btScalar(1.));
+      const bool dynamic = !o->isStaticOrKinematicObject();
+      o->setIslandTag(dynamic ? 0 : -1);
+      o->setCompanionId(dynamic ? -1 : -2);
+    }
+  }
+
+  void solveConstraints(btContactSolverInfo& info) override {
+    if (!one_die() || info.m_minimumSolverBatchSize <= 1) {
+      btDiscreteDynamicsWorld::solveConstraints(info);
+      return;
+    }
+    btCollisionObject* die = m_nonStaticRigidBodies[0];
+    btDispatcher* dispatcher = getDispatcher();
+    m_constraintSolver->prepareSolve(getNumCollisionObjects(), dispatcher->getNumManifolds());
+    // btSimulationIslandManager::buildIslands: an island none of whose bodies is active
+    // (ACTIVE_TAG) or kept awake (DISABLE_DEACTIVATION) sleeps; then the manifolds with a
+    // body awake and a contact response.
+    const int state = die->getActivationState();
+    if (state != ACTIVE_TAG && state != DISABLE_DEACTIVATION) {
+      die->setActivationState(ISLAND_SLEEPING);
+    }
+    manifolds_.resize(0);
+    for (int i = 0; i < dispatcher->getNumManifolds(); i++) {
+      btPersistentManifold* m = dispatcher->getManifoldByIndexInternal(i);
+      if (getDispatchInfo().m_deterministicOverlappingPairs && m->getNumContacts() == 0) continue;
+      const btCollisionObject* a = m->getBody0();
+      const btCollisionObject* b = m->getBody1();
+      const bool awake = (a && a->getActivationState() != ISLAND_SLEEPING) ||
+                         (b && b->getActivationState() != ISLAND_SLEEPING);
+      if (awake && dispatcher->needsResponse(a, b)) manifolds_.push_back(m);
+    }
+    // processIslands hands a waking island to the callback, which defers it (batches of
+    // m_minimumSolverBatchSize); solveConstraints then solves what was deferred, if anything.
+    if (die->isActive()) {
+      m_constraintSolver->solveGroup(&die, 1, manifolds_.size() ? &manifolds_[0] : nullptr,
+                                     manifolds_.size(), nullptr, 0, info, getDebugDrawer(),
+                                     dispatcher);
+    } else {
+      m_constraintSolver->solveGroup(nullptr, 0, nullptr, 0, nullptr, 0, info, getDebugDrawer(),
+                                     dispatcher);
+    }
+    m_constraintSolver->allSolved(info, getDebugDrawer());
+  }
+
   void createPredictiveContacts(btScalar dt) override {
     if (getDispatchInfo().m_useContinuous) {
       btDiscreteDynamicsWorld::createPredictiveContacts(dt);
@@ -37,6 +114,9 @@ class DiceWorld : public btDiscreteDynamicsWorld {
       m_nonStaticRigidBodies[i]->setHitFraction(1.f);
     }
   }
+
+ private:
+  btAlignedObjectArray<btPersistentManifold*> manifolds_;  // the die's island's, this step
 
   void predictUnconstraintMotion(btScalar dt) override {
     for (int i = 0; i < m_nonStaticRigidBodies.size(); i++) {
@@ -69,8 +149,13 @@ BulletWorld::BulletWorld(const BulletScene& s)
   // Two bodies: the simplest broadphase does (the pair is the same; measured identical).
   broadphase_ = std::make_unique<btSimpleBroadphase>(4);
   solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
-  world_ = std::make_unique<DiceWorld>(dispatcher_.get(), broadphase_.get(),
-                                                     solver_.get(), config_.get());
+  if (s.stock_world) {
+    world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
+                                                       solver_.get(), config_.get());
+  } else {
+    world_ = std::make_unique<DiceWorld>(dispatcher_.get(), broadphase_.get(), solver_.get(),
+                                         config_.get());
+  }
   world_->setGravity(btVector3(0, -s.gravity, 0));
   // The floor never moves: do not recompute its bounding box every step.
   world_->setForceUpdateAllAabbs(false);
@@ -83,7 +168,7 @@ BulletWorld::BulletWorld(const BulletScene& s)
   // 1.4 mm, long before the boxes, grown by 2 cm, part). The prediction, a second transform
   // integrated per step, is then left out (DiceWorld). Measured: every roll identical
   // (scripts/prove-exact.sh).
-  world_->getDispatchInfo().m_useContinuous = false;
+  if (!s.stock_world) world_->getDispatchInfo().m_useContinuous = false;
   btContactSolverInfo& info = world_->getSolverInfo();
   info.m_splitImpulse = s.split_impulse ? 1 : 0;
   info.m_restitutionVelocityThreshold = s.restitution_velocity_threshold;

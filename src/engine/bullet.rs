@@ -36,6 +36,9 @@ mod ffi {
         /// (1 − d)^dt each step (`Scene::bullet_damping`); DicePhys: 0, 0.
         linear_damping: f64,
         angular_damping: f64,
+        /// Bullet's own world, every part of a step as Bullet does it, without the shim's
+        /// shortcuts (`DiceWorld` in cpp/shim.cc): for the check that they change nothing.
+        stock_world: bool,
     }
 
     /// The die's state: position, orientation (x, y, z, w), velocities, and whether Bullet
@@ -112,6 +115,17 @@ pub struct Bullet {
 impl Bullet {
     /// A fresh Bullet world for the scene, its solver set by the scene's preset.
     pub fn new(scene: &Scene) -> crate::Result<Bullet> {
+        Bullet::build(scene, false)
+    }
+
+    /// The same world, stepped by Bullet's own `btDiscreteDynamicsWorld` without the shim's
+    /// shortcuts (its swept bounding boxes, predictions and island manager, which change
+    /// nothing for one die on a static floor): the check that they change nothing.
+    pub fn stock(scene: &Scene) -> crate::Result<Bullet> {
+        Bullet::build(scene, true)
+    }
+
+    fn build(scene: &Scene, stock_world: bool) -> crate::Result<Bullet> {
         let s = solver(scene.preset);
         let (linear_damping, angular_damping) = scene.bullet_damping();
         let desc = ffi::BulletScene {
@@ -133,6 +147,7 @@ impl Bullet {
             deactivation: scene.sleeping,
             linear_damping,
             angular_damping,
+            stock_world,
         };
         let world =
             ffi::new_world(&desc).map_err(|e| crate::Error::Engine(format!("bullet: {e}")))?;

@@ -215,3 +215,51 @@ fn keyed_throws_agree_with_dicephys_ratio_within_3_sigma() {
     );
     assert_eq!(t.failed_total() + t.unconverged, 0);
 }
+
+/// The shim's shortcuts on Bullet's step (`DiceWorld` in cpp/shim.cc: no swept bounding box,
+/// no second prediction of the transform, no damping by pow(1, dt), the die's island found
+/// directly) change nothing: every state of every roll is bit for bit that of Bullet's own
+/// world, awake or asleep, in 2D and 3D, on the box floor and the plane, at 1 ms and 1/60 s.
+#[test]
+fn the_shims_shortcuts_leave_every_state_as_bullets_own_world_has_it() {
+    use dicephys::engine::bullet::Bullet;
+    use dicephys::engine::Engine;
+    use dicephys::model::scene::Floor;
+    use dicephys::model::throws::ThrowStyle;
+    let mut asleep = 0;
+    let cases = [
+        (Mode::ThreeD, Floor::Box, 0.001, ThrowStyle::Paper),
+        (Mode::TwoD, Floor::Box, 0.001, ThrowStyle::Paper),
+        (Mode::ThreeD, Floor::Box, 0.001, ThrowStyle::Tumble),
+        (Mode::ThreeD, Floor::Box, 0.001, ThrowStyle::Rest),
+        (Mode::TwoD, Floor::Box, 0.001, ThrowStyle::Rest),
+        (Mode::ThreeD, Floor::Plane, 0.001, ThrowStyle::Paper),
+        (Mode::ThreeD, Floor::Box, 1.0 / 60.0, ThrowStyle::Paper),
+        (Mode::TwoD, Floor::Box, 1.0 / 60.0, ThrowStyle::Paper),
+    ];
+    for (mode, floor, dt, style) in cases {
+        let mut scene = Scene::paper(block(), mode);
+        (scene.floor, scene.dt) = (floor, dt);
+        let throws = Throws::styled(ThrowKind::Keyed, style, 11, ThrowRanges::default(), 40);
+        let mut ours = Bullet::new(&scene).unwrap();
+        let mut stock = Bullet::stock(&scene).unwrap();
+        for index in 0..40 {
+            let start = throws.get(index).start(&scene);
+            let mut states = [Vec::new(), Vec::new()];
+            let mut ends = Vec::new();
+            for (k, engine) in [&mut ours as &mut dyn Engine, &mut stock].into_iter().enumerate() {
+                let seen = &mut states[k];
+                ends.push(run_from(engine, &scene, &start, &RollConfig::faithful(), |_, s| {
+                    seen.push(*s)
+                }));
+            }
+            let case = format!("{mode:?} {floor:?} dt {dt} {style:?} throw {index}");
+            assert_eq!(ends[0], ends[1], "{case}");
+            assert_eq!(states[0], states[1], "{case}");
+            asleep += states[0].iter().filter(|s| s.sleeping).count();
+        }
+    }
+    // Dice released at rest fall asleep (Bullet's 2 s timer) before the rest rule fires on a
+    // few throws: the sleeping island is exercised too.
+    assert!(asleep > 0, "no die fell asleep: the sleeping island went untested");
+}
