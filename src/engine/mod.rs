@@ -24,7 +24,8 @@ pub trait Engine: Send {
     }
     /// True if, out of contact, the engine moves the die exactly as `flight::Flight` does
     /// (gravity, symplectic Euler, constant angular velocity): Bullet without its gyroscopic
-    /// term. Not Rapier, which keeps the gyroscopic term and integrates rotation to first order.
+    /// term. Not Rapier, which keeps the gyroscopic term and integrates rotation to first order:
+    /// it flies its own flight instead (`own_flight`).
     fn ballistic_flight(&self) -> bool {
         false
     }

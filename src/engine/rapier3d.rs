@@ -98,7 +98,9 @@ impl Flight {
     /// The broad-phase AABB of the die at body pose `p`, as `compute_broad_phase_aabb`.
     fn aabb(&self, world: &PhysicsWorld, p: &Pose) -> Aabb {
         let co = &world.colliders[self.collider];
-        co.shape().compute_aabb(&(*p * self.co_offset)).loosened(self.loosen)
+        co.shape()
+            .compute_aabb(&(*p * self.co_offset))
+            .loosened(self.loosen)
     }
 
     /// The leaf after Rapier's `set_aabb` of `aabb` on leaf `leaf`, and whether it changed.
@@ -120,7 +122,9 @@ impl Flight {
     fn resets_timer(&self, prev: &Pose, now: &BodyState) -> bool {
         let w = from_na(&now.angular_velocity);
         let half_pi = std::f64::consts::FRAC_PI_2;
-        if !(w.dot(w) < half_pi * half_pi) || self.sleep_threshold_dt < 0.0 {
+        // Rapier's test, as it is: angular_ok = |ω|² < (π/2)².
+        let angular_ok = w.dot(w) < half_pi * half_pi;
+        if !angular_ok || self.sleep_threshold_dt < 0.0 {
             return true;
         }
         let trans = (from_na(&now.position) - prev.translation).length();
@@ -267,7 +271,7 @@ impl Rapier3d {
 
     /// Sets up the die's own flight after a reset: its constants from the body as Rapier
     /// holds it, its leaf as the first step inserts it (the start's AABB, not fattened).
-    fn flight_of(&self, h: RigidBodyHandle, start: &Pose) -> Option<Flight> {
+    fn flight_of(&self, h: RigidBodyHandle) -> Option<Flight> {
         let w = &self.world;
         let p = &w.integration_parameters;
         let b = &w.bodies[h];
@@ -287,7 +291,9 @@ impl Rapier3d {
         let substeps = p.num_solver_iterations;
         let hdt = p.dt / substeps as f64;
         let force = b.user_force()
-            + w.gravity * mp.effective_inv_mass.map(|x| if x == 0.0 { 0.0 } else { 1.0 / x })
+            + w.gravity
+                * mp.effective_inv_mass
+                    .map(|x| if x == 0.0 { 0.0 } else { 1.0 / x })
                 * b.gravity_scale();
         let loosen = co.contact_skin() + (p.prediction_distance() / 2.0 + 0.0);
         let skin = 4.0e-2 * p.length_unit;
@@ -312,9 +318,7 @@ impl Rapier3d {
             fast_rotation: b.is_fast_rotation_allowed(),
             damp_linear: 1.0 / (1.0 + p.dt * b.linear_damping()),
             damp_angular: 1.0 / (1.0 + p.dt * b.angular_damping()),
-            sleep_threshold_dt: b.activation().normalized_linear_threshold
-                * p.length_unit
-                * p.dt,
+            sleep_threshold_dt: b.activation().normalized_linear_threshold * p.length_unit * p.dt,
             collider: co_handle,
             loosen,
             co_offset: *co.position_wrt_parent()?,
@@ -327,7 +331,7 @@ impl Rapier3d {
         if b.activation().normalized_linear_threshold < 0.0 {
             f.sleep_threshold_dt = -1.0;
         }
-        f.leaf = f.aabb(w, start);
+        f.leaf = f.aabb(w, b.position());
         Some(f)
     }
 
@@ -381,13 +385,15 @@ impl Engine for Rapier3d {
             .can_sleep(self.can_sleep);
         let (h, _) = self.world.insert(body, self.die_collider.clone());
         self.die = Some(h);
-        self.flight = self.flight_of(h, &pose);
+        self.flight = self.flight_of(h);
         Ok(())
     }
 
     fn set_state(&mut self, now: &BodyState) -> crate::Result<()> {
         let (Some(h), Some(f)) = (self.die, self.flight.as_mut()) else {
-            return Err(crate::Error::Engine("rapier: no flight to hand back".into()));
+            return Err(crate::Error::Engine(
+                "rapier: no flight to hand back".into(),
+            ));
         };
         if let Some((leaf, refats)) = f.course.take() {
             let params = self.world.integration_parameters;
