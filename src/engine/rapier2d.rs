@@ -256,6 +256,19 @@ impl Rapier2d {
         Some(f)
     }
 
+    /// What the world keeps of the die besides its state, for checks: its contact pairs (with
+    /// any manifold, empty or not), its sleep timer, and whether it sleeps.
+    pub fn die_world(&self) -> Option<(usize, f64, bool)> {
+        let h = self.die?;
+        let b = &self.world.bodies[h];
+        let pairs = self
+            .world
+            .narrow_phase
+            .contact_pairs_with(b.colliders()[0])
+            .count();
+        Some((pairs, b.activation().time_since_can_sleep, b.is_sleeping()))
+    }
+
     /// The die's mass and moment of inertia as Rapier holds them (it keeps inverses).
     pub fn die_mass_inertia(&self) -> Option<(f64, f64)> {
         self.die.map(|h| {
