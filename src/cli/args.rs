@@ -96,7 +96,8 @@ pub enum SettleArg {
 /// How free flight is stepped, on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum FlightArg {
-    /// Integrated in closed form where the engine's flight is ballistic.
+    /// Integrated outside the engine: in closed form where its flight is ballistic (Bullet),
+    /// or as the engine itself steps it (Rapier).
     Fast,
     /// Every step by the engine.
     Stepped,
@@ -126,8 +127,9 @@ pub struct RunArgs {
     /// and whether it named the same outcome.
     #[arg(long)]
     pub audit: bool,
-    /// Free flight: fast (integrated in closed form where the engine's flight is ballistic,
-    /// the default) or stepped (every step by the engine).
+    /// Free flight: fast (integrated outside the engine: in closed form where its flight is
+    /// ballistic, Bullet; as the engine steps it, Rapier; the default) or stepped (every step
+    /// by the engine).
     #[arg(long, value_enum, default_value = "fast")]
     pub flight: FlightArg,
     /// DicePhys exactly as the paper ran it: --settle dicephys --flight stepped (with the

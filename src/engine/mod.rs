@@ -24,7 +24,8 @@ pub trait Engine: Send {
     }
     /// True if, out of contact, the engine moves the die exactly as `flight::Flight` does
     /// (gravity, symplectic Euler, constant angular velocity): Bullet without its gyroscopic
-    /// term. Not Rapier, which keeps the gyroscopic term and integrates rotation to first order.
+    /// term. Not Rapier, which keeps the gyroscopic term and integrates rotation to first order:
+    /// it flies its own flight instead (`own_flight`).
     fn ballistic_flight(&self) -> bool {
         false
     }
@@ -32,6 +33,22 @@ pub trait Engine: Send {
     /// its next step from a state clear of the floor is free flight (`flight::Flight`).
     fn contact_free(&self) -> bool {
         false
+    }
+    /// True if the engine flies the die itself, in Rust, bit for bit as its own steps would
+    /// (`own_flight_start`, `own_flight_step`; Rapier), rather than as `flight::Flight`.
+    fn own_flight(&self) -> bool {
+        false
+    }
+    /// Starts a flight from `s`, the state after the engine's last step, if the engine's
+    /// next step from it would be pure flight (`own_flight`). A started flight ends with
+    /// `set_state` (when a step was flown) or with the engine's next `step`.
+    fn own_flight_start(&mut self, _s: &BodyState) -> bool {
+        false
+    }
+    /// One step of the started flight from `s`, exactly as the engine would take it, or
+    /// `None` if the engine must take it (a contact could form, the die could fall asleep).
+    fn own_flight_step(&mut self, _s: &BodyState) -> Option<BodyState> {
+        None
     }
     /// Advances the world by one fixed time step.
     fn step(&mut self) -> Result<()>;

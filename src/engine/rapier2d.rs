@@ -20,6 +20,126 @@ pub struct Rapier2d {
     damping: (f64, f64),
     /// The die may sleep (`Scene::sleeping`).
     can_sleep: bool,
+    /// What the die's own free flight needs (`Engine::own_flight`); `None` if not flown.
+    flight: Option<Flight>,
+}
+
+/// The die's state as Rapier holds it. The crate's `BodyState` gives the rotation as an
+/// angle (`state`), which does not give back Rapier's unit complex to the bit, so a flight
+/// carries this instead and hands it back as it is.
+#[derive(Clone, Copy)]
+struct Exact {
+    t: Vector,
+    r: Rotation,
+    v: Vector,
+    w: f64,
+}
+
+impl Exact {
+    fn pose(&self) -> Pose {
+        Pose::from_parts(self.t, self.r)
+    }
+
+    /// The state as `Engine::state` reports it.
+    fn state(&self) -> BodyState {
+        BodyState {
+            position: Vector3::new(self.t.x, self.t.y, 0.0),
+            rotation: UnitQuaternion::from_axis_angle(&Vector3::z_axis(), self.r.angle()),
+            linear_velocity: Vector3::new(self.v.x, self.v.y, 0.0),
+            angular_velocity: Vector3::new(0.0, 0.0, self.w),
+            sleeping: false,
+        }
+    }
+}
+
+/// The 2D die's free flight, flown exactly as Rapier steps it: as in 3D (`rapier3d::Flight`,
+/// whose reasoning about contacts and the sleep timer holds here word for word), with the
+/// 2D integration (no gyroscopic pass; the rotation a unit complex).
+struct Flight {
+    h: f64,
+    substeps: usize,
+    incr_linear: Vector,
+    local_com: Vector,
+    max_linear: f64,
+    max_angular: f64,
+    fast_rotation: bool,
+    damp_linear: f64,
+    damp_angular: f64,
+    sleep_threshold_dt: f64,
+    collider: ColliderHandle,
+    loosen: f64,
+    co_offset: Pose,
+    skin: f64,
+    floor_top: f64,
+    leaf: Aabb,
+    sleep_prev: Option<Pose>,
+    /// The flight under way: its leaf, the AABBs that refattened it, the last flown state.
+    course: Option<(Aabb, Vec<Aabb>, Exact)>,
+}
+
+impl Flight {
+    fn aabb(&self, world: &PhysicsWorld, p: &Pose) -> Aabb {
+        let co = &world.colliders[self.collider];
+        co.shape()
+            .compute_aabb(&(*p * self.co_offset))
+            .loosened(self.loosen)
+    }
+
+    fn refatten(&self, leaf: &Aabb, aabb: &Aabb) -> Option<Aabb> {
+        let contains = leaf.mins.cmple(aabb.mins).all() && leaf.maxs.cmpge(aabb.maxs).all();
+        (!contains).then(|| Aabb {
+            mins: aabb.mins - Vector::splat(self.skin),
+            maxs: aabb.maxs + Vector::splat(self.skin),
+        })
+    }
+
+    fn leaf_clear(&self, leaf: &Aabb) -> bool {
+        leaf.mins.y > self.floor_top
+    }
+
+    fn resets_timer(&self, prev: &Pose, now: &Exact) -> bool {
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        // Rapier's test, as it is: angular_ok = ω² < (π/2)².
+        let angular_ok = now.w * now.w < half_pi * half_pi;
+        if !angular_ok || self.sleep_threshold_dt < 0.0 {
+            return true;
+        }
+        let trans = (now.t - prev.translation).length();
+        trans * 0.5 >= self.sleep_threshold_dt * (1.0 + 1e-12)
+    }
+
+    fn fly(&self, s: &Exact) -> Exact {
+        let pose = s.pose().prepend_translation(self.local_com);
+        let (mut t, mut r) = (pose.translation, pose.rotation);
+        let (mut v, mut w) = (s.v, s.w);
+        for _ in 0..self.substeps {
+            v += self.incr_linear;
+            // Inverse inertia × zero torque × h: +0.
+            w += 0.0;
+            if self.max_linear != f64::MAX {
+                let n = v.length();
+                if n > self.max_linear {
+                    v *= self.max_linear / n;
+                }
+            }
+            if !self.fast_rotation && w.abs() > self.max_angular {
+                w = w.signum() * self.max_angular;
+            }
+            let dang = w * self.h;
+            let new_cos = r.re - dang * r.im;
+            let new_sin = r.im + dang * r.re;
+            r = Rotation::from_cos_sin_unchecked(new_cos, new_sin);
+            r.normalize_mut();
+            t += v * self.h;
+        }
+        let next = Pose::from_parts(t, r).prepend_translation(-self.local_com);
+        Exact {
+            t: next.translation,
+            r: next.rotation,
+            v: v * self.damp_linear,
+            w: w * self.damp_angular,
+        }
+    }
 }
 
 impl Rapier2d {
@@ -72,7 +192,81 @@ impl Rapier2d {
             die_collider,
             damping: scene.rapier_damping(),
             can_sleep: scene.sleeping,
+            flight: None,
         })
+    }
+
+    /// Sets up the die's own flight after a reset (see `rapier3d::Rapier3d::flight_of`).
+    fn flight_of(&self, h: RigidBodyHandle) -> Option<Flight> {
+        let w = &self.world;
+        let p = &w.integration_parameters;
+        let b = &w.bodies[h];
+        let co_handle = b.colliders()[0];
+        let co = &w.colliders[co_handle];
+        if p.max_ccd_substeps != 0
+            || b.additional_solver_iterations() != 0
+            || b.user_force() != Vector::ZERO
+            || b.user_torque() != 0.0
+            || b.colliders().len() != 1
+        {
+            return None;
+        }
+        let mp = b.mass_properties();
+        let substeps = p.num_solver_iterations;
+        let hdt = p.dt / substeps as f64;
+        let force = b.user_force()
+            + w.gravity
+                * mp.effective_inv_mass
+                    .map(|x| if x == 0.0 { 0.0 } else { 1.0 / x })
+                * b.gravity_scale();
+        let skin = 4.0e-2 * p.length_unit;
+        let floor_top = w
+            .colliders
+            .iter()
+            .filter(|(ch, _)| *ch != co_handle)
+            .map(|(_, c)| c.compute_broad_phase_aabb(p, &w.bodies).maxs.y)
+            .fold(f64::NEG_INFINITY, f64::max)
+            + skin;
+        let threshold = b.activation().normalized_linear_threshold;
+        let mut f = Flight {
+            h: hdt,
+            substeps,
+            incr_linear: force * mp.effective_inv_mass * hdt,
+            local_com: mp.local_mprops.local_com,
+            max_linear: p.max_linear_velocity(),
+            max_angular: std::f64::consts::FRAC_PI_4 * p.inv_dt(),
+            fast_rotation: b.is_fast_rotation_allowed(),
+            damp_linear: 1.0 / (1.0 + p.dt * b.linear_damping()),
+            damp_angular: 1.0 / (1.0 + p.dt * b.angular_damping()),
+            sleep_threshold_dt: if threshold < 0.0 {
+                -1.0
+            } else {
+                threshold * p.length_unit * p.dt
+            },
+            collider: co_handle,
+            loosen: co.contact_skin() + (p.prediction_distance() / 2.0 + 0.0),
+            co_offset: *co.position_wrt_parent()?,
+            skin,
+            floor_top,
+            leaf: Aabb::new_invalid(),
+            sleep_prev: None,
+            course: None,
+        };
+        f.leaf = f.aabb(w, b.position());
+        Some(f)
+    }
+
+    /// What the world keeps of the die besides its state, for checks: its contact pairs (with
+    /// any manifold, empty or not), its sleep timer, and whether it sleeps.
+    pub fn die_world(&self) -> Option<(usize, f64, bool)> {
+        let h = self.die?;
+        let b = &self.world.bodies[h];
+        let pairs = self
+            .world
+            .narrow_phase
+            .contact_pairs_with(b.colliders()[0])
+            .count();
+        Some((pairs, b.activation().time_since_can_sleep, b.is_sleeping()))
     }
 
     /// The die's mass and moment of inertia as Rapier holds them (it keeps inverses).
@@ -123,14 +317,121 @@ impl Engine for Rapier2d {
             .can_sleep(self.can_sleep);
         let (h, _) = self.world.insert(body, self.die_collider.clone());
         self.die = Some(h);
+        self.flight = self.flight_of(h);
         Ok(())
     }
 
+    /// Hands back the flight's last state as the flight holds it (`Exact`); `now` is its view.
+    fn set_state(&mut self, now: &BodyState) -> crate::Result<()> {
+        let (Some(h), Some(f)) = (self.die, self.flight.as_mut()) else {
+            return Err(crate::Error::Engine(
+                "rapier2d: no flight to hand back".into(),
+            ));
+        };
+        let Some((leaf, refats, exact)) = f.course.take() else {
+            return Err(crate::Error::Engine(
+                "rapier2d: no flight to hand back".into(),
+            ));
+        };
+        if exact.state() != *now {
+            return Err(crate::Error::Engine(
+                "rapier2d: the state handed back is not the flight's".into(),
+            ));
+        }
+        let params = self.world.integration_parameters;
+        for aabb in refats {
+            self.world.broad_phase.set_aabb(&params, f.collider, aabb);
+        }
+        f.leaf = leaf;
+        let b = &mut self.world.bodies[h];
+        b.set_position(exact.pose(), false);
+        b.set_linvel(exact.v, false);
+        b.set_angvel(exact.w, false);
+        Ok(())
+    }
+
+    fn own_flight(&self) -> bool {
+        self.flight.is_some()
+    }
+
+    fn own_flight_start(&mut self, s: &BodyState) -> bool {
+        let (Some(h), Some(f)) = (self.die, self.flight.as_mut()) else {
+            return false;
+        };
+        let Some(prev) = f.sleep_prev else {
+            return false;
+        };
+        let b = &self.world.bodies[h];
+        let exact = Exact {
+            t: b.translation(),
+            r: *b.rotation(),
+            v: b.linvel(),
+            w: b.angvel(),
+        };
+        if s.sleeping
+            || b.is_sleeping()
+            || !f.leaf_clear(&f.leaf)
+            || !f.resets_timer(&prev, &exact)
+            || self
+                .world
+                .narrow_phase
+                .contact_pairs_with(f.collider)
+                .next()
+                .is_some()
+        {
+            return false;
+        }
+        f.course = Some((f.leaf, Vec::new(), exact));
+        true
+    }
+
+    /// One flown step from the flight's last state (of which `_s` is the view).
+    fn own_flight_step(&mut self, _s: &BodyState) -> Option<BodyState> {
+        let f = self.flight.as_ref()?;
+        let (leaf, _, now) = f.course.as_ref()?;
+        let next = f.fly(now);
+        let finite = next.t.is_finite() && next.r.re.is_finite() && next.r.im.is_finite();
+        if !(finite
+            && next.v.is_finite()
+            && next.w.is_finite()
+            && f.resets_timer(&now.pose(), &next)
+            && f.resets_timer(f.sleep_prev.as_ref()?, &next))
+        {
+            return None;
+        }
+        let aabb = f.aabb(&self.world, &next.pose());
+        let refat = f.refatten(leaf, &aabb);
+        if let Some(l) = &refat {
+            if !f.leaf_clear(l) {
+                return None;
+            }
+        }
+        let f = self.flight.as_mut()?;
+        let (leaf, refats, now) = f.course.as_mut()?;
+        if let Some(l) = refat {
+            *leaf = l;
+            refats.push(aabb);
+        }
+        *now = next;
+        Some(next.state())
+    }
+
     fn step(&mut self) -> crate::Result<()> {
-        if self.die.is_none() {
+        let Some(h) = self.die else {
             return Err(crate::Error::Engine("rapier2d: step before reset".into()));
+        };
+        if let Some(f) = self.flight.as_mut() {
+            let b = &self.world.bodies[h];
+            f.sleep_prev = (!b.is_sleeping()).then(|| *b.position());
+            f.course = None;
         }
         self.world.step();
+        if let Some(f) = self.flight.as_ref() {
+            let aabb = f.aabb(&self.world, self.world.bodies[h].position());
+            if let Some(l) = f.refatten(&f.leaf, &aabb) {
+                self.flight.as_mut().unwrap().leaf = l;
+            }
+        }
         // A quarantined body is reset to a finite pose at rest; report it (see rapier3d.rs).
         if !self.world.quarantine().is_empty() {
             return Err(crate::Error::Engine(

@@ -32,6 +32,179 @@ pub struct Rapier3d {
     damping: (f64, f64),
     /// The die may sleep (`Scene::sleeping`).
     can_sleep: bool,
+    /// What the die's own free flight needs (`Engine::own_flight`); `None` if not flown.
+    flight: Option<Flight>,
+}
+
+/// The die's free flight, flown here exactly as Rapier steps it (see `fly`), and what Rapier's
+/// world keeps of the die besides its state: its broad-phase leaf and its sleep timer's pose.
+///
+/// When is a Rapier step pure flight? With no contact pair between the die and the floor in
+/// the narrow phase, a step makes one only if the broad phase reports a new pair, which it
+/// does only where the die's tree leaf (its AABB fattened by the change-detection skin,
+/// refattened only when the AABB leaves it) meets the floor's. That leaf is mirrored here
+/// step by step with parry's rule, so a flight lasts while the leaf stays above the floor's
+/// (fattened too, to spare). The sleep timer resets at every step where the die moved more
+/// than its threshold (or spins faster than π/2 rad/s); a flown step must be one, from the
+/// pose before it and from the pose Rapier still holds from the last engine step (which is
+/// what the first engine step after the flight compares against).
+struct Flight {
+    /// The substep, s.
+    h: f64,
+    substeps: usize,
+    /// The velocity increment per substep: force × inverse mass × h, as the solver bakes it.
+    incr_linear: Vector,
+    /// The gyroscopic pass (3D dynamic body with the gyroscopic forces on: Rapier's default).
+    gyro: bool,
+    principal_frame: Rotation,
+    principal_inertia: Vector,
+    inv_principal_inertia: Vector,
+    local_com: Vector,
+    /// Speed caps per substep (Rapier's `max_linear_velocity`, π/4 per step of rotation).
+    max_linear: f64,
+    max_angular: f64,
+    fast_rotation: bool,
+    /// Damping factors at the end of the step, 1 / (1 + dt c).
+    damp_linear: f64,
+    damp_angular: f64,
+    /// The sleep rule's linear threshold × dt (negative: the die never sleeps).
+    sleep_threshold_dt: f64,
+    /// The die's collider: its shape's AABB loosening and offset from the body.
+    collider: ColliderHandle,
+    loosen: f64,
+    co_offset: Pose,
+    skin: f64,
+    /// The floor leaf's top, with the change-detection skin on top of it to spare.
+    floor_top: f64,
+    /// The die's broad-phase leaf as Rapier's tree holds it after the engine's last step.
+    leaf: Aabb,
+    /// The body pose at the start of the engine's last step (Rapier's `sleep_prev_pose`);
+    /// `None` if unknown (the die was asleep then).
+    sleep_prev: Option<Pose>,
+    /// The flight under way: the leaf as the flown steps leave it, the AABBs that refattened
+    /// it (replayed into the tree by `set_state`).
+    course: Option<(Aabb, Vec<Aabb>)>,
+}
+
+fn pose_of(s: &BodyState) -> Pose {
+    let q = s.rotation.quaternion();
+    Pose::from_parts(
+        from_na(&s.position),
+        Rotation::from_xyzw(q.i, q.j, q.k, q.w),
+    )
+}
+
+impl Flight {
+    /// The broad-phase AABB of the die at body pose `p`, as `compute_broad_phase_aabb`.
+    fn aabb(&self, world: &PhysicsWorld, p: &Pose) -> Aabb {
+        let co = &world.colliders[self.collider];
+        co.shape()
+            .compute_aabb(&(*p * self.co_offset))
+            .loosened(self.loosen)
+    }
+
+    /// The leaf after Rapier's `set_aabb` of `aabb` on leaf `leaf`, and whether it changed.
+    fn refatten(&self, leaf: &Aabb, aabb: &Aabb) -> Option<Aabb> {
+        let contains = leaf.mins.cmple(aabb.mins).all() && leaf.maxs.cmpge(aabb.maxs).all();
+        (!contains).then(|| Aabb {
+            mins: aabb.mins - Vector::splat(self.skin),
+            maxs: aabb.maxs + Vector::splat(self.skin),
+        })
+    }
+
+    fn leaf_clear(&self, leaf: &Aabb) -> bool {
+        leaf.mins.y > self.floor_top
+    }
+
+    /// True if Rapier's sleep rule, from `prev` to the pose of `now` (spinning at `now`'s
+    /// angular velocity), finds the die moving: the rule's drift is at least the
+    /// translation, so a translation over the threshold (or a fast spin) is enough.
+    fn resets_timer(&self, prev: &Pose, now: &BodyState) -> bool {
+        let w = from_na(&now.angular_velocity);
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        // Rapier's test, as it is: angular_ok = |ω|² < (π/2)².
+        let angular_ok = w.dot(w) < half_pi * half_pi;
+        if !angular_ok || self.sleep_threshold_dt < 0.0 {
+            return true;
+        }
+        let trans = (from_na(&now.position) - prev.translation).length();
+        trans * 0.5 >= self.sleep_threshold_dt * (1.0 + 1e-12)
+    }
+
+    /// One Rapier step of a body with no contact and no joint, operation for operation as
+    /// the staged solver takes it: per substep, the velocity increment and the gyroscopic
+    /// correction, the speed caps, then `integrate_linearized`; at the end, damping.
+    fn fly(&self, s: &BodyState) -> BodyState {
+        let pose = pose_of(s).prepend_translation(self.local_com);
+        let (mut t, mut r) = (pose.translation, pose.rotation);
+        let mut v = from_na(&s.linear_velocity);
+        let mut w = from_na(&s.angular_velocity);
+        for _ in 0..self.substeps {
+            v += self.incr_linear;
+            // The angular increment: inverse inertia × zero torque × h, +0 in every component.
+            w += Vector::ZERO;
+            if self.gyro {
+                w = gyroscopic_corrected_angvel(
+                    w,
+                    r * self.principal_frame,
+                    self.principal_inertia,
+                    self.inv_principal_inertia,
+                    self.h,
+                );
+            }
+            if self.max_linear != f64::MAX {
+                let n = v.length();
+                if n > self.max_linear {
+                    v *= self.max_linear / n;
+                }
+            }
+            if !self.fast_rotation {
+                let n = w.length();
+                if n > self.max_angular {
+                    w *= self.max_angular / n;
+                }
+            }
+            let hang = w * (self.h * 0.5);
+            let id_plus_hang = Rotation::from_xyzw(hang.x, hang.y, hang.z, 1.0);
+            r = id_plus_hang * r;
+            r = r.normalize();
+            t += v * self.h;
+        }
+        let v = v * self.damp_linear;
+        let w = w * self.damp_angular;
+        let next = Pose::from_parts(t, r).prepend_translation(-self.local_com);
+        let q = next.rotation;
+        BodyState {
+            position: to_na(next.translation),
+            rotation: UnitQuaternion::new_unchecked(Quaternion::new(q.w, q.x, q.y, q.z)),
+            linear_velocity: to_na(v),
+            angular_velocity: to_na(w),
+            sleeping: false,
+        }
+    }
+}
+
+/// Rapier's `gyroscopic_corrected_angvel` (crate-private there), copied as it is.
+fn gyroscopic_corrected_angvel(
+    angvel: Vector,
+    principal_axes: Rotation,
+    principal_inertia: Vector,
+    inv_principal_inertia: Vector,
+    dt: f64,
+) -> Vector {
+    let w = principal_axes.inverse() * angvel;
+    let curr_momentum = principal_inertia * w;
+    let explicit_gyro_momentum = -w.cross(curr_momentum) * dt;
+    let total_momentum = curr_momentum + explicit_gyro_momentum;
+    let total_momentum_sqnorm = total_momentum.length_squared();
+
+    if total_momentum_sqnorm != 0.0 {
+        let capped_momentum =
+            total_momentum * (curr_momentum.length_squared() / total_momentum_sqnorm).sqrt();
+        principal_axes * (inv_principal_inertia * capped_momentum)
+    } else {
+        angvel
+    }
 }
 
 impl Rapier3d {
@@ -92,7 +265,87 @@ impl Rapier3d {
             locked,
             damping: scene.rapier_damping(),
             can_sleep: scene.sleeping,
+            flight: None,
         })
+    }
+
+    /// Sets up the die's own flight after a reset: its constants from the body as Rapier
+    /// holds it, its leaf as the first step inserts it (the start's AABB, not fattened).
+    fn flight_of(&self, h: RigidBodyHandle) -> Option<Flight> {
+        let w = &self.world;
+        let p = &w.integration_parameters;
+        let b = &w.bodies[h];
+        let co_handle = b.colliders()[0];
+        let co = &w.colliders[co_handle];
+        // Only the case worked through: one solve group of `num_solver_iterations`
+        // substeps, no CCD, no user force or torque.
+        if p.max_ccd_substeps != 0
+            || b.additional_solver_iterations() != 0
+            || b.user_force() != Vector::ZERO
+            || b.user_torque() != Vector::ZERO
+            || b.colliders().len() != 1
+        {
+            return None;
+        }
+        let mp = b.mass_properties();
+        let substeps = p.num_solver_iterations;
+        let hdt = p.dt / substeps as f64;
+        let force = b.user_force()
+            + w.gravity
+                * mp.effective_inv_mass
+                    .map(|x| if x == 0.0 { 0.0 } else { 1.0 / x })
+                * b.gravity_scale();
+        let loosen = co.contact_skin() + (p.prediction_distance() / 2.0 + 0.0);
+        let skin = 4.0e-2 * p.length_unit;
+        let floor_top = w
+            .colliders
+            .iter()
+            .filter(|(ch, _)| *ch != co_handle)
+            .map(|(_, c)| c.compute_broad_phase_aabb(p, &w.bodies).maxs.y)
+            .fold(f64::NEG_INFINITY, f64::max)
+            + skin;
+        let mut f = Flight {
+            h: hdt,
+            substeps,
+            incr_linear: force * mp.effective_inv_mass * hdt,
+            gyro: b.gyroscopic_forces_enabled(),
+            principal_frame: mp.local_mprops.principal_inertia_local_frame,
+            principal_inertia: mp.local_mprops.principal_inertia(),
+            inv_principal_inertia: mp.local_mprops.inv_principal_inertia,
+            local_com: mp.local_mprops.local_com,
+            max_linear: p.max_linear_velocity(),
+            max_angular: std::f64::consts::FRAC_PI_4 * p.inv_dt(),
+            fast_rotation: b.is_fast_rotation_allowed(),
+            damp_linear: 1.0 / (1.0 + p.dt * b.linear_damping()),
+            damp_angular: 1.0 / (1.0 + p.dt * b.angular_damping()),
+            sleep_threshold_dt: b.activation().normalized_linear_threshold * p.length_unit * p.dt,
+            collider: co_handle,
+            loosen,
+            co_offset: *co.position_wrt_parent()?,
+            skin,
+            floor_top,
+            leaf: Aabb::new_invalid(),
+            sleep_prev: None,
+            course: None,
+        };
+        if b.activation().normalized_linear_threshold < 0.0 {
+            f.sleep_threshold_dt = -1.0;
+        }
+        f.leaf = f.aabb(w, b.position());
+        Some(f)
+    }
+
+    /// What the world keeps of the die besides its state, for checks: its contact pairs (with
+    /// any manifold, empty or not), its sleep timer, and whether it sleeps.
+    pub fn die_world(&self) -> Option<(usize, f64, bool)> {
+        let h = self.die?;
+        let b = &self.world.bodies[h];
+        let pairs = self
+            .world
+            .narrow_phase
+            .contact_pairs_with(b.colliders()[0])
+            .count();
+        Some((pairs, b.activation().time_since_can_sleep, b.is_sleeping()))
     }
 
     /// The die's mass as Rapier holds it (it keeps 1/m), for checks.
@@ -145,14 +398,101 @@ impl Engine for Rapier3d {
             .can_sleep(self.can_sleep);
         let (h, _) = self.world.insert(body, self.die_collider.clone());
         self.die = Some(h);
+        self.flight = self.flight_of(h);
         Ok(())
     }
 
+    fn set_state(&mut self, now: &BodyState) -> crate::Result<()> {
+        let (Some(h), Some(f)) = (self.die, self.flight.as_mut()) else {
+            return Err(crate::Error::Engine(
+                "rapier: no flight to hand back".into(),
+            ));
+        };
+        if let Some((leaf, refats)) = f.course.take() {
+            let params = self.world.integration_parameters;
+            for aabb in refats {
+                self.world.broad_phase.set_aabb(&params, f.collider, aabb);
+            }
+            f.leaf = leaf;
+        }
+        let b = &mut self.world.bodies[h];
+        b.set_position(pose_of(now), false);
+        b.set_linvel(from_na(&now.linear_velocity), false);
+        b.set_angvel(from_na(&now.angular_velocity), false);
+        Ok(())
+    }
+
+    fn own_flight(&self) -> bool {
+        self.flight.is_some()
+    }
+
+    fn own_flight_start(&mut self, s: &BodyState) -> bool {
+        let (Some(h), Some(f)) = (self.die, self.flight.as_mut()) else {
+            return false;
+        };
+        let Some(prev) = f.sleep_prev else {
+            return false;
+        };
+        if s.sleeping
+            || !f.leaf_clear(&f.leaf)
+            || !f.resets_timer(&prev, s)
+            || self.world.bodies[h].is_sleeping()
+            || self
+                .world
+                .narrow_phase
+                .contact_pairs_with(f.collider)
+                .next()
+                .is_some()
+        {
+            return false;
+        }
+        f.course = Some((f.leaf, Vec::new()));
+        true
+    }
+
+    fn own_flight_step(&mut self, s: &BodyState) -> Option<BodyState> {
+        let f = self.flight.as_ref()?;
+        let (leaf, _) = f.course.as_ref()?;
+        let next = f.fly(s);
+        if !(next.is_finite()
+            && f.resets_timer(&pose_of(s), &next)
+            && f.resets_timer(f.sleep_prev.as_ref()?, &next))
+        {
+            return None;
+        }
+        let aabb = f.aabb(&self.world, &pose_of(&next));
+        let refat = f.refatten(leaf, &aabb);
+        if let Some(l) = &refat {
+            if !f.leaf_clear(l) {
+                return None;
+            }
+        }
+        let f = self.flight.as_mut()?;
+        let (leaf, refats) = f.course.as_mut()?;
+        if let Some(l) = refat {
+            *leaf = l;
+            refats.push(aabb);
+        }
+        Some(next)
+    }
+
     fn step(&mut self) -> crate::Result<()> {
-        if self.die.is_none() {
+        let Some(h) = self.die else {
             return Err(crate::Error::Engine("rapier: step before reset".into()));
+        };
+        if let Some(f) = self.flight.as_mut() {
+            let b = &self.world.bodies[h];
+            // Rapier keeps the pose before the step for its sleep rule, unless asleep.
+            f.sleep_prev = (!b.is_sleeping()).then(|| *b.position());
+            f.course = None;
         }
         self.world.step();
+        if let Some(f) = self.flight.as_ref() {
+            let aabb = f.aabb(&self.world, self.world.bodies[h].position());
+            if let Some(l) = f.refatten(&f.leaf, &aabb) {
+                self.flight.as_mut().unwrap().leaf = l;
+            }
+        }
         // Rapier does not let a NaN through: it puts the body back at its last finite pose
         // with zero velocity and disables it, which would look like a die at rest. Report it.
         if !self.world.quarantine().is_empty() {

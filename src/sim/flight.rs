@@ -18,6 +18,11 @@
 //! timer is the one other thing such a step changes: it resets while the die moves faster
 //! than the sleeping thresholds, so flight is only taken at such speeds and the engine's
 //! `set_state` resets the timer, as those steps would have.
+//!
+//! Rapier's flight is not this one (substeps, the gyroscopic pass, a linearised rotation): it
+//! is flown by the engine itself, in Rust, operation for operation as its solver would
+//! (`Engine::own_flight`; `engine::rapier3d::Flight` says when a Rapier step is pure flight),
+//! and the roll walks and jumps it as it does this one (`roll::jump_own`).
 
 use crate::model::scene::{Floor, Scene};
 use crate::model::state::BodyState;

@@ -358,6 +358,56 @@ fn quiet_steps(die: &DieShape, s: &BodyState, ceiling: f64, f: &Flight) -> u64 {
     }
 }
 
+/// `quiet_steps` for an engine's own flight (Rapier): its substepped symplectic Euler loses
+/// ½g·h² of energy height per substep, n·½g(dt/n)² = ½g·dt²/n a step, less than the ½g·dt²
+/// taken off here; its gyroscopic pass changes |ω|, so the rotational energy is left out of
+/// the bound (it is never negative). Damping takes energy faster: then nothing is jumped.
+fn quiet_steps_own(s: &BodyState, ceiling: f64, scene: &Scene) -> u64 {
+    if ceiling == f64::NEG_INFINITY {
+        return u64::MAX;
+    }
+    if scene.damped() {
+        return 0;
+    }
+    let g = scene.gravity;
+    let height = s.position.y + 0.5 * s.linear_velocity.norm_squared() / g - 1e-9;
+    let above = height - ceiling;
+    let per_step = 0.5 * g * scene.dt * scene.dt * (1.0 + 1e-6) + 1e-15;
+    if above > 0.0 {
+        ((above / per_step).floor() as u64).saturating_sub(1)
+    } else {
+        0
+    }
+}
+
+/// `Flight::jump` for an engine's own flight: takes the flown steps `step` gives from `s`, at
+/// most `max`, leaving `s` at the last and the rest rule's window as if each state had been
+/// pushed (every flown step keeps the die moving, so the rule cannot fire). Each flown state
+/// ends clear of the floor, so no check but the certificate (bounded by `max`) can fire.
+fn jump_own(
+    s: &mut BodyState,
+    max: u64,
+    rest: &mut RestDetector,
+    mut step: impl FnMut(&BodyState) -> Option<BodyState>,
+) -> u64 {
+    let mut last = [*s; REST_WINDOW];
+    let mut n = 0u64;
+    while n < max {
+        let Some(next) = step(s) else {
+            break;
+        };
+        *s = next;
+        last[(n % REST_WINDOW as u64) as usize] = next;
+        n += 1;
+    }
+    let first = n.saturating_sub(REST_WINDOW as u64);
+    rest.skip(first);
+    for k in first..n {
+        rest.record(&last[(k % REST_WINDOW as u64) as usize]);
+    }
+    n
+}
+
 /// How a roll from a start state ended.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct End {
@@ -415,6 +465,9 @@ fn run(
     if engine.reset(start).is_err() {
         return end;
     }
+    // An engine that flies the die itself (Rapier) does so bit for bit as its own steps, so
+    // every check is walked over its flown steps as over its own, the energy watch too.
+    let own = cfg.fast_flight && flight.is_none() && engine.own_flight();
     let mut energy = EnergyWatch::new(&die, start);
     observe(0, &engine.state());
     let mut rest = RestDetector::default();
@@ -422,6 +475,7 @@ fn run(
     // In free flight (`flight::Flight`) the roll steps the die itself: `flying` holds the
     // step's rotation, and the engine is behind until the state is handed back.
     let mut flying: Option<UnitQuaternion<f64>> = None;
+    let mut in_own_flight = false;
     let mut behind = false;
     // Flown steps in a row so far, and what a jumped state must be above for the certificate
     // to be out of reach (when it is checked at all).
@@ -433,6 +487,43 @@ fn run(
     };
     while end.steps < cfg.max_steps {
         let mut next = None;
+        if own {
+            if !in_own_flight {
+                in_own_flight = engine.own_flight_start(&state);
+            }
+            if in_own_flight {
+                // As below: a full window of flown steps, nothing the certificate can reach.
+                if jump && flown_in_a_row >= REST_WINDOW as u64 {
+                    let quiet = quiet_steps_own(&state, ceiling, scene);
+                    let max = quiet.min(cfg.max_steps - end.steps);
+                    let n = jump_own(&mut state, max, &mut rest, |s| {
+                        let next = engine.own_flight_step(s)?;
+                        energy.push(&die, &next);
+                        Some(next)
+                    });
+                    if n > 0 {
+                        end.steps += n;
+                        flown_in_a_row += n;
+                        end.energy_gain = energy.gained;
+                        end.dip.push(&die, &state);
+                        behind = true;
+                        if end.steps >= cfg.max_steps {
+                            break;
+                        }
+                    }
+                }
+                next = engine.own_flight_step(&state);
+                if next.is_none() {
+                    in_own_flight = false;
+                    if behind && engine.set_state(&state).is_err() {
+                        return end;
+                    }
+                    behind = false;
+                } else {
+                    behind = true;
+                }
+            }
+        }
         if let Some(f) = &flight {
             if flying.is_none() && f.may_start(&state, || engine.contact_free()) {
                 flying = Some(f.step_rotation(&state.angular_velocity));
@@ -494,7 +585,7 @@ fn run(
             end.fate = Fate::Failed(f);
             return end;
         }
-        if !flown {
+        if !flown || own {
             energy.push(&die, &state);
             end.energy_gain = energy.gained;
         }

@@ -210,6 +210,18 @@ impl crate::engine::Engine for TimedEngine {
     fn contact_free(&self) -> bool {
         self.inner.contact_free()
     }
+    fn own_flight(&self) -> bool {
+        self.inner.own_flight()
+    }
+    fn own_flight_start(&mut self, s: &crate::model::state::BodyState) -> bool {
+        self.inner.own_flight_start(s)
+    }
+    fn own_flight_step(
+        &mut self,
+        s: &crate::model::state::BodyState,
+    ) -> Option<crate::model::state::BodyState> {
+        self.inner.own_flight_step(s)
+    }
     fn step(&mut self) -> crate::Result<()> {
         let t = Instant::now();
         let r = self.inner.step();

@@ -267,3 +267,147 @@ fn friction_stops_a_sliding_box() {
 fn friction_stops_a_sliding_locked_3d_box() {
     assert!(slides_to_a_stop(EngineKind::RapierLocked, Mode::TwoD));
 }
+
+#[test]
+fn a_flown_step_is_rapiers_own_step_bit_for_bit() {
+    // Rapier's free flight flown in Rust (`Engine::own_flight`) against Rapier stepping: the
+    // same states to the bit, step after step; then, handed back, the same landing and
+    // bounce, step after step. The free 3D body, the locked 3D body in 2D, the true 2D body.
+    for (kind, mode) in [
+        (EngineKind::Rapier, Mode::ThreeD),
+        (EngineKind::RapierLocked, Mode::TwoD),
+        (EngineKind::Rapier, Mode::TwoD),
+    ] {
+        let scene = scene(mode);
+        let planar = mode == Mode::TwoD;
+        let start = BodyState {
+            position: Vector3::new(0.0, 0.5, 0.0),
+            rotation: if planar {
+                UnitQuaternion::from_euler_angles(0.0, 0.0, 0.2)
+            } else {
+                UnitQuaternion::from_euler_angles(0.3, 0.1, 0.2)
+            },
+            linear_velocity: Vector3::new(0.1, 1.0, 0.0),
+            angular_velocity: if planar {
+                Vector3::new(0.0, 0.0, 120.0)
+            } else {
+                Vector3::new(5.0, -3.0, 120.0)
+            },
+            sleeping: false,
+        };
+        let mut stepped = new_engine(kind, &scene).unwrap();
+        let mut flown = new_engine(kind, &scene).unwrap();
+        for e in [&mut stepped, &mut flown] {
+            e.reset(&start).unwrap();
+            e.step().unwrap();
+        }
+        assert!(flown.own_flight(), "{kind:?} {mode:?}");
+        let mut s = flown.state();
+        assert!(flown.own_flight_start(&s), "{kind:?} {mode:?}");
+        let mut n = 0;
+        while let Some(next) = flown.own_flight_step(&s) {
+            stepped.step().unwrap();
+            assert_eq!(stepped.state(), next, "{kind:?} {mode:?}: flown step {n}");
+            s = next;
+            n += 1;
+        }
+        // Up 5 cm and down to a few cm over the floor.
+        assert!(n > 300, "{kind:?} {mode:?}: {n} steps flown");
+        flown.set_state(&s).unwrap();
+        let mut bounced = false;
+        for k in 0..400 {
+            stepped.step().unwrap();
+            flown.step().unwrap();
+            let (a, b) = (stepped.state(), flown.state());
+            assert_eq!(a, b, "{kind:?} {mode:?}: step {k} after the flight");
+            bounced |= k > 0 && a.linear_velocity.y > 0.0;
+        }
+        assert!(bounced, "{kind:?} {mode:?}: no bounce in the window");
+    }
+}
+
+#[test]
+fn a_flight_handed_back_leaves_rapiers_world_as_its_steps_would() {
+    // Beyond the die's state: the contact pairs Rapier's broad phase makes (their timing
+    // follows its tree leaf, which the flight mirrors and hands back), the sleep timer and
+    // the sleeping flag, step after step through a flight, the landing and the bounces.
+    let starts = |planar: bool| BodyState {
+        position: Vector3::new(0.0, 0.4, 0.0),
+        rotation: if planar {
+            UnitQuaternion::from_euler_angles(0.0, 0.0, 0.7)
+        } else {
+            UnitQuaternion::from_euler_angles(0.3, 0.9, 0.2)
+        },
+        linear_velocity: Vector3::new(0.3, 0.5, 0.0),
+        angular_velocity: if planar {
+            Vector3::new(0.0, 0.0, 30.0)
+        } else {
+            Vector3::new(5.0, -3.0, 30.0)
+        },
+        sleeping: false,
+    };
+    // Walks `e` with its own flight where it may, `reference` stepping; compares each step.
+    fn compare<E: Engine>(
+        what: &str,
+        mut e: E,
+        mut reference: E,
+        start: &BodyState,
+        view: impl Fn(&E) -> (usize, f64, bool),
+    ) {
+        e.reset(start).unwrap();
+        reference.reset(start).unwrap();
+        let (mut flown, mut flying, mut behind) = (0, false, false);
+        let mut s = e.state();
+        for k in 0..3000 {
+            if !flying {
+                flying = e.own_flight_start(&s);
+            }
+            let mut next = None;
+            if flying {
+                next = e.own_flight_step(&s);
+                if next.is_none() {
+                    flying = false;
+                    if behind {
+                        e.set_state(&s).unwrap();
+                    }
+                }
+            }
+            behind = next.is_some();
+            s = match next {
+                Some(n) => {
+                    flown += 1;
+                    n
+                }
+                None => {
+                    e.step().unwrap();
+                    e.state()
+                }
+            };
+            reference.step().unwrap();
+            assert_eq!(s, reference.state(), "{what}: step {k}");
+            if !behind {
+                assert_eq!(view(&e), view(&reference), "{what}: step {k}");
+            }
+        }
+        assert!(flown > 150, "{what}: {flown} flown");
+    }
+    for mode in [Mode::ThreeD, Mode::TwoD] {
+        let scene = scene(mode);
+        let start = starts(mode == Mode::TwoD);
+        compare(
+            &format!("rapier3d {mode:?}"),
+            Rapier3d::new(&scene).unwrap(),
+            Rapier3d::new(&scene).unwrap(),
+            &start,
+            |e| e.die_world().unwrap(),
+        );
+    }
+    let scene = scene(Mode::TwoD);
+    compare(
+        "rapier2d",
+        Rapier2d::new(&scene).unwrap(),
+        Rapier2d::new(&scene).unwrap(),
+        &starts(true),
+        |e| e.die_world().unwrap(),
+    );
+}
