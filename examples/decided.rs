@@ -115,8 +115,14 @@ fn main() {
     }
     let mean = |x: u64| x as f64 / n as f64;
     println!("{block} {mode:?}, {n} rolls: engine steps per roll");
-    println!("  the certificate (the fast roll ends):   {:.1}", mean(certificate));
-    println!("  the last change of face region:         {:.1}", mean(decided));
+    println!(
+        "  the certificate (the fast roll ends):   {:.1}",
+        mean(certificate)
+    );
+    println!(
+        "  the last change of face region:         {:.1}",
+        mean(decided)
+    );
     println!(
         "  without horizontal kinetic energy:      {:.1}, wrong face on {} rolls",
         mean(horizontal.0),

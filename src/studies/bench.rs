@@ -118,6 +118,8 @@ pub fn methods() -> Vec<Method> {
         Method::new("all + plane floor", Bullet, Plane, Certificate, true),
         Method::new("rapier", Rapier, Box, Dicephys, false),
         Method::new("rapier early stop", Rapier, Box, Certificate, false),
+        // Rapier's free flight flown in Rust as its own steps would (its defaults).
+        Method::new("rapier stop + flight", Rapier, Box, Certificate, true),
     ]
 }
 

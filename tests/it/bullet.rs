@@ -247,11 +247,18 @@ fn the_shims_shortcuts_leave_every_state_as_bullets_own_world_has_it() {
             let start = throws.get(index).start(&scene);
             let mut states = [Vec::new(), Vec::new()];
             let mut ends = Vec::new();
-            for (k, engine) in [&mut ours as &mut dyn Engine, &mut stock].into_iter().enumerate() {
+            for (k, engine) in [&mut ours as &mut dyn Engine, &mut stock]
+                .into_iter()
+                .enumerate()
+            {
                 let seen = &mut states[k];
-                ends.push(run_from(engine, &scene, &start, &RollConfig::faithful(), |_, s| {
-                    seen.push(*s)
-                }));
+                ends.push(run_from(
+                    engine,
+                    &scene,
+                    &start,
+                    &RollConfig::faithful(),
+                    |_, s| seen.push(*s),
+                ));
             }
             let case = format!("{mode:?} {floor:?} dt {dt} {style:?} throw {index}");
             assert_eq!(ends[0], ends[1], "{case}");
@@ -261,5 +268,8 @@ fn the_shims_shortcuts_leave_every_state_as_bullets_own_world_has_it() {
     }
     // Dice released at rest fall asleep (Bullet's 2 s timer) before the rest rule fires on a
     // few throws: the sleeping island is exercised too.
-    assert!(asleep > 0, "no die fell asleep: the sleeping island went untested");
+    assert!(
+        asleep > 0,
+        "no die fell asleep: the sleeping island went untested"
+    );
 }
