@@ -21,8 +21,8 @@ pub struct SceneArgs {
     /// DicePhys's 2D mode: a 1 m deep box locked to the x-y plane.
     #[arg(long = "2d")]
     pub two_d: bool,
-    /// Fixed time step, s (the paper: 0.001).
-    #[arg(long, default_value_t = 0.001)]
+    /// Fixed time step, s, as a decimal or a fraction (the paper: 0.001, or 1/1000).
+    #[arg(long, default_value = "0.001", value_parser = parse_step)]
     pub dt: f64,
     /// The contact's friction coefficient μ (the die's; the floor's is 1).
     #[arg(long, default_value_t = 0.29)]
@@ -141,6 +141,10 @@ pub struct RunArgs {
 /// `--block` as clap reads it.
 pub fn parse_block(s: &str) -> std::result::Result<Block, dicephys::Error> {
     s.parse()
+}
+/// `--dt` as clap reads it: a decimal or a fraction (the scene checks its range).
+pub fn parse_step(s: &str) -> std::result::Result<f64, dicephys::Error> {
+    dicephys::studies::sweep::parse_seconds(s)
 }
 /// `LO:HI` as clap reads it.
 pub fn parse_range(s: &str) -> std::result::Result<Range, dicephys::Error> {

@@ -138,10 +138,11 @@ pub fn rolls_to_resolve(err: f64, rolls: u64) -> Option<u64> {
         .then(|| (rolls as f64 * (err / (0.5 * ONE_PERCENT)).powi(2)).ceil() as u64)
 }
 
-/// Parses a time step: seconds (0.001) or a fraction (1/1000).
-pub fn parse_dt(s: &str) -> Result<f64> {
+/// Parses a number of seconds written as a decimal (0.001) or a fraction (1/1000); its range
+/// is the caller's to check.
+pub fn parse_seconds(s: &str) -> Result<f64> {
     let bad = || Error::Invalid(format!("bad dt '{s}'"));
-    let v = match s.split_once('/') {
+    Ok(match s.split_once('/') {
         Some((a, b)) => {
             let (a, b): (f64, f64) = (
                 a.trim().parse().map_err(|_| bad())?,
@@ -150,7 +151,12 @@ pub fn parse_dt(s: &str) -> Result<f64> {
             a / b
         }
         None => s.trim().parse().map_err(|_| bad())?,
-    };
+    })
+}
+
+/// Parses a time step: seconds (0.001) or a fraction (1/1000), in (0, 0.1] s.
+pub fn parse_dt(s: &str) -> Result<f64> {
+    let v = parse_seconds(s)?;
     if v.is_finite() && v > 0.0 && v <= 0.1 {
         Ok(v)
     } else {

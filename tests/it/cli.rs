@@ -11,6 +11,8 @@ fn bad_input_gets_one_line_and_exit_code_2() {
         &["roll", "--block", "140x24x20", "--dt", "0"],
         &["roll", "--block", "140x24x20", "--dt", "0.5"],
         &["roll", "--block", "140x24x20", "--dt", "nan"],
+        &["roll", "--block", "140x24x20", "--dt", "1/0"],
+        &["roll", "--block", "140x24x20", "--dt", "1/x"],
         &["roll", "--block", "140x24x20", "--friction", "-1"],
         &["roll", "--block", "140x24x20", "--restitution", "1.5"],
         &["roll", "--block", "140x24x20", "--spin", "160:31"],

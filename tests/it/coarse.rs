@@ -316,6 +316,8 @@ fn the_early_stop_is_on_by_default_only_where_it_is_exact() {
     assert_eq!(json("0.004", &[])["settle"], "certificate");
     assert_eq!(json("0.008333333333333333", &[])["settle"], "dicephys");
     assert_eq!(json("0.016666666666666666", &[])["settle"], "dicephys");
+    // A fraction is the same step as its decimal.
+    assert_eq!(json("1/60", &[])["dt"], 1.0 / 60.0);
     // Asked for by name, it is used at any dt.
     let v = json("0.016666666666666666", &["--settle", "certificate"]);
     assert_eq!(v["settle"], "certificate");
