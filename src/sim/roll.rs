@@ -408,6 +408,17 @@ fn jump_own(
     n
 }
 
+/// Whether the roll is flying the die itself this step, and how.
+#[derive(Clone, Copy, Debug)]
+enum Flying {
+    /// The engine steps.
+    No,
+    /// Bullet's ballistic flight (`flight::Flight`), with the rotation one step applies.
+    Ballistic(UnitQuaternion<f64>),
+    /// The engine's own flight, redone outside it (`Engine::own_flight_step`: Rapier).
+    Own,
+}
+
 /// How a roll from a start state ended.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct End {
@@ -472,10 +483,9 @@ fn run(
     observe(0, &engine.state());
     let mut rest = RestDetector::default();
     let mut state = *start;
-    // In free flight (`flight::Flight`) the roll steps the die itself: `flying` holds the
-    // step's rotation, and the engine is behind until the state is handed back.
-    let mut flying: Option<UnitQuaternion<f64>> = None;
-    let mut in_own_flight = false;
+    // In free flight the roll steps the die itself (`Flying`), and the engine is behind until
+    // the state is handed back.
+    let mut flying = Flying::No;
     let mut behind = false;
     // Flown steps in a row so far, and what a jumped state must be above for the certificate
     // to be out of reach (when it is checked at all).
@@ -487,81 +497,71 @@ fn run(
     };
     while end.steps < cfg.max_steps {
         let mut next = None;
-        if own {
-            if !in_own_flight {
-                in_own_flight = engine.own_flight_start(&state);
-            }
-            if in_own_flight {
-                // As below: a full window of flown steps, nothing the certificate can reach.
-                if jump && flown_in_a_row >= REST_WINDOW as u64 {
-                    let quiet = quiet_steps_own(&state, ceiling, scene);
-                    let max = quiet.min(cfg.max_steps - end.steps);
-                    let n = jump_own(&mut state, max, &mut rest, |s| {
-                        let next = engine.own_flight_step(s)?;
-                        energy.push(&die, &next);
-                        Some(next)
-                    });
-                    if n > 0 {
-                        end.steps += n;
-                        flown_in_a_row += n;
-                        end.energy_gain = energy.gained;
-                        end.dip.push(&die, &state);
-                        behind = true;
-                        if end.steps >= cfg.max_steps {
-                            break;
-                        }
-                    }
-                }
-                next = engine.own_flight_step(&state);
-                if next.is_none() {
-                    in_own_flight = false;
-                    if behind && engine.set_state(&state).is_err() {
-                        return end;
-                    }
-                    behind = false;
+        if matches!(flying, Flying::No) {
+            flying = if own {
+                if engine.own_flight_start(&state) {
+                    Flying::Own
                 } else {
-                    behind = true;
+                    Flying::No
                 }
-            }
+            } else {
+                match &flight {
+                    Some(f) if f.may_start(&state, || engine.contact_free()) => {
+                        Flying::Ballistic(f.step_rotation(&state.angular_velocity))
+                    }
+                    _ => Flying::No,
+                }
+            };
         }
-        if let Some(f) = &flight {
-            if flying.is_none() && f.may_start(&state, || engine.contact_free()) {
-                flying = Some(f.step_rotation(&state.angular_velocity));
-            }
-            if let Some(dq) = &flying {
-                // Once the rest rule's window holds flown steps only it cannot fire in flight
-                // (every flown step keeps the die awake: its ω is the same every step, or its
-                // speed is above 0.8 m/s with the vertical velocity of one sign, so neither
-                // sum of ten is near 0). The certificate cannot fire while the energy is
-                // above its ceiling, and a state clear of the floor fails no check. So
-                // those steps are jumped, the rest rule's window kept filled, and the walk
-                // takes over where a check could fire or the die reaches the floor.
-                if jump && flown_in_a_row >= REST_WINDOW as u64 {
-                    let quiet = quiet_steps(&die, &state, ceiling, f);
-                    let max = quiet.min(cfg.max_steps - end.steps);
-                    let n = f.jump(&mut state, dq, max, &mut rest);
-                    if n > 0 {
-                        end.steps += n;
-                        flown_in_a_row += n;
-                        // What the jumped states did to the dip record: the centre above the
-                        // floor ends any run of dips (their depths, negative, change nothing).
-                        end.dip.push(&die, &state);
-                        behind = true;
-                        if end.steps >= cfg.max_steps {
-                            break;
-                        }
+        if !matches!(flying, Flying::No) {
+            // Once the rest rule's window holds flown steps only it cannot fire in flight
+            // (every flown step keeps the die awake: its ω is the same every step, or its
+            // speed is above 0.8 m/s with the vertical velocity of one sign, so neither
+            // sum of ten is near 0). The certificate cannot fire while the energy is
+            // above its ceiling, and a state clear of the floor fails no check. So
+            // those steps are jumped, the rest rule's window kept filled, and the walk
+            // takes over where a check could fire or the die reaches the floor.
+            if jump && flown_in_a_row >= REST_WINDOW as u64 {
+                let left = cfg.max_steps - end.steps;
+                let n = match (&flying, &flight) {
+                    (Flying::Ballistic(dq), Some(f)) => {
+                        let max = quiet_steps(&die, &state, ceiling, f).min(left);
+                        f.jump(&mut state, dq, max, &mut rest)
                     }
-                }
-                next = f.next(&state, dq);
-                if next.is_none() {
-                    flying = None;
-                    if behind && engine.set_state(&state).is_err() {
-                        return end;
+                    _ => {
+                        let max = quiet_steps_own(&state, ceiling, scene).min(left);
+                        jump_own(&mut state, max, &mut rest, |s| {
+                            let next = engine.own_flight_step(s)?;
+                            energy.push(&die, &next);
+                            Some(next)
+                        })
                     }
-                    behind = false;
-                } else {
+                };
+                if n > 0 {
+                    end.steps += n;
+                    flown_in_a_row += n;
+                    end.energy_gain = energy.gained;
+                    // What the jumped states did to the dip record: the centre above the
+                    // floor ends any run of dips (their depths, negative, change nothing).
+                    end.dip.push(&die, &state);
                     behind = true;
+                    if end.steps >= cfg.max_steps {
+                        break;
+                    }
                 }
+            }
+            next = match (&flying, &flight) {
+                (Flying::Ballistic(dq), Some(f)) => f.next(&state, dq),
+                _ => engine.own_flight_step(&state),
+            };
+            if next.is_none() {
+                flying = Flying::No;
+                if behind && engine.set_state(&state).is_err() {
+                    return end;
+                }
+                behind = false;
+            } else {
+                behind = true;
             }
         }
         let flown = next.is_some();
