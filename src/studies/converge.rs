@@ -141,6 +141,32 @@ pub struct Claim {
     pub rolls: (u64, u64),
 }
 
+impl Claim {
+    /// The claim about a cell at `CLAIM_DT` against the finest dt: its departure and error,
+    /// resolved when 2σ ≤ 1 %, decided at 2σ (`decide`).
+    fn of(
+        cell: &Cell,
+        dt_finest: f64,
+        (departure, departure_err): (f64, f64),
+        rolls_needed: Option<u64>,
+        rolls: (u64, u64),
+    ) -> Claim {
+        Claim {
+            block: cell.block.clone(),
+            engine: cell.engine.clone(),
+            mode: cell.mode.clone(),
+            dt: cell.dt,
+            dt_finest,
+            departure,
+            departure_err,
+            resolved: 2.0 * departure_err <= ONE_PERCENT,
+            within_one_percent: decide(departure, departure_err),
+            rolls_needed,
+            rolls,
+        }
+    }
+}
+
 /// The convergence test's results.
 #[derive(Clone, Debug, Serialize)]
 pub struct Converge {
@@ -209,20 +235,13 @@ pub fn run(
                     let cell = Cell::of(block, engine, mode, *dt, m, (d, d_err), None);
                     log(&format_cell(&cell));
                     if (dt - CLAIM_DT).abs() < 1e-12 && *dt > finest {
-                        let resolved = 2.0 * d_err <= ONE_PERCENT;
-                        claims.push(Claim {
-                            block: cell.block.clone(),
-                            engine: cell.engine.clone(),
-                            mode: cell.mode.clone(),
-                            dt: *dt,
-                            dt_finest: finest,
-                            departure: d,
-                            departure_err: d_err,
-                            resolved,
-                            within_one_percent: decide(d, d_err),
-                            rolls_needed: rolls_to_resolve(d_err, cfg.rolls),
-                            rolls: (cfg.rolls, cfg.rolls),
-                        });
+                        claims.push(Claim::of(
+                            &cell,
+                            finest,
+                            (d, d_err),
+                            rolls_to_resolve(d_err, cfg.rolls),
+                            (cfg.rolls, cfg.rolls),
+                        ));
                     }
                     cells.push(cell);
                 }
@@ -370,20 +389,13 @@ fn run_resolved(
             );
             log(&format_cell(&cell));
             if (dt - CLAIM_DT).abs() < 1e-12 && *dt > finest {
-                let ok = 2.0 * d.err <= ONE_PERCENT;
-                claims.push(Claim {
-                    block: cell.block.clone(),
-                    engine: cell.engine.clone(),
-                    mode: cell.mode.clone(),
-                    dt: *dt,
-                    dt_finest: finest,
-                    departure: d.value,
-                    departure_err: d.err,
-                    resolved: ok,
-                    within_one_percent: decide(d.value, d.err),
-                    rolls_needed: d.rolls_both(ONE_PERCENT),
-                    rolls: (s.rolls(), streams[0].1.rolls()),
-                });
+                claims.push(Claim::of(
+                    &cell,
+                    finest,
+                    (d.value, d.err),
+                    d.rolls_both(ONE_PERCENT),
+                    (s.rolls(), streams[0].1.rolls()),
+                ));
             }
             cells.push(cell);
         }
