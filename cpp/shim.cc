@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include "dicephys/src/engine/bullet.rs.h"
 
@@ -132,6 +133,334 @@ class DiceWorld : public btDiscreteDynamicsWorld {
     }
   }
 };
+
+// Bullet's sequential-impulse solver, for one die on fixed bodies (floors) done without its
+// generality: no pools of solver bodies and rows, no row solver behind a function pointer.
+// The arithmetic is Bullet 3.24's, operation for operation, in the same order:
+// - each contact point's rows are set up by Bullet's own setupContactConstraint and
+//   setupFrictionConstraint, with convertContact's own steps (relative positions and
+//   velocity, the friction direction) copied from it;
+// - the passes over the rows are gResolveSingleConstraintRow{LowerLimit,Generic} and
+//   gResolveSplitPenetrationImpulse (the scalar reference, which double precision uses) on
+//   the die's side of each row. The floor's side is kept as the one term Bullet computes
+//   for it, (0 . 0 + 0 . 0) * J: a fixed body's row part is zeroed and its velocity deltas
+//   never move. Applying an impulse to it does nothing in Bullet, and is left out;
+// - the residual that stops the passes early is kept exactly;
+// - the write-back (warm-starting impulses to the contact points; velocities, split-impulse
+//   transform and companion id to the die) is solveGroupCacheFriendlyFinish's.
+// Any other world (joints, two moving bodies, a kinematic body), solver mode, or contact
+// (its own CFM/ERP, stiffness, friction anchors, rolling or anisotropic friction) goes through
+// Bullet's own solveGroup.
+class DieSolver : public btSequentialImpulseConstraintSolver {
+ public:
+  btScalar solveGroup(btCollisionObject** bodies, int numBodies, btPersistentManifold** manifolds,
+                      int numManifolds, btTypedConstraint** constraints, int numConstraints,
+                      const btContactSolverInfo& info, btIDebugDraw* debugDrawer,
+                      btDispatcher* dispatcher) override {
+    btRigidBody* die = numBodies == 1 ? btRigidBody::upcast(bodies[0]) : nullptr;
+    if (numConstraints != 0 || !die || !fits(die, manifolds, numManifolds, info)) {
+      return btSequentialImpulseConstraintSolver::solveGroup(bodies, numBodies, manifolds,
+                                                             numManifolds, constraints,
+                                                             numConstraints, info, debugDrawer,
+                                                             dispatcher);
+    }
+    setup(die, manifolds, numManifolds, info);
+    iterate(info, numManifolds);
+    finish(die, info);
+    return 0.f;
+  }
+
+ private:
+  // One row, the die's side of it: its normal and r x n, and what an impulse along it does
+  // to the die (n times the inverse mass, and the angular component).
+  struct Row {
+    btVector3 normal, torque_axis, linear, angular;
+    btScalar jac_diag_inv, rhs, rhs_penetration, cfm, lower, upper, friction;
+    btScalar applied, applied_push;
+    bool die_is_a;             // the die is the row's body A (else B; the floor is the other)
+    int contact;               // a friction row's contact row
+    btManifoldPoint* point;    // a contact row's point
+  };
+  // Grown, never shrunk: a step's rows are the first contact_rows_ (friction_rows_).
+  std::vector<Row> contacts_, frictions_;
+  int contact_rows_ = 0, friction_rows_ = 0;
+  btVector3 delta_linear_, delta_angular_, push_, turn_, linear_factor_, angular_factor_;
+
+  static constexpr int kDie = 0, kFixed = 1;  // the die's and the floors' solver bodies
+  static btScalar square(btScalar x) { return x * x; }
+
+  // Whether Bullet's solveGroup would treat this as the one die this class solves.
+  bool fits(btRigidBody* die, btPersistentManifold** manifolds, int numManifolds,
+            const btContactSolverInfo& info) const {
+#ifdef USE_SIMD
+    return false;  // Bullet's SIMD row solvers (single precision only) are not these
+#endif
+    const int unsupported = SOLVER_RANDMIZE_ORDER | SOLVER_USE_2_FRICTION_DIRECTIONS |
+                            SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
+                            SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION |
+                            SOLVER_INTERLEAVE_CONTACT_AND_FRICTION_CONSTRAINTS;
+    if ((info.m_solverMode & unsupported) || die->getInvMass() == 0 ||
+        die->isKinematicObject() || die->hasAnisotropicFriction() ||
+        (die->getFlags() &
+         (BT_ENABLE_GYROSCOPIC_FORCE_EXPLICIT | BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_WORLD))) {
+      return false;
+    }
+    const int own = BT_CONTACT_FLAG_HAS_CONTACT_CFM | BT_CONTACT_FLAG_HAS_CONTACT_ERP |
+                    BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING | BT_CONTACT_FLAG_FRICTION_ANCHOR;
+    for (int i = 0; i < numManifolds; i++) {
+      const btPersistentManifold* m = manifolds[i];
+      const btCollisionObject* other = m->getBody0() == die ? m->getBody1() : m->getBody0();
+      if (m->getBody0() != die && m->getBody1() != die) return false;
+      // Bullet's getOrInitSolverBody makes it the fixed body only so.
+      const btRigidBody* rb = btRigidBody::upcast(other);
+      if (other == die || other->getCompanionId() >= 0 || other->hasAnisotropicFriction() ||
+          (rb && (rb->getInvMass() != 0 || rb->isKinematicObject()))) {
+        return false;
+      }
+      for (int j = 0; j < m->getNumContacts(); j++) {
+        const btManifoldPoint& cp = m->getContactPoint(j);
+        if ((cp.m_contactPointFlags & own) || cp.m_combinedRollingFriction > 0.f) return false;
+      }
+    }
+    return true;
+  }
+
+  // solveGroupCacheFriendlySetup: convertBodies, then convertContacts.
+  void setup(btRigidBody* die, btPersistentManifold** manifolds, int numManifolds,
+             const btContactSolverInfo& info) {
+    if (info.m_solverMode != m_cachedSolverMode) {
+      setupSolverFunctions(!!(info.m_solverMode & SOLVER_SIMD));
+      m_cachedSolverMode = info.m_solverMode;
+    }
+    m_maxOverrideNumSolverIterations = 0;
+    // convertBodies: the die's solver body, then its gyroscopic impulse.
+    if (m_tmpSolverBodyPool.size() < 2) m_tmpSolverBodyPool.resize(2);
+    btSolverBody& body = m_tmpSolverBodyPool[kDie];
+    initSolverBody(&body, die, info.m_timeStep);
+    die->setCompanionId(kDie);
+    if (die->getFlags() & BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_BODY) {
+      body.m_externalTorqueImpulse += die->computeGyroscopicImpulseImplicit_Body(info.m_timeStep);
+    }
+    initSolverBody(&m_tmpSolverBodyPool[kFixed], nullptr, info.m_timeStep);
+    contact_rows_ = 0;
+    friction_rows_ = 0;
+    for (int i = 0; i < numManifolds; i++) convert_contact(manifolds[i], die, info);
+    delta_linear_ = body.m_deltaLinearVelocity;  // warm starting has moved them
+    delta_angular_ = body.m_deltaAngularVelocity;
+    push_ = body.m_pushVelocity;
+    turn_ = body.m_turnVelocity;
+    linear_factor_ = body.m_linearFactor;
+    angular_factor_ = body.m_angularFactor;
+  }
+
+  // convertContact, for a manifold between the die and a fixed body: a contact row and one
+  // friction row per point within the processing threshold.
+  void convert_contact(btPersistentManifold* manifold, btRigidBody* die,
+                       const btContactSolverInfo& info) {
+    btCollisionObject* colObj0 = (btCollisionObject*)manifold->getBody0();
+    btCollisionObject* colObj1 = (btCollisionObject*)manifold->getBody1();
+    const bool die_is_a = colObj0 == die;
+    const int solverBodyIdA = die_is_a ? kDie : kFixed;
+    const int solverBodyIdB = die_is_a ? kFixed : kDie;
+    const btSolverBody* solverBodyA = &m_tmpSolverBodyPool[solverBodyIdA];
+    const btSolverBody* solverBodyB = &m_tmpSolverBodyPool[solverBodyIdB];
+    if (solverBodyA->m_invMass.fuzzyZero() && solverBodyB->m_invMass.fuzzyZero()) return;
+    for (int j = 0; j < manifold->getNumContacts(); j++) {
+      btManifoldPoint& cp = manifold->getContactPoint(j);
+      if (!(cp.getDistance() <= manifold->getContactProcessingThreshold())) continue;
+      const btVector3 rel_pos1 = cp.getPositionWorldOnA() - colObj0->getWorldTransform().getOrigin();
+      const btVector3 rel_pos2 = cp.getPositionWorldOnB() - colObj1->getWorldTransform().getOrigin();
+      btVector3 vel1, vel2;
+      solverBodyA->getVelocityInLocalPointNoDelta(rel_pos1, vel1);
+      solverBodyB->getVelocityInLocalPointNoDelta(rel_pos2, vel2);
+      const btVector3 vel = vel1 - vel2;
+      const btScalar rel_vel = cp.m_normalWorldOnB.dot(vel);
+      btScalar relaxation;
+      scratch_.m_solverBodyIdA = solverBodyIdA;
+      scratch_.m_solverBodyIdB = solverBodyIdB;
+      scratch_.m_originalContactPoint = &cp;
+      setupContactConstraint(scratch_, solverBodyIdA, solverBodyIdB, cp, info, relaxation,
+                             rel_pos1, rel_pos2);
+      const int contact = push_row(contacts_, contact_rows_, scratch_, die_is_a);
+      contacts_[contact].point = &cp;
+      // The friction direction: along the sliding velocity, or any if there is none.
+      cp.m_lateralFrictionDir1 = vel - cp.m_normalWorldOnB * rel_vel;
+      const btScalar lat_rel_vel = cp.m_lateralFrictionDir1.length2();
+      if (lat_rel_vel > SIMD_EPSILON) {
+        cp.m_lateralFrictionDir1 *= 1.f / btSqrt(lat_rel_vel);
+      } else {
+        btPlaneSpace1(cp.m_normalWorldOnB, cp.m_lateralFrictionDir1, cp.m_lateralFrictionDir2);
+      }
+      setupFrictionConstraint(scratch_, cp.m_lateralFrictionDir1, solverBodyIdA, solverBodyIdB,
+                              cp, rel_pos1, rel_pos2, colObj0, colObj1, relaxation, info);
+      const int friction = push_row(frictions_, friction_rows_, scratch_, die_is_a);
+      frictions_[friction].contact = contact;
+    }
+  }
+
+  int push_row(std::vector<Row>& rows, int& used, const btSolverConstraint& c, bool die_is_a) {
+    if (rows.size() <= std::size_t(used)) rows.resize(used + 1);
+    Row& r = rows[used];
+    r.die_is_a = die_is_a;
+    r.normal = die_is_a ? c.m_contactNormal1 : c.m_contactNormal2;
+    r.torque_axis = die_is_a ? c.m_relpos1CrossNormal : c.m_relpos2CrossNormal;
+    // internalApplyImpulse's linear component: the normal times the die's inverse mass.
+    r.linear = r.normal * m_tmpSolverBodyPool[kDie].internalGetInvMass();
+    r.angular = die_is_a ? c.m_angularComponentA : c.m_angularComponentB;
+    r.jac_diag_inv = c.m_jacDiagABInv;
+    r.rhs = c.m_rhs;
+    r.rhs_penetration = c.m_rhsPenetration;
+    r.cfm = c.m_cfm;
+    r.lower = c.m_lowerLimit;
+    r.upper = c.m_upperLimit;
+    r.friction = c.m_friction;
+    r.applied = c.m_appliedImpulse;
+    r.applied_push = c.m_appliedPushImpulse;
+    return used++;
+  }
+
+  // solveGroupCacheFriendlyIterations: the split-impulse passes, then the velocity passes.
+  void iterate(const btContactSolverInfo& info, int numManifolds) {
+    const int n = info.m_numIterations;
+    if (info.m_splitImpulse) {
+      for (int iteration = 0; iteration < n; iteration++) {
+        btScalar residual = 0.f;
+        for (int i = 0; i < contact_rows_; i++) {
+          residual = btMax(residual, square(push(contacts_[i])));
+        }
+        if (residual <= info.m_leastSquaresResidualThreshold || iteration >= n - 1) break;
+      }
+    }
+    // solveSingleIteration: the contact rows, then the friction rows, each bounded by its
+    // contact's impulse so far.
+    const int maxIterations = m_maxOverrideNumSolverIterations > n ? m_maxOverrideNumSolverIterations : n;
+    for (int iteration = 0; iteration < maxIterations; iteration++) {
+      btScalar residual = 0.f;
+      if (iteration < n) {
+        for (int i = 0; i < contact_rows_; i++) {
+          residual = btMax(residual, square(lower_limit(contacts_[i])));
+        }
+        for (int i = 0; i < friction_rows_; i++) {
+          Row& f = frictions_[i];
+          const btScalar total = contacts_[f.contact].applied;
+          if (total > btScalar(0)) {
+            f.lower = -(f.friction * total);
+            f.upper = f.friction * total;
+            residual = btMax(residual, square(generic(f)));
+          }
+        }
+      }
+      m_leastSquaresResidual = residual;
+      if (residual <= info.m_leastSquaresResidualThreshold || iteration >= maxIterations - 1) {
+        m_analyticsData.m_numSolverCalls++;
+        m_analyticsData.m_numIterationsUsed = iteration + 1;
+        m_analyticsData.m_islandId = kDie;  // the die's companion id at this point
+        m_analyticsData.m_numBodies = 1;
+        m_analyticsData.m_numContactManifolds = numManifolds;
+        m_analyticsData.m_remainingLeastSquaresResidual = residual;
+        break;
+      }
+    }
+  }
+
+  // solveGroupCacheFriendlyFinish: writeBackContacts, then writeBackBodies.
+  void finish(btRigidBody* die, const btContactSolverInfo& info) {
+    if (info.m_solverMode & SOLVER_USE_WARMSTARTING) {
+      for (int i = 0; i < contact_rows_; i++) {
+        contacts_[i].point->m_appliedImpulse = contacts_[i].applied;
+        contacts_[i].point->m_appliedImpulseLateral1 = frictions_[i].applied;
+      }
+    }
+    btSolverBody& body = m_tmpSolverBodyPool[kDie];
+    body.m_deltaLinearVelocity = delta_linear_;
+    body.m_deltaAngularVelocity = delta_angular_;
+    body.m_pushVelocity = push_;
+    body.m_turnVelocity = turn_;
+    if (info.m_splitImpulse) {
+      body.writebackVelocityAndTransform(info.m_timeStep, info.m_splitImpulseTurnErp);
+    } else {
+      body.writebackVelocity();
+    }
+    die->setLinearVelocity(body.m_linearVelocity + body.m_externalForceImpulse);
+    die->setAngularVelocity(body.m_angularVelocity + body.m_externalTorqueImpulse);
+    if (info.m_splitImpulse) die->setWorldTransform(body.m_worldTransform);
+    die->setCompanionId(-1);
+  }
+
+  // The floor's side of a row, as Bullet computes it: (0 . 0 + 0 . 0) * J.
+  static btScalar fixed_term(const Row& c) { return btScalar(0) * c.jac_diag_inv; }
+
+  // deltaImpulse less both bodies' velocity terms, in Bullet's order (body A's first).
+  static btScalar less_velocity(btScalar deltaImpulse, const Row& c, btScalar deltaVelDotn) {
+    if (c.die_is_a) {
+      deltaImpulse -= deltaVelDotn * c.jac_diag_inv;
+      deltaImpulse -= fixed_term(c);
+    } else {
+      deltaImpulse -= fixed_term(c);
+      deltaImpulse -= deltaVelDotn * c.jac_diag_inv;
+    }
+    return deltaImpulse;
+  }
+
+  // gResolveSingleConstraintRowGeneric_scalar_reference.
+  btScalar generic(Row& c) {
+    btScalar deltaImpulse = c.rhs - btScalar(c.applied) * c.cfm;
+    deltaImpulse = less_velocity(
+        deltaImpulse, c, c.normal.dot(delta_linear_) + c.torque_axis.dot(delta_angular_));
+    const btScalar sum = btScalar(c.applied) + deltaImpulse;
+    if (sum < c.lower) {
+      deltaImpulse = c.lower - c.applied;
+      c.applied = c.lower;
+    } else if (sum > c.upper) {
+      deltaImpulse = c.upper - c.applied;
+      c.applied = c.upper;
+    } else {
+      c.applied = sum;
+    }
+    delta_linear_ += c.linear * deltaImpulse * linear_factor_;
+    delta_angular_ += c.angular * (deltaImpulse * angular_factor_);
+    return deltaImpulse * (1. / c.jac_diag_inv);
+  }
+
+  // gResolveSingleConstraintRowLowerLimit_scalar_reference.
+  btScalar lower_limit(Row& c) {
+    btScalar deltaImpulse = c.rhs - btScalar(c.applied) * c.cfm;
+    deltaImpulse = less_velocity(
+        deltaImpulse, c, c.normal.dot(delta_linear_) + c.torque_axis.dot(delta_angular_));
+    const btScalar sum = btScalar(c.applied) + deltaImpulse;
+    if (sum < c.lower) {
+      deltaImpulse = c.lower - c.applied;
+      c.applied = c.lower;
+    } else {
+      c.applied = sum;
+    }
+    delta_linear_ += c.linear * deltaImpulse * linear_factor_;
+    delta_angular_ += c.angular * (deltaImpulse * angular_factor_);
+    return deltaImpulse * (1. / c.jac_diag_inv);
+  }
+
+  // gResolveSplitPenetrationImpulse_scalar_reference (less its global statistics counter,
+  // gNumSplitImpulseRecoveries).
+  btScalar push(Row& c) {
+    btScalar deltaImpulse = 0.f;
+    if (c.rhs_penetration) {
+      deltaImpulse = c.rhs_penetration - btScalar(c.applied_push) * c.cfm;
+      deltaImpulse = less_velocity(deltaImpulse, c, c.normal.dot(push_) + c.torque_axis.dot(turn_));
+      const btScalar sum = btScalar(c.applied_push) + deltaImpulse;
+      if (sum < c.lower) {
+        deltaImpulse = c.lower - c.applied_push;
+        c.applied_push = c.lower;
+      } else {
+        c.applied_push = sum;
+      }
+      push_ += c.linear * deltaImpulse * linear_factor_;
+      turn_ += c.angular * (deltaImpulse * angular_factor_);
+    }
+    return deltaImpulse * (1. / c.jac_diag_inv);
+  }
+
+  btSolverConstraint scratch_;  // the row Bullet's set-up functions fill
+};
 }  // namespace
 
 BulletWorld::BulletWorld(const BulletScene& s)
@@ -148,7 +477,11 @@ BulletWorld::BulletWorld(const BulletScene& s)
   dispatcher_ = std::make_unique<btCollisionDispatcher>(config_.get());
   // Two bodies: the simplest broadphase does (the pair is the same; measured identical).
   broadphase_ = std::make_unique<btSimpleBroadphase>(4);
-  solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
+  if (s.stock_world) {
+    solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
+  } else {
+    solver_ = std::make_unique<DieSolver>();
+  }
   if (s.stock_world) {
     world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
                                                        solver_.get(), config_.get());

@@ -218,28 +218,78 @@ fn keyed_throws_agree_with_dicephys_ratio_within_3_sigma() {
 
 /// The shim's shortcuts on Bullet's step (`DiceWorld` in cpp/shim.cc: no swept bounding box,
 /// no second prediction of the transform, no damping by pow(1, dt), the die's island found
-/// directly) change nothing: every state of every roll is bit for bit that of Bullet's own
-/// world, awake or asleep, in 2D and 3D, on the box floor and the plane, at 1 ms and 1/60 s.
+/// directly; `DieSolver`: the contact solver without its pools and function pointers) change
+/// nothing: every state of every roll is bit for bit that of Bullet's own world and solver,
+/// awake or asleep, in 2D and 3D, on the box floor and the plane, at 1 ms and 1/60 s, with
+/// Bullet 3's preset (its gyroscopic impulse) and with damping. A change of one unit in the
+/// last place of a friction direction fails it (checked by sabotage).
 #[test]
 fn the_shims_shortcuts_leave_every_state_as_bullets_own_world_has_it() {
     use dicephys::engine::bullet::Bullet;
     use dicephys::engine::Engine;
-    use dicephys::model::scene::Floor;
+    use dicephys::model::scene::{Floor, Preset};
     use dicephys::model::throws::ThrowStyle;
     let mut asleep = 0;
+    let (d281, b3) = (Preset::Dicephys281, Preset::Bullet3);
     let cases = [
-        (Mode::ThreeD, Floor::Box, 0.001, ThrowStyle::Paper),
-        (Mode::TwoD, Floor::Box, 0.001, ThrowStyle::Paper),
-        (Mode::ThreeD, Floor::Box, 0.001, ThrowStyle::Tumble),
-        (Mode::ThreeD, Floor::Box, 0.001, ThrowStyle::Rest),
-        (Mode::TwoD, Floor::Box, 0.001, ThrowStyle::Rest),
-        (Mode::ThreeD, Floor::Plane, 0.001, ThrowStyle::Paper),
-        (Mode::ThreeD, Floor::Box, 1.0 / 60.0, ThrowStyle::Paper),
-        (Mode::TwoD, Floor::Box, 1.0 / 60.0, ThrowStyle::Paper),
+        (
+            Mode::ThreeD,
+            Floor::Box,
+            0.001,
+            ThrowStyle::Paper,
+            d281,
+            0.0,
+        ),
+        (Mode::TwoD, Floor::Box, 0.001, ThrowStyle::Paper, d281, 0.0),
+        (
+            Mode::ThreeD,
+            Floor::Box,
+            0.001,
+            ThrowStyle::Tumble,
+            d281,
+            0.0,
+        ),
+        (Mode::ThreeD, Floor::Box, 0.001, ThrowStyle::Rest, d281, 0.0),
+        (Mode::TwoD, Floor::Box, 0.001, ThrowStyle::Rest, d281, 0.0),
+        (
+            Mode::ThreeD,
+            Floor::Plane,
+            0.001,
+            ThrowStyle::Paper,
+            d281,
+            0.0,
+        ),
+        (
+            Mode::ThreeD,
+            Floor::Box,
+            1.0 / 60.0,
+            ThrowStyle::Paper,
+            d281,
+            0.0,
+        ),
+        (
+            Mode::TwoD,
+            Floor::Box,
+            1.0 / 60.0,
+            ThrowStyle::Paper,
+            d281,
+            0.0,
+        ),
+        (Mode::ThreeD, Floor::Box, 0.001, ThrowStyle::Paper, b3, 0.0),
+        (Mode::TwoD, Floor::Box, 0.001, ThrowStyle::Paper, b3, 0.0),
+        (
+            Mode::ThreeD,
+            Floor::Box,
+            0.001,
+            ThrowStyle::Paper,
+            d281,
+            2.0,
+        ),
     ];
-    for (mode, floor, dt, style) in cases {
+    for (mode, floor, dt, style, preset, damping) in cases {
         let mut scene = Scene::paper(block(), mode);
-        (scene.floor, scene.dt) = (floor, dt);
+        (scene.floor, scene.dt, scene.preset) = (floor, dt, preset);
+        (scene.linear_damping, scene.angular_damping) = (damping, damping);
         let throws = Throws::styled(ThrowKind::Keyed, style, 11, ThrowRanges::default(), 40);
         let mut ours = Bullet::new(&scene).unwrap();
         let mut stock = Bullet::stock(&scene).unwrap();
@@ -260,7 +310,8 @@ fn the_shims_shortcuts_leave_every_state_as_bullets_own_world_has_it() {
                     |_, s| seen.push(*s),
                 ));
             }
-            let case = format!("{mode:?} {floor:?} dt {dt} {style:?} throw {index}");
+            let case =
+                format!("{mode:?} {floor:?} dt {dt} {style:?} {preset:?} {damping} throw {index}");
             assert_eq!(ends[0], ends[1], "{case}");
             assert_eq!(states[0], states[1], "{case}");
             asleep += states[0].iter().filter(|s| s.sleeping).count();
