@@ -589,12 +589,13 @@ void BulletWorld::set_state(const BodyStateFfi& now) {
   die_->setActivationState(ACTIVE_TAG);  // no effect under DISABLE_DEACTIVATION
 }
 
-// One fixed step per call, as DicePhys: stepSimulation(dt, 1, dt). Returns the state after
-// it, so that a step and its read cross the FFI once.
-BodyStateFfi BulletWorld::step() {
+// One fixed step per call, as DicePhys: stepSimulation(dt, 1, dt). Writes the state after
+// it straight into the caller's (Rust's) copy, so that a step and its read cross the FFI
+// once and the state is not copied on the way.
+void BulletWorld::step(BodyStateFfi& out) {
   if (!die_) throw std::logic_error("step before reset");
   world_->stepSimulation(dt_, 1, dt_);
-  return state();
+  read(out);
 }
 
 // The same n steps, each with its state read, without returning to Rust: used only to
@@ -602,16 +603,23 @@ BodyStateFfi BulletWorld::step() {
 void BulletWorld::step_n(std::uint32_t n) {
   if (!die_) throw std::logic_error("step before reset");
   volatile double sink = 0;
+  BodyStateFfi s{};
   for (std::uint32_t i = 0; i < n; ++i) {
     world_->stepSimulation(dt_, 1, dt_);
-    const BodyStateFfi s = state();
+    read(s);
     sink = sink + s.position[1] + s.rotation[3] + s.angular_velocity[2];
   }
 }
 
 BodyStateFfi BulletWorld::state() const {
-  if (!die_) return BodyStateFfi{};
-  BodyStateFfi out;  // every field set below: no zeroing first (this runs every step)
+  BodyStateFfi out{};
+  read(out);
+  return out;
+}
+
+// The die's state into out (every field; left as it is before the first reset).
+void BulletWorld::read(BodyStateFfi& out) const {
+  if (!die_) return;
   const btTransform& t = die_->getWorldTransform();
   const btQuaternion q = t.getRotation();
   out.position = arr(t.getOrigin());
@@ -619,7 +627,6 @@ BodyStateFfi BulletWorld::state() const {
   out.linear_velocity = arr(die_->getLinearVelocity());
   out.angular_velocity = arr(die_->getAngularVelocity());
   out.sleeping = die_->getActivationState() == ISLAND_SLEEPING;
-  return out;
 }
 
 // Contact points kept in the world's manifolds (the die's with the floor): after a step, those

@@ -28,9 +28,10 @@ class BulletWorld {
 
   void reset(const BodyStateFfi& start);
   void set_state(const BodyStateFfi& now);
-  BodyStateFfi step();
+  void step(BodyStateFfi& out);
   void step_n(std::uint32_t n);
   BodyStateFfi state() const;
+  void read(BodyStateFfi& out) const;
   std::uint32_t contact_points() const;
 
  private:

@@ -59,7 +59,7 @@ mod ffi {
         fn new_world(scene: &BulletScene) -> Result<UniquePtr<BulletWorld>>;
         fn reset(self: Pin<&mut BulletWorld>, start: &BodyStateFfi) -> Result<()>;
         fn set_state(self: Pin<&mut BulletWorld>, now: &BodyStateFfi) -> Result<()>;
-        fn step(self: Pin<&mut BulletWorld>) -> Result<BodyStateFfi>;
+        fn step(self: Pin<&mut BulletWorld>, out: &mut BodyStateFfi) -> Result<()>;
         fn step_n(self: Pin<&mut BulletWorld>, n: u32) -> Result<()>;
         fn state(self: &BulletWorld) -> BodyStateFfi;
         fn contact_points(self: &BulletWorld) -> u32;
@@ -211,12 +211,10 @@ impl Engine for Bullet {
     }
 
     fn step(&mut self) -> crate::Result<()> {
-        self.now = self
-            .world
+        self.world
             .pin_mut()
-            .step()
-            .map_err(|e| crate::Error::Engine(e.to_string()))?;
-        Ok(())
+            .step(&mut self.now)
+            .map_err(|e| crate::Error::Engine(e.to_string()))
     }
 
     fn state(&self) -> BodyState {
