@@ -136,15 +136,16 @@ class DiceWorld : public btDiscreteDynamicsWorld {
 
 // Bullet's sequential-impulse solver, for one die on fixed bodies (floors) done without its
 // generality: no pools of solver bodies and rows, no row solver behind a function pointer.
-// The arithmetic is Bullet 3.24's, operation for operation, in the same order:
-// - each contact point's rows are set up by Bullet's own setupContactConstraint and
-//   setupFrictionConstraint, with convertContact's own steps (relative positions and
-//   velocity, the friction direction) copied from it;
+// The arithmetic is Bullet 3.24's, operation for operation, in the same order, on the die's
+// side of each row. A fixed body's side of a row is zero (Bullet zeroes its normal, r x n and
+// angular component), its velocity and velocity deltas are zero and never move, and applying
+// an impulse to it does nothing; so what it adds to a sum is +0, kept where it is added
+// (x + 0 turns -0 into +0) and left out where it is subtracted (x - (+0) = x):
+// - convertContact, setupContactConstraint and setupFrictionConstraint set up each contact
+//   point's two rows (a contact and one friction direction: Bullet's default mode);
 // - the passes over the rows are gResolveSingleConstraintRow{LowerLimit,Generic} and
-//   gResolveSplitPenetrationImpulse (the scalar reference, which double precision uses) on
-//   the die's side of each row. The floor's side is kept as the one term Bullet computes
-//   for it, (0 . 0 + 0 . 0) * J: a fixed body's row part is zeroed and its velocity deltas
-//   never move. Applying an impulse to it does nothing in Bullet, and is left out;
+//   gResolveSplitPenetrationImpulse (the scalar reference, which double precision uses). The
+//   floor's term there, (0 . 0 + 0 . 0) * J, is kept as computed (J could be anything);
 // - the residual that stops the passes early is kept exactly;
 // - the write-back (warm-starting impulses to the contact points; velocities, split-impulse
 //   transform and companion id to the die) is solveGroupCacheFriendlyFinish's.
@@ -186,7 +187,7 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
   int contact_rows_ = 0, friction_rows_ = 0;
   btVector3 delta_linear_, delta_angular_, push_, turn_, linear_factor_, angular_factor_;
 
-  static constexpr int kDie = 0, kFixed = 1;  // the die's and the floors' solver bodies
+  static constexpr int kDie = 0;  // the die's solver body
   static btScalar square(btScalar x) { return x * x; }
 
   // Whether Bullet's solveGroup would treat this as the one die this class solves.
@@ -234,23 +235,22 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
     }
     m_maxOverrideNumSolverIterations = 0;
     // convertBodies: the die's solver body, then its gyroscopic impulse.
-    if (m_tmpSolverBodyPool.size() < 2) m_tmpSolverBodyPool.resize(2);
+    if (m_tmpSolverBodyPool.size() < 1) m_tmpSolverBodyPool.resize(1);
     btSolverBody& body = m_tmpSolverBodyPool[kDie];
     initSolverBody(&body, die, info.m_timeStep);
     die->setCompanionId(kDie);
     if (die->getFlags() & BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_BODY) {
       body.m_externalTorqueImpulse += die->computeGyroscopicImpulseImplicit_Body(info.m_timeStep);
     }
-    initSolverBody(&m_tmpSolverBodyPool[kFixed], nullptr, info.m_timeStep);
-    contact_rows_ = 0;
-    friction_rows_ = 0;
-    for (int i = 0; i < numManifolds; i++) convert_contact(manifolds[i], die, info);
-    delta_linear_ = body.m_deltaLinearVelocity;  // warm starting has moved them
+    delta_linear_ = body.m_deltaLinearVelocity;
     delta_angular_ = body.m_deltaAngularVelocity;
     push_ = body.m_pushVelocity;
     turn_ = body.m_turnVelocity;
     linear_factor_ = body.m_linearFactor;
     angular_factor_ = body.m_angularFactor;
+    contact_rows_ = 0;
+    friction_rows_ = 0;
+    for (int i = 0; i < numManifolds; i++) convert_contact(manifolds[i], die, info);
   }
 
   // convertContact, for a manifold between the die and a fixed body: a contact row and one
@@ -260,28 +260,23 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
     btCollisionObject* colObj0 = (btCollisionObject*)manifold->getBody0();
     btCollisionObject* colObj1 = (btCollisionObject*)manifold->getBody1();
     const bool die_is_a = colObj0 == die;
-    const int solverBodyIdA = die_is_a ? kDie : kFixed;
-    const int solverBodyIdB = die_is_a ? kFixed : kDie;
-    const btSolverBody* solverBodyA = &m_tmpSolverBodyPool[solverBodyIdA];
-    const btSolverBody* solverBodyB = &m_tmpSolverBodyPool[solverBodyIdB];
-    if (solverBodyA->m_invMass.fuzzyZero() && solverBodyB->m_invMass.fuzzyZero()) return;
+    const btSolverBody& body = m_tmpSolverBodyPool[kDie];
+    // (The fixed body's inverse mass is zero.)
+    if (body.m_invMass.fuzzyZero()) return;
+    const btVector3 zero(0, 0, 0);  // the fixed body's velocity, and its side of each row
     for (int j = 0; j < manifold->getNumContacts(); j++) {
       btManifoldPoint& cp = manifold->getContactPoint(j);
       if (!(cp.getDistance() <= manifold->getContactProcessingThreshold())) continue;
       const btVector3 rel_pos1 = cp.getPositionWorldOnA() - colObj0->getWorldTransform().getOrigin();
       const btVector3 rel_pos2 = cp.getPositionWorldOnB() - colObj1->getWorldTransform().getOrigin();
-      btVector3 vel1, vel2;
-      solverBodyA->getVelocityInLocalPointNoDelta(rel_pos1, vel1);
-      solverBodyB->getVelocityInLocalPointNoDelta(rel_pos2, vel2);
-      const btVector3 vel = vel1 - vel2;
+      const btVector3& rel_pos = die_is_a ? rel_pos1 : rel_pos2;  // the die's
+      // getVelocityInLocalPointNoDelta of each body (the fixed body's is zero).
+      const btVector3 die_vel = body.m_linearVelocity + body.m_externalForceImpulse +
+                                (body.m_angularVelocity + body.m_externalTorqueImpulse).cross(rel_pos);
+      const btVector3 vel = die_is_a ? die_vel - zero : zero - die_vel;
       const btScalar rel_vel = cp.m_normalWorldOnB.dot(vel);
-      btScalar relaxation;
-      scratch_.m_solverBodyIdA = solverBodyIdA;
-      scratch_.m_solverBodyIdB = solverBodyIdB;
-      scratch_.m_originalContactPoint = &cp;
-      setupContactConstraint(scratch_, solverBodyIdA, solverBodyIdB, cp, info, relaxation,
-                             rel_pos1, rel_pos2);
-      const int contact = push_row(contacts_, contact_rows_, scratch_, die_is_a);
+      const btScalar relaxation = info.m_sor;
+      const int contact = contact_row(cp, die, die_is_a, rel_pos, info);
       contacts_[contact].point = &cp;
       // The friction direction: along the sliding velocity, or any if there is none.
       cp.m_lateralFrictionDir1 = vel - cp.m_normalWorldOnB * rel_vel;
@@ -291,32 +286,138 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
       } else {
         btPlaneSpace1(cp.m_normalWorldOnB, cp.m_lateralFrictionDir1, cp.m_lateralFrictionDir2);
       }
-      setupFrictionConstraint(scratch_, cp.m_lateralFrictionDir1, solverBodyIdA, solverBodyIdB,
-                              cp, rel_pos1, rel_pos2, colObj0, colObj1, relaxation, info);
-      const int friction = push_row(frictions_, friction_rows_, scratch_, die_is_a);
+      const int friction =
+          friction_row(cp, cp.m_lateralFrictionDir1, die, die_is_a, rel_pos, relaxation);
       frictions_[friction].contact = contact;
     }
   }
 
-  int push_row(std::vector<Row>& rows, int& used, const btSolverConstraint& c, bool die_is_a) {
+  Row& new_row(std::vector<Row>& rows, int& used) {
     if (rows.size() <= std::size_t(used)) rows.resize(used + 1);
-    Row& r = rows[used];
+    return rows[used++];
+  }
+
+  // setupContactConstraint, the die's side; the fixed body's side is zero (its normal, r x n
+  // and angular component), its velocity zero, and no impulse is applied to it. Each value
+  // is computed as Bullet computes it, the fixed body's zero terms included where they
+  // are added (x + 0 turns -0 into +0).
+  int contact_row(btManifoldPoint& cp, btRigidBody* die, bool die_is_a, const btVector3& rel_pos,
+                  const btContactSolverInfo& info) {
+    const btVector3& n = cp.m_normalWorldOnB;
+    const btScalar relaxation = info.m_sor;
+    const btScalar invTimeStep = btScalar(1) / info.m_timeStep;
+    btScalar cfm = info.m_globalCfm;
+    const btScalar erp = info.m_erp2;
+    cfm *= invTimeStep;
+    Row& r = new_row(contacts_, contact_rows_);
     r.die_is_a = die_is_a;
-    r.normal = die_is_a ? c.m_contactNormal1 : c.m_contactNormal2;
-    r.torque_axis = die_is_a ? c.m_relpos1CrossNormal : c.m_relpos2CrossNormal;
-    // internalApplyImpulse's linear component: the normal times the die's inverse mass.
-    r.linear = r.normal * m_tmpSolverBodyPool[kDie].internalGetInvMass();
-    r.angular = die_is_a ? c.m_angularComponentA : c.m_angularComponentB;
-    r.jac_diag_inv = c.m_jacDiagABInv;
-    r.rhs = c.m_rhs;
-    r.rhs_penetration = c.m_rhsPenetration;
-    r.cfm = c.m_cfm;
-    r.lower = c.m_lowerLimit;
-    r.upper = c.m_upperLimit;
-    r.friction = c.m_friction;
-    r.applied = c.m_appliedImpulse;
-    r.applied_push = c.m_appliedPushImpulse;
-    return used++;
+    const btVector3 torqueAxis = rel_pos.cross(n);
+    btScalar denom;
+    if (die_is_a) {
+      r.angular = die->getInvInertiaTensorWorld() * torqueAxis * die->getAngularFactor();
+      const btScalar denom0 = die->getInvMass() + n.dot(r.angular.cross(rel_pos));
+      denom = relaxation / (denom0 + btScalar(0) + cfm);
+      r.normal = n;
+      r.torque_axis = torqueAxis;
+    } else {
+      r.angular = die->getInvInertiaTensorWorld() * -torqueAxis * die->getAngularFactor();
+      const btScalar denom1 = die->getInvMass() + n.dot((-r.angular).cross(rel_pos));
+      denom = relaxation / (btScalar(0) + denom1 + cfm);
+      r.normal = -n;
+      r.torque_axis = -torqueAxis;
+    }
+    r.jac_diag_inv = denom;
+    const btSolverBody& body = m_tmpSolverBodyPool[kDie];
+    r.linear = r.normal * body.internalGetInvMass();
+    btScalar restitution = 0.f;
+    const btScalar penetration = cp.getDistance() + info.m_linearSlop;
+    {
+      const btVector3 die_vel = die->getVelocityInLocalPoint(rel_pos);
+      const btVector3 vel = die_is_a ? die_vel - btVector3(0, 0, 0) : btVector3(0, 0, 0) - die_vel;
+      const btScalar rel_vel = n.dot(vel);
+      r.friction = cp.m_combinedFriction;
+      restitution = restitutionCurve(rel_vel, cp.m_combinedRestitution,
+                                     info.m_restitutionVelocityThreshold);
+      if (restitution <= btScalar(0.)) restitution = 0.f;
+    }
+    if (info.m_solverMode & SOLVER_USE_WARMSTARTING) {
+      r.applied = cp.m_appliedImpulse * info.m_warmstartingFactor;
+      // internalApplyImpulse on the die: as body A with the impulse, as body B with both the
+      // direction and the impulse negated.
+      if (die_is_a) {
+        delta_linear_ += r.linear * r.applied * linear_factor_;
+        delta_angular_ += r.angular * (r.applied * angular_factor_);
+      } else {
+        const btScalar minus = -(btScalar)r.applied;
+        delta_linear_ += (-r.normal * body.internalGetInvMass()) * minus * linear_factor_;
+        delta_angular_ += -r.angular * (minus * angular_factor_);
+      }
+    } else {
+      r.applied = 0.f;
+    }
+    r.applied_push = 0.f;
+    {
+      const btScalar dieDotn =
+          r.normal.dot(body.m_linearVelocity + body.m_externalForceImpulse) +
+          r.torque_axis.dot(body.m_angularVelocity + body.m_externalTorqueImpulse);
+      // vel1Dotn + vel2Dotn, the fixed body's being +0.
+      const btScalar rel_vel = die_is_a ? dieDotn + btScalar(0) : btScalar(0) + dieDotn;
+      btScalar positionalError = 0.f;
+      btScalar velocityError = restitution - rel_vel;
+      if (penetration > 0) {
+        positionalError = 0;
+        velocityError -= penetration * invTimeStep;
+      } else {
+        positionalError = -penetration * erp * invTimeStep;
+      }
+      const btScalar penetrationImpulse = positionalError * r.jac_diag_inv;
+      const btScalar velocityImpulse = velocityError * r.jac_diag_inv;
+      if (!info.m_splitImpulse || (penetration > info.m_splitImpulsePenetrationThreshold)) {
+        r.rhs = penetrationImpulse + velocityImpulse;
+        r.rhs_penetration = 0.f;
+      } else {
+        r.rhs = velocityImpulse;
+        r.rhs_penetration = penetrationImpulse;
+      }
+      r.cfm = cfm * r.jac_diag_inv;
+      r.lower = 0;
+      r.upper = 1e10f;
+    }
+    return contact_rows_ - 1;
+  }
+
+  // setupFrictionConstraint (no friction anchor, no slip), the die's side, as contact_row.
+  int friction_row(btManifoldPoint& cp, const btVector3& normalAxis, btRigidBody* die,
+                   bool die_is_a, const btVector3& rel_pos, btScalar relaxation) {
+    Row& r = new_row(frictions_, friction_rows_);
+    r.die_is_a = die_is_a;
+    r.friction = cp.m_combinedFriction;
+    r.applied = 0.f;
+    r.applied_push = 0.f;
+    r.normal = die_is_a ? normalAxis : -normalAxis;
+    r.torque_axis = rel_pos.cross(r.normal);
+    r.angular = die->getInvInertiaTensorWorld() * r.torque_axis * die->getAngularFactor();
+    const btSolverBody& body = m_tmpSolverBodyPool[kDie];
+    r.linear = r.normal * body.internalGetInvMass();
+    btScalar dieDotn;
+    if (die_is_a) {
+      const btScalar denom0 = die->getInvMass() + normalAxis.dot(r.angular.cross(rel_pos));
+      r.jac_diag_inv = relaxation / (denom0 + btScalar(0.f));
+    } else {
+      const btScalar denom1 = die->getInvMass() + normalAxis.dot((-r.angular).cross(rel_pos));
+      r.jac_diag_inv = relaxation / (btScalar(0.f) + denom1);
+    }
+    dieDotn = r.normal.dot(body.m_linearVelocity + body.m_externalForceImpulse) +
+              r.torque_axis.dot(body.m_angularVelocity);
+    const btScalar rel_vel = die_is_a ? dieDotn + btScalar(0) : btScalar(0) + dieDotn;
+    const btScalar velocityError = btScalar(0.) - rel_vel;
+    const btScalar velocityImpulse = velocityError * r.jac_diag_inv;
+    r.rhs = btScalar(0) + velocityImpulse;
+    r.rhs_penetration = 0.f;
+    r.cfm = 0.;
+    r.lower = -r.friction;
+    r.upper = r.friction;
+    return friction_rows_ - 1;
   }
 
   // solveGroupCacheFriendlyIterations: the split-impulse passes, then the velocity passes.
@@ -458,8 +559,6 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
     }
     return deltaImpulse * (1. / c.jac_diag_inv);
   }
-
-  btSolverConstraint scratch_;  // the row Bullet's set-up functions fill
 };
 }  // namespace
 
