@@ -36,8 +36,9 @@ mod ffi {
         /// (1 − d)^dt each step (`Scene::bullet_damping`); DicePhys: 0, 0.
         linear_damping: f64,
         angular_damping: f64,
-        /// Bullet's own world, every part of a step as Bullet does it, without the shim's
-        /// shortcuts (`DiceWorld` in cpp/shim.cc): for the check that they change nothing.
+        /// Bullet's own world and solver, every part of a step as Bullet does it, without the
+        /// shim's shortcuts (`DiceWorld`, `DieSolver` in cpp/shim.cc): for the check that
+        /// they change nothing.
         stock_world: bool,
     }
 
@@ -118,9 +119,10 @@ impl Bullet {
         Bullet::build(scene, false)
     }
 
-    /// The same world, stepped by Bullet's own `btDiscreteDynamicsWorld` without the shim's
-    /// shortcuts (its swept bounding boxes, predictions and island manager, which change
-    /// nothing for one die on a static floor): the check that they change nothing.
+    /// The same world, stepped by Bullet's own `btDiscreteDynamicsWorld` and
+    /// `btSequentialImpulseConstraintSolver` without the shim's shortcuts (its swept bounding
+    /// boxes, predictions, island manager and the solver's pools, which change nothing for
+    /// one die on a static floor): the check that they change nothing.
     pub fn stock(scene: &Scene) -> crate::Result<Bullet> {
         Bullet::build(scene, true)
     }

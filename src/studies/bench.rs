@@ -433,7 +433,7 @@ pub fn run(
     }
     let ffi = ffi_cost(&Scene::paper(block, Mode::ThreeD))?;
     log(&format!(
-        "FFI: {} steps (fastest of 3 per throw), Rust loop (one cxx call per step, returning the state) {:.3} s, C++ loop (the same steps and state reads) {:.3} s: overhead {:+.1} %",
+        "FFI: {} steps (fastest of 3 per throw), Rust loop (one cxx call per step, writing the state into Rust's copy) {:.3} s, C++ loop (the same steps and state reads) {:.3} s: overhead {:+.1} %",
         ffi.steps,
         ffi.rust_loop_s,
         ffi.cpp_loop_s,
@@ -488,9 +488,9 @@ pub fn run(
 }
 
 /// What one cxx call per step costs: the same 1,000-step stretch of the same throws, stepped
-/// from Rust (one call per step, which returns the state, as a roll does) and inside C++
-/// alone (the same steps and state reads), interleaved and repeated so that machine noise
-/// falls on both alike.
+/// from Rust (one call per step, which writes the state into Rust's copy, as a roll does)
+/// and inside C++ alone (the same steps and state reads), interleaved and repeated so that
+/// machine noise falls on both alike.
 pub fn ffi_cost(scene: &Scene) -> crate::Result<FfiCost> {
     use crate::engine::Engine;
     let mut bullet = crate::engine::bullet::Bullet::new(scene)?;
