@@ -439,7 +439,7 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
       btScalar residual = 0.f;
       if (iteration < n) {
         for (int i = 0; i < contact_rows_; i++) {
-          residual = btMax(residual, square(lower_limit(contacts_[i])));
+          residual = btMax(residual, square(solve<false>(contacts_[i])));
         }
         for (int i = 0; i < friction_rows_; i++) {
           Row& f = frictions_[i];
@@ -447,7 +447,7 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
           if (total > btScalar(0)) {
             f.lower = -(f.friction * total);
             f.upper = f.friction * total;
-            residual = btMax(residual, square(generic(f)));
+            residual = btMax(residual, square(solve<true>(f)));
           }
         }
       }
@@ -503,8 +503,11 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
     return deltaImpulse;
   }
 
-  // gResolveSingleConstraintRowGeneric_scalar_reference.
-  btScalar generic(Row& c) {
+  // gResolveSingleConstraintRowGeneric_scalar_reference (a friction row: both limits) and
+  // gResolveSingleConstraintRowLowerLimit_scalar_reference (a contact row: the lower one),
+  // which differ only there.
+  template <bool kUpperLimit>
+  btScalar solve(Row& c) {
     btScalar deltaImpulse = c.rhs - btScalar(c.applied) * c.cfm;
     deltaImpulse = less_velocity(
         deltaImpulse, c, c.normal.dot(delta_linear_) + c.torque_axis.dot(delta_angular_));
@@ -512,32 +515,20 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
     if (sum < c.lower) {
       deltaImpulse = c.lower - c.applied;
       c.applied = c.lower;
-    } else if (sum > c.upper) {
+    } else if (kUpperLimit && sum > c.upper) {
       deltaImpulse = c.upper - c.applied;
       c.applied = c.upper;
     } else {
       c.applied = sum;
     }
-    delta_linear_ += c.linear * deltaImpulse * linear_factor_;
-    delta_angular_ += c.angular * (deltaImpulse * angular_factor_);
+    apply(delta_linear_, delta_angular_, c, deltaImpulse);
     return deltaImpulse * (1. / c.jac_diag_inv);
   }
 
-  // gResolveSingleConstraintRowLowerLimit_scalar_reference.
-  btScalar lower_limit(Row& c) {
-    btScalar deltaImpulse = c.rhs - btScalar(c.applied) * c.cfm;
-    deltaImpulse = less_velocity(
-        deltaImpulse, c, c.normal.dot(delta_linear_) + c.torque_axis.dot(delta_angular_));
-    const btScalar sum = btScalar(c.applied) + deltaImpulse;
-    if (sum < c.lower) {
-      deltaImpulse = c.lower - c.applied;
-      c.applied = c.lower;
-    } else {
-      c.applied = sum;
-    }
-    delta_linear_ += c.linear * deltaImpulse * linear_factor_;
-    delta_angular_ += c.angular * (deltaImpulse * angular_factor_);
-    return deltaImpulse * (1. / c.jac_diag_inv);
+  // btSolverBody::internalApplyImpulse (internalApplyPushImpulse) on the die.
+  void apply(btVector3& linear, btVector3& angular, const Row& c, btScalar impulse) const {
+    linear += c.linear * impulse * linear_factor_;
+    angular += c.angular * (impulse * angular_factor_);
   }
 
   // gResolveSplitPenetrationImpulse_scalar_reference (less its global statistics counter,
@@ -554,8 +545,7 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
       } else {
         c.applied_push = sum;
       }
-      push_ += c.linear * deltaImpulse * linear_factor_;
-      turn_ += c.angular * (deltaImpulse * angular_factor_);
+      apply(push_, turn_, c, deltaImpulse);
     }
     return deltaImpulse * (1. / c.jac_diag_inv);
   }

@@ -231,60 +231,22 @@ fn the_shims_shortcuts_leave_every_state_as_bullets_own_world_has_it() {
     use dicephys::model::throws::ThrowStyle;
     let mut asleep = 0;
     let (d281, b3) = (Preset::Dicephys281, Preset::Bullet3);
+    let (three, two, plane) = (Mode::ThreeD, Mode::TwoD, Floor::Plane);
+    let (paper, rest, ms) = (ThrowStyle::Paper, ThrowStyle::Rest, 0.001);
+    let box_ = Floor::Box;
+    let coarse = 1.0 / 60.0;
     let cases = [
-        (
-            Mode::ThreeD,
-            Floor::Box,
-            0.001,
-            ThrowStyle::Paper,
-            d281,
-            0.0,
-        ),
-        (Mode::TwoD, Floor::Box, 0.001, ThrowStyle::Paper, d281, 0.0),
-        (
-            Mode::ThreeD,
-            Floor::Box,
-            0.001,
-            ThrowStyle::Tumble,
-            d281,
-            0.0,
-        ),
-        (Mode::ThreeD, Floor::Box, 0.001, ThrowStyle::Rest, d281, 0.0),
-        (Mode::TwoD, Floor::Box, 0.001, ThrowStyle::Rest, d281, 0.0),
-        (
-            Mode::ThreeD,
-            Floor::Plane,
-            0.001,
-            ThrowStyle::Paper,
-            d281,
-            0.0,
-        ),
-        (
-            Mode::ThreeD,
-            Floor::Box,
-            1.0 / 60.0,
-            ThrowStyle::Paper,
-            d281,
-            0.0,
-        ),
-        (
-            Mode::TwoD,
-            Floor::Box,
-            1.0 / 60.0,
-            ThrowStyle::Paper,
-            d281,
-            0.0,
-        ),
-        (Mode::ThreeD, Floor::Box, 0.001, ThrowStyle::Paper, b3, 0.0),
-        (Mode::TwoD, Floor::Box, 0.001, ThrowStyle::Paper, b3, 0.0),
-        (
-            Mode::ThreeD,
-            Floor::Box,
-            0.001,
-            ThrowStyle::Paper,
-            d281,
-            2.0,
-        ),
+        (three, box_, ms, paper, d281, 0.0),
+        (two, box_, ms, paper, d281, 0.0),
+        (three, box_, ms, ThrowStyle::Tumble, d281, 0.0),
+        (three, box_, ms, rest, d281, 0.0),
+        (two, box_, ms, rest, d281, 0.0),
+        (three, plane, ms, paper, d281, 0.0),
+        (three, box_, coarse, paper, d281, 0.0),
+        (two, box_, coarse, paper, d281, 0.0),
+        (three, box_, ms, paper, b3, 0.0),
+        (two, box_, ms, paper, b3, 0.0),
+        (three, box_, ms, paper, d281, 2.0),
     ];
     for (mode, floor, dt, style, preset, damping) in cases {
         let mut scene = Scene::paper(block(), mode);
