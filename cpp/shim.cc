@@ -333,7 +333,8 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
     const btScalar penetration = cp.getDistance() + info.m_linearSlop;
     {
       const btVector3 die_vel = die->getVelocityInLocalPoint(rel_pos);
-      const btVector3 vel = die_is_a ? die_vel - btVector3(0, 0, 0) : btVector3(0, 0, 0) - die_vel;
+      const btVector3 zero(0, 0, 0);  // the fixed body's velocity
+      const btVector3 vel = die_is_a ? die_vel - zero : zero - die_vel;
       const btScalar rel_vel = n.dot(vel);
       r.friction = cp.m_combinedFriction;
       restitution = restitutionCurve(rel_vel, cp.m_combinedRestitution,
@@ -399,7 +400,6 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
     r.angular = die->getInvInertiaTensorWorld() * r.torque_axis * die->getAngularFactor();
     const btSolverBody& body = m_tmpSolverBodyPool[kDie];
     r.linear = r.normal * body.internalGetInvMass();
-    btScalar dieDotn;
     if (die_is_a) {
       const btScalar denom0 = die->getInvMass() + normalAxis.dot(r.angular.cross(rel_pos));
       r.jac_diag_inv = relaxation / (denom0 + btScalar(0.f));
@@ -407,8 +407,8 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
       const btScalar denom1 = die->getInvMass() + normalAxis.dot((-r.angular).cross(rel_pos));
       r.jac_diag_inv = relaxation / (btScalar(0.f) + denom1);
     }
-    dieDotn = r.normal.dot(body.m_linearVelocity + body.m_externalForceImpulse) +
-              r.torque_axis.dot(body.m_angularVelocity);
+    const btScalar dieDotn = r.normal.dot(body.m_linearVelocity + body.m_externalForceImpulse) +
+                             r.torque_axis.dot(body.m_angularVelocity);
     const btScalar rel_vel = die_is_a ? dieDotn + btScalar(0) : btScalar(0) + dieDotn;
     const btScalar velocityError = btScalar(0.) - rel_vel;
     const btScalar velocityImpulse = velocityError * r.jac_diag_inv;
