@@ -1,6 +1,6 @@
 //! The command line as a user meets it: the built binary, its exit codes, its outputs.
 
-use super::helpers::{dicephys, json};
+use super::helpers::{dicephys, json, Scratch};
 
 #[test]
 fn bad_input_gets_one_line_and_exit_code_2() {
@@ -128,7 +128,7 @@ fn trace_prints_a_trajectory() {
 
 #[test]
 fn a_tiny_paper_run_is_complete_and_repeatable() {
-    let dir = std::env::temp_dir().join(format!("dicephys-paper-{}", std::process::id()));
+    let dir = Scratch::absent("paper");
     let d = dir.to_str().unwrap();
     let run = || {
         let out = dicephys(&["paper", "--rolls", "40", "--seed", "3", "--out", d]);
@@ -179,5 +179,4 @@ fn a_tiny_paper_run_is_complete_and_repeatable() {
         assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "{fig}.png");
     }
     assert!(dir.join("results.csv").exists());
-    let _ = std::fs::remove_dir_all(&dir);
 }

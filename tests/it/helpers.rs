@@ -1,5 +1,6 @@
 //! What the integration tests share.
 
+use std::path::Path;
 use std::process::Command;
 
 /// The `dicephys` binary cargo built for these tests.
@@ -20,4 +21,62 @@ pub fn json(out: &std::process::Output) -> serde_json::Value {
         String::from_utf8_lossy(&out.stderr)
     );
     serde_json::from_slice(&out.stdout).expect("one JSON document")
+}
+
+/// A test's scratch directory: unique, under the system's temporary directory, and removed
+/// when the test passes. A failing test keeps it, and says where, for a look at what the run
+/// left there.
+pub struct Scratch(Option<tempfile::TempDir>);
+
+impl Scratch {
+    /// A new, empty directory named after `name`.
+    pub fn new(name: &str) -> Scratch {
+        let dir = tempfile::Builder::new()
+            .prefix(&format!("dicephys-{name}-"))
+            .tempdir()
+            .expect("a scratch directory");
+        Scratch(Some(dir))
+    }
+
+    /// A path for `dicephys` to create (its name held, nothing there yet): an output or
+    /// checkpoint directory whose creation is part of the test.
+    pub fn absent(name: &str) -> Scratch {
+        let s = Scratch::new(name);
+        std::fs::remove_dir(s.path()).expect("the scratch directory, empty");
+        s
+    }
+
+    /// The directory's path.
+    pub fn path(&self) -> &Path {
+        self.0.as_ref().expect("scratch directory").path()
+    }
+}
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        self.path()
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        self.path()
+    }
+}
+
+impl AsRef<std::ffi::OsStr> for Scratch {
+    fn as_ref(&self) -> &std::ffi::OsStr {
+        self.path().as_os_str()
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            if let Some(dir) = self.0.take() {
+                eprintln!("kept the failing test's scratch: {}", dir.keep().display());
+            }
+        }
+    }
 }

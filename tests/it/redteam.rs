@@ -1,16 +1,13 @@
 //! The red team: what a hostile user tried against dicephys (issue "Reliability, round 2"),
 //! each probe at a small size, run on every CI run. Every probe here failed once.
 
-use super::helpers::bin;
+use super::helpers::{bin, Scratch};
 use std::path::{Path, PathBuf};
 use std::process::{Output, Stdio};
 use std::time::Duration;
 
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("dicephys-red-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn scratch(name: &str) -> Scratch {
+    Scratch::new(&format!("red-{name}"))
 }
 
 fn stderr(o: &Output) -> String {

@@ -10,12 +10,10 @@ use nalgebra::{UnitQuaternion, Vector3};
 use std::process::Stdio;
 use std::time::Duration;
 
-use super::helpers::bin;
+use super::helpers::{bin, Scratch};
 
-fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("dicephys-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+fn tmp(name: &str) -> Scratch {
+    Scratch::absent(name)
 }
 
 const RUN: [&str; 8] = [

@@ -2,9 +2,9 @@
 //! `scripts/slurm-local.sh start` (`.ci/run` starts it). Without `sbatch`, or with no cluster
 //! answering, each test says why on stderr and passes without running.
 
-use super::helpers::bin;
 use super::helpers::json;
-use std::path::{Path, PathBuf};
+use super::helpers::{bin, Scratch};
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
@@ -59,10 +59,8 @@ fn cluster(test: &str) -> Option<std::sync::MutexGuard<'static, ()>> {
     }
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("dicephys-slurm-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+fn tmp(name: &str) -> Scratch {
+    Scratch::absent(&format!("slurm-{name}"))
 }
 
 /// `dicephys slurm COMMAND RUN --tasks N --dir D --submit`: the array's and the finisher's ids.

@@ -1,6 +1,7 @@
 //! The sweeps at tiny size (their JSON and figures), and the failure detectors on failures
 //! made on purpose.
 
+use super::helpers::Scratch;
 use dicephys::engine::{new_engine, EngineKind};
 use dicephys::model::scene::{Floor, Mode, Scene};
 use dicephys::model::state::BodyState;
@@ -22,10 +23,8 @@ fn dicephys(args: &[&str]) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).expect("one JSON document")
 }
 
-fn out_dir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("dicephys-sweeps-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+fn out_dir(name: &str) -> Scratch {
+    Scratch::absent(&format!("sweeps-{name}"))
 }
 
 fn has_keys(v: &serde_json::Value, keys: &[&str]) {

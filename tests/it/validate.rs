@@ -5,7 +5,7 @@
 //! command's own verdict is 3; the seeds are fixed, so these are exact regressions, and 4
 //! leaves room for an engine upgrade's rounding to move a few dice).
 
-use super::helpers::{dicephys, json};
+use super::helpers::{dicephys, json, Scratch};
 use dicephys::engine::{new_engine, EngineKind};
 use dicephys::model::block::{Block, Outcome};
 use dicephys::model::scene::{Mode, Scene};
@@ -199,10 +199,8 @@ fn damping_slows_both_engines_by_the_same_rate_in_flight() {
     }
 }
 
-fn out_dir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("dicephys-validate-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+fn out_dir(name: &str) -> Scratch {
+    Scratch::absent(&format!("validate-{name}"))
 }
 
 #[test]
