@@ -102,7 +102,8 @@ pub struct Row {
     pub cpu_s_per_1000: f64,
     /// Simulated steps per roll.
     pub steps_per_roll: f64,
-    /// Relative departure from the reference, ratio/reference − 1 (a fraction).
+    /// Relative departure from the reference, ratio/reference − 1 (a fraction), with the
+    /// shared throws as a control variate (`studies::sweep::paired_departure`).
     pub error: f64,
     /// Its standard error, paired on the shared throws.
     pub error_err: f64,
