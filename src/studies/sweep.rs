@@ -302,11 +302,11 @@ impl Stream {
 /// throws are used through a control variate: with the method at n throws and the reference
 /// at N > n, ln q = ln r_m(n) − ln r_ref(N) − β (ln r_ref(n) − ln r_ref(N)), with β the
 /// regression of the method's per-throw influence on the reference's over the shared throws,
-/// cov/V_r there: the least-variance weight (the bracket has mean 0 whatever β). β = 0 is the plain comparison
-/// of each stream's whole ratio; β = 1 compares the shared throws alone. Two methods that end
-/// alike throw for throw (β ≈ 1) then differ by what their shared throws say, not by how far
-/// the reference's first n throws happen to sit from its N (the plain comparison measured
-/// mostly that). Symmetrically when the method has rolled further.
+/// cov/V_r there: the least-variance weight (the bracket has mean 0 whatever β). β = 0 is
+/// the plain comparison of each stream's whole ratio; β = 1 compares the shared throws alone.
+/// Two methods that end alike throw for throw (β ≈ 1) then differ by what their shared
+/// throws say, not by how far the reference's first n throws happen to sit from its N (the
+/// plain comparison measured mostly that). Symmetrically when the method has rolled further.
 #[derive(Clone, Copy, Debug, serde::Serialize)]
 pub struct Departure {
     /// r_m/r_ref − 1.
@@ -657,8 +657,8 @@ mod tests {
     fn stream(outcomes: Vec<u8>) -> Stream {
         let scene = Scene::paper(Block::from_mm(140.0, 24.0, 20.0).unwrap(), Mode::ThreeD);
         let mut s = Stream::new(EngineKind::Bullet, scene, RollConfig::default(), 1);
-        s.tally.counts.breadth = outcomes.iter().filter(|&&x| x == 1).count() as u64;
-        s.tally.counts.width = outcomes.iter().filter(|&&x| x == 2).count() as u64;
+        let (b, w) = breadth_width(&outcomes);
+        (s.tally.counts.breadth, s.tally.counts.width) = (b as u64, w as u64);
         s.tally.rolls = outcomes.len() as u64;
         s.outcomes = outcomes;
         s
