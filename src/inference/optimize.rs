@@ -14,6 +14,8 @@ pub struct Minimum {
     pub f: f64,
     /// Function evaluations spent.
     pub evals: usize,
+    /// The simplex closed to the tolerance (rather than running out of evaluations).
+    pub converged: bool,
 }
 
 fn clamp(x: &mut [f64]) {
@@ -33,6 +35,7 @@ pub fn minimize(f: &dyn Fn(&[f64]) -> f64, x0: &[f64], step: f64, tol: f64) -> M
             best = Minimum { evals, ..again };
         } else {
             best.evals = evals;
+            best.converged |= again.converged;
         }
         if gain < tol {
             break;
@@ -54,6 +57,7 @@ fn nelder_mead(
             x: vec![],
             f: f(&[]),
             evals: 1,
+            converged: true,
         };
     }
     let evals = std::cell::Cell::new(0usize);
@@ -82,10 +86,15 @@ fn nelder_mead(
         let v = eval(&x);
         simplex.push((x, v));
     }
+    let mut converged = false;
     loop {
         simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
         let spread = simplex[n].1 - simplex[0].1;
-        if spread.abs() < tol || evals.get() >= max_evals {
+        if spread.abs() < tol {
+            converged = true;
+            break;
+        }
+        if evals.get() >= max_evals {
             break;
         }
         let centroid: Vec<f64> = (0..n)
@@ -135,6 +144,7 @@ fn nelder_mead(
         x,
         f: fx,
         evals: evals.get(),
+        converged,
     }
 }
 
@@ -161,8 +171,7 @@ pub fn minimize_with(
     let m = minimize(&g, &others, 0.1, tol);
     Minimum {
         x: full(&m.x),
-        f: m.f,
-        evals: m.evals,
+        ..m
     }
 }
 

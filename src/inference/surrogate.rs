@@ -96,6 +96,8 @@ pub struct Surrogate {
     pub outcomes: usize,
     /// The polynomials' total degree.
     pub degree: usize,
+    /// The exponents of each feature's Legendre polynomials ([`exponents`]).
+    pub exps: Vec<Vec<usize>>,
     /// The coefficients, (outcomes − 1) × features, row-major.
     pub beta: Vec<f64>,
     /// Their covariance, widened by the dispersion when it is above 1, row-major, square of
@@ -119,13 +121,9 @@ pub struct Prediction {
 }
 
 impl Surrogate {
-    fn exps(&self) -> Vec<Vec<usize>> {
-        exponents(self.dims, self.degree)
-    }
-
     /// The number of features.
     pub fn features(&self) -> usize {
-        self.exps().len()
+        self.exps.len()
     }
 
     /// Fits the surrogate of total degree `degree` to `design` (every point's counts over the
@@ -241,6 +239,7 @@ impl Surrogate {
             dims,
             outcomes,
             degree,
+            exps,
             beta: beta.iter().copied().collect(),
             cov: (cov * dispersion).iter().copied().collect(),
             deviance,
@@ -286,19 +285,17 @@ impl Surrogate {
 
     /// The probabilities at `x` (unit coordinates).
     pub fn p(&self, x: &[f64]) -> Vec<f64> {
-        let exps = self.exps();
-        let phi = features(x, &exps, self.degree);
+        let phi = features(x, &self.exps, self.degree);
         let beta = DVector::from_column_slice(&self.beta);
-        Self::probs(&beta, &phi, self.outcomes - 1, exps.len())
+        Self::probs(&beta, &phi, self.outcomes - 1, self.exps.len())
     }
 
     /// The probabilities at `x` with their covariance, by the delta method:
     /// ∂p_k/∂β_a = p_k (δ_ka − p_a) φ.
     pub fn predict(&self, x: &[f64]) -> Prediction {
-        let exps = self.exps();
-        let m = exps.len();
+        let m = self.exps.len();
         let k1 = self.outcomes - 1;
-        let phi = features(x, &exps, self.degree);
+        let phi = features(x, &self.exps, self.degree);
         let beta = DVector::from_column_slice(&self.beta);
         let p = Self::probs(&beta, &phi, k1, m);
         let size = k1 * m;

@@ -3,6 +3,7 @@
 
 pub mod bench;
 pub mod converge;
+pub mod fit;
 pub mod paper;
 pub mod stability;
 pub mod sweep;

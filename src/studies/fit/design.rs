@@ -1,0 +1,278 @@
+//! The simulations a fit stands on: for each block (and mode) among the rows, the simulator
+//! run at many parameter points spread over the free parameters' box, and a surrogate
+//! ([`crate::inference::surrogate`]) fitted through them.
+//!
+//! The points are the box's 2^d corners, its centre, then a Halton sequence (bases 2, 3, 5, 7):
+//! fixed in advance, so a run can be split over a cluster, resumed, or checked against another.
+//! Each point rolls its own keyed throws (its seed is a hash of the run's seed, the block and
+//! the point's number), so the points' counts are independent and the surrogate's covariance
+//! is its simulation noise. Common throws across the points (one stream for all) were
+//! measured against this: see [`crate::studies::fit`]'s documentation for why they were not
+//! kept.
+//!
+//! Rows with the same block and mode share one design: their surfaces differ only in which
+//! coordinates the likelihood reads the surrogate at.
+
+use crate::error::{Error, Result};
+use crate::inference::surrogate::{DesignPoint, Surrogate};
+use crate::model::block::Block;
+use crate::model::scene::Mode;
+use crate::run::runner::Runner;
+use crate::studies::fit::data::DataRow;
+use crate::studies::fit::model::{Method, ModelSpec};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// How densely each block is simulated.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DesignSpec {
+    /// Parameter points per block (at least the corners and the centre).
+    pub points: usize,
+    /// Rolls at each point.
+    pub rolls: u64,
+    /// The surrogate's polynomial degree (raised, up to `max_degree`, while it lacks fit).
+    pub degree: usize,
+    /// The highest degree tried.
+    pub max_degree: usize,
+}
+
+impl Default for DesignSpec {
+    fn default() -> Self {
+        DesignSpec {
+            points: 64,
+            rolls: 1000,
+            degree: 3,
+            max_degree: 4,
+        }
+    }
+}
+
+impl DesignSpec {
+    /// Checks the sizes.
+    pub fn validate(&self, dims: usize) -> Result<()> {
+        let bad = |m: String| Err(Error::Invalid(m));
+        let corners = 1usize << dims.min(20);
+        if self.points < corners + 1 {
+            return bad(format!(
+                "points {}: a design over {dims} parameters needs at least {} (its corners and centre)",
+                self.points,
+                corners + 1
+            ));
+        }
+        if self.points > 100_000 {
+            return bad(format!("points {}: at most 100000", self.points));
+        }
+        if self.rolls == 0 || self.rolls > crate::run::spec::MAX_ROLLS {
+            return bad(format!("rolls {}: 1 to {}", self.rolls, crate::run::spec::MAX_ROLLS));
+        }
+        if !(1..=6).contains(&self.degree) || self.max_degree < self.degree || self.max_degree > 6
+        {
+            return bad(format!(
+                "degree {}..{}: from 1 to 6, the highest not below the first",
+                self.degree, self.max_degree
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The radical inverse of `i` in `base`: the Halton sequence's coordinate.
+fn halton(mut i: usize, base: usize) -> f64 {
+    let (mut f, mut r) = (1.0, 0.0);
+    while i > 0 {
+        f /= base as f64;
+        r += f * (i % base) as f64;
+        i /= base;
+    }
+    r
+}
+
+/// The design's `n` points in [0, 1]^dims: the corners, the centre, then Halton points.
+pub fn points(dims: usize, n: usize) -> Vec<Vec<f64>> {
+    const BASES: [usize; 6] = [2, 3, 5, 7, 11, 13];
+    if dims == 0 {
+        return vec![vec![]];
+    }
+    let mut out: Vec<Vec<f64>> = (0..1usize << dims)
+        .map(|c| (0..dims).map(|j| ((c >> j) & 1) as f64).collect())
+        .collect();
+    out.push(vec![0.5; dims]);
+    let mut i = 1;
+    while out.len() < n.max(out.len()) {
+        out.push((0..dims).map(|j| halton(i, BASES[j])).collect());
+        i += 1;
+    }
+    out.truncate(n.max(1 + (1 << dims)));
+    out
+}
+
+/// A block simulated over the design.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Design {
+    /// The block.
+    pub block: Block,
+    /// 2D or 3D.
+    pub mode: Mode,
+    /// Each point and its counts of length, breadth and width vertical.
+    pub points: Vec<DesignPoint>,
+    /// Rolls that did not settle on a face (unknown, unconverged or failed), over all points.
+    pub unsettled: u64,
+    /// Rolls made.
+    pub rolls: u64,
+    /// The surrogate through the points.
+    pub surrogate: Surrogate,
+}
+
+impl Design {
+    /// "140x24x20 3d".
+    pub fn name(&self) -> String {
+        format!("{} {}", self.block, self.mode.name())
+    }
+}
+
+/// The distinct (block, mode) pairs of `rows`, in first-seen order.
+pub fn keys(rows: &[DataRow]) -> Vec<(Block, Mode)> {
+    let mut out: Vec<(Block, Mode)> = Vec::new();
+    for r in rows {
+        if !out.contains(&(r.block, r.mode)) {
+            out.push((r.block, r.mode));
+        }
+    }
+    out
+}
+
+/// The seed of one point's throws: FNV-1a of the run's seed, the block, the mode and the point.
+pub fn point_seed(seed: u64, block: Block, mode: Mode, point: usize) -> u64 {
+    let text = format!("{seed}/{block}/{}/{point}", mode.name());
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in text.bytes() {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+/// Everything `simulate` needs.
+pub struct Plan<'a> {
+    /// The model (which parameters are free, their ranges).
+    pub model: &'a ModelSpec,
+    /// How each throw is simulated.
+    pub method: &'a Method,
+    /// How densely.
+    pub design: &'a DesignSpec,
+    /// The run's seed.
+    pub seed: u64,
+}
+
+impl Plan<'_> {
+    /// The rolls `simulate` makes for `keys`.
+    pub fn total_rolls(&self, keys: usize) -> u64 {
+        let dims = self.model.free.len();
+        keys as u64 * points(dims, self.design.points).len() as u64 * self.design.rolls
+    }
+}
+
+/// Simulates every key over the design (each point a cell of its own under `dir`, resumed
+/// from there) and fits its surrogate. `None` if a stop request ended it early: what was rolled
+/// is kept in `dir`.
+pub fn simulate(
+    plan: &Plan,
+    keys: &[(Block, Mode)],
+    runner: &Runner,
+    dir: Option<&Path>,
+) -> Result<Option<Vec<Design>>> {
+    let dims = plan.model.free.len();
+    let xs = points(dims, plan.design.points);
+    let mut done_before = 0u64;
+    let mut out = Vec::new();
+    for &(block, mode) in keys {
+        let mut design_points = Vec::new();
+        let (mut unsettled, mut rolls) = (0u64, 0u64);
+        for (g, x) in xs.iter().enumerate() {
+            let values = plan.model.values(x);
+            let seed = point_seed(plan.seed, block, mode, g);
+            let spec = plan.method.spec(block, mode, &values, seed, plan.design.rolls);
+            spec.validate(false)?;
+            let ck = match dir {
+                Some(d) => Some(runner.open_cell(
+                    &d.join(format!("{block}-{}", mode.name()))
+                        .join(format!("point-{g:05}")),
+                    &spec,
+                )?),
+                None => None,
+            };
+            let base = done_before;
+            let progress = |n| (runner.progress)(base + n);
+            let done = runner
+                .with_progress(&progress)
+                .run(&spec, ck.as_ref(), &mut |_| Ok(()))?;
+            done_before += plan.design.rolls;
+            if !done.complete {
+                return Ok(None);
+            }
+            let t = &done.tally;
+            unsettled += t.rolls - (t.counts.length + t.counts.breadth + t.counts.width);
+            rolls += t.rolls;
+            design_points.push(DesignPoint {
+                x: x.clone(),
+                counts: vec![t.counts.length, t.counts.breadth, t.counts.width],
+            });
+        }
+        // A 2D block has no length outcome: its surrogate is over breadth and width.
+        let (outcomes, pts): (usize, Vec<DesignPoint>) = match mode {
+            Mode::ThreeD => (3, design_points.clone()),
+            Mode::TwoD => (
+                2,
+                design_points
+                    .iter()
+                    .map(|p| DesignPoint {
+                        x: p.x.clone(),
+                        counts: p.counts[1..].to_vec(),
+                    })
+                    .collect(),
+            ),
+        };
+        let surrogate = Surrogate::fit_best(
+            &pts,
+            dims,
+            outcomes,
+            plan.design.degree,
+            plan.design.max_degree,
+        );
+        out.push(Design {
+            block,
+            mode,
+            points: design_points,
+            unsettled,
+            rolls,
+            surrogate,
+        });
+    }
+    Ok(Some(out))
+}
+
+/// The surrogate's probabilities over [length, breadth, width] (a 2D design: length 0).
+pub fn three(p: &[f64], mode: Mode) -> Vec<f64> {
+    match mode {
+        Mode::ThreeD => p.to_vec(),
+        Mode::TwoD => vec![0.0, p[0], p[1]],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_design_starts_at_the_corners_and_fills_the_box() {
+        let p = points(2, 20);
+        assert_eq!(p.len(), 20);
+        assert_eq!(&p[..5], &[vec![0.0, 0.0], vec![1.0, 0.0], vec![0.0, 1.0], vec![1.0, 1.0], vec![0.5, 0.5]]);
+        assert_eq!(p[5], vec![0.5, 1.0 / 3.0]);
+        assert!(p.iter().all(|x| x.iter().all(|v| (0.0..=1.0).contains(v))));
+        assert_eq!(points(0, 10), vec![Vec::<f64>::new()]);
+        let b: Block = "140x24x20".parse().unwrap();
+        assert_ne!(point_seed(1, b, Mode::ThreeD, 0), point_seed(1, b, Mode::ThreeD, 1));
+        assert_ne!(point_seed(1, b, Mode::ThreeD, 0), point_seed(1, b, Mode::TwoD, 0));
+    }
+}

@@ -1,0 +1,366 @@
+//! From surrogates and measured counts to parameters: the likelihood of every row, its
+//! maximum, profile-likelihood intervals, the joint region, the goodness of fit, and draws from
+//! the posterior for predictions.
+
+use crate::error::{Error, Result};
+use crate::inference::likelihood::{concentration, ln_dirichlet_multinomial, merge, pearson};
+use crate::inference::optimize::{interval, minimize, profile, Interval, Minimum};
+use crate::inference::posterior;
+use crate::model::scene::Mode;
+use crate::studies::fit::data::DataRow;
+use crate::studies::fit::design::Design;
+use crate::studies::fit::model::{ModelSpec, Param};
+use crate::theory::stats;
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+/// The confidence of the "2σ" region: the normal's two-sided 2σ coverage, 95.45 %.
+pub const TWO_SIGMA: f64 = 0.954_499_736_103_642;
+
+/// Δ(−2 ln L) bounding the joint `coverage` region of `dims` parameters (Wilks: χ²_dims).
+pub fn region_delta(dims: usize, coverage: f64) -> f64 {
+    use statrs::distribution::{ChiSquared, ContinuousCDF};
+    if dims == 0 {
+        return 0.0;
+    }
+    ChiSquared::new(dims as f64)
+        .map(|d| d.inverse_cdf(coverage))
+        .unwrap_or(f64::NAN)
+}
+
+/// The likelihood of a set of rows given the designs' surrogates.
+pub struct Likelihood<'a> {
+    rows: &'a [DataRow],
+    designs: &'a [Design],
+    row_design: Vec<usize>,
+    row_dims: Vec<Vec<usize>>,
+    /// Rows counted (a leave-one-out fit leaves one out).
+    pub include: Vec<bool>,
+}
+
+/// One row's probabilities at a point, over its outcome groups, with the simulation's noise.
+#[derive(Clone, Debug)]
+pub struct RowPrediction {
+    /// The groups' probabilities.
+    pub p: Vec<f64>,
+    /// Their covariance from the surrogate.
+    pub cov: DMatrix<f64>,
+    /// The Dirichlet concentration matching it.
+    pub c: f64,
+}
+
+impl<'a> Likelihood<'a> {
+    /// The likelihood of `rows` (each simulated by the design of its block and mode) under
+    /// `model`, whose free parameters are `params`.
+    pub fn new(
+        rows: &'a [DataRow],
+        designs: &'a [Design],
+        model: &ModelSpec,
+        params: &[Param],
+    ) -> Likelihood<'a> {
+        let row_design = rows
+            .iter()
+            .map(|r| {
+                designs
+                    .iter()
+                    .position(|d| d.block == r.block && d.mode == r.mode)
+                    .expect("a design for every row")
+            })
+            .collect();
+        Likelihood {
+            rows,
+            designs,
+            row_design,
+            row_dims: rows.iter().map(|r| model.row_dims(params, r)).collect(),
+            include: vec![true; rows.len()],
+        }
+    }
+
+    /// Row `r`'s outcome groups' names.
+    pub fn group_names(&self, r: usize) -> Vec<String> {
+        self.rows[r].group_names()
+    }
+
+    /// Row `r`'s coordinates in its design at the parameters `x`.
+    pub fn local(&self, r: usize, x: &[f64]) -> Vec<f64> {
+        self.row_dims[r].iter().map(|&d| x[d]).collect()
+    }
+
+    /// Row `r`'s probabilities at the parameters `x`.
+    pub fn predict(&self, r: usize, x: &[f64]) -> RowPrediction {
+        let design = &self.designs[self.row_design[r]];
+        let pr = design.surrogate.predict(&self.local(r, x));
+        // Groups index [length, breadth, width]; a 2D surrogate has only breadth and width.
+        let shift = usize::from(design.mode == Mode::TwoD);
+        let groups: Vec<Vec<usize>> = self.rows[r]
+            .groups
+            .iter()
+            .map(|g| g.iter().map(|k| k - shift).collect())
+            .collect();
+        let (p, cov) = merge(&pr.p, &pr.cov, &groups);
+        let c = concentration(&p, &cov);
+        RowPrediction { p, cov, c }
+    }
+
+    /// −2 ln L at `x` (unit coordinates), up to a constant.
+    pub fn minus_two_ln_l(&self, x: &[f64]) -> f64 {
+        let mut ll = 0.0;
+        for r in 0..self.rows.len() {
+            if !self.include[r] {
+                continue;
+            }
+            let pr = self.predict(r, x);
+            ll += ln_dirichlet_multinomial(&self.rows[r].grouped(), &pr.p, pr.c);
+        }
+        -2.0 * ll
+    }
+}
+
+/// Where a parameter's 2σ profile interval ends.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Identified {
+    /// Bounded on both sides inside its range.
+    Yes,
+    /// Bounded above only: its region runs to the lower end of the range.
+    UpperBoundOnly,
+    /// Bounded below only: its region runs to the upper end of the range.
+    LowerBoundOnly,
+    /// Its 2σ region spans the whole range: the data do not fix it.
+    No,
+}
+
+impl Identified {
+    fn of(i: &Interval) -> Identified {
+        match (i.lo_open, i.hi_open) {
+            (false, false) => Identified::Yes,
+            (true, false) => Identified::UpperBoundOnly,
+            (false, true) => Identified::LowerBoundOnly,
+            (true, true) => Identified::No,
+        }
+    }
+
+    /// A sentence for the report.
+    pub fn says(self) -> &'static str {
+        match self {
+            Identified::Yes => "identified",
+            Identified::UpperBoundOnly => "bounded above only (its 2σ region reaches the range's lower end)",
+            Identified::LowerBoundOnly => "bounded below only (its 2σ region reaches the range's upper end)",
+            Identified::No => "not identifiable: its 2σ region spans the whole range",
+        }
+    }
+}
+
+/// A fitted parameter.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ParamFit {
+    /// Which.
+    pub param: Param,
+    /// "e[MDF]".
+    pub name: String,
+    /// The maximum-likelihood value.
+    pub value: f64,
+    /// The 1σ profile interval (Δ(−2 ln L) = 1), [lo, hi].
+    pub one_sigma: [f64; 2],
+    /// The 2σ profile interval (Δ = 4).
+    pub two_sigma: [f64; 2],
+    /// Whether the data bound it.
+    pub identified: Identified,
+    /// The profile: value and Δ(−2 ln L) at each grid point.
+    pub profile: Vec<[f64; 2]>,
+}
+
+/// A row's fit.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RowFit {
+    /// The row's label.
+    pub label: String,
+    /// Its surface.
+    pub surface: String,
+    /// The groups' names.
+    pub outcomes: Vec<String>,
+    /// Measured counts per group.
+    pub counts: Vec<u64>,
+    /// Fitted probabilities per group.
+    pub p: Vec<f64>,
+    /// Their errors from the simulation's noise alone.
+    pub p_err: Vec<f64>,
+    /// (count − N p)/σ per group, σ the Dirichlet-multinomial's.
+    pub z: Vec<f64>,
+    /// The row's Pearson χ².
+    pub chi2: f64,
+}
+
+/// The fit's result.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Estimate {
+    /// The maximum, in unit coordinates.
+    pub x: Vec<f64>,
+    /// −2 ln L there (up to a constant).
+    pub minus_two_ln_l: f64,
+    /// Each parameter.
+    pub params: Vec<ParamFit>,
+    /// Each row counted.
+    pub rows: Vec<RowFit>,
+    /// Pearson's χ² over the rows.
+    pub chi2: f64,
+    /// Its degrees of freedom: independent counts less free parameters.
+    pub dof: i64,
+    /// P(χ²_dof ≥ χ²).
+    pub p_value: f64,
+    /// Δ(−2 ln L) bounding the joint 2σ region (χ² quantile at 95.45 % for as many
+    /// parameters).
+    pub region_delta: f64,
+    /// Local maxima the search met besides the best, with their −2 ln L (a second maximum
+    /// within the region makes the region two islands).
+    pub other_maxima: Vec<f64>,
+    /// Posterior draws (flat prior on the box), unit coordinates.
+    pub draws: Vec<Vec<f64>>,
+}
+
+/// Settings of the search.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct Search {
+    /// Starting points of the maximum's search.
+    pub starts: usize,
+    /// Grid points of each profile.
+    pub profile_points: usize,
+    /// Posterior draws kept.
+    pub draws: usize,
+    /// Seed of the posterior's chain.
+    pub seed: u64,
+}
+
+impl Default for Search {
+    fn default() -> Self {
+        Search {
+            starts: 8,
+            profile_points: 21,
+            draws: 1000,
+            seed: 1,
+        }
+    }
+}
+
+/// The maximum of `lik` over the unit box, from `starts` starting points (the centre and a
+/// Halton sequence).
+pub fn maximise(lik: &Likelihood, dims: usize, starts: usize) -> Result<(Minimum, Vec<f64>)> {
+    let f = |x: &[f64]| lik.minus_two_ln_l(x);
+    let mut found: Vec<Minimum> = Vec::new();
+    let mut start_points = vec![vec![0.5; dims]];
+    start_points.extend(
+        crate::studies::fit::design::points(dims, starts + (1 << dims.min(10)) + 1)
+            .into_iter()
+            .skip((1 << dims.min(10)) + 1)
+            .take(starts.saturating_sub(1)),
+    );
+    for s in &start_points {
+        found.push(minimize(&f, s, 0.15, 1e-7));
+    }
+    found.sort_by(|a, b| a.f.total_cmp(&b.f));
+    let best = found[0].clone();
+    if !best.f.is_finite() {
+        return Err(Error::Failed(
+            "the fit did not converge: the likelihood is zero everywhere it looked (a measured \
+             outcome the simulations never give?)"
+                .into(),
+        ));
+    }
+    if !best.converged {
+        return Err(Error::Failed(format!(
+            "the fit did not converge: the search ran out of steps at −2 ln L = {:.3}",
+            best.f
+        )));
+    }
+    // Other maxima: distinct ends (in value by more than 0.1, in place by more than 0.05).
+    let mut others: Vec<f64> = Vec::new();
+    for m in &found[1..] {
+        let far = m.x.iter().zip(&best.x).any(|(a, b)| (a - b).abs() > 0.05);
+        if m.converged && far && m.f - best.f > 0.1 && !others.iter().any(|o| (o - m.f).abs() < 0.1) {
+            others.push(m.f);
+        }
+    }
+    Ok((best, others))
+}
+
+/// Fits `rows`: the maximum, the profiles, the goodness of fit and posterior draws.
+pub fn estimate(
+    lik: &Likelihood,
+    model: &ModelSpec,
+    params: &[Param],
+    search: &Search,
+) -> Result<Estimate> {
+    let dims = params.len();
+    let f = |x: &[f64]| lik.minus_two_ln_l(x);
+    let (best, other_maxima) = maximise(lik, dims, search.starts)?;
+    let mut fits = Vec::new();
+    for (j, param) in params.iter().enumerate() {
+        let prof = profile(&f, &best, j, search.profile_points, 1e-6);
+        // A profile point below the maximum means the search missed it: take the lower.
+        let fmin = prof.iter().map(|p| p.1).fold(best.f, f64::min);
+        let one = interval(&prof, fmin, 1.0);
+        let two = interval(&prof, fmin, 4.0);
+        let range = model.range(param.kind);
+        let phys = |u: f64| param.kind.value(range, u);
+        fits.push(ParamFit {
+            param: param.clone(),
+            name: param.name(),
+            value: phys(best.x[j]),
+            one_sigma: [phys(one.lo), phys(one.hi)],
+            two_sigma: [phys(two.lo), phys(two.hi)],
+            identified: Identified::of(&two),
+            profile: prof.iter().map(|(u, v)| [phys(*u), v - fmin]).collect(),
+        });
+    }
+    let rows = row_fits(lik, &best.x);
+    let chi2: f64 = rows.iter().map(|r| r.chi2).sum();
+    let cells: i64 = rows.iter().map(|r| r.counts.len() as i64 - 1).sum();
+    let dof = cells - dims as i64;
+    let draws = posterior::sample(&f, &best.x, search.draws, 2000, 4, search.seed);
+    Ok(Estimate {
+        x: best.x.clone(),
+        minus_two_ln_l: best.f,
+        params: fits,
+        rows,
+        chi2,
+        dof,
+        p_value: if dof > 0 {
+            stats::chi_square_p_value(chi2, dof as usize)
+        } else {
+            f64::NAN
+        },
+        region_delta: region_delta(dims, TWO_SIGMA),
+        other_maxima,
+        draws,
+    })
+}
+
+/// Each counted row's fit at `x`.
+pub fn row_fits(lik: &Likelihood, x: &[f64]) -> Vec<RowFit> {
+    let mut out = Vec::new();
+    for (r, row) in lik.rows.iter().enumerate() {
+        if !lik.include[r] {
+            continue;
+        }
+        let pr = lik.predict(r, x);
+        let counts = row.grouped();
+        let n = counts.iter().sum::<u64>() as f64;
+        let inflate = (n + pr.c) / (1.0 + pr.c);
+        let z = counts
+            .iter()
+            .zip(&pr.p)
+            .map(|(&k, &p)| (k as f64 - n * p) / (n * p * (1.0 - p) * inflate).sqrt())
+            .collect();
+        out.push(RowFit {
+            label: row.label.clone(),
+            surface: row.surface.clone(),
+            outcomes: row.group_names(),
+            counts: counts.clone(),
+            p: pr.p.clone(),
+            p_err: (0..pr.p.len()).map(|k| pr.cov[(k, k)].max(0.0).sqrt()).collect(),
+            z,
+            chi2: pearson(&counts, &pr.p, pr.c),
+        });
+    }
+    out
+}
