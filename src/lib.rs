@@ -19,6 +19,7 @@
 
 #![warn(missing_docs)]
 
+pub mod calibration;
 pub mod engine;
 pub mod error;
 pub mod inference;

@@ -27,7 +27,10 @@ pub const MAX_CONCENTRATION: f64 = 1e12;
 /// covariance is summed over the members' pairs.
 pub fn merge(p: &[f64], cov: &DMatrix<f64>, groups: &[Vec<usize>]) -> (Vec<f64>, DMatrix<f64>) {
     let g = groups.len();
-    let pm: Vec<f64> = groups.iter().map(|m| m.iter().map(|&k| p[k]).sum()).collect();
+    let pm: Vec<f64> = groups
+        .iter()
+        .map(|m| m.iter().map(|&k| p[k]).sum())
+        .collect();
     let mut cm = DMatrix::zeros(g, g);
     for (a, ma) in groups.iter().enumerate() {
         for (b, mb) in groups.iter().enumerate() {
@@ -135,7 +138,8 @@ mod tests {
         // A noisy simulation (small c) flattens the likelihood: a far point loses less.
         let far = [0.2, 0.6, 0.2];
         let sharp = ln_dirichlet_multinomial(&k, &p, 1e9) - ln_dirichlet_multinomial(&k, &far, 1e9);
-        let soft = ln_dirichlet_multinomial(&k, &p, 100.0) - ln_dirichlet_multinomial(&k, &far, 100.0);
+        let soft =
+            ln_dirichlet_multinomial(&k, &p, 100.0) - ln_dirichlet_multinomial(&k, &far, 100.0);
         assert!(soft > 0.0 && soft < sharp, "{soft} {sharp}");
     }
 
@@ -164,7 +168,11 @@ mod tests {
         let v = 0.25 * 0.75 / 101.0;
         let cov = DMatrix::from_row_slice(2, 2, &[v, -v, -v, v]);
         assert!((concentration(&p, &cov) - 100.0).abs() < 1e-9);
-        let (pm, cm) = merge(&[0.1, 0.2, 0.7], &DMatrix::identity(3, 3), &[vec![0, 1], vec![2]]);
+        let (pm, cm) = merge(
+            &[0.1, 0.2, 0.7],
+            &DMatrix::identity(3, 3),
+            &[vec![0, 1], vec![2]],
+        );
         assert!((pm[0] - 0.3).abs() < 1e-15 && cm[(0, 0)] == 2.0 && cm[(0, 1)] == 0.0);
     }
 }

@@ -169,10 +169,7 @@ pub fn minimize_with(
     };
     let g = |y: &[f64]| f(&full(y));
     let m = minimize(&g, &others, 0.1, tol);
-    Minimum {
-        x: full(&m.x),
-        ..m
-    }
+    Minimum { x: full(&m.x), ..m }
 }
 
 /// A profile-likelihood interval of one coordinate, in unit coordinates: where the profile of
@@ -201,7 +198,9 @@ pub fn profile(
     tol: f64,
 ) -> Vec<(f64, f64)> {
     let points = points.max(3);
-    let grid: Vec<f64> = (0..points).map(|i| i as f64 / (points - 1) as f64).collect();
+    let grid: Vec<f64> = (0..points)
+        .map(|i| i as f64 / (points - 1) as f64)
+        .collect();
     let mut out = vec![(0.0, f64::INFINITY); points];
     let centre = grid
         .iter()
@@ -280,10 +279,16 @@ mod tests {
             (a * a - 2.0 * r * a * b + b * b) / (1.0 - r * r)
         };
         let m = minimize(&f, &[0.5, 0.5], 0.1, 1e-12);
-        assert!((m.x[0] - m0).abs() < 1e-4 && (m.x[1] - m1).abs() < 1e-4, "{m:?}");
+        assert!(
+            (m.x[0] - m0).abs() < 1e-4 && (m.x[1] - m1).abs() < 1e-4,
+            "{m:?}"
+        );
         let p = profile(&f, &m, 0, 81, 1e-10);
         let i = interval(&p, m.f, 1.0);
-        assert!((i.lo - (m0 - s0)).abs() < 2e-3 && (i.hi - (m0 + s0)).abs() < 2e-3, "{i:?}");
+        assert!(
+            (i.lo - (m0 - s0)).abs() < 2e-3 && (i.hi - (m0 + s0)).abs() < 2e-3,
+            "{i:?}"
+        );
         assert!(!i.lo_open && !i.hi_open);
     }
 
@@ -299,6 +304,9 @@ mod tests {
         assert!((m.x[0] - 1.0).abs() < 1e-9);
         let i = interval(&profile(&g, &m, 0, 41, 1e-10), m.f, 1.0);
         // ((x − 1.2)/0.5)² ≤ 0.16 + 1 from x = 1.2 − 0.5·√1.16 = 0.6615.
-        assert!(i.hi_open && !i.lo_open && (i.lo - 0.6615).abs() < 0.01, "{i:?}");
+        assert!(
+            i.hi_open && !i.lo_open && (i.lo - 0.6615).abs() < 0.01,
+            "{i:?}"
+        );
     }
 }

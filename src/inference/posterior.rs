@@ -103,7 +103,11 @@ mod tests {
             let mean = s.iter().map(|x| x[i]).sum::<f64>() / n;
             let var = s.iter().map(|x| (x[i] - mean).powi(2)).sum::<f64>() / (n - 1.0);
             assert!((mean - m).abs() < 0.2 * sd, "{i}: mean {mean}");
-            assert!((var.sqrt() / sd - 1.0).abs() < 0.15, "{i}: sd {}", var.sqrt());
+            assert!(
+                (var.sqrt() / sd - 1.0).abs() < 0.15,
+                "{i}: sd {}",
+                var.sqrt()
+            );
         }
         // The same seed, the same draws.
         assert_eq!(s, sample(&f, &[0.5, 0.5], 4000, 4000, 5, 1));

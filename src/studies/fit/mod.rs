@@ -1,139 +1,19 @@
-//! `dicephys fit`: what restitution, friction and throw make the simulator match measured
-//! counts, how sure that is, and (`predict`) what it then says of a die not thrown.
-//!
-//! 1. [`data`]: the counts, one row per block and surface.
-//! 2. [`model`]: the free parameters (e, μ per surface or shared; κ and the spin scale per
-//!    thrower), their ranges and unit coordinates, and the simulation method.
-//! 3. [`design`]: each block simulated at fixed points spread over the box, each point on its
-//!    own keyed throws, and a surrogate (a polynomial multinomial logit) through them.
-//! 4. [`estimate`]: the Dirichlet-multinomial likelihood of every row (the surrogate's noise
-//!    folded in), its maximum, profile-likelihood intervals, the joint 2σ region, χ², and
-//!    posterior draws.
-//! 5. [`predict`]: a new block simulated at posterior draws; its probabilities with an error
-//!    from the parameters and one from the simulation.
-//!
-//! Why independent throws at each design point rather than common random numbers (the same
-//! keyed throws at every point): the surrogate averages over the points, and common throws
-//! give every point the same noise, so averaging removes none of it; independent throws give
-//! the surrogate's level the noise of all the points' rolls together. Common throws help a
-//! method that compares points one by one (a grid search, a finite difference); a surrogate
-//! does not. The comparison is measured in docs/results/calibration.md.
+//! `dicephys fit` and `predict`: the rolling behind a calibration ([`crate::calibration`]): each
+//! block simulated over its design, the data simulated at a known truth for the recovery
+//! check, and a new block simulated at the fit's posterior draws.
 
-pub mod data;
-pub mod design;
-pub mod estimate;
-pub mod model;
 pub mod predict;
+pub mod recovery;
+pub mod simulate;
 
-use crate::error::{Error, Result};
+use crate::calibration::design::{self, Design};
+use crate::calibration::{estimate_with, FitConfig, FitCost, FitResult};
+use crate::error::Result;
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::runner::Runner;
-use data::DataRow;
-use design::{Design, DesignSpec, Plan};
-use estimate::{Estimate, Likelihood, Search};
-use model::{Method, ModelSpec, Param};
-use serde::{Deserialize, Serialize};
+use simulate::Plan;
 use std::path::Path;
 use std::time::Instant;
-
-/// What to fit.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct FitConfig {
-    /// The measured counts.
-    pub rows: Vec<DataRow>,
-    /// What is free, where.
-    pub model: ModelSpec,
-    /// How each throw is simulated.
-    pub method: Method,
-    /// How densely each block is simulated.
-    pub design: DesignSpec,
-    /// The search's settings.
-    pub search: Search,
-    /// The throws' seed.
-    pub seed: u64,
-}
-
-impl FitConfig {
-    /// Checks every value before anything runs.
-    pub fn validate(&self) -> Result<()> {
-        self.model.validate()?;
-        self.design.validate(self.model.free.len())?;
-        if self.rows.is_empty() {
-            return Err(Error::Invalid("no rows to fit".into()));
-        }
-        let params = self.model.params(&self.rows);
-        if params.len() > 40 {
-            return Err(Error::Invalid(format!(
-                "{} free parameters: at most 40 (share e or mu across surfaces?)",
-                params.len()
-            )));
-        }
-        let cells: usize = self.rows.iter().map(|r| r.groups.len() - 1).sum();
-        if params.len() > cells {
-            return Err(Error::Invalid(format!(
-                "{} free parameters from {cells} independent counts: the data cannot fix them \
-                 (fewer free parameters, or shared ones)",
-                params.len()
-            )));
-        }
-        // One cell checks the method (engine, step, roll) for every row's block.
-        for r in &self.rows {
-            let v = self.model.values(&vec![0.5; self.model.free.len()]);
-            self.method
-                .spec(r.block, r.mode, &v, self.seed, self.design.rolls)
-                .validate(false)?;
-        }
-        Ok(())
-    }
-
-    /// The rolls the design makes.
-    pub fn total_rolls(&self) -> u64 {
-        self.plan().total_rolls(design::keys(&self.rows).len())
-    }
-
-    fn plan(&self) -> Plan<'_> {
-        Plan {
-            model: &self.model,
-            method: &self.method,
-            design: &self.design,
-            seed: self.seed,
-        }
-    }
-}
-
-/// What a fit cost.
-#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
-pub struct FitCost {
-    /// Rolls simulated (or read back from the checkpoints).
-    pub rolls: u64,
-    /// Of which did not settle on a face (unknown, unconverged, failed): left out.
-    pub unsettled: u64,
-    /// Wall-clock seconds.
-    pub wall_s: f64,
-    /// CPU seconds of this process.
-    pub cpu_s: f64,
-}
-
-/// A fit's result: everything `predict` needs, and what the report shows.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct FitResult {
-    /// What was fitted.
-    pub config: FitConfig,
-    /// The free parameters, in the estimate's order.
-    pub params: Vec<Param>,
-    /// The blocks simulated, with their surrogates.
-    pub designs: Vec<Design>,
-    /// The estimate.
-    pub estimate: Estimate,
-    /// What it cost.
-    pub cost: FitCost,
-    /// The command line that made it.
-    pub command_line: String,
-    /// This program's version.
-    pub dicephys_version: String,
-    /// When it ended, UTC.
-    pub date_utc: String,
-}
 
 /// Simulates the designs of `cfg`'s rows (`None` if stopped early, what was rolled kept under
 /// `dir`).
@@ -142,20 +22,13 @@ pub fn simulate(
     runner: &Runner,
     dir: Option<&Path>,
 ) -> Result<Option<Vec<Design>>> {
-    design::simulate(&cfg.plan(), &design::keys(&cfg.rows), runner, dir)
-}
-
-/// Fits `rows` with the designs already simulated (the cheap part: no rolls).
-pub fn estimate_with(
-    rows: &[DataRow],
-    model: &ModelSpec,
-    designs: &[Design],
-    search: &Search,
-) -> Result<(Vec<Param>, Estimate)> {
-    let params = model.params(rows);
-    let lik = Likelihood::new(rows, designs, model, &params);
-    let est = estimate::estimate(&lik, model, &params, search)?;
-    Ok((params, est))
+    let plan = Plan {
+        model: &cfg.model,
+        method: &cfg.method,
+        design: &cfg.design,
+        seed: cfg.seed,
+    };
+    simulate::simulate(&plan, &design::keys(&cfg.rows), runner, dir)
 }
 
 /// Runs the fit: simulates (resuming from `dir`), then estimates. `None` if a stop request

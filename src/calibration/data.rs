@@ -86,7 +86,11 @@ impl DataRow {
 
 /// The outcome groups of a row: every outcome apart, less a 2D row's length, with each `-`
 /// merged into the congruent outcome that carries the count. `sides`: length, breadth, width.
-fn groups(mode: Mode, sides: [f64; 3], dashed: [bool; 3]) -> std::result::Result<Vec<Vec<usize>>, String> {
+fn groups(
+    mode: Mode,
+    sides: [f64; 3],
+    dashed: [bool; 3],
+) -> std::result::Result<Vec<Vec<usize>>, String> {
     let live: Vec<usize> = match mode {
         Mode::ThreeD => vec![0, 1, 2],
         Mode::TwoD => vec![1, 2],
@@ -173,7 +177,13 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
                 .parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite() && *v > 0.0)
-                .ok_or_else(|| bad(line, c, format!("'{}' is not a positive number of mm", &rec[c])))?;
+                .ok_or_else(|| {
+                    bad(
+                        line,
+                        c,
+                        format!("'{}' is not a positive number of mm", &rec[c]),
+                    )
+                })?;
         }
         let mode: Mode = rec[5]
             .parse()
@@ -186,7 +196,11 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
                 "-" => dashed[k] = true,
                 v => {
                     counts[k] = v.parse().map_err(|_| {
-                        bad(line, c, format!("'{v}' is not a count (a whole number, or '-')"))
+                        bad(
+                            line,
+                            c,
+                            format!("'{v}' is not a count (a whole number, or '-')"),
+                        )
                     })?
                 }
             }
@@ -203,11 +217,7 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
         let row = DataRow {
             label,
             surface,
-            thrower: if with_thrower {
-                text(9)?
-            } else {
-                "all".into()
-            },
+            thrower: if with_thrower { text(9)? } else { "all".into() },
             block,
             mode,
             counts,
@@ -216,7 +226,11 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
         if row.n() == 0 {
             return Err(bad(line, 6, "no throws counted".into()));
         }
-        if row.counts.iter().try_fold(0u64, |a, &c| a.checked_add(c)).is_none()
+        if row
+            .counts
+            .iter()
+            .try_fold(0u64, |a, &c| a.checked_add(c))
+            .is_none()
             || row.n() > 1_000_000_000_000
         {
             return Err(bad(line, 6, "counts too large".into()));
@@ -278,21 +292,45 @@ mod tests {
     #[test]
     fn bad_files_name_line_and_column() {
         let cases = [
-            (format!("{HEAD}a,MDF,140,24,20,3d,0,x,639\n"), "line 2, column 8 (breadth_vertical)"),
-            (format!("{HEAD}a,MDF,140,24,20,3d,0,361,-\n"), "line 2, column 7"),
-            (format!("{HEAD}a,MDF,140,-2,20,3d,0,361,6\n"), "line 2, column 4 (breadth_mm)"),
-            (format!("{HEAD}a,MDF,140,24,20,4d,0,361,6\n"), "line 2, column 6 (mode)"),
+            (
+                format!("{HEAD}a,MDF,140,24,20,3d,0,x,639\n"),
+                "line 2, column 8 (breadth_vertical)",
+            ),
+            (
+                format!("{HEAD}a,MDF,140,24,20,3d,0,361,-\n"),
+                "line 2, column 7",
+            ),
+            (
+                format!("{HEAD}a,MDF,140,-2,20,3d,0,361,6\n"),
+                "line 2, column 4 (breadth_mm)",
+            ),
+            (
+                format!("{HEAD}a,MDF,140,24,20,4d,0,361,6\n"),
+                "line 2, column 6 (mode)",
+            ),
             (format!("{HEAD}a,MDF,140,24,20,3d,0,361\n"), "line 2"),
-            (format!("{HEAD}a,MDF,140,24,20,3d,0,1,1\na,MDF,140,24,20,3d,0,1,1\n"), "line 3, column 1 (label)"),
-            (format!("{HEAD}a,,140,24,20,3d,0,1,1\n"), "line 2, column 2 (surface)"),
+            (
+                format!("{HEAD}a,MDF,140,24,20,3d,0,1,1\na,MDF,140,24,20,3d,0,1,1\n"),
+                "line 3, column 1 (label)",
+            ),
+            (
+                format!("{HEAD}a,,140,24,20,3d,0,1,1\n"),
+                "line 2, column 2 (surface)",
+            ),
             (format!("{HEAD}a,MDF,140,24,20,3d,0,0,0\n"), "no throws"),
             ("label,surface\n".to_string(), "line 1: the header"),
             (HEAD.to_string(), "no rows"),
-            (format!("{HEAD}a,MDF,140,24,20,3d,0,-18446744073709551615,1\n"), "column 8"),
+            (
+                format!("{HEAD}a,MDF,140,24,20,3d,0,-18446744073709551615,1\n"),
+                "column 8",
+            ),
         ];
         for (text, want) in cases {
             let e = parse(&text, "f.csv").unwrap_err().to_string();
-            assert!(e.starts_with("f.csv: ") && e.contains(want), "{e} (wanted {want})");
+            assert!(
+                e.starts_with("f.csv: ") && e.contains(want),
+                "{e} (wanted {want})"
+            );
             assert!(!e.contains('\n'), "{e}");
         }
     }

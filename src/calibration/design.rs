@@ -1,6 +1,7 @@
 //! The simulations a fit stands on: for each block (and mode) among the rows, the simulator
 //! run at many parameter points spread over the free parameters' box, and a surrogate
-//! ([`crate::inference::surrogate`]) fitted through them.
+//! ([`crate::inference::surrogate`]) fitted through them. The rolling itself is
+//! [`crate::studies::fit`]'s; here are the points, the seeds and the result.
 //!
 //! The points are the box's 2^d corners, its centre, then a Halton sequence (bases 2, 3, 5, 7):
 //! fixed in advance, so a run can be split over a cluster, resumed, or checked against another.
@@ -13,15 +14,12 @@
 //! Rows with the same block and mode share one design: their surfaces differ only in which
 //! coordinates the likelihood reads the surrogate at.
 
+use crate::calibration::data::DataRow;
 use crate::error::{Error, Result};
 use crate::inference::surrogate::{DesignPoint, Surrogate};
 use crate::model::block::Block;
 use crate::model::scene::Mode;
-use crate::run::runner::Runner;
-use crate::studies::fit::data::DataRow;
-use crate::studies::fit::model::{Method, ModelSpec};
 use serde::{Deserialize, Serialize};
-use std::path::Path;
 
 /// How densely each block is simulated.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -63,10 +61,13 @@ impl DesignSpec {
             return bad(format!("points {}: at most 100000", self.points));
         }
         if self.rolls == 0 || self.rolls > crate::run::spec::MAX_ROLLS {
-            return bad(format!("rolls {}: 1 to {}", self.rolls, crate::run::spec::MAX_ROLLS));
+            return bad(format!(
+                "rolls {}: 1 to {}",
+                self.rolls,
+                crate::run::spec::MAX_ROLLS
+            ));
         }
-        if !(1..=6).contains(&self.degree) || self.max_degree < self.degree || self.max_degree > 6
-        {
+        if !(1..=6).contains(&self.degree) || self.max_degree < self.degree || self.max_degree > 6 {
             return bad(format!(
                 "degree {}..{}: from 1 to 6, the highest not below the first",
                 self.degree, self.max_degree
@@ -152,105 +153,6 @@ pub fn point_seed(seed: u64, block: Block, mode: Mode, point: usize) -> u64 {
     h
 }
 
-/// Everything `simulate` needs.
-pub struct Plan<'a> {
-    /// The model (which parameters are free, their ranges).
-    pub model: &'a ModelSpec,
-    /// How each throw is simulated.
-    pub method: &'a Method,
-    /// How densely.
-    pub design: &'a DesignSpec,
-    /// The run's seed.
-    pub seed: u64,
-}
-
-impl Plan<'_> {
-    /// The rolls `simulate` makes for `keys`.
-    pub fn total_rolls(&self, keys: usize) -> u64 {
-        let dims = self.model.free.len();
-        keys as u64 * points(dims, self.design.points).len() as u64 * self.design.rolls
-    }
-}
-
-/// Simulates every key over the design (each point a cell of its own under `dir`, resumed
-/// from there) and fits its surrogate. `None` if a stop request ended it early: what was rolled
-/// is kept in `dir`.
-pub fn simulate(
-    plan: &Plan,
-    keys: &[(Block, Mode)],
-    runner: &Runner,
-    dir: Option<&Path>,
-) -> Result<Option<Vec<Design>>> {
-    let dims = plan.model.free.len();
-    let xs = points(dims, plan.design.points);
-    let mut done_before = 0u64;
-    let mut out = Vec::new();
-    for &(block, mode) in keys {
-        let mut design_points = Vec::new();
-        let (mut unsettled, mut rolls) = (0u64, 0u64);
-        for (g, x) in xs.iter().enumerate() {
-            let values = plan.model.values(x);
-            let seed = point_seed(plan.seed, block, mode, g);
-            let spec = plan.method.spec(block, mode, &values, seed, plan.design.rolls);
-            spec.validate(false)?;
-            let ck = match dir {
-                Some(d) => Some(runner.open_cell(
-                    &d.join(format!("{block}-{}", mode.name()))
-                        .join(format!("point-{g:05}")),
-                    &spec,
-                )?),
-                None => None,
-            };
-            let base = done_before;
-            let progress = |n| (runner.progress)(base + n);
-            let done = runner
-                .with_progress(&progress)
-                .run(&spec, ck.as_ref(), &mut |_| Ok(()))?;
-            done_before += plan.design.rolls;
-            if !done.complete {
-                return Ok(None);
-            }
-            let t = &done.tally;
-            unsettled += t.rolls - (t.counts.length + t.counts.breadth + t.counts.width);
-            rolls += t.rolls;
-            design_points.push(DesignPoint {
-                x: x.clone(),
-                counts: vec![t.counts.length, t.counts.breadth, t.counts.width],
-            });
-        }
-        // A 2D block has no length outcome: its surrogate is over breadth and width.
-        let (outcomes, pts): (usize, Vec<DesignPoint>) = match mode {
-            Mode::ThreeD => (3, design_points.clone()),
-            Mode::TwoD => (
-                2,
-                design_points
-                    .iter()
-                    .map(|p| DesignPoint {
-                        x: p.x.clone(),
-                        counts: p.counts[1..].to_vec(),
-                    })
-                    .collect(),
-            ),
-        };
-        let surrogate = Surrogate::fit_best(
-            &pts,
-            dims,
-            outcomes,
-            plan.design.degree,
-            plan.design.max_degree,
-        );
-        out.push(Design {
-            block,
-            mode,
-            points: design_points,
-            unsettled,
-            rolls,
-            surrogate,
-        });
-    }
-    Ok(Some(out))
-}
-
 /// The surrogate's probabilities over [length, breadth, width] (a 2D design: length 0).
 pub fn three(p: &[f64], mode: Mode) -> Vec<f64> {
     match mode {
@@ -267,12 +169,27 @@ mod tests {
     fn the_design_starts_at_the_corners_and_fills_the_box() {
         let p = points(2, 20);
         assert_eq!(p.len(), 20);
-        assert_eq!(&p[..5], &[vec![0.0, 0.0], vec![1.0, 0.0], vec![0.0, 1.0], vec![1.0, 1.0], vec![0.5, 0.5]]);
+        assert_eq!(
+            &p[..5],
+            &[
+                vec![0.0, 0.0],
+                vec![1.0, 0.0],
+                vec![0.0, 1.0],
+                vec![1.0, 1.0],
+                vec![0.5, 0.5]
+            ]
+        );
         assert_eq!(p[5], vec![0.5, 1.0 / 3.0]);
         assert!(p.iter().all(|x| x.iter().all(|v| (0.0..=1.0).contains(v))));
         assert_eq!(points(0, 10), vec![Vec::<f64>::new()]);
         let b: Block = "140x24x20".parse().unwrap();
-        assert_ne!(point_seed(1, b, Mode::ThreeD, 0), point_seed(1, b, Mode::ThreeD, 1));
-        assert_ne!(point_seed(1, b, Mode::ThreeD, 0), point_seed(1, b, Mode::TwoD, 0));
+        assert_ne!(
+            point_seed(1, b, Mode::ThreeD, 0),
+            point_seed(1, b, Mode::ThreeD, 1)
+        );
+        assert_ne!(
+            point_seed(1, b, Mode::ThreeD, 0),
+            point_seed(1, b, Mode::TwoD, 0)
+        );
     }
 }

@@ -2,14 +2,14 @@
 //! maximum, profile-likelihood intervals, the joint region, the goodness of fit, and draws from
 //! the posterior for predictions.
 
+use crate::calibration::data::DataRow;
+use crate::calibration::design::Design;
+use crate::calibration::params::{ModelSpec, Param};
 use crate::error::{Error, Result};
 use crate::inference::likelihood::{concentration, ln_dirichlet_multinomial, merge, pearson};
 use crate::inference::optimize::{interval, minimize, profile, Interval, Minimum};
 use crate::inference::posterior;
 use crate::model::scene::Mode;
-use crate::studies::fit::data::DataRow;
-use crate::studies::fit::design::Design;
-use crate::studies::fit::model::{ModelSpec, Param};
 use crate::theory::stats;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
@@ -144,8 +144,12 @@ impl Identified {
     pub fn says(self) -> &'static str {
         match self {
             Identified::Yes => "identified",
-            Identified::UpperBoundOnly => "bounded above only (its 2σ region reaches the range's lower end)",
-            Identified::LowerBoundOnly => "bounded below only (its 2σ region reaches the range's upper end)",
+            Identified::UpperBoundOnly => {
+                "bounded above only (its 2σ region reaches the range's lower end)"
+            }
+            Identified::LowerBoundOnly => {
+                "bounded below only (its 2σ region reaches the range's upper end)"
+            }
             Identified::No => "not identifiable: its 2σ region spans the whole range",
         }
     }
@@ -249,7 +253,7 @@ pub fn maximise(lik: &Likelihood, dims: usize, starts: usize) -> Result<(Minimum
     let mut found: Vec<Minimum> = Vec::new();
     let mut start_points = vec![vec![0.5; dims]];
     start_points.extend(
-        crate::studies::fit::design::points(dims, starts + (1 << dims.min(10)) + 1)
+        crate::calibration::design::points(dims, starts + (1 << dims.min(10)) + 1)
             .into_iter()
             .skip((1 << dims.min(10)) + 1)
             .take(starts.saturating_sub(1)),
@@ -276,7 +280,8 @@ pub fn maximise(lik: &Likelihood, dims: usize, starts: usize) -> Result<(Minimum
     let mut others: Vec<f64> = Vec::new();
     for m in &found[1..] {
         let far = m.x.iter().zip(&best.x).any(|(a, b)| (a - b).abs() > 0.05);
-        if m.converged && far && m.f - best.f > 0.1 && !others.iter().any(|o| (o - m.f).abs() < 0.1) {
+        if m.converged && far && m.f - best.f > 0.1 && !others.iter().any(|o| (o - m.f).abs() < 0.1)
+        {
             others.push(m.f);
         }
     }
@@ -357,7 +362,9 @@ pub fn row_fits(lik: &Likelihood, x: &[f64]) -> Vec<RowFit> {
             outcomes: row.group_names(),
             counts: counts.clone(),
             p: pr.p.clone(),
-            p_err: (0..pr.p.len()).map(|k| pr.cov[(k, k)].max(0.0).sqrt()).collect(),
+            p_err: (0..pr.p.len())
+                .map(|k| pr.cov[(k, k)].max(0.0).sqrt())
+                .collect(),
             z,
             chi2: pearson(&counts, &pr.p, pr.c),
         });

@@ -10,6 +10,7 @@
 //! 3 % from κ = 10⁴ down), because a throw spun exactly about its horizontal long axis lands
 //! flat along its whole length, and any tilt breaks that.
 
+use crate::calibration::data::DataRow;
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
@@ -17,7 +18,6 @@ use crate::model::scene::{Mode, Scene};
 use crate::model::throws::{Range, ThrowRanges};
 use crate::run::spec::{RunSpec, ThrowSpec, MAX_KAPPA};
 use crate::sim::roll::{early_stop_exact, RollConfig, Rule};
-use crate::studies::fit::data::DataRow;
 use serde::{Deserialize, Serialize};
 
 /// A kind of parameter.
@@ -231,7 +231,11 @@ impl ModelSpec {
 
     /// The range of a free kind.
     pub fn range(&self, kind: Kind) -> Range {
-        let i = self.free.iter().position(|k| *k == kind).expect("free kind");
+        let i = self
+            .free
+            .iter()
+            .position(|k| *k == kind)
+            .expect("free kind");
         self.ranges[i]
     }
 
@@ -366,7 +370,7 @@ mod tests {
 
     #[test]
     fn rows_map_to_their_surface_and_thrower() {
-        let rows = crate::studies::fit::data::paper_rows().unwrap();
+        let rows = crate::calibration::data::paper_rows().unwrap();
         let m = ModelSpec {
             free: vec![Kind::E, Kind::Mu, Kind::Kappa],
             shared: vec![],
@@ -393,6 +397,10 @@ mod tests {
             ranges: vec![Range::new(0.5, 1.5), m.ranges[1], m.ranges[2]],
             ..m
         };
-        assert!(bad.validate().unwrap_err().to_string().contains("range of e"));
+        assert!(bad
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("range of e"));
     }
 }

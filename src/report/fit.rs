@@ -1,0 +1,264 @@
+//! What a fit says: `report.md`, its figures, and a prediction's lines.
+
+use crate::error::Result;
+use crate::report::figures::fit::{self as fig, Profile, RowRatio};
+use crate::report::figures::Point;
+use crate::calibration::params::{FixedThrow, Kind};
+use crate::calibration::predict::{BlockPrediction, Predicted};
+use crate::calibration::FitResult;
+use crate::theory::stats;
+use std::fmt::Write;
+use std::path::Path;
+
+fn num(v: f64) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else if v.abs() >= 1000.0 || v.abs() < 0.01 {
+        format!("{v:.3e}")
+    } else {
+        format!("{v:.3}")
+    }
+}
+
+/// The fixed values of the kinds not free, as a sentence.
+pub fn fixed_text(res: &FitResult) -> String {
+    let m = &res.config.model;
+    let mut parts = Vec::new();
+    let f = m.fixed;
+    if !m.is_free(Kind::E) {
+        parts.push(format!("e = {}", f.e));
+    }
+    if !m.is_free(Kind::Mu) {
+        parts.push(format!("μ = {}", f.mu));
+    }
+    if !m.is_free(Kind::Kappa) {
+        parts.push(match f.throw {
+            FixedThrow::Paper => "the paper's throw".into(),
+            FixedThrow::Hand(k) => format!("a hand's throw with κ = {k}"),
+        });
+    }
+    if !m.is_free(Kind::Spin) {
+        parts.push(format!("spin scale {}", f.spin));
+    }
+    if parts.is_empty() {
+        "none".into()
+    } else {
+        parts.join(", ")
+    }
+}
+
+/// `report.md` for a fit; `figures` are the stems written beside it.
+pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
+    let e = &res.estimate;
+    let c = &res.config;
+    let mut s = String::new();
+    let _ = writeln!(s, "# Fit of the simulator to measured counts\n");
+    let _ = writeln!(
+        s,
+        "`{}` — dicephys {}, {}.\n",
+        res.command_line, res.dicephys_version, res.date_utc
+    );
+    let _ = writeln!(
+        s,
+        "Method: {} at dt = {} s, {} rows on {} blocks, each simulated at {} parameter points × {} \
+         rolls (seed {}); {} rolls in all ({} did not settle on a face and are left out), {:.0} s \
+         wall, {:.0} s CPU. Fixed: {}.\n",
+        c.method.engine,
+        c.method.dt,
+        c.rows.len(),
+        res.designs.len(),
+        res.designs.first().map_or(0, |d| d.points.len()),
+        c.design.rolls,
+        c.seed,
+        res.cost.rolls,
+        res.cost.unsettled,
+        res.cost.wall_s,
+        res.cost.cpu_s,
+        fixed_text(res),
+    );
+    let _ = writeln!(s, "## Parameters\n");
+    let _ = writeln!(
+        s,
+        "Maximum likelihood, with profile-likelihood intervals (Δ(−2 ln L) = 1 for 1σ, 4 for 2σ) \
+         inside the searched range. The joint 2σ region of all {} is Δ(−2 ln L) ≤ {:.2} (χ² at \
+         95.45 %).\n",
+        res.params.len(),
+        e.region_delta
+    );
+    let _ = writeln!(s, "| parameter | range | fitted | 1σ | 2σ | |");
+    let _ = writeln!(s, "|---|---|---:|---|---|---|");
+    for p in &e.params {
+        let r = c.model.range(p.param.kind);
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} – {} | {} – {} | {} |",
+            p.name,
+            r,
+            num(p.value),
+            num(p.one_sigma[0]),
+            num(p.one_sigma[1]),
+            num(p.two_sigma[0]),
+            num(p.two_sigma[1]),
+            p.identified.says()
+        );
+    }
+    if !e.other_maxima.is_empty() {
+        let _ = writeln!(
+            s,
+            "\nThe search also ended at other local maxima, −2 ln L higher by {}: the region may \
+             be more than one island.",
+            e.other_maxima
+                .iter()
+                .map(|f| format!("{:.2}", f - e.minus_two_ln_l))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    let _ = writeln!(s, "\n## Goodness of fit\n");
+    let _ = writeln!(
+        s,
+        "Pearson's χ² = {:.2} on {} degrees of freedom (independent counts less free parameters), \
+         p = {}. Each count's z is (measured − N p)/σ with σ the Dirichlet-multinomial's (the \
+         binomial widened by the simulation's noise).\n",
+        e.chi2,
+        e.dof,
+        if e.p_value.is_finite() {
+            format!("{:.3}", e.p_value)
+        } else {
+            "undefined (no degrees of freedom left)".into()
+        }
+    );
+    let _ = writeln!(s, "| row | surface | outcome | counted | fitted p | z |");
+    let _ = writeln!(s, "|---|---|---|---:|---|---:|");
+    for r in &e.rows {
+        let n: u64 = r.counts.iter().sum();
+        for (g, name) in r.outcomes.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} / {} | {:.4} ± {:.4} | {:+.2} |",
+                r.label, r.surface, name, r.counts[g], n, r.p[g], r.p_err[g], r.z[g]
+            );
+        }
+    }
+    let _ = writeln!(s, "\n## Surrogates\n");
+    let _ = writeln!(
+        s,
+        "Each block's outcome probabilities as a polynomial multinomial logit in the free \
+         parameters, fitted to its design's counts. Lack of fit: the deviance against its \
+         degrees of freedom; a dispersion above 1 widens the surrogate's error by it.\n"
+    );
+    let _ = writeln!(s, "| block | degree | deviance / dof | lack-of-fit p | dispersion | not settled |");
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|");
+    for d in &res.designs {
+        let sg = &d.surrogate;
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.1} / {} | {:.3} | {:.2} | {} of {} |",
+            d.name(),
+            sg.degree,
+            sg.deviance,
+            sg.dof,
+            sg.lack_of_fit_p(),
+            sg.dispersion,
+            d.unsettled,
+            d.rolls
+        );
+    }
+    if !figures.is_empty() {
+        let _ = writeln!(s, "\n## Figures\n");
+        for f in figures {
+            let _ = writeln!(s, "![{f}]({f}.png)");
+        }
+    }
+    s
+}
+
+/// The rows' measured ratio and the fit's, for [`fig::rows`].
+pub fn row_ratios(res: &FitResult) -> Vec<RowRatio> {
+    res.estimate
+        .rows
+        .iter()
+        .filter_map(|r| {
+            let b = r.outcomes.iter().position(|o| o == "breadth")?;
+            let w = r.outcomes.iter().position(|o| o == "width")?;
+            let m = stats::ratio(r.counts[b], r.counts[w]);
+            let (pb, pw) = (r.p[b], r.p[w]);
+            let err = ((r.p_err[b] / pw).powi(2) + (r.p_err[w] * pb / (pw * pw)).powi(2)).sqrt();
+            Some(RowRatio {
+                label: r.label.clone(),
+                measured: Point {
+                    x: 0.0,
+                    y: m.value,
+                    y_err: m.err,
+                },
+                simulated: Point {
+                    x: 0.0,
+                    y: pb / pw,
+                    y_err: err,
+                },
+                theory: None,
+            })
+        })
+        .collect()
+}
+
+/// Writes the fit's figures into `dir`; returns their stems.
+pub fn write_figures(dir: &Path, res: &FitResult) -> Result<Vec<&'static str>> {
+    let profiles: Vec<Profile> = res
+        .estimate
+        .params
+        .iter()
+        .map(|p| Profile {
+            name: p.name.clone(),
+            points: p.profile.iter().map(|v| (v[0], v[1])).collect(),
+            best: p.value,
+            log: p.param.kind == Kind::Kappa,
+        })
+        .collect();
+    let mut stems = Vec::new();
+    if !profiles.is_empty() {
+        fig::profiles(dir, "Profile likelihood of each parameter", &profiles)?;
+        stems.push("fit_profiles");
+    }
+    let rows = row_ratios(res);
+    if !rows.is_empty() {
+        fig::rows(dir, "fit_rows", "Each row: measured against fitted", "fitted", &rows)?;
+        stems.push("fit_rows");
+    }
+    Ok(stems)
+}
+
+fn predicted(p: &Predicted) -> String {
+    format!(
+        "{:.4} ± {:.4} (parameters {:.4}, simulation {:.4})",
+        p.value, p.err, p.err_params, p.err_sim
+    )
+}
+
+/// A prediction's lines for the terminal.
+pub fn prediction_text(p: &BlockPrediction) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{} {} on {} (thrower {}): {} posterior draws × {} rolls",
+        p.block,
+        p.mode.name(),
+        p.surface,
+        p.thrower,
+        p.draws,
+        p.rolls
+    );
+    for (name, v) in ["length", "breadth", "width"].iter().zip(&p.p) {
+        let _ = writeln!(s, "  P({name} vertical)  {}", predicted(v));
+    }
+    let _ = writeln!(
+        s,
+        "  ratio breadth/width  {}   theory (MasterEqu) {:.4}",
+        predicted(&p.ratio),
+        p.theory_ratio
+    );
+    if p.unsettled > 0 {
+        let _ = writeln!(s, "  {} rolls did not settle on a face (left out)", p.unsettled);
+    }
+    s
+}
