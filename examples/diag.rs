@@ -87,6 +87,10 @@ a,S,140,24,20,3d,0,400,600\nb,S,140,30,10,3d,0,50,950\nc,S,99.3,43.9,43.2,3d,20,
             .map(|p| format!("{:.3}", p.value))
             .collect::<Vec<_>>()
     );
+    println!(
+        "bartlett {:.2} region {:.2}",
+        est.bartlett, est.region_delta
+    );
     for (which, x) in [("truth", &x_true), ("mle", &est.x)] {
         for r in row_fits(&lik, x) {
             println!(

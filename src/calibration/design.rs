@@ -15,6 +15,7 @@
 //! coordinates the likelihood reads the surrogate at.
 
 use crate::calibration::data::DataRow;
+use crate::calibration::params::{Axes, ModelSpec, Param};
 use crate::error::{Error, Result};
 use crate::inference::surrogate::{DesignPoint, Surrogate};
 use crate::model::block::Block;
@@ -114,6 +115,8 @@ pub struct Design {
     pub block: Block,
     /// 2D or 3D.
     pub mode: Mode,
+    /// Its coordinates: each free kind and its range.
+    pub axes: Axes,
     /// Each point and its counts of length, breadth and width vertical.
     pub points: Vec<DesignPoint>,
     /// Rolls that did not settle on a face (unknown, unconverged or failed), over all points.
@@ -131,8 +134,61 @@ impl Design {
     }
 }
 
+/// What one design simulates: a block, a mode, and its axes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Key {
+    /// The block.
+    pub block: Block,
+    /// 2D or 3D.
+    pub mode: Mode,
+    /// The free kinds and their ranges.
+    pub axes: Axes,
+}
+
+impl Key {
+    /// The key of `row` under `model` with its parameters `params`.
+    pub fn of(row: &DataRow, model: &ModelSpec, params: &[Param]) -> Key {
+        Key {
+            block: row.block,
+            mode: row.mode,
+            axes: model.axes(params, &model.row_dims(params, row)),
+        }
+    }
+
+    /// A name for its directory and its seeds: the block, the mode, and a hash of the axes.
+    pub fn tag(&self) -> String {
+        let axes: Vec<String> = self.axes.iter().map(|(k, r)| format!("{k}={r}")).collect();
+        let h = fnv(&axes.join(","));
+        format!("{}-{}-{:08x}", self.block, self.mode.name(), h >> 32)
+    }
+
+    /// The seed of point `point`'s throws.
+    pub fn seed(&self, seed: u64, point: usize) -> u64 {
+        fnv(&format!("{seed}/{}/{point}", self.tag()))
+    }
+
+    /// True if `d` is this key's design.
+    pub fn is(&self, d: &Design) -> bool {
+        d.block == self.block && d.mode == self.mode && d.axes == self.axes
+    }
+}
+
+/// The distinct keys of `rows`, in first-seen order: rows with the same block, mode and
+/// parameter ranges share one design.
+pub fn keys(rows: &[DataRow], model: &ModelSpec) -> Vec<Key> {
+    let params = model.params(rows);
+    let mut out: Vec<Key> = Vec::new();
+    for r in rows {
+        let k = Key::of(r, model, &params);
+        if !out.contains(&k) {
+            out.push(k);
+        }
+    }
+    out
+}
+
 /// The distinct (block, mode) pairs of `rows`, in first-seen order.
-pub fn keys(rows: &[DataRow]) -> Vec<(Block, Mode)> {
+pub fn blocks(rows: &[DataRow]) -> Vec<(Block, Mode)> {
     let mut out: Vec<(Block, Mode)> = Vec::new();
     for r in rows {
         if !out.contains(&(r.block, r.mode)) {
@@ -142,15 +198,20 @@ pub fn keys(rows: &[DataRow]) -> Vec<(Block, Mode)> {
     out
 }
 
-/// The seed of one point's throws: FNV-1a of the run's seed, the block, the mode and the point.
-pub fn point_seed(seed: u64, block: Block, mode: Mode, point: usize) -> u64 {
-    let text = format!("{seed}/{block}/{}/{point}", mode.name());
+/// 64-bit FNV-1a of a text.
+fn fnv(text: &str) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for b in text.bytes() {
         h ^= b as u64;
         h = h.wrapping_mul(0x0000_0100_0000_01b3);
     }
     h
+}
+
+/// The seed of one numbered set of throws of a block: FNV-1a of the run's seed, the block, the
+/// mode and the number.
+pub fn point_seed(seed: u64, block: Block, mode: Mode, point: usize) -> u64 {
+    fnv(&format!("{seed}/{block}/{}/{point}", mode.name()))
 }
 
 /// The surrogate's probabilities over [length, breadth, width] (a 2D design: length 0).

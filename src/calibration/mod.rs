@@ -20,11 +20,14 @@
 //! method that compares points one by one (a grid search, a finite difference); a surrogate
 //! does not. The comparison is measured in docs/results/calibration.md.
 
+pub mod check;
+pub mod crossval;
 pub mod data;
 pub mod design;
 pub mod estimate;
 pub mod params;
 pub mod predict;
+pub mod recovery;
 
 use crate::error::{Error, Result};
 use data::DataRow;
@@ -75,7 +78,11 @@ impl FitConfig {
         }
         // One cell checks the method (engine, step, roll) for every row's block.
         for r in &self.rows {
-            let v = self.model.values(&vec![0.5; self.model.free.len()]);
+            let v = params::values(
+                &self.model.fixed,
+                &self.model.whole_axes(),
+                &vec![0.5; self.model.free.len()],
+            );
             self.method
                 .spec(r.block, r.mode, &v, self.seed, self.design.rolls)
                 .validate(false)?;
@@ -86,7 +93,7 @@ impl FitConfig {
     /// The rolls the design makes.
     pub fn total_rolls(&self) -> u64 {
         let per_key = design::points(self.model.free.len(), self.design.points).len() as u64;
-        design::keys(&self.rows).len() as u64 * per_key * self.design.rolls
+        design::keys(&self.rows, &self.model).len() as u64 * per_key * self.design.rolls
     }
 }
 
@@ -133,6 +140,6 @@ pub fn estimate_with(
 ) -> Result<(Vec<Param>, Estimate)> {
     let params = model.params(rows);
     let lik = Likelihood::new(rows, designs, model, &params);
-    let est = estimate::estimate(&lik, model, &params, search)?;
+    let est = estimate::estimate(&lik, &params, search)?;
     Ok((params, est))
 }

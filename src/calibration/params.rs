@@ -164,15 +164,47 @@ pub struct ModelSpec {
     pub ranges: Vec<Range>,
     /// The values of the kinds not free.
     pub fixed: Fixed,
+    /// Ranges of single parameters, narrower than their kind's (a refined fit's second pass).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub narrowed: Vec<Narrowed>,
+}
+
+/// One parameter's own range, by its name ("e[MDF]").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Narrowed {
+    /// The parameter's name.
+    pub param: String,
+    /// Its range.
+    pub range: Range,
+}
+
+/// A design's coordinates: each free kind with its range, in [`Kind::ALL`]'s order.
+pub type Axes = Vec<(Kind, Range)>;
+
+/// The physical values at unit coordinates `x` on `axes`, the rest as `fixed`.
+pub fn values(fixed: &Fixed, axes: &[(Kind, Range)], x: &[f64]) -> Fixed {
+    let mut v = *fixed;
+    for ((kind, range), &u) in axes.iter().zip(x) {
+        let value = kind.value(*range, u);
+        match kind {
+            Kind::E => v.e = value,
+            Kind::Mu => v.mu = value,
+            Kind::Kappa => v.throw = FixedThrow::Hand(value),
+            Kind::Spin => v.spin = value,
+        }
+    }
+    v
 }
 
 /// One free parameter: a kind, for one surface or thrower (or "all").
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Param {
     /// Its kind.
     pub kind: Kind,
     /// The surface (e, μ) or thrower (κ, spin) it belongs to, or "all" when shared.
     pub group: String,
+    /// The range it is searched in.
+    pub range: Range,
 }
 
 impl Param {
@@ -221,6 +253,22 @@ impl ModelSpec {
                 return bad(format!("kappa {k}: must be in [0, {MAX_KAPPA:e}]"));
             }
         }
+        for n in &self.narrowed {
+            let kind = self
+                .free
+                .iter()
+                .find(|k| n.param.starts_with(&format!("{k}[")))
+                .ok_or_else(|| {
+                    Error::Invalid(format!("narrowed {}: not a free parameter", n.param))
+                })?;
+            let r = self.range(*kind);
+            if !(n.range.lo >= r.lo && n.range.hi <= r.hi && n.range.lo < n.range.hi) {
+                return bad(format!(
+                    "narrowed {} {}: must lie inside {kind}'s range {r}",
+                    n.param, n.range
+                ));
+            }
+        }
         Ok(())
     }
 
@@ -256,13 +304,17 @@ impl ModelSpec {
         let mut out: Vec<Param> = Vec::new();
         for &kind in &self.free {
             for r in rows {
-                let p = Param {
-                    kind,
-                    group: self.group_of(kind, r),
-                };
-                if !out.contains(&p) {
-                    out.push(p);
+                let group = self.group_of(kind, r);
+                if out.iter().any(|p| p.kind == kind && p.group == group) {
+                    continue;
                 }
+                let name = format!("{kind}[{group}]");
+                let range = self
+                    .narrowed
+                    .iter()
+                    .find(|n| n.param == name)
+                    .map_or_else(|| self.range(kind), |n| n.range);
+                out.push(Param { kind, group, range });
             }
         }
         out
@@ -282,20 +334,20 @@ impl ModelSpec {
             .collect()
     }
 
-    /// The physical values (e, μ, throw, spin) at a row's unit coordinates `x` (one per free
-    /// kind).
-    pub fn values(&self, x: &[f64]) -> Fixed {
-        let mut v = self.fixed;
-        for ((kind, range), &u) in self.free.iter().zip(&self.ranges).zip(x) {
-            let value = kind.value(*range, u);
-            match kind {
-                Kind::E => v.e = value,
-                Kind::Mu => v.mu = value,
-                Kind::Kappa => v.throw = FixedThrow::Hand(value),
-                Kind::Spin => v.spin = value,
-            }
-        }
-        v
+    /// A row's axes: its parameters' kinds and ranges, in order.
+    pub fn axes(&self, params: &[Param], dims: &[usize]) -> Axes {
+        dims.iter()
+            .map(|&d| (params[d].kind, params[d].range))
+            .collect()
+    }
+
+    /// The kinds' whole ranges as axes (a design before any narrowing).
+    pub fn whole_axes(&self) -> Axes {
+        self.free
+            .iter()
+            .copied()
+            .zip(self.ranges.iter().copied())
+            .collect()
     }
 }
 
@@ -380,6 +432,7 @@ mod tests {
                 Kind::Kappa.default_range(),
             ],
             fixed: Fixed::default(),
+            narrowed: vec![],
         };
         m.validate().unwrap();
         let params = m.params(&rows);

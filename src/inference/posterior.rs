@@ -38,8 +38,8 @@ pub fn sample(
     seed: u64,
 ) -> Vec<Vec<f64>> {
     let d = start.len();
-    if d == 0 {
-        return vec![vec![]; draws];
+    if d == 0 || draws == 0 {
+        return vec![start.to_vec(); draws];
     }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut x = start.to_vec();

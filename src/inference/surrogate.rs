@@ -23,6 +23,9 @@ use serde::{Deserialize, Serialize};
 /// rolls, decisive only for an outcome that never occurs).
 pub const RIDGE: f64 = 1e-3;
 
+/// An outcome's polynomial keeps at least this many of its events per coefficient.
+pub const EVENTS_PER_COEFFICIENT: f64 = 10.0;
+
 /// Simulated counts at one parameter point.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DesignPoint {
@@ -96,6 +99,8 @@ pub struct Surrogate {
     pub outcomes: usize,
     /// The polynomials' total degree.
     pub degree: usize,
+    /// Each non-reference outcome's own degree (lower for a rare outcome).
+    pub degrees: Vec<usize>,
     /// The exponents of each feature's Legendre polynomials ([`exponents`]).
     pub exps: Vec<Vec<usize>>,
     /// The coefficients, (outcomes − 1) × features, row-major.
@@ -129,6 +134,13 @@ impl Surrogate {
     /// Fits the surrogate of total degree `degree` to `design` (every point's counts over the
     /// same `outcomes` outcomes; a point with no counts adds nothing). Newton's method on the
     /// penalised log-likelihood, from β = 0, to a relative change below 1e-10.
+    ///
+    /// Rare outcomes: an outcome seen T times over the whole design gets polynomials only up to
+    /// the degree that leaves at least [`EVENTS_PER_COEFFICIENT`] events a coefficient (a
+    /// constant log-odds when T is small), and half a pseudo-count spread evenly over the design
+    /// (Jeffreys's prior for the whole design's total, biasing it by 1/(2·rolls)); so an
+    /// outcome never or rarely seen keeps a small probability with a wide error, rather than a
+    /// log-odds driven to −∞ with a spuriously tight one.
     pub fn fit(design: &[DesignPoint], dims: usize, outcomes: usize, degree: usize) -> Surrogate {
         let exps = exponents(dims, degree);
         let m = exps.len();
@@ -138,23 +150,74 @@ impl Surrogate {
             .iter()
             .map(|d| features(&d.x, &exps, degree))
             .collect();
+        let live_points = design
+            .iter()
+            .filter(|d| d.counts.iter().sum::<u64>() > 0)
+            .count()
+            .max(1) as f64;
+        let pseudo = 0.5 / live_points;
+        let counts: Vec<Vec<f64>> = design
+            .iter()
+            .map(|d| {
+                if d.counts.iter().sum::<u64>() == 0 {
+                    vec![0.0; outcomes]
+                } else {
+                    d.counts.iter().map(|&c| c as f64 + pseudo).collect()
+                }
+            })
+            .collect();
+        // Each outcome's degree, from its events over the design.
+        let degrees: Vec<usize> = (0..k1)
+            .map(|a| {
+                let events: u64 = design.iter().map(|d| d.counts[a]).sum();
+                (0..=degree)
+                    .rev()
+                    .find(|&d| {
+                        exponents(dims, d).len() as f64 * EVENTS_PER_COEFFICIENT <= events as f64
+                    })
+                    .unwrap_or(0)
+            })
+            .collect();
+        // A coefficient above its outcome's degree is held at 0 by a stiff penalty.
+        let ridge: Vec<f64> = (0..size)
+            .map(|i| {
+                let (a, f) = (i / m, i % m);
+                if exps[f].iter().sum::<usize>() > degrees[a] {
+                    1e12
+                } else {
+                    RIDGE
+                }
+            })
+            .collect();
         let mut beta = DVector::<f64>::zeros(size);
         let mut info = DMatrix::<f64>::zeros(size, size);
+        let objective = |b: &DVector<f64>| -> f64 {
+            let mut ll: f64 = -(0..size).map(|i| ridge[i] * b[i] * b[i]).sum::<f64>();
+            for (c, phi) in counts.iter().zip(&phis) {
+                let p = Self::probs(b, phi, k1, m);
+                for (ck, pk) in c.iter().zip(&p) {
+                    if *ck > 0.0 {
+                        ll += ck * pk.max(1e-300).ln();
+                    }
+                }
+            }
+            ll
+        };
         for _ in 0..100 {
-            let mut grad = -2.0 * RIDGE * &beta;
+            let mut grad =
+                DVector::from_iterator(size, (0..size).map(|i| -2.0 * ridge[i] * beta[i]));
             info.fill(0.0);
             for i in 0..size {
-                info[(i, i)] = 2.0 * RIDGE;
+                info[(i, i)] = 2.0 * ridge[i];
             }
-            for (d, phi) in design.iter().zip(&phis) {
-                let n: u64 = d.counts.iter().sum();
-                if n == 0 {
+            for (c, phi) in counts.iter().zip(&phis) {
+                let nf: f64 = c.iter().sum();
+                if nf == 0.0 {
                     continue;
                 }
-                let nf = n as f64;
                 let p = Self::probs(&beta, phi, k1, m);
                 for a in 0..k1 {
-                    let r = d.counts[a] as f64 - nf * p[a];
+                    let r = c[a] - nf * p[a];
                     for i in 0..m {
                         grad[a * m + i] += r * phi[i];
                     }
@@ -178,18 +241,6 @@ impl Surrogate {
             let step = chol.solve(&grad);
             // Newton's step, halved until the penalised log-likelihood does not fall (far from
             // the optimum a full step on a nearly separable outcome can overshoot).
-            let objective = |b: &DVector<f64>| -> f64 {
-                let mut ll = -RIDGE * b.norm_squared();
-                for (d, phi) in design.iter().zip(&phis) {
-                    let p = Self::probs(b, phi, k1, m);
-                    for (c, pk) in d.counts.iter().zip(&p) {
-                        if *c > 0 {
-                            ll += *c as f64 * pk.max(1e-300).ln();
-                        }
-                    }
-                }
-                ll
-            };
             let before = objective(&beta);
             let mut t = 1.0;
             let mut next = &beta + &step;
@@ -228,8 +279,11 @@ impl Surrogate {
                 }
             }
         }
-        let live = seen.iter().filter(|s| **s).count().saturating_sub(1);
-        let dof = cells.saturating_sub(live * m);
+        let coefficients: usize = (0..k1)
+            .filter(|&a| seen[a])
+            .map(|a| exponents(dims, degrees[a]).len())
+            .sum();
+        let dof = cells.saturating_sub(coefficients);
         let dispersion = if dof > 0 {
             (deviance / dof as f64).max(1.0)
         } else {
@@ -239,6 +293,7 @@ impl Surrogate {
             dims,
             outcomes,
             degree,
+            degrees,
             exps,
             beta: beta.iter().copied().collect(),
             cov: (cov * dispersion).iter().copied().collect(),

@@ -1,11 +1,12 @@
 //! What a fit says: `report.md`, its figures, and a prediction's lines.
 
+use crate::calibration::params::{FixedThrow, Kind};
+use crate::calibration::predict::{BlockPrediction, Predicted};
+use crate::calibration::recovery::Recovery;
+use crate::calibration::FitResult;
 use crate::error::Result;
 use crate::report::figures::fit::{self as fig, Profile, RowRatio};
 use crate::report::figures::Point;
-use crate::calibration::params::{FixedThrow, Kind};
-use crate::calibration::predict::{BlockPrediction, Predicted};
-use crate::calibration::FitResult;
 use crate::theory::stats;
 use std::fmt::Write;
 use std::path::Path;
@@ -88,7 +89,7 @@ pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
     let _ = writeln!(s, "| parameter | range | fitted | 1σ | 2σ | |");
     let _ = writeln!(s, "|---|---|---:|---|---|---|");
     for p in &e.params {
-        let r = c.model.range(p.param.kind);
+        let r = p.param.range;
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} – {} | {} – {} | {} |",
@@ -147,7 +148,10 @@ pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
          parameters, fitted to its design's counts. Lack of fit: the deviance against its \
          degrees of freedom; a dispersion above 1 widens the surrogate's error by it.\n"
     );
-    let _ = writeln!(s, "| block | degree | deviance / dof | lack-of-fit p | dispersion | not settled |");
+    let _ = writeln!(
+        s,
+        "| block | degree | deviance / dof | lack-of-fit p | dispersion | not settled |"
+    );
     let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|");
     for d in &res.designs {
         let sg = &d.surrogate;
@@ -222,7 +226,13 @@ pub fn write_figures(dir: &Path, res: &FitResult) -> Result<Vec<&'static str>> {
     }
     let rows = row_ratios(res);
     if !rows.is_empty() {
-        fig::rows(dir, "fit_rows", "Each row: measured against fitted", "fitted", &rows)?;
+        fig::rows(
+            dir,
+            "fit_rows",
+            "Each row: measured against fitted",
+            "fitted",
+            &rows,
+        )?;
         stems.push("fit_rows");
     }
     Ok(stems)
@@ -258,7 +268,48 @@ pub fn prediction_text(p: &BlockPrediction) -> String {
         p.theory_ratio
     );
     if p.unsettled > 0 {
-        let _ = writeln!(s, "  {} rolls did not settle on a face (left out)", p.unsettled);
+        let _ = writeln!(
+            s,
+            "  {} rolls did not settle on a face (left out)",
+            p.unsettled
+        );
+    }
+    s
+}
+
+/// A recovery check's lines for the terminal.
+pub fn recovery_text(r: &Recovery) -> String {
+    let n = r.repetitions.len();
+    let covered = r.repetitions.iter().filter(|x| x.covered).count();
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "recovery: {n} repetitions, {} rolls; the truth inside the joint 2σ region (Δ(−2 ln L) ≤ {:.2}) in {covered} of {n} ({:.0} %; stated 95.45 %)",
+        r.rolls,
+        r.region_delta,
+        100.0 * r.coverage
+    );
+    let mean = r.repetitions.iter().map(|x| x.truth_delta).sum::<f64>() / n.max(1) as f64;
+    let _ = writeln!(
+        s,
+        "  the truth's Δ(−2 ln L): mean {mean:.2} (χ² with {} degrees of freedom: {})",
+        r.names.len(),
+        r.names.len()
+    );
+    for (j, name) in r.names.iter().enumerate() {
+        let vals: Vec<f64> = r.repetitions.iter().map(|x| x.values[j]).collect();
+        let m = vals.iter().sum::<f64>() / vals.len().max(1) as f64;
+        let sd = (vals.iter().map(|v| (v - m).powi(2)).sum::<f64>()
+            / (vals.len().max(2) - 1) as f64)
+            .sqrt();
+        let _ = writeln!(
+            s,
+            "  {name}: truth {}, fitted {} ± {} (mean ± sd over repetitions), inside its 2σ interval in {:.0} %",
+            num(r.truth[j]),
+            num(m),
+            num(sd),
+            100.0 * r.interval_coverage[j]
+        );
     }
     s
 }

@@ -2,6 +2,7 @@
 //! Markdown and CSV, and the figures.
 
 pub mod figures;
+pub mod fit;
 pub mod outcomes;
 pub mod paper;
 pub mod per_roll;

@@ -2,6 +2,7 @@
 //! block simulated over its design, the data simulated at a known truth for the recovery
 //! check, and a new block simulated at the fit's posterior draws.
 
+pub mod check;
 pub mod predict;
 pub mod recovery;
 pub mod simulate;
@@ -28,7 +29,7 @@ pub fn simulate(
         design: &cfg.design,
         seed: cfg.seed,
     };
-    simulate::simulate(&plan, &design::keys(&cfg.rows), runner, dir)
+    simulate::simulate(&plan, &design::keys(&cfg.rows, &cfg.model), runner, dir)
 }
 
 /// Runs the fit: simulates (resuming from `dir`), then estimates. `None` if a stop request

@@ -39,6 +39,7 @@ pub fn predict_block(
     };
     let model = &fit.config.model;
     let dims = model.row_dims(&fit.params, &row);
+    let axes = model.axes(&fit.params, &dims);
     let step = fit.estimate.draws.len() / cfg.draws;
     let mut freq: [Vec<f64>; 3] = Default::default();
     let mut ratios = Vec::new();
@@ -46,7 +47,7 @@ pub fn predict_block(
     for m in 0..cfg.draws {
         let x = &fit.estimate.draws[m * step];
         let local: Vec<f64> = dims.iter().map(|&d| x[d]).collect();
-        let values = model.values(&local);
+        let values = crate::calibration::params::values(&model.fixed, &axes, &local);
         let seed = point_seed(cfg.seed, cfg.block, cfg.mode, m);
         let spec = fit
             .config

@@ -8,45 +8,11 @@ use crate::calibration::data::DataRow;
 use crate::calibration::design::{self, point_seed, Design};
 use crate::calibration::estimate::Likelihood;
 use crate::calibration::params::Fixed;
+use crate::calibration::recovery::{Recovery, Repetition};
 use crate::calibration::FitConfig;
 use crate::error::{Error, Result};
 use crate::run::runner::Runner;
 use crate::studies::fit::simulate::Plan;
-use serde::{Deserialize, Serialize};
-
-/// One repetition.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct Repetition {
-    /// Its seed.
-    pub seed: u64,
-    /// Δ(−2 ln L) of the truth above the maximum.
-    pub truth_delta: f64,
-    /// The truth inside the joint 2σ region (Δ ≤ the region's bound).
-    pub covered: bool,
-    /// Per parameter: the truth inside its 2σ profile interval.
-    pub in_interval: Vec<bool>,
-    /// The fitted values.
-    pub values: Vec<f64>,
-}
-
-/// The check's result.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct Recovery {
-    /// The truth, per parameter.
-    pub truth: Vec<f64>,
-    /// The parameters' names.
-    pub names: Vec<String>,
-    /// The joint region's Δ bound.
-    pub region_delta: f64,
-    /// Each repetition.
-    pub repetitions: Vec<Repetition>,
-    /// The fraction whose joint 2σ region holds the truth.
-    pub coverage: f64,
-    /// Per parameter, the fraction whose 2σ interval holds it.
-    pub interval_coverage: Vec<f64>,
-    /// Rolls made.
-    pub rolls: u64,
-}
 
 /// Counts of `rows`' blocks simulated at `truth` with as many throws as each row counts.
 pub fn simulate_data(
@@ -118,8 +84,9 @@ pub fn run(
         .zip(truth)
         .map(|((k, r), v)| k.coordinate(*r, *v))
         .collect();
-    let truth_values = model.values(&coords);
-    let keys = design::keys(&cfg.rows);
+    let truth_values =
+        crate::calibration::params::values(&model.fixed, &model.whole_axes(), &coords);
+    let keys = design::keys(&cfg.rows, model);
     let mut reps = Vec::new();
     let mut rolls = 0u64;
     let mut names = Vec::new();

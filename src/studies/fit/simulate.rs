@@ -1,11 +1,9 @@
 //! Rolling the designs of a fit: each parameter point a cell of its own (resumable, keyed).
 
-use crate::calibration::design::point_seed;
-use crate::calibration::design::{points, Design, DesignSpec};
-use crate::calibration::params::{Method, ModelSpec};
+use crate::calibration::design::{points, Design, DesignSpec, Key};
+use crate::calibration::params::{self, Method, ModelSpec};
 use crate::error::Result;
 use crate::inference::surrogate::{DesignPoint, Surrogate};
-use crate::model::block::Block;
 use crate::model::scene::Mode;
 use crate::run::runner::Runner;
 use std::path::Path;
@@ -35,7 +33,7 @@ impl Plan<'_> {
 /// is kept in `dir`.
 pub fn simulate(
     plan: &Plan,
-    keys: &[(Block, Mode)],
+    keys: &[Key],
     runner: &Runner,
     dir: Option<&Path>,
 ) -> Result<Option<Vec<Design>>> {
@@ -43,23 +41,20 @@ pub fn simulate(
     let xs = points(dims, plan.design.points);
     let mut done_before = 0u64;
     let mut out = Vec::new();
-    for &(block, mode) in keys {
+    for key in keys {
+        let (block, mode) = (key.block, key.mode);
         let mut design_points = Vec::new();
         let (mut unsettled, mut rolls) = (0u64, 0u64);
         for (g, x) in xs.iter().enumerate() {
-            let values = plan.model.values(x);
-            let seed = point_seed(plan.seed, block, mode, g);
+            let values = params::values(&plan.model.fixed, &key.axes, x);
+            let seed = key.seed(plan.seed, g);
             let spec = plan
                 .method
                 .spec(block, mode, &values, seed, plan.design.rolls);
             spec.validate(false)?;
             let ck = match dir {
                 Some(d) => Some(
-                    runner.open_cell(
-                        &d.join(format!("{block}-{}", mode.name()))
-                            .join(format!("point-{g:05}")),
-                        &spec,
-                    )?,
+                    runner.open_cell(&d.join(key.tag()).join(format!("point-{g:05}")), &spec)?,
                 ),
                 None => None,
             };
@@ -104,6 +99,7 @@ pub fn simulate(
         out.push(Design {
             block,
             mode,
+            axes: key.axes.clone(),
             points: design_points,
             unsettled,
             rolls,

@@ -1,0 +1,377 @@
+//! `dicephys fit` (calibrate e, μ and the throw to measured counts, or check that a fit
+//! recovers known values) and `dicephys predict` (a block the fit did not see).
+
+use super::args::{parse_block, parse_engine, parse_step};
+use super::error::{Error, Result};
+use super::outln;
+use clap::Args;
+use dicephys::calibration::data;
+use dicephys::calibration::design::DesignSpec;
+use dicephys::calibration::estimate::Search;
+use dicephys::calibration::params::{Fixed, FixedThrow, Kind, Method, ModelSpec};
+use dicephys::calibration::predict::PredictConfig;
+use dicephys::calibration::{FitConfig, FitResult};
+use dicephys::engine::EngineKind;
+use dicephys::model::block::Block;
+use dicephys::model::scene::Mode;
+use dicephys::model::throws::Range;
+use dicephys::report::fit as report;
+use dicephys::sim::roll::DEFAULT_MAX_STEPS;
+use dicephys::studies::fit as study;
+use std::path::{Path, PathBuf};
+
+/// `dicephys fit`'s arguments.
+#[derive(Args, Debug)]
+pub struct FitArgs {
+    /// The measured counts: a CSV with the columns label, surface, length_mm, breadth_mm,
+    /// width_mm, mode (2d or 3d), length_vertical, breadth_vertical, width_vertical and
+    /// optionally thrower (docs/guide.md, "Calibrating").
+    #[arg(long, value_name = "COUNTS.csv")]
+    pub data: PathBuf,
+    /// The free parameters (comma-separated): e (restitution), mu (friction), kappa (the
+    /// throw's concentration, --throw hand), spin (a factor on the spin range).
+    #[arg(long, value_delimiter = ',', default_value = "e,mu", value_parser = parse_kind)]
+    pub free: Vec<Kind>,
+    /// Surface parameters shared by every surface instead of one per surface (e, mu).
+    #[arg(long, value_delimiter = ',', value_parser = parse_kind)]
+    pub shared: Vec<Kind>,
+    /// A free parameter's range, NAME=LO:HI (repeat for several). Defaults: e=0.05:0.9,
+    /// mu=0.1:1, kappa=0:10000, spin=0.5:2.
+    #[arg(long = "range", value_name = "NAME=LO:HI")]
+    pub ranges: Vec<String>,
+    /// e where it is not free.
+    #[arg(long, default_value_t = 0.5)]
+    pub restitution: f64,
+    /// μ where it is not free.
+    #[arg(long, default_value_t = 0.29)]
+    pub friction: f64,
+    /// The throw where kappa is not free: "paper" (the paper's throw) or a hand's κ.
+    #[arg(long, default_value = "paper")]
+    pub kappa: String,
+    /// The spin scale where spin is not free.
+    #[arg(long, default_value_t = 1.0)]
+    pub spin_scale: f64,
+    /// The engine.
+    #[arg(long, default_value = "bullet", value_parser = parse_engine)]
+    pub engine: EngineKind,
+    /// The time step, s or 1/N.
+    #[arg(long, default_value = "1/1000", value_parser = parse_step)]
+    pub dt: f64,
+    /// Steps after which a roll not at rest counts as unconverged.
+    #[arg(long, default_value_t = DEFAULT_MAX_STEPS)]
+    pub max_steps: u64,
+    /// Parameter points each block is simulated at.
+    #[arg(long, default_value_t = 64)]
+    pub points: usize,
+    /// Rolls at each point.
+    #[arg(long, default_value_t = 1000)]
+    pub rolls: u64,
+    /// The surrogate's polynomial degree (raised while it lacks fit, up to --max-degree).
+    #[arg(long, default_value_t = 3)]
+    pub degree: usize,
+    /// The highest surrogate degree tried.
+    #[arg(long, default_value_t = 4)]
+    pub max_degree: usize,
+    /// Seed of the keyed throws.
+    #[arg(long, default_value_t = 2385)]
+    pub seed: u64,
+    /// Worker threads (0: one per core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Output directory: fit.json, report.md, figures, and the simulations' checkpoints.
+    #[arg(long, default_value = "fit-out")]
+    pub out: PathBuf,
+    /// Instead of fitting the file's counts: simulate counts of its rows (same blocks and
+    /// numbers of throws) at these values, NAME=V,… for every free parameter, fit them back,
+    /// --repeats times, and report how often the 2σ region holds the truth.
+    #[arg(long, value_name = "NAME=V,...")]
+    pub recover: Option<String>,
+    /// With --recover: repetitions (each its own data and simulations).
+    #[arg(long, default_value_t = 20)]
+    pub repeats: usize,
+    /// Print the result's JSON to stdout instead of the report.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `dicephys predict`'s arguments.
+#[derive(Args, Debug)]
+pub struct PredictArgs {
+    /// The fit to predict from (a fit's fit.json).
+    #[arg(long, value_name = "FIT.json")]
+    pub fit: PathBuf,
+    /// The block, LENGTHxBREADTHxWIDTH in mm.
+    #[arg(long, value_parser = parse_block)]
+    pub block: Block,
+    /// Simulate it in 2D (DicePhys's plane-locked block).
+    #[arg(long = "2d")]
+    pub two_d: bool,
+    /// The surface whose fitted e and μ to use (when the fit has one per surface).
+    #[arg(long)]
+    pub surface: Option<String>,
+    /// The thrower whose fitted throw to use (when the fit has several).
+    #[arg(long)]
+    pub thrower: Option<String>,
+    /// Posterior draws to simulate the block at.
+    #[arg(long, default_value_t = 16)]
+    pub draws: usize,
+    /// Rolls at each draw.
+    #[arg(long, default_value_t = 2000)]
+    pub rolls: u64,
+    /// Seed of the keyed throws.
+    #[arg(long, default_value_t = 2385)]
+    pub seed: u64,
+    /// Worker threads (0: one per core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Print the prediction's JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// A parameter's name as clap reads it.
+pub fn parse_kind(s: &str) -> std::result::Result<Kind, dicephys::Error> {
+    dicephys::error::parse_name("parameter", s)
+}
+
+/// `NAME=V` pairs, comma-separated, each name a parameter kind.
+fn pairs<T>(
+    flag: &str,
+    items: &[&str],
+    value: impl Fn(&str) -> Option<T>,
+) -> Result<Vec<(Kind, T)>> {
+    items
+        .iter()
+        .map(|item| {
+            let (k, v) = item
+                .split_once('=')
+                .ok_or_else(|| Error::Usage(format!("{flag} {item}: write NAME=VALUE")))?;
+            let kind =
+                parse_kind(k.trim()).map_err(|e| Error::Usage(format!("{flag} {item}: {e}")))?;
+            let v = value(v.trim()).ok_or_else(|| {
+                Error::Usage(format!("{flag} {item}: '{v}' is not a valid value"))
+            })?;
+            Ok((kind, v))
+        })
+        .collect()
+}
+
+impl FitArgs {
+    fn model(&self) -> Result<ModelSpec> {
+        let mut free = self.free.clone();
+        free.sort();
+        free.dedup();
+        let mut ranges: Vec<Range> = free.iter().map(|k| k.default_range()).collect();
+        let given: Vec<&str> = self.ranges.iter().map(String::as_str).collect();
+        for (kind, r) in pairs("--range", &given, |v| v.parse::<Range>().ok())? {
+            let i = free.iter().position(|k| *k == kind).ok_or_else(|| {
+                Error::Usage(format!("--range {kind}=…: {kind} is not among --free"))
+            })?;
+            ranges[i] = r;
+        }
+        let throw = match self.kappa.as_str() {
+            "paper" => FixedThrow::Paper,
+            k => FixedThrow::Hand(k.parse().map_err(|_| {
+                Error::Usage(format!("--kappa {k}: 'paper' or a concentration >= 0"))
+            })?),
+        };
+        let model = ModelSpec {
+            free,
+            shared: self.shared.clone(),
+            ranges,
+            fixed: Fixed {
+                e: self.restitution,
+                mu: self.friction,
+                throw,
+                spin: self.spin_scale,
+            },
+            narrowed: vec![],
+        };
+        model.validate()?;
+        Ok(model)
+    }
+
+    fn config(&self) -> Result<FitConfig> {
+        let text = std::fs::read_to_string(&self.data).map_err(|e| {
+            Error::Usage(format!(
+                "--data {}: cannot read it ({e})",
+                self.data.display()
+            ))
+        })?;
+        let rows = data::parse(&text, &self.data.display().to_string())?;
+        let cfg = FitConfig {
+            rows,
+            model: self.model()?,
+            method: Method {
+                engine: self.engine,
+                dt: self.dt,
+                max_steps: self.max_steps,
+            },
+            design: DesignSpec {
+                points: self.points,
+                rolls: self.rolls,
+                degree: self.degree,
+                max_degree: self.max_degree,
+            },
+            search: Search {
+                seed: self.seed,
+                ..Search::default()
+            },
+            seed: self.seed,
+        };
+        cfg.validate()?;
+        Ok(cfg)
+    }
+}
+
+/// A progress bar over `total` rolls on a terminal, hidden otherwise.
+fn bar(total: u64, quiet: bool) -> indicatif::ProgressBar {
+    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+    use std::io::IsTerminal;
+    if quiet || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+    b.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{wide_bar}] {pos}/{len} rolls, ETA {eta}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    b
+}
+
+fn interrupted(dir: &Path) -> Error {
+    Error::Interrupted(format!(
+        "interrupted; {} kept what was rolled: run the same command to continue",
+        dir.display()
+    ))
+}
+
+/// Runs `dicephys fit`.
+pub fn run(a: &FitArgs) -> Result<()> {
+    let cfg = a.config()?;
+    let threads = super::args::threads(a.threads)?;
+    if a.recover.is_some() && a.repeats == 0 {
+        return Err(Error::Usage(
+            "--repeats 0: need at least one repetition".into(),
+        ));
+    }
+    std::fs::create_dir_all(&a.out)
+        .map_err(|e| Error::Usage(format!("--out {}: cannot create it ({e})", a.out.display())))?;
+    let command_line = std::env::args().collect::<Vec<_>>().join(" ");
+    if let Some(truth) = &a.recover {
+        return recover(a, &cfg, truth, threads);
+    }
+    let outputs = [
+        super::output(&a.out.join("fit.json"))?,
+        super::output(&a.out.join("report.md"))?,
+    ];
+    let bar = bar(cfg.total_rolls(), a.json);
+    let progress = |n| bar.set_position(n);
+    let runner = super::runner(threads);
+    let cells = a.out.join("cells");
+    let res = study::run(
+        &cfg,
+        command_line,
+        &runner.with_progress(&progress),
+        Some(&cells),
+    )?;
+    bar.finish_and_clear();
+    let Some(res) = res else {
+        return Err(interrupted(&cells));
+    };
+    let figures = report::write_figures(&a.out, &res)?;
+    let md = report::markdown(&res, &figures);
+    let json = serde_json::to_string_pretty(&res).map_err(|e| Error::Run(e.to_string()))?;
+    outputs[0].write(json.as_bytes())?;
+    outputs[1].write(md.as_bytes())?;
+    if a.json {
+        outln!("{json}");
+    } else {
+        outln!("{md}");
+        eprintln!("wrote {}/fit.json, report.md and figures", a.out.display());
+    }
+    Ok(())
+}
+
+fn recover(a: &FitArgs, cfg: &FitConfig, truth: &str, threads: usize) -> Result<()> {
+    let given: Vec<&str> = truth.split(',').collect();
+    let values = pairs("--recover", &given, |v| {
+        v.parse::<f64>().ok().filter(|x| x.is_finite())
+    })?;
+    let mut truth = Vec::new();
+    for k in &cfg.model.free {
+        let v = values.iter().find(|(kind, _)| kind == k).ok_or_else(|| {
+            Error::Usage(format!(
+                "--recover: give a value for the free parameter {k}"
+            ))
+        })?;
+        truth.push(v.1);
+    }
+    if let Some((k, _)) = values.iter().find(|(k, _)| !cfg.model.free.contains(k)) {
+        return Err(Error::Usage(format!(
+            "--recover {k}=…: {k} is not among --free"
+        )));
+    }
+    let output = super::output(&a.out.join("recovery.json"))?;
+    let rows_per_rep: u64 = cfg.rows.iter().map(|r| r.counts.iter().sum::<u64>()).sum();
+    let bar = bar(
+        (cfg.total_rolls() + rows_per_rep) * a.repeats as u64,
+        a.json,
+    );
+    let progress = |n| bar.set_position(n);
+    let runner = super::runner(threads);
+    let res = study::recovery::run(cfg, &truth, a.repeats, &runner.with_progress(&progress))?;
+    bar.finish_and_clear();
+    let Some(res) = res else {
+        return Err(Error::Interrupted(
+            "interrupted before the repetitions were done".into(),
+        ));
+    };
+    let json = serde_json::to_string_pretty(&res).map_err(|e| Error::Run(e.to_string()))?;
+    output.write(json.as_bytes())?;
+    if a.json {
+        outln!("{json}");
+    } else {
+        outln!("{}", report::recovery_text(&res));
+    }
+    Ok(())
+}
+
+/// Runs `dicephys predict`.
+pub fn predict(a: &PredictArgs) -> Result<()> {
+    let text = std::fs::read_to_string(&a.fit)
+        .map_err(|e| Error::Usage(format!("--fit {}: cannot read it ({e})", a.fit.display())))?;
+    let fit: FitResult = serde_json::from_str(&text).map_err(|e| {
+        Error::Usage(format!(
+            "--fit {}: not a fit's fit.json ({e})",
+            a.fit.display()
+        ))
+    })?;
+    let threads = super::args::threads(a.threads)?;
+    let cfg = PredictConfig {
+        block: a.block,
+        mode: if a.two_d { Mode::TwoD } else { Mode::ThreeD },
+        surface: a.surface.clone(),
+        thrower: a.thrower.clone(),
+        draws: a.draws,
+        rolls: a.rolls,
+        seed: a.seed,
+    };
+    let bar = bar(a.draws as u64 * a.rolls, a.json);
+    let progress = |n| bar.set_position(n);
+    let runner = super::runner(threads);
+    let p = study::predict::predict_block(&fit, &cfg, &runner.with_progress(&progress), None)?;
+    bar.finish_and_clear();
+    let Some(p) = p else {
+        return Err(Error::Interrupted(
+            "interrupted before the draws were rolled".into(),
+        ));
+    };
+    if a.json {
+        let json = serde_json::to_string_pretty(&p).map_err(|e| Error::Run(e.to_string()))?;
+        outln!("{json}");
+    } else {
+        super::out!("{}", report::prediction_text(&p));
+    }
+    Ok(())
+}
