@@ -33,15 +33,19 @@ pub struct DesignSpec {
     pub degree: usize,
     /// The highest degree tried.
     pub max_degree: usize,
+    /// A second pass: every block simulated afresh over a box narrowed to the first pass's
+    /// region ([`crate::calibration::narrow`]), and the fit made again there.
+    pub refine: bool,
 }
 
 impl Default for DesignSpec {
     fn default() -> Self {
         DesignSpec {
             points: 64,
-            rolls: 1000,
+            rolls: 500,
             degree: 3,
             max_degree: 4,
+            refine: true,
         }
     }
 }
@@ -56,6 +60,16 @@ impl DesignSpec {
                 "points {}: a design over {dims} parameters needs at least {} (its corners and centre)",
                 self.points,
                 corners + 1
+            ));
+        }
+        let features = crate::inference::surrogate::exponents(dims, self.degree).len();
+        if self.points < 2 * features {
+            return bad(format!(
+                "points {}: a degree-{} surrogate over {dims} parameters has {features} coefficients \
+                 an outcome, and needs at least twice as many points ({})",
+                self.points,
+                self.degree,
+                2 * features
             ));
         }
         if self.points > 100_000 {
@@ -89,9 +103,26 @@ fn halton(mut i: usize, base: usize) -> f64 {
     r
 }
 
+/// The first `n` primes, the Halton sequence's bases.
+fn primes(n: usize) -> Vec<usize> {
+    let mut out: Vec<usize> = Vec::with_capacity(n);
+    let mut k = 2;
+    while out.len() < n {
+        if out.iter().all(|p| k % p != 0) {
+            out.push(k);
+        }
+        k += 1;
+    }
+    out
+}
+
+/// Point `i` (from 1) of the Halton sequence in [0, 1)^dims.
+pub fn halton_point(i: usize, dims: usize) -> Vec<f64> {
+    primes(dims).into_iter().map(|b| halton(i, b)).collect()
+}
+
 /// The design's `n` points in [0, 1]^dims: the corners, the centre, then Halton points.
 pub fn points(dims: usize, n: usize) -> Vec<Vec<f64>> {
-    const BASES: [usize; 6] = [2, 3, 5, 7, 11, 13];
     if dims == 0 {
         return vec![vec![]];
     }
@@ -101,7 +132,7 @@ pub fn points(dims: usize, n: usize) -> Vec<Vec<f64>> {
     out.push(vec![0.5; dims]);
     let mut i = 1;
     while out.len() < n.max(out.len()) {
-        out.push((0..dims).map(|j| halton(i, BASES[j])).collect());
+        out.push(halton_point(i, dims));
         i += 1;
     }
     out.truncate(n.max(1 + (1 << dims)));

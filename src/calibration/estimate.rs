@@ -136,10 +136,19 @@ pub enum Identified {
     LowerBoundOnly,
     /// Its 2σ region spans the whole range: the data do not fix it.
     No,
+    /// Its 2σ region reaches a face of the box a first pass narrowed it to: the narrowing cut
+    /// the region (widen the range, or fit in one pass).
+    Cut,
 }
 
 impl Identified {
-    fn of(i: &Interval) -> Identified {
+    fn of(i: &Interval, p: &Param) -> Identified {
+        // An open side on a face of a narrowed range that is not the kind's own face.
+        let cut_lo = i.lo_open && p.range.lo > p.whole.lo;
+        let cut_hi = i.hi_open && p.range.hi < p.whole.hi;
+        if cut_lo || cut_hi {
+            return Identified::Cut;
+        }
         match (i.lo_open, i.hi_open) {
             (false, false) => Identified::Yes,
             (true, false) => Identified::UpperBoundOnly,
@@ -159,6 +168,7 @@ impl Identified {
                 "bounded below only (its 2σ region reaches the range's upper end)"
             }
             Identified::No => "not identifiable: its 2σ region spans the whole range",
+            Identified::Cut => "its 2σ region reaches the edge of the second pass's narrowed box: the box cut it",
         }
     }
 }
@@ -265,10 +275,7 @@ impl Default for Search {
 pub fn maximise(lik: &Likelihood, dims: usize, starts: usize) -> Result<(Minimum, Vec<f64>)> {
     let mut start_points = vec![vec![0.5; dims]];
     start_points.extend(
-        crate::calibration::design::points(dims, starts + (1 << dims.min(10)) + 1)
-            .into_iter()
-            .skip((1 << dims.min(10)) + 1)
-            .take(starts.saturating_sub(1)),
+        (1..starts.max(1)).map(|i| crate::calibration::design::halton_point(i, dims)),
     );
     maximise_from(lik, &start_points)
 }
@@ -333,7 +340,7 @@ pub fn estimate(lik: &Likelihood, params: &[Param], search: &Search) -> Result<E
             value: phys(best.x[j]),
             one_sigma: [phys(one.lo), phys(one.hi)],
             two_sigma: [phys(two.lo), phys(two.hi)],
-            identified: Identified::of(&two),
+            identified: Identified::of(&two, param),
             profile: prof.iter().map(|(u, v)| [phys(*u), v - fmin]).collect(),
         });
     }

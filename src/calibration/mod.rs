@@ -25,6 +25,7 @@ pub mod crossval;
 pub mod data;
 pub mod design;
 pub mod estimate;
+pub mod paper;
 pub mod params;
 pub mod predict;
 pub mod recovery;
@@ -90,11 +91,12 @@ impl FitConfig {
         Ok(())
     }
 
-    /// The rolls the design makes.
+    /// The rolls the first pass makes.
     pub fn total_rolls(&self) -> u64 {
         let per_key = design::points(self.model.free.len(), self.design.points).len() as u64;
         design::keys(&self.rows, &self.model).len() as u64 * per_key * self.design.rolls
     }
+
 }
 
 /// What a fit cost.
@@ -115,8 +117,11 @@ pub struct FitCost {
 pub struct FitResult {
     /// What was fitted.
     pub config: FitConfig,
-    /// The free parameters, in the estimate's order.
+    /// The free parameters, in the estimate's order (with the second pass's ranges).
     pub params: Vec<Param>,
+    /// The first pass's parameters, when a second pass refined them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first_pass: Option<Vec<estimate::ParamFit>>,
     /// The blocks simulated, with their surrogates.
     pub designs: Vec<Design>,
     /// The estimate.
@@ -129,6 +134,41 @@ pub struct FitResult {
     pub dicephys_version: String,
     /// When it ended, UTC.
     pub date_utc: String,
+}
+
+/// The second pass's box: each parameter's first-pass 2σ profile interval, widened by half its
+/// width on each side (and to at least a tenth of its range), within its range. A parameter
+/// whose widened interval still covers 80 % of its range keeps the whole range, and so does one
+/// that only one row informs: a fit that leaves that row out (a leave-one-out prediction) must
+/// then know nothing of it, not a box the row itself chose.
+pub fn narrow(rows: &[DataRow], model: &ModelSpec, params: &[Param], first: &Estimate) -> Vec<params::Narrowed> {
+    let mut uses = vec![0usize; params.len()];
+    for r in rows {
+        for d in model.row_dims(params, r) {
+            uses[d] += 1;
+        }
+    }
+    let mut out = Vec::new();
+    for ((p, fit), &n) in params.iter().zip(&first.params).zip(&uses) {
+        if n < 2 {
+            continue;
+        }
+        let u = |v: f64| p.kind.coordinate(p.range, v).clamp(0.0, 1.0);
+        let (lo, hi) = (u(fit.two_sigma[0]), u(fit.two_sigma[1]));
+        let pad = (0.5 * (hi - lo)).max(0.05);
+        let (a, b) = ((lo - pad).max(0.0), (hi + pad).min(1.0));
+        if b - a >= 0.8 {
+            continue;
+        }
+        out.push(params::Narrowed {
+            param: p.name(),
+            range: crate::model::throws::Range::new(
+                p.kind.value(p.range, a),
+                p.kind.value(p.range, b),
+            ),
+        });
+    }
+    out
 }
 
 /// Fits `rows` with the designs already simulated (the cheap part: no rolls).

@@ -35,7 +35,7 @@ pub struct FitArgs {
     /// Surface parameters shared by every surface instead of one per surface (e, mu).
     #[arg(long, value_delimiter = ',', value_parser = parse_kind)]
     pub shared: Vec<Kind>,
-    /// A free parameter's range, NAME=LO:HI (repeat for several). Defaults: e=0.05:0.9,
+    /// A free parameter's range, NAME=LO:HI (repeat for several). Defaults: e=0.05:0.8,
     /// mu=0.1:1, kappa=0:10000, spin=0.5:2.
     #[arg(long = "range", value_name = "NAME=LO:HI")]
     pub ranges: Vec<String>,
@@ -64,7 +64,7 @@ pub struct FitArgs {
     #[arg(long, default_value_t = 64)]
     pub points: usize,
     /// Rolls at each point.
-    #[arg(long, default_value_t = 1000)]
+    #[arg(long, default_value_t = 500)]
     pub rolls: u64,
     /// The surrogate's polynomial degree (raised while it lacks fit, up to --max-degree).
     #[arg(long, default_value_t = 3)]
@@ -72,6 +72,9 @@ pub struct FitArgs {
     /// The highest surrogate degree tried.
     #[arg(long, default_value_t = 4)]
     pub max_degree: usize,
+    /// One pass only: no second pass over the box narrowed to the first pass's region.
+    #[arg(long)]
+    pub no_refine: bool,
     /// Seed of the keyed throws.
     #[arg(long, default_value_t = 2385)]
     pub seed: u64,
@@ -212,6 +215,7 @@ impl FitArgs {
                 rolls: self.rolls,
                 degree: self.degree,
                 max_degree: self.max_degree,
+                refine: !self.no_refine,
             },
             search: Search {
                 seed: self.seed,

@@ -338,31 +338,42 @@ impl Surrogate {
         softmax(&eta)
     }
 
+    /// The log-odds at features `phi`, from the coefficients as stored.
+    fn eta(&self, phi: &DVector<f64>) -> Vec<f64> {
+        let m = self.exps.len();
+        (0..self.outcomes - 1)
+            .map(|a| (0..m).map(|i| self.beta[a * m + i] * phi[i]).sum())
+            .collect()
+    }
+
     /// The probabilities at `x` (unit coordinates).
     pub fn p(&self, x: &[f64]) -> Vec<f64> {
-        let phi = features(x, &self.exps, self.degree);
-        let beta = DVector::from_column_slice(&self.beta);
-        Self::probs(&beta, &phi, self.outcomes - 1, self.exps.len())
+        softmax(&self.eta(&features(x, &self.exps, self.degree)))
     }
 
     /// The probabilities at `x` with their covariance, by the delta method:
-    /// ∂p_k/∂β_a = p_k (δ_ka − p_a) φ.
+    /// ∂p_k/∂β_a = p_k (δ_ka − p_a) φ. Read from the stored coefficients and covariance in
+    /// place (this runs for every row at every step of every search).
     pub fn predict(&self, x: &[f64]) -> Prediction {
         let m = self.exps.len();
         let k1 = self.outcomes - 1;
-        let phi = features(x, &self.exps, self.degree);
-        let beta = DVector::from_column_slice(&self.beta);
-        let p = Self::probs(&beta, &phi, k1, m);
         let size = k1 * m;
-        let cov_b = DMatrix::from_row_slice(size, size, &self.cov);
-        // The log-odds' covariance first (k1 × k1), then the softmax's Jacobian.
-        let mut g = DMatrix::<f64>::zeros(k1, size);
+        let phi = features(x, &self.exps, self.degree);
+        let p = softmax(&self.eta(&phi));
+        // The log-odds' covariance: V_ab = φᵀ C_ab φ over the (a, b) block of the coefficients'.
+        let mut v_eta = DMatrix::<f64>::zeros(k1, k1);
         for a in 0..k1 {
-            for i in 0..m {
-                g[(a, a * m + i)] = phi[i];
+            for b in a..k1 {
+                let mut v = 0.0;
+                for i in 0..m {
+                    let row = &self.cov[(a * m + i) * size + b * m..(a * m + i) * size + b * m + m];
+                    let dot: f64 = row.iter().zip(phi.iter()).map(|(c, f)| c * f).sum();
+                    v += phi[i] * dot;
+                }
+                v_eta[(a, b)] = v;
+                v_eta[(b, a)] = v;
             }
         }
-        let v_eta = &g * cov_b * g.transpose();
         let mut j = DMatrix::<f64>::zeros(self.outcomes, k1);
         for k in 0..self.outcomes {
             for a in 0..k1 {

@@ -2,6 +2,7 @@
 //! against cost and of where methods fail.
 
 pub mod bench;
+pub mod calibrated;
 pub mod converge;
 pub mod fit;
 pub mod paper;

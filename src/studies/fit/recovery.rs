@@ -5,14 +5,13 @@
 //! surrogates' noise is part of what is checked.
 
 use crate::calibration::data::DataRow;
-use crate::calibration::design::{self, point_seed, Design};
+use crate::calibration::design::point_seed;
 use crate::calibration::estimate::Likelihood;
 use crate::calibration::params::Fixed;
 use crate::calibration::recovery::{Recovery, Repetition};
 use crate::calibration::FitConfig;
 use crate::error::{Error, Result};
 use crate::run::runner::Runner;
-use crate::studies::fit::simulate::Plan;
 
 /// Counts of `rows`' blocks simulated at `truth` with as many throws as each row counts.
 pub fn simulate_data(
@@ -86,40 +85,40 @@ pub fn run(
         .collect();
     let truth_values =
         crate::calibration::params::values(&model.fixed, &model.whole_axes(), &coords);
-    let keys = design::keys(&cfg.rows, model);
     let mut reps = Vec::new();
     let mut rolls = 0u64;
     let mut names = Vec::new();
     let mut region = 0.0;
+    let session = super::Session::default();
     for rep in 0..repeats {
         let seed = cfg.seed.wrapping_add(1_000_003 * rep as u64);
         let Some(rows) = simulate_data(cfg, &truth_values, seed ^ 0x5eed_da7a, runner)? else {
             return Ok(None);
         };
-        let plan = Plan {
-            model,
-            method: &cfg.method,
-            design: &cfg.design,
+        let data_cfg = FitConfig {
+            rows,
             seed,
+            ..cfg.clone()
         };
-        let Some(designs): Option<Vec<Design>> =
-            crate::studies::fit::simulate::simulate(&plan, &keys, runner, None)?
-        else {
+        let Some(fitted) = super::fit(&data_cfg, runner, None, &session)? else {
             return Ok(None);
         };
-        rolls += designs.iter().map(|d| d.rolls).sum::<u64>()
-            + rows
-                .iter()
-                .map(|r| r.counts.iter().sum::<u64>())
-                .sum::<u64>();
-        let (params, est) = crate::calibration::estimate_with(&rows, model, &designs, &cfg.search)?;
-        let lik = Likelihood::new(&rows, &designs, model, &params);
-        // The truth in the full parameter vector: every group of a kind at its value.
+        rolls += fitted.rolls + data_cfg.rows.iter().map(|r| r.counts.iter().sum::<u64>()).sum::<u64>();
+        let (params, est) = (&fitted.params, &fitted.estimate);
+        let lik = Likelihood::new(&data_cfg.rows, &fitted.designs, &fitted.config.model, params);
+        // The truth in the full parameter vector, each parameter's own coordinate (outside
+        // its narrowed box: not covered).
+        let value_of = |kind| truth[model.free.iter().position(|k| *k == kind).expect("free")];
         let x_true: Vec<f64> = params
             .iter()
-            .map(|p| coords[model.free.iter().position(|k| *k == p.kind).expect("free")])
+            .map(|p| p.kind.coordinate(p.range, value_of(p.kind)))
             .collect();
-        let delta = lik.minus_two_ln_l(&x_true) - est.minus_two_ln_l;
+        let inside = x_true.iter().all(|u| (-1e-12..=1.0 + 1e-12).contains(u));
+        let delta = if inside {
+            lik.minus_two_ln_l(&x_true) - est.minus_two_ln_l
+        } else {
+            f64::INFINITY
+        };
         names = est.params.iter().map(|p| p.name.clone()).collect();
         region = est.region_delta;
         let in_interval = est

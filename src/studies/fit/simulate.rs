@@ -7,6 +7,24 @@ use crate::inference::surrogate::{DesignPoint, Surrogate};
 use crate::model::scene::Mode;
 use crate::run::runner::Runner;
 use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+
+/// What the fits of one command share: the rolls made so far (the progress reported goes on
+/// from one fit to the next) and the designs already simulated, by key (a design is a pure
+/// function of its key and the seed, so a second model that needs it takes it as it is).
+#[derive(Default)]
+pub struct Session {
+    rolled: AtomicU64,
+    cache: Mutex<Vec<(Key, u64, Design)>>,
+}
+
+impl Session {
+    /// Rolls made so far in this session.
+    pub fn rolled(&self) -> u64 {
+        self.rolled.load(Ordering::Relaxed)
+    }
+}
 
 /// Everything `simulate` needs.
 pub struct Plan<'a> {
@@ -18,6 +36,8 @@ pub struct Plan<'a> {
     pub design: &'a DesignSpec,
     /// The run's seed.
     pub seed: u64,
+    /// The session it belongs to.
+    pub session: &'a Session,
 }
 
 impl Plan<'_> {
@@ -39,9 +59,23 @@ pub fn simulate(
 ) -> Result<Option<Vec<Design>>> {
     let dims = plan.model.free.len();
     let xs = points(dims, plan.design.points);
-    let mut done_before = 0u64;
     let mut out = Vec::new();
     for key in keys {
+        let cached = plan
+            .session
+            .cache
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .iter()
+            .find(|(k, seed, d)| {
+                k == key && *seed == plan.seed && d.points.len() == xs.len()
+                    && d.rolls == xs.len() as u64 * plan.design.rolls
+            })
+            .map(|c| c.2.clone());
+        if let Some(d) = cached {
+            out.push(d);
+            continue;
+        }
         let (block, mode) = (key.block, key.mode);
         let mut design_points = Vec::new();
         let (mut unsettled, mut rolls) = (0u64, 0u64);
@@ -58,12 +92,14 @@ pub fn simulate(
                 ),
                 None => None,
             };
-            let base = done_before;
+            let base = plan.session.rolled();
             let progress = |n| (runner.progress)(base + n);
             let done = runner
                 .with_progress(&progress)
                 .run(&spec, ck.as_ref(), &mut |_| Ok(()))?;
-            done_before += plan.design.rolls;
+            plan.session
+                .rolled
+                .fetch_add(plan.design.rolls, Ordering::Relaxed);
             if !done.complete {
                 return Ok(None);
             }
@@ -96,7 +132,7 @@ pub fn simulate(
             plan.design.degree,
             plan.design.max_degree,
         );
-        out.push(Design {
+        let design = Design {
             block,
             mode,
             axes: key.axes.clone(),
@@ -104,7 +140,13 @@ pub fn simulate(
             unsettled,
             rolls,
             surrogate,
-        });
+        };
+        plan.session
+            .cache
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push((key.clone(), plan.seed, design.clone()));
+        out.push(design);
     }
     Ok(Some(out))
 }
