@@ -1,5 +1,6 @@
-//! The documentation against the program: docs/json.md lists exactly the keys each `--json`
-//! output has.
+//! The documentation against the program: every relative link in README.md, CHANGELOG.md and
+//! docs/ resolves (file and anchor), the README keeps the two commands `.ci/run` reads, and
+//! docs/json.md lists exactly the keys each `--json` output has.
 //!
 //! docs/json.md gives each document a table after a marker `<!-- keys: NAME -->`: one row per
 //! key path (`counts.breadth`, `rows[].method`, `failed.<reason>` for keys that vary), its
@@ -19,6 +20,213 @@ fn root() -> PathBuf {
 
 fn read(p: &Path) -> String {
     std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Links
+
+/// README.md, CHANGELOG.md and every Markdown file under docs/.
+fn markdown_files() -> Vec<PathBuf> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        let mut entries: Vec<_> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        entries.sort();
+        for p in entries {
+            if p.is_dir() {
+                walk(&p, out);
+            } else if p.extension().is_some_and(|e| e == "md") {
+                out.push(p);
+            }
+        }
+    }
+    let mut v = vec![root().join("README.md"), root().join("CHANGELOG.md")];
+    walk(&root().join("docs"), &mut v);
+    v
+}
+
+/// The text outside fenced code blocks, with inline code spans blanked, line by line.
+fn prose_lines(text: &str) -> Vec<String> {
+    let mut fenced = false;
+    let mut out = Vec::new();
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+            continue;
+        }
+        if fenced {
+            continue;
+        }
+        let mut s = String::new();
+        let mut code = false;
+        for c in line.chars() {
+            if c == '`' {
+                code = !code;
+            } else if !code {
+                s.push(c);
+            }
+        }
+        out.push(s);
+    }
+    out
+}
+
+/// The targets of inline links and images, `[text](target)`.
+fn link_targets(text: &str) -> Vec<String> {
+    let mut v = Vec::new();
+    for line in prose_lines(text) {
+        let mut rest = line.as_str();
+        while let Some(i) = rest.find("](") {
+            let after = &rest[i + 2..];
+            let end = after.find(')').unwrap_or(after.len());
+            v.push(after[..end].trim().to_string());
+            rest = &after[end..];
+        }
+    }
+    v
+}
+
+/// GitHub's anchor for a heading: lower case, inline code and link markup dropped, letters,
+/// digits, `-` and `_` kept, spaces turned into `-`, everything else left out.
+fn slug(heading: &str) -> String {
+    let mut text = String::new();
+    let mut rest = heading;
+    // [text](target) -> text
+    while let Some(i) = rest.find('[') {
+        text.push_str(&rest[..i]);
+        let after = &rest[i + 1..];
+        match (after.find("]("), after.find(')')) {
+            (Some(j), Some(k)) if j < k => {
+                text.push_str(&after[..j]);
+                rest = &after[k + 1..];
+            }
+            _ => {
+                text.push('[');
+                rest = after;
+            }
+        }
+    }
+    text.push_str(rest);
+    text.trim()
+        .to_lowercase()
+        .chars()
+        .filter_map(|c| match c {
+            ' ' => Some('-'),
+            '-' | '_' => Some(c),
+            c if c.is_alphanumeric() => Some(c),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Every anchor a Markdown text's headings make (repeats get `-1`, `-2`, … as on GitHub).
+fn anchors(text: &str) -> BTreeSet<String> {
+    let mut seen: BTreeMap<String, usize> = BTreeMap::new();
+    let mut out = BTreeSet::new();
+    let mut fenced = false;
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+            continue;
+        }
+        if fenced || !line.starts_with('#') {
+            continue;
+        }
+        let s = slug(line.trim_start_matches('#'));
+        let n = seen.entry(s.clone()).or_insert(0);
+        out.insert(if *n == 0 {
+            s.clone()
+        } else {
+            format!("{s}-{n}")
+        });
+        *n += 1;
+    }
+    out
+}
+
+/// What is wrong with the relative links of `file`: a target that does not exist, or an
+/// anchor that no heading of the target makes.
+fn broken_links(file: &Path) -> Vec<String> {
+    let text = read(file);
+    let dir = file.parent().unwrap();
+    let mut bad = Vec::new();
+    for t in link_targets(&text) {
+        if t.contains("://") || t.starts_with("mailto:") || t.is_empty() {
+            continue;
+        }
+        let (path, anchor) = match t.split_once('#') {
+            Some((p, a)) => (p, Some(a)),
+            None => (t.as_str(), None),
+        };
+        let target = if path.is_empty() {
+            file.to_path_buf()
+        } else {
+            dir.join(path)
+        };
+        if !target.exists() {
+            bad.push(format!("{}: {t}: no such file", file.display()));
+            continue;
+        }
+        if let Some(a) = anchor {
+            if target.extension().is_some_and(|e| e == "md") && !anchors(&read(&target)).contains(a)
+            {
+                bad.push(format!("{}: {t}: no heading makes #{a}", file.display()));
+            }
+        }
+    }
+    bad
+}
+
+#[test]
+fn every_relative_link_in_the_docs_resolves() {
+    let files = markdown_files();
+    assert!(files.len() >= 10, "README, CHANGELOG and docs/: {files:?}");
+    let bad: Vec<String> = files.iter().flat_map(|f| broken_links(f)).collect();
+    assert!(bad.is_empty(), "broken links:\n{}", bad.join("\n"));
+}
+
+#[test]
+fn the_link_check_finds_a_missing_file_and_a_missing_anchor() {
+    let dir = Scratch::new("links");
+    std::fs::write(dir.join("b.md"), "# One heading\n\n## `roll --json`\n").unwrap();
+    let a = dir.join("a.md");
+    std::fs::write(
+        &a,
+        "[ok](b.md#one-heading) [ok](b.md#roll---json) [code](`x.md`) `[not](a link)`\n\
+         [gone](c.md) [bad anchor](b.md#two) ![pic](d.png) [web](https://example.org/x)\n\
+         ```\n[fenced](nowhere.md)\n```\n",
+    )
+    .unwrap();
+    let bad = broken_links(&a);
+    assert_eq!(bad.len(), 3, "{bad:#?}");
+    assert!(bad[0].ends_with("c.md: no such file"));
+    assert!(bad[1].ends_with("b.md#two: no heading makes #two"));
+    assert!(bad[2].ends_with("d.png: no such file"));
+}
+
+#[test]
+fn the_readme_keeps_its_two_commands_first_and_stays_short() {
+    let text = read(&root().join("README.md"));
+    // As `.ci/run` reads it: the lines of the first fenced block.
+    let block: Vec<&str> = text
+        .lines()
+        .skip_while(|l| !l.starts_with("```"))
+        .skip(1)
+        .take_while(|l| !l.starts_with("```"))
+        .collect();
+    assert_eq!(
+        block,
+        [
+            "sh setup.sh && cargo run --release -- paper",
+            "sh setup.sh && cargo test --release"
+        ]
+    );
+    let n = text.lines().count();
+    assert!(
+        n <= 250,
+        "README.md has {n} lines; the guide and results live in docs/"
+    );
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -419,16 +627,18 @@ fn json_md_lists_the_keys_of_paper_converge_and_stability() {
 #[test]
 fn json_md_lists_the_keys_of_tradeoff_and_validate() {
     let mut c = checker();
-    // Coarse steps keep the pilot (1,000 rolls of every method) to a few seconds.
+    // The coarsest steps keep the pilot (1,000 rolls of every method) to a few CPU seconds.
     let (v, f) = study(
         &[
             "tradeoff",
             "--dts",
-            "1/30",
+            "1/10",
             "--rapier-dts",
-            "1/30",
+            "1/10",
             "--reference-dt",
-            "1/60",
+            "1/20",
+            "--max-steps",
+            "2000",
             "--ladder",
             "none",
             "--precision",
