@@ -17,8 +17,8 @@
 //!   paper expects the ratio to move from near the no-bounce ratio towards eq. (MasterEqu).
 //!   A curve, not a verdict.
 //!
-//! Why these limits are exact (README, "Validation"): a die at rest on a corner, moving so
-//! slowly that it carries no momentum, follows the steepest descent of its centre's height
+//! Why these limits are exact (docs/results/validation.md): a die at rest on a corner, moving
+//! so slowly that it carries no momentum, follows the steepest descent of its centre's height
 //! h(u) = Σ sᵢ|uᵢ| over the directions u of gravity in body axes (with isotropic damping about
 //! the contact point, ω ∝ u × ∇h, so du/dt ∝ −(∇h − (u·∇h)u)). The planes uᵢ/sᵢ = uⱼ/sⱼ that
 //! bound the solid angle of each face are invariant under that flow (its component along their
@@ -28,7 +28,7 @@
 //! freezes a slow die mid-fall) and the certificate audited (`sim::certificate`). A die still
 //! moving at the step cap but certified in a face region (its energy below the barrier out of
 //! it) is counted on that face and reported apart, as "moving at the cap": such dice creep or
-//! rock on their face for ever (Bullet; README).
+//! rock on their face for ever (Bullet; docs/results/validation.md).
 
 pub mod flight;
 
@@ -1124,7 +1124,7 @@ fn num(v: f64) -> String {
     }
 }
 
-/// The Markdown table of the rows, as the README quotes it.
+/// The Markdown table of the rows, as docs/results/validation.md quotes it.
 pub fn markdown_table(res: &Validation) -> String {
     let mut s = String::from(
         "| case | engine | subject | quantity | closed form | measured ± err | n | z | verdict | note |\n\
