@@ -8,7 +8,7 @@ use dicephys::error::parse_name;
 use dicephys::model::block::Block;
 use dicephys::model::scene::{Floor, Mode, Preset, Scene};
 use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
-use dicephys::run::runner::MAX_THREADS;
+use dicephys::run::batch::MAX_THREADS;
 use dicephys::run::spec::{Shard, ThrowSpec};
 use dicephys::sim::roll::{early_stop_exact, RollConfig, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
 
@@ -261,5 +261,5 @@ pub fn threads(asked: usize) -> Result<usize> {
             "--threads {asked}: at most {MAX_THREADS}"
         )));
     }
-    Ok(dicephys::run::runner::threads(asked))
+    Ok(dicephys::run::batch::threads(asked))
 }

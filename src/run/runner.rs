@@ -6,7 +6,7 @@
 //! roll: what was rolled is kept.
 
 use crate::error::{Error, Result};
-use crate::run::batch;
+use crate::run::batch::{self, threads};
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::io::write_atomic;
 use crate::run::spec::RunSpec;
@@ -87,18 +87,6 @@ impl Chunks {
         matches!(self, Chunks::Task { .. } | Chunks::DryRun)
     }
 }
-
-/// Worker threads: 0 means one per core.
-pub fn threads(asked: usize) -> usize {
-    if asked == 0 {
-        std::thread::available_parallelism().map_or(1, |n| n.get())
-    } else {
-        asked
-    }
-}
-
-/// The most worker threads a run takes.
-pub const MAX_THREADS: usize = 1024;
 
 /// The outcome of a run: the exact tally of the rolls made, and whether all were.
 #[derive(Clone, Debug)]
