@@ -1,7 +1,7 @@
 //! The command line: a thin layer over the library. Each subcommand has a module of its own.
 
 use clap::{Parser, Subcommand};
-use dicephys::run::runner::{Chunks, Runner};
+use dicephys::run::runner::{ChunkShare, Runner};
 use dicephys::run::stop::Stop;
 use error::Error;
 
@@ -67,21 +67,21 @@ pub fn stop() -> &'static Stop {
 
 /// Which chunks this process rolls: all, unless `dicephys slurm task` or `slurm finish` set it,
 /// once, before running the command they run.
-pub fn chunks() -> &'static std::sync::OnceLock<Chunks> {
-    static CHUNKS: std::sync::OnceLock<Chunks> = std::sync::OnceLock::new();
+pub fn chunks() -> &'static std::sync::OnceLock<ChunkShare> {
+    static CHUNKS: std::sync::OnceLock<ChunkShare> = std::sync::OnceLock::new();
     &CHUNKS
 }
 
 /// The runner every command rolls with: these threads, stopped by Ctrl-C or SIGTERM, rolling
 /// the chunks [`chunks`] gives it.
 pub fn runner(threads: usize) -> Runner<'static> {
-    Runner::new(threads, stop().clone()).with_chunks(chunks().get().cloned().unwrap_or_default())
+    Runner::new(threads, stop().clone()).with_share(chunks().get().cloned().unwrap_or_default())
 }
 
 /// True in a cluster task, whose results are its share only (it keeps its chunks and reports
 /// nothing), and in a dry run.
 pub fn is_task() -> bool {
-    chunks().get().is_some_and(Chunks::is_partial)
+    chunks().get().is_some_and(ChunkShare::is_partial)
 }
 
 /// The command line a report names as its own: this process's, or, in a cluster run's

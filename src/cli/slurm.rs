@@ -13,7 +13,7 @@ use super::sweeps::{ConvergeArgs, StabilityArgs, TradeoffArgs};
 use super::{Cli, Command};
 use clap::{Args, Parser, Subcommand};
 use dicephys::report::summary::{RunSummary, ShardResult};
-use dicephys::run::runner::{Checkpoint, Chunks};
+use dicephys::run::runner::{Checkpoint, ChunkShare};
 use dicephys::run::slurm::{self, Layout, Options, Plan};
 use std::path::{Path, PathBuf};
 
@@ -242,7 +242,7 @@ fn study(job: &JobArgs) -> Result<()> {
     // checking its arguments and stopping at its first cell.
     let (lay, opt, bin) = prepare(&plan, job, threads, |lay| {
         place(&mut cmd, lay, threads)?;
-        let _ = super::chunks().set(Chunks::DryRun);
+        let _ = super::chunks().set(ChunkShare::DryRun);
         match super::dispatch(cmd) {
             Ok(()) | Err(Error::Interrupted(_)) => Ok(()),
             Err(e) => Err(e),
@@ -285,7 +285,7 @@ fn task(dir: &Path, k: u64) -> Result<()> {
     }
     let mut cmd = parse_study(&args)?;
     place(&mut cmd, &lay, threads)?;
-    let _ = super::chunks().set(Chunks::task(k, tasks));
+    let _ = super::chunks().set(ChunkShare::task(k, tasks));
     super::dispatch(cmd)?;
     super::output(&lay.task_done(k))?.write(format!("task {k} of {tasks}\n").as_bytes())?;
     eprintln!(
@@ -503,10 +503,10 @@ fn finish(dir: &Path) -> Result<()> {
                 // back and rolling on where a method needs more.
                 Command::Tradeoff(t) => {
                     t.preroll = None;
-                    Chunks::All
+                    ChunkShare::All
                 }
                 // Every chunk is on disk: the study reads them all and rolls none.
-                _ => Chunks::Assemble,
+                _ => ChunkShare::Assemble,
             };
             let _ = super::chunks().set(chunks);
             let _ = super::command_line().set(format!(

@@ -383,7 +383,9 @@ pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
         seed: a.seed,
         max_steps: a.max_steps,
         plan_only: a.plan,
-        preroll_chunks: a.preroll.map(|r| r.div_ceil(dicephys::run::runner::CHUNK)),
+        preroll_chunks: a
+            .preroll
+            .map(|r| r.div_ceil(dicephys::run::runner::CHUNK_ROLLS)),
     };
     if a.preroll == Some(0) {
         return Err(Error::Usage("--preroll 0: give at least 1 roll".into()));

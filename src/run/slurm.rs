@@ -9,7 +9,7 @@
 //! or resubmitted continues from its last whole chunk, and no command line is ever re-parsed.
 //!
 //! A study of several cells (`paper`, `crosscheck`, `converge`, `tradeoff`, `stability`) is
-//! split chunk by chunk instead ([`crate::run::runner::Chunks`]): task K runs the command with
+//! split chunk by chunk instead ([`crate::run::runner::ChunkShare`]): task K runs the command with
 //! its share of the chunks, into the checkpoint directories under `DIR` that all tasks share,
 //! and marks itself done in `DIR/tasks/`; the finishing job runs the very command once more,
 //! rolling nothing, and writes its outputs into `DIR` exactly as one machine would.

@@ -8,7 +8,8 @@
 
 use super::sweep::{
     cell_spec, departure, dt_label, measure, paired_departure, plan_cpu, resolve_departure,
-    resolve_reference, rolls_for_ratio, rolls_to_resolve, Departure, Stream, Study, ONE_PERCENT,
+    resolve_reference, rolls_for_one_percent, rolls_for_ratio, Departure, Stream, Study,
+    ONE_PERCENT,
 };
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
@@ -239,7 +240,7 @@ pub fn run(
                             &cell,
                             finest,
                             (d, d_err),
-                            rolls_to_resolve(d_err, cfg.rolls),
+                            rolls_for_one_percent(d_err, cfg.rolls),
                             (cfg.rolls, cfg.rolls),
                         ));
                     }

@@ -15,7 +15,7 @@ use crate::model::block::Outcome;
 use crate::model::scene::Scene;
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::io::write_atomic;
-use crate::run::runner::{Runner, CHUNK};
+use crate::run::runner::{Runner, CHUNK_ROLLS};
 use crate::run::spec::{RunSpec, ThrowSpec};
 use crate::run::tally::Tally;
 use crate::sim::roll::{Fate, RollConfig, RollRecord};
@@ -92,7 +92,7 @@ pub fn measure(spec: &RunSpec, study: &Study) -> Result<Measured> {
         .as_ref()
         .map(|root| root.join(format!("{}-{}", spec.engine, spec.key())));
     // A cluster task's tally is its share only: it neither reads nor keeps a cell's result.
-    let task = study.runner.chunks.is_partial();
+    let task = study.runner.share.is_partial();
     let kept = dir
         .as_ref()
         .filter(|_| !task)
@@ -133,7 +133,7 @@ pub fn departure(r: stats::Ratio, reference: stats::Ratio) -> (f64, f64) {
 
 /// Rolls per cell needed for a departure's error to resolve 1 % at 2σ (σ ≤ 0.5 %), from one
 /// measured at `rolls` per cell: the error falls as 1/√rolls.
-pub fn rolls_to_resolve(err: f64, rolls: u64) -> Option<u64> {
+pub fn rolls_for_one_percent(err: f64, rolls: u64) -> Option<u64> {
     (err.is_finite() && err > 0.0)
         .then(|| (rolls as f64 * (err / (0.5 * ONE_PERCENT)).powi(2)).ceil() as u64)
 }
@@ -242,7 +242,7 @@ impl Stream {
         study: &Study,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<()> {
-        let have = self.rolls() / CHUNK;
+        let have = self.rolls() / CHUNK_ROLLS;
         if chunks <= have {
             return Ok(());
         }
@@ -256,7 +256,7 @@ impl Stream {
         let cpu = process_cpu_seconds();
         let mut outcomes = Vec::new();
         let mut tally = Tally::default();
-        let run = study.runner.with_progress(progress).run_chunks(
+        let run = study.runner.with_progress(progress).run_range(
             &self.spec,
             ck.as_ref(),
             have..chunks,
@@ -459,7 +459,7 @@ pub fn chunks_to_resolve(d: &Departure, nr: u64, precision: f64, max_chunks: u64
         return None;
     }
     // err_at falls as nm grows, so the first chunk count that resolves is found by bisection.
-    let ok = |k: u64| 2.0 * d.err_at(k * CHUNK, nr) <= precision;
+    let ok = |k: u64| 2.0 * d.err_at(k * CHUNK_ROLLS, nr) <= precision;
     if !ok(max_chunks.max(1)) {
         return None;
     }
@@ -505,18 +505,18 @@ impl Departure {
 /// The chunks a stream may roll in `budget_s` CPU seconds, at its cost so far (at least the
 /// chunks it has).
 pub fn max_chunks(s: &Stream, budget_s: f64) -> u64 {
-    let per_chunk = s.cpu_s_per_roll() * CHUNK as f64;
+    let per_chunk = s.cpu_s_per_roll() * CHUNK_ROLLS as f64;
     if per_chunk.is_finite() && per_chunk > 0.0 {
-        ((budget_s / per_chunk).floor() as u64).max(s.rolls() / CHUNK)
+        ((budget_s / per_chunk).floor() as u64).max(s.rolls() / CHUNK_ROLLS)
     } else {
-        s.rolls() / CHUNK
+        s.rolls() / CHUNK_ROLLS
     }
 }
 
 /// The chunks a reference is planned to: 2σ of its own ratio at most half the precision, so
 /// that its noise takes at most a quarter of each departure's variance.
 pub fn reference_chunks(s: &Stream, precision: f64) -> Option<u64> {
-    rolls_for_ratio(s, 0.5 * precision).map(|n| n.div_ceil(CHUNK).max(1))
+    rolls_for_ratio(s, 0.5 * precision).map(|n| n.div_ceil(CHUNK_ROLLS).max(1))
 }
 
 /// Rolls a reference in rounds until 2σ of its ratio is at most precision/2 or its budget is
@@ -532,7 +532,7 @@ pub fn resolve_reference(
     let mut spent = 0.0;
     loop {
         let want = reference_chunks(s, precision).unwrap_or(cap).min(cap);
-        let have = s.rolls() / CHUNK;
+        let have = s.rolls() / CHUNK_ROLLS;
         if want <= have {
             return Ok(());
         }
@@ -573,7 +573,7 @@ pub fn resolve_departure(
     let mut spent = 0.0;
     loop {
         let d = paired_departure(s, reference);
-        let have = s.rolls() / CHUNK;
+        let have = s.rolls() / CHUNK_ROLLS;
         if 2.0 * d.err <= precision {
             return Ok(());
         }
@@ -600,7 +600,7 @@ impl Departure {
 }
 
 /// The most chunks one stream is ever planned to (`STREAM_ROLLS`).
-pub const NO_BUDGET: u64 = STREAM_ROLLS / CHUNK;
+pub const NO_BUDGET: u64 = STREAM_ROLLS / CHUNK_ROLLS;
 
 /// The CPU seconds still to spend, at the streams' measured costs and variances, for every
 /// group (its reference first, then the streams compared with it) to be resolved to
@@ -616,16 +616,16 @@ pub fn plan_cpu(groups: &[Vec<&Stream>], precision: f64, budgets: Option<(f64, f
         let kr = reference_chunks(reference, precision)
             .unwrap_or(cap)
             .min(cap)
-            .max(reference.rolls() / CHUNK);
-        cpu += kr as f64 * CHUNK as f64 * reference.cpu_s_per_roll() - reference.cpu_s;
+            .max(reference.rolls() / CHUNK_ROLLS);
+        cpu += kr as f64 * CHUNK_ROLLS as f64 * reference.cpu_s_per_roll() - reference.cpu_s;
         for s in rest {
             let cap = budgets.map_or(NO_BUDGET, |(_, b)| max_chunks(s, b));
             let d = paired_departure(s, reference);
             // Past its budget a method stops at once (`resolve_departure`).
-            let k = chunks_to_resolve(&d, kr * CHUNK, precision, cap)
+            let k = chunks_to_resolve(&d, kr * CHUNK_ROLLS, precision, cap)
                 .unwrap_or(if budgets.is_some() { 0 } else { cap })
-                .max(s.rolls() / CHUNK);
-            cpu += k as f64 * CHUNK as f64 * s.cpu_s_per_roll() - s.cpu_s;
+                .max(s.rolls() / CHUNK_ROLLS);
+            cpu += k as f64 * CHUNK_ROLLS as f64 * s.cpu_s_per_roll() - s.cpu_s;
         }
     }
     cpu.max(0.0)

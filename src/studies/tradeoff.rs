@@ -22,7 +22,7 @@ use crate::error::Result;
 use crate::model::block::Block;
 use crate::model::scene::{Floor, Mode, Scene};
 use crate::report::text::{left, right, Columns};
-use crate::run::runner::CHUNK;
+use crate::run::runner::CHUNK_ROLLS;
 use crate::sim::roll::{RollConfig, Rule};
 use serde::Serialize;
 
@@ -56,7 +56,7 @@ pub struct Config {
     pub preroll_chunks: Option<u64>,
 }
 
-/// Chunks every stream rolls first, to measure its cost and its variance.
+/// ChunkShare every stream rolls first, to measure its cost and its variance.
 pub const PILOT_CHUNKS: u64 = 1;
 
 /// What a row is.
@@ -456,7 +456,7 @@ fn row(cfg: &Config, mode: Mode, m: &Method, s: &Stream, reference: Option<&Stre
     let (resolved, rolls_needed) = match reference {
         Some(rf) => (
             2.0 * d.err <= cfg.precision,
-            chunks_to_resolve(&d, rf.rolls(), cfg.precision, NO_BUDGET).map(|k| k * CHUNK),
+            chunks_to_resolve(&d, rf.rolls(), cfg.precision, NO_BUDGET).map(|k| k * CHUNK_ROLLS),
         ),
         None => {
             let need = rolls_for_ratio(s, 0.5 * cfg.precision);
