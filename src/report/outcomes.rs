@@ -6,7 +6,7 @@
 
 use crate::model::block::Block;
 use crate::run::tally::Counts;
-use crate::theory;
+use crate::theory::{self, stats};
 use serde::{Deserialize, Serialize};
 
 /// One outcome's probability.
@@ -25,13 +25,12 @@ pub struct Probability {
 impl Probability {
     /// `k` of `n` against the prediction `s`.
     pub fn of(k: u64, n: u64, s: f64) -> Probability {
-        let nf = n as f64;
-        let p = k as f64 / nf;
+        let p = stats::proportion(k, n);
         Probability {
-            p,
-            err: (p * (1.0 - p) / nf).sqrt(),
+            p: p.value,
+            err: p.err,
             solid_angle: s,
-            z: (p - s) / (s * (1.0 - s) / nf).sqrt(),
+            z: (p.value - s) / stats::binomial_err(s, n),
         }
     }
 }

@@ -131,14 +131,10 @@ impl Cell {
 
     /// The binomial standard error of a fraction `f` of this cell's rolls.
     pub fn err(&self, f: f64) -> f64 {
-        fraction_err(f, self.rolls)
+        crate::theory::stats::binomial_err(f, self.rolls.max(1))
     }
 }
 
-/// √(f(1−f)/n): the standard error of a fraction of n rolls.
-pub fn fraction_err(f: f64, n: u64) -> f64 {
-    (f * (1.0 - f) / n.max(1) as f64).sqrt()
-}
 
 /// The 95 % upper bound of a fraction seen 0 times in n rolls: 1 − 0.05^(1/n) (≈ 3/n).
 pub fn zero_below_95(n: u64) -> f64 {

@@ -573,7 +573,7 @@ fn probability_row(
     (k, n): (u64, u64),
 ) -> Row {
     let measured = k as f64 / n.max(1) as f64;
-    let err = (p * (1.0 - p) / n.max(1) as f64).sqrt();
+    let err = crate::theory::stats::binomial_err(p, n.max(1));
     let z = if n == 0 {
         f64::NAN
     } else {
