@@ -6,11 +6,12 @@
 //! Rolls end by DicePhys's own rule with every step stepped (no early stop, no closed-form
 //! flight): this is a study of the integrator, so nothing else may change with dt.
 
-use super::sweep::{
-    cell_spec, departure, dt_label, measure, paired_departure, plan_cpu, resolve_departure,
-    resolve_reference, rolls_for_one_percent, rolls_for_ratio, Departure, Stream, Study,
-    ONE_PERCENT,
+use super::departure::{
+    paired_departure, rolls_for_one_percent, rolls_for_ratio, unpaired_departure, Departure,
 };
+use super::precision::{plan_cpu, resolve_departure, resolve_reference};
+use super::stream::Stream;
+use super::sweep::{cell_spec, dt_label, measure, Measured, Study, ONE_PERCENT};
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
@@ -88,7 +89,7 @@ impl Cell {
         engine: EngineKind,
         mode: Mode,
         dt: f64,
-        m: &super::sweep::Measured,
+        m: &Measured,
         (departure, departure_err): (f64, f64),
         resolved: Option<bool>,
     ) -> Cell {
@@ -232,7 +233,7 @@ pub fn run(
                     .ok_or_else(|| Error::Invalid("no dt given".into()))?;
                 for (dt, m) in &row {
                     let r = m.ratio();
-                    let (d, d_err) = departure(r, reference);
+                    let (d, d_err) = unpaired_departure(r, reference);
                     let cell = Cell::of(block, engine, mode, *dt, m, (d, d_err), None);
                     log(&format_cell(&cell));
                     if (dt - CLAIM_DT).abs() < 1e-12 && *dt > finest {

@@ -3,8 +3,11 @@
 
 pub mod bench;
 pub mod converge;
+pub mod departure;
 pub mod paper;
+pub mod precision;
 pub mod stability;
+pub mod stream;
 pub mod sweep;
 pub mod tradeoff;
 pub mod validate;

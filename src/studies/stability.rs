@@ -135,7 +135,6 @@ impl Cell {
     }
 }
 
-
 /// The 95 % upper bound of a fraction seen 0 times in n rolls: 1 − 0.05^(1/n) (≈ 3/n).
 pub fn zero_below_95(n: u64) -> f64 {
     1.0 - 0.05f64.powf(1.0 / n.max(1) as f64)

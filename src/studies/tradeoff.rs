@@ -6,17 +6,19 @@
 //! finest dt), each mode (2D, 3D) its own.
 //!
 //! Precision is the input, rolls the output: every method rolls the same keyed throw stream
-//! (`sweep::Stream`) in rounds until 2σ of its departure is at most the precision, or its CPU
+//! (`stream::Stream`) in rounds until 2σ of its departure is at most the precision, or its CPU
 //! budget is spent; the reference first, to 2σ ≤ precision/2 so that its own noise takes at
 //! most a quarter of each departure's variance. A departure's error is paired: the method
 //! and the reference share their first throws, and where they end alike (the same dt, another
 //! rule) the noise cancels; at another dt or engine the outcomes decorrelate (measured: about
 //! 54 % agreement, what chance gives) and the pairing changes nothing.
 
-use super::sweep::{
-    chunks_to_resolve, dt_label, paired_departure, plan_cpu, precision_in_an_hour,
-    resolve_departure, resolve_reference, rolls_for_ratio, Departure, Stream, Study, NO_BUDGET,
+use super::departure::{chunks_to_resolve, paired_departure, rolls_for_ratio, Departure};
+use super::precision::{
+    plan_cpu, precision_in_an_hour, resolve_departure, resolve_reference, NO_BUDGET,
 };
+use super::stream::Stream;
+use super::sweep::{dt_label, Study};
 use crate::engine::EngineKind;
 use crate::error::Result;
 use crate::model::block::Block;
@@ -103,7 +105,7 @@ pub struct Row {
     /// Simulated steps per roll.
     pub steps_per_roll: f64,
     /// Relative departure from the reference, ratio/reference − 1 (a fraction), with the
-    /// shared throws as a control variate (`studies::sweep::paired_departure`).
+    /// shared throws as a control variate (`studies::departure::paired_departure`).
     pub error: f64,
     /// Its standard error, paired on the shared throws.
     pub error_err: f64,
