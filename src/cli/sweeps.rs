@@ -9,8 +9,9 @@ use dicephys::engine::EngineKind;
 use dicephys::model::block::Block;
 use dicephys::report::figures::sweeps as fig;
 use dicephys::report::figures::Point;
+use dicephys::report::text::dt_label;
 use dicephys::studies::stability::Sweep;
-use dicephys::studies::sweep::{dt_label, parse_dt, Study};
+use dicephys::studies::sweep::{parse_dt, Study};
 use dicephys::studies::{converge, stability, tradeoff};
 use std::path::{Path, PathBuf};
 

@@ -8,3 +8,4 @@ pub mod per_roll;
 pub mod summary;
 pub mod table;
 pub mod text;
+pub mod validate;

@@ -11,11 +11,12 @@ use super::departure::{
 };
 use super::precision::{plan_cpu, resolve_departure, resolve_reference};
 use super::stream::Stream;
-use super::sweep::{cell_spec, dt_label, measure, Measured, Study, ONE_PERCENT};
+use super::sweep::{cell_spec, measure, Measured, Study, ONE_PERCENT};
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::scene::{Mode, Scene};
+use crate::report::text::dt_label;
 use crate::report::text::{left, right, Columns};
 use crate::sim::roll::{RollConfig, Rule};
 use serde::Serialize;

@@ -294,7 +294,7 @@ fn describe(c: &Cell) -> String {
             "{} {} dt {} e {}",
             c.engine,
             c.mode,
-            super::sweep::dt_label(c.dt),
+            crate::report::text::dt_label(c.dt),
             c.restitution
         ),
     }
@@ -341,7 +341,7 @@ pub fn format_cell(c: &Cell) -> String {
         c.engine.to_string(),
         c.mode.to_string(),
         c.block.clone(),
-        super::sweep::dt_label(c.dt),
+        crate::report::text::dt_label(c.dt),
         c.restitution.to_string(),
         c.friction.to_string(),
         pc(c.unconverged),

@@ -152,13 +152,3 @@ pub fn parse_dt(s: &str) -> Result<f64> {
         Err(Error::Invalid(format!("dt '{s}' must be in (0, 0.1] s")))
     }
 }
-
-/// A time step as people write it: 1/1000 for 0.001.
-pub fn dt_label(dt: f64) -> String {
-    let n = 1.0 / dt;
-    if (n - n.round()).abs() < 1e-6 * n {
-        format!("1/{}", n.round())
-    } else {
-        format!("{dt}")
-    }
-}

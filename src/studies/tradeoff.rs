@@ -18,11 +18,12 @@ use super::precision::{
     plan_cpu, precision_in_an_hour, resolve_departure, resolve_reference, NO_BUDGET,
 };
 use super::stream::Stream;
-use super::sweep::{dt_label, Study};
+use super::sweep::Study;
 use crate::engine::EngineKind;
 use crate::error::Result;
 use crate::model::block::Block;
 use crate::model::scene::{Floor, Mode, Scene};
+use crate::report::text::dt_label;
 use crate::report::text::{left, right, Columns};
 use crate::run::runner::CHUNK_ROLLS;
 use crate::sim::roll::{RollConfig, Rule};
