@@ -7,10 +7,8 @@ use super::outln;
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::model::block::Block;
-use dicephys::report::figures::sweeps as fig;
-use dicephys::report::figures::Point;
+use dicephys::report;
 use dicephys::report::text::dt_label;
-use dicephys::studies::stability::Sweep;
 use dicephys::studies::sweep::{parse_dt, Study};
 use dicephys::studies::{converge, stability, tradeoff};
 use std::path::{Path, PathBuf};
@@ -276,7 +274,7 @@ pub fn converge(a: &ConvergeArgs) -> Result<()> {
         bar.set_length((1000.0 * total) as u64);
         bar.set_position((1000.0 * done.min(total)) as u64);
     };
-    let res = logged(a.json, &converge::header(), |log| {
+    let res = logged(a.json, &report::converge::header(), |log| {
         let log = |l: &str| bar.suspend(|| log(l));
         converge::run(&cfg, &study, &log, &progress)
     });
@@ -284,68 +282,9 @@ pub fn converge(a: &ConvergeArgs) -> Result<()> {
     let Some(res) = res? else {
         return Ok(());
     };
-    let lines: Vec<fig::Line> = group(&res.cells, |c| {
-        format!("{} {} {}", c.block, c.engine, c.mode)
-    })
-    .into_iter()
-    .map(|(label, cells)| fig::Line {
-        label,
-        points: cells
-            .iter()
-            .map(|c| Point {
-                x: c.dt,
-                y: c.ratio,
-                y_err: c.ratio_err,
-            })
-            .collect(),
-    })
-    .collect();
-    fig::convergence(
-        &a.out,
-        "converge",
-        &match a.precision {
-            Some(p) => format!(
-                "Ratio against dt (each departure resolved to ±{:.2} % at 2σ, or marked)",
-                100.0 * p
-            ),
-            None => format!("Ratio against dt ({} rolls per point)", a.rolls),
-        },
-        &lines,
-    )?;
-    let mut md = format!(
-        "# Convergence in dt\n\n{}, seed {}, rolls ended by {}.\n\n```\n{}\n",
-        match a.precision {
-            Some(p) => format!(
-                "Every cell rolled until 2σ of its departure from the finest dt is at most {:.2} % \
-                 or its budget spent",
-                100.0 * p
-            ),
-            None => format!("{} rolls per cell", res.rolls),
-        },
-        res.seed,
-        res.settle,
-        converge::header()
-    );
-    for c in &res.cells {
-        md += &converge::format_cell(c);
-        md.push('\n');
-    }
-    md += "```\n\n";
-    md += &format!("{}\n\n![ratio against dt](converge.svg)\n", res.verdict);
+    let figures = report::converge::write_figures(&a.out, &res, a.precision)?;
+    let md = report::converge::markdown(&res, a.precision, &figures);
     finish(&a.out, "converge.json", &to_json(&res)?, &md, a.json)
-}
-
-/// Items grouped by a key, in first-seen order.
-fn group<T>(items: &[T], key: impl Fn(&T) -> String) -> Vec<(String, Vec<&T>)> {
-    let mut out: Vec<(String, Vec<&T>)> = Vec::new();
-    for it in items {
-        let k = key(it);
-        match out.iter_mut().find(|(g, _)| *g == k) {
-            Some((_, v)) => v.push(it),
-            None => out.push((k, vec![it])),
-        }
-    }
-    out
 }
 
 pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
@@ -396,7 +335,7 @@ pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
         bar.set_length((1000.0 * total) as u64);
         bar.set_position((1000.0 * done.min(total)) as u64);
     };
-    let res = logged(a.json, &tradeoff::header(), |log| {
+    let res = logged(a.json, &report::tradeoff::header(), |log| {
         let log = |l: &str| bar.suspend(|| log(l));
         tradeoff::run(&cfg, &study, &log, &progress)
     });
@@ -419,111 +358,8 @@ pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
         );
         return Ok(());
     }
-    let mut pts = Vec::new();
-    let mut bands = Vec::new();
-    if let Some(row) = dicephys::theory::paper_data::load().ok().and_then(|t| {
-        t.rows
-            .into_iter()
-            .find(|r| r.simulated && r.block_dims().ok() == Some(a.block))
-    }) {
-        let m = row.measured_ratio();
-        let rel = 200.0 * m.err / m.value;
-        bands.push(fig::Band {
-            label: format!("the paper's experiment, {}: ±{rel:.1} % (2σ)", row.label()),
-            lo: 0.0,
-            hi: rel,
-            two_d: None,
-        });
-    }
-    for m in &res.modes {
-        let two_d = m.mode == dicephys::model::scene::Mode::TwoD;
-        for r in &m.rows {
-            pts.push(fig::MethodPoint {
-                label: r.method.clone(),
-                cost: r.cpu_s_per_1000,
-                error: 100.0 * r.error.abs(),
-                error_err: 100.0 * r.error_err,
-                two_d,
-                resolved: r.resolved,
-                on_front: m.pareto_front.contains(&r.method),
-                cheapest: m.cheapest_within.as_ref() == Some(&r.method),
-            });
-        }
-        // Rapier's converged departure: its box floor, exact levers, at its finest step.
-        if let Some(r) = m
-            .rows
-            .iter()
-            .filter(|r| {
-                r.engine == EngineKind::Rapier
-                    && r.rule == "fast"
-                    && r.floor == dicephys::model::scene::Floor::Box
-            })
-            .min_by(|x, y| x.dt.total_cmp(&y.dt))
-        {
-            let (d, e) = (100.0 * r.error.abs(), 200.0 * r.error_err);
-            bands.push(fig::Band {
-                label: format!(
-                    "Rapier {} {} against Bullet: {:+.1} ± {:.1} % (2σ)",
-                    m.mode.name(),
-                    dt_label(r.dt),
-                    100.0 * r.error,
-                    e
-                ),
-                lo: d - e,
-                hi: d + e,
-                two_d: Some(two_d),
-            });
-        }
-    }
-    fig::tradeoff(
-        &a.out,
-        "tradeoff",
-        &format!(
-            "{}: cost against departure from Bullet at {} (±{} % at 2σ asked)",
-            res.block,
-            dt_label(res.reference_dt),
-            100.0 * res.precision
-        ),
-        &pts,
-        &bands,
-        100.0 * res.precision,
-    )?;
-    let mut md = format!(
-        "# Accuracy against cost\n\n{}, seed {}; every departure rolled until 2σ ≤ {:.2} % or \
-         {:.0} CPU s spent; reference: Bullet, box floor, the exact levers (early stop, fast \
-         flight), dt {}, to 2σ ≤ {:.2} % of its own. Planned after the pilot: {:.0} CPU s; \
-         spent on rolls: {:.0} CPU s. At ±1 % the plan is {:.0} CPU s.\n\n",
-        res.block,
-        res.seed,
-        100.0 * res.precision,
-        res.budget_s,
-        dt_label(res.reference_dt),
-        50.0 * res.precision,
-        res.planned_cpu_s,
-        res.cpu_s,
-        res.planned_cpu_s_at_one_percent
-    );
-    for m in &res.modes {
-        md += &format!(
-            "## {}\n\n```\n{}\n{}  (reference)\n",
-            m.mode,
-            tradeoff::header(),
-            tradeoff::format_row(&m.reference)
-        );
-        for r in &m.checks {
-            md += &format!("{}  ({:?})\n", tradeoff::format_row(r), r.role);
-        }
-        for r in &m.rows {
-            md += &tradeoff::format_row(r);
-            md.push('\n');
-        }
-        md += &format!(
-            "```\n\nPareto front over resolved methods (cheapest first): {}.\n\n{}\n\n",
-            m.pareto_front.join("; "),
-            m.note
-        );
-    }
-    md += "![cost against departure](tradeoff.svg)\n";
+    let figures = report::tradeoff::write_figures(&a.out, &res, a.block)?;
+    let md = report::tradeoff::markdown(&res, &figures);
     finish(&a.out, "tradeoff.json", &to_json(&res)?, &md, a.json)
 }
 
@@ -563,97 +399,15 @@ pub fn stability(a: &StabilityArgs) -> Result<()> {
         max_steps: a.max_steps,
         floor_thickness: a.floor_thickness,
     };
-    let Some(res) = logged(a.json, &stability::header(), |log| {
+    let Some(res) = logged(a.json, &report::stability::header(), |log| {
         stability::run(&cfg, &study, log)
     })?
     else {
         return Ok(());
     };
-    let mut figures = Vec::new();
-    for kind in stability::KINDS {
-        let panels: Vec<fig::Panel> = group(
-            &res.cells
-                .iter()
-                .filter(|c| c.sweep == Sweep::DtRestitution)
-                .collect::<Vec<_>>(),
-            |c| format!("{} {}", c.engine, c.mode),
-        )
-        .into_iter()
-        .map(|(title, cells)| fig::Panel {
-            title,
-            x_desc: "dt, s".into(),
-            y_desc: "restitution e".into(),
-            x_labels: res.dts.iter().map(|&d| dt_label(d)).collect(),
-            y_labels: res.restitutions.iter().map(|e| e.to_string()).collect(),
-            values: res
-                .restitutions
-                .iter()
-                .map(|&e| {
-                    res.dts
-                        .iter()
-                        .map(|&d| {
-                            cells
-                                .iter()
-                                .find(|c| c.dt == d && c.restitution == e)
-                                .map_or(f64::NAN, |c| c.kind(kind))
-                        })
-                        .collect()
-                })
-                .collect(),
-        })
-        .collect();
-        let stem = format!("stability_{kind}");
-        fig::heatmap(
-            &a.out,
-            &stem,
-            &format!(
-                "Fraction of rolls {kind} ({} rolls per cell: ± ≤ {:.1} %, 0 < {:.1} %; μ 0.29, 140x24x20{})",
-                res.rolls,
-                100.0 * res.fraction_err_max,
-                100.0 * res.zero_below_95,
-                floor_note(res.floor_thickness)
-            ),
-            &panels,
-        )?;
-        figures.push(stem);
-    }
-    let mut md = format!(
-        "# Where methods fail\n\n{} rolls per cell, seed {}, cap {} steps, energy-gain tolerance \
-         {} % of the starting energy{}. Each fraction f carries a binomial standard error \
-         √(f(1−f)/{}), at most {:.1} % (column ±max: the largest in the row); a 0 means below \
-         {:.1} % at 95 % confidence.\n\n```\n{}\n",
-        res.rolls,
-        res.seed,
-        res.max_steps,
-        100.0 * res.energy_gain_tolerance,
-        floor_note(res.floor_thickness),
-        res.rolls,
-        100.0 * res.fraction_err_max,
-        100.0 * res.zero_below_95,
-        stability::header()
-    );
-    for c in &res.cells {
-        md += &stability::format_cell(c);
-        md.push('\n');
-    }
-    md += "```\n\n";
-    for f in &res.findings {
-        md += &format!("- {f}\n");
-    }
-    md.push('\n');
-    for f in &figures {
-        md += &format!("![{f}]({f}.svg)\n");
-    }
+    let figures = report::stability::write_figures(&a.out, &res)?;
+    let md = report::stability::markdown(&res, &figures);
     finish(&a.out, "stability.json", &to_json(&res)?, &md, a.json)
-}
-
-/// The floor, where it is not DicePhys's.
-fn floor_note(thickness: f64) -> String {
-    if thickness == dicephys::model::scene::DICEPHYS_FLOOR_THICKNESS {
-        String::new()
-    } else {
-        format!(", floor {} m thick", thickness)
-    }
 }
 
 /// Runs a sweep, logging its header and each cell to stderr unless the output is JSON. In a

@@ -16,10 +16,9 @@ use crate::engine::EngineKind;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::scene::{Mode, Scene};
+use crate::report::converge::{format_cell, Cell, Claim, Converge};
 use crate::report::text::dt_label;
-use crate::report::text::{left, right, Columns};
 use crate::sim::roll::{RollConfig, Rule};
-use serde::Serialize;
 
 /// What the convergence test runs.
 pub struct Config {
@@ -44,43 +43,6 @@ pub struct Config {
     /// Roll with the exact levers (early stop, closed-form flight) instead of DicePhys's rule
     /// with every step stepped.
     pub fast: bool,
-}
-
-/// One cell: a block, an engine, 2D or 3D, a dt.
-#[derive(Clone, Debug, Serialize)]
-pub struct Cell {
-    /// The block, `LxBxW` in mm.
-    pub block: String,
-    /// The engine's name.
-    pub engine: String,
-    /// "3d" or "2d".
-    pub mode: String,
-    /// The time step, s.
-    pub dt: f64,
-    /// Rolls made.
-    pub rolls: u64,
-    /// N(breadth vertical)/N(width vertical).
-    pub ratio: f64,
-    /// Its binomial error.
-    pub ratio_err: f64,
-    /// Simulated steps per roll.
-    pub steps_per_roll: f64,
-    /// Process CPU seconds per roll, all threads.
-    pub cpu_s_per_roll: f64,
-    /// Rolls not at rest at the step cap.
-    pub unconverged: u64,
-    /// Rolls that failed, for any reason.
-    pub failed: u64,
-    /// Rolls in which the engine injected energy.
-    pub energy_gain: u64,
-    /// ratio / ratio at the finest dt − 1.
-    pub departure: f64,
-    /// Its error (with `--precision`: paired on the shared throws).
-    pub departure_err: f64,
-    /// With `--precision`: 2σ of the departure (of the finest dt: of its own ratio, to half
-    /// the precision) is within the precision.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub resolved: Option<bool>,
 }
 
 impl Cell {
@@ -115,35 +77,6 @@ impl Cell {
     }
 }
 
-/// The paper's claim for one block × engine × mode.
-#[derive(Clone, Debug, Serialize)]
-pub struct Claim {
-    /// The block, `LxBxW` in mm.
-    pub block: String,
-    /// The engine's name.
-    pub engine: String,
-    /// "3d" or "2d".
-    pub mode: String,
-    /// The dt the claim is about (`CLAIM_DT`), s.
-    pub dt: f64,
-    /// The finest dt of the run, the reference, s.
-    pub dt_finest: f64,
-    /// The ratio at `dt` over the ratio at `dt_finest`, − 1.
-    pub departure: f64,
-    /// Its error.
-    pub departure_err: f64,
-    /// 2σ of the departure is at most 1 %.
-    pub resolved: bool,
-    /// The claim decided at 2σ (`decide`): yes if resolved and |departure| ≤ 1 %; no if
-    /// resolved and beyond 1 %, or if even |departure| − 2σ > 1 %; else open.
-    pub within_one_percent: Option<bool>,
-    /// Rolls per cell for 2σ = 1 % (with `--precision`: both cells at that count, on the
-    /// same throws).
-    pub rolls_needed: Option<u64>,
-    /// Rolls at `dt` and at `dt_finest` (equal without `--precision`).
-    pub rolls: (u64, u64),
-}
-
 impl Claim {
     /// The claim about a cell at `CLAIM_DT` against the finest dt: its departure and error,
     /// resolved when 2σ ≤ 1 %, decided at 2σ (`decide`).
@@ -168,29 +101,6 @@ impl Claim {
             rolls,
         }
     }
-}
-
-/// The convergence test's results.
-#[derive(Clone, Debug, Serialize)]
-pub struct Converge {
-    /// How rolls end, in words.
-    pub settle: String,
-    /// Rolls per cell.
-    pub rolls: u64,
-    /// The throws' seed.
-    pub seed: u64,
-    /// The time steps run, coarse to fine, s.
-    pub dts: Vec<f64>,
-    /// The step cap per roll.
-    pub max_steps: u64,
-    /// Every cell: by block, engine, 3D then 2D, then dt.
-    pub cells: Vec<Cell>,
-    /// The paper's claim per block × engine × mode; none without dt = 0.001 s and a finer one.
-    pub claims: Vec<Claim>,
-    /// Every claim resolved.
-    pub resolved: bool,
-    /// Plain words: does the run resolve the paper's claim, and if not, what would.
-    pub verdict: String,
 }
 
 /// The dt the paper's claim is about.
@@ -504,47 +414,6 @@ fn verdict(claims: &[Claim], finest: f64, how: &str) -> String {
         )
     }
 }
-
-/// The column heads of the log's cell lines (`format_cell`).
-pub fn header() -> String {
-    TABLE.header()
-}
-
-/// One cell as a line of the log, under `header`.
-pub fn format_cell(c: &Cell) -> String {
-    TABLE.row(&[
-        c.block.clone(),
-        c.engine.to_string(),
-        c.mode.to_string(),
-        dt_label(c.dt),
-        format!("{:.4} ± {:.4}", c.ratio, c.ratio_err),
-        format!("{:.0}", c.steps_per_roll),
-        format!("{:.5}", c.cpu_s_per_roll),
-        format!(
-            "{:+.1} ± {:.1} %",
-            100.0 * c.departure,
-            100.0 * c.departure_err
-        ),
-        c.unconverged.to_string(),
-        c.failed.to_string(),
-        c.energy_gain.to_string(),
-    ])
-}
-
-/// The columns of the log and of report.md.
-const TABLE: Columns = Columns(&[
-    left("block", 10),
-    left("engine", 13),
-    right("mode", 4),
-    right("dt", 8),
-    right("ratio", 17),
-    right("steps", 8),
-    right("CPU s/roll", 10),
-    right("vs finest dt", 18),
-    right("unconv", 6),
-    right("failed", 6),
-    right("gain", 5),
-]);
 
 /// The paper's claim for one departure d ± err (1σ), at 2σ: `Some(true)` if 2σ ≤ 1 % and
 /// |d| ≤ 1 %; `Some(false)` if 2σ ≤ 1 % and |d| > 1 %, or if |d| − 2σ > 1 % (the interval
