@@ -2,13 +2,14 @@
 
 use super::args::{parse_engine, parse_shard, RunArgs, SceneArgs, ThrowArgs};
 use super::error::{Error, Result};
+use super::progress::{Progress, Unit};
 use super::{out, outln};
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::report::per_roll::PerRoll;
 use dicephys::report::summary::{Cost, RunSummary};
 use dicephys::run::cputime::process_cpu_seconds;
-use dicephys::run::runner::Checkpoint;
+use dicephys::run::runner::{Checkpoint, Runner};
 use dicephys::run::spec::{RunSpec, Shard};
 use dicephys::sim::roll::RollRecord;
 use std::path::PathBuf;
@@ -116,8 +117,13 @@ pub fn run(a: &RollArgs) -> Result<()> {
     };
     let wall = Instant::now();
     let cpu = process_cpu_seconds();
-    let runner = super::runner(threads);
-    let done = runner.run(&spec, checkpoint.as_ref(), &mut sink)?;
+    let total = spec.indices().len();
+    let bar = Progress::new("roll", Unit::Rolls { per_cell: 0 }, false, a.json);
+    let progress = |n: u64| bar.set(n as f64, total as f64);
+    let runner = Runner::new(threads, super::stop().clone());
+    let done = runner
+        .with_progress(&progress)
+        .run(&spec, checkpoint.as_ref(), &mut sink)?;
     // A resumed run's cost is the sum over its segments: the resumed chunks carry theirs.
     let cost = Cost {
         wall_s: wall.elapsed().as_secs_f64() + done.resumed_wall_s,

@@ -1,17 +1,16 @@
-//! `dicephys converge`, `tradeoff` and `stability`: the sweeps (`dicephys::studies::sweep`), each writing
-//! `<command>.json`, `report.md` and its figures into --out.
+//! `dicephys converge`, `tradeoff` and `stability`: the sweeps' flags, turned into the library's
+//! configurations (`dicephys::studies::{converge, tradeoff, stability}`); each writes
+//! `<command>.json`, `report.md` and its figures into --out (`super::study`).
 
 use super::args::{parse_block, parse_engine};
 use super::error::{Error, Result};
-use super::outln;
+use super::study;
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::model::block::Block;
-use dicephys::report;
-use dicephys::report::text::dt_label;
-use dicephys::studies::sweep::{parse_dt, Study};
-use dicephys::studies::{converge, stability, tradeoff};
-use std::path::{Path, PathBuf};
+use dicephys::studies::sweep::parse_dt;
+use dicephys::studies::{converge, stability, tradeoff, StudyConfig};
+use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct ConvergeArgs {
@@ -49,8 +48,9 @@ pub struct ConvergeArgs {
     /// exact at fine steps by `tradeoff`'s levers row, instead of every step stepped.
     #[arg(long)]
     pub fast: bool,
-    #[arg(long, default_value = "converge-out")]
-    pub out: PathBuf,
+    /// Output directory [default: converge-out].
+    #[arg(long, value_name = "OUT")]
+    pub out: Option<PathBuf>,
     /// Print converge.json to stdout instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -88,8 +88,9 @@ pub struct TradeoffArgs {
     pub threads: usize,
     #[arg(long, default_value_t = 2_000_000)]
     pub max_steps: u64,
-    #[arg(long, default_value = "tradeoff-out")]
-    pub out: PathBuf,
+    /// Output directory [default: tradeoff-out].
+    #[arg(long, value_name = "OUT")]
+    pub out: Option<PathBuf>,
     /// Roll the pilot (a chunk of every method, kept), print the plan (the CPU the precision
     /// asked costs, and the precision an hour buys) and stop.
     #[arg(long)]
@@ -133,24 +134,6 @@ fn parse_dt_or_none(s: &str) -> std::result::Result<Option<f64>, String> {
     }
 }
 
-/// A progress bar on stderr in estimated CPU seconds (so its ETA weighs dear and cheap rolls
-/// right), hidden for --json or when stderr is not a terminal.
-pub(super) fn cpu_bar(quiet: bool) -> indicatif::ProgressBar {
-    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-    use std::io::IsTerminal;
-    if quiet || !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let b = ProgressBar::with_draw_target(Some(1), ProgressDrawTarget::stderr());
-    b.set_style(
-        ProgressStyle::with_template(
-            "{elapsed_precise} [{wide_bar}] {percent}% of the planned CPU, ETA {eta}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    b
-}
-
 #[derive(Args, Debug)]
 pub struct StabilityArgs {
     #[arg(long, value_delimiter = ',', default_value = "bullet,rapier", value_parser = parse_engine)]
@@ -182,251 +165,96 @@ pub struct StabilityArgs {
     /// coarse step really pass through it.
     #[arg(long, default_value_t = dicephys::model::scene::DICEPHYS_FLOOR_THICKNESS)]
     pub floor_thickness: f64,
-    #[arg(long, default_value = "stability-out")]
-    pub out: PathBuf,
+    /// Output directory [default: stability-out].
+    #[arg(long, value_name = "OUT")]
+    pub out: Option<PathBuf>,
     #[arg(long)]
     pub json: bool,
 }
 
-/// Checks what every sweep takes, creates --out, and sets up how cells are run: on these
-/// threads, stopped by Ctrl-C, kept under --out/checkpoint.
-pub(super) fn check_common(
-    rolls: u64,
-    max_steps: u64,
-    t: usize,
-    out: &Path,
-    file: &str,
-) -> Result<Study<'static>> {
-    if rolls == 0 || rolls > dicephys::run::spec::MAX_ROLLS {
-        return Err(Error::Usage(format!("--rolls {rolls}: must be in 1..=1e9")));
-    }
-    if max_steps == 0 {
-        return Err(Error::Usage("--max-steps 0: need at least one step".into()));
-    }
-    let threads = super::args::threads(t)?;
-    std::fs::create_dir_all(out)
-        .map_err(|e| Error::Usage(format!("--out {}: cannot create it ({e})", out.display())))?;
-    super::output(&out.join(file))?;
-    super::output(&out.join("report.md"))?;
-    Ok(Study {
-        runner: super::runner(threads),
-        checkpoint: Some(out.join("checkpoint")),
-    })
-}
-
-fn nonempty<T>(v: &[T], name: &str) -> Result<()> {
-    if v.is_empty() {
-        Err(Error::Usage(format!("{name}: give at least one value")))
-    } else {
-        Ok(())
+impl ConvergeArgs {
+    /// The study's configuration.
+    pub fn config(&self) -> converge::Config {
+        converge::Config {
+            blocks: self.blocks.clone(),
+            dts: self.dts.clone(),
+            engines: self.engines.clone(),
+            rolls: self.rolls,
+            seed: self.seed,
+            max_steps: self.max_steps,
+            precision: self.precision,
+            budget_s: self.budget,
+            reference_budget_s: self.reference_budget,
+            fast: self.fast,
+        }
     }
 }
 
-pub(super) fn to_json<T: serde::Serialize>(v: &T) -> Result<String> {
-    serde_json::to_string_pretty(v).map_err(|e| Error::Run(e.to_string()))
-}
-
-/// Writes the JSON and the report, prints one or the other.
-pub(super) fn finish(
-    out: &Path,
-    file: &str,
-    json: &str,
-    report: &str,
-    print_json: bool,
-) -> Result<()> {
-    super::output(&out.join(file))?.write(json.as_bytes())?;
-    super::output(&out.join("report.md"))?.write(report.as_bytes())?;
-    if print_json {
-        outln!("{json}");
-    } else {
-        outln!("{report}");
-        eprintln!("wrote {}/{file}, report.md and figures", out.display());
+impl TradeoffArgs {
+    /// The study's configuration.
+    pub fn config(&self) -> Result<tradeoff::Config> {
+        if self.preroll == Some(0) {
+            return Err(Error::Usage("--preroll 0: give at least 1 roll".into()));
+        }
+        Ok(tradeoff::Config {
+            block: self.block,
+            dts: self.dts.clone(),
+            rapier_dts: self.rapier_dts.clone(),
+            reference_dt: self.reference_dt,
+            ladder: self.ladder.iter().flatten().copied().collect(),
+            precision: self.precision,
+            budget_s: self.budget,
+            reference_budget_s: self.reference_budget,
+            seed: self.seed,
+            max_steps: self.max_steps,
+            plan_only: self.plan,
+            preroll_chunks: self
+                .preroll
+                .map(|r| r.div_ceil(dicephys::run::runner::CHUNK_ROLLS)),
+        })
     }
-    Ok(())
 }
 
+impl StabilityArgs {
+    /// The study's configuration.
+    pub fn config(&self) -> stability::Config {
+        stability::Config {
+            engines: self.engines.clone(),
+            dts: self.dts.clone(),
+            restitutions: self.restitutions.clone(),
+            frictions: self.frictions.clone(),
+            blocks: self.blocks.clone(),
+            rolls: self.rolls,
+            seed: self.seed,
+            max_steps: self.max_steps,
+            floor_thickness: self.floor_thickness,
+        }
+    }
+}
+
+/// Runs `dicephys converge`.
 pub fn converge(a: &ConvergeArgs) -> Result<()> {
-    nonempty(&a.blocks, "--blocks")?;
-    nonempty(&a.dts, "--dts")?;
-    nonempty(&a.engines, "--engines")?;
-    let study = check_common(a.rolls, a.max_steps, a.threads, &a.out, "converge.json")?;
-    let cfg = converge::Config {
-        blocks: a.blocks.clone(),
-        dts: a.dts.clone(),
-        engines: a.engines.clone(),
-        rolls: a.rolls,
-        seed: a.seed,
-        max_steps: a.max_steps,
-        precision: a.precision,
-        budget_s: (a.budget, a.reference_budget),
-        fast: a.fast,
-    };
-    for (v, name) in [
-        (a.budget, "--budget"),
-        (a.reference_budget, "--reference-budget"),
-    ] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(Error::Usage(format!("{name} {v}: CPU seconds, above 0")));
-        }
-    }
-    let bar = cpu_bar(a.json || a.precision.is_none());
-    let progress = |done: f64, total: f64| {
-        bar.set_length((1000.0 * total) as u64);
-        bar.set_position((1000.0 * done.min(total)) as u64);
-    };
-    let res = logged(a.json, &report::converge::header(), |log| {
-        let log = |l: &str| bar.suspend(|| log(l));
-        converge::run(&cfg, &study, &log, &progress)
-    });
-    bar.finish_and_clear();
-    let Some(res) = res? else {
-        return Ok(());
-    };
-    let figures = report::converge::write_figures(&a.out, &res, a.precision)?;
-    let md = report::converge::markdown(&res, a.precision, &figures);
-    finish(&a.out, "converge.json", &to_json(&res)?, &md, a.json)
+    let out = a.out.clone().unwrap_or_else(|| "converge-out".into());
+    study::run(
+        &StudyConfig::Converge(a.config()),
+        &study::local(&out, a.threads, a.json)?,
+    )
 }
 
+/// Runs `dicephys tradeoff`.
 pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
-    nonempty(&a.dts, "--dts")?;
-    let ladder: Vec<f64> = a.ladder.iter().flatten().copied().collect();
-    let mut all_dts = a.dts.iter().chain(&a.rapier_dts);
-    if all_dts.any(|&d| d <= a.reference_dt) {
-        return Err(Error::Usage(format!(
-            "--reference-dt {}: must be finer than every --dts and --rapier-dts",
-            dt_label(a.reference_dt)
-        )));
-    }
-    if ladder.contains(&a.reference_dt) {
-        return Err(Error::Usage(
-            "--ladder: the reference's dt is not a rung".into(),
-        ));
-    }
-    for (v, name) in [
-        (a.budget, "--budget"),
-        (a.reference_budget, "--reference-budget"),
-    ] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(Error::Usage(format!("{name} {v}: CPU seconds, above 0")));
-        }
-    }
-    let study = check_common(1, a.max_steps, a.threads, &a.out, "tradeoff.json")?;
-    let cfg = tradeoff::Config {
-        block: a.block,
-        dts: a.dts.clone(),
-        rapier_dts: a.rapier_dts.clone(),
-        reference_dt: a.reference_dt,
-        ladder,
-        precision: a.precision,
-        budget_s: a.budget,
-        reference_budget_s: a.reference_budget,
-        seed: a.seed,
-        max_steps: a.max_steps,
-        plan_only: a.plan,
-        preroll_chunks: a
-            .preroll
-            .map(|r| r.div_ceil(dicephys::run::runner::CHUNK_ROLLS)),
-    };
-    if a.preroll == Some(0) {
-        return Err(Error::Usage("--preroll 0: give at least 1 roll".into()));
-    }
-    let bar = cpu_bar(a.json);
-    let progress = |done: f64, total: f64| {
-        bar.set_length((1000.0 * total) as u64);
-        bar.set_position((1000.0 * done.min(total)) as u64);
-    };
-    let res = logged(a.json, &report::tradeoff::header(), |log| {
-        let log = |l: &str| bar.suspend(|| log(l));
-        tradeoff::run(&cfg, &study, &log, &progress)
-    });
-    bar.finish_and_clear();
-    let Some(res) = res? else {
-        return Ok(());
-    };
-    if a.plan {
-        if a.json {
-            outln!("{}", to_json(&res)?);
-        }
-        return Ok(());
-    }
-    if let Some(r) = a.preroll {
-        eprintln!(
-            "rolled the first {r} throws of every stream into {}/checkpoint ({:.0} CPU s); \
-             the same command without --preroll reads them back",
-            a.out.display(),
-            res.cpu_s
-        );
-        return Ok(());
-    }
-    let figures = report::tradeoff::write_figures(&a.out, &res, a.block)?;
-    let md = report::tradeoff::markdown(&res, &figures);
-    finish(&a.out, "tradeoff.json", &to_json(&res)?, &md, a.json)
+    let out = a.out.clone().unwrap_or_else(|| "tradeoff-out".into());
+    study::run(
+        &StudyConfig::Tradeoff(a.config()?),
+        &study::local(&out, a.threads, a.json)?,
+    )
 }
 
+/// Runs `dicephys stability`.
 pub fn stability(a: &StabilityArgs) -> Result<()> {
-    nonempty(&a.engines, "--engines")?;
-    nonempty(&a.dts, "--dts")?;
-    nonempty(&a.restitutions, "--restitutions")?;
-    if let Some(e) = a
-        .restitutions
-        .iter()
-        .find(|e| !(e.is_finite() && (0.0..=1.0).contains(*e)))
-    {
-        return Err(Error::Usage(format!(
-            "--restitutions {e}: must be in [0, 1]"
-        )));
-    }
-    if let Some(m) = a.frictions.iter().find(|m| !(m.is_finite() && **m >= 0.0)) {
-        return Err(Error::Usage(format!(
-            "--frictions {m}: must be finite and >= 0"
-        )));
-    }
-    if !(0.001..=dicephys::model::scene::DICEPHYS_FLOOR_THICKNESS).contains(&a.floor_thickness) {
-        return Err(Error::Usage(format!(
-            "--floor-thickness {}: must be in [0.001, 100] m",
-            a.floor_thickness
-        )));
-    }
-    let study = check_common(a.rolls, a.max_steps, a.threads, &a.out, "stability.json")?;
-    let cfg = stability::Config {
-        engines: a.engines.clone(),
-        dts: a.dts.clone(),
-        restitutions: a.restitutions.clone(),
-        frictions: a.frictions.clone(),
-        blocks: a.blocks.clone(),
-        rolls: a.rolls,
-        seed: a.seed,
-        max_steps: a.max_steps,
-        floor_thickness: a.floor_thickness,
-    };
-    let Some(res) = logged(a.json, &report::stability::header(), |log| {
-        stability::run(&cfg, &study, log)
-    })?
-    else {
-        return Ok(());
-    };
-    let figures = report::stability::write_figures(&a.out, &res)?;
-    let md = report::stability::markdown(&res, &figures);
-    finish(&a.out, "stability.json", &to_json(&res)?, &md, a.json)
-}
-
-/// Runs a sweep, logging its header and each cell to stderr unless the output is JSON. In a
-/// cluster task it runs silently and gives None: the task's share is for the finishing job to
-/// assemble, not to report.
-pub(super) fn logged<T>(
-    quiet: bool,
-    header: &str,
-    run: impl FnOnce(&dyn Fn(&str)) -> dicephys::Result<T>,
-) -> Result<Option<T>> {
-    let task = super::is_task();
-    let quiet = quiet || task;
-    if !quiet {
-        eprintln!("{header}");
-    }
-    let res = run(&|l| {
-        if !quiet {
-            eprintln!("{l}")
-        }
-    })?;
-    Ok((!task).then_some(res))
+    let out = a.out.clone().unwrap_or_else(|| "stability-out".into());
+    study::run(
+        &StudyConfig::Stability(a.config()),
+        &study::local(&out, a.threads, a.json)?,
+    )
 }

@@ -4,11 +4,10 @@
 
 use super::args::{parse_block, parse_engine};
 use super::error::Result;
-use super::sweeps::{check_common, finish, logged, to_json};
+use super::study;
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::model::block::Block;
-use dicephys::report::validate as report;
 use dicephys::studies::sweep::parse_dt;
 use dicephys::studies::validate as v;
 use std::path::PathBuf;
@@ -68,32 +67,28 @@ fn parse_point(s: &str) -> std::result::Result<Option<(f64, f64)>, dicephys::Err
     )))
 }
 
+impl ValidateArgs {
+    /// The study's configuration.
+    pub fn config(&self) -> v::Config {
+        v::Config {
+            engines: self.engines.clone(),
+            rolls: self.rolls,
+            trend_rolls: self.trend_rolls,
+            seed: self.seed,
+            blocks_2d: self.blocks_2d.clone(),
+            blocks_3d: self.blocks_3d.clone(),
+            trend_block: self.trend_block,
+            trend: self.trend.iter().flatten().copied().collect(),
+            flight_dts: self.flight_dts.clone(),
+            resolve: self.resolve,
+            ..v::Config::default()
+        }
+    }
+}
+
 /// Runs `dicephys validate`.
 pub fn run(a: &ValidateArgs) -> Result<()> {
-    let cfg = v::Config {
-        engines: a.engines.clone(),
-        rolls: a.rolls,
-        trend_rolls: a.trend_rolls,
-        seed: a.seed,
-        blocks_2d: a.blocks_2d.clone(),
-        blocks_3d: a.blocks_3d.clone(),
-        trend_block: a.trend_block,
-        trend: a.trend.iter().flatten().copied().collect(),
-        flight_dts: a.flight_dts.clone(),
-        resolve: a.resolve,
-        ..v::Config::default()
-    };
+    let cfg = a.config();
     cfg.validate()?;
-    let study = check_common(a.rolls, cfg.max_steps, a.threads, &a.out, "validate.json")?;
-    let Some(res) = logged(a.json, &report::header(), |log| v::run(&cfg, &study, log))? else {
-        return Ok(());
-    };
-    let figures = report::write_figures(&a.out, &res)?;
-    finish(
-        &a.out,
-        "validate.json",
-        &to_json(&res)?,
-        &report::markdown(&res, &figures),
-        a.json,
-    )
+    study::validate(&cfg, &study::local(&a.out, a.threads, a.json)?)
 }

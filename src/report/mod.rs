@@ -2,6 +2,7 @@
 //! Markdown and CSV, and the figures.
 
 pub mod converge;
+pub mod crosscheck;
 pub mod figures;
 pub mod outcomes;
 pub mod paper;

@@ -101,7 +101,7 @@ pub fn cell(res: &PaperResults, row: usize, engine: EngineKind, mode: Mode) -> O
 }
 
 /// report.md: the table formatted like the paper's, the simulation columns, and a reading.
-pub fn report_markdown(res: &PaperResults, figures: &[&str]) -> String {
+pub fn markdown(res: &PaperResults, figures: &[&str]) -> String {
     let p = &res.provenance;
     let engines: Vec<EngineKind> = {
         let mut v: Vec<EngineKind> = res.simulations.iter().map(|c| c.engine).collect();

@@ -338,6 +338,23 @@ pub struct ShardResult {
     pub threads: usize,
 }
 
+impl ShardResult {
+    /// A shard's `roll --json` output from `p`, if it is there, whole, and of the run `want`;
+    /// else why not.
+    pub fn read(p: &std::path::Path, want: &RunSpec) -> std::result::Result<ShardResult, String> {
+        let text = std::fs::read_to_string(p).map_err(|_| format!("no {}", p.display()))?;
+        let s: ShardResult =
+            serde_json::from_str(&text).map_err(|e| format!("{} is damaged: {e}", p.display()))?;
+        if s.spec != *want {
+            return Err(format!("{} is of another run", p.display()));
+        }
+        if s.partial {
+            return Err(format!("{} is partial", p.display()));
+        }
+        Ok(s)
+    }
+}
+
 impl RunSummary {
     /// Combines the shards of one run into the unsharded run's summary: the same exact counts.
     /// Refuses shards of different runs (compared by specification, however their command
@@ -361,10 +378,9 @@ impl RunSummary {
                     "merge: a shard is partial (interrupted); resume it first".into(),
                 ));
             }
-            let s = p
-                .spec
-                .shard
-                .ok_or_else(|| Mismatch("merge: an input is not a shard (no --shard)".into()))?;
+            let s = p.spec.shard.ok_or_else(|| {
+                Mismatch("merge: an input is not a shard (it names no shard)".into())
+            })?;
             s.validate()?;
             p.tally.check()?;
             if s.n != n || seen.get(s.k as usize).copied().unwrap_or(true) {

@@ -53,7 +53,7 @@ pub enum ChunkShare {
         k: u64,
         /// How many tasks.
         n: u64,
-        /// ChunkShare met so far.
+        /// Chunks met so far.
         met: Arc<AtomicU64>,
     },
     /// Roll nothing: every chunk must be in the checkpoint already (the finishing job).
@@ -333,7 +333,7 @@ impl Checkpoint {
         }
         if Checkpoint::spec_in(dir)? != *spec {
             return Err(Error::Mismatch(format!(
-                "checkpoint {}: it holds another run; resume that with --resume, or use a new directory",
+                "checkpoint {}: it holds another run; resume that run, or use a new directory",
                 dir.display()
             )));
         }

@@ -11,7 +11,10 @@ use super::departure::{
 };
 use super::precision::{plan_cpu, resolve_departure, resolve_reference};
 use super::stream::Stream;
-use super::sweep::{cell_spec, measure, Measured, Study, ONE_PERCENT};
+use super::sweep::{
+    cell_spec, check_budget, check_rolls_and_steps, measure, nonempty, Measured, ONE_PERCENT,
+};
+use super::{Progress, Study};
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
@@ -19,8 +22,10 @@ use crate::model::scene::{Mode, Scene};
 use crate::report::converge::{format_cell, Cell, Claim, Converge};
 use crate::report::text::dt_label;
 use crate::sim::roll::{RollConfig, Rule};
+use serde::{Deserialize, Serialize};
 
 /// What the convergence test runs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Config {
     /// The blocks.
     pub blocks: Vec<Block>,
@@ -38,8 +43,10 @@ pub struct Config {
     /// one keyed stream until its 2σ is at most this (a fraction), the finest to half of it;
     /// `rolls` is then ignored.
     pub precision: Option<f64>,
-    /// With `precision`: CPU seconds a cell may spend, and the finest dt's cell.
-    pub budget_s: (f64, f64),
+    /// With `precision`: CPU seconds a cell may spend.
+    pub budget_s: f64,
+    /// With `precision`: CPU seconds the finest dt's cell may spend.
+    pub reference_budget_s: f64,
     /// Roll with the exact levers (early stop, closed-form flight) instead of DicePhys's rule
     /// with every step stepped.
     pub fast: bool,
@@ -103,6 +110,18 @@ impl Claim {
     }
 }
 
+impl Config {
+    /// Checks every value before anything runs.
+    pub fn validate(&self) -> Result<()> {
+        nonempty(&self.blocks, "blocks")?;
+        nonempty(&self.dts, "dts")?;
+        nonempty(&self.engines, "engines")?;
+        check_rolls_and_steps(self.rolls, self.max_steps)?;
+        check_budget(self.budget_s, "budget_s")?;
+        check_budget(self.reference_budget_s, "reference_budget_s")
+    }
+}
+
 /// The dt the paper's claim is about.
 pub const CLAIM_DT: f64 = 0.001;
 
@@ -111,8 +130,9 @@ pub fn run(
     cfg: &Config,
     study: &Study,
     log: &dyn Fn(&str),
-    progress: super::tradeoff::Progress,
+    progress: Progress,
 ) -> Result<Converge> {
+    cfg.validate()?;
     let mut dts = cfg.dts.clone();
     dts.sort_by(|a, b| b.total_cmp(a));
     dts.dedup();
@@ -125,6 +145,8 @@ pub fn run(
     let settle = settle(cfg, finest);
     let mut cells = Vec::new();
     let mut claims = Vec::new();
+    // Progress in cells.
+    let total = (cfg.blocks.len() * cfg.engines.len() * 2 * dts.len()) as f64;
     for block in &cfg.blocks {
         for &engine in &cfg.engines {
             for mode in [Mode::ThreeD, Mode::TwoD] {
@@ -137,6 +159,7 @@ pub fn run(
                         study,
                     )?;
                     row.push((dt, m));
+                    progress((cells.len() + row.len()) as f64, total);
                 }
                 let reference = row
                     .last()
@@ -213,7 +236,7 @@ fn run_resolved(
     dts: &[f64],
     study: &Study,
     log: &dyn Fn(&str),
-    progress: super::tradeoff::Progress,
+    progress: Progress,
 ) -> Result<Converge> {
     let finest = *dts
         .last()
@@ -248,7 +271,11 @@ fn run_resolved(
             .iter()
             .map(|g| g.3.iter().map(|(_, s)| s).collect())
             .collect();
-        let total = plan_cpu(&plan, precision, Some((cfg.budget_s.1, cfg.budget_s.0)));
+        let total = plan_cpu(
+            &plan,
+            precision,
+            Some((cfg.reference_budget_s, cfg.budget_s)),
+        );
         log(&format!(
             "plan: the pilot took {spent:.0} CPU s; ±{:.2} % (2σ) takes about {total:.0} CPU s \
              more within the budgets, {:.0} without; ±1 % {:.0} CPU s",
@@ -266,13 +293,17 @@ fn run_resolved(
         let (reference, rest) = streams.split_first_mut().expect("a dt is given");
         let before = reference.1.cpu_s;
         let base = done;
-        resolve_reference(&mut reference.1, precision, cfg.budget_s.1, study, &|c| {
-            progress(base + c, total)
-        })?;
+        resolve_reference(
+            &mut reference.1,
+            precision,
+            cfg.reference_budget_s,
+            study,
+            &|c| progress(base + c, total),
+        )?;
         done += reference.1.cpu_s - before;
         for (_, s) in rest.iter_mut() {
             let (base, before) = (done, s.cpu_s);
-            resolve_departure(s, &reference.1, precision, cfg.budget_s.0, study, &|c| {
+            resolve_departure(s, &reference.1, precision, cfg.budget_s, study, &|c| {
                 progress(base + c, total)
             })?;
             done += s.cpu_s - before;
@@ -320,8 +351,8 @@ fn run_resolved(
         &format!(
             "rolled to ±{:.2} % (2σ) within the budgets ({} and {} CPU s a cell)",
             100.0 * precision,
-            cfg.budget_s.0,
-            cfg.budget_s.1
+            cfg.budget_s,
+            cfg.reference_budget_s
         ),
     );
     Ok(Converge {

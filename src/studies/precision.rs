@@ -4,7 +4,7 @@
 
 use super::departure::{chunks_to_resolve, paired_departure, rolls_for_ratio};
 use super::stream::{Stream, STREAM_ROLLS};
-use super::sweep::Study;
+use super::Study;
 use crate::error::Result;
 use crate::run::runner::CHUNK_ROLLS;
 

@@ -8,15 +8,18 @@
 //! its binomial standard error (`Cell::err`); the default rolls per cell make a 0 mean below
 //! 1 % at 95 %.
 
-use super::sweep::{cell_spec, measure, Study};
+use super::sweep::{cell_spec, check_rolls_and_steps, measure, nonempty};
+use super::{Progress, Study};
 use crate::engine::EngineKind;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::block::Block;
-use crate::model::scene::{Mode, Scene};
+use crate::model::scene::{Mode, Scene, DICEPHYS_FLOOR_THICKNESS};
 use crate::report::stability::{format_cell, Cell, Stability, Sweep, KINDS};
 use crate::sim::roll::{Failure, RollConfig, Rule};
+use serde::{Deserialize, Serialize};
 
 /// What the stability sweeps run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Config {
     /// The engines.
     pub engines: Vec<EngineKind>,
@@ -37,6 +40,37 @@ pub struct Config {
     /// The box floor's thickness, m: DicePhys's 100 m, or a table top (2 cm) that a die can
     /// really pass through.
     pub floor_thickness: f64,
+}
+
+impl Config {
+    /// Checks every value before anything runs.
+    pub fn validate(&self) -> Result<()> {
+        nonempty(&self.engines, "engines")?;
+        nonempty(&self.dts, "dts")?;
+        nonempty(&self.restitutions, "restitutions")?;
+        if let Some(e) = self
+            .restitutions
+            .iter()
+            .find(|e| !(e.is_finite() && (0.0..=1.0).contains(*e)))
+        {
+            return Err(Error::field("restitutions", e, "must be in [0, 1]"));
+        }
+        if let Some(m) = self
+            .frictions
+            .iter()
+            .find(|m| !(m.is_finite() && **m >= 0.0))
+        {
+            return Err(Error::field("frictions", m, "must be finite and >= 0"));
+        }
+        if !(0.001..=DICEPHYS_FLOOR_THICKNESS).contains(&self.floor_thickness) {
+            return Err(Error::field(
+                "floor_thickness",
+                self.floor_thickness,
+                "must be in [0.001, 100] m",
+            ));
+        }
+        check_rolls_and_steps(self.rolls, self.max_steps)
+    }
 }
 
 /// The 95 % upper bound of a fraction seen 0 times in n rolls: 1 − 0.05^(1/n) (≈ 3/n).
@@ -115,12 +149,21 @@ fn cell(
 }
 
 /// Measures every cell, logging each as it is measured.
-pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Stability> {
+pub fn run(
+    cfg: &Config,
+    study: &Study,
+    log: &dyn Fn(&str),
+    progress: Progress,
+) -> Result<Stability> {
+    cfg.validate()?;
     let (dt0, e0, mu0) = (0.001, 0.5, 0.29);
+    let per_mode = cfg.dts.len() * cfg.restitutions.len() + cfg.frictions.len() + cfg.blocks.len();
+    let total = (cfg.engines.len() * 2 * per_mode) as f64;
     let mut cells = Vec::new();
     let mut push = |c: Cell| {
         log(&format_cell(&c));
         cells.push(c);
+        progress(cells.len() as f64, total);
     };
     for &engine in &cfg.engines {
         for mode in [Mode::ThreeD, Mode::TwoD] {

@@ -19,12 +19,11 @@ use crate::error::{Error, Result};
 use crate::model::scene::Scene;
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::io::write_atomic;
-use crate::run::runner::Runner;
 use crate::run::spec::{RunSpec, ThrowSpec};
 use crate::run::tally::Tally;
 use crate::sim::roll::RollConfig;
+use crate::studies::Study;
 use crate::theory::stats;
-use std::path::PathBuf;
 
 /// The relative departure asked of a method: the paper's "within 1 %".
 pub const ONE_PERCENT: f64 = 0.01;
@@ -55,17 +54,6 @@ impl Measured {
     pub fn frac(&self, n: u64) -> f64 {
         n as f64 / self.tally.rolls.max(1) as f64
     }
-}
-
-/// How a sweep runs its cells: the runner (threads, stop, progress), and where finished cells
-/// are kept (`--out/checkpoint`): a finished cell, with the CPU time it took, is not rolled
-/// again when the same command is run again after a crash or Ctrl-C. A cell is kept whole or
-/// not at all, so its cost stays true.
-pub struct Study<'a> {
-    /// Threads and stop requests.
-    pub runner: Runner<'a>,
-    /// Where finished cells are kept, if anywhere.
-    pub checkpoint: Option<PathBuf>,
 }
 
 /// A sweep cell's run: `rolls` keyed throws of the paper's ranges from `seed`.
@@ -150,5 +138,34 @@ pub fn parse_dt(s: &str) -> Result<f64> {
         Ok(v)
     } else {
         Err(Error::Invalid(format!("dt '{s}' must be in (0, 0.1] s")))
+    }
+}
+
+/// Checks what every sweep takes: its rolls per cell and its step cap.
+pub fn check_rolls_and_steps(rolls: u64, max_steps: u64) -> Result<()> {
+    if rolls == 0 || rolls > crate::run::spec::MAX_ROLLS {
+        return Err(Error::field("rolls", rolls, "must be in 1..=1e9"));
+    }
+    if max_steps == 0 {
+        return Err(Error::field("max_steps", 0, "need at least one step"));
+    }
+    Ok(())
+}
+
+/// Refuses an empty list: "blocks: give at least one value".
+pub fn nonempty<T>(v: &[T], field: &'static str) -> Result<()> {
+    if v.is_empty() {
+        Err(Error::field(field, "", "give at least one value"))
+    } else {
+        Ok(())
+    }
+}
+
+/// Refuses a CPU budget that is not a positive number of seconds.
+pub fn check_budget(v: f64, field: &'static str) -> Result<()> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::field(field, v, "CPU seconds, above 0"))
     }
 }

@@ -18,17 +18,20 @@ use super::precision::{
     plan_cpu, precision_in_an_hour, resolve_departure, resolve_reference, NO_BUDGET,
 };
 use super::stream::Stream;
-use super::sweep::Study;
+use super::sweep::{check_budget, check_rolls_and_steps, nonempty};
+use super::{Progress, Study};
 use crate::engine::EngineKind;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::scene::{Floor, Mode, Scene};
 use crate::report::text::dt_label;
 use crate::report::tradeoff::{format_row, ModeResult, Role, Row, Tradeoff};
 use crate::run::runner::CHUNK_ROLLS;
 use crate::sim::roll::{RollConfig, Rule};
+use serde::{Deserialize, Serialize};
 
 /// What the trade-off study runs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Config {
     /// The block.
     pub block: Block,
@@ -58,7 +61,36 @@ pub struct Config {
     pub preroll_chunks: Option<u64>,
 }
 
-/// ChunkShare every stream rolls first, to measure its cost and its variance.
+impl Config {
+    /// Checks every value before anything runs.
+    pub fn validate(&self) -> Result<()> {
+        nonempty(&self.dts, "dts")?;
+        if self
+            .dts
+            .iter()
+            .chain(&self.rapier_dts)
+            .any(|&d| d <= self.reference_dt)
+        {
+            return Err(Error::field(
+                "reference_dt",
+                dt_label(self.reference_dt),
+                "must be finer than every `dts` and `rapier_dts`",
+            ));
+        }
+        if self.ladder.contains(&self.reference_dt) {
+            return Err(Error::field(
+                "ladder",
+                "",
+                "the reference's dt is not a rung",
+            ));
+        }
+        check_budget(self.budget_s, "budget_s")?;
+        check_budget(self.reference_budget_s, "reference_budget_s")?;
+        check_rolls_and_steps(1, self.max_steps)
+    }
+}
+
+/// Chunks every stream rolls first, to measure its cost and its variance.
 pub const PILOT_CHUNKS: u64 = 1;
 
 #[derive(Clone, Copy)]
@@ -168,9 +200,6 @@ pub fn pareto(rows: &[Row]) -> Vec<String> {
     front
 }
 
-/// Progress: estimated CPU seconds done and planned in all.
-pub type Progress<'a> = &'a (dyn Fn(f64, f64) + Sync);
-
 /// Measures every method against its reference to the precision asked, logging the plan and
 /// each method as it is resolved, reporting progress in estimated CPU seconds.
 pub fn run(
@@ -179,6 +208,7 @@ pub fn run(
     log: &dyn Fn(&str),
     progress: Progress,
 ) -> Result<Tradeoff> {
+    cfg.validate()?;
     let modes = [Mode::ThreeD, Mode::TwoD];
     let mut all: Vec<(Mode, Vec<(Method, Stream)>)> = modes
         .iter()

@@ -324,7 +324,7 @@ fn pairing_cancels_the_noise_of_a_lever_at_one_step_and_not_across_steps() {
     use dicephys::run::runner::Runner;
     use dicephys::studies::departure::paired_departure;
     use dicephys::studies::stream::Stream;
-    use dicephys::studies::sweep::Study;
+    use dicephys::studies::Study;
     let study = Study {
         runner: Runner::new(2, dicephys::run::stop::Stop::default()),
         checkpoint: None,

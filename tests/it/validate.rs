@@ -15,10 +15,10 @@ use dicephys::report::validate::{Config, Integrator, LimitCell};
 use dicephys::run::runner::Runner;
 use dicephys::run::spec::{RunSpec, ThrowSpec};
 use dicephys::run::stop::Stop;
-use dicephys::studies::sweep::Study;
 use dicephys::studies::validate::flight::fly;
 use dicephys::studies::validate::limits::{limit_roll, limit_scene, measure_limit};
 use dicephys::studies::validate::LIMIT_MAX_STEPS;
+use dicephys::studies::Study;
 use dicephys::theory;
 use nalgebra::{UnitQuaternion, Vector3};
 

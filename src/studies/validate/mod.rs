@@ -44,7 +44,7 @@ pub use crate::report::validate::Config;
 use crate::report::validate::{format_row, Row, Validation, Verdict};
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::spec::{RunSpec, ThrowSpec};
-use crate::studies::sweep::Study;
+use crate::studies::{Progress, Study};
 use limits::{limit_roll, limit_scene};
 use trend::trend_scene;
 
@@ -101,37 +101,39 @@ impl Default for Config {
 impl Config {
     /// Checks every value before anything runs.
     pub fn validate(&self) -> Result<()> {
-        let bad = |m: String| Err(Error::Invalid(m));
+        let bad = |field, v: String, why: &str| Err(Error::field(field, v, why));
         if self.engines.is_empty() {
-            return bad("--engines: name at least one engine".into());
+            return bad("engines", String::new(), "name at least one engine");
         }
-        for (name, r) in [("--rolls", self.rolls), ("--trend-rolls", self.trend_rolls)] {
+        for (name, r) in [("rolls", self.rolls), ("trend_rolls", self.trend_rolls)] {
             if r == 0 || r > crate::run::spec::MAX_ROLLS {
-                return bad(format!("{name} {r}: must be in 1..=1e9"));
+                return bad(name, r.to_string(), "must be in 1..=1e9");
             }
         }
         if !(self.resolve.is_finite() && self.resolve > 0.0 && self.resolve < 1.0) {
-            return bad(format!("--resolve {}: must be in (0, 1)", self.resolve));
+            return bad("resolve", self.resolve.to_string(), "must be in (0, 1)");
         }
         if !(self.flight_time.is_finite() && self.flight_time > 0.0 && self.flight_time <= 100.0) {
-            return bad(format!(
-                "--flight-time {}: must be in (0, 100] s",
-                self.flight_time
-            ));
+            let t = self.flight_time.to_string();
+            return bad("flight_time", t, "must be in (0, 100] s");
         }
         if self.trend.is_empty() && self.blocks_2d.is_empty() && self.blocks_3d.is_empty() {
-            return bad("nothing to validate: give blocks or trend points".into());
+            return Err(Error::Invalid(
+                "nothing to validate: give blocks or trend points".into(),
+            ));
         }
         for &(e, mu) in &self.trend {
             if !(e.is_finite() && (0.0..=1.0).contains(&e) && mu.is_finite() && mu >= 0.0) {
-                return bad(format!(
-                    "--trend {e}:{mu}: each point is E:MU with e in [0, 1] and μ >= 0"
-                ));
+                return bad(
+                    "trend",
+                    format!("{e}:{mu}"),
+                    "each point is E:MU with e in [0, 1] and μ >= 0",
+                );
             }
         }
         for &dt in &self.flight_dts {
             if !(dt.is_finite() && dt > 0.0 && dt <= 0.1) {
-                return bad(format!("--flight-dts {dt}: must be in (0, 0.1] s"));
+                return bad("flight_dts", dt.to_string(), "must be in (0, 0.1] s");
             }
         }
         let scene = limit_scene(self, self.trend_block, Mode::ThreeD, true);
@@ -156,23 +158,52 @@ impl Config {
 pub(crate) struct Rows<'a> {
     rows: Vec<Row>,
     log: &'a dyn Fn(&str),
+    progress: Progress<'a>,
+    total: usize,
 }
 
 impl Rows<'_> {
     fn push(&mut self, r: Row) {
         (self.log)(&format_row(&r));
         self.rows.push(r);
+        (self.progress)(self.rows.len() as f64, self.total as f64);
     }
 }
 
+impl Config {
+    /// The rows `run` measures: two per 2D block, three per 3D block, three per flight
+    /// integrator, one per trend point, for each engine asked.
+    pub fn rows(&self) -> usize {
+        let flights = flight_integrators(&self.engines);
+        self.engines.len()
+            * (2 * self.blocks_2d.len() + 3 * self.blocks_3d.len() + self.trend.len())
+            + if self.flight_dts.is_empty() {
+                0
+            } else {
+                3 * flights
+            }
+    }
+}
+
+fn flight_integrators(engines: &[EngineKind]) -> usize {
+    crate::report::validate::Integrator::for_engines(engines).len()
+}
+
 /// Runs every case, logging each row as it is measured.
-pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Validation> {
+pub fn run(
+    cfg: &Config,
+    study: &Study,
+    log: &dyn Fn(&str),
+    progress: Progress,
+) -> Result<Validation> {
     cfg.validate()?;
     let wall = std::time::Instant::now();
     let cpu0 = process_cpu_seconds();
     let mut rows = Rows {
         rows: Vec::new(),
         log,
+        progress,
+        total: cfg.rows(),
     };
     let mut cells = limits::no_bounce_2d(cfg, study, &mut rows)?;
     cells.extend(limits::quasi_static_3d(cfg, study, &mut rows)?);
