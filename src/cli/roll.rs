@@ -1,6 +1,6 @@
 //! `dicephys roll`: many throws of one block on one engine.
 
-use super::args::{parse_engine, parse_shard, RunArgs, SceneArgs, ThrowArgs};
+use super::args::{parse_engine, RunArgs, SceneArgs, ThrowArgs};
 use super::error::{Error, Result};
 use super::progress::{Progress, Unit};
 use super::{out, outln};
@@ -72,7 +72,7 @@ pub struct RollArgs {
     pub resume: Option<PathBuf>,
     /// Roll only throws with index ≡ K (mod N); `dicephys merge` combines the shards' --json
     /// outputs into the unsharded result.
-    #[arg(long, value_name = "K/N", value_parser = parse_shard)]
+    #[arg(long, value_name = "K/N")]
     pub shard: Option<Shard>,
 }
 

@@ -13,7 +13,7 @@ use super::study;
 use super::sweeps::{ConvergeArgs, StabilityArgs, TradeoffArgs};
 use super::{out, outln};
 use clap::{Args, Subcommand};
-use dicephys::report::summary::{RunSummary, ShardResult};
+use dicephys::report::summary::RunSummary;
 use dicephys::run::runner::{Checkpoint, ChunkShare};
 use dicephys::run::slurm::{self, Layout, Options, Plan};
 use dicephys::studies::outputs::Place;
@@ -408,32 +408,7 @@ fn finish(dir: &Path) -> Result<()> {
             study::run(&cfg, &placed(&lay, threads, json, share, &line))?;
         }
         Plan::Roll { spec, tasks } => {
-            let mut parts = Vec::new();
-            let mut missing = Vec::new();
-            let mut why = Vec::new();
-            for k in 0..*tasks {
-                let p = lay.shard_result(k);
-                match ShardResult::read(&p, &Plan::shard_spec(spec, k, *tasks)) {
-                    Ok(s) => parts.push(s),
-                    Err(e) => {
-                        missing.push(k.to_string());
-                        why.push(e);
-                    }
-                }
-            }
-            if !missing.is_empty() {
-                return Err(lay.not_finished(*tasks, &missing, &why.join("; ")).into());
-            }
-            let merged = RunSummary::merge(&parts)?;
-            let json =
-                serde_json::to_string_pretty(&merged).map_err(|e| Error::Run(e.to_string()))?;
-            let text = merged.human();
-            let (j, t) = (
-                super::output(&lay.result_json())?,
-                super::output(&lay.result_text())?,
-            );
-            j.write(format!("{json}\n").as_bytes())?;
-            t.write(text.as_bytes())?;
+            let text = RunSummary::merge_tasks(&lay, spec, *tasks)?;
             super::stdout(&text)?;
             outln!(
                 "slurm finish: {tasks} tasks merged into {}",

@@ -2,7 +2,7 @@
 //! configurations (`dicephys::studies::{converge, tradeoff, stability}`); each writes
 //! `<command>.json`, `report.md` and its figures into --out (`super::study`).
 
-use super::args::{parse_block, parse_engine};
+use super::args::parse_engine;
 use super::error::{Error, Result};
 use super::study;
 use clap::Args;
@@ -15,7 +15,11 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct ConvergeArgs {
     /// Blocks, LENGTHxBREADTHxWIDTH in mm (comma-separated).
-    #[arg(long, value_delimiter = ',', default_value = "140x24x20,140x22x13,140x30x10", value_parser = parse_block)]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "140x24x20,140x22x13,140x30x10"
+    )]
     pub blocks: Vec<Block>,
     /// Time steps, s or 1/N (comma-separated); the paper's full set is
     /// 1/60,1/120,1/240,1/500,1/1000,1/2000,1/5000,1/10000.
@@ -58,7 +62,7 @@ pub struct ConvergeArgs {
 
 #[derive(Args, Debug)]
 pub struct TradeoffArgs {
-    #[arg(long, default_value = "140x24x20", value_parser = parse_block)]
+    #[arg(long, default_value = "140x24x20")]
     pub block: Block,
     /// Bullet's time steps (comma-separated).
     #[arg(long, value_delimiter = ',', default_value = "1/100,1/250,1/1000", value_parser = parse_dt)]
@@ -148,7 +152,11 @@ pub struct StabilityArgs {
     #[arg(long, value_delimiter = ',', default_value = "0,0.29,0.8,1.5")]
     pub frictions: Vec<f64>,
     /// Blocks of the aspect line: breadth/width up to 10, length/breadth down to 1.
-    #[arg(long, value_delimiter = ',', default_value = "140x24x20,140x40x20,140x100x20,200x200x20,24x24x20", value_parser = parse_block)]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "140x24x20,140x40x20,140x100x20,200x200x20,24x24x20"
+    )]
     pub blocks: Vec<Block>,
     /// Rolls per cell: 300 make a fraction's standard error at most 2.9 % and a 0 mean below
     /// 1 % at 95 %.

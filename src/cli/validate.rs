@@ -2,7 +2,7 @@
 //! closed form (`dicephys::studies::validate`); writes `validate.json`, `report.md` and the
 //! figures into --out.
 
-use super::args::{parse_block, parse_engine};
+use super::args::parse_engine;
 use super::error::Result;
 use super::study;
 use clap::Args;
@@ -29,13 +29,21 @@ pub struct ValidateArgs {
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
     /// The 2D no-bounce case's blocks (several R).
-    #[arg(long = "blocks-2d", value_delimiter = ',', default_value = "140x24x24,140x24x20,140x22x13,140x30x10", value_parser = parse_block)]
+    #[arg(
+        long = "blocks-2d",
+        value_delimiter = ',',
+        default_value = "140x24x24,140x24x20,140x22x13,140x30x10"
+    )]
     pub blocks_2d: Vec<Block>,
     /// The 3D quasi-static case's blocks (a cube, a square cuboid, three different sides).
-    #[arg(long = "blocks-3d", value_delimiter = ',', default_value = "20x20x20,40x20x20,30x20x10", value_parser = parse_block)]
+    #[arg(
+        long = "blocks-3d",
+        value_delimiter = ',',
+        default_value = "20x20x20,40x20x20,30x20x10"
+    )]
     pub blocks_3d: Vec<Block>,
     /// The trend's block (2D, the paper's throw).
-    #[arg(long, default_value = "140x22x13", value_parser = parse_block)]
+    #[arg(long, default_value = "140x22x13")]
     pub trend_block: Block,
     /// The trend's points, E:MU, bouncier and grippier in turn ("none" skips it).
     #[arg(long, value_delimiter = ',', default_value = "0:0.1,0.2:0.29,0.5:0.5,0.7:1,0.9:1.5", value_parser = parse_point)]

@@ -11,5 +11,6 @@ pub mod stability;
 pub mod summary;
 pub mod table;
 pub mod text;
+pub mod trace;
 pub mod tradeoff;
 pub mod validate;

@@ -4,6 +4,8 @@
 use crate::engine::EngineKind;
 use crate::model::scene::{Floor, Mode, Preset};
 use crate::model::throws::{ThrowKind, ThrowRanges};
+use crate::run::io::Output;
+use crate::run::slurm::{Layout, Plan};
 use crate::run::spec::RunSpec;
 use crate::run::tally::{Counts, Tally};
 use crate::sim::roll::{Failure, Rule};
@@ -336,6 +338,38 @@ pub struct ShardResult {
     pub cpu_s: f64,
     /// Worker threads.
     pub threads: usize,
+}
+
+impl RunSummary {
+    /// The finishing job of a `roll` through Slurm: every task's result there, whole and of
+    /// its shard, merged and written whole into the run's directory (`result.json`,
+    /// `result.txt`; rerun, it writes the same); the text it printed.
+    pub fn merge_tasks(lay: &Layout, spec: &RunSpec, tasks: u64) -> crate::Result<String> {
+        let (mut parts, mut missing, mut why) = (Vec::new(), Vec::new(), Vec::new());
+        for k in 0..tasks {
+            match ShardResult::read(&lay.shard_result(k), &Plan::shard_spec(spec, k, tasks)) {
+                Ok(s) => parts.push(s),
+                Err(e) => {
+                    missing.push(k.to_string());
+                    why.push(e);
+                }
+            }
+        }
+        if !missing.is_empty() {
+            return Err(lay.not_finished(tasks, &missing, &why.join("; ")));
+        }
+        let merged = RunSummary::merge(&parts)?;
+        let json = serde_json::to_string_pretty(&merged)
+            .map_err(|e| crate::Error::Failed(e.to_string()))?;
+        let text = merged.human();
+        let (j, t) = (
+            Output::check(&lay.result_json())?,
+            Output::check(&lay.result_text())?,
+        );
+        j.write(format!("{json}\n").as_bytes())?;
+        t.write(text.as_bytes())?;
+        Ok(text)
+    }
 }
 
 impl ShardResult {
