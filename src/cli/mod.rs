@@ -10,7 +10,6 @@ pub mod crosscheck;
 pub mod error;
 pub mod merge;
 pub mod paper;
-pub mod progress;
 pub mod roll;
 pub mod slurm;
 pub mod study;

@@ -2,11 +2,11 @@
 
 use super::args::{parse_engine, RunArgs, SceneArgs, ThrowArgs};
 use super::error::{Error, Result};
-use super::progress::{Progress, Unit};
 use super::{out, outln};
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::report::per_roll::PerRoll;
+use dicephys::report::progress::{Progress, Unit};
 use dicephys::report::summary::{Cost, RunSummary};
 use dicephys::run::cputime::process_cpu_seconds;
 use dicephys::run::runner::{Checkpoint, Runner};
@@ -118,7 +118,8 @@ pub fn run(a: &RollArgs) -> Result<()> {
     let wall = Instant::now();
     let cpu = process_cpu_seconds();
     let total = spec.indices().len();
-    let bar = Progress::new("roll", Unit::Rolls { per_cell: 0 }, false, a.json);
+    let unit = Unit::Rolls { per_cell: 0 };
+    let bar = Progress::new("roll", unit, false, a.json, super::study::every());
     let progress = |n: u64| bar.set(n as f64, total as f64);
     let runner = Runner::new(threads, super::stop().clone());
     let done = runner

@@ -4,11 +4,12 @@
 
 use super::error::{Error, Result};
 use super::out;
-use super::progress::Progress;
+use dicephys::report::progress::Progress;
 use dicephys::run::runner::ChunkShare;
 use dicephys::studies::outputs::{self, Done, Hooks, Place};
 use dicephys::studies::{paper::PaperConfig, validate, StudyConfig};
 use std::path::Path;
+use std::time::Duration;
 
 /// A study run here, on all its chunks, writing into `out` (its cells under `out/checkpoint`).
 pub fn local(out: &Path, threads: usize, json: bool) -> Result<Place> {
@@ -50,6 +51,16 @@ pub fn validate(cfg: &validate::Config, place: &Place) -> Result<()> {
     )
 }
 
+/// How often a command whose stderr is not a terminal says how far it has come:
+/// `DICEPHYS_PROGRESS_SECS` seconds, default 30.
+pub fn every() -> Duration {
+    std::env::var("DICEPHYS_PROGRESS_SECS")
+        .ok()
+        .and_then(|s| s.parse::<f64>().ok())
+        .filter(|s| s.is_finite() && *s >= 0.0)
+        .map_or(Duration::from_secs(30), Duration::from_secs_f64)
+}
+
 /// Runs a study with its log on stderr (out of the bar's way) and its progress shown, then
 /// prints what it says.
 fn with_hooks(
@@ -59,7 +70,7 @@ fn with_hooks(
     json: bool,
     run: impl FnOnce(&Hooks) -> dicephys::Result<Done>,
 ) -> Result<()> {
-    let progress = Progress::new(command, unit, bar, json);
+    let progress = Progress::new(command, unit, bar, json, every());
     let log = |l: &str| progress.suspend(|| eprintln!("{l}"));
     let set = |done: f64, total: f64| progress.set(done, total);
     let done = run(&Hooks {

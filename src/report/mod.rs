@@ -7,6 +7,7 @@ pub mod figures;
 pub mod outcomes;
 pub mod paper;
 pub mod per_roll;
+pub mod progress;
 pub mod stability;
 pub mod summary;
 pub mod table;

@@ -6,6 +6,7 @@
 use super::{Progress, Study, StudyConfig};
 use crate::error::{Error, Result};
 use crate::report;
+pub use crate::report::progress::Unit;
 use crate::run::io::Output;
 use crate::run::runner::{ChunkShare, Runner};
 use crate::run::stop::Stop;
@@ -51,20 +52,6 @@ pub struct Done {
     pub note: Option<String>,
     /// Stopped before the end, and what was kept: the caller ends with its own exit code.
     pub interrupted: Option<String>,
-}
-
-/// What a study's progress counts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Unit {
-    /// Rolls, `per_cell` to a cell.
-    Rolls {
-        /// Rolls in a cell.
-        per_cell: u64,
-    },
-    /// The study's cells (or rows).
-    Cells,
-    /// Estimated CPU seconds of a study rolled to a precision.
-    Cpu,
 }
 
 impl StudyConfig {

@@ -1,11 +1,25 @@
 //! Progress on stderr while a long command runs: a bar on a terminal; elsewhere (a log file, a
-//! cluster job's output) a line now and then, so that no command is silent for minutes.
+//! cluster job's output) a line now and then, so that no command is silent for minutes:
+//! "dicephys converge: 50 % (12 of 24 cells done), ETA 3 min 20 s".
 
-pub use dicephys::studies::outputs::Unit;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
+
+/// What a study's progress counts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unit {
+    /// Rolls, `per_cell` to a cell.
+    Rolls {
+        /// Rolls in a cell.
+        per_cell: u64,
+    },
+    /// The study's cells (or rows).
+    Cells,
+    /// Estimated CPU seconds of a study rolled to a precision.
+    Cpu,
+}
 
 /// A command's progress: `set` it as work is done.
 pub struct Progress {
@@ -19,9 +33,14 @@ pub struct Progress {
 
 impl Progress {
     /// Progress of `command` in `unit`: a bar on a terminal unless `quiet` (`--json`) or
-    /// `bar` is false; a line every `DICEPHYS_PROGRESS_SECS` seconds (default 30) when stderr
-    /// is not a terminal.
-    pub fn new(command: &'static str, unit: Unit, bar: bool, quiet: bool) -> Progress {
+    /// `bar` is false; a line at most `every` when stderr is not a terminal.
+    pub fn new(
+        command: &'static str,
+        unit: Unit,
+        bar: bool,
+        quiet: bool,
+        every: Duration,
+    ) -> Progress {
         let terminal = std::io::stderr().is_terminal();
         let b = if terminal && bar && !quiet {
             let b = ProgressBar::with_draw_target(Some(1), ProgressDrawTarget::stderr());
@@ -37,11 +56,6 @@ impl Progress {
         } else {
             ProgressBar::hidden()
         };
-        let every = std::env::var("DICEPHYS_PROGRESS_SECS")
-            .ok()
-            .and_then(|s| s.parse::<f64>().ok())
-            .filter(|s| s.is_finite() && *s >= 0.0)
-            .map_or(Duration::from_secs(30), Duration::from_secs_f64);
         let now = Instant::now();
         Progress {
             command,
