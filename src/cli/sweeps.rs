@@ -109,7 +109,7 @@ pub struct TradeoffArgs {
 }
 
 /// `tradeoff`'s default precision, per cent at 2σ: what about 60 minutes on 2 cores buys at
-/// the defaults (README, Speed against accuracy).
+/// the defaults (docs/results/tradeoff.md).
 pub const DEFAULT_PRECISION: &str = "2";
 
 /// `tradeoff`'s default ladder under the reference.

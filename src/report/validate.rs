@@ -361,7 +361,7 @@ fn num(v: f64) -> String {
     }
 }
 
-/// The Markdown table of the rows, as the README quotes it.
+/// The Markdown table of the rows, as docs/results/validation.md quotes it.
 pub fn markdown_table(res: &Validation) -> String {
     let mut s = String::from(
         "| case | engine | subject | quantity | closed form | measured ± err | n | z | verdict | note |\n\

@@ -17,7 +17,7 @@
 //!   paper expects the ratio to move from near the no-bounce ratio towards eq. (MasterEqu).
 //!   A curve, not a verdict.
 //!
-//! Why these limits are exact (README, "Validation"): a die at rest on a corner, moving so
+//! Why these limits are exact (docs/method.md; measured: docs/results/validation.md): a die at rest on a corner, moving so
 //! slowly that it carries no momentum, follows the steepest descent of its centre's height
 //! h(u) = Σ sᵢ|uᵢ| over the directions u of gravity in body axes (with isotropic damping about
 //! the contact point, ω ∝ u × ∇h, so du/dt ∝ −(∇h − (u·∇h)u)). The planes uᵢ/sᵢ = uⱼ/sⱼ that
@@ -28,7 +28,7 @@
 //! freezes a slow die mid-fall) and the certificate audited (`sim::certificate`). A die still
 //! moving at the step cap but certified in a face region (its energy below the barrier out of
 //! it) is counted on that face and reported apart, as "moving at the cap": such dice creep or
-//! rock on their face for ever (Bullet; README).
+//! rock on their face for ever (Bullet; docs/results/validation.md).
 
 mod findings;
 pub mod flight;
