@@ -79,7 +79,7 @@ impl Progress {
             return;
         };
         let Ok(mut last) = last.lock() else { return };
-        if last.elapsed() < self.every || !(total > 0.0) {
+        if last.elapsed() < self.every || total.is_nan() || total <= 0.0 {
             return;
         }
         *last = Instant::now();

@@ -61,6 +61,16 @@ impl Columns {
     }
 }
 
+/// A time step as people write it: 1/1000 for 0.001.
+pub fn dt_label(dt: f64) -> String {
+    let n = 1.0 / dt;
+    if (n - n.round()).abs() < 1e-6 * n {
+        format!("1/{}", n.round())
+    } else {
+        format!("{dt}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -72,15 +82,5 @@ mod tests {
         let row = T.row(&["ab".into(), "0.5000 ± 0.0100".into(), "+1.0".into()]);
         assert_eq!(row, "ab     0.5000 ± 0.0100 +1.0");
         assert_eq!(row.chars().count(), T.header().chars().count());
-    }
-}
-
-/// A time step as people write it: 1/1000 for 0.001.
-pub fn dt_label(dt: f64) -> String {
-    let n = 1.0 / dt;
-    if (n - n.round()).abs() < 1e-6 * n {
-        format!("1/{}", n.round())
-    } else {
-        format!("{dt}")
     }
 }
