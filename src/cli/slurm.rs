@@ -16,7 +16,7 @@ use clap::{Args, Subcommand};
 use dicephys::report::summary::RunSummary;
 use dicephys::run::runner::{Checkpoint, ChunkShare};
 use dicephys::run::slurm::{self, Layout, Options, Plan};
-use dicephys::studies::outputs::Place;
+use dicephys::studies::outputs::{self, Place};
 use dicephys::studies::StudyConfig;
 use std::path::{Path, PathBuf};
 
@@ -162,19 +162,6 @@ fn study_of(c: &SlurmCommand) -> Result<Option<Flags<'_>>> {
     }))
 }
 
-/// Where a study of a cluster run writes, on every task and in the finishing job alike: its
-/// outputs into DIR, its cells under DIR/checkpoint.
-fn placed(lay: &Layout, threads: usize, json: bool, share: ChunkShare, line: &str) -> Place {
-    Place {
-        out: lay.dir.clone(),
-        checkpoint: Some(lay.cells()),
-        threads,
-        share,
-        json,
-        command_line: line.to_string(),
-    }
-}
-
 /// `dicephys slurm <study>`: the study checked, run dry, its plan stored, the scripts written.
 fn submit_study((cfg, threads, json, given, job): Flags) -> Result<()> {
     if let Some(flag) = given {
@@ -201,7 +188,7 @@ fn submit_study((cfg, threads, json, given, job): Flags) -> Result<()> {
     // Bad input is refused here, before anything is submitted or stored: the study runs dry,
     // checking its arguments and stopping at its first cell.
     let (lay, opt, bin) = prepare(&plan, job, threads, |lay| {
-        let dry = placed(lay, threads, json, ChunkShare::DryRun, &line);
+        let dry = Place::cluster(lay, threads, json, ChunkShare::DryRun, &line);
         match study::run(&cfg, &dry) {
             Ok(()) | Err(Error::Interrupted(_)) => Ok(()),
             Err(e) => Err(e),
@@ -212,42 +199,20 @@ fn submit_study((cfg, threads, json, given, job): Flags) -> Result<()> {
     emit(&plan, &lay, &opt, &bin, job.submit)
 }
 
-/// A study's plan read back: its configuration and how it runs.
-fn study_plan(lay: &Layout) -> Result<(StudyConfig, bool, String, usize, u64)> {
-    let Plan::Study {
-        config,
-        json,
-        command_line,
-        threads,
-        tasks,
-    } = lay.read_plan()?
-    else {
-        return Err(Error::Usage(format!(
-            "slurm task: {} is not a study's run",
-            lay.dir.display()
-        )));
-    };
-    let cfg = serde_json::from_value(config)
-        .map_err(|e| Error::Usage(format!("{} is damaged ({e})", lay.plan().display())))?;
-    Ok((cfg, json, command_line, threads, tasks))
-}
-
 /// One array task of a study: the study with this task's share of the chunks, then its mark.
 fn task(dir: &Path, k: u64) -> Result<()> {
     let lay = Layout {
         dir: dir.to_path_buf(),
     };
-    let (cfg, json, line, threads, tasks) = study_plan(&lay)?;
+    let (cfg, place, tasks) = outputs::planned(&lay)?;
     if k >= tasks {
         return Err(Error::Usage(format!(
             "slurm task {k}: the run has tasks 0 to {}",
             tasks - 1
         )));
     }
-    study::run(
-        &cfg,
-        &placed(&lay, threads, json, ChunkShare::task(k, tasks), &line),
-    )?;
+    let share = ChunkShare::task(k, tasks);
+    study::run(&cfg, &Place { share, ..place })?;
     super::output(&lay.task_done(k))?.write(format!("task {k} of {tasks}\n").as_bytes())?;
     eprintln!(
         "task {k}: its share is rolled ({})",
@@ -401,11 +366,11 @@ fn finish(dir: &Path) -> Result<()> {
     match &plan {
         Plan::Study { tasks, .. } => {
             lay.check_marks(*tasks)?;
-            let (cfg, json, line, threads, _) = study_plan(&lay)?;
             // Every chunk is on disk: the study reads them all and rolls none (but tradeoff,
             // whose tasks rolled ahead, runs here, rolling on where a method needs more).
+            let (cfg, place, _) = outputs::planned(&lay)?;
             let (cfg, share) = cfg.finishing();
-            study::run(&cfg, &placed(&lay, threads, json, share, &line))?;
+            study::run(&cfg, &Place { share, ..place })?;
         }
         Plan::Roll { spec, tasks } => {
             let text = RunSummary::merge_tasks(&lay, spec, *tasks)?;

@@ -9,6 +9,7 @@ use crate::report;
 pub use crate::report::progress::Unit;
 use crate::run::io::Output;
 use crate::run::runner::{ChunkShare, Runner};
+use crate::run::slurm::{Layout, Plan};
 use crate::run::stop::Stop;
 use crate::studies;
 use serde::Serialize;
@@ -69,7 +70,48 @@ impl StudyConfig {
     }
 }
 
+/// The study stored in a cluster run's plan, where it runs (on all its chunks: a task narrows
+/// the share) and the run's tasks.
+pub fn planned(lay: &Layout) -> Result<(StudyConfig, Place, u64)> {
+    let Plan::Study {
+        config,
+        json,
+        command_line,
+        threads,
+        tasks,
+    } = lay.read_plan()?
+    else {
+        return Err(Error::Invalid(format!(
+            "{} is a roll's run, not a study's",
+            lay.dir.display()
+        )));
+    };
+    let cfg = serde_json::from_value(config)
+        .map_err(|e| Error::Invalid(format!("{} is damaged ({e})", lay.plan().display())))?;
+    let place = Place::cluster(lay, threads, json, ChunkShare::All, &command_line);
+    Ok((cfg, place, tasks))
+}
+
 impl Place {
+    /// Where a study of a cluster run writes, on every task and in the finishing job alike:
+    /// its outputs into the run's directory, its cells under its `checkpoint/`.
+    pub fn cluster(
+        lay: &Layout,
+        threads: usize,
+        json: bool,
+        share: ChunkShare,
+        command_line: &str,
+    ) -> Place {
+        Place {
+            out: lay.dir.clone(),
+            checkpoint: Some(lay.cells()),
+            threads,
+            share,
+            json,
+            command_line: command_line.to_string(),
+        }
+    }
+
     /// A cluster task's share or a dry run: its tallies are partial, for no report.
     fn partial(&self) -> bool {
         self.share.is_partial()
