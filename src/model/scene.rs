@@ -329,7 +329,16 @@ mod tests {
         s.validate(false).unwrap();
         for bad in [-1.0, MAX_DAMPING * 1.01, f64::NAN, f64::INFINITY] {
             s.linear_damping = bad;
-            assert!(matches!(s.validate(false), Err(Error::Invalid(_))), "{bad}");
+            assert!(
+                matches!(
+                    s.validate(false),
+                    Err(Error::Field {
+                        field: "linear_damping",
+                        ..
+                    })
+                ),
+                "{bad}"
+            );
         }
     }
 
