@@ -72,7 +72,7 @@ fn flag(field: &str) -> String {
 }
 
 /// A library message with each field it names in backquotes, `like_this`, named by its flag.
-fn flags_in(why: &str) -> String {
+pub fn flags_in(why: &str) -> String {
     let mut out = String::new();
     for (i, part) in why.split('`').enumerate() {
         if i % 2 == 1 {

@@ -82,7 +82,7 @@ fn with_hooks(
     let done = done?;
     out!("{}", done.stdout);
     if let Some(n) = done.note {
-        eprintln!("{n}");
+        eprintln!("{}", super::error::flags_in(&n));
     }
     match done.interrupted {
         Some(m) => Err(Error::Interrupted(m)),

@@ -49,7 +49,8 @@ pub struct Hooks<'a> {
 pub struct Done {
     /// For stdout: the report, or the JSON result.
     pub stdout: String,
-    /// For stderr: what was written where.
+    /// For stderr: what was written where (a field it names in backquotes, as in
+    /// `Error::Field`).
     pub note: Option<String>,
     /// Stopped before the end, and what was kept: the caller ends with its own exit code.
     pub interrupted: Option<String>,
@@ -288,7 +289,7 @@ pub fn tradeoff(cfg: &studies::tradeoff::Config, place: &Place, hooks: &Hooks) -
         return Ok(Done {
             note: Some(format!(
                 "rolled the first {} throws of every stream into {}/checkpoint ({:.0} CPU s); \
-                 the same command without --preroll reads them back",
+                 the same study without `preroll_chunks` reads them back",
                 k * crate::run::runner::CHUNK_ROLLS,
                 place.out.display(),
                 res.cpu_s
