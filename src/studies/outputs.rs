@@ -6,14 +6,20 @@
 use super::{Progress, Study, StudyConfig};
 use crate::error::{Error, Result};
 use crate::report;
+use crate::report::per_roll::PerRoll;
 pub use crate::report::progress::Unit;
+use crate::report::summary::{Cost, RunSummary};
+use crate::run::cputime::process_cpu_seconds;
 use crate::run::io::Output;
-use crate::run::runner::{ChunkShare, Runner};
+use crate::run::runner::{Checkpoint, ChunkShare, Runner};
 use crate::run::slurm::{Layout, Plan};
+use crate::run::spec::RunSpec;
 use crate::run::stop::Stop;
+use crate::sim::roll::RollRecord;
 use crate::studies;
 use serde::Serialize;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 /// Where and how a study runs: its threads, its share of the chunks, where its outputs and
 /// cells go, what it prints.
@@ -149,6 +155,43 @@ impl Place {
             interrupted: None,
         }
     }
+}
+
+/// `roll`: one run, its chunks kept in `checkpoint` if given (a run there is continued), one
+/// CSV row per throw into `per_roll` if given (grown chunk by chunk in a temporary file, put
+/// in place at the end). Its summary is partial if a stop request ended it; a resumed run's
+/// cost is the sum over its segments (the resumed chunks carry theirs).
+pub fn roll(
+    spec: &RunSpec,
+    checkpoint: Option<&Path>,
+    per_roll: Option<Output>,
+    runner: &Runner,
+) -> Result<RunSummary> {
+    let checkpoint = checkpoint.map(|d| Checkpoint::open(d, spec)).transpose()?;
+    let mut csv = match &per_roll {
+        Some(out) => Some(PerRoll::new(out.writer()?, spec.scene.dt)?),
+        None => None,
+    };
+    let mut sink = |recs: &[RollRecord]| -> Result<()> {
+        match csv.as_mut() {
+            Some(c) => c.write(recs),
+            None => Ok(()),
+        }
+    };
+    let wall = Instant::now();
+    let cpu = process_cpu_seconds();
+    let done = runner.run(spec, checkpoint.as_ref(), &mut sink)?;
+    let cost = Cost {
+        wall_s: wall.elapsed().as_secs_f64() + done.resumed_wall_s,
+        cpu_s: process_cpu_seconds() - cpu + done.resumed_cpu_s,
+        threads: runner.threads,
+    };
+    if let Some(c) = csv {
+        c.finish()?.commit()?;
+    }
+    let mut summary = RunSummary::new(spec, &done.tally, cost);
+    summary.partial = !done.complete;
+    Ok(summary)
 }
 
 /// Runs a study that a cluster can split.
