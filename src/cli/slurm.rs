@@ -15,7 +15,7 @@ use super::{out, outln};
 use clap::{Args, Subcommand};
 use dicephys::report::summary::RunSummary;
 use dicephys::run::runner::{Checkpoint, ChunkShare};
-use dicephys::run::slurm::{self, Layout, Options, Plan};
+use dicephys::run::slurm::{Layout, Options, Plan};
 use dicephys::studies::outputs::{self, Place};
 use dicephys::studies::StudyConfig;
 use std::path::{Path, PathBuf};
@@ -284,33 +284,18 @@ fn prepare(
             .and_then(|p| p.canonicalize())
             .map_err(|e| Error::Run(format!("cannot find this binary's path ({e})")))?,
     };
-    std::fs::create_dir_all(&job.dir).map_err(|e| {
-        Error::Usage(format!(
-            "--dir {}: cannot create it ({e})",
-            job.dir.display()
-        ))
-    })?;
-    let dir = job
-        .dir
-        .canonicalize()
-        .map_err(|e| Error::Usage(format!("--dir {}: {e}", job.dir.display())))?;
-    let lay = Layout { dir };
+    let lay = Layout::create(&job.dir)?;
     check(&lay)?;
     lay.store(plan).map_err(|e| match e {
         dicephys::Error::Mismatch(m) => Error::Usage(format!("--dir {m}")),
         e => e.into(),
     })?;
-    std::fs::create_dir_all(lay.logs())
-        .map_err(|e| Error::Run(format!("{}: {e}", lay.logs().display())))?;
     Ok((lay, opt, bin))
 }
 
 /// Writes both scripts; prints them, or submits them and prints the job ids.
 fn emit(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path, submit: bool) -> Result<()> {
-    let array = slurm::array_script(plan, lay, opt, bin)?;
-    let fin = slurm::finish_script(plan, lay, opt, bin)?;
-    super::output(&lay.array_script())?.write(array.as_bytes())?;
-    super::output(&lay.finish_script())?.write(fin.as_bytes())?;
+    let [array, fin] = lay.write_scripts(plan, opt, bin)?;
     let (a, f) = (lay.array_script(), lay.finish_script());
     if !submit {
         outln!("# {}\n{array}", a.display());

@@ -131,8 +131,29 @@ pub struct Layout {
 }
 
 impl Layout {
-    /// Stores `plan` in the run's directory, or checks that the directory holds this very run.
+    /// The run's directory `dir`, made if need be, by its absolute path (the scripts run on
+    /// other nodes).
+    pub fn create(dir: &Path) -> Result<Layout> {
+        let bad = |e: std::io::Error| Error::field("dir", dir.display(), e.to_string());
+        std::fs::create_dir_all(dir).map_err(bad)?;
+        Ok(Layout {
+            dir: dir.canonicalize().map_err(bad)?,
+        })
+    }
+
+    /// Writes the two scripts (`array_script`, `finish_script`) whole; returns their text.
+    pub fn write_scripts(&self, plan: &Plan, opt: &Options, bin: &Path) -> Result<[String; 2]> {
+        let array = array_script(plan, self, opt, bin)?;
+        let fin = finish_script(plan, self, opt, bin)?;
+        Output::check(&self.array_script())?.write(array.as_bytes())?;
+        Output::check(&self.finish_script())?.write(fin.as_bytes())?;
+        Ok([array, fin])
+    }
+
+    /// Stores `plan` in the run's directory, or checks that the directory holds this very run;
+    /// makes the logs' directory.
     pub fn store(&self, plan: &Plan) -> Result<()> {
+        std::fs::create_dir_all(self.logs()).map_err(|e| Error::io(&self.logs(), e))?;
         match self.read_plan() {
             Ok(stored) if stored.same_run(plan) => Ok(()),
             Ok(_) => Err(Error::Mismatch(format!(
