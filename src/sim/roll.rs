@@ -176,15 +176,17 @@ impl RollConfig {
 
     /// Checks every value before anything runs.
     pub fn validate(&self) -> crate::Result<()> {
-        let bad = |m: String| Err(crate::Error::Invalid(m));
+        use crate::Error;
         if self.max_steps == 0 {
-            return bad("--max-steps 0: need at least one step".into());
+            return Err(Error::field("max_steps", 0, "need at least one step"));
         }
         if !(self.margin.is_finite() && (0.0..1.0).contains(&self.margin)) {
-            return bad(format!("--margin {}: must be in [0, 1)", self.margin));
+            return Err(Error::field("margin", self.margin, "must be in [0, 1)"));
         }
         if self.audit && self.rule == Rule::Certificate {
-            return bad("an audit settles fully: it needs the dicephys rule".into());
+            return Err(Error::Invalid(
+                "an audit settles fully: it needs the dicephys rule".into(),
+            ));
         }
         Ok(())
     }
