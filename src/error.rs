@@ -8,6 +8,19 @@ pub enum Error {
     /// A value refused before anything runs: out of range, malformed, or inconsistent.
     #[error("{0}")]
     Invalid(String),
+    /// A value of a configuration refused before anything runs, named by its field as the
+    /// library spells it (`max_steps`, `rolls`): "max_steps 0: need at least one step". A
+    /// field named in `why` is written in backquotes, `like_this`, so that a caller can name
+    /// each as its user knows it (the command line maps them to its flags).
+    #[error("{}", field_line(field, value, why))]
+    Field {
+        /// The field, e.g. `max_steps`.
+        field: &'static str,
+        /// Its value as given (empty if the field as a whole is wrong, e.g. an empty list).
+        value: String,
+        /// What is wrong with it, and what would do.
+        why: String,
+    },
     /// Inputs that do not belong together: a checkpoint of another run, shards of two runs.
     #[error("{0}")]
     Mismatch(String),
@@ -30,7 +43,25 @@ pub enum Error {
     Failed(String),
 }
 
+/// "field value: why", or "field: why" without a value.
+fn field_line(field: &str, value: &str, why: &str) -> String {
+    if value.is_empty() {
+        format!("{field}: {why}")
+    } else {
+        format!("{field} {value}: {why}")
+    }
+}
+
 impl Error {
+    /// A value of `field` refused: see [`Error::Field`].
+    pub fn field(field: &'static str, value: impl ToString, why: impl Into<String>) -> Error {
+        Error::Field {
+            field,
+            value: value.to_string(),
+            why: why.into(),
+        }
+    }
+
     /// An I/O error on `path`.
     pub fn io(path: &Path, source: std::io::Error) -> Error {
         Error::Io {
@@ -41,7 +72,10 @@ impl Error {
 
     /// True for errors in what was asked (bad values, mismatched inputs), not in running it.
     pub fn is_input(&self) -> bool {
-        matches!(self, Error::Invalid(_) | Error::Mismatch(_))
+        matches!(
+            self,
+            Error::Invalid(_) | Error::Field { .. } | Error::Mismatch(_)
+        )
     }
 }
 

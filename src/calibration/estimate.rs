@@ -168,7 +168,9 @@ impl Identified {
                 "bounded below only (its 2σ region reaches the range's upper end)"
             }
             Identified::No => "not identifiable: its 2σ region spans the whole range",
-            Identified::Cut => "its 2σ region reaches the edge of the second pass's narrowed box: the box cut it",
+            Identified::Cut => {
+                "its 2σ region reaches the edge of the second pass's narrowed box: the box cut it"
+            }
         }
     }
 }
@@ -274,9 +276,8 @@ impl Default for Search {
 /// Halton sequence).
 pub fn maximise(lik: &Likelihood, dims: usize, starts: usize) -> Result<(Minimum, Vec<f64>)> {
     let mut start_points = vec![vec![0.5; dims]];
-    start_points.extend(
-        (1..starts.max(1)).map(|i| crate::calibration::design::halton_point(i, dims)),
-    );
+    start_points
+        .extend((1..starts.max(1)).map(|i| crate::calibration::design::halton_point(i, dims)));
     maximise_from(lik, &start_points)
 }
 

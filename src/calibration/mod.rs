@@ -96,7 +96,6 @@ impl FitConfig {
         let per_key = design::points(self.model.free.len(), self.design.points).len() as u64;
         design::keys(&self.rows, &self.model).len() as u64 * per_key * self.design.rolls
     }
-
 }
 
 /// What a fit cost.
@@ -141,7 +140,12 @@ pub struct FitResult {
 /// whose widened interval still covers 80 % of its range keeps the whole range, and so does one
 /// that only one row informs: a fit that leaves that row out (a leave-one-out prediction) must
 /// then know nothing of it, not a box the row itself chose.
-pub fn narrow(rows: &[DataRow], model: &ModelSpec, params: &[Param], first: &Estimate) -> Vec<params::Narrowed> {
+pub fn narrow(
+    rows: &[DataRow],
+    model: &ModelSpec,
+    params: &[Param],
+    first: &Estimate,
+) -> Vec<params::Narrowed> {
     let mut uses = vec![0usize; params.len()];
     for r in rows {
         for d in model.row_dims(params, r) {

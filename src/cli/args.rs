@@ -8,15 +8,15 @@ use dicephys::error::parse_name;
 use dicephys::model::block::Block;
 use dicephys::model::scene::{Floor, Mode, Preset, Scene};
 use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
-use dicephys::run::runner::MAX_THREADS;
-use dicephys::run::spec::{Shard, ThrowSpec};
+use dicephys::run::batch::MAX_THREADS;
+use dicephys::run::spec::ThrowSpec;
 use dicephys::sim::roll::{early_stop_exact, RollConfig, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
 
 /// The scene: the block, the surface, the time step.
 #[derive(Args, Debug, Clone)]
 pub struct SceneArgs {
     /// The block, LENGTHxBREADTHxWIDTH in mm (the paper's order), e.g. 140x24x20.
-    #[arg(long, value_parser = parse_block)]
+    #[arg(long)]
     pub block: Option<Block>,
     /// DicePhys's 2D mode: a 1 m deep box locked to the x-y plane.
     #[arg(long = "2d")]
@@ -68,13 +68,13 @@ pub struct ThrowArgs {
     #[arg(long, default_value = "keyed", value_parser = parse_throw_kind)]
     pub throws: ThrowKind,
     /// Linear velocity along x, m/s: LO:HI, or one number.
-    #[arg(long, default_value = "-0.2:0.2", value_parser = parse_range, allow_hyphen_values = true)]
+    #[arg(long, default_value = "-0.2:0.2", allow_hyphen_values = true)]
     pub velocity: Range,
     /// Spin about the length axis, rad/s: LO:HI, or one number.
-    #[arg(long, default_value = "31:160", value_parser = parse_range, allow_hyphen_values = true)]
+    #[arg(long, default_value = "31:160", allow_hyphen_values = true)]
     pub spin: Range,
     /// Drop height added to the longest side, m: LO:HI, or one number.
-    #[arg(long, default_value = "0.2:0.4", value_parser = parse_range, allow_hyphen_values = true)]
+    #[arg(long, default_value = "0.2:0.4", allow_hyphen_values = true)]
     pub drop_height: Range,
     /// How the die is thrown: paper (length along z, spin about it, velocity along x), tumble
     /// (random orientation, spin axis uniform on the sphere, velocity in a random horizontal
@@ -144,17 +144,9 @@ pub struct RunArgs {
     pub faithful: bool,
 }
 
-/// `--block` as clap reads it.
-pub fn parse_block(s: &str) -> std::result::Result<Block, dicephys::Error> {
-    s.parse()
-}
 /// `--dt` as clap reads it: a decimal or a fraction (the scene checks its range).
 pub fn parse_step(s: &str) -> std::result::Result<f64, dicephys::Error> {
     dicephys::studies::sweep::parse_seconds(s)
-}
-/// `LO:HI` as clap reads it.
-pub fn parse_range(s: &str) -> std::result::Result<Range, dicephys::Error> {
-    s.parse()
 }
 /// `--preset` as clap reads it.
 pub fn parse_preset(s: &str) -> std::result::Result<Preset, dicephys::Error> {
@@ -175,10 +167,6 @@ pub fn parse_throw_style(s: &str) -> std::result::Result<ThrowStyle, dicephys::E
 /// `--engine` as clap reads it.
 pub fn parse_engine(s: &str) -> std::result::Result<EngineKind, dicephys::Error> {
     parse_name("engine", s)
-}
-/// `--shard K/N` as clap reads it.
-pub fn parse_shard(s: &str) -> std::result::Result<Shard, dicephys::Error> {
-    s.parse()
 }
 
 impl SceneArgs {
@@ -280,5 +268,5 @@ pub fn threads(asked: usize) -> Result<usize> {
             "--threads {asked}: at most {MAX_THREADS}"
         )));
     }
-    Ok(dicephys::run::runner::threads(asked))
+    Ok(dicephys::run::batch::threads(asked))
 }

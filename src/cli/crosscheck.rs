@@ -1,18 +1,15 @@
-//! `dicephys crosscheck`: the very same throws on several engines, side by side.
+//! `dicephys crosscheck`: the very same throws on several engines, side by side
+//! (`dicephys::studies::crosscheck`).
 
 use super::args::{parse_engine, RunArgs, SceneArgs, ThrowArgs};
 use super::error::{Error, Result};
-use super::{out, outln};
+use super::study;
 use clap::Args;
 use dicephys::engine::EngineKind;
-use dicephys::report::summary::{Cost, RunSummary};
-use dicephys::run::cputime::process_cpu_seconds;
 use dicephys::run::spec::RunSpec;
-use dicephys::run::tally::Agreement;
-use dicephys::theory::stats;
-use serde::Serialize;
-use std::path::PathBuf;
-use std::time::Instant;
+use dicephys::studies::outputs::Place;
+use dicephys::studies::{crosscheck, StudyConfig};
+use std::path::{Path, PathBuf};
 
 /// `dicephys crosscheck`'s arguments.
 #[derive(Args, Debug)]
@@ -35,127 +32,38 @@ pub struct CrosscheckArgs {
     pub json: bool,
 }
 
-/// One engine against the baseline, on identical throws.
-#[derive(Clone, Debug, Serialize)]
-pub struct Versus {
-    /// The engine compared.
-    pub engine: EngineKind,
-    /// The baseline engine.
-    pub baseline: EngineKind,
-    /// (ratio − baseline ratio) / combined binomial error.
-    pub z: f64,
-    /// Throws both engines settled: how many, and the fraction of them with the same outcome.
-    pub both_settled: u64,
-    /// Same outcome over the throws both settled.
-    pub same_outcome_fraction: f64,
-    /// This engine's CPU time per roll over the baseline's.
-    pub cpu_ratio: f64,
-}
-
-/// The whole cross-check.
-#[derive(Clone, Debug, Serialize)]
-pub struct Crosscheck {
-    /// Each engine's run, baseline first.
-    pub runs: Vec<RunSummary>,
-    /// Each other engine against the baseline.
-    pub versus: Vec<Versus>,
+impl CrosscheckArgs {
+    /// The study's configuration, checked.
+    pub fn config(&self) -> Result<crosscheck::Config> {
+        if self.engines.len() < 2 {
+            return Err(Error::Usage(
+                "--engines: name at least two engines to compare".into(),
+            ));
+        }
+        let scene = self.scene.scene()?;
+        let cfg = crosscheck::Config {
+            engines: self.engines.clone(),
+            spec: RunSpec {
+                engine: self.engines[0],
+                roll: self.run.roll(scene.dt)?,
+                scene,
+                throws: self.throw.spec()?,
+                rolls: self.run.rolls,
+                shard: None,
+            },
+            allow_restitution_above_one: self.scene.allow_restitution_above_one,
+        };
+        cfg.validate()?;
+        Ok(cfg)
+    }
 }
 
 /// Runs `dicephys crosscheck`.
 pub fn run(a: &CrosscheckArgs) -> Result<()> {
-    if a.engines.len() < 2 {
-        return Err(Error::Usage(
-            "--engines: name at least two engines to compare".into(),
-        ));
-    }
-    let scene = a.scene.scene()?;
-    let base = RunSpec {
-        engine: a.engines[0],
-        roll: a.run.roll(scene.dt)?,
-        scene,
-        throws: a.throw.spec()?,
-        rolls: a.run.rolls,
-        shard: None,
+    let cfg = a.config()?;
+    let place = Place {
+        checkpoint: a.checkpoint.clone(),
+        ..study::local(Path::new(""), a.run.threads, a.json)?
     };
-    base.validate(a.scene.allow_restitution_above_one)?;
-    let threads = a.run.threads()?;
-    let runner = super::runner(threads);
-    let mut runs = Vec::new();
-    let mut records = Vec::new();
-    for &engine in &a.engines {
-        let spec = RunSpec {
-            engine,
-            ..base.clone()
-        };
-        let wall = Instant::now();
-        let cpu = process_cpu_seconds();
-        let mut recs = Vec::new();
-        let ck = a
-            .checkpoint
-            .as_ref()
-            .map(|d| runner.open_cell(&d.join(format!("{engine}-{}", spec.key())), &spec))
-            .transpose()?;
-        let done = runner.run(&spec, ck.as_ref(), &mut |r| {
-            recs.extend_from_slice(r);
-            Ok(())
-        })?;
-        let cost = Cost {
-            wall_s: wall.elapsed().as_secs_f64(),
-            cpu_s: process_cpu_seconds() - cpu,
-            threads,
-        };
-        if !done.complete {
-            return Err(Error::Interrupted(format!(
-                "interrupted during {engine} after {} of {} rolls; nothing compared",
-                done.tally.rolls, spec.rolls
-            )));
-        }
-        runs.push(RunSummary::new(&spec, &done.tally, cost));
-        records.push(recs);
-    }
-    if super::is_task() {
-        // A cluster task's share: its chunks are kept for the finishing job; nothing to compare.
-        return Ok(());
-    }
-    let versus: Vec<Versus> = (1..runs.len())
-        .map(|i| {
-            let agree = Agreement::of(&records[0], &records[i]);
-            Versus {
-                engine: runs[i].engine,
-                baseline: runs[0].engine,
-                z: stats::z_score(
-                    runs[i].ratio,
-                    runs[i].ratio_err,
-                    runs[0].ratio,
-                    runs[0].ratio_err,
-                ),
-                both_settled: agree.both_settled,
-                same_outcome_fraction: agree.of_settled(),
-                cpu_ratio: runs[i].cpu_ms_per_roll / runs[0].cpu_ms_per_roll,
-            }
-        })
-        .collect();
-    let out = Crosscheck { runs, versus };
-    if a.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&out).map_err(|e| Error::Run(e.to_string()))?
-        );
-    } else {
-        for r in &out.runs {
-            out!("{}", r.human());
-        }
-        for v in &out.versus {
-            outln!(
-                "{} vs {}: {:+.1} σ apart; same outcome on {:.1} % of the {} throws both settled; CPU per roll {:.2}x",
-                v.engine,
-                v.baseline,
-                v.z,
-                100.0 * v.same_outcome_fraction,
-                v.both_settled,
-                v.cpu_ratio
-            );
-        }
-    }
-    Ok(())
+    study::run(&StudyConfig::Crosscheck(cfg), &place)
 }

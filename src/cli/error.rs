@@ -42,12 +42,46 @@ impl From<dicephys::Error> for Error {
             Error::Interrupted(
                 "interrupted; the finished work is kept: run the same command to continue".into(),
             )
+        } else if let dicephys::Error::Field { field, value, why } = &e {
+            let line = if value.is_empty() {
+                format!("{}: {}", flag(field), flags_in(why))
+            } else {
+                format!("{} {value}: {}", flag(field), flags_in(why))
+            };
+            Error::Usage(line)
         } else if e.is_input() {
             Error::Usage(e.to_string())
         } else {
             Error::Run(e.to_string())
         }
     }
+}
+
+/// The flag that sets a field of the library's configurations: most are the field's name,
+/// `--` and kebab case; these few are spelt otherwise.
+fn flag(field: &str) -> String {
+    match field {
+        "style" => "--throw".into(),
+        "kind" => "--throws".into(),
+        "budget_s" => "--budget".into(),
+        "reference_budget_s" => "--reference-budget".into(),
+        "preroll_chunks" => "--preroll".into(),
+        "plan_only" => "--plan".into(),
+        f => format!("--{}", f.replace('_', "-")),
+    }
+}
+
+/// A library message with each field it names in backquotes, `like_this`, named by its flag.
+pub fn flags_in(why: &str) -> String {
+    let mut out = String::new();
+    for (i, part) in why.split('`').enumerate() {
+        if i % 2 == 1 {
+            out += &flag(part);
+        } else {
+            out += part;
+        }
+    }
+    out
 }
 
 impl From<std::io::Error> for Error {

@@ -1,9 +1,8 @@
 //! `dicephys fit` (calibrate e, μ and the throw to measured counts, or check that a fit
 //! recovers known values) and `dicephys predict` (a block the fit did not see).
 
-use super::args::{parse_block, parse_engine, parse_step};
+use super::args::{parse_engine, parse_step};
 use super::error::{Error, Result};
-use super::outln;
 use clap::Args;
 use dicephys::calibration::data;
 use dicephys::calibration::design::DesignSpec;
@@ -15,10 +14,8 @@ use dicephys::engine::EngineKind;
 use dicephys::model::block::Block;
 use dicephys::model::scene::Mode;
 use dicephys::model::throws::Range;
-use dicephys::report::fit as report;
 use dicephys::sim::roll::DEFAULT_MAX_STEPS;
-use dicephys::studies::fit as study;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// `dicephys fit`'s arguments.
 #[derive(Args, Debug)]
@@ -81,9 +78,10 @@ pub struct FitArgs {
     /// Worker threads (0: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
-    /// Output directory: fit.json, report.md, figures, and the simulations' checkpoints.
-    #[arg(long, default_value = "fit-out")]
-    pub out: PathBuf,
+    /// Output directory: fit.json, report.md, figures, and the simulations' cells
+    /// [default: fit-out].
+    #[arg(long, value_name = "OUT")]
+    pub out: Option<PathBuf>,
     /// Instead of fitting the file's counts: simulate counts of its rows (same blocks and
     /// numbers of throws) at these values, NAME=V,… for every free parameter, fit them back,
     /// --repeats times, and report how often the 2σ region holds the truth.
@@ -104,7 +102,7 @@ pub struct PredictArgs {
     #[arg(long, value_name = "FIT.json")]
     pub fit: PathBuf,
     /// The block, LENGTHxBREADTHxWIDTH in mm.
-    #[arg(long, value_parser = parse_block)]
+    #[arg(long)]
     pub block: Block,
     /// Simulate it in 2D (DicePhys's plane-locked block).
     #[arg(long = "2d")]
@@ -228,117 +226,53 @@ impl FitArgs {
     }
 }
 
-/// A progress bar over `total` rolls on a terminal, hidden otherwise.
-fn bar(total: u64, quiet: bool) -> indicatif::ProgressBar {
-    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-    use std::io::IsTerminal;
-    if quiet || !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
-    b.set_style(
-        ProgressStyle::with_template("{elapsed_precise} [{wide_bar}] {pos}/{len} rolls, ETA {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    b
-}
-
-fn interrupted(dir: &Path) -> Error {
-    Error::Interrupted(format!(
-        "interrupted; {} kept what was rolled: run the same command to continue",
-        dir.display()
-    ))
-}
-
 /// Runs `dicephys fit`.
 pub fn run(a: &FitArgs) -> Result<()> {
     let cfg = a.config()?;
-    let threads = super::args::threads(a.threads)?;
     if a.recover.is_some() && a.repeats == 0 {
         return Err(Error::Usage(
             "--repeats 0: need at least one repetition".into(),
         ));
     }
-    std::fs::create_dir_all(&a.out)
-        .map_err(|e| Error::Usage(format!("--out {}: cannot create it ({e})", a.out.display())))?;
-    let command_line = std::env::args().collect::<Vec<_>>().join(" ");
-    if let Some(truth) = &a.recover {
-        return recover(a, &cfg, truth, threads);
+    let out = a.out.clone().unwrap_or_else(|| "fit-out".into());
+    let mut place = super::study::local(&out, a.threads, a.json)?;
+    // The simulations' cells under --out/cells.
+    place.checkpoint = Some(out.join("cells"));
+    match &a.recover {
+        Some(truth) => {
+            let truth = truth_values(&cfg, truth)?;
+            super::study::recover(&cfg, &truth, a.repeats, &place)
+        }
+        None => super::study::fit(&cfg, &place),
     }
-    let outputs = [
-        super::output(&a.out.join("fit.json"))?,
-        super::output(&a.out.join("report.md"))?,
-    ];
-    let bar = bar(cfg.total_rolls(), a.json);
-    let progress = |n| bar.set_position(n);
-    let runner = super::runner(threads);
-    let cells = a.out.join("cells");
-    let res = study::run(
-        &cfg,
-        command_line,
-        &runner.with_progress(&progress),
-        Some(&cells),
-    )?;
-    bar.finish_and_clear();
-    let Some(res) = res else {
-        return Err(interrupted(&cells));
-    };
-    let figures = report::write_figures(&a.out, &res)?;
-    let md = report::markdown(&res, &figures);
-    let json = serde_json::to_string_pretty(&res).map_err(|e| Error::Run(e.to_string()))?;
-    outputs[0].write(json.as_bytes())?;
-    outputs[1].write(md.as_bytes())?;
-    if a.json {
-        outln!("{json}");
-    } else {
-        outln!("{md}");
-        eprintln!("wrote {}/fit.json, report.md and figures", a.out.display());
-    }
-    Ok(())
 }
 
-fn recover(a: &FitArgs, cfg: &FitConfig, truth: &str, threads: usize) -> Result<()> {
+/// `--recover NAME=V,…`: a value for every free parameter, in the model's order.
+fn truth_values(cfg: &FitConfig, truth: &str) -> Result<Vec<f64>> {
     let given: Vec<&str> = truth.split(',').collect();
     let values = pairs("--recover", &given, |v| {
         v.parse::<f64>().ok().filter(|x| x.is_finite())
     })?;
-    let mut truth = Vec::new();
-    for k in &cfg.model.free {
-        let v = values.iter().find(|(kind, _)| kind == k).ok_or_else(|| {
-            Error::Usage(format!(
-                "--recover: give a value for the free parameter {k}"
-            ))
-        })?;
-        truth.push(v.1);
-    }
     if let Some((k, _)) = values.iter().find(|(k, _)| !cfg.model.free.contains(k)) {
         return Err(Error::Usage(format!(
             "--recover {k}=…: {k} is not among --free"
         )));
     }
-    let output = super::output(&a.out.join("recovery.json"))?;
-    let rows_per_rep: u64 = cfg.rows.iter().map(|r| r.counts.iter().sum::<u64>()).sum();
-    let bar = bar(
-        (cfg.total_rolls() + rows_per_rep) * a.repeats as u64,
-        a.json,
-    );
-    let progress = |n| bar.set_position(n);
-    let runner = super::runner(threads);
-    let res = study::recovery::run(cfg, &truth, a.repeats, &runner.with_progress(&progress))?;
-    bar.finish_and_clear();
-    let Some(res) = res else {
-        return Err(Error::Interrupted(
-            "interrupted before the repetitions were done".into(),
-        ));
-    };
-    let json = serde_json::to_string_pretty(&res).map_err(|e| Error::Run(e.to_string()))?;
-    output.write(json.as_bytes())?;
-    if a.json {
-        outln!("{json}");
-    } else {
-        outln!("{}", report::recovery_text(&res));
-    }
-    Ok(())
+    cfg.model
+        .free
+        .iter()
+        .map(|k| {
+            values
+                .iter()
+                .find(|(kind, _)| kind == k)
+                .map(|v| v.1)
+                .ok_or_else(|| {
+                    Error::Usage(format!(
+                        "--recover: give a value for the free parameter {k}"
+                    ))
+                })
+        })
+        .collect()
 }
 
 /// Runs `dicephys predict`.
@@ -351,7 +285,6 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
             a.fit.display()
         ))
     })?;
-    let threads = super::args::threads(a.threads)?;
     let cfg = PredictConfig {
         block: a.block,
         mode: if a.two_d { Mode::TwoD } else { Mode::ThreeD },
@@ -361,21 +294,7 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
         rolls: a.rolls,
         seed: a.seed,
     };
-    let bar = bar(a.draws as u64 * a.rolls, a.json);
-    let progress = |n| bar.set_position(n);
-    let runner = super::runner(threads);
-    let p = study::predict::predict_block(&fit, &cfg, &runner.with_progress(&progress), None)?;
-    bar.finish_and_clear();
-    let Some(p) = p else {
-        return Err(Error::Interrupted(
-            "interrupted before the draws were rolled".into(),
-        ));
-    };
-    if a.json {
-        let json = serde_json::to_string_pretty(&p).map_err(|e| Error::Run(e.to_string()))?;
-        outln!("{json}");
-    } else {
-        super::out!("{}", report::prediction_text(&p));
-    }
-    Ok(())
+    let mut place = super::study::local(std::path::Path::new("."), a.threads, a.json)?;
+    place.checkpoint = None;
+    super::study::predict(&fit, &cfg, &place)
 }

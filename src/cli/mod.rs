@@ -1,7 +1,6 @@
 //! The command line: a thin layer over the library. Each subcommand has a module of its own.
 
-use clap::{Parser, Subcommand};
-use dicephys::run::runner::{Chunks, Runner};
+use clap::{CommandFactory, Parser, Subcommand};
 use dicephys::run::stop::Stop;
 use error::Error;
 
@@ -14,6 +13,7 @@ pub mod merge;
 pub mod paper;
 pub mod roll;
 pub mod slurm;
+pub mod study;
 pub mod sweeps;
 pub mod theory;
 pub mod trace;
@@ -63,38 +63,20 @@ pub enum Command {
     /// The engines against the limits known in closed form: no bounce (2D), solid angles (3D),
     /// free flight, and the trend towards the paper's theory.
     Validate(validate::ValidateArgs),
+    /// A shell's completions for dicephys, on stdout (e.g. `dicephys completions bash >
+    /// ~/.local/share/bash-completion/completions/dicephys`).
+    Completions {
+        /// The shell.
+        shell: clap_complete::Shell,
+    },
+    /// The manual page, roff on stdout (e.g. `dicephys man > ~/.local/share/man/man1/dicephys.1`).
+    Man,
 }
 
 /// The process's stop flag, raised by Ctrl-C or SIGTERM.
 pub fn stop() -> &'static Stop {
     static STOP: std::sync::OnceLock<Stop> = std::sync::OnceLock::new();
     STOP.get_or_init(Stop::new)
-}
-
-/// Which chunks this process rolls: all, unless `dicephys slurm task` or `slurm finish` set it,
-/// once, before running the command they run.
-pub fn chunks() -> &'static std::sync::OnceLock<Chunks> {
-    static CHUNKS: std::sync::OnceLock<Chunks> = std::sync::OnceLock::new();
-    &CHUNKS
-}
-
-/// The runner every command rolls with: these threads, stopped by Ctrl-C or SIGTERM, rolling
-/// the chunks [`chunks`] gives it.
-pub fn runner(threads: usize) -> Runner<'static> {
-    Runner::new(threads, stop().clone()).with_chunks(chunks().get().cloned().unwrap_or_default())
-}
-
-/// True in a cluster task, whose results are its share only (it keeps its chunks and reports
-/// nothing), and in a dry run.
-pub fn is_task() -> bool {
-    chunks().get().is_some_and(Chunks::is_partial)
-}
-
-/// The command line a report names as its own: this process's, or, in a cluster run's
-/// finishing job, the study's as it was submitted.
-pub fn command_line() -> &'static std::sync::OnceLock<String> {
-    static LINE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-    &LINE
 }
 
 /// Runs the command line; returns the process exit code (0 ok, 2 bad input, 1 failure, 130
@@ -139,6 +121,18 @@ pub fn dispatch(command: Command) -> error::Result<()> {
         Command::Slurm(a) => slurm::run(&a),
         Command::Trace(a) => trace::run(&a),
         Command::Validate(a) => validate::run(&a),
+        Command::Completions { shell } => {
+            let mut text = Vec::new();
+            clap_complete::generate(shell, &mut Cli::command(), "dicephys", &mut text);
+            stdout(&String::from_utf8_lossy(&text))
+        }
+        Command::Man => {
+            let mut text = Vec::new();
+            clap_mangen::Man::new(Cli::command())
+                .render(&mut text)
+                .map_err(|e| Error::Run(e.to_string()))?;
+            stdout(&String::from_utf8_lossy(&text))
+        }
     }
 }
 

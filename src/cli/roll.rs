@@ -1,18 +1,15 @@
 //! `dicephys roll`: many throws of one block on one engine.
 
-use super::args::{parse_engine, parse_shard, RunArgs, SceneArgs, ThrowArgs};
+use super::args::{parse_engine, RunArgs, SceneArgs, ThrowArgs};
 use super::error::{Error, Result};
 use super::{out, outln};
 use clap::Args;
 use dicephys::engine::EngineKind;
-use dicephys::report::per_roll::PerRoll;
-use dicephys::report::summary::{Cost, RunSummary};
-use dicephys::run::cputime::process_cpu_seconds;
-use dicephys::run::runner::Checkpoint;
+use dicephys::report::progress::{Progress, Unit};
+use dicephys::run::runner::{Checkpoint, Runner};
 use dicephys::run::spec::{RunSpec, Shard};
-use dicephys::sim::roll::RollRecord;
+use dicephys::studies::outputs;
 use std::path::PathBuf;
-use std::time::Instant;
 
 /// The options that define a run: `--resume` takes them from the checkpoint instead.
 const DEFINING: [&str; 24] = [
@@ -71,7 +68,7 @@ pub struct RollArgs {
     pub resume: Option<PathBuf>,
     /// Roll only throws with index ≡ K (mod N); `dicephys merge` combines the shards' --json
     /// outputs into the unsharded result.
-    #[arg(long, value_name = "K/N", value_parser = parse_shard)]
+    #[arg(long, value_name = "K/N")]
     pub shard: Option<Shard>,
 }
 
@@ -102,34 +99,14 @@ pub fn run(a: &RollArgs) -> Result<()> {
     let threads = a.run.threads()?;
     let per_roll = a.per_roll.as_deref().map(super::output).transpose()?;
     let dir = a.resume.as_ref().or(a.checkpoint.as_ref());
-    let checkpoint = dir.map(|d| Checkpoint::open(d, &spec)).transpose()?;
-    // The per-roll CSV grows chunk by chunk in a temporary file, put in place at the end.
-    let mut csv = match &per_roll {
-        Some(out) => Some(PerRoll::new(out.writer()?, spec.scene.dt)?),
-        None => None,
-    };
-    let mut sink = |recs: &[RollRecord]| -> dicephys::Result<()> {
-        match csv.as_mut() {
-            Some(c) => c.write(recs),
-            None => Ok(()),
-        }
-    };
-    let wall = Instant::now();
-    let cpu = process_cpu_seconds();
-    let runner = super::runner(threads);
-    let done = runner.run(&spec, checkpoint.as_ref(), &mut sink)?;
-    // A resumed run's cost is the sum over its segments: the resumed chunks carry theirs.
-    let cost = Cost {
-        wall_s: wall.elapsed().as_secs_f64() + done.resumed_wall_s,
-        cpu_s: process_cpu_seconds() - cpu + done.resumed_cpu_s,
-        threads,
-    };
-    if let Some(c) = csv {
-        c.finish()?.commit()?;
-    }
-    let tally = done.tally;
-    let mut summary = RunSummary::new(&spec, &tally, cost);
-    summary.partial = !done.complete;
+    let total = spec.indices().len();
+    let unit = Unit::Rolls { per_cell: 0 };
+    let bar = Progress::new("roll", unit, false, a.json, super::study::every());
+    let progress = |n: u64| bar.set(n as f64, total as f64);
+    let runner = Runner::new(threads, super::stop().clone());
+    let runner = runner.with_progress(&progress);
+    let summary = outputs::roll(&spec, dir.map(PathBuf::as_path), per_roll, &runner)?;
+    let rolled = summary.rolls;
     if a.json {
         outln!(
             "{}",
@@ -138,15 +115,14 @@ pub fn run(a: &RollArgs) -> Result<()> {
     } else {
         out!("{}", summary.human());
     }
-    if !done.complete {
-        let total = spec.indices().len();
+    if summary.partial {
         return Err(Error::Interrupted(match dir {
             Some(d) => format!(
-                "interrupted after {} of {total} rolls; continue with: dicephys roll --resume {}",
-                tally.rolls,
+                "interrupted after {rolled} of {total} rolls; continue with: dicephys roll \
+                 --resume {}",
                 d.display()
             ),
-            None => format!("interrupted after {} of {total} rolls", tally.rolls),
+            None => format!("interrupted after {rolled} of {total} rolls"),
         }));
     }
     Ok(())

@@ -1,20 +1,23 @@
 //! `dicephys slurm`: a run as a Slurm job array and a finishing job that merges it exactly
 //! (the scripts: `dicephys::run::slurm`), and `dicephys slurm finish DIR`, the finishing step.
 //! `roll` is split into shards of its throws; the studies (`paper`, `crosscheck`, `converge`,
-//! `tradeoff`, `stability`) chunk by chunk, each task running the command itself with its
-//! share (`dicephys slurm task DIR K`), and the finishing job running it once more.
+//! `tradeoff`, `stability`) chunk by chunk: the plan stores the study's configuration, each
+//! task runs the library's study from it with its share (`dicephys slurm task DIR K`), and the
+//! finishing job runs it once more.
 
 use super::crosscheck::CrosscheckArgs;
 use super::error::{Error, Result};
-use super::outln;
 use super::paper::PaperArgs;
 use super::roll::RollArgs;
+use super::study;
 use super::sweeps::{ConvergeArgs, StabilityArgs, TradeoffArgs};
-use super::{Cli, Command};
-use clap::{Args, Parser, Subcommand};
-use dicephys::report::summary::{RunSummary, ShardResult};
-use dicephys::run::runner::{Checkpoint, Chunks};
-use dicephys::run::slurm::{self, Layout, Options, Plan};
+use super::{out, outln};
+use clap::{Args, Subcommand};
+use dicephys::report::summary::RunSummary;
+use dicephys::run::runner::{Checkpoint, ChunkShare};
+use dicephys::run::slurm::{Layout, Options, Plan};
+use dicephys::studies::outputs::{self, Place};
+use dicephys::studies::StudyConfig;
 use std::path::{Path, PathBuf};
 
 /// `dicephys slurm`'s arguments.
@@ -111,139 +114,82 @@ pub struct FinishArgs {
 
 /// Runs `dicephys slurm`.
 pub fn run(a: &SlurmArgs) -> Result<()> {
+    if let Some(flags) = study_of(&a.command)? {
+        return submit_study(flags);
+    }
     match &a.command {
         SlurmCommand::Roll(r) => roll(r),
-        SlurmCommand::Paper(a) => study(&a.job),
-        SlurmCommand::Crosscheck(a) => study(&a.job),
-        SlurmCommand::Converge(a) => study(&a.job),
-        SlurmCommand::Tradeoff(a) => study(&a.job),
-        SlurmCommand::Stability(a) => study(&a.job),
         SlurmCommand::Finish(f) => finish(&f.dir),
         SlurmCommand::Task(t) => task(&t.dir, t.k),
+        _ => Ok(()),
     }
 }
 
-/// The scheduler's options, which `dicephys slurm` takes and the study does not.
-const JOB_OPTIONS: [&str; 6] = [
-    "--tasks",
-    "--dir",
-    "--partition",
-    "--time",
-    "--account",
-    "--bin",
-];
+/// A study's configuration from its flags, and what a cluster run takes of them: its threads,
+/// `--json`, whether it was given the output flag a cluster run sets itself, and the job.
+type Flags<'a> = (StudyConfig, usize, bool, Option<&'static str>, &'a JobArgs);
 
-/// The study's own command line, from this process's: the words after `slurm`, without the
-/// scheduler's options (clap has parsed them all already).
-fn study_args() -> Vec<String> {
-    let argv: Vec<String> = std::env::args().collect();
-    let start = argv
-        .iter()
-        .position(|w| w == "slurm")
-        .map_or(argv.len(), |i| i + 1);
-    let mut args = Vec::new();
-    let mut words = argv[start..].iter();
-    while let Some(w) = words.next() {
-        if w == "--submit" {
-            continue;
+fn study_of(c: &SlurmCommand) -> Result<Option<Flags<'_>>> {
+    let out = |given: bool| given.then_some("--out");
+    Ok(Some(match c {
+        SlurmCommand::Paper(a) => {
+            let s = &a.study;
+            let cfg = StudyConfig::Paper(s.config());
+            (cfg, s.threads, s.json, out(s.out.is_some()), &a.job)
         }
-        if JOB_OPTIONS.contains(&w.as_str()) {
-            words.next();
-            continue;
+        SlurmCommand::Crosscheck(a) => {
+            let s = &a.study;
+            let cfg = StudyConfig::Crosscheck(s.config()?);
+            let given = s.checkpoint.is_some().then_some("--checkpoint");
+            (cfg, s.run.threads, s.json, given, &a.job)
         }
-        if JOB_OPTIONS.iter().any(|o| w.starts_with(&format!("{o}="))) {
-            continue;
+        SlurmCommand::Converge(a) => {
+            let s = &a.study;
+            let cfg = StudyConfig::Converge(s.config());
+            (cfg, s.threads, s.json, out(s.out.is_some()), &a.job)
         }
-        args.push(w.clone());
-    }
-    args
+        SlurmCommand::Tradeoff(a) => {
+            let s = &a.study;
+            let cfg = StudyConfig::Tradeoff(s.config()?);
+            (cfg, s.threads, s.json, out(s.out.is_some()), &a.job)
+        }
+        SlurmCommand::Stability(a) => {
+            let s = &a.study;
+            let cfg = StudyConfig::Stability(s.config());
+            (cfg, s.threads, s.json, out(s.out.is_some()), &a.job)
+        }
+        _ => return Ok(None),
+    }))
 }
 
-/// Parses a study's command line again (as a task or the finishing job does).
-fn parse_study(args: &[String]) -> Result<Command> {
-    let cli =
-        Cli::try_parse_from(std::iter::once("dicephys".to_string()).chain(args.iter().cloned()))
-            .map_err(|e| {
-                Error::Usage(format!(
-                    "slurm: the stored command line does not parse: {}",
-                    e.kind()
-                ))
-            })?;
-    Ok(cli.command)
-}
-
-/// Points a study at the run's directory and its threads: its outputs (and checkpoints) go to
-/// DIR, on every task and in the finishing job alike.
-fn place(cmd: &mut Command, lay: &Layout, threads: usize) -> Result<()> {
-    match cmd {
-        Command::Paper(a) => (a.out, a.threads) = (lay.dir.clone(), threads),
-        Command::Converge(a) => (a.out, a.threads) = (lay.dir.clone(), threads),
-        Command::Tradeoff(a) => (a.out, a.threads) = (lay.dir.clone(), threads),
-        Command::Stability(a) => (a.out, a.threads) = (lay.dir.clone(), threads),
-        Command::Crosscheck(a) => (a.checkpoint, a.run.threads) = (Some(lay.cells()), threads),
-        _ => return Err(Error::Usage("slurm: not a study this runs".into())),
+/// `dicephys slurm <study>`: the study checked, run dry, its plan stored, the scripts written.
+fn submit_study((cfg, threads, json, given, job): Flags) -> Result<()> {
+    if let Some(flag) = given {
+        return Err(Error::Usage(format!(
+            "slurm {}: {flag}: the study writes into --dir (its outputs, and its chunks under \
+             --dir/checkpoint)",
+            cfg.name()
+        )));
     }
-    Ok(())
-}
-
-/// The threads the study asked for (0: one per core).
-fn threads_of(cmd: &Command) -> usize {
-    match cmd {
-        Command::Paper(a) => a.threads,
-        Command::Converge(a) => a.threads,
-        Command::Tradeoff(a) => a.threads,
-        Command::Stability(a) => a.threads,
-        Command::Crosscheck(a) => a.run.threads,
-        _ => 1,
-    }
-}
-
-fn study(job: &JobArgs) -> Result<()> {
-    let args = study_args();
-    let name = args.first().cloned().unwrap_or_default();
-    for w in &args {
-        for (flag, why) in [
-            ("--out", "the study writes its outputs into --dir"),
-            ("--checkpoint", "the tasks keep their chunks under --dir"),
-        ] {
-            if w == flag || w.starts_with(&format!("{flag}=")) {
-                return Err(Error::Usage(format!("slurm {name}: {flag}: {why}")));
-            }
-        }
-    }
-    let mut cmd = parse_study(&args)?;
-    // A precision run decides each round from all the rolls so far, which no task sees whole.
-    match &cmd {
-        Command::Tradeoff(t) if t.preroll.is_none() => {
-            return Err(Error::Usage(
-                "slurm tradeoff: give --preroll ROLLS: its rounds are decided from every roll \
-                 so far, which no task sees, so the tasks roll the first ROLLS throws of every \
-                 stream ahead and the finishing job runs the study, reading them back and \
-                 rolling on itself where a method needs more (`tradeoff --plan` prints the rolls \
-                 each needs)"
-                    .into(),
-            ))
-        }
-        Command::Converge(c) if c.precision.is_some() => {
-            return Err(Error::Usage(
-                "slurm converge: --precision decides each cell's rounds from all its rolls, \
-                 which no task sees; give --rolls N (a --precision run prints the rolls each \
-                 cell needs)"
-                    .into(),
-            ))
-        }
-        _ => {}
-    }
+    cfg.validate()?;
+    // A study that decides its rounds from all the rolls so far cannot be split.
+    cfg.check_splittable()?;
     // A cluster task takes the threads it asks for; "one per core" means one.
-    let threads = threads_of(&cmd).max(1);
+    let threads = threads.max(1);
     super::args::threads(threads)?;
-    let plan = plan_of(&args, threads, job);
+    let line = std::env::args().collect::<Vec<_>>().join(" ");
+    let plan = Plan::Study {
+        config: serde_json::to_value(&cfg).map_err(|e| Error::Run(e.to_string()))?,
+        json,
+        command_line: line.clone(),
+        threads,
+        tasks: job.tasks,
+    };
     // Bad input is refused here, before anything is submitted or stored: the study runs dry,
     // checking its arguments and stopping at its first cell.
     let (lay, opt, bin) = prepare(&plan, job, threads, |lay| {
-        place(&mut cmd, lay, threads)?;
-        let _ = super::chunks().set(Chunks::DryRun);
-        match super::dispatch(cmd) {
+        let dry = Place::cluster(lay, threads, json, ChunkShare::DryRun, &line);
+        match study::run(&cfg, &dry) {
             Ok(()) | Err(Error::Interrupted(_)) => Ok(()),
             Err(e) => Err(e),
         }
@@ -253,40 +199,20 @@ fn study(job: &JobArgs) -> Result<()> {
     emit(&plan, &lay, &opt, &bin, job.submit)
 }
 
-fn plan_of(args: &[String], threads: usize, job: &JobArgs) -> Plan {
-    Plan::Study {
-        args: args.to_vec(),
-        threads,
-        tasks: job.tasks,
-    }
-}
-
-/// One array task of a study: the command with this task's share of the chunks, then its mark.
+/// One array task of a study: the study with this task's share of the chunks, then its mark.
 fn task(dir: &Path, k: u64) -> Result<()> {
     let lay = Layout {
         dir: dir.to_path_buf(),
     };
-    let Plan::Study {
-        args,
-        threads,
-        tasks,
-    } = read_plan(&lay)?
-    else {
-        return Err(Error::Usage(format!(
-            "slurm task: {} is not a study's run",
-            dir.display()
-        )));
-    };
+    let (cfg, place, tasks) = outputs::planned(&lay)?;
     if k >= tasks {
         return Err(Error::Usage(format!(
             "slurm task {k}: the run has tasks 0 to {}",
             tasks - 1
         )));
     }
-    let mut cmd = parse_study(&args)?;
-    place(&mut cmd, &lay, threads)?;
-    let _ = super::chunks().set(Chunks::task(k, tasks));
-    super::dispatch(cmd)?;
+    let share = ChunkShare::task(k, tasks);
+    study::run(&cfg, &Place { share, ..place })?;
     super::output(&lay.task_done(k))?.write(format!("task {k} of {tasks}\n").as_bytes())?;
     eprintln!(
         "task {k}: its share is rolled ({})",
@@ -358,71 +284,23 @@ fn prepare(
             .and_then(|p| p.canonicalize())
             .map_err(|e| Error::Run(format!("cannot find this binary's path ({e})")))?,
     };
-    std::fs::create_dir_all(&job.dir).map_err(|e| {
-        Error::Usage(format!(
-            "--dir {}: cannot create it ({e})",
-            job.dir.display()
-        ))
-    })?;
-    let dir = job
-        .dir
-        .canonicalize()
-        .map_err(|e| Error::Usage(format!("--dir {}: {e}", job.dir.display())))?;
-    let lay = Layout { dir };
+    let lay = Layout::create(&job.dir)?;
     check(&lay)?;
-    match read_plan(&lay) {
-        Ok(stored) if stored == *plan => {}
-        Ok(_) => {
-            return Err(Error::Usage(format!(
-                "--dir {}: it holds another Slurm run ({}); use a new directory",
-                lay.dir.display(),
-                lay.plan().display()
-            )))
-        }
-        Err(_) if !lay.plan().exists() => {
-            let json = serde_json::to_string_pretty(plan).map_err(|e| Error::Run(e.to_string()))?;
-            super::output(&lay.plan())?.write(format!("{json}\n").as_bytes())?;
-        }
-        Err(e) => return Err(e),
-    }
-    std::fs::create_dir_all(lay.logs())
-        .map_err(|e| Error::Run(format!("{}: {e}", lay.logs().display())))?;
-    Ok((lay, opt, bin))
-}
-
-fn read_plan(lay: &Layout) -> Result<Plan> {
-    let p = lay.plan();
-    let text = std::fs::read_to_string(&p).map_err(|e| {
-        Error::Usage(format!(
-            "{}: not a `dicephys slurm` run directory ({}: {e})",
-            lay.dir.display(),
-            p.display()
-        ))
+    lay.store(plan).map_err(|e| match e {
+        dicephys::Error::Mismatch(m) => Error::Usage(format!("--dir {m}")),
+        e => e.into(),
     })?;
-    serde_json::from_str(&text)
-        .map_err(|e| Error::Usage(format!("{} is damaged ({e})", p.display())))
+    Ok((lay, opt, bin))
 }
 
 /// Writes both scripts; prints them, or submits them and prints the job ids.
 fn emit(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path, submit: bool) -> Result<()> {
-    let array = slurm::array_script(plan, lay, opt, bin)?;
-    let fin = slurm::finish_script(plan, lay, opt, bin)?;
-    super::output(&lay.array_script())?.write(array.as_bytes())?;
-    super::output(&lay.finish_script())?.write(fin.as_bytes())?;
+    let [array, fin] = lay.write_scripts(plan, opt, bin)?;
     let (a, f) = (lay.array_script(), lay.finish_script());
     if !submit {
         outln!("# {}\n{array}", a.display());
         outln!("# {}\n{fin}", f.display());
-        outln!("# submit with:");
-        outln!(
-            "#   jid=$(sbatch --parsable {})",
-            slurm::quote(&a.to_string_lossy())
-        );
-        outln!(
-            "#   sbatch --dependency=afterany:${{jid%%;*}} {}",
-            slurm::quote(&f.to_string_lossy())
-        );
-        outln!("# result: {}", result_of(plan, lay));
+        out!("{}", lay.instructions(plan));
         return Ok(());
     }
     let array_id = sbatch(&[a.as_os_str()])?;
@@ -432,22 +310,9 @@ fn emit(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path, submit: bool) -> R
         "array job {array_id} ({} tasks), finishing job {fin_id}",
         plan.tasks()
     );
-    outln!("result: {}", result_of(plan, lay));
+    outln!("result: {}", lay.result_of(plan));
     outln!("logs: {}", lay.logs().display());
     Ok(())
-}
-
-/// Where the finishing job puts the result, for the user.
-fn result_of(plan: &Plan, lay: &Layout) -> String {
-    match plan {
-        Plan::Roll { .. } => lay.result_json().display().to_string(),
-        Plan::Study { .. } => format!(
-            "{} (the {} outputs; its printed report in {})",
-            lay.dir.display(),
-            plan.command(),
-            lay.stdout().display()
-        ),
-    }
 }
 
 /// Runs `sbatch --parsable ARGS` and returns the job id it prints.
@@ -482,67 +347,18 @@ fn finish(dir: &Path) -> Result<()> {
     let lay = Layout {
         dir: dir.to_path_buf(),
     };
-    let plan = read_plan(&lay)?;
+    let plan = lay.read_plan()?;
     match &plan {
-        Plan::Study {
-            args,
-            threads,
-            tasks,
-        } => {
-            let missing: Vec<String> = (0..*tasks)
-                .filter(|&k| !lay.task_done(k).exists())
-                .map(|k| k.to_string())
-                .collect();
-            if !missing.is_empty() {
-                return Err(not_finished(&lay, *tasks, &missing, "no mark in tasks/"));
-            }
-            let mut cmd = parse_study(args)?;
-            place(&mut cmd, &lay, *threads)?;
-            let chunks = match &mut cmd {
-                // The tasks rolled ahead; the study itself runs here, reading their chunks
-                // back and rolling on where a method needs more.
-                Command::Tradeoff(t) => {
-                    t.preroll = None;
-                    Chunks::All
-                }
-                // Every chunk is on disk: the study reads them all and rolls none.
-                _ => Chunks::Assemble,
-            };
-            let _ = super::chunks().set(chunks);
-            let _ = super::command_line().set(format!(
-                "dicephys {} (through Slurm: {tasks} tasks, {})",
-                args.join(" "),
-                lay.dir.display()
-            ));
-            super::dispatch(cmd)?;
+        Plan::Study { tasks, .. } => {
+            lay.check_marks(*tasks)?;
+            // Every chunk is on disk: the study reads them all and rolls none (but tradeoff,
+            // whose tasks rolled ahead, runs here, rolling on where a method needs more).
+            let (cfg, place, _) = outputs::planned(&lay)?;
+            let (cfg, share) = cfg.finishing();
+            study::run(&cfg, &Place { share, ..place })?;
         }
         Plan::Roll { spec, tasks } => {
-            let mut parts = Vec::new();
-            let mut missing = Vec::new();
-            let mut why = Vec::new();
-            for k in 0..*tasks {
-                let p = lay.shard_result(k);
-                match read_shard(&p, &Plan::shard_spec(spec, k, *tasks)) {
-                    Ok(s) => parts.push(s),
-                    Err(e) => {
-                        missing.push(k.to_string());
-                        why.push(e);
-                    }
-                }
-            }
-            if !missing.is_empty() {
-                return Err(not_finished(&lay, *tasks, &missing, &why.join("; ")));
-            }
-            let merged = RunSummary::merge(&parts)?;
-            let json =
-                serde_json::to_string_pretty(&merged).map_err(|e| Error::Run(e.to_string()))?;
-            let text = merged.human();
-            let (j, t) = (
-                super::output(&lay.result_json())?,
-                super::output(&lay.result_text())?,
-            );
-            j.write(format!("{json}\n").as_bytes())?;
-            t.write(text.as_bytes())?;
+            let text = RunSummary::merge_tasks(&lay, spec, *tasks)?;
             super::stdout(&text)?;
             outln!(
                 "slurm finish: {tasks} tasks merged into {}",
@@ -551,35 +367,4 @@ fn finish(dir: &Path) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// The finishing job's refusal: which tasks have not finished, and how to finish them.
-fn not_finished(lay: &Layout, tasks: u64, missing: &[String], why: &str) -> Error {
-    Error::Run(format!(
-        "slurm finish: {} of {tasks} tasks have not finished: {} ({why}); \
-         rerun them with `sbatch --array={} {}` (each resumes from its checkpoint), \
-         then `sbatch {}`",
-        missing.len(),
-        missing.join(", "),
-        missing.join(","),
-        lay.array_script().display(),
-        lay.finish_script().display()
-    ))
-}
-
-/// One task's result, if it is there, whole, and of this task.
-fn read_shard(
-    p: &Path,
-    want: &dicephys::run::spec::RunSpec,
-) -> std::result::Result<ShardResult, String> {
-    let text = std::fs::read_to_string(p).map_err(|_| format!("no {}", p.display()))?;
-    let s: ShardResult =
-        serde_json::from_str(&text).map_err(|e| format!("{} is damaged: {e}", p.display()))?;
-    if s.spec != *want {
-        return Err(format!("{} is of another run", p.display()));
-    }
-    if s.partial {
-        return Err(format!("{} is partial", p.display()));
-    }
-    Ok(s)
 }

@@ -1,23 +1,25 @@
-//! `dicephys converge`, `tradeoff` and `stability`: the sweeps (`dicephys::studies::sweep`), each writing
-//! `<command>.json`, `report.md` and its figures into --out.
+//! `dicephys converge`, `tradeoff` and `stability`: the sweeps' flags, turned into the library's
+//! configurations (`dicephys::studies::{converge, tradeoff, stability}`); each writes
+//! `<command>.json`, `report.md` and its figures into --out (`super::study`).
 
-use super::args::{parse_block, parse_engine};
+use super::args::parse_engine;
 use super::error::{Error, Result};
-use super::outln;
+use super::study;
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::model::block::Block;
-use dicephys::report::figures::sweeps as fig;
-use dicephys::report::figures::Point;
-use dicephys::studies::stability::Sweep;
-use dicephys::studies::sweep::{dt_label, parse_dt, Study};
-use dicephys::studies::{converge, stability, tradeoff};
-use std::path::{Path, PathBuf};
+use dicephys::studies::sweep::parse_dt;
+use dicephys::studies::{converge, stability, tradeoff, StudyConfig};
+use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct ConvergeArgs {
     /// Blocks, LENGTHxBREADTHxWIDTH in mm (comma-separated).
-    #[arg(long, value_delimiter = ',', default_value = "140x24x20,140x22x13,140x30x10", value_parser = parse_block)]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "140x24x20,140x22x13,140x30x10"
+    )]
     pub blocks: Vec<Block>,
     /// Time steps, s or 1/N (comma-separated); the paper's full set is
     /// 1/60,1/120,1/240,1/500,1/1000,1/2000,1/5000,1/10000.
@@ -50,8 +52,9 @@ pub struct ConvergeArgs {
     /// exact at fine steps by `tradeoff`'s levers row, instead of every step stepped.
     #[arg(long)]
     pub fast: bool,
-    #[arg(long, default_value = "converge-out")]
-    pub out: PathBuf,
+    /// Output directory [default: converge-out].
+    #[arg(long, value_name = "OUT")]
+    pub out: Option<PathBuf>,
     /// Print converge.json to stdout instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -59,7 +62,7 @@ pub struct ConvergeArgs {
 
 #[derive(Args, Debug)]
 pub struct TradeoffArgs {
-    #[arg(long, default_value = "140x24x20", value_parser = parse_block)]
+    #[arg(long, default_value = "140x24x20")]
     pub block: Block,
     /// Bullet's time steps (comma-separated).
     #[arg(long, value_delimiter = ',', default_value = "1/100,1/250,1/1000", value_parser = parse_dt)]
@@ -89,8 +92,9 @@ pub struct TradeoffArgs {
     pub threads: usize,
     #[arg(long, default_value_t = 2_000_000)]
     pub max_steps: u64,
-    #[arg(long, default_value = "tradeoff-out")]
-    pub out: PathBuf,
+    /// Output directory [default: tradeoff-out].
+    #[arg(long, value_name = "OUT")]
+    pub out: Option<PathBuf>,
     /// Roll the pilot (a chunk of every method, kept), print the plan (the CPU the precision
     /// asked costs, and the precision an hour buys) and stop.
     #[arg(long)]
@@ -105,7 +109,7 @@ pub struct TradeoffArgs {
 }
 
 /// `tradeoff`'s default precision, per cent at 2σ: what about 60 minutes on 2 cores buys at
-/// the defaults (README, Speed against accuracy).
+/// the defaults (docs/results/tradeoff.md).
 pub const DEFAULT_PRECISION: &str = "2";
 
 /// `tradeoff`'s default ladder under the reference.
@@ -134,24 +138,6 @@ fn parse_dt_or_none(s: &str) -> std::result::Result<Option<f64>, String> {
     }
 }
 
-/// A progress bar on stderr in estimated CPU seconds (so its ETA weighs dear and cheap rolls
-/// right), hidden for --json or when stderr is not a terminal.
-pub(super) fn cpu_bar(quiet: bool) -> indicatif::ProgressBar {
-    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-    use std::io::IsTerminal;
-    if quiet || !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let b = ProgressBar::with_draw_target(Some(1), ProgressDrawTarget::stderr());
-    b.set_style(
-        ProgressStyle::with_template(
-            "{elapsed_precise} [{wide_bar}] {percent}% of the planned CPU, ETA {eta}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    b
-}
-
 #[derive(Args, Debug)]
 pub struct StabilityArgs {
     #[arg(long, value_delimiter = ',', default_value = "bullet,rapier", value_parser = parse_engine)]
@@ -166,7 +152,11 @@ pub struct StabilityArgs {
     #[arg(long, value_delimiter = ',', default_value = "0,0.29,0.8,1.5")]
     pub frictions: Vec<f64>,
     /// Blocks of the aspect line: breadth/width up to 10, length/breadth down to 1.
-    #[arg(long, value_delimiter = ',', default_value = "140x24x20,140x40x20,140x100x20,200x200x20,24x24x20", value_parser = parse_block)]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "140x24x20,140x40x20,140x100x20,200x200x20,24x24x20"
+    )]
     pub blocks: Vec<Block>,
     /// Rolls per cell: 300 make a fraction's standard error at most 2.9 % and a 0 mean below
     /// 1 % at 95 %.
@@ -183,493 +173,96 @@ pub struct StabilityArgs {
     /// coarse step really pass through it.
     #[arg(long, default_value_t = dicephys::model::scene::DICEPHYS_FLOOR_THICKNESS)]
     pub floor_thickness: f64,
-    #[arg(long, default_value = "stability-out")]
-    pub out: PathBuf,
+    /// Output directory [default: stability-out].
+    #[arg(long, value_name = "OUT")]
+    pub out: Option<PathBuf>,
     #[arg(long)]
     pub json: bool,
 }
 
-/// Checks what every sweep takes, creates --out, and sets up how cells are run: on these
-/// threads, stopped by Ctrl-C, kept under --out/checkpoint.
-pub(super) fn check_common(
-    rolls: u64,
-    max_steps: u64,
-    t: usize,
-    out: &Path,
-    file: &str,
-) -> Result<Study<'static>> {
-    if rolls == 0 || rolls > dicephys::run::spec::MAX_ROLLS {
-        return Err(Error::Usage(format!("--rolls {rolls}: must be in 1..=1e9")));
-    }
-    if max_steps == 0 {
-        return Err(Error::Usage("--max-steps 0: need at least one step".into()));
-    }
-    let threads = super::args::threads(t)?;
-    std::fs::create_dir_all(out)
-        .map_err(|e| Error::Usage(format!("--out {}: cannot create it ({e})", out.display())))?;
-    super::output(&out.join(file))?;
-    super::output(&out.join("report.md"))?;
-    Ok(Study {
-        runner: super::runner(threads),
-        checkpoint: Some(out.join("checkpoint")),
-    })
-}
-
-fn nonempty<T>(v: &[T], name: &str) -> Result<()> {
-    if v.is_empty() {
-        Err(Error::Usage(format!("{name}: give at least one value")))
-    } else {
-        Ok(())
+impl ConvergeArgs {
+    /// The study's configuration.
+    pub fn config(&self) -> converge::Config {
+        converge::Config {
+            blocks: self.blocks.clone(),
+            dts: self.dts.clone(),
+            engines: self.engines.clone(),
+            rolls: self.rolls,
+            seed: self.seed,
+            max_steps: self.max_steps,
+            precision: self.precision,
+            budget_s: self.budget,
+            reference_budget_s: self.reference_budget,
+            fast: self.fast,
+        }
     }
 }
 
-pub(super) fn to_json<T: serde::Serialize>(v: &T) -> Result<String> {
-    serde_json::to_string_pretty(v).map_err(|e| Error::Run(e.to_string()))
-}
-
-/// Writes the JSON and the report, prints one or the other.
-pub(super) fn finish(
-    out: &Path,
-    file: &str,
-    json: &str,
-    report: &str,
-    print_json: bool,
-) -> Result<()> {
-    super::output(&out.join(file))?.write(json.as_bytes())?;
-    super::output(&out.join("report.md"))?.write(report.as_bytes())?;
-    if print_json {
-        outln!("{json}");
-    } else {
-        outln!("{report}");
-        eprintln!("wrote {}/{file}, report.md and figures", out.display());
-    }
-    Ok(())
-}
-
-pub fn converge(a: &ConvergeArgs) -> Result<()> {
-    nonempty(&a.blocks, "--blocks")?;
-    nonempty(&a.dts, "--dts")?;
-    nonempty(&a.engines, "--engines")?;
-    let study = check_common(a.rolls, a.max_steps, a.threads, &a.out, "converge.json")?;
-    let cfg = converge::Config {
-        blocks: a.blocks.clone(),
-        dts: a.dts.clone(),
-        engines: a.engines.clone(),
-        rolls: a.rolls,
-        seed: a.seed,
-        max_steps: a.max_steps,
-        precision: a.precision,
-        budget_s: (a.budget, a.reference_budget),
-        fast: a.fast,
-    };
-    for (v, name) in [
-        (a.budget, "--budget"),
-        (a.reference_budget, "--reference-budget"),
-    ] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(Error::Usage(format!("{name} {v}: CPU seconds, above 0")));
+impl TradeoffArgs {
+    /// The study's configuration.
+    pub fn config(&self) -> Result<tradeoff::Config> {
+        if self.preroll == Some(0) {
+            return Err(Error::Usage("--preroll 0: give at least 1 roll".into()));
         }
-    }
-    let bar = cpu_bar(a.json || a.precision.is_none());
-    let progress = |done: f64, total: f64| {
-        bar.set_length((1000.0 * total) as u64);
-        bar.set_position((1000.0 * done.min(total)) as u64);
-    };
-    let res = logged(a.json, &converge::header(), |log| {
-        let log = |l: &str| bar.suspend(|| log(l));
-        converge::run(&cfg, &study, &log, &progress)
-    });
-    bar.finish_and_clear();
-    let Some(res) = res? else {
-        return Ok(());
-    };
-    let lines: Vec<fig::Line> = group(&res.cells, |c| {
-        format!("{} {} {}", c.block, c.engine, c.mode)
-    })
-    .into_iter()
-    .map(|(label, cells)| fig::Line {
-        label,
-        points: cells
-            .iter()
-            .map(|c| Point {
-                x: c.dt,
-                y: c.ratio,
-                y_err: c.ratio_err,
-            })
-            .collect(),
-    })
-    .collect();
-    fig::convergence(
-        &a.out,
-        "converge",
-        &match a.precision {
-            Some(p) => format!(
-                "Ratio against dt (each departure resolved to ±{:.2} % at 2σ, or marked)",
-                100.0 * p
-            ),
-            None => format!("Ratio against dt ({} rolls per point)", a.rolls),
-        },
-        &lines,
-    )?;
-    let mut md = format!(
-        "# Convergence in dt\n\n{}, seed {}, rolls ended by {}.\n\n```\n{}\n",
-        match a.precision {
-            Some(p) => format!(
-                "Every cell rolled until 2σ of its departure from the finest dt is at most {:.2} % \
-                 or its budget spent",
-                100.0 * p
-            ),
-            None => format!("{} rolls per cell", res.rolls),
-        },
-        res.seed,
-        res.settle,
-        converge::header()
-    );
-    for c in &res.cells {
-        md += &converge::format_cell(c);
-        md.push('\n');
-    }
-    md += "```\n\n";
-    md += &format!("{}\n\n![ratio against dt](converge.svg)\n", res.verdict);
-    finish(&a.out, "converge.json", &to_json(&res)?, &md, a.json)
-}
-
-/// Items grouped by a key, in first-seen order.
-fn group<T>(items: &[T], key: impl Fn(&T) -> String) -> Vec<(String, Vec<&T>)> {
-    let mut out: Vec<(String, Vec<&T>)> = Vec::new();
-    for it in items {
-        let k = key(it);
-        match out.iter_mut().find(|(g, _)| *g == k) {
-            Some((_, v)) => v.push(it),
-            None => out.push((k, vec![it])),
-        }
-    }
-    out
-}
-
-pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
-    nonempty(&a.dts, "--dts")?;
-    let ladder: Vec<f64> = a.ladder.iter().flatten().copied().collect();
-    let mut all_dts = a.dts.iter().chain(&a.rapier_dts);
-    if all_dts.any(|&d| d <= a.reference_dt) {
-        return Err(Error::Usage(format!(
-            "--reference-dt {}: must be finer than every --dts and --rapier-dts",
-            dt_label(a.reference_dt)
-        )));
-    }
-    if ladder.contains(&a.reference_dt) {
-        return Err(Error::Usage(
-            "--ladder: the reference's dt is not a rung".into(),
-        ));
-    }
-    for (v, name) in [
-        (a.budget, "--budget"),
-        (a.reference_budget, "--reference-budget"),
-    ] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(Error::Usage(format!("{name} {v}: CPU seconds, above 0")));
-        }
-    }
-    let study = check_common(1, a.max_steps, a.threads, &a.out, "tradeoff.json")?;
-    let cfg = tradeoff::Config {
-        block: a.block,
-        dts: a.dts.clone(),
-        rapier_dts: a.rapier_dts.clone(),
-        reference_dt: a.reference_dt,
-        ladder,
-        precision: a.precision,
-        budget_s: a.budget,
-        reference_budget_s: a.reference_budget,
-        seed: a.seed,
-        max_steps: a.max_steps,
-        plan_only: a.plan,
-        preroll_chunks: a.preroll.map(|r| r.div_ceil(dicephys::run::runner::CHUNK)),
-    };
-    if a.preroll == Some(0) {
-        return Err(Error::Usage("--preroll 0: give at least 1 roll".into()));
-    }
-    let bar = cpu_bar(a.json);
-    let progress = |done: f64, total: f64| {
-        bar.set_length((1000.0 * total) as u64);
-        bar.set_position((1000.0 * done.min(total)) as u64);
-    };
-    let res = logged(a.json, &tradeoff::header(), |log| {
-        let log = |l: &str| bar.suspend(|| log(l));
-        tradeoff::run(&cfg, &study, &log, &progress)
-    });
-    bar.finish_and_clear();
-    let Some(res) = res? else {
-        return Ok(());
-    };
-    if a.plan {
-        if a.json {
-            outln!("{}", to_json(&res)?);
-        }
-        return Ok(());
-    }
-    if let Some(r) = a.preroll {
-        eprintln!(
-            "rolled the first {r} throws of every stream into {}/checkpoint ({:.0} CPU s); \
-             the same command without --preroll reads them back",
-            a.out.display(),
-            res.cpu_s
-        );
-        return Ok(());
-    }
-    let mut pts = Vec::new();
-    let mut bands = Vec::new();
-    if let Some(row) = dicephys::theory::paper_data::load().ok().and_then(|t| {
-        t.rows
-            .into_iter()
-            .find(|r| r.simulated && r.block_dims().ok() == Some(a.block))
-    }) {
-        let m = row.measured_ratio();
-        let rel = 200.0 * m.err / m.value;
-        bands.push(fig::Band {
-            label: format!("the paper's experiment, {}: ±{rel:.1} % (2σ)", row.label()),
-            lo: 0.0,
-            hi: rel,
-            two_d: None,
-        });
-    }
-    for m in &res.modes {
-        let two_d = m.mode == dicephys::model::scene::Mode::TwoD;
-        for r in &m.rows {
-            pts.push(fig::MethodPoint {
-                label: r.method.clone(),
-                cost: r.cpu_s_per_1000,
-                error: 100.0 * r.error.abs(),
-                error_err: 100.0 * r.error_err,
-                two_d,
-                resolved: r.resolved,
-                on_front: m.pareto_front.contains(&r.method),
-                cheapest: m.cheapest_within.as_ref() == Some(&r.method),
-            });
-        }
-        // Rapier's converged departure: its box floor, exact levers, at its finest step.
-        if let Some(r) = m
-            .rows
-            .iter()
-            .filter(|r| {
-                r.engine == EngineKind::Rapier
-                    && r.rule == "fast"
-                    && r.floor == dicephys::model::scene::Floor::Box
-            })
-            .min_by(|x, y| x.dt.total_cmp(&y.dt))
-        {
-            let (d, e) = (100.0 * r.error.abs(), 200.0 * r.error_err);
-            bands.push(fig::Band {
-                label: format!(
-                    "Rapier {} {} against Bullet: {:+.1} ± {:.1} % (2σ)",
-                    m.mode.name(),
-                    dt_label(r.dt),
-                    100.0 * r.error,
-                    e
-                ),
-                lo: d - e,
-                hi: d + e,
-                two_d: Some(two_d),
-            });
-        }
-    }
-    fig::tradeoff(
-        &a.out,
-        "tradeoff",
-        &format!(
-            "{}: cost against departure from Bullet at {} (±{} % at 2σ asked)",
-            res.block,
-            dt_label(res.reference_dt),
-            100.0 * res.precision
-        ),
-        &pts,
-        &bands,
-        100.0 * res.precision,
-    )?;
-    let mut md = format!(
-        "# Accuracy against cost\n\n{}, seed {}; every departure rolled until 2σ ≤ {:.2} % or \
-         {:.0} CPU s spent; reference: Bullet, box floor, the exact levers (early stop, fast \
-         flight), dt {}, to 2σ ≤ {:.2} % of its own. Planned after the pilot: {:.0} CPU s; \
-         spent on rolls: {:.0} CPU s. At ±1 % the plan is {:.0} CPU s.\n\n",
-        res.block,
-        res.seed,
-        100.0 * res.precision,
-        res.budget_s,
-        dt_label(res.reference_dt),
-        50.0 * res.precision,
-        res.planned_cpu_s,
-        res.cpu_s,
-        res.planned_cpu_s_at_one_percent
-    );
-    for m in &res.modes {
-        md += &format!(
-            "## {}\n\n```\n{}\n{}  (reference)\n",
-            m.mode,
-            tradeoff::header(),
-            tradeoff::format_row(&m.reference)
-        );
-        for r in &m.checks {
-            md += &format!("{}  ({:?})\n", tradeoff::format_row(r), r.role);
-        }
-        for r in &m.rows {
-            md += &tradeoff::format_row(r);
-            md.push('\n');
-        }
-        md += &format!(
-            "```\n\nPareto front over resolved methods (cheapest first): {}.\n\n{}\n\n",
-            m.pareto_front.join("; "),
-            m.note
-        );
-    }
-    md += "![cost against departure](tradeoff.svg)\n";
-    finish(&a.out, "tradeoff.json", &to_json(&res)?, &md, a.json)
-}
-
-pub fn stability(a: &StabilityArgs) -> Result<()> {
-    nonempty(&a.engines, "--engines")?;
-    nonempty(&a.dts, "--dts")?;
-    nonempty(&a.restitutions, "--restitutions")?;
-    if let Some(e) = a
-        .restitutions
-        .iter()
-        .find(|e| !(e.is_finite() && (0.0..=1.0).contains(*e)))
-    {
-        return Err(Error::Usage(format!(
-            "--restitutions {e}: must be in [0, 1]"
-        )));
-    }
-    if let Some(m) = a.frictions.iter().find(|m| !(m.is_finite() && **m >= 0.0)) {
-        return Err(Error::Usage(format!(
-            "--frictions {m}: must be finite and >= 0"
-        )));
-    }
-    if !(0.001..=dicephys::model::scene::DICEPHYS_FLOOR_THICKNESS).contains(&a.floor_thickness) {
-        return Err(Error::Usage(format!(
-            "--floor-thickness {}: must be in [0.001, 100] m",
-            a.floor_thickness
-        )));
-    }
-    let study = check_common(a.rolls, a.max_steps, a.threads, &a.out, "stability.json")?;
-    let cfg = stability::Config {
-        engines: a.engines.clone(),
-        dts: a.dts.clone(),
-        restitutions: a.restitutions.clone(),
-        frictions: a.frictions.clone(),
-        blocks: a.blocks.clone(),
-        rolls: a.rolls,
-        seed: a.seed,
-        max_steps: a.max_steps,
-        floor_thickness: a.floor_thickness,
-    };
-    let Some(res) = logged(a.json, &stability::header(), |log| {
-        stability::run(&cfg, &study, log)
-    })?
-    else {
-        return Ok(());
-    };
-    let mut figures = Vec::new();
-    for kind in stability::KINDS {
-        let panels: Vec<fig::Panel> = group(
-            &res.cells
-                .iter()
-                .filter(|c| c.sweep == Sweep::DtRestitution)
-                .collect::<Vec<_>>(),
-            |c| format!("{} {}", c.engine, c.mode),
-        )
-        .into_iter()
-        .map(|(title, cells)| fig::Panel {
-            title,
-            x_desc: "dt, s".into(),
-            y_desc: "restitution e".into(),
-            x_labels: res.dts.iter().map(|&d| dt_label(d)).collect(),
-            y_labels: res.restitutions.iter().map(|e| e.to_string()).collect(),
-            values: res
-                .restitutions
-                .iter()
-                .map(|&e| {
-                    res.dts
-                        .iter()
-                        .map(|&d| {
-                            cells
-                                .iter()
-                                .find(|c| c.dt == d && c.restitution == e)
-                                .map_or(f64::NAN, |c| c.kind(kind))
-                        })
-                        .collect()
-                })
-                .collect(),
+        Ok(tradeoff::Config {
+            block: self.block,
+            dts: self.dts.clone(),
+            rapier_dts: self.rapier_dts.clone(),
+            reference_dt: self.reference_dt,
+            ladder: self.ladder.iter().flatten().copied().collect(),
+            precision: self.precision,
+            budget_s: self.budget,
+            reference_budget_s: self.reference_budget,
+            seed: self.seed,
+            max_steps: self.max_steps,
+            plan_only: self.plan,
+            preroll_chunks: self
+                .preroll
+                .map(|r| r.div_ceil(dicephys::run::runner::CHUNK_ROLLS)),
         })
-        .collect();
-        let stem = format!("stability_{kind}");
-        fig::heatmap(
-            &a.out,
-            &stem,
-            &format!(
-                "Fraction of rolls {kind} ({} rolls per cell: ± ≤ {:.1} %, 0 < {:.1} %; μ 0.29, 140x24x20{})",
-                res.rolls,
-                100.0 * res.fraction_err_max,
-                100.0 * res.zero_below_95,
-                floor_note(res.floor_thickness)
-            ),
-            &panels,
-        )?;
-        figures.push(stem);
-    }
-    let mut md = format!(
-        "# Where methods fail\n\n{} rolls per cell, seed {}, cap {} steps, energy-gain tolerance \
-         {} % of the starting energy{}. Each fraction f carries a binomial standard error \
-         √(f(1−f)/{}), at most {:.1} % (column ±max: the largest in the row); a 0 means below \
-         {:.1} % at 95 % confidence.\n\n```\n{}\n",
-        res.rolls,
-        res.seed,
-        res.max_steps,
-        100.0 * res.energy_gain_tolerance,
-        floor_note(res.floor_thickness),
-        res.rolls,
-        100.0 * res.fraction_err_max,
-        100.0 * res.zero_below_95,
-        stability::header()
-    );
-    for c in &res.cells {
-        md += &stability::format_cell(c);
-        md.push('\n');
-    }
-    md += "```\n\n";
-    for f in &res.findings {
-        md += &format!("- {f}\n");
-    }
-    md.push('\n');
-    for f in &figures {
-        md += &format!("![{f}]({f}.svg)\n");
-    }
-    finish(&a.out, "stability.json", &to_json(&res)?, &md, a.json)
-}
-
-/// The floor, where it is not DicePhys's.
-fn floor_note(thickness: f64) -> String {
-    if thickness == dicephys::model::scene::DICEPHYS_FLOOR_THICKNESS {
-        String::new()
-    } else {
-        format!(", floor {} m thick", thickness)
     }
 }
 
-/// Runs a sweep, logging its header and each cell to stderr unless the output is JSON. In a
-/// cluster task it runs silently and gives None: the task's share is for the finishing job to
-/// assemble, not to report.
-pub(super) fn logged<T>(
-    quiet: bool,
-    header: &str,
-    run: impl FnOnce(&dyn Fn(&str)) -> dicephys::Result<T>,
-) -> Result<Option<T>> {
-    let task = super::is_task();
-    let quiet = quiet || task;
-    if !quiet {
-        eprintln!("{header}");
-    }
-    let res = run(&|l| {
-        if !quiet {
-            eprintln!("{l}")
+impl StabilityArgs {
+    /// The study's configuration.
+    pub fn config(&self) -> stability::Config {
+        stability::Config {
+            engines: self.engines.clone(),
+            dts: self.dts.clone(),
+            restitutions: self.restitutions.clone(),
+            frictions: self.frictions.clone(),
+            blocks: self.blocks.clone(),
+            rolls: self.rolls,
+            seed: self.seed,
+            max_steps: self.max_steps,
+            floor_thickness: self.floor_thickness,
         }
-    })?;
-    Ok((!task).then_some(res))
+    }
+}
+
+/// Runs `dicephys converge`.
+pub fn converge(a: &ConvergeArgs) -> Result<()> {
+    let out = a.out.clone().unwrap_or_else(|| "converge-out".into());
+    study::run(
+        &StudyConfig::Converge(a.config()),
+        &study::local(&out, a.threads, a.json)?,
+    )
+}
+
+/// Runs `dicephys tradeoff`.
+pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
+    let out = a.out.clone().unwrap_or_else(|| "tradeoff-out".into());
+    study::run(
+        &StudyConfig::Tradeoff(a.config()?),
+        &study::local(&out, a.threads, a.json)?,
+    )
+}
+
+/// Runs `dicephys stability`.
+pub fn stability(a: &StabilityArgs) -> Result<()> {
+    let out = a.out.clone().unwrap_or_else(|| "stability-out".into());
+    study::run(
+        &StudyConfig::Stability(a.config()),
+        &study::local(&out, a.threads, a.json)?,
+    )
 }

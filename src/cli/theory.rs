@@ -1,6 +1,6 @@
 //! `dicephys theory`: the paper's closed-form predictions for one block (`--block`), or its
 //! whole experimental table set against the theory (`--table`). Text, or one JSON document with
-//! `--json` (fields documented in docs/json-theory.md).
+//! `--json` (fields documented in docs/json.md).
 
 use clap::{ArgGroup, Args};
 use serde::Serialize;

@@ -6,7 +6,8 @@ use clap::Args;
 use dicephys::engine::{new_engine, EngineKind};
 use dicephys::model::die::DieShape;
 use dicephys::model::state::BodyState;
-use dicephys::sim::roll::{roll_observed, Fate, RollConfig, DEFAULT_MAX_STEPS};
+use dicephys::report::trace;
+use dicephys::sim::roll::{roll_observed, RollConfig, DEFAULT_MAX_STEPS};
 use std::io::Write;
 
 /// `dicephys trace`'s arguments.
@@ -53,40 +54,12 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     let mut engine = new_engine(a.engine, &scene)?;
     let out = std::io::stdout();
     let mut out = std::io::BufWriter::new(out.lock());
-    writeln!(
-        out,
-        "step,time_s,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,kinetic_j,potential_j,total_j,sleeping"
-    )?;
+    writeln!(out, "{}", trace::HEADER)?;
     // The first failed write is kept and returned after the roll (a roll cannot be stopped
     // from its observer); later lines are not attempted.
     let mut failed: Option<std::io::Error> = None;
     let mut last = None;
-    let line = |step: u64, s: &BodyState| -> String {
-        let q = s.rotation.quaternion();
-        let (k, p) = (die.kinetic(s), die.potential(s));
-        format!(
-            "{},{:.6},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9e},{:.9e},{:.9e},{}",
-            step,
-            step as f64 * scene.dt,
-            s.position.x,
-            s.position.y,
-            s.position.z,
-            q.w,
-            q.i,
-            q.j,
-            q.k,
-            s.linear_velocity.x,
-            s.linear_velocity.y,
-            s.linear_velocity.z,
-            s.angular_velocity.x,
-            s.angular_velocity.y,
-            s.angular_velocity.z,
-            k,
-            p,
-            k + p,
-            s.sleeping as u8
-        )
-    };
+    let line = |step: u64, s: &BodyState| trace::row(&die, scene.dt, step, s);
     let settle = RollConfig {
         max_steps: a.max_steps,
         fast_flight: a.flight == FlightArg::Fast,
@@ -110,14 +83,6 @@ pub fn run(a: &TraceArgs) -> Result<()> {
         writeln!(out, "{l}")?;
     }
     out.flush()?;
-    let fate = match record.fate {
-        Fate::Settled(o) => format!("settled, {} vertical", o.name()),
-        Fate::Unconverged(o) => format!("unconverged ({} vertical at the cap)", o.name()),
-        Fate::Failed(f) => format!("failed: {}", f.name()),
-    };
-    eprintln!(
-        "throw {}: drop {:.4} m, v {:.4} m/s, spin {:.3} rad/s: {} after {} steps",
-        a.index, throw.drop_height, throw.velocity, throw.spin, fate, record.steps
-    );
+    eprintln!("{}", trace::ending(a.index, &throw, &record));
     Ok(())
 }

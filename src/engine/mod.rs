@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 pub mod bullet;
 pub mod rapier2d;
 pub mod rapier3d;
+mod rapier_shared;
 
 /// One world with one die in it, reused throw after throw.
 pub trait Engine: Send {

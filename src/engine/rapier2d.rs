@@ -77,26 +77,9 @@ struct Flight {
     course: Option<(Aabb, Vec<Aabb>, Exact)>,
 }
 
+super::rapier_shared::shared!("rapier2d");
+
 impl Flight {
-    fn aabb(&self, world: &PhysicsWorld, p: &Pose) -> Aabb {
-        let co = &world.colliders[self.collider];
-        co.shape()
-            .compute_aabb(&(*p * self.co_offset))
-            .loosened(self.loosen)
-    }
-
-    fn refatten(&self, leaf: &Aabb, aabb: &Aabb) -> Option<Aabb> {
-        let contains = leaf.mins.cmple(aabb.mins).all() && leaf.maxs.cmpge(aabb.maxs).all();
-        (!contains).then(|| Aabb {
-            mins: aabb.mins - Vector::splat(self.skin),
-            maxs: aabb.maxs + Vector::splat(self.skin),
-        })
-    }
-
-    fn leaf_clear(&self, leaf: &Aabb) -> bool {
-        leaf.mins.y > self.floor_top
-    }
-
     fn resets_timer(&self, prev: &Pose, now: &Exact) -> bool {
         let half_pi = std::f64::consts::FRAC_PI_2;
         // Rapier's test, as it is: angular_ok = ω² < (π/2)².
@@ -155,37 +138,23 @@ impl Rapier2d {
                 "rapier2d: bad scene (dt and mass must be positive)".into(),
             ));
         }
-        let mut world = PhysicsWorld::new();
-        world.gravity = Vector::new(0.0, -scene.gravity);
-        world.integration_parameters.dt = scene.dt;
-        // No CCD, as DicePhys (0 also turns off Rapier's automatic CCD of fast bodies).
-        world.integration_parameters.max_ccd_substeps = 0;
-
-        // Friction and restitution multiply, as in Bullet (see rapier3d.rs).
-        let floor = match scene.floor {
-            Floor::Box => ColliderBuilder::cuboid(5000.0, 0.5 * scene.floor_thickness)
-                .translation(Vector::new(0.0, -0.5 * scene.floor_thickness)),
-            Floor::Plane => ColliderBuilder::new(SharedShape::halfspace(Vector::Y)),
-        };
-        world.insert_collider(
-            floor
-                .friction(scene.floor_friction)
-                .restitution(scene.floor_restitution)
-                .friction_combine_rule(CoefficientCombineRule::Multiply)
-                .restitution_combine_rule(CoefficientCombineRule::Multiply),
-            None,
+        let t = scene.floor_thickness;
+        let world = world_with_floor(
+            scene,
+            Vector::new(0.0, -scene.gravity),
+            ColliderBuilder::cuboid(5000.0, 0.5 * t).translation(Vector::new(0.0, -0.5 * t)),
         );
 
         let [b, w, _] = scene.body_sides();
         let m = scene.mass();
         // The locked 3D box's I_z, as Bullet computes it: m/12 (b² + w²).
         let inertia = m / 12.0 * (b * b + w * w);
-        let die_collider = ColliderBuilder::cuboid(0.5 * b, 0.5 * w)
-            .mass_properties(MassProperties::new(Vector::ZERO, m, inertia))
-            .friction(scene.friction)
-            .restitution(scene.restitution)
-            .friction_combine_rule(CoefficientCombineRule::Multiply)
-            .restitution_combine_rule(CoefficientCombineRule::Multiply);
+        let die_collider = multiply(
+            ColliderBuilder::cuboid(0.5 * b, 0.5 * w)
+                .mass_properties(MassProperties::new(Vector::ZERO, m, inertia))
+                .friction(scene.friction)
+                .restitution(scene.restitution),
+        );
         Ok(Rapier2d {
             world,
             die: None,
@@ -220,13 +189,7 @@ impl Rapier2d {
                     .map(|x| if x == 0.0 { 0.0 } else { 1.0 / x })
                 * b.gravity_scale();
         let skin = 4.0e-2 * p.length_unit;
-        let floor_top = w
-            .colliders
-            .iter()
-            .filter(|(ch, _)| *ch != co_handle)
-            .map(|(_, c)| c.compute_broad_phase_aabb(p, &w.bodies).maxs.y)
-            .fold(f64::NEG_INFINITY, f64::max)
-            + skin;
+        let floor_top = floor_top(w, co_handle, skin);
         let threshold = b.activation().normalized_linear_threshold;
         let mut f = Flight {
             h: hdt,
@@ -259,14 +222,7 @@ impl Rapier2d {
     /// What the world keeps of the die besides its state, for checks: its contact pairs (with
     /// any manifold, empty or not), its sleep timer, and whether it sleeps.
     pub fn die_world(&self) -> Option<(usize, f64, bool)> {
-        let h = self.die?;
-        let b = &self.world.bodies[h];
-        let pairs = self
-            .world
-            .narrow_phase
-            .contact_pairs_with(b.colliders()[0])
-            .count();
-        Some((pairs, b.activation().time_since_can_sleep, b.is_sleeping()))
+        die_world_of(&self.world, self.die)
     }
 
     /// The die's mass and moment of inertia as Rapier holds them (it keeps inverses).
@@ -417,28 +373,7 @@ impl Engine for Rapier2d {
     }
 
     fn step(&mut self) -> crate::Result<()> {
-        let Some(h) = self.die else {
-            return Err(crate::Error::Engine("rapier2d: step before reset".into()));
-        };
-        if let Some(f) = self.flight.as_mut() {
-            let b = &self.world.bodies[h];
-            f.sleep_prev = (!b.is_sleeping()).then(|| *b.position());
-            f.course = None;
-        }
-        self.world.step();
-        if let Some(f) = self.flight.as_ref() {
-            let aabb = f.aabb(&self.world, self.world.bodies[h].position());
-            if let Some(l) = f.refatten(&f.leaf, &aabb) {
-                self.flight.as_mut().unwrap().leaf = l;
-            }
-        }
-        // A quarantined body is reset to a finite pose at rest; report it (see rapier3d.rs).
-        if !self.world.quarantine().is_empty() {
-            return Err(crate::Error::Engine(
-                "rapier2d: the die's state went non-finite (quarantined)".into(),
-            ));
-        }
-        Ok(())
+        step_world(&mut self.world, self.die, &mut self.flight)
     }
 
     fn state(&self) -> BodyState {

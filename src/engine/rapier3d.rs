@@ -94,28 +94,9 @@ fn pose_of(s: &BodyState) -> Pose {
     )
 }
 
+super::rapier_shared::shared!("rapier");
+
 impl Flight {
-    /// The broad-phase AABB of the die at body pose `p`, as `compute_broad_phase_aabb`.
-    fn aabb(&self, world: &PhysicsWorld, p: &Pose) -> Aabb {
-        let co = &world.colliders[self.collider];
-        co.shape()
-            .compute_aabb(&(*p * self.co_offset))
-            .loosened(self.loosen)
-    }
-
-    /// The leaf after Rapier's `set_aabb` of `aabb` on leaf `leaf`, and whether it changed.
-    fn refatten(&self, leaf: &Aabb, aabb: &Aabb) -> Option<Aabb> {
-        let contains = leaf.mins.cmple(aabb.mins).all() && leaf.maxs.cmpge(aabb.maxs).all();
-        (!contains).then(|| Aabb {
-            mins: aabb.mins - Vector::splat(self.skin),
-            maxs: aabb.maxs + Vector::splat(self.skin),
-        })
-    }
-
-    fn leaf_clear(&self, leaf: &Aabb) -> bool {
-        leaf.mins.y > self.floor_top
-    }
-
     /// True if Rapier's sleep rule, from `prev` to the pose of `now` (spinning at `now`'s
     /// angular velocity), finds the die moving: the rule's drift is at least the
     /// translation, so a translation over the threshold (or a fast spin) is enough.
@@ -215,39 +196,28 @@ impl Rapier3d {
                 "rapier: bad scene (dt and mass must be positive)".into(),
             ));
         }
-        let mut world = PhysicsWorld::new();
-        world.gravity = Vector::new(0.0, -scene.gravity, 0.0);
-        world.integration_parameters.dt = scene.dt;
         // No CCD, as DicePhys. Rapier's default (1 substep) still sweeps any fast-moving
-        // dynamic body against fixed colliders; 0 turns all of it off.
-        world.integration_parameters.max_ccd_substeps = 0;
-
-        // Friction and restitution combine as in Bullet: the product of the two colliders'
-        // coefficients (Rapier's default is their average). The floor's are 1, so the
-        // contact's μ and e are the die's. Both colliders say Multiply, so no rule outranks it.
-        let floor = match scene.floor {
-            // DicePhys's static 10000 x 100 x 10000 m box, top face at y = 0.
-            // (`--floor-thickness` makes it thinner.)
-            Floor::Box => ColliderBuilder::cuboid(5000.0, 0.5 * scene.floor_thickness, 5000.0)
-                .translation(Vector::new(0.0, -0.5 * scene.floor_thickness, 0.0)),
-            Floor::Plane => ColliderBuilder::new(SharedShape::halfspace(Vector::Y)),
-        };
-        world.insert_collider(
-            floor
-                .friction(scene.floor_friction)
-                .restitution(scene.floor_restitution)
-                .friction_combine_rule(CoefficientCombineRule::Multiply)
-                .restitution_combine_rule(CoefficientCombineRule::Multiply),
-            None,
+        // dynamic body against fixed colliders; 0 turns all of it off. The floor's friction
+        // and restitution are 1, so the contact's μ and e are the die's (`multiply`). Its box
+        // is DicePhys's static 10000 x 100 x 10000 m (`floor_thickness` makes it thinner).
+        let t = scene.floor_thickness;
+        let world = world_with_floor(
+            scene,
+            Vector::new(0.0, -scene.gravity, 0.0),
+            ColliderBuilder::cuboid(5000.0, 0.5 * t, 5000.0).translation(Vector::new(
+                0.0,
+                -0.5 * t,
+                0.0,
+            )),
         );
 
         let [bx, by, bz] = scene.body_sides();
-        let die_collider = ColliderBuilder::cuboid(0.5 * bx, 0.5 * by, 0.5 * bz)
-            .mass_properties(box_mass_properties(scene.mass(), [bx, by, bz]))
-            .friction(scene.friction)
-            .restitution(scene.restitution)
-            .friction_combine_rule(CoefficientCombineRule::Multiply)
-            .restitution_combine_rule(CoefficientCombineRule::Multiply);
+        let die_collider = multiply(
+            ColliderBuilder::cuboid(0.5 * bx, 0.5 * by, 0.5 * bz)
+                .mass_properties(box_mass_properties(scene.mass(), [bx, by, bz]))
+                .friction(scene.friction)
+                .restitution(scene.restitution),
+        );
 
         // DicePhys's 2D mode is Bullet's linear factor (1,1,0) and angular factor (0,0,1).
         // Rapier 0.36.1 applies no friction at all to a body with a locked translation (its
@@ -297,13 +267,7 @@ impl Rapier3d {
                 * b.gravity_scale();
         let loosen = co.contact_skin() + (p.prediction_distance() / 2.0 + 0.0);
         let skin = 4.0e-2 * p.length_unit;
-        let floor_top = w
-            .colliders
-            .iter()
-            .filter(|(ch, _)| *ch != co_handle)
-            .map(|(_, c)| c.compute_broad_phase_aabb(p, &w.bodies).maxs.y)
-            .fold(f64::NEG_INFINITY, f64::max)
-            + skin;
+        let floor_top = floor_top(w, co_handle, skin);
         let mut f = Flight {
             h: hdt,
             substeps,
@@ -338,14 +302,7 @@ impl Rapier3d {
     /// What the world keeps of the die besides its state, for checks: its contact pairs (with
     /// any manifold, empty or not), its sleep timer, and whether it sleeps.
     pub fn die_world(&self) -> Option<(usize, f64, bool)> {
-        let h = self.die?;
-        let b = &self.world.bodies[h];
-        let pairs = self
-            .world
-            .narrow_phase
-            .contact_pairs_with(b.colliders()[0])
-            .count();
-        Some((pairs, b.activation().time_since_can_sleep, b.is_sleeping()))
+        die_world_of(&self.world, self.die)
     }
 
     /// The die's mass as Rapier holds it (it keeps 1/m), for checks.
@@ -477,30 +434,7 @@ impl Engine for Rapier3d {
     }
 
     fn step(&mut self) -> crate::Result<()> {
-        let Some(h) = self.die else {
-            return Err(crate::Error::Engine("rapier: step before reset".into()));
-        };
-        if let Some(f) = self.flight.as_mut() {
-            let b = &self.world.bodies[h];
-            // Rapier keeps the pose before the step for its sleep rule, unless asleep.
-            f.sleep_prev = (!b.is_sleeping()).then(|| *b.position());
-            f.course = None;
-        }
-        self.world.step();
-        if let Some(f) = self.flight.as_ref() {
-            let aabb = f.aabb(&self.world, self.world.bodies[h].position());
-            if let Some(l) = f.refatten(&f.leaf, &aabb) {
-                self.flight.as_mut().unwrap().leaf = l;
-            }
-        }
-        // Rapier does not let a NaN through: it puts the body back at its last finite pose
-        // with zero velocity and disables it, which would look like a die at rest. Report it.
-        if !self.world.quarantine().is_empty() {
-            return Err(crate::Error::Engine(
-                "rapier: the die's state went non-finite (quarantined)".into(),
-            ));
-        }
-        Ok(())
+        step_world(&mut self.world, self.die, &mut self.flight)
     }
 
     fn state(&self) -> BodyState {

@@ -174,15 +174,12 @@ impl Scene {
     /// Checks every value before anything runs. A restitution above 1 is not physics; it is
     /// accepted (up to 10) only for engine-stability studies that ask for it.
     pub fn validate(&self, allow_restitution_above_one: bool) -> Result<()> {
-        let bad = |m: String| Err(Error::Invalid(m));
+        let bad = |field, v: f64, why: String| Err(Error::field(field, v, why));
         if !(self.dt.is_finite() && self.dt > 0.0 && self.dt <= 0.1) {
-            return bad(format!("--dt {}: must be in (0, 0.1] s", self.dt));
+            return bad("dt", self.dt, "must be in (0, 0.1] s".into());
         }
         if !(self.friction.is_finite() && self.friction >= 0.0) {
-            return bad(format!(
-                "--friction {}: must be finite and >= 0",
-                self.friction
-            ));
+            return bad("friction", self.friction, "must be finite and >= 0".into());
         }
         let e_max = if allow_restitution_above_one {
             10.0
@@ -190,33 +187,38 @@ impl Scene {
             1.0
         };
         if !(self.restitution.is_finite() && self.restitution >= 0.0 && self.restitution <= e_max) {
-            return bad(format!(
-                "--restitution {}: must be in [0, 1] (above 1 only with --allow-restitution-above-one)",
-                self.restitution
-            ));
+            return bad(
+                "restitution",
+                self.restitution,
+                "must be in [0, 1] (above 1 only with `allow_restitution_above_one`)".into(),
+            );
         }
         if !(self.floor_thickness.is_finite()
             && (0.001..=DICEPHYS_FLOOR_THICKNESS).contains(&self.floor_thickness))
         {
-            return bad(format!(
-                "--floor-thickness {}: must be in [0.001, 100] m",
-                self.floor_thickness
-            ));
+            return bad(
+                "floor_thickness",
+                self.floor_thickness,
+                "must be in [0.001, 100] m".into(),
+            );
         }
         if !(self.density.is_finite() && self.density > 0.0 && self.density <= 1e5) {
-            return bad(format!(
-                "--density {}: must be in (0, 100000] kg/m³",
-                self.density
-            ));
+            return bad(
+                "density",
+                self.density,
+                "must be in (0, 100000] kg/m³".into(),
+            );
         }
         for (name, v) in [
-            ("--linear-damping", self.linear_damping),
-            ("--angular-damping", self.angular_damping),
+            ("linear_damping", self.linear_damping),
+            ("angular_damping", self.angular_damping),
         ] {
             if !(v.is_finite() && (0.0..=MAX_DAMPING).contains(&v)) {
-                return bad(format!(
-                    "{name} {v}: must be in [0, {MAX_DAMPING}] 1/s (Bullet cannot hold a faster rate)"
-                ));
+                return bad(
+                    name,
+                    v,
+                    format!("must be in [0, {MAX_DAMPING}] 1/s (Bullet cannot hold a faster rate)"),
+                );
             }
         }
         Ok(())
@@ -327,7 +329,16 @@ mod tests {
         s.validate(false).unwrap();
         for bad in [-1.0, MAX_DAMPING * 1.01, f64::NAN, f64::INFINITY] {
             s.linear_damping = bad;
-            assert!(matches!(s.validate(false), Err(Error::Invalid(_))), "{bad}");
+            assert!(
+                matches!(
+                    s.validate(false),
+                    Err(Error::Field {
+                        field: "linear_damping",
+                        ..
+                    })
+                ),
+                "{bad}"
+            );
         }
     }
 

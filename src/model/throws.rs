@@ -99,25 +99,20 @@ pub struct ThrowRanges {
 impl ThrowRanges {
     /// Checks the ranges: spin and drop height not negative, no magnitude absurdly large.
     pub fn validate(&self) -> crate::Result<()> {
-        let bad = |m: String| Err(crate::Error::Invalid(m));
+        let bad = |field, r: Range, why: String| Err(crate::Error::field(field, r, why));
         if self.spin.lo < 0.0 {
-            return bad(format!("--spin {}: must be >= 0 rad/s", self.spin));
+            return bad("spin", self.spin, "must be >= 0 rad/s".into());
         }
         if self.drop_height.lo < 0.0 {
-            return bad(format!(
-                "--drop-height {}: must be >= 0 m",
-                self.drop_height
-            ));
+            return bad("drop_height", self.drop_height, "must be >= 0 m".into());
         }
         for (name, r, max) in [
-            ("--velocity", self.velocity, 100.0),
-            ("--spin", self.spin, 10_000.0),
-            ("--drop-height", self.drop_height, 100.0),
+            ("velocity", self.velocity, 100.0),
+            ("spin", self.spin, 10_000.0),
+            ("drop_height", self.drop_height, 100.0),
         ] {
             if r.lo.abs() > max || r.hi.abs() > max {
-                return bad(format!(
-                    "{name} {r}: magnitudes above {max} are not accepted"
-                ));
+                return bad(name, r, format!("magnitudes above {max} are not accepted"));
             }
         }
         Ok(())

@@ -1,8 +1,8 @@
 //! What a fit says: `report.md`, its figures, and a prediction's lines.
 
+use crate::calibration::paper::CalibratedPaper;
 use crate::calibration::params::{FixedThrow, Kind};
 use crate::calibration::predict::{BlockPrediction, Predicted};
-use crate::calibration::paper::CalibratedPaper;
 use crate::calibration::recovery::Recovery;
 use crate::calibration::FitResult;
 use crate::error::Result;
@@ -320,7 +320,10 @@ pub fn recovery_text(r: &Recovery) -> String {
 pub fn calibrated_markdown(c: &CalibratedPaper, figures: &[&str]) -> String {
     let f = &c.fit;
     let mut s = String::new();
-    let _ = writeln!(s, "# The paper's 19 rows, simulated with calibrated e, μ and throw\n");
+    let _ = writeln!(
+        s,
+        "# The paper's 19 rows, simulated with calibrated e, μ and throw\n"
+    );
     let _ = writeln!(
         s,
         "`{}` — dicephys {}, {}. {} rolls in all ({:.0} s wall, {:.0} s CPU). Method: {} at dt \
@@ -366,8 +369,16 @@ pub fn calibrated_markdown(c: &CalibratedPaper, figures: &[&str]) -> String {
     );
     let _ = writeln!(s, "| | within 1σ | within 2σ | rows |");
     let _ = writeln!(s, "|---|---:|---:|---:|");
-    let _ = writeln!(s, "| calibrated simulator (leave one out) | {} | {} | {} |", sim.0, sim.1, sim.2);
-    let _ = writeln!(s, "| the paper's theory (eq. MasterEqu) | {} | {} | {} |", theory.0, theory.1, theory.2);
+    let _ = writeln!(
+        s,
+        "| calibrated simulator (leave one out) | {} | {} | {} |",
+        sim.0, sim.1, sim.2
+    );
+    let _ = writeln!(
+        s,
+        "| the paper's theory (eq. MasterEqu) | {} | {} | {} |",
+        theory.0, theory.1, theory.2
+    );
     let _ = writeln!(
         s,
         "| simulator, end counts (length vertical; no theory) | {} | {} | {} |\n",
@@ -405,13 +416,19 @@ pub fn calibrated_markdown(c: &CalibratedPaper, figures: &[&str]) -> String {
             if r.alone { " (alone)" } else { "" },
             row.block,
             row.mode.name(),
-            cell(r.measured_ratio.map(|m| format!("{:.3} ± {:.3}", m.value, m.err))),
+            cell(
+                r.measured_ratio
+                    .map(|m| format!("{:.3} ± {:.3}", m.value, m.err))
+            ),
             cell(r.ratio.map(|p| format!("{:.3} ± {:.3}", p.value, p.err))),
             cell(r.z.map(|z| format!("{z:+.2}"))),
             cell(t.map(|t| format!("{:.3} ± {:.3}", t.ratio.value, t.ratio.err))),
             cell(t.map(|t| format!("{:+.2}", t.z))),
             cell(r.end.map(|e| format!("{} / {}", e.counted, e.throws))),
-            cell(r.end.map(|e| format!("{:.4} ± {:.4}", e.predicted.value, e.predicted.err))),
+            cell(
+                r.end
+                    .map(|e| format!("{:.4} ± {:.4}", e.predicted.value, e.predicted.err))
+            ),
             cell(r.end.map(|e| format!("{:+.2}", e.z))),
         );
     }
@@ -447,7 +464,9 @@ pub fn calibrated_markdown(c: &CalibratedPaper, figures: &[&str]) -> String {
     let _ = writeln!(s);
     for d in &c.decisions {
         let lr = d.lr_test.map_or(String::new(), |(stat, dof, p)| {
-            format!(" Likelihood ratio: −2 ln Λ = {stat:.1} on {dof} degrees of freedom, p = {p:.3}.")
+            format!(
+                " Likelihood ratio: −2 ln Λ = {stat:.1} on {dof} degrees of freedom, p = {p:.3}."
+            )
         });
         let _ = writeln!(s, "- **{}** {}.{}", d.question, d.verdict, lr);
     }
@@ -484,7 +503,10 @@ pub fn calibrated_markdown(c: &CalibratedPaper, figures: &[&str]) -> String {
             "Not every block is within: read the fit's values with the departures below in mind."
         }
     );
-    let _ = writeln!(s, "| block | rolls | P(breadth) departure | P(length) departure | data's error | within |");
+    let _ = writeln!(
+        s,
+        "| block | rolls | P(breadth) departure | P(length) departure | data's error | within |"
+    );
     let _ = writeln!(s, "|---|---:|---|---|---:|---|");
     for b in &ck.blocks {
         let _ = writeln!(
@@ -521,9 +543,21 @@ pub fn write_calibrated_figures(dir: &Path, c: &CalibratedPaper) -> Result<Vec<&
             let t = c.theory.iter().find(|t| t.label == r.label)?;
             Some(RowRatio {
                 label: r.label.clone(),
-                measured: Point { x: 0.0, y: m.value, y_err: m.err },
-                simulated: Point { x: 0.0, y: p.value, y_err: p.err },
-                theory: Some(Point { x: 0.0, y: t.ratio.value, y_err: t.ratio.err }),
+                measured: Point {
+                    x: 0.0,
+                    y: m.value,
+                    y_err: m.err,
+                },
+                simulated: Point {
+                    x: 0.0,
+                    y: p.value,
+                    y_err: p.err,
+                },
+                theory: Some(Point {
+                    x: 0.0,
+                    y: t.ratio.value,
+                    y_err: t.ratio.err,
+                }),
             })
         })
         .collect();

@@ -1,11 +1,18 @@
 //! What results say: a run's summary, the theory and the paper's table as reports, the paper's
 //! Markdown and CSV, and the figures.
 
+pub mod converge;
+pub mod crosscheck;
 pub mod figures;
 pub mod fit;
 pub mod outcomes;
 pub mod paper;
 pub mod per_roll;
+pub mod progress;
+pub mod stability;
 pub mod summary;
 pub mod table;
 pub mod text;
+pub mod trace;
+pub mod tradeoff;
+pub mod validate;

@@ -6,7 +6,7 @@
 
 use crate::model::block::Block;
 use crate::run::tally::Counts;
-use crate::theory;
+use crate::theory::{self, stats};
 use serde::{Deserialize, Serialize};
 
 /// One outcome's probability.
@@ -25,13 +25,12 @@ pub struct Probability {
 impl Probability {
     /// `k` of `n` against the prediction `s`.
     pub fn of(k: u64, n: u64, s: f64) -> Probability {
-        let nf = n as f64;
-        let p = k as f64 / nf;
+        let p = stats::proportion(k, n);
         Probability {
-            p,
-            err: (p * (1.0 - p) / nf).sqrt(),
+            p: p.value,
+            err: p.err,
             solid_angle: s,
-            z: (p - s) / (s * (1.0 - s) / nf).sqrt(),
+            z: (p.value - s) / stats::binomial_err(s, n),
         }
     }
 }
@@ -80,74 +79,6 @@ impl Outcomes3d {
             f("length", &self.length)
         )
     }
-}
-
-/// `paper`'s report: for each block simulated in 3D, the three outcomes of the experiment (the
-/// paper's counts) and of each engine, beside the solid angles.
-pub fn paper_markdown(res: &crate::report::paper::PaperResults) -> String {
-    let cells: Vec<_> = res
-        .simulations
-        .iter()
-        .filter(|c| c.run.outcomes.is_some())
-        .collect();
-    if cells.is_empty() {
-        return String::new();
-    }
-    let cell = |p: &Probability| {
-        format!(
-            "{:.4} ± {:.4} ({:.4}, {:+.1} σ)",
-            p.p, p.err, p.solid_angle, p.z
-        )
-    };
-    let mut s = String::from(
-        "## The three outcomes in 3D\n\n\
-         Each probability over the dice that came to rest on a face, ± its binomial error; in \
-         brackets the solid-angle (Simpson) prediction, (2/π) arctan(w_j w_k / (w_i |w|)), and how \
-         many of its standard errors apart. The paper expects bouncing dice to favour the \
-         low-energy faces over Simpson's.\n\n\
-         | row | block | source | n | P(breadth vertical) | P(width vertical) | P(length vertical) |\n\
-         |---|---|---|---|---|---|---|\n",
-    );
-    let mut rows: Vec<usize> = cells.iter().map(|c| c.row).collect();
-    rows.dedup();
-    for row in rows {
-        let here: Vec<_> = cells.iter().filter(|c| c.row == row).collect();
-        let label = &here[0].label;
-        if let Some(t) = res.table.rows.iter().find(|t| t.row == row) {
-            let counts = Counts {
-                breadth: t.breadth_vertical,
-                width: t.width_vertical,
-                length: t.length_vertical,
-                unknown: 0,
-            };
-            if let Some(o) = Block::from_mm(t.length_mm, t.breadth_mm, t.width_mm)
-                .ok()
-                .and_then(|b| Outcomes3d::of(&b, &counts))
-            {
-                s += &format!(
-                    "| {row} | {label} | experiment | {} | {} | {} | {} |\n",
-                    o.n,
-                    cell(&o.breadth),
-                    cell(&o.width),
-                    cell(&o.length)
-                );
-            }
-        }
-        for c in here {
-            if let Some(o) = &c.run.outcomes {
-                s += &format!(
-                    "| {row} | {label} | {} | {} | {} | {} | {} |\n",
-                    c.engine,
-                    o.n,
-                    cell(&o.breadth),
-                    cell(&o.width),
-                    cell(&o.length)
-                );
-            }
-        }
-    }
-    s.push('\n');
-    s
 }
 
 #[cfg(test)]

@@ -2,9 +2,12 @@
 
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
+use crate::model::block::Block;
 use crate::model::scene::{Mode, Preset};
+use crate::report::outcomes::{Outcomes3d, Probability};
 use crate::report::summary::RunSummary;
 use crate::report::table::TableReport;
+use crate::run::tally::Counts;
 use crate::theory::stats::Ratio;
 use serde::Serialize;
 
@@ -98,7 +101,7 @@ pub fn cell(res: &PaperResults, row: usize, engine: EngineKind, mode: Mode) -> O
 }
 
 /// report.md: the table formatted like the paper's, the simulation columns, and a reading.
-pub fn report_markdown(res: &PaperResults, figures: &[&str]) -> String {
+pub fn markdown(res: &PaperResults, figures: &[&str]) -> String {
     let p = &res.provenance;
     let engines: Vec<EngineKind> = {
         let mut v: Vec<EngineKind> = res.simulations.iter().map(|c| c.engine).collect();
@@ -213,7 +216,7 @@ pub fn report_markdown(res: &PaperResults, figures: &[&str]) -> String {
         s += &d.join("; ");
         s += ".\n\n";
     }
-    s += &crate::report::outcomes::paper_markdown(res);
+    s += &outcomes_markdown(res);
     s += "## Reading\n\n";
     for e in &engines {
         for (m, name) in [("3d", "3D"), ("2d", "2D")] {
@@ -254,6 +257,74 @@ pub fn report_markdown(res: &PaperResults, figures: &[&str]) -> String {
             s += &format!("![{f}]({f}.svg)\n\n");
         }
     }
+    s
+}
+
+/// `paper`'s report: for each block simulated in 3D, the three outcomes of the experiment (the
+/// paper's counts) and of each engine, beside the solid angles.
+fn outcomes_markdown(res: &PaperResults) -> String {
+    let cells: Vec<_> = res
+        .simulations
+        .iter()
+        .filter(|c| c.run.outcomes.is_some())
+        .collect();
+    if cells.is_empty() {
+        return String::new();
+    }
+    let cell = |p: &Probability| {
+        format!(
+            "{:.4} ± {:.4} ({:.4}, {:+.1} σ)",
+            p.p, p.err, p.solid_angle, p.z
+        )
+    };
+    let mut s = String::from(
+        "## The three outcomes in 3D\n\n\
+         Each probability over the dice that came to rest on a face, ± its binomial error; in \
+         brackets the solid-angle (Simpson) prediction, (2/π) arctan(w_j w_k / (w_i |w|)), and how \
+         many of its standard errors apart. The paper expects bouncing dice to favour the \
+         low-energy faces over Simpson's.\n\n\
+         | row | block | source | n | P(breadth vertical) | P(width vertical) | P(length vertical) |\n\
+         |---|---|---|---|---|---|---|\n",
+    );
+    let mut rows: Vec<usize> = cells.iter().map(|c| c.row).collect();
+    rows.dedup();
+    for row in rows {
+        let here: Vec<_> = cells.iter().filter(|c| c.row == row).collect();
+        let label = &here[0].label;
+        if let Some(t) = res.table.rows.iter().find(|t| t.row == row) {
+            let counts = Counts {
+                breadth: t.breadth_vertical,
+                width: t.width_vertical,
+                length: t.length_vertical,
+                unknown: 0,
+            };
+            if let Some(o) = Block::from_mm(t.length_mm, t.breadth_mm, t.width_mm)
+                .ok()
+                .and_then(|b| Outcomes3d::of(&b, &counts))
+            {
+                s += &format!(
+                    "| {row} | {label} | experiment | {} | {} | {} | {} |\n",
+                    o.n,
+                    cell(&o.breadth),
+                    cell(&o.width),
+                    cell(&o.length)
+                );
+            }
+        }
+        for c in here {
+            if let Some(o) = &c.run.outcomes {
+                s += &format!(
+                    "| {row} | {label} | {} | {} | {} | {} | {} |\n",
+                    c.engine,
+                    o.n,
+                    cell(&o.breadth),
+                    cell(&o.width),
+                    cell(&o.length)
+                );
+            }
+        }
+    }
+    s.push('\n');
     s
 }
 

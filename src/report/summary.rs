@@ -4,6 +4,8 @@
 use crate::engine::EngineKind;
 use crate::model::scene::{Floor, Mode, Preset};
 use crate::model::throws::{ThrowKind, ThrowRanges};
+use crate::run::io::Output;
+use crate::run::slurm::{Layout, Plan};
 use crate::run::spec::RunSpec;
 use crate::run::tally::{Counts, Tally};
 use crate::sim::roll::{Failure, Rule};
@@ -339,6 +341,55 @@ pub struct ShardResult {
 }
 
 impl RunSummary {
+    /// The finishing job of a `roll` through Slurm: every task's result there, whole and of
+    /// its shard, merged and written whole into the run's directory (`result.json`,
+    /// `result.txt`; rerun, it writes the same); the text it printed.
+    pub fn merge_tasks(lay: &Layout, spec: &RunSpec, tasks: u64) -> crate::Result<String> {
+        let (mut parts, mut missing, mut why) = (Vec::new(), Vec::new(), Vec::new());
+        for k in 0..tasks {
+            match ShardResult::read(&lay.shard_result(k), &Plan::shard_spec(spec, k, tasks)) {
+                Ok(s) => parts.push(s),
+                Err(e) => {
+                    missing.push(k.to_string());
+                    why.push(e);
+                }
+            }
+        }
+        if !missing.is_empty() {
+            return Err(lay.not_finished(tasks, &missing, &why.join("; ")));
+        }
+        let merged = RunSummary::merge(&parts)?;
+        let json = serde_json::to_string_pretty(&merged)
+            .map_err(|e| crate::Error::Failed(e.to_string()))?;
+        let text = merged.human();
+        let (j, t) = (
+            Output::check(&lay.result_json())?,
+            Output::check(&lay.result_text())?,
+        );
+        j.write(format!("{json}\n").as_bytes())?;
+        t.write(text.as_bytes())?;
+        Ok(text)
+    }
+}
+
+impl ShardResult {
+    /// A shard's `roll --json` output from `p`, if it is there, whole, and of the run `want`;
+    /// else why not.
+    pub fn read(p: &std::path::Path, want: &RunSpec) -> std::result::Result<ShardResult, String> {
+        let text = std::fs::read_to_string(p).map_err(|_| format!("no {}", p.display()))?;
+        let s: ShardResult =
+            serde_json::from_str(&text).map_err(|e| format!("{} is damaged: {e}", p.display()))?;
+        if s.spec != *want {
+            return Err(format!("{} is of another run", p.display()));
+        }
+        if s.partial {
+            return Err(format!("{} is partial", p.display()));
+        }
+        Ok(s)
+    }
+}
+
+impl RunSummary {
     /// Combines the shards of one run into the unsharded run's summary: the same exact counts.
     /// Refuses shards of different runs (compared by specification, however their command
     /// lines were spelled), partial, missing or repeated shards, and tallies that do not add up.
@@ -361,10 +412,9 @@ impl RunSummary {
                     "merge: a shard is partial (interrupted); resume it first".into(),
                 ));
             }
-            let s = p
-                .spec
-                .shard
-                .ok_or_else(|| Mismatch("merge: an input is not a shard (no --shard)".into()))?;
+            let s = p.spec.shard.ok_or_else(|| {
+                Mismatch("merge: an input is not a shard (it names no shard)".into())
+            })?;
             s.validate()?;
             p.tally.check()?;
             if s.n != n || seen.get(s.k as usize).copied().unwrap_or(true) {

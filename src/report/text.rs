@@ -1,5 +1,6 @@
 //! Fixed-width text tables, for the rows the bench and the sweeps print as they go: one place
-//! says each column's title and width, so a header and its rows cannot drift apart.
+//! says each column's title and width, so a header and its rows cannot drift apart. And a time
+//! step as people write it.
 
 /// One column: its title, its width in characters, and its alignment.
 #[derive(Clone, Copy, Debug)]
@@ -57,6 +58,16 @@ impl Columns {
             })
             .collect();
         padded.join(" ").trim_end().to_string()
+    }
+}
+
+/// A time step as people write it: 1/1000 for 0.001.
+pub fn dt_label(dt: f64) -> String {
+    let n = 1.0 / dt;
+    if (n - n.round()).abs() < 1e-6 * n {
+        format!("1/{}", n.round())
+    } else {
+        format!("{dt}")
     }
 }
 

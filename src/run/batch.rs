@@ -26,6 +26,18 @@ pub struct Job<'a> {
     pub cfg: &'a RollConfig,
 }
 
+/// Worker threads: 0 means one per core.
+pub fn threads(asked: usize) -> usize {
+    if asked == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        asked
+    }
+}
+
+/// The most worker threads a run takes.
+pub const MAX_THREADS: usize = 1024;
+
 /// Rolls throws `indices` with `threads` threads (0: one per core), no stop; records in index
 /// order.
 pub fn run(
@@ -44,7 +56,7 @@ pub fn run(
         throws,
         cfg,
     };
-    let threads = crate::run::runner::threads(threads);
+    let threads = self::threads(threads);
     run_indices(&job, &list, threads, &Stop::new(), progress)
 }
 

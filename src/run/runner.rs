@@ -6,7 +6,7 @@
 //! roll: what was rolled is kept.
 
 use crate::error::{Error, Result};
-use crate::run::batch;
+use crate::run::batch::{self, threads};
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::io::write_atomic;
 use crate::run::spec::RunSpec;
@@ -20,7 +20,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 /// Rolls per chunk: a chunk file per 1,000 rolls costs nothing.
-pub const CHUNK: u64 = 1000;
+pub const CHUNK_ROLLS: u64 = 1000;
 
 /// How runs are carried out: threads, stop requests, progress. Nothing here changes a result.
 #[derive(Clone)]
@@ -32,7 +32,7 @@ pub struct Runner<'a> {
     /// Called with the rolls finished so far in the current run, from any thread.
     pub progress: &'a (dyn Fn(u64) + Sync),
     /// Which chunks this process rolls: all of them, except on a cluster.
-    pub chunks: Chunks,
+    pub share: ChunkShare,
 }
 
 /// Which of its runs' chunks a process rolls. On one machine, all. On a cluster, a study of
@@ -40,7 +40,7 @@ pub struct Runner<'a> {
 /// a job array, all writing into the same checkpoint directories; the finishing job then runs
 /// the study once more and finds every chunk there, so its counts are those of one machine.
 #[derive(Clone, Debug, Default)]
-pub enum Chunks {
+pub enum ChunkShare {
     /// Roll every chunk not already in the checkpoint.
     #[default]
     All,
@@ -63,10 +63,10 @@ pub enum Chunks {
     DryRun,
 }
 
-impl Chunks {
+impl ChunkShare {
     /// Task `k` of `n`.
-    pub fn task(k: u64, n: u64) -> Chunks {
-        Chunks::Task {
+    pub fn task(k: u64, n: u64) -> ChunkShare {
+        ChunkShare::Task {
             k,
             n,
             met: Arc::new(AtomicU64::new(0)),
@@ -76,7 +76,7 @@ impl Chunks {
     /// Whether this process takes the next chunk it meets.
     fn take_next(&self) -> bool {
         match self {
-            Chunks::Task { k, n, met } => met.fetch_add(1, Ordering::Relaxed) % n == *k,
+            ChunkShare::Task { k, n, met } => met.fetch_add(1, Ordering::Relaxed) % n == *k,
             _ => true,
         }
     }
@@ -84,25 +84,13 @@ impl Chunks {
     /// True for a task's share or a dry run: their tallies are partial by design, for no
     /// report.
     pub fn is_partial(&self) -> bool {
-        matches!(self, Chunks::Task { .. } | Chunks::DryRun)
+        matches!(self, ChunkShare::Task { .. } | ChunkShare::DryRun)
     }
 }
 
-/// Worker threads: 0 means one per core.
-pub fn threads(asked: usize) -> usize {
-    if asked == 0 {
-        std::thread::available_parallelism().map_or(1, |n| n.get())
-    } else {
-        asked
-    }
-}
-
-/// The most worker threads a run takes.
-pub const MAX_THREADS: usize = 1024;
-
-/// The outcome of a run: the exact tally of the rolls made, and whether all were.
+/// What a run rolled: the exact tally of the rolls made, and whether all were.
 #[derive(Clone, Debug)]
-pub struct Chunked {
+pub struct Rolled {
     /// The rolls made (or read back from the checkpoint).
     pub tally: Tally,
     /// False if a stop request ended the run early.
@@ -132,21 +120,21 @@ impl<'a> Runner<'a> {
             threads: threads(threads_asked),
             stop,
             progress: &|_| {},
-            chunks: Chunks::All,
+            share: ChunkShare::All,
         }
     }
 
-    /// The same runner, rolling only the chunks `chunks` gives it.
-    pub fn with_chunks(self, chunks: Chunks) -> Runner<'a> {
-        Runner { chunks, ..self }
+    /// The same runner, rolling only its share of the chunks.
+    pub fn with_share(self, share: ChunkShare) -> Runner<'a> {
+        Runner { share, ..self }
     }
 
     /// Opens a cell's checkpoint directory for `spec` (see [`Checkpoint::open_fresh`]). A
     /// task of a cluster run shares the directory with the other tasks: it takes a lock of its
     /// own, and refuses, rather than empties, a directory holding another run.
     pub fn open_cell(&self, dir: &Path, spec: &RunSpec) -> Result<Checkpoint> {
-        match &self.chunks {
-            Chunks::Task { k, .. } => Checkpoint::open_as(dir, spec, &format!("lock-task-{k}")),
+        match &self.share {
+            ChunkShare::Task { k, .. } => Checkpoint::open_as(dir, spec, &format!("lock-task-{k}")),
             _ => Checkpoint::open_fresh(dir, spec),
         }
     }
@@ -157,7 +145,7 @@ impl<'a> Runner<'a> {
             threads: self.threads,
             stop: self.stop.clone(),
             progress,
-            chunks: self.chunks.clone(),
+            share: self.share.clone(),
         }
     }
 
@@ -172,42 +160,43 @@ impl<'a> Runner<'a> {
         spec: &RunSpec,
         checkpoint: Option<&Checkpoint>,
         sink: &mut dyn FnMut(&[RollRecord]) -> Result<()>,
-    ) -> Result<Chunked> {
-        let all = 0..spec.indices().len().div_ceil(CHUNK);
-        self.run_chunks(spec, checkpoint, all, sink)
+    ) -> Result<Rolled> {
+        let all = 0..spec.indices().len().div_ceil(CHUNK_ROLLS);
+        self.run_range(spec, checkpoint, all, sink)
     }
 
-    /// `run`, over the chunks `chunks` only (chunk c holds the run's throws c·CHUNK onwards):
-    /// a run whose `rolls` is a large fixed cap is then one keyed throw stream, rolled a
-    /// prefix at a time into one checkpoint whose key does not change as the prefix grows
-    /// (`studies::sweep::Stream`). `complete` means every chunk in `chunks` was rolled.
-    pub fn run_chunks(
+    /// `run`, over the chunks in `range` only (chunk c holds the run's throws c·CHUNK_ROLLS
+    /// onwards): a run whose `rolls` is a large fixed cap is then one keyed throw stream,
+    /// rolled a prefix at a time into one checkpoint whose key does not change as the prefix
+    /// grows (`studies::stream::Stream`). `complete` means every chunk in `range` was rolled.
+    pub fn run_range(
         &self,
         spec: &RunSpec,
         checkpoint: Option<&Checkpoint>,
-        chunks: std::ops::Range<u64>,
+        range: std::ops::Range<u64>,
         sink: &mut dyn FnMut(&[RollRecord]) -> Result<()>,
-    ) -> Result<Chunked> {
+    ) -> Result<Rolled> {
         let indices = spec.indices();
-        let end = chunks.end.min(indices.len().div_ceil(CHUNK));
-        let throws = spec
-            .throws
-            .source(spec.rolls.min(end.saturating_mul(CHUNK) * indices.n.max(1)));
+        let end = range.end.min(indices.len().div_ceil(CHUNK_ROLLS));
+        let throws = spec.throws.source(
+            spec.rolls
+                .min(end.saturating_mul(CHUNK_ROLLS) * indices.n.max(1)),
+        );
         let key = spec.key();
-        let mut done = Chunked {
+        let mut done = Rolled {
             tally: Tally::default(),
             complete: false,
             resumed: 0,
             resumed_cpu_s: 0.0,
             resumed_wall_s: 0.0,
         };
-        if let Chunks::DryRun = self.chunks {
+        if let ChunkShare::DryRun = self.share {
             return Ok(done);
         }
-        for c in chunks.start..end {
-            let chunk = indices.chunk(c, CHUNK);
+        for c in range.start..end {
+            let chunk = indices.chunk(c, CHUNK_ROLLS);
             let path = checkpoint.map(|d| d.chunk_path(chunk[0], chunk.len()));
-            if !self.chunks.take_next() {
+            if !self.share.take_next() {
                 continue;
             }
             if let Some(p) = path.as_ref().filter(|p| p.exists()) {
@@ -220,7 +209,7 @@ impl<'a> Runner<'a> {
                 (self.progress)(done.tally.rolls);
                 continue;
             }
-            if let Chunks::Assemble = self.chunks {
+            if let ChunkShare::Assemble = self.share {
                 let first = chunk[0];
                 return Err(Error::Failed(format!(
                     "{}: throws {first}.. ({} of them) were never rolled; the task that rolls \
@@ -344,7 +333,7 @@ impl Checkpoint {
         }
         if Checkpoint::spec_in(dir)? != *spec {
             return Err(Error::Mismatch(format!(
-                "checkpoint {}: it holds another run; resume that with --resume, or use a new directory",
+                "checkpoint {}: it holds another run; resume that run, or use a new directory",
                 dir.display()
             )));
         }

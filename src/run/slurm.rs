@@ -9,14 +9,16 @@
 //! or resubmitted continues from its last whole chunk, and no command line is ever re-parsed.
 //!
 //! A study of several cells (`paper`, `crosscheck`, `converge`, `tradeoff`, `stability`) is
-//! split chunk by chunk instead ([`crate::run::runner::Chunks`]): task K runs the command with
-//! its share of the chunks, into the checkpoint directories under `DIR` that all tasks share,
-//! and marks itself done in `DIR/tasks/`; the finishing job runs the very command once more,
-//! rolling nothing, and writes its outputs into `DIR` exactly as one machine would.
+//! split chunk by chunk instead ([`crate::run::runner::ChunkShare`]): the plan holds the
+//! study's configuration, serialized; task K runs the study from it with its share of the
+//! chunks, into the checkpoint directories under `DIR` that all tasks share, and marks itself
+//! done in `DIR/tasks/`; the finishing job runs the very study once more, rolling nothing, and
+//! writes its outputs into `DIR` exactly as one machine would.
 //!
 //! This module writes the scripts; it never calls the scheduler.
 
 use crate::error::{Error, Result};
+use crate::run::io::Output;
 use crate::run::spec::{RunSpec, Shard};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -35,12 +37,15 @@ pub enum Plan {
         /// Array tasks, one shard each.
         tasks: u64,
     },
-    /// A study of several cells: `dicephys ARGS`, its chunks shared among the tasks.
+    /// A study of several cells, its chunks shared among the tasks.
     Study {
-        /// The command line after `dicephys`, as given (without the scheduler's options);
-        /// the tasks and the finishing job parse it again, then write into the run's
-        /// directory and take `threads` threads.
-        args: Vec<String>,
+        /// The study's configuration, serialized (`studies::StudyConfig`, tagged by the
+        /// study's name): each task, and the finishing job, runs the library's study from it.
+        config: serde_json::Value,
+        /// Print the study's JSON result rather than its report (`--json`).
+        json: bool,
+        /// The command line it was submitted with, named in the report (never parsed).
+        command_line: String,
         /// Threads per task (each task's `--cpus-per-task`).
         threads: usize,
         /// Array tasks.
@@ -60,8 +65,33 @@ impl Plan {
     pub fn command(&self) -> &str {
         match self {
             Plan::Roll { .. } => "roll",
-            Plan::Study { args, .. } => args.first().map_or("study", String::as_str),
+            Plan::Study { config, .. } => config
+                .get("study")
+                .and_then(serde_json::Value::as_str)
+                .unwrap_or("study"),
         }
+    }
+
+    /// True if `other` is this very run (the command line it was submitted with aside: the
+    /// scripts may be printed first, then submitted).
+    pub fn same_run(&self, other: &Plan) -> bool {
+        let bare = |p: &Plan| match p {
+            Plan::Study {
+                config,
+                json,
+                threads,
+                tasks,
+                ..
+            } => Plan::Study {
+                config: config.clone(),
+                json: *json,
+                command_line: String::new(),
+                threads: *threads,
+                tasks: *tasks,
+            },
+            roll => roll.clone(),
+        };
+        bare(self) == bare(other)
     }
 
     /// Task `k`'s share of a `roll`: the same run with shard k/N.
@@ -76,15 +106,18 @@ impl Plan {
     pub fn validate(&self) -> Result<()> {
         let n = self.tasks();
         if n == 0 || n > MAX_TASKS {
-            return Err(Error::Invalid(format!(
-                "--tasks {n}: need 1 to {MAX_TASKS} tasks"
-            )));
+            return Err(Error::field(
+                "tasks",
+                n,
+                format!("need 1 to {MAX_TASKS} tasks"),
+            ));
         }
         match self {
-            Plan::Roll { spec, .. } if n > spec.rolls => Err(Error::Invalid(format!(
-                "--tasks {n}: more tasks than the run's {} rolls",
-                spec.rolls
-            ))),
+            Plan::Roll { spec, .. } if n > spec.rolls => Err(Error::field(
+                "tasks",
+                n,
+                format!("more tasks than the run's {} rolls", spec.rolls),
+            )),
             _ => Ok(()),
         }
     }
@@ -98,6 +131,111 @@ pub struct Layout {
 }
 
 impl Layout {
+    /// The run's directory `dir`, made if need be, by its absolute path (the scripts run on
+    /// other nodes).
+    pub fn create(dir: &Path) -> Result<Layout> {
+        let bad = |e: std::io::Error| Error::field("dir", dir.display(), e.to_string());
+        std::fs::create_dir_all(dir).map_err(bad)?;
+        Ok(Layout {
+            dir: dir.canonicalize().map_err(bad)?,
+        })
+    }
+
+    /// Writes the two scripts (`array_script`, `finish_script`) whole; returns their text.
+    pub fn write_scripts(&self, plan: &Plan, opt: &Options, bin: &Path) -> Result<[String; 2]> {
+        let array = array_script(plan, self, opt, bin)?;
+        let fin = finish_script(plan, self, opt, bin)?;
+        Output::check(&self.array_script())?.write(array.as_bytes())?;
+        Output::check(&self.finish_script())?.write(fin.as_bytes())?;
+        Ok([array, fin])
+    }
+
+    /// Stores `plan` in the run's directory, or checks that the directory holds this very run;
+    /// makes the logs' directory.
+    pub fn store(&self, plan: &Plan) -> Result<()> {
+        std::fs::create_dir_all(self.logs()).map_err(|e| Error::io(&self.logs(), e))?;
+        match self.read_plan() {
+            Ok(stored) if stored.same_run(plan) => Ok(()),
+            Ok(_) => Err(Error::Mismatch(format!(
+                "{}: it holds another Slurm run ({}); use a new directory",
+                self.dir.display(),
+                self.plan().display()
+            ))),
+            Err(_) if !self.plan().exists() => {
+                let json =
+                    serde_json::to_string_pretty(plan).map_err(|e| Error::Failed(e.to_string()))?;
+                Output::check(&self.plan())?.write(format!("{json}\n").as_bytes())
+            }
+            Err(e) => Err(e),
+        }
+    }
+
+    /// The plan stored in the run's directory.
+    pub fn read_plan(&self) -> Result<Plan> {
+        let p = self.plan();
+        let text = std::fs::read_to_string(&p).map_err(|e| {
+            Error::Invalid(format!(
+                "{}: not a `dicephys slurm` run directory ({}: {e})",
+                self.dir.display(),
+                p.display()
+            ))
+        })?;
+        serde_json::from_str(&text)
+            .map_err(|e| Error::Invalid(format!("{} is damaged ({e})", p.display())))
+    }
+
+    /// The finishing job's refusal: which of the `tasks` have not finished (`missing`, and
+    /// `why`), and how to finish them.
+    pub fn not_finished(&self, tasks: u64, missing: &[String], why: &str) -> Error {
+        Error::Failed(format!(
+            "slurm finish: {} of {tasks} tasks have not finished: {} ({why}); \
+             rerun them with `sbatch --array={} {}` (each resumes from its checkpoint), \
+             then `sbatch {}`",
+            missing.len(),
+            missing.join(", "),
+            missing.join(","),
+            self.array_script().display(),
+            self.finish_script().display()
+        ))
+    }
+
+    /// A study's tasks that have not marked themselves done, or the finishing job's refusal.
+    pub fn check_marks(&self, tasks: u64) -> Result<()> {
+        let missing: Vec<String> = (0..tasks)
+            .filter(|&k| !self.task_done(k).exists())
+            .map(|k| k.to_string())
+            .collect();
+        if missing.is_empty() {
+            Ok(())
+        } else {
+            Err(self.not_finished(tasks, &missing, "no mark in tasks/"))
+        }
+    }
+
+    /// Where the finishing job puts the result, for the user.
+    pub fn result_of(&self, plan: &Plan) -> String {
+        match plan {
+            Plan::Roll { .. } => self.result_json().display().to_string(),
+            Plan::Study { .. } => format!(
+                "{} (the {} outputs; its printed report in {})",
+                self.dir.display(),
+                plan.command(),
+                self.stdout().display()
+            ),
+        }
+    }
+
+    /// How to submit the two scripts by hand, as shell comments.
+    pub fn instructions(&self, plan: &Plan) -> String {
+        let (a, f) = (self.array_script(), self.finish_script());
+        format!(
+            "# submit with:\n#   jid=$(sbatch --parsable {})\n#   sbatch --dependency=afterany:${{jid%%;*}} {}\n# result: {}\n",
+            quote(&a.to_string_lossy()),
+            quote(&f.to_string_lossy()),
+            self.result_of(plan)
+        )
+    }
+
     /// The plan, `slurm.json`.
     pub fn plan(&self) -> PathBuf {
         self.dir.join("slurm.json")
@@ -172,9 +310,11 @@ impl Options {
         ] {
             if let Some(v) = v {
                 if v.is_empty() || v.chars().any(|c| c.is_whitespace() || c.is_control()) {
-                    return Err(Error::Invalid(format!(
-                        "--{name} '{v}': one word without spaces"
-                    )));
+                    return Err(Error::field(
+                        name,
+                        format!("'{v}'"),
+                        "one word without spaces",
+                    ));
                 }
             }
         }

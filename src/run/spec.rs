@@ -89,16 +89,19 @@ impl ThrowSpec {
             }
         }
         if self.kind == ThrowKind::Dicephys && !self.style.is_paper() {
-            return Err(Error::Invalid(format!(
-                "--throw {}: the dicephys throw source draws the paper's throw only; use --throws keyed",
-                self.style
-            )));
+            return Err(Error::field(
+                "style",
+                self.style,
+                "the dicephys throw source draws the paper's throw only; use the keyed throws \
+                 (`kind` keyed)",
+            ));
         }
         if self.kind == ThrowKind::Dicephys && self.seed > u32::MAX as u64 {
-            return Err(Error::Invalid(format!(
-                "--seed {}: the dicephys throw source takes a 32-bit seed (srand)",
-                self.seed
-            )));
+            return Err(Error::field(
+                "seed",
+                self.seed,
+                "the dicephys throw source takes a 32-bit seed (srand)",
+            ));
         }
         Ok(())
     }
@@ -171,13 +174,14 @@ impl RunSpec {
         self.throws.validate()?;
         self.roll.validate()?;
         if self.rolls == 0 {
-            return Err(Error::Invalid("--rolls 0: need at least one roll".into()));
+            return Err(Error::field("rolls", 0, "need at least one roll"));
         }
         if self.rolls > MAX_ROLLS {
-            return Err(Error::Invalid(format!(
-                "--rolls {}: at most {MAX_ROLLS}",
-                self.rolls
-            )));
+            return Err(Error::field(
+                "rolls",
+                self.rolls,
+                format!("at most {MAX_ROLLS}"),
+            ));
         }
         if let Some(s) = self.shard {
             s.validate()?;

@@ -65,7 +65,7 @@ impl Certificate {
         // potential energy than it will once the engine has pushed it back out: count it at
         // the height it will be pushed back to, its lowest point on the floor's top face.
         // Without this the certificate fired on dips and was wrong on up to 3 % of rolls at
-        // dt = 1/60 (README, "Coarse time steps").
+        // dt = 1/60 (docs/results/coarse-steps.md).
         let sunk = (-(s.position.y - up.abs().dot(&die.half))).max(0.0);
         let g = die.gravity;
         if s.position.y + sunk + 0.5 * s.linear_velocity.norm_squared() / g - rest >= allowed {

@@ -144,13 +144,14 @@ pub struct RollConfig {
     pub fast_flight: bool,
 }
 
-/// The certificate's default margin: measured to be never wrong (see README, "Speed").
+/// The certificate's default margin: measured to be never wrong (docs/method.md, "The
+/// certificate").
 pub const DEFAULT_MARGIN: f64 = 0.1;
 
 /// The coarsest time step at which the early stop is on by default, s (1/250). Audited with
 /// the default margin on 20,000 throws of each MDF block, 2D and 3D: never wrong at 1/1000,
 /// 1/500 and 1/250; wrong on 23 of 200,000 rolls at 1/120 and 712 at 1/60, where a contact
-/// step can inject more energy than the margin (README, "Coarse time steps").
+/// step can inject more energy than the margin (docs/results/coarse-steps.md).
 pub const EARLY_STOP_MAX_DT: f64 = 0.004;
 
 /// True if the early stop is audited exact at this time step (`EARLY_STOP_MAX_DT`).
@@ -175,15 +176,17 @@ impl RollConfig {
 
     /// Checks every value before anything runs.
     pub fn validate(&self) -> crate::Result<()> {
-        let bad = |m: String| Err(crate::Error::Invalid(m));
+        use crate::Error;
         if self.max_steps == 0 {
-            return bad("--max-steps 0: need at least one step".into());
+            return Err(Error::field("max_steps", 0, "need at least one step"));
         }
         if !(self.margin.is_finite() && (0.0..1.0).contains(&self.margin)) {
-            return bad(format!("--margin {}: must be in [0, 1)", self.margin));
+            return Err(Error::field("margin", self.margin, "must be in [0, 1)"));
         }
         if self.audit && self.rule == Rule::Certificate {
-            return bad("an audit settles fully: it needs the dicephys rule".into());
+            return Err(Error::Invalid(
+                "an audit settles fully: it needs the dicephys rule".into(),
+            ));
         }
         Ok(())
     }
@@ -224,10 +227,10 @@ pub fn check(s: &BodyState, die: &DieShape, dip: &Dip, floor_bottom: f64) -> Opt
 /// the roll counts as gone through. An engine pushes a die out of the floor over some steps:
 /// Bullet's split impulse takes a fifth of the penetration a step while gravity pulls the die
 /// back by g·dt² (1.1 cm a step at 1/30 s), so a thin block landing flat at a coarse step can
-/// sit with its centre under the top face for a while and still come out. Measured (README,
-/// "Coarse time steps"): the longest dip that recovered was 19 steps at dt = 1/60 and 39 at 1/30
-/// (Bullet, e = 0, 140x30x10), 74 in a 5 m/s drop at dt = 0.1; Rapier's, 8. One that did not
-/// lasted 19,912 steps, to the cap.
+/// sit with its centre under the top face for a while and still come out. Measured
+/// (docs/results/coarse-steps.md): the longest dip that recovered was 19 steps at dt = 1/60
+/// and 39 at 1/30 (Bullet, e = 0, 140x30x10), 74 in a 5 m/s drop at dt = 0.1; Rapier's, 8.
+/// One that did not lasted 19,912 steps, to the cap.
 /// A die that stays under longer than this is held inside the floor or falling beneath it.
 pub const MAX_DIP_STEPS: u64 = 100;
 
@@ -275,7 +278,8 @@ impl Dip {
     ///
     /// Wholly below the *top* face is not enough: at dt = 1/60 a thin block landing flat
     /// falls 4-5 cm in one step, ends it entirely inside DicePhys's box floor, and Bullet
-    /// pushes it back out (8,947 of 20,000 rolls of 140x27x13 in 2D; README, "Coarse time steps").
+    /// pushes it back out (8,947 of 20,000 rolls of 140x27x13 in 2D;
+    /// docs/results/coarse-steps.md).
     /// A die at rest with its centre below the top face is a failure too (`run_from`).
     pub fn through(&self, die: &DieShape, s: &BodyState, floor_bottom: f64) -> bool {
         let reach = s.position.y - crate::model::die::lowest_point(&die.half, s);

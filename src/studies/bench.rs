@@ -58,7 +58,7 @@ pub struct Method {
     pub rule: Rule,
     /// Free flight integrated in closed form.
     pub fast_flight: bool,
-    /// Shown by a cross-check at >= 20,000 rolls not to change the result (README, Speed);
+    /// Shown by a cross-check at >= 20,000 rolls not to change the result (docs/method.md);
     /// only such methods can be the benchmark's verdict.
     pub proven: bool,
 }
@@ -78,7 +78,7 @@ impl Method {
             floor,
             rule,
             fast_flight,
-            // The plane floor changes the contact and so the result (measured: README).
+            // The plane floor changes the contact and so the result (measured: docs/method.md).
             proven: floor == Floor::Box,
         }
     }

@@ -81,14 +81,24 @@ pub fn models(rows: &[DataRow]) -> Vec<(&'static str, &'static str, ModelSpec, V
         })
         .collect();
     vec![
-        ("hand", "e and μ per surface; a hand's throw, κ free", hand.clone(), rows.to_vec()),
+        (
+            "hand",
+            "e and μ per surface; a hand's throw, κ free",
+            hand.clone(),
+            rows.to_vec(),
+        ),
         (
             "paper-throw",
             "e and μ per surface; the paper's throw (κ → ∞)",
             paper_throw,
             rows.to_vec(),
         ),
-        ("shared", "one e and one μ for every surface; κ free", shared, rows.to_vec()),
+        (
+            "shared",
+            "one e and one μ for every surface; κ free",
+            shared,
+            rows.to_vec(),
+        ),
         (
             "long-2d",
             "as hand, the long pine blocks (≥ 300 mm) in 2D",
@@ -138,7 +148,13 @@ fn gain(simple: &[LooRow], rich: &[LooRow], sides: bool) -> (f64, f64) {
     (d.iter().sum(), (n * var).sqrt())
 }
 
-fn verdict(question: &str, simpler: &str, richer: &str, g: (f64, f64), lr: Option<(f64, usize, f64)>) -> Decision {
+fn verdict(
+    question: &str,
+    simpler: &str,
+    richer: &str,
+    g: (f64, f64),
+    lr: Option<(f64, usize, f64)>,
+) -> Decision {
     let (gain, err) = g;
     let text = if gain > 2.0 * err {
         format!("{richer} predicts the rows it did not see better (log score +{gain:.1} ± {err:.1}): it earns its place")
@@ -208,7 +224,13 @@ pub fn run(
     let models: Vec<ModelScore> = fits
         .iter()
         .map(|(name, description, f, loo)| {
-            ModelScore::of(name, description, f.params.len(), f.estimate.minus_two_ln_l, loo)
+            ModelScore::of(
+                name,
+                description,
+                f.params.len(),
+                f.estimate.minus_two_ln_l,
+                loo,
+            )
         })
         .collect();
     let by = |name: &str| fits.iter().position(|f| f.0 == name).expect("model");

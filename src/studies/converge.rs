@@ -6,19 +6,26 @@
 //! Rolls end by DicePhys's own rule with every step stepped (no early stop, no closed-form
 //! flight): this is a study of the integrator, so nothing else may change with dt.
 
-use super::sweep::{
-    cell_spec, departure, dt_label, measure, paired_departure, plan_cpu, resolve_departure,
-    resolve_reference, rolls_for_ratio, rolls_to_resolve, Departure, Stream, Study, ONE_PERCENT,
+use super::departure::{
+    paired_departure, rolls_for_one_percent, rolls_for_ratio, unpaired_departure, Departure,
 };
+use super::precision::{plan_cpu, resolve_departure, resolve_reference};
+use super::stream::Stream;
+use super::sweep::{
+    cell_spec, check_budget, check_rolls_and_steps, measure, nonempty, Measured, ONE_PERCENT,
+};
+use super::{Progress, Study};
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::scene::{Mode, Scene};
-use crate::report::text::{left, right, Columns};
+use crate::report::converge::{format_cell, Cell, Claim, Converge};
+use crate::report::text::dt_label;
 use crate::sim::roll::{RollConfig, Rule};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// What the convergence test runs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Config {
     /// The blocks.
     pub blocks: Vec<Block>,
@@ -36,48 +43,13 @@ pub struct Config {
     /// one keyed stream until its 2σ is at most this (a fraction), the finest to half of it;
     /// `rolls` is then ignored.
     pub precision: Option<f64>,
-    /// With `precision`: CPU seconds a cell may spend, and the finest dt's cell.
-    pub budget_s: (f64, f64),
+    /// With `precision`: CPU seconds a cell may spend.
+    pub budget_s: f64,
+    /// With `precision`: CPU seconds the finest dt's cell may spend.
+    pub reference_budget_s: f64,
     /// Roll with the exact levers (early stop, closed-form flight) instead of DicePhys's rule
     /// with every step stepped.
     pub fast: bool,
-}
-
-/// One cell: a block, an engine, 2D or 3D, a dt.
-#[derive(Clone, Debug, Serialize)]
-pub struct Cell {
-    /// The block, `LxBxW` in mm.
-    pub block: String,
-    /// The engine's name.
-    pub engine: String,
-    /// "3d" or "2d".
-    pub mode: String,
-    /// The time step, s.
-    pub dt: f64,
-    /// Rolls made.
-    pub rolls: u64,
-    /// N(breadth vertical)/N(width vertical).
-    pub ratio: f64,
-    /// Its binomial error.
-    pub ratio_err: f64,
-    /// Simulated steps per roll.
-    pub steps_per_roll: f64,
-    /// Process CPU seconds per roll, all threads.
-    pub cpu_s_per_roll: f64,
-    /// Rolls not at rest at the step cap.
-    pub unconverged: u64,
-    /// Rolls that failed, for any reason.
-    pub failed: u64,
-    /// Rolls in which the engine injected energy.
-    pub energy_gain: u64,
-    /// ratio / ratio at the finest dt − 1.
-    pub departure: f64,
-    /// Its error (with `--precision`: paired on the shared throws).
-    pub departure_err: f64,
-    /// With `--precision`: 2σ of the departure (of the finest dt: of its own ratio, to half
-    /// the precision) is within the precision.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub resolved: Option<bool>,
 }
 
 impl Cell {
@@ -87,7 +59,7 @@ impl Cell {
         engine: EngineKind,
         mode: Mode,
         dt: f64,
-        m: &super::sweep::Measured,
+        m: &Measured,
         (departure, departure_err): (f64, f64),
         resolved: Option<bool>,
     ) -> Cell {
@@ -110,35 +82,6 @@ impl Cell {
             resolved,
         }
     }
-}
-
-/// The paper's claim for one block × engine × mode.
-#[derive(Clone, Debug, Serialize)]
-pub struct Claim {
-    /// The block, `LxBxW` in mm.
-    pub block: String,
-    /// The engine's name.
-    pub engine: String,
-    /// "3d" or "2d".
-    pub mode: String,
-    /// The dt the claim is about (`CLAIM_DT`), s.
-    pub dt: f64,
-    /// The finest dt of the run, the reference, s.
-    pub dt_finest: f64,
-    /// The ratio at `dt` over the ratio at `dt_finest`, − 1.
-    pub departure: f64,
-    /// Its error.
-    pub departure_err: f64,
-    /// 2σ of the departure is at most 1 %.
-    pub resolved: bool,
-    /// The claim decided at 2σ (`decide`): yes if resolved and |departure| ≤ 1 %; no if
-    /// resolved and beyond 1 %, or if even |departure| − 2σ > 1 %; else open.
-    pub within_one_percent: Option<bool>,
-    /// Rolls per cell for 2σ = 1 % (with `--precision`: both cells at that count, on the
-    /// same throws).
-    pub rolls_needed: Option<u64>,
-    /// Rolls at `dt` and at `dt_finest` (equal without `--precision`).
-    pub rolls: (u64, u64),
 }
 
 impl Claim {
@@ -167,27 +110,16 @@ impl Claim {
     }
 }
 
-/// The convergence test's results.
-#[derive(Clone, Debug, Serialize)]
-pub struct Converge {
-    /// How rolls end, in words.
-    pub settle: String,
-    /// Rolls per cell.
-    pub rolls: u64,
-    /// The throws' seed.
-    pub seed: u64,
-    /// The time steps run, coarse to fine, s.
-    pub dts: Vec<f64>,
-    /// The step cap per roll.
-    pub max_steps: u64,
-    /// Every cell: by block, engine, 3D then 2D, then dt.
-    pub cells: Vec<Cell>,
-    /// The paper's claim per block × engine × mode; none without dt = 0.001 s and a finer one.
-    pub claims: Vec<Claim>,
-    /// Every claim resolved.
-    pub resolved: bool,
-    /// Plain words: does the run resolve the paper's claim, and if not, what would.
-    pub verdict: String,
+impl Config {
+    /// Checks every value before anything runs.
+    pub fn validate(&self) -> Result<()> {
+        nonempty(&self.blocks, "blocks")?;
+        nonempty(&self.dts, "dts")?;
+        nonempty(&self.engines, "engines")?;
+        check_rolls_and_steps(self.rolls, self.max_steps)?;
+        check_budget(self.budget_s, "budget_s")?;
+        check_budget(self.reference_budget_s, "reference_budget_s")
+    }
 }
 
 /// The dt the paper's claim is about.
@@ -198,8 +130,9 @@ pub fn run(
     cfg: &Config,
     study: &Study,
     log: &dyn Fn(&str),
-    progress: super::tradeoff::Progress,
+    progress: Progress,
 ) -> Result<Converge> {
+    cfg.validate()?;
     let mut dts = cfg.dts.clone();
     dts.sort_by(|a, b| b.total_cmp(a));
     dts.dedup();
@@ -212,6 +145,8 @@ pub fn run(
     let settle = settle(cfg, finest);
     let mut cells = Vec::new();
     let mut claims = Vec::new();
+    // Progress in cells.
+    let total = (cfg.blocks.len() * cfg.engines.len() * 2 * dts.len()) as f64;
     for block in &cfg.blocks {
         for &engine in &cfg.engines {
             for mode in [Mode::ThreeD, Mode::TwoD] {
@@ -224,6 +159,7 @@ pub fn run(
                         study,
                     )?;
                     row.push((dt, m));
+                    progress((cells.len() + row.len()) as f64, total);
                 }
                 let reference = row
                     .last()
@@ -231,7 +167,7 @@ pub fn run(
                     .ok_or_else(|| Error::Invalid("no dt given".into()))?;
                 for (dt, m) in &row {
                     let r = m.ratio();
-                    let (d, d_err) = departure(r, reference);
+                    let (d, d_err) = unpaired_departure(r, reference);
                     let cell = Cell::of(block, engine, mode, *dt, m, (d, d_err), None);
                     log(&format_cell(&cell));
                     if (dt - CLAIM_DT).abs() < 1e-12 && *dt > finest {
@@ -239,7 +175,7 @@ pub fn run(
                             &cell,
                             finest,
                             (d, d_err),
-                            rolls_to_resolve(d_err, cfg.rolls),
+                            rolls_for_one_percent(d_err, cfg.rolls),
                             (cfg.rolls, cfg.rolls),
                         ));
                     }
@@ -300,7 +236,7 @@ fn run_resolved(
     dts: &[f64],
     study: &Study,
     log: &dyn Fn(&str),
-    progress: super::tradeoff::Progress,
+    progress: Progress,
 ) -> Result<Converge> {
     let finest = *dts
         .last()
@@ -335,7 +271,11 @@ fn run_resolved(
             .iter()
             .map(|g| g.3.iter().map(|(_, s)| s).collect())
             .collect();
-        let total = plan_cpu(&plan, precision, Some((cfg.budget_s.1, cfg.budget_s.0)));
+        let total = plan_cpu(
+            &plan,
+            precision,
+            Some((cfg.reference_budget_s, cfg.budget_s)),
+        );
         log(&format!(
             "plan: the pilot took {spent:.0} CPU s; ±{:.2} % (2σ) takes about {total:.0} CPU s \
              more within the budgets, {:.0} without; ±1 % {:.0} CPU s",
@@ -353,13 +293,17 @@ fn run_resolved(
         let (reference, rest) = streams.split_first_mut().expect("a dt is given");
         let before = reference.1.cpu_s;
         let base = done;
-        resolve_reference(&mut reference.1, precision, cfg.budget_s.1, study, &|c| {
-            progress(base + c, total)
-        })?;
+        resolve_reference(
+            &mut reference.1,
+            precision,
+            cfg.reference_budget_s,
+            study,
+            &|c| progress(base + c, total),
+        )?;
         done += reference.1.cpu_s - before;
         for (_, s) in rest.iter_mut() {
             let (base, before) = (done, s.cpu_s);
-            resolve_departure(s, &reference.1, precision, cfg.budget_s.0, study, &|c| {
+            resolve_departure(s, &reference.1, precision, cfg.budget_s, study, &|c| {
                 progress(base + c, total)
             })?;
             done += s.cpu_s - before;
@@ -407,8 +351,8 @@ fn run_resolved(
         &format!(
             "rolled to ±{:.2} % (2σ) within the budgets ({} and {} CPU s a cell)",
             100.0 * precision,
-            cfg.budget_s.0,
-            cfg.budget_s.1
+            cfg.budget_s,
+            cfg.reference_budget_s
         ),
     );
     Ok(Converge {
@@ -501,47 +445,6 @@ fn verdict(claims: &[Claim], finest: f64, how: &str) -> String {
         )
     }
 }
-
-/// The column heads of the log's cell lines (`format_cell`).
-pub fn header() -> String {
-    TABLE.header()
-}
-
-/// One cell as a line of the log, under `header`.
-pub fn format_cell(c: &Cell) -> String {
-    TABLE.row(&[
-        c.block.clone(),
-        c.engine.to_string(),
-        c.mode.to_string(),
-        dt_label(c.dt),
-        format!("{:.4} ± {:.4}", c.ratio, c.ratio_err),
-        format!("{:.0}", c.steps_per_roll),
-        format!("{:.5}", c.cpu_s_per_roll),
-        format!(
-            "{:+.1} ± {:.1} %",
-            100.0 * c.departure,
-            100.0 * c.departure_err
-        ),
-        c.unconverged.to_string(),
-        c.failed.to_string(),
-        c.energy_gain.to_string(),
-    ])
-}
-
-/// The columns of the log and of report.md.
-const TABLE: Columns = Columns(&[
-    left("block", 10),
-    left("engine", 13),
-    right("mode", 4),
-    right("dt", 8),
-    right("ratio", 17),
-    right("steps", 8),
-    right("CPU s/roll", 10),
-    right("vs finest dt", 18),
-    right("unconv", 6),
-    right("failed", 6),
-    right("gain", 5),
-]);
 
 /// The paper's claim for one departure d ± err (1σ), at 2σ: `Some(true)` if 2σ ≤ 1 % and
 /// |d| ≤ 1 %; `Some(false)` if 2σ ≤ 1 % and |d| > 1 %, or if |d| − 2σ > 1 % (the interval

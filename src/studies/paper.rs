@@ -11,16 +11,15 @@ use crate::report::paper::{PaperResults, Provenance, SimCell};
 use crate::report::summary::{Cost, RunSummary};
 use crate::report::table::{table_report, TableReport};
 use crate::run::cputime::process_cpu_seconds;
-use crate::run::runner::Runner;
 use crate::run::spec::{RunSpec, ThrowSpec};
 use crate::sim::roll::{early_stop_exact, RollConfig, Rule};
+use crate::studies::Study;
 use crate::theory::stats;
-use serde::Serialize;
-use std::path::Path;
+use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
 /// What to simulate.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PaperConfig {
     /// Rolls per cell.
     pub rolls: u64,
@@ -55,7 +54,7 @@ impl PaperConfig {
     pub fn validate(&self) -> Result<()> {
         use crate::error::Error;
         if self.engines.is_empty() {
-            return Err(Error::Invalid("--engines: name at least one engine".into()));
+            return Err(Error::field("engines", "", "name at least one engine"));
         }
         let mut scene = Scene::paper(Block::from_mm(140.0, 24.0, 20.0)?, Mode::ThreeD);
         scene.dt = self.dt;
@@ -101,12 +100,9 @@ pub fn total_rolls(cfg: &PaperConfig) -> Result<u64> {
 
 /// Runs every simulated cell. The runner's `progress` gets the rolls finished so far, over all
 /// cells.
-pub fn run(
-    cfg: &PaperConfig,
-    command_line: String,
-    runner: &Runner,
-    checkpoint_dir: Option<&Path>,
-) -> Result<PaperResults> {
+pub fn run(cfg: &PaperConfig, command_line: String, study: &Study) -> Result<PaperResults> {
+    cfg.validate()?;
+    let runner = &study.runner;
     let mut partial = false;
     let table = table_report()?;
     let settle = cfg.roll();
@@ -133,7 +129,7 @@ pub fn run(
                     shard: None,
                 };
                 let ck =
-                    match checkpoint_dir {
+                    match &study.checkpoint {
                         Some(d) => Some(runner.open_cell(
                             &d.join(format!("row{row}-{engine}-{}", mode.name())),
                             &spec,

@@ -8,16 +8,18 @@
 //! its binomial standard error (`Cell::err`); the default rolls per cell make a 0 mean below
 //! 1 % at 95 %.
 
-use super::sweep::{cell_spec, measure, Study};
+use super::sweep::{cell_spec, check_rolls_and_steps, measure, nonempty};
+use super::{Progress, Study};
 use crate::engine::EngineKind;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::block::Block;
-use crate::model::scene::{Mode, Scene};
-use crate::report::text::{left, right, Columns};
+use crate::model::scene::{Mode, Scene, DICEPHYS_FLOOR_THICKNESS};
+use crate::report::stability::{format_cell, Cell, Stability, Sweep, KINDS};
 use crate::sim::roll::{Failure, RollConfig, Rule};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// What the stability sweeps run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Config {
     /// The engines.
     pub engines: Vec<EngineKind>,
@@ -40,141 +42,40 @@ pub struct Config {
     pub floor_thickness: f64,
 }
 
-/// The failure kinds, in the order of the figures and tables.
-pub const KINDS: [&str; 6] = [
-    "unconverged",
-    "unknown",
-    "non_finite",
-    "tunnelled",
-    "energy_gain",
-    "dipped",
-];
-
-/// Which sweep a cell belongs to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, strum::Display, strum::IntoStaticStr)]
-#[serde(rename_all = "snake_case")]
-#[strum(serialize_all = "snake_case")]
-pub enum Sweep {
-    /// The grid of time step against restitution.
-    DtRestitution,
-    /// The line over friction.
-    Friction,
-    /// The line over the block's aspect ratios.
-    Aspect,
-}
-
-/// One measured cell.
-#[derive(Clone, Debug, Serialize)]
-pub struct Cell {
-    /// The grid or line the cell is on.
-    pub sweep: Sweep,
-    /// The engine.
-    pub engine: EngineKind,
-    /// 2D or 3D.
-    pub mode: Mode,
-    /// The block, `LxBxW` in mm.
-    pub block: String,
-    /// breadth/width.
-    pub breadth_over_width: f64,
-    /// length/breadth.
-    pub length_over_breadth: f64,
-    /// The time step, s.
-    pub dt: f64,
-    /// The contact's restitution e.
-    pub restitution: f64,
-    /// The contact's friction μ.
-    pub friction: f64,
-    /// Rolls made.
-    pub rolls: u64,
-    /// Fraction of rolls not at rest at the step cap.
-    pub unconverged: f64,
-    /// Fraction of rolls at rest with no side vertical.
-    pub unknown: f64,
-    /// Fraction of rolls failed non-finite.
-    pub non_finite: f64,
-    /// Fraction of rolls failed tunnelled through the floor.
-    pub tunnelled: f64,
-    /// Fraction of rolls failed by an engine error.
-    pub engine_error: f64,
-    /// Fraction of rolls in which the engine injected energy.
-    pub energy_gain: f64,
-    /// Rolls whose centre went under the floor's top face at a step (a flag, not a failure).
-    #[serde(default)]
-    pub dipped: f64,
-    /// The largest binomial standard error of this cell's fractions, √(f(1−f)/rolls).
-    #[serde(default)]
-    pub fraction_err_max: f64,
-    /// A fraction measured as 0 is below this at 95 % confidence: 1 − 0.05^(1/rolls).
-    #[serde(default)]
-    pub zero_below_95: f64,
-    /// N(breadth vertical)/N(width vertical).
-    pub ratio: f64,
-    /// Its binomial error.
-    pub ratio_err: f64,
-    /// Simulated steps per roll.
-    pub steps_per_roll: f64,
-}
-
-impl Cell {
-    /// The fraction of failure kind `k` (one of `KINDS`); NaN for any other name.
-    pub fn kind(&self, k: &str) -> f64 {
-        match k {
-            "unconverged" => self.unconverged,
-            "unknown" => self.unknown,
-            "non_finite" => self.non_finite,
-            "tunnelled" => self.tunnelled,
-            "energy_gain" => self.energy_gain,
-            "dipped" => self.dipped,
-            _ => f64::NAN,
+impl Config {
+    /// Checks every value before anything runs.
+    pub fn validate(&self) -> Result<()> {
+        nonempty(&self.engines, "engines")?;
+        nonempty(&self.dts, "dts")?;
+        nonempty(&self.restitutions, "restitutions")?;
+        if let Some(e) = self
+            .restitutions
+            .iter()
+            .find(|e| !(e.is_finite() && (0.0..=1.0).contains(*e)))
+        {
+            return Err(Error::field("restitutions", e, "must be in [0, 1]"));
         }
+        if let Some(m) = self
+            .frictions
+            .iter()
+            .find(|m| !(m.is_finite() && **m >= 0.0))
+        {
+            return Err(Error::field("frictions", m, "must be finite and >= 0"));
+        }
+        if !(0.001..=DICEPHYS_FLOOR_THICKNESS).contains(&self.floor_thickness) {
+            return Err(Error::field(
+                "floor_thickness",
+                self.floor_thickness,
+                "must be in [0.001, 100] m",
+            ));
+        }
+        check_rolls_and_steps(self.rolls, self.max_steps)
     }
-
-    /// The binomial standard error of a fraction `f` of this cell's rolls.
-    pub fn err(&self, f: f64) -> f64 {
-        fraction_err(f, self.rolls)
-    }
-}
-
-/// √(f(1−f)/n): the standard error of a fraction of n rolls.
-pub fn fraction_err(f: f64, n: u64) -> f64 {
-    (f * (1.0 - f) / n.max(1) as f64).sqrt()
 }
 
 /// The 95 % upper bound of a fraction seen 0 times in n rolls: 1 − 0.05^(1/n) (≈ 3/n).
 pub fn zero_below_95(n: u64) -> f64 {
     1.0 - 0.05f64.powf(1.0 / n.max(1) as f64)
-}
-
-/// The stability sweeps' results.
-#[derive(Clone, Debug, Serialize)]
-pub struct Stability {
-    /// Rolls per cell.
-    pub rolls: u64,
-    /// The throws' seed.
-    pub seed: u64,
-    /// The step cap per roll.
-    pub max_steps: u64,
-    /// The energy gain flagged, a fraction of the starting energy (`ENERGY_GAIN_TOLERANCE`).
-    pub energy_gain_tolerance: f64,
-    /// The box floor's thickness, m (DicePhys's: 100).
-    pub floor_thickness: f64,
-    /// Per cell: a fraction's standard error is at most 0.5/√rolls; a 0 is below
-    /// `zero_below_95` at 95 %.
-    pub fraction_err_max: f64,
-    /// A fraction measured as 0 is below this at 95 % confidence.
-    pub zero_below_95: f64,
-    /// The grid's time steps, s.
-    pub dts: Vec<f64>,
-    /// The grid's restitutions.
-    pub restitutions: Vec<f64>,
-    /// The friction line's μ.
-    pub frictions: Vec<f64>,
-    /// The aspect line's blocks, `LxBxW` in mm.
-    pub blocks: Vec<String>,
-    /// Every cell: per engine, 3D then 2D, the grid, then the friction line, then the aspect line.
-    pub cells: Vec<Cell>,
-    /// One sentence per failure kind: where it happens most.
-    pub findings: Vec<String>,
 }
 
 /// The paper's block and contact, the centre of every line.
@@ -248,12 +149,21 @@ fn cell(
 }
 
 /// Measures every cell, logging each as it is measured.
-pub fn run(cfg: &Config, study: &Study, log: &dyn Fn(&str)) -> Result<Stability> {
+pub fn run(
+    cfg: &Config,
+    study: &Study,
+    log: &dyn Fn(&str),
+    progress: Progress,
+) -> Result<Stability> {
+    cfg.validate()?;
     let (dt0, e0, mu0) = (0.001, 0.5, 0.29);
+    let per_mode = cfg.dts.len() * cfg.restitutions.len() + cfg.frictions.len() + cfg.blocks.len();
+    let total = (cfg.engines.len() * 2 * per_mode) as f64;
     let mut cells = Vec::new();
     let mut push = |c: Cell| {
         log(&format_cell(&c));
         cells.push(c);
+        progress(cells.len() as f64, total);
     };
     for &engine in &cfg.engines {
         for mode in [Mode::ThreeD, Mode::TwoD] {
@@ -299,7 +209,7 @@ fn describe(c: &Cell) -> String {
             "{} {} dt {} e {}",
             c.engine,
             c.mode,
-            super::sweep::dt_label(c.dt),
+            crate::report::text::dt_label(c.dt),
             c.restitution
         ),
     }
@@ -332,49 +242,3 @@ fn findings(cells: &[Cell]) -> Vec<String> {
         })
         .collect()
 }
-
-/// The column heads of the log's cell lines (`format_cell`).
-pub fn header() -> String {
-    TABLE.header()
-}
-
-/// One cell as a line of the log, under `header`.
-pub fn format_cell(c: &Cell) -> String {
-    let pc = |v: f64| format!("{:.1}%", 100.0 * v);
-    TABLE.row(&[
-        c.sweep.to_string(),
-        c.engine.to_string(),
-        c.mode.to_string(),
-        c.block.clone(),
-        super::sweep::dt_label(c.dt),
-        c.restitution.to_string(),
-        c.friction.to_string(),
-        pc(c.unconverged),
-        pc(c.unknown),
-        pc(c.non_finite),
-        pc(c.tunnelled),
-        pc(c.energy_gain),
-        pc(c.dipped),
-        pc(c.fraction_err_max),
-        format!("{:.0}", c.steps_per_roll),
-    ])
-}
-
-/// The columns of the log and of report.md.
-const TABLE: Columns = Columns(&[
-    left("sweep", 15),
-    left("engine", 13),
-    right("mode", 4),
-    left("block", 11),
-    right("dt", 8),
-    right("e", 5),
-    right("μ", 5),
-    right("unconv", 7),
-    right("unknown", 7),
-    right("nonfin", 7),
-    right("tunnel", 7),
-    right("gain", 7),
-    right("dipped", 7),
-    right("±max", 6),
-    right("steps", 7),
-]);

@@ -6,27 +6,32 @@
 //! finest dt), each mode (2D, 3D) its own.
 //!
 //! Precision is the input, rolls the output: every method rolls the same keyed throw stream
-//! (`sweep::Stream`) in rounds until 2σ of its departure is at most the precision, or its CPU
+//! (`stream::Stream`) in rounds until 2σ of its departure is at most the precision, or its CPU
 //! budget is spent; the reference first, to 2σ ≤ precision/2 so that its own noise takes at
 //! most a quarter of each departure's variance. A departure's error is paired: the method
 //! and the reference share their first throws, and where they end alike (the same dt, another
 //! rule) the noise cancels; at another dt or engine the outcomes decorrelate (measured: about
 //! 54 % agreement, what chance gives) and the pairing changes nothing.
 
-use super::sweep::{
-    chunks_to_resolve, dt_label, paired_departure, plan_cpu, precision_in_an_hour,
-    resolve_departure, resolve_reference, rolls_for_ratio, Departure, Stream, Study, NO_BUDGET,
+use super::departure::{chunks_to_resolve, paired_departure, rolls_for_ratio, Departure};
+use super::precision::{
+    plan_cpu, precision_in_an_hour, resolve_departure, resolve_reference, NO_BUDGET,
 };
+use super::stream::Stream;
+use super::sweep::{check_budget, check_rolls_and_steps, nonempty};
+use super::{Progress, Study};
 use crate::engine::EngineKind;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::scene::{Floor, Mode, Scene};
-use crate::report::text::{left, right, Columns};
-use crate::run::runner::CHUNK;
+use crate::report::text::dt_label;
+use crate::report::tradeoff::{format_row, ModeResult, Role, Row, Tradeoff};
+use crate::run::runner::CHUNK_ROLLS;
 use crate::sim::roll::{RollConfig, Rule};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// What the trade-off study runs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Config {
     /// The block.
     pub block: Block,
@@ -56,125 +61,37 @@ pub struct Config {
     pub preroll_chunks: Option<u64>,
 }
 
+impl Config {
+    /// Checks every value before anything runs.
+    pub fn validate(&self) -> Result<()> {
+        nonempty(&self.dts, "dts")?;
+        if self
+            .dts
+            .iter()
+            .chain(&self.rapier_dts)
+            .any(|&d| d <= self.reference_dt)
+        {
+            return Err(Error::field(
+                "reference_dt",
+                dt_label(self.reference_dt),
+                "must be finer than every `dts` and `rapier_dts`",
+            ));
+        }
+        if self.ladder.contains(&self.reference_dt) {
+            return Err(Error::field(
+                "ladder",
+                "",
+                "the reference's dt is not a rung",
+            ));
+        }
+        check_budget(self.budget_s, "budget_s")?;
+        check_budget(self.reference_budget_s, "reference_budget_s")?;
+        check_rolls_and_steps(1, self.max_steps)
+    }
+}
+
 /// Chunks every stream rolls first, to measure its cost and its variance.
 pub const PILOT_CHUNKS: u64 = 1;
-
-/// What a row is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Role {
-    /// A method on the chart.
-    Method,
-    /// The reference itself.
-    Reference,
-    /// A rung of the reference's ladder (another fine step, the same levers).
-    Ladder,
-    /// The reference's scene rolled faithfully (DicePhys's rule, stepped): shows the levers
-    /// exact at the reference's step.
-    Levers,
-}
-
-/// One method's measurement (or the reference's).
-#[derive(Clone, Debug, Serialize)]
-pub struct Row {
-    /// The method's name: engine, mode, dt, rule, floor.
-    pub method: String,
-    /// What the row is.
-    pub role: Role,
-    /// The engine.
-    pub engine: EngineKind,
-    /// 2D or 3D.
-    pub mode: Mode,
-    /// The time step, s.
-    pub dt: f64,
-    /// `faithful` (DicePhys's rule, stepped flight) or `fast` (the defaults: closed-form flight,
-    /// and the early stop where it is exact, dt <= 1/250).
-    pub rule: String,
-    /// The floor: DicePhys's box, or the plane.
-    pub floor: Floor,
-    /// Rolls made: the first `rolls` throws of the keyed stream.
-    pub rolls: u64,
-    /// N(breadth vertical)/N(width vertical).
-    pub ratio: f64,
-    /// Its binomial error.
-    pub ratio_err: f64,
-    /// Process CPU seconds per 1,000 rolls, all threads.
-    pub cpu_s_per_1000: f64,
-    /// Simulated steps per roll.
-    pub steps_per_roll: f64,
-    /// Relative departure from the reference, ratio/reference − 1 (a fraction), with the
-    /// shared throws as a control variate (`studies::sweep::paired_departure`).
-    pub error: f64,
-    /// Its standard error, paired on the shared throws.
-    pub error_err: f64,
-    /// The same error had the throws been independent.
-    pub error_err_unpaired: f64,
-    /// The fraction of shared throws ending alike (breadth, width, other) with the reference.
-    pub agreement: f64,
-    /// The departure in standard errors, `error / error_err` (0 unless that error is positive).
-    pub error_sigma: f64,
-    /// 2σ of the departure (for the reference: of its own ratio) is at most the precision.
-    pub resolved: bool,
-    /// Unresolved: the rolls that would resolve it (the reference as rolled), if any would.
-    pub rolls_needed: Option<u64>,
-    /// Rolls not at rest at the step cap.
-    pub unconverged: u64,
-    /// Rolls that failed, for any reason.
-    pub failed: u64,
-    /// Rolls in which the engine injected energy.
-    pub energy_gain: u64,
-    /// Rolls whose die's centre went under the floor's top face at a step (not failures).
-    #[serde(default)]
-    pub dipped: u64,
-    /// This row is the reference (its departure 0).
-    pub reference: bool,
-}
-
-/// One mode's methods against its reference, its Pareto front and its verdict.
-#[derive(Clone, Debug, Serialize)]
-pub struct ModeResult {
-    /// 2D or 3D.
-    pub mode: Mode,
-    /// The reference: Bullet, box floor, the exact levers, at the reference dt.
-    pub reference: Row,
-    /// The reference's scene rolled faithfully, and the ladder's rungs.
-    pub checks: Vec<Row>,
-    /// Every method, in the order run.
-    pub rows: Vec<Row>,
-    /// Resolved methods no other resolved one is both cheaper and closer to the reference
-    /// than, cheapest first (among methods failing or unconverged on at most 1 % of rolls).
-    pub pareto_front: Vec<String>,
-    /// The cheapest resolved method whose |departure| is at most the precision, if any.
-    pub cheapest_within: Option<String>,
-    /// Plain words: the cheapest method within the precision, and what is unresolved.
-    pub note: String,
-}
-
-/// The trade-off study's results.
-#[derive(Clone, Debug, Serialize)]
-pub struct Tradeoff {
-    /// The block, `LxBxW` in mm.
-    pub block: String,
-    /// The 2σ half-width asked of every departure, a fraction.
-    pub precision: f64,
-    /// CPU seconds a method may spend.
-    pub budget_s: f64,
-    /// The throws' seed.
-    pub seed: u64,
-    /// The reference's time step, s.
-    pub reference_dt: f64,
-    /// After the pilot: the CPU seconds the whole run was planned to take.
-    pub planned_cpu_s: f64,
-    /// The same plan at 1 % (no budget): what resolving the paper's 1 % costs.
-    pub planned_cpu_s_at_one_percent: f64,
-    /// The precision the whole run (pilot included, no budget) would reach in an hour of
-    /// all this run's threads, from the pilot's costs and variances.
-    pub precision_in_an_hour: f64,
-    /// CPU seconds the rolls took (read back with their chunks on a resumed run).
-    pub cpu_s: f64,
-    /// 3D, then 2D.
-    pub modes: Vec<ModeResult>,
-}
 
 #[derive(Clone, Copy)]
 struct Method {
@@ -283,9 +200,6 @@ pub fn pareto(rows: &[Row]) -> Vec<String> {
     front
 }
 
-/// Progress: estimated CPU seconds done and planned in all.
-pub type Progress<'a> = &'a (dyn Fn(f64, f64) + Sync);
-
 /// Measures every method against its reference to the precision asked, logging the plan and
 /// each method as it is resolved, reporting progress in estimated CPU seconds.
 pub fn run(
@@ -294,6 +208,7 @@ pub fn run(
     log: &dyn Fn(&str),
     progress: Progress,
 ) -> Result<Tradeoff> {
+    cfg.validate()?;
     let modes = [Mode::ThreeD, Mode::TwoD];
     let mut all: Vec<(Mode, Vec<(Method, Stream)>)> = modes
         .iter()
@@ -456,7 +371,7 @@ fn row(cfg: &Config, mode: Mode, m: &Method, s: &Stream, reference: Option<&Stre
     let (resolved, rolls_needed) = match reference {
         Some(rf) => (
             2.0 * d.err <= cfg.precision,
-            chunks_to_resolve(&d, rf.rolls(), cfg.precision, NO_BUDGET).map(|k| k * CHUNK),
+            chunks_to_resolve(&d, rf.rolls(), cfg.precision, NO_BUDGET).map(|k| k * CHUNK_ROLLS),
         ),
         None => {
             let need = rolls_for_ratio(s, 0.5 * cfg.precision);
@@ -523,38 +438,3 @@ fn note(cfg: &Config, reference: &Row, rows: &[Row], cheapest: &Option<String>) 
     }
     s
 }
-
-/// The column heads of the log's method lines (`format_row`).
-pub fn header() -> String {
-    TABLE.header()
-}
-
-/// One method as a line of the log, under `header`.
-pub fn format_row(r: &Row) -> String {
-    TABLE.row(&[
-        r.method.clone(),
-        r.rolls.to_string(),
-        format!("{:.4} ± {:.4}", r.ratio, r.ratio_err),
-        format!("{:.3}", r.cpu_s_per_1000),
-        format!("{:.0}", r.steps_per_roll),
-        format!("{:+.2} ± {:.2} %", 100.0 * r.error, 100.0 * r.error_err),
-        if r.resolved { "yes" } else { "no" }.into(),
-        format!("{:.3}", r.agreement),
-        (r.failed + r.unconverged).to_string(),
-        r.dipped.to_string(),
-    ])
-}
-
-/// The columns of the log and of report.md.
-const TABLE: Columns = Columns(&[
-    left("method", 38),
-    right("rolls", 8),
-    right("ratio", 17),
-    right("CPU s/1000", 11),
-    right("steps", 7),
-    right("departure ±1σ", 18),
-    right("res.", 4),
-    right("agree", 6),
-    right("failed", 6),
-    right("dipped", 6),
-]);

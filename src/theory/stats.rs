@@ -86,10 +86,16 @@ pub fn proportion(k: u64, n: u64) -> Proportion {
         k,
         n,
         value: p,
-        err: var.sqrt(),
+        err: binomial_err(p, n),
         wilson_low: (centre - half).max(0.0),
         wilson_high: (centre + half).min(1.0),
     }
+}
+
+/// √(p(1−p)/n): the binomial standard error of a proportion p over n trials (of a measured
+/// one, `proportion(k, n).err`; of a predicted one, the error a measurement of it carries).
+pub fn binomial_err(p: f64, n: u64) -> f64 {
+    (p * (1.0 - p) / n as f64).sqrt()
 }
 
 /// The paper's probability N_L/(N_L + N_K) ± sqrt(N_L N_K / (N_L + N_K)³): the proportion of

@@ -180,3 +180,185 @@ fn a_tiny_paper_run_is_complete_and_repeatable() {
     }
     assert!(dir.join("results.csv").exists());
 }
+
+/// The library names a bad value by its field (`max_steps`); the command line names it by the
+/// flag the user typed.
+#[test]
+fn bad_input_names_the_flag_that_was_typed() {
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["roll", "--block", "140x24x20", "--max-steps", "0"],
+            "--max-steps 0",
+        ),
+        (
+            &["roll", "--block", "140x24x20", "--margin", "2"],
+            "--margin 2",
+        ),
+        (
+            &["roll", "--block", "140x24x20", "--drop-height", "-1"],
+            "--drop-height",
+        ),
+        (
+            &["roll", "--block", "140x24x20", "--restitution", "1.5"],
+            "--allow-restitution-above-one",
+        ),
+        (
+            &[
+                "roll",
+                "--block",
+                "140x24x20",
+                "--throw",
+                "rest",
+                "--throws",
+                "dicephys",
+            ],
+            "--throws keyed",
+        ),
+        (
+            &["paper", "--engines", "", "--out", "/nonexistent/x"],
+            "--engines",
+        ),
+        (
+            &["converge", "--budget", "0", "--out", "/nonexistent/x"],
+            "--budget",
+        ),
+        (
+            &[
+                "converge",
+                "--reference-budget",
+                "0",
+                "--out",
+                "/nonexistent/x",
+            ],
+            "--reference-budget",
+        ),
+        (
+            &[
+                "tradeoff",
+                "--reference-dt",
+                "1/100",
+                "--out",
+                "/nonexistent/x",
+            ],
+            "--reference-dt 1/100",
+        ),
+        (
+            &["stability", "--frictions", "nan", "--out", "/nonexistent/x"],
+            "--frictions",
+        ),
+    ];
+    for (args, flag) in cases {
+        let out = dicephys(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(flag), "{args:?}: {err} does not name {flag}");
+        assert!(!err.contains('`') && !err.contains('_'), "{args:?}: {err}");
+    }
+}
+
+/// Shell completions and the manual page come from the flags themselves.
+#[test]
+fn completions_and_the_man_page_come_from_the_flags() {
+    for shell in ["bash", "zsh", "fish", "elvish", "powershell"] {
+        let out = dicephys(&["completions", shell]);
+        assert!(out.status.success(), "{shell}");
+        let text = String::from_utf8_lossy(&out.stdout);
+        // Each shell spells a long flag its own way (fish: `-l reference-dt`).
+        for word in ["dicephys", "converge", "block", "reference-dt"] {
+            assert!(text.contains(word), "{shell} completions lack {word}");
+        }
+    }
+    let out = dicephys(&["completions", "tcsh"]);
+    assert_eq!(out.status.code(), Some(2));
+    let man = dicephys(&["man"]);
+    assert!(man.status.success());
+    let text = String::from_utf8_lossy(&man.stdout);
+    assert!(
+        text.starts_with(".ie") || text.contains(".TH dicephys 1"),
+        "{text}"
+    );
+    for word in ["paper", "converge", "slurm", "completions"] {
+        assert!(text.contains(word), "the man page lacks {word}");
+    }
+}
+
+/// Without a terminal on stderr (a log file, a cluster job's output), a long command says how
+/// far it has come now and then (`DICEPHYS_PROGRESS_SECS`: here at every cell).
+#[test]
+fn without_a_terminal_a_study_prints_progress_lines() {
+    let dir = Scratch::new("progress");
+    let out = super::helpers::bin()
+        .args([
+            "converge",
+            "--blocks",
+            "140x24x20",
+            "--dts",
+            "1/250,1/1000",
+            "--engines",
+            "bullet",
+            "--rolls",
+            "20",
+            "--json",
+            "--out",
+        ])
+        .arg(dir.path())
+        .env("DICEPHYS_PROGRESS_SECS", "0")
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("dicephys converge: "))
+        .collect();
+    assert_eq!(lines.len(), 4, "a line per cell (2 dts, 3D and 2D):\n{err}");
+    assert!(lines[3].contains("100 % (4 of 4 cells done), ETA"), "{err}");
+    json(&out);
+}
+
+/// `cargo install --path .` builds and installs the binary; here into a scratch root, offline,
+/// in this build's target directory (only dicephys itself is compiled again, ~30 s).
+///
+/// Ignored by default: in the shared target directory the install relinks
+/// `target/release/dicephys` (without the dev-dependencies' features) under the tests that run
+/// it; in a target directory of its own it compiles every dependency again (~6 min on 2
+/// cores). Run it alone: `cargo test --release --test it -- --ignored cargo_install`.
+#[test]
+#[ignore]
+fn cargo_install_puts_a_working_binary_in_the_root() {
+    let Some(cargo) = option_env!("CARGO") else {
+        eprintln!("cargo_install: skipped: not run by cargo (no CARGO in the environment)");
+        return;
+    };
+    // .../target/release/deps/it-HASH: the target directory is three levels up.
+    let exe = std::env::current_exe().unwrap();
+    let target = exe.ancestors().nth(3).unwrap().to_path_buf();
+    let root = Scratch::new("install");
+    let out = std::process::Command::new(cargo)
+        .args([
+            "install",
+            "--offline",
+            "--locked",
+            "--path",
+            env!("CARGO_MANIFEST_DIR"),
+            "--root",
+        ])
+        .arg(root.path())
+        .arg("--target-dir")
+        .arg(&target)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bin = root.path().join("bin").join("dicephys");
+    let v = std::process::Command::new(&bin)
+        .arg("--version")
+        .output()
+        .unwrap();
+    assert!(v.status.success());
+    assert!(String::from_utf8_lossy(&v.stdout).starts_with("dicephys "));
+}

@@ -249,8 +249,9 @@ fn coasting_matches_bullet_stepping_at_coarse_steps() {
 #[test]
 fn fast_flight_keeps_outcomes_at_coarse_steps() {
     // 2,000 throws (seed 10), DicePhys's rule, stepped against fast flight. Measured on
-    // 20,000 per MDF block (README): 99.61-100 % identical, ratios within 0.13 σ; here the
-    // test asks 99.5 % of 2,000 in the most chaotic cell, 3D 140x22x13 at 1/60.
+    // 20,000 per MDF block (docs/results/coarse-steps.md): 99.61-100 % identical, ratios
+    // within 0.13 σ; here the test asks 99.5 % of 2,000 in the most chaotic cell, 3D
+    // 140x22x13 at 1/60.
     let sc = scene("140x22x13", Mode::ThreeD, DT_60);
     let throws = Throws::new(ThrowKind::Keyed, 10, ThrowRanges::default(), 0);
     let run = |fast_flight: bool| {

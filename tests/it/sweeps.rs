@@ -322,7 +322,9 @@ fn pairing_cancels_the_noise_of_a_lever_at_one_step_and_not_across_steps() {
     // alike, so the departure's paired error is a small part of the independent one; against
     // 1/250 s they decorrelate and pairing gains nothing (within a tenth).
     use dicephys::run::runner::Runner;
-    use dicephys::studies::sweep::{paired_departure, Stream, Study};
+    use dicephys::studies::departure::paired_departure;
+    use dicephys::studies::stream::Stream;
+    use dicephys::studies::Study;
     let study = Study {
         runner: Runner::new(2, dicephys::run::stop::Stop::default()),
         checkpoint: None,

@@ -11,14 +11,14 @@ use dicephys::model::block::{Block, Outcome};
 use dicephys::model::scene::{Mode, Scene};
 use dicephys::model::state::BodyState;
 use dicephys::model::throws::ThrowStyle;
+use dicephys::report::validate::{Config, Integrator, LimitCell};
 use dicephys::run::runner::Runner;
 use dicephys::run::spec::{RunSpec, ThrowSpec};
 use dicephys::run::stop::Stop;
-use dicephys::studies::sweep::Study;
-use dicephys::studies::validate::flight::{fly, Integrator};
-use dicephys::studies::validate::{
-    limit_roll, limit_scene, measure_limit, Config, LimitCell, LIMIT_MAX_STEPS,
-};
+use dicephys::studies::validate::flight::fly;
+use dicephys::studies::validate::limits::{limit_roll, limit_scene, measure_limit};
+use dicephys::studies::validate::LIMIT_MAX_STEPS;
+use dicephys::studies::Study;
 use dicephys::theory;
 use nalgebra::{UnitQuaternion, Vector3};
 

@@ -379,3 +379,16 @@ fn legend<'a, DB: DrawingBackend + 'a>(
         .draw()
         .map_err(plot_err)
 }
+
+/// Items grouped by a key, in first-seen order: a figure's series or panels.
+pub fn group<T>(items: &[T], key: impl Fn(&T) -> String) -> Vec<(String, Vec<&T>)> {
+    let mut out: Vec<(String, Vec<&T>)> = Vec::new();
+    for it in items {
+        let k = key(it);
+        match out.iter_mut().find(|(g, _)| *g == k) {
+            Some((_, v)) => v.push(it),
+            None => out.push((k, vec![it])),
+        }
+    }
+    out
+}

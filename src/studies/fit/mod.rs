@@ -3,6 +3,7 @@
 //! check, and a new block simulated at the fit's posterior draws.
 
 pub mod check;
+pub mod outputs;
 pub mod predict;
 pub mod recovery;
 pub mod simulate;
@@ -12,8 +13,8 @@ use crate::calibration::{estimate_with, FitConfig, FitCost, FitResult};
 use crate::error::Result;
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::runner::Runner;
-pub use simulate::Session;
 use simulate::Plan;
+pub use simulate::Session;
 use std::path::Path;
 use std::time::Instant;
 
@@ -83,8 +84,7 @@ pub fn fit(
         estimate,
         first_pass: None,
     };
-    let narrowed =
-        crate::calibration::narrow(&cfg.rows, &cfg.model, &out.params, &out.estimate);
+    let narrowed = crate::calibration::narrow(&cfg.rows, &cfg.model, &out.params, &out.estimate);
     if cfg.design.refine && !narrowed.is_empty() {
         out.config.model.narrowed = narrowed;
         let Some(second) = simulate(&out.config, runner, dir, session)? else {

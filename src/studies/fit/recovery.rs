@@ -103,9 +103,19 @@ pub fn run(
         let Some(fitted) = super::fit(&data_cfg, runner, None, &session)? else {
             return Ok(None);
         };
-        rolls += fitted.rolls + data_cfg.rows.iter().map(|r| r.counts.iter().sum::<u64>()).sum::<u64>();
+        rolls += fitted.rolls
+            + data_cfg
+                .rows
+                .iter()
+                .map(|r| r.counts.iter().sum::<u64>())
+                .sum::<u64>();
         let (params, est) = (&fitted.params, &fitted.estimate);
-        let lik = Likelihood::new(&data_cfg.rows, &fitted.designs, &fitted.config.model, params);
+        let lik = Likelihood::new(
+            &data_cfg.rows,
+            &fitted.designs,
+            &fitted.config.model,
+            params,
+        );
         // The truth in the full parameter vector, each parameter's own coordinate (outside
         // its narrowed box: not covered).
         let value_of = |kind| truth[model.free.iter().position(|k| *k == kind).expect("free")];

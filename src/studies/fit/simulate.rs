@@ -68,7 +68,9 @@ pub fn simulate(
             .unwrap_or_else(|e| e.into_inner())
             .iter()
             .find(|(k, seed, d)| {
-                k == key && *seed == plan.seed && d.points.len() == xs.len()
+                k == key
+                    && *seed == plan.seed
+                    && d.points.len() == xs.len()
                     && d.rolls == xs.len() as u64 * plan.design.rolls
             })
             .map(|c| c.2.clone());

@@ -1,0 +1,143 @@
+//! A study run from the command line: where it writes, its log and progress on stderr, and
+//! what it prints. The study, its rendering and its files are the library's
+//! (`dicephys::studies::outputs`).
+
+use super::error::{Error, Result};
+use super::out;
+use dicephys::report::progress::Progress;
+use dicephys::run::runner::ChunkShare;
+use dicephys::studies::outputs::{self, Done, Hooks, Place};
+use dicephys::studies::{paper::PaperConfig, validate, StudyConfig};
+use std::path::Path;
+use std::time::Duration;
+
+/// A study run here, on all its chunks, writing into `out` (its cells under `out/checkpoint`).
+pub fn local(out: &Path, threads: usize, json: bool) -> Result<Place> {
+    Ok(Place {
+        out: out.to_path_buf(),
+        checkpoint: Some(out.join("checkpoint")),
+        threads: super::args::threads(threads)?,
+        share: ChunkShare::All,
+        json,
+        command_line: std::env::args().collect::<Vec<_>>().join(" "),
+    })
+}
+
+/// Runs a study a cluster can split, with a bar (or progress lines) and its log on stderr.
+pub fn run(cfg: &StudyConfig, place: &Place) -> Result<()> {
+    // Bars as before: paper's rolls, and the CPU of a study rolled to a precision.
+    let bar = matches!(
+        cfg,
+        StudyConfig::Paper(_) | StudyConfig::Tradeoff(_) | StudyConfig::Converge(_)
+    ) && cfg.unit() != outputs::Unit::Cells;
+    with_hooks(cfg.name(), cfg.unit(), bar, place.json, |hooks| {
+        outputs::run(cfg, place, hooks)
+    })
+}
+
+/// Runs `paper`.
+pub fn paper(cfg: &PaperConfig, place: &Place) -> Result<()> {
+    run(&StudyConfig::Paper(cfg.clone()), place)
+}
+
+/// Runs `validate`.
+pub fn validate(cfg: &validate::Config, place: &Place) -> Result<()> {
+    with_hooks(
+        "validate",
+        outputs::Unit::Cells,
+        false,
+        place.json,
+        |hooks| outputs::validate(cfg, place, hooks),
+    )
+}
+
+/// How often a command whose stderr is not a terminal says how far it has come:
+/// `DICEPHYS_PROGRESS_SECS` seconds, default 30.
+pub fn every() -> Duration {
+    std::env::var("DICEPHYS_PROGRESS_SECS")
+        .ok()
+        .and_then(|s| s.parse::<f64>().ok())
+        .filter(|s| s.is_finite() && *s >= 0.0)
+        .map_or(Duration::from_secs(30), Duration::from_secs_f64)
+}
+
+/// Runs a study with its log on stderr (out of the bar's way) and its progress shown, then
+/// prints what it says.
+fn with_hooks(
+    command: &'static str,
+    unit: outputs::Unit,
+    bar: bool,
+    json: bool,
+    run: impl FnOnce(&Hooks) -> dicephys::Result<Done>,
+) -> Result<()> {
+    let progress = Progress::new(command, unit, bar, json, every());
+    let log = |l: &str| progress.suspend(|| eprintln!("{l}"));
+    let set = |done: f64, total: f64| progress.set(done, total);
+    let done = run(&Hooks {
+        log: &log,
+        progress: &set,
+        stop: super::stop().clone(),
+    });
+    progress.finish();
+    let done = done?;
+    out!("{}", done.stdout);
+    if let Some(n) = done.note {
+        eprintln!("{}", super::error::flags_in(&n));
+    }
+    match done.interrupted {
+        Some(m) => Err(Error::Interrupted(m)),
+        None => Ok(()),
+    }
+}
+
+/// Runs `fit`.
+pub fn fit(cfg: &dicephys::calibration::FitConfig, place: &Place) -> Result<()> {
+    let unit = outputs::Unit::Rolls {
+        per_cell: cfg.design.rolls,
+    };
+    with_hooks("fit", unit, true, place.json, |hooks| {
+        dicephys::studies::fit::outputs::fit(cfg, place, hooks)
+    })
+}
+
+/// Runs `fit --recover`.
+pub fn recover(
+    cfg: &dicephys::calibration::FitConfig,
+    truth: &[f64],
+    repeats: usize,
+    place: &Place,
+) -> Result<()> {
+    let unit = outputs::Unit::Rolls {
+        per_cell: cfg.design.rolls,
+    };
+    with_hooks("fit", unit, true, place.json, |hooks| {
+        dicephys::studies::fit::outputs::recover(cfg, truth, repeats, place, hooks)
+    })
+}
+
+/// Runs `predict`.
+pub fn predict(
+    fit: &dicephys::calibration::FitResult,
+    cfg: &dicephys::calibration::predict::PredictConfig,
+    place: &Place,
+) -> Result<()> {
+    let unit = outputs::Unit::Rolls {
+        per_cell: cfg.rolls,
+    };
+    with_hooks("predict", unit, true, place.json, |hooks| {
+        dicephys::studies::fit::outputs::predict(fit, cfg, place, hooks)
+    })
+}
+
+/// Runs `paper --calibrated`.
+pub fn calibrated(
+    cfg: &dicephys::studies::calibrated::CalibratedConfig,
+    place: &Place,
+) -> Result<()> {
+    let unit = outputs::Unit::Rolls {
+        per_cell: cfg.design.rolls,
+    };
+    with_hooks("paper --calibrated", unit, true, place.json, |hooks| {
+        dicephys::studies::fit::outputs::calibrated(cfg, place, hooks)
+    })
+}

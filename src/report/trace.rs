@@ -1,0 +1,52 @@
+//! One throw's trajectory as CSV (`trace`): step, time, position, orientation, velocities,
+//! energies, and the line that says how the throw ended.
+
+use crate::model::die::DieShape;
+use crate::model::state::BodyState;
+use crate::model::throws::Throw;
+use crate::sim::roll::{Fate, RollRecord};
+
+/// The CSV's header.
+pub const HEADER: &str =
+    "step,time_s,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,kinetic_j,potential_j,total_j,sleeping";
+
+/// The CSV row of the state after `step` steps of `dt`.
+pub fn row(die: &DieShape, dt: f64, step: u64, s: &BodyState) -> String {
+    let q = s.rotation.quaternion();
+    let (k, p) = (die.kinetic(s), die.potential(s));
+    format!(
+        "{},{:.6},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9e},{:.9e},{:.9e},{}",
+        step,
+        step as f64 * dt,
+        s.position.x,
+        s.position.y,
+        s.position.z,
+        q.w,
+        q.i,
+        q.j,
+        q.k,
+        s.linear_velocity.x,
+        s.linear_velocity.y,
+        s.linear_velocity.z,
+        s.angular_velocity.x,
+        s.angular_velocity.y,
+        s.angular_velocity.z,
+        k,
+        p,
+        k + p,
+        s.sleeping as u8
+    )
+}
+
+/// How throw `index` ended, in one line.
+pub fn ending(index: u64, throw: &Throw, record: &RollRecord) -> String {
+    let fate = match record.fate {
+        Fate::Settled(o) => format!("settled, {} vertical", o.name()),
+        Fate::Unconverged(o) => format!("unconverged ({} vertical at the cap)", o.name()),
+        Fate::Failed(f) => format!("failed: {}", f.name()),
+    };
+    format!(
+        "throw {index}: drop {:.4} m, v {:.4} m/s, spin {:.3} rad/s: {fate} after {} steps",
+        throw.drop_height, throw.velocity, throw.spin, record.steps
+    )
+}

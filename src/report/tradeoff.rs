@@ -1,0 +1,278 @@
+//! `tradeoff`'s results and report: each method's cost against its departure from the
+//! reference, resolved to a precision, with the Pareto front (the study: `studies::tradeoff`).
+
+use crate::engine::EngineKind;
+use crate::error::Result;
+use crate::model::block::Block;
+use crate::model::scene::{Floor, Mode};
+use crate::report::figures::sweeps as fig;
+use crate::report::text::{dt_label, left, right, Columns};
+use serde::Serialize;
+use std::path::Path;
+
+/// What a row is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Role {
+    /// A method on the chart.
+    Method,
+    /// The reference itself.
+    Reference,
+    /// A rung of the reference's ladder (another fine step, the same levers).
+    Ladder,
+    /// The reference's scene rolled faithfully (DicePhys's rule, stepped): shows the levers
+    /// exact at the reference's step.
+    Levers,
+}
+
+/// One method's measurement (or the reference's).
+#[derive(Clone, Debug, Serialize)]
+pub struct Row {
+    /// The method's name: engine, mode, dt, rule, floor.
+    pub method: String,
+    /// What the row is.
+    pub role: Role,
+    /// The engine.
+    pub engine: EngineKind,
+    /// 2D or 3D.
+    pub mode: Mode,
+    /// The time step, s.
+    pub dt: f64,
+    /// `faithful` (DicePhys's rule, stepped flight) or `fast` (the defaults: closed-form flight,
+    /// and the early stop where it is exact, dt <= 1/250).
+    pub rule: String,
+    /// The floor: DicePhys's box, or the plane.
+    pub floor: Floor,
+    /// Rolls made: the first `rolls` throws of the keyed stream.
+    pub rolls: u64,
+    /// N(breadth vertical)/N(width vertical).
+    pub ratio: f64,
+    /// Its binomial error.
+    pub ratio_err: f64,
+    /// Process CPU seconds per 1,000 rolls, all threads.
+    pub cpu_s_per_1000: f64,
+    /// Simulated steps per roll.
+    pub steps_per_roll: f64,
+    /// Relative departure from the reference, ratio/reference − 1 (a fraction), with the
+    /// shared throws as a control variate (`studies::departure::paired_departure`).
+    pub error: f64,
+    /// Its standard error, paired on the shared throws.
+    pub error_err: f64,
+    /// The same error had the throws been independent.
+    pub error_err_unpaired: f64,
+    /// The fraction of shared throws ending alike (breadth, width, other) with the reference.
+    pub agreement: f64,
+    /// The departure in standard errors, `error / error_err` (0 unless that error is positive).
+    pub error_sigma: f64,
+    /// 2σ of the departure (for the reference: of its own ratio) is at most the precision.
+    pub resolved: bool,
+    /// Unresolved: the rolls that would resolve it (the reference as rolled), if any would.
+    pub rolls_needed: Option<u64>,
+    /// Rolls not at rest at the step cap.
+    pub unconverged: u64,
+    /// Rolls that failed, for any reason.
+    pub failed: u64,
+    /// Rolls in which the engine injected energy.
+    pub energy_gain: u64,
+    /// Rolls whose die's centre went under the floor's top face at a step (not failures).
+    #[serde(default)]
+    pub dipped: u64,
+    /// This row is the reference (its departure 0).
+    pub reference: bool,
+}
+
+/// One mode's methods against its reference, its Pareto front and its verdict.
+#[derive(Clone, Debug, Serialize)]
+pub struct ModeResult {
+    /// 2D or 3D.
+    pub mode: Mode,
+    /// The reference: Bullet, box floor, the exact levers, at the reference dt.
+    pub reference: Row,
+    /// The reference's scene rolled faithfully, and the ladder's rungs.
+    pub checks: Vec<Row>,
+    /// Every method, in the order run.
+    pub rows: Vec<Row>,
+    /// Resolved methods no other resolved one is both cheaper and closer to the reference
+    /// than, cheapest first (among methods failing or unconverged on at most 1 % of rolls).
+    pub pareto_front: Vec<String>,
+    /// The cheapest resolved method whose |departure| is at most the precision, if any.
+    pub cheapest_within: Option<String>,
+    /// Plain words: the cheapest method within the precision, and what is unresolved.
+    pub note: String,
+}
+
+/// The trade-off study's results.
+#[derive(Clone, Debug, Serialize)]
+pub struct Tradeoff {
+    /// The block, `LxBxW` in mm.
+    pub block: String,
+    /// The 2σ half-width asked of every departure, a fraction.
+    pub precision: f64,
+    /// CPU seconds a method may spend.
+    pub budget_s: f64,
+    /// The throws' seed.
+    pub seed: u64,
+    /// The reference's time step, s.
+    pub reference_dt: f64,
+    /// After the pilot: the CPU seconds the whole run was planned to take.
+    pub planned_cpu_s: f64,
+    /// The same plan at 1 % (no budget): what resolving the paper's 1 % costs.
+    pub planned_cpu_s_at_one_percent: f64,
+    /// The precision the whole run (pilot included, no budget) would reach in an hour of
+    /// all this run's threads, from the pilot's costs and variances.
+    pub precision_in_an_hour: f64,
+    /// CPU seconds the rolls took (read back with their chunks on a resumed run).
+    pub cpu_s: f64,
+    /// 3D, then 2D.
+    pub modes: Vec<ModeResult>,
+}
+
+/// The column heads of the log's method lines (`format_row`).
+pub fn header() -> String {
+    TABLE.header()
+}
+
+/// One method as a line of the log, under `header`.
+pub fn format_row(r: &Row) -> String {
+    TABLE.row(&[
+        r.method.clone(),
+        r.rolls.to_string(),
+        format!("{:.4} ± {:.4}", r.ratio, r.ratio_err),
+        format!("{:.3}", r.cpu_s_per_1000),
+        format!("{:.0}", r.steps_per_roll),
+        format!("{:+.2} ± {:.2} %", 100.0 * r.error, 100.0 * r.error_err),
+        if r.resolved { "yes" } else { "no" }.into(),
+        format!("{:.3}", r.agreement),
+        (r.failed + r.unconverged).to_string(),
+        r.dipped.to_string(),
+    ])
+}
+
+/// The columns of the log and of report.md.
+const TABLE: Columns = Columns(&[
+    left("method", 38),
+    right("rolls", 8),
+    right("ratio", 17),
+    right("CPU s/1000", 11),
+    right("steps", 7),
+    right("departure ±1σ", 18),
+    right("res.", 4),
+    right("agree", 6),
+    right("failed", 6),
+    right("dipped", 6),
+]);
+
+/// report.md: how the methods were rolled, each mode's table, front and verdict, and the
+/// figure.
+pub fn markdown(res: &Tradeoff, figures: &[&str]) -> String {
+    let mut md = format!(
+        "# Accuracy against cost\n\n{}, seed {}; every departure rolled until 2σ ≤ {:.2} % or \
+         {:.0} CPU s spent; reference: Bullet, box floor, the exact levers (early stop, fast \
+         flight), dt {}, to 2σ ≤ {:.2} % of its own. Planned after the pilot: {:.0} CPU s; \
+         spent on rolls: {:.0} CPU s. At ±1 % the plan is {:.0} CPU s.\n\n",
+        res.block,
+        res.seed,
+        100.0 * res.precision,
+        res.budget_s,
+        dt_label(res.reference_dt),
+        50.0 * res.precision,
+        res.planned_cpu_s,
+        res.cpu_s,
+        res.planned_cpu_s_at_one_percent
+    );
+    for m in &res.modes {
+        md += &format!(
+            "## {}\n\n```\n{}\n{}  (reference)\n",
+            m.mode,
+            header(),
+            format_row(&m.reference)
+        );
+        for r in &m.checks {
+            md += &format!("{}  ({:?})\n", format_row(r), r.role);
+        }
+        for r in &m.rows {
+            md += &format_row(r);
+            md.push('\n');
+        }
+        md += &format!(
+            "```\n\nPareto front over resolved methods (cheapest first): {}.\n\n{}\n\n",
+            m.pareto_front.join("; "),
+            m.note
+        );
+    }
+    for f in figures {
+        md += &format!("![cost against departure]({f}.svg)\n");
+    }
+    md
+}
+
+/// Draws cost against departure, with the paper's experimental error for `block` (the
+/// study's) and Rapier's converged departure as yardsticks, into `dir`; returns its stem.
+pub fn write_figures(dir: &Path, res: &Tradeoff, block: Block) -> Result<Vec<&'static str>> {
+    let mut pts = Vec::new();
+    let mut bands = Vec::new();
+    if let Some(row) = crate::theory::paper_data::load().ok().and_then(|t| {
+        t.rows
+            .into_iter()
+            .find(|r| r.simulated && r.block_dims().ok() == Some(block))
+    }) {
+        let m = row.measured_ratio();
+        let rel = 200.0 * m.err / m.value;
+        bands.push(fig::Band {
+            label: format!("the paper's experiment, {}: ±{rel:.1} % (2σ)", row.label()),
+            lo: 0.0,
+            hi: rel,
+            two_d: None,
+        });
+    }
+    for m in &res.modes {
+        let two_d = m.mode == Mode::TwoD;
+        for r in &m.rows {
+            pts.push(fig::MethodPoint {
+                label: r.method.clone(),
+                cost: r.cpu_s_per_1000,
+                error: 100.0 * r.error.abs(),
+                error_err: 100.0 * r.error_err,
+                two_d,
+                resolved: r.resolved,
+                on_front: m.pareto_front.contains(&r.method),
+                cheapest: m.cheapest_within.as_ref() == Some(&r.method),
+            });
+        }
+        // Rapier's converged departure: its box floor, exact levers, at its finest step.
+        if let Some(r) = m
+            .rows
+            .iter()
+            .filter(|r| r.engine == EngineKind::Rapier && r.rule == "fast" && r.floor == Floor::Box)
+            .min_by(|x, y| x.dt.total_cmp(&y.dt))
+        {
+            let (d, e) = (100.0 * r.error.abs(), 200.0 * r.error_err);
+            bands.push(fig::Band {
+                label: format!(
+                    "Rapier {} {} against Bullet: {:+.1} ± {:.1} % (2σ)",
+                    m.mode.name(),
+                    dt_label(r.dt),
+                    100.0 * r.error,
+                    e
+                ),
+                lo: d - e,
+                hi: d + e,
+                two_d: Some(two_d),
+            });
+        }
+    }
+    fig::tradeoff(
+        dir,
+        "tradeoff",
+        &format!(
+            "{}: cost against departure from Bullet at {} (±{} % at 2σ asked)",
+            res.block,
+            dt_label(res.reference_dt),
+            100.0 * res.precision
+        ),
+        &pts,
+        &bands,
+        100.0 * res.precision,
+    )?;
+    Ok(vec!["tradeoff"])
+}

@@ -1,0 +1,412 @@
+//! A study end to end, the same on one machine and on a cluster: its output files checked
+//! before it rolls anything, the study run, its results rendered (`report`) and written whole.
+//! A cluster task rolls its share and writes nothing; the finishing job writes the result.
+//! What the caller should print comes back as [`Done`].
+
+use super::{Progress, Study, StudyConfig};
+use crate::error::{Error, Result};
+use crate::report;
+use crate::report::per_roll::PerRoll;
+pub use crate::report::progress::Unit;
+use crate::report::summary::{Cost, RunSummary};
+use crate::run::cputime::process_cpu_seconds;
+use crate::run::io::Output;
+use crate::run::runner::{Checkpoint, ChunkShare, Runner};
+use crate::run::slurm::{Layout, Plan};
+use crate::run::spec::RunSpec;
+use crate::run::stop::Stop;
+use crate::sim::roll::RollRecord;
+use crate::studies;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Where and how a study runs: its threads, its share of the chunks, where its outputs and
+/// cells go, what it prints.
+#[derive(Clone, Debug)]
+pub struct Place {
+    /// The output directory. `crosscheck` writes none.
+    pub out: PathBuf,
+    /// Where the cells are kept (a directory per cell), if anywhere.
+    pub checkpoint: Option<PathBuf>,
+    /// Worker threads, at least 1.
+    pub threads: usize,
+    /// All the chunks; a cluster task's share; none (the finishing job, or a dry run).
+    pub share: ChunkShare,
+    /// Print the JSON result instead of the report.
+    pub json: bool,
+    /// The command line the report names as its own.
+    pub command_line: String,
+}
+
+/// What the caller hears while a study runs: its log lines, its progress (done and in all, in
+/// the unit `Hooks::unit` gives), and the stop flag it is stopped by.
+pub struct Hooks<'a> {
+    /// A line of the log (a cell, a row, the plan).
+    pub log: &'a (dyn Fn(&str) + Sync),
+    /// Progress: done and in all.
+    pub progress: Progress<'a>,
+    /// Checked before every roll.
+    pub stop: Stop,
+}
+
+/// What a study's caller prints when it is done.
+#[derive(Debug, Default)]
+pub struct Done {
+    /// For stdout: the report, or the JSON result.
+    pub stdout: String,
+    /// For stderr: what was written where (a field it names in backquotes, as in
+    /// `Error::Field`).
+    pub note: Option<String>,
+    /// Stopped before the end, and what was kept: the caller ends with its own exit code.
+    pub interrupted: Option<String>,
+}
+
+impl StudyConfig {
+    /// What the study's progress counts.
+    pub fn unit(&self) -> Unit {
+        match self {
+            StudyConfig::Paper(c) => Unit::Rolls { per_cell: c.rolls },
+            StudyConfig::Crosscheck(c) => Unit::Rolls {
+                per_cell: c.spec.indices().len(),
+            },
+            StudyConfig::Converge(c) if c.precision.is_some() => Unit::Cpu,
+            StudyConfig::Tradeoff(_) => Unit::Cpu,
+            _ => Unit::Cells,
+        }
+    }
+}
+
+/// The study stored in a cluster run's plan, where it runs (on all its chunks: a task narrows
+/// the share) and the run's tasks.
+pub fn planned(lay: &Layout) -> Result<(StudyConfig, Place, u64)> {
+    let Plan::Study {
+        config,
+        json,
+        command_line,
+        threads,
+        tasks,
+    } = lay.read_plan()?
+    else {
+        return Err(Error::Invalid(format!(
+            "{} is a roll's run, not a study's",
+            lay.dir.display()
+        )));
+    };
+    let cfg = serde_json::from_value(config)
+        .map_err(|e| Error::Invalid(format!("{} is damaged ({e})", lay.plan().display())))?;
+    let place = Place::cluster(lay, threads, json, ChunkShare::All, &command_line);
+    Ok((cfg, place, tasks))
+}
+
+impl Place {
+    /// Where a study of a cluster run writes, on every task and in the finishing job alike:
+    /// its outputs into the run's directory, its cells under its `checkpoint/`.
+    pub fn cluster(
+        lay: &Layout,
+        threads: usize,
+        json: bool,
+        share: ChunkShare,
+        command_line: &str,
+    ) -> Place {
+        Place {
+            out: lay.dir.clone(),
+            checkpoint: Some(lay.cells()),
+            threads,
+            share,
+            json,
+            command_line: command_line.to_string(),
+        }
+    }
+
+    /// A cluster task's share or a dry run: its tallies are partial, for no report.
+    pub(crate) fn partial(&self) -> bool {
+        self.share.is_partial()
+    }
+
+    /// How the study's cells run: these threads, its share, stopped by `stop`, telling
+    /// `progress` the rolls made in the current run.
+    pub(crate) fn study<'a>(&self, stop: &Stop, progress: &'a (dyn Fn(u64) + Sync)) -> Study<'a> {
+        Study {
+            runner: Runner::new(self.threads, stop.clone())
+                .with_share(self.share.clone())
+                .with_progress(progress),
+            checkpoint: self.checkpoint.clone(),
+        }
+    }
+
+    /// Creates the output directory and checks that `files` can be written in it.
+    pub(crate) fn outputs(&self, files: &[&str]) -> Result<Vec<Output>> {
+        std::fs::create_dir_all(&self.out).map_err(|e| {
+            Error::field("out", self.out.display(), format!("cannot create it ({e})"))
+        })?;
+        files
+            .iter()
+            .map(|f| Output::check(&self.out.join(f)))
+            .collect()
+    }
+
+    /// The JSON, or the report, to print; the note that says what was written.
+    pub(crate) fn done(&self, json: &str, report: &str, file: &str) -> Done {
+        Done {
+            stdout: format!("{}\n", if self.json { json } else { report }),
+            note: (!self.json)
+                .then(|| format!("wrote {}/{file}, report.md and figures", self.out.display())),
+            interrupted: None,
+        }
+    }
+}
+
+/// `roll`: one run, its chunks kept in `checkpoint` if given (a run there is continued), one
+/// CSV row per throw into `per_roll` if given (grown chunk by chunk in a temporary file, put
+/// in place at the end). Its summary is partial if a stop request ended it; a resumed run's
+/// cost is the sum over its segments (the resumed chunks carry theirs).
+pub fn roll(
+    spec: &RunSpec,
+    checkpoint: Option<&Path>,
+    per_roll: Option<Output>,
+    runner: &Runner,
+) -> Result<RunSummary> {
+    let checkpoint = checkpoint.map(|d| Checkpoint::open(d, spec)).transpose()?;
+    let mut csv = match &per_roll {
+        Some(out) => Some(PerRoll::new(out.writer()?, spec.scene.dt)?),
+        None => None,
+    };
+    let mut sink = |recs: &[RollRecord]| -> Result<()> {
+        match csv.as_mut() {
+            Some(c) => c.write(recs),
+            None => Ok(()),
+        }
+    };
+    let wall = Instant::now();
+    let cpu = process_cpu_seconds();
+    let done = runner.run(spec, checkpoint.as_ref(), &mut sink)?;
+    let cost = Cost {
+        wall_s: wall.elapsed().as_secs_f64() + done.resumed_wall_s,
+        cpu_s: process_cpu_seconds() - cpu + done.resumed_cpu_s,
+        threads: runner.threads,
+    };
+    if let Some(c) = csv {
+        c.finish()?.commit()?;
+    }
+    let mut summary = RunSummary::new(spec, &done.tally, cost);
+    summary.partial = !done.complete;
+    Ok(summary)
+}
+
+/// Runs a study that a cluster can split.
+pub fn run(config: &StudyConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
+    match config {
+        StudyConfig::Paper(c) => paper(c, place, hooks),
+        StudyConfig::Crosscheck(c) => crosscheck(c, place, hooks),
+        StudyConfig::Converge(c) => converge(c, place, hooks),
+        StudyConfig::Tradeoff(c) => tradeoff(c, place, hooks),
+        StudyConfig::Stability(c) => stability(c, place, hooks),
+    }
+}
+
+/// `paper`: results.json, results.csv, report.md and the figures, in `place.out`; its cells
+/// under `place.checkpoint`, so that the same study run again continues where it stopped.
+pub fn paper(cfg: &studies::paper::PaperConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
+    cfg.validate()?;
+    let outputs = place.outputs(&["results.json", "results.csv", "report.md"])?;
+    let total = studies::paper::total_rolls(cfg)? as f64;
+    let progress = |n: u64| (hooks.progress)(n as f64, total);
+    let res = studies::paper::run(
+        cfg,
+        place.command_line.clone(),
+        &place.study(&hooks.stop, &progress),
+    )?;
+    if place.partial() {
+        return Ok(Done::default());
+    }
+    if res.partial {
+        // A partial run leaves the last complete outputs alone: its report goes to stdout.
+        let figures = ["master_graph", "prob_2d", "len_graph", "dreidel"];
+        return Ok(Done {
+            stdout: format!("{}\n", report::paper::markdown(&res, &figures)),
+            note: None,
+            interrupted: Some(format!(
+                "interrupted; {} kept what was rolled: run the same command to continue",
+                place.out.join("checkpoint").display()
+            )),
+        });
+    }
+    let figures = report::paper::write_figures(&place.out, &res)?;
+    let md = report::paper::markdown(&res, &figures);
+    let json = to_json(&res)?;
+    outputs[0].write(json.as_bytes())?;
+    outputs[1].write(report::paper::results_csv(&res)?.as_bytes())?;
+    outputs[2].write(md.as_bytes())?;
+    let mut done = place.done(&json, &md, "report.md");
+    done.note = done.note.map(|_| {
+        format!(
+            "wrote {}/report.md, results.json, results.csv and figures",
+            place.out.display()
+        )
+    });
+    Ok(done)
+}
+
+/// `crosscheck`: each engine's run and each against the baseline, printed (no files).
+pub fn crosscheck(cfg: &studies::crosscheck::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
+    cfg.validate()?;
+    let rolls = cfg.spec.indices().len();
+    let total = (rolls * cfg.engines.len() as u64) as f64;
+    // The runner counts each engine's run from 0: the runs before it are whole.
+    let engine = std::sync::atomic::AtomicU64::new(0);
+    let progress = |n: u64| {
+        let before = engine.load(std::sync::atomic::Ordering::Relaxed) * rolls;
+        if n == rolls {
+            engine.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        }
+        (hooks.progress)((before + n) as f64, total);
+    };
+    let res = match studies::crosscheck::run(cfg, &place.study(&hooks.stop, &progress)) {
+        Err(Error::Stopped) => {
+            return Ok(Done {
+                interrupted: Some(match &place.checkpoint {
+                    Some(d) => format!(
+                        "interrupted; nothing compared; the rolls made are kept in {}: run the \
+                         same command to continue",
+                        d.display()
+                    ),
+                    None => "interrupted; nothing compared".into(),
+                }),
+                ..Done::default()
+            })
+        }
+        r => r?,
+    };
+    if place.partial() {
+        // A cluster task's share: its chunks are kept for the finishing job; nothing to compare.
+        return Ok(Done::default());
+    }
+    Ok(Done {
+        stdout: if place.json {
+            format!("{}\n", to_json(&res)?)
+        } else {
+            report::crosscheck::human(&res)
+        },
+        ..Done::default()
+    })
+}
+
+/// `converge`: converge.json, report.md and its figure.
+pub fn converge(cfg: &studies::converge::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
+    cfg.validate()?;
+    let outputs = place.outputs(&["converge.json", "report.md"])?;
+    let Some(res) = logged(place, hooks, &report::converge::header(), |study, log| {
+        studies::converge::run(cfg, study, log, hooks.progress)
+    })?
+    else {
+        return Ok(Done::default());
+    };
+    let figures = report::converge::write_figures(&place.out, &res, cfg.precision)?;
+    let md = report::converge::markdown(&res, cfg.precision, &figures);
+    write(place, &outputs, &res, &md, "converge.json")
+}
+
+/// `tradeoff`: tradeoff.json, report.md and its figure; or the plan; or the rolls ahead.
+pub fn tradeoff(cfg: &studies::tradeoff::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
+    cfg.validate()?;
+    let outputs = place.outputs(&["tradeoff.json", "report.md"])?;
+    let Some(res) = logged(place, hooks, &report::tradeoff::header(), |study, log| {
+        studies::tradeoff::run(cfg, study, log, hooks.progress)
+    })?
+    else {
+        return Ok(Done::default());
+    };
+    if cfg.plan_only {
+        let stdout = if place.json {
+            format!("{}\n", to_json(&res)?)
+        } else {
+            String::new()
+        };
+        return Ok(Done {
+            stdout,
+            ..Done::default()
+        });
+    }
+    if let Some(k) = cfg.preroll_chunks {
+        return Ok(Done {
+            note: Some(format!(
+                "rolled the first {} throws of every stream into {}/checkpoint ({:.0} CPU s); \
+                 the same study without `preroll_chunks` reads them back",
+                k * crate::run::runner::CHUNK_ROLLS,
+                place.out.display(),
+                res.cpu_s
+            )),
+            ..Done::default()
+        });
+    }
+    let figures = report::tradeoff::write_figures(&place.out, &res, cfg.block)?;
+    let md = report::tradeoff::markdown(&res, &figures);
+    write(place, &outputs, &res, &md, "tradeoff.json")
+}
+
+/// `stability`: stability.json, report.md and its heat maps.
+pub fn stability(cfg: &studies::stability::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
+    cfg.validate()?;
+    let outputs = place.outputs(&["stability.json", "report.md"])?;
+    let Some(res) = logged(place, hooks, &report::stability::header(), |study, log| {
+        studies::stability::run(cfg, study, log, hooks.progress)
+    })?
+    else {
+        return Ok(Done::default());
+    };
+    let figures = report::stability::write_figures(&place.out, &res)?;
+    let md = report::stability::markdown(&res, &figures);
+    write(place, &outputs, &res, &md, "stability.json")
+}
+
+/// `validate`: validate.json, report.md and its figures.
+pub fn validate(cfg: &studies::validate::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
+    cfg.validate()?;
+    let outputs = place.outputs(&["validate.json", "report.md"])?;
+    let Some(res) = logged(place, hooks, &report::validate::header(), |study, log| {
+        studies::validate::run(cfg, study, log, hooks.progress)
+    })?
+    else {
+        return Ok(Done::default());
+    };
+    let figures = report::validate::write_figures(&place.out, &res)?;
+    let md = report::validate::markdown(&res, &figures);
+    write(place, &outputs, &res, &md, "validate.json")
+}
+
+pub(crate) fn to_json<T: Serialize>(v: &T) -> Result<String> {
+    serde_json::to_string_pretty(v).map_err(|e| Error::Failed(e.to_string()))
+}
+
+/// Writes the JSON and the report into the outputs checked before the run.
+fn write<T: Serialize>(
+    place: &Place,
+    outputs: &[Output],
+    res: &T,
+    report: &str,
+    file: &str,
+) -> Result<Done> {
+    let json = to_json(res)?;
+    outputs[0].write(json.as_bytes())?;
+    outputs[1].write(report.as_bytes())?;
+    Ok(place.done(&json, report, file))
+}
+
+/// Runs a sweep, logging its header and each cell unless the output is JSON. A cluster task's
+/// share runs silently and gives None: it is for the finishing job to assemble, not to report.
+fn logged<T>(
+    place: &Place,
+    hooks: &Hooks,
+    header: &str,
+    run: impl FnOnce(&Study, &(dyn Fn(&str) + Sync)) -> Result<T>,
+) -> Result<Option<T>> {
+    let quiet = place.json || place.partial();
+    if !quiet {
+        (hooks.log)(header);
+    }
+    let silent = |_: &str| {};
+    let log: &(dyn Fn(&str) + Sync) = if quiet { &silent } else { hooks.log };
+    let res = run(&place.study(&hooks.stop, &|_| {}), log)?;
+    Ok((!place.partial()).then_some(res))
+}

@@ -1,0 +1,715 @@
+//! The documentation against the program: every relative link in README.md, CHANGELOG.md and
+//! docs/ resolves (file and anchor), the README keeps the two commands `.ci/run` reads, and
+//! docs/json.md lists exactly the keys each `--json` output has.
+//!
+//! docs/json.md gives each document a table after a marker `<!-- keys: NAME -->`: one row per
+//! key path (`counts.breadth`, `rows[].method`, `failed.<reason>` for keys that vary), its
+//! second cell empty when the key is always there. A document is checked at its top level and
+//! one level down in full (every key listed, every always-present key there), and deeper
+//! wherever json.md lists the keys; every key a table lists must turn up in at least one of
+//! the runs here. The runs are tiny (a few seconds in all) and fixed-seed.
+
+use super::helpers::{dicephys, json, Scratch};
+use serde_json::Value;
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn read(p: &Path) -> String {
+    std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Links
+
+/// README.md, CHANGELOG.md and every Markdown file under docs/.
+fn markdown_files() -> Vec<PathBuf> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        let mut entries: Vec<_> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        entries.sort();
+        for p in entries {
+            if p.is_dir() {
+                walk(&p, out);
+            } else if p.extension().is_some_and(|e| e == "md") {
+                out.push(p);
+            }
+        }
+    }
+    let mut v = vec![root().join("README.md"), root().join("CHANGELOG.md")];
+    walk(&root().join("docs"), &mut v);
+    v
+}
+
+/// The text outside fenced code blocks, with inline code spans blanked, line by line.
+fn prose_lines(text: &str) -> Vec<String> {
+    let mut fenced = false;
+    let mut out = Vec::new();
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+            continue;
+        }
+        if fenced {
+            continue;
+        }
+        let mut s = String::new();
+        let mut code = false;
+        for c in line.chars() {
+            if c == '`' {
+                code = !code;
+            } else if !code {
+                s.push(c);
+            }
+        }
+        out.push(s);
+    }
+    out
+}
+
+/// The targets of inline links and images, `[text](target)`.
+fn link_targets(text: &str) -> Vec<String> {
+    let mut v = Vec::new();
+    for line in prose_lines(text) {
+        let mut rest = line.as_str();
+        while let Some(i) = rest.find("](") {
+            let after = &rest[i + 2..];
+            let end = after.find(')').unwrap_or(after.len());
+            v.push(after[..end].trim().to_string());
+            rest = &after[end..];
+        }
+    }
+    v
+}
+
+/// GitHub's anchor for a heading: lower case, inline code and link markup dropped, letters,
+/// digits, `-` and `_` kept, spaces turned into `-`, everything else left out.
+fn slug(heading: &str) -> String {
+    let mut text = String::new();
+    let mut rest = heading;
+    // [text](target) -> text
+    while let Some(i) = rest.find('[') {
+        text.push_str(&rest[..i]);
+        let after = &rest[i + 1..];
+        match (after.find("]("), after.find(')')) {
+            (Some(j), Some(k)) if j < k => {
+                text.push_str(&after[..j]);
+                rest = &after[k + 1..];
+            }
+            _ => {
+                text.push('[');
+                rest = after;
+            }
+        }
+    }
+    text.push_str(rest);
+    text.trim()
+        .to_lowercase()
+        .chars()
+        .filter_map(|c| match c {
+            ' ' => Some('-'),
+            '-' | '_' => Some(c),
+            c if c.is_alphanumeric() => Some(c),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Every anchor a Markdown text's headings make (repeats get `-1`, `-2`, … as on GitHub).
+fn anchors(text: &str) -> BTreeSet<String> {
+    let mut seen: BTreeMap<String, usize> = BTreeMap::new();
+    let mut out = BTreeSet::new();
+    let mut fenced = false;
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+            continue;
+        }
+        if fenced || !line.starts_with('#') {
+            continue;
+        }
+        let s = slug(line.trim_start_matches('#'));
+        let n = seen.entry(s.clone()).or_insert(0);
+        out.insert(if *n == 0 {
+            s.clone()
+        } else {
+            format!("{s}-{n}")
+        });
+        *n += 1;
+    }
+    out
+}
+
+/// What is wrong with the relative links of `file`: a target that does not exist, or an
+/// anchor that no heading of the target makes.
+fn broken_links(file: &Path) -> Vec<String> {
+    let text = read(file);
+    let dir = file.parent().unwrap();
+    let mut bad = Vec::new();
+    for t in link_targets(&text) {
+        if t.contains("://") || t.starts_with("mailto:") || t.is_empty() {
+            continue;
+        }
+        let (path, anchor) = match t.split_once('#') {
+            Some((p, a)) => (p, Some(a)),
+            None => (t.as_str(), None),
+        };
+        let target = if path.is_empty() {
+            file.to_path_buf()
+        } else {
+            dir.join(path)
+        };
+        if !target.exists() {
+            bad.push(format!("{}: {t}: no such file", file.display()));
+            continue;
+        }
+        if let Some(a) = anchor {
+            if target.extension().is_some_and(|e| e == "md") && !anchors(&read(&target)).contains(a)
+            {
+                bad.push(format!("{}: {t}: no heading makes #{a}", file.display()));
+            }
+        }
+    }
+    bad
+}
+
+#[test]
+fn every_relative_link_in_the_docs_resolves() {
+    let files = markdown_files();
+    assert!(files.len() >= 10, "README, CHANGELOG and docs/: {files:?}");
+    let bad: Vec<String> = files.iter().flat_map(|f| broken_links(f)).collect();
+    assert!(bad.is_empty(), "broken links:\n{}", bad.join("\n"));
+}
+
+#[test]
+fn the_link_check_finds_a_missing_file_and_a_missing_anchor() {
+    let dir = Scratch::new("links");
+    std::fs::write(dir.join("b.md"), "# One heading\n\n## `roll --json`\n").unwrap();
+    let a = dir.join("a.md");
+    std::fs::write(
+        &a,
+        "[ok](b.md#one-heading) [ok](b.md#roll---json) [code](`x.md`) `[not](a link)`\n\
+         [gone](c.md) [bad anchor](b.md#two) ![pic](d.png) [web](https://example.org/x)\n\
+         ```\n[fenced](nowhere.md)\n```\n",
+    )
+    .unwrap();
+    let bad = broken_links(&a);
+    assert_eq!(bad.len(), 3, "{bad:#?}");
+    assert!(bad[0].ends_with("c.md: no such file"));
+    assert!(bad[1].ends_with("b.md#two: no heading makes #two"));
+    assert!(bad[2].ends_with("d.png: no such file"));
+}
+
+#[test]
+fn the_readme_keeps_its_two_commands_first_and_stays_short() {
+    let text = read(&root().join("README.md"));
+    // As `.ci/run` reads it: the lines of the first fenced block.
+    let block: Vec<&str> = text
+        .lines()
+        .skip_while(|l| !l.starts_with("```"))
+        .skip(1)
+        .take_while(|l| !l.starts_with("```"))
+        .collect();
+    assert_eq!(
+        block,
+        [
+            "sh setup.sh && cargo run --release -- paper",
+            "sh setup.sh && cargo test --release"
+        ]
+    );
+    let n = text.lines().count();
+    assert!(
+        n <= 250,
+        "README.md has {n} lines; the guide and results live in docs/"
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// docs/json.md against the outputs
+
+/// One documented key path and whether it is always there.
+#[derive(Debug)]
+struct Key {
+    path: String,
+    required: bool,
+}
+
+/// Every `<!-- keys: NAME -->` table of a Markdown text: NAME → its key paths.
+fn key_tables(md: &str) -> BTreeMap<String, Vec<Key>> {
+    let mut tables: BTreeMap<String, Vec<Key>> = BTreeMap::new();
+    let mut current: Option<String> = None;
+    for line in md.lines() {
+        let t = line.trim();
+        if let Some(rest) = t.strip_prefix("<!-- keys:") {
+            let name = rest.trim_end_matches("-->").trim().to_string();
+            assert!(!tables.contains_key(&name), "two tables named {name}");
+            tables.insert(name.clone(), Vec::new());
+            current = Some(name);
+        } else if t.starts_with('#') {
+            current = None;
+        } else if let (Some(name), true) = (&current, t.starts_with("| `")) {
+            let cells: Vec<&str> = t.split('|').collect();
+            let required = cells[2].trim().is_empty();
+            for (i, part) in cells[1].split('`').enumerate() {
+                if i % 2 == 1 {
+                    tables.get_mut(name).unwrap().push(Key {
+                        path: part.to_string(),
+                        required,
+                    });
+                }
+            }
+        }
+    }
+    tables
+}
+
+/// A table's paths with their implied parents (`a.b[].c` implies `a` and `a.b[]`), each
+/// required if it is listed as such or any key under it is.
+fn expand(keys: &[Key]) -> BTreeMap<String, bool> {
+    let mut m: BTreeMap<String, bool> = BTreeMap::new();
+    for k in keys {
+        let segs: Vec<&str> = k.path.split('.').collect();
+        for n in 1..=segs.len() {
+            let p = segs[..n].join(".");
+            *m.entry(p).or_insert(false) |= k.required;
+        }
+    }
+    // A listed optional key stays optional even if a required key sits under it.
+    for k in keys {
+        if !k.required {
+            m.insert(k.path.clone(), false);
+        }
+    }
+    m
+}
+
+/// Where a document holds another documented one: (table, path, the table it follows).
+const REFS: &[(&str, &str, &str)] = &[
+    ("roll", "outcomes.breadth", "probability"),
+    ("roll", "outcomes.width", "probability"),
+    ("roll", "outcomes.length", "probability"),
+    ("roll", "tally", "tally"),
+    ("crosscheck", "runs[]", "roll"),
+    ("paper", "table", "theory-table"),
+    ("paper", "simulations[].run", "roll"),
+    ("tradeoff", "modes[].reference", "tradeoff-row"),
+    ("tradeoff", "modes[].checks[]", "tradeoff-row"),
+    ("tradeoff", "modes[].rows[]", "tradeoff-row"),
+    ("validate", "cells[].tally", "tally"),
+];
+
+fn parent(path: &str) -> &str {
+    path.rfind('.').map_or("", |i| &path[..i])
+}
+
+fn join(parent: &str, seg: &str) -> String {
+    if parent.is_empty() {
+        seg.to_string()
+    } else {
+        format!("{parent}.{seg}")
+    }
+}
+
+/// Checks documents against json.md's tables, and keeps which documented paths were seen.
+struct Checker {
+    tables: BTreeMap<String, BTreeMap<String, bool>>,
+    seen: BTreeMap<String, BTreeSet<String>>,
+    errors: Vec<String>,
+}
+
+impl Checker {
+    fn new(md: &str) -> Checker {
+        let tables = key_tables(md)
+            .into_iter()
+            .map(|(n, keys)| (n, expand(&keys)))
+            .collect();
+        Checker {
+            tables,
+            seen: BTreeMap::new(),
+            errors: Vec::new(),
+        }
+    }
+
+    /// Checks one document (`what` names it in messages) against table `table`.
+    fn document(&mut self, table: &str, what: &str, v: &Value) {
+        assert!(
+            self.tables.contains_key(table),
+            "docs/json.md has no `<!-- keys: {table} -->` table"
+        );
+        match v {
+            Value::Object(_) => self.object(table, "", what, v),
+            Value::Array(a) => {
+                for e in a {
+                    self.object(table, "", what, e);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn object(&mut self, table: &str, at: &str, what: &str, v: &Value) {
+        let Value::Object(obj) = v else { return };
+        let doc = &self.tables[table];
+        let children: BTreeMap<String, String> = doc
+            .keys()
+            .filter(|p| parent(p) == at && p.len() > at.len())
+            .map(|p| {
+                let seg = &p[if at.is_empty() { 0 } else { at.len() + 1 }..];
+                (seg.trim_end_matches("[]").to_string(), p.clone())
+            })
+            .collect();
+        if children.keys().any(|k| k.starts_with('<')) {
+            return; // keys that vary (`failed.<reason>`)
+        }
+        let depth = if at.is_empty() {
+            0
+        } else {
+            at.split('.').count()
+        };
+        let here = if at.is_empty() { "(top level)" } else { at };
+        if children.is_empty() {
+            if depth <= 1 && !obj.is_empty() {
+                self.errors.push(format!(
+                    "{what}: {table}: `{here}` has keys {:?} and json.md lists none of them",
+                    obj.keys().collect::<Vec<_>>()
+                ));
+            }
+            return;
+        }
+        for k in obj.keys() {
+            if !children.contains_key(k) {
+                self.errors.push(format!(
+                    "{what}: {table}: `{}` is in the output, not in docs/json.md",
+                    join(at, k)
+                ));
+            }
+        }
+        for (k, p) in &children {
+            if doc[p] && !obj.contains_key(k) {
+                self.errors.push(format!(
+                    "{what}: {table}: `{p}` is listed as always present and is missing"
+                ));
+            }
+        }
+        for (k, x) in obj {
+            let Some(p) = children.get(k).cloned() else {
+                continue;
+            };
+            self.seen.entry(table.into()).or_default().insert(p.clone());
+            if let Some(&(_, _, other)) = REFS.iter().find(|r| r.0 == table && r.1 == p) {
+                let sub = format!("{what} `{p}`");
+                self.document(other, &sub, x);
+                continue;
+            }
+            match x {
+                Value::Object(_) => self.object(table, &p, what, x),
+                Value::Array(a) => {
+                    let elem = if p.ends_with("[]") {
+                        p.clone()
+                    } else {
+                        format!("{p}[]")
+                    };
+                    for e in a {
+                        self.object(table, &elem, what, e);
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// Fails on every error so far, and on any key of `tables` that no document showed.
+    fn finish(self, tables: &[&str]) {
+        let mut errors = self.errors;
+        errors.dedup();
+        for t in tables {
+            let seen = self.seen.get(*t).cloned().unwrap_or_default();
+            for p in self.tables[*t].keys() {
+                if !p.contains('<') && !seen.contains(p) {
+                    errors.push(format!(
+                        "{t}: `{p}` is in docs/json.md and in none of the outputs"
+                    ));
+                }
+            }
+        }
+        assert!(
+            errors.is_empty(),
+            "docs/json.md and the outputs disagree:\n{}",
+            errors.join("\n")
+        );
+    }
+}
+
+fn checker() -> Checker {
+    Checker::new(&read(&root().join("docs/json.md")))
+}
+
+/// A command's `--json` document.
+fn run(args: &[&str]) -> Value {
+    json(&dicephys(args))
+}
+
+/// A study's `--json` document, with the file it wrote into `--out` beside it.
+fn study(args: &[&str], file: &str) -> (Value, Value) {
+    let out = Scratch::absent("docs-json");
+    let o = out.to_str().unwrap();
+    let mut a = args.to_vec();
+    a.extend(["--out", o, "--json"]);
+    let v = run(&a);
+    let f: Value = serde_json::from_str(&read(&out.join(file))).unwrap();
+    (v, f)
+}
+
+#[test]
+fn json_md_lists_the_keys_of_roll_and_merge() {
+    let mut c = checker();
+    let roll = |extra: &[&str]| {
+        let mut a = vec!["roll", "--rolls", "20", "--seed", "1", "--threads", "1"];
+        a.extend(extra);
+        a.push("--json");
+        run(&a)
+    };
+    let d3 = roll(&["--block", "140x24x20"]);
+    let d2 = roll(&["--block", "140x24x20", "--2d"]);
+    let odd = roll(&[
+        "--block",
+        "30x20x10",
+        "--audit",
+        "--throw",
+        "tumble",
+        "--linear-damping",
+        "1",
+        "--angular-damping",
+        "1",
+        "--no-sleep",
+    ]);
+    let none = roll(&["--block", "140x24x20", "--max-steps", "1"]);
+    // The documented absences: 3D has its three outcomes, 2D none, and neither has them when
+    // no die came to rest on a face.
+    assert!(d3.get("outcomes").is_some());
+    assert!(d2.get("outcomes").is_none());
+    assert_eq!(none["unconverged"], 20);
+    assert!(none.get("outcomes").is_none());
+
+    let dir = Scratch::new("docs-merge");
+    let mut shards = Vec::new();
+    for k in ["0/2", "1/2"] {
+        let s = roll(&["--block", "140x24x20", "--shard", k]);
+        let f = dir.join(format!("s{}.json", &k[..1]));
+        std::fs::write(&f, serde_json::to_string(&s).unwrap()).unwrap();
+        c.document("roll", &format!("roll --shard {k}"), &s);
+        shards.push(f);
+    }
+    let merged = json(
+        &super::helpers::bin()
+            .arg("merge")
+            .args(&shards)
+            .arg("--json")
+            .output()
+            .unwrap(),
+    );
+    assert!(merged["spec"]["shard"].is_null());
+    for (what, v) in [
+        ("roll 3D", &d3),
+        ("roll 2D", &d2),
+        ("roll --audit --throw tumble, damped", &odd),
+        ("roll --max-steps 1", &none),
+        ("merge", &merged),
+    ] {
+        c.document("roll", what, v);
+    }
+    c.finish(&["roll", "probability", "tally"]);
+}
+
+#[test]
+fn json_md_lists_the_keys_of_crosscheck_theory_and_bench() {
+    let mut c = checker();
+    let cc = run(&[
+        "crosscheck",
+        "--block",
+        "140x24x20",
+        "--rolls",
+        "20",
+        "--threads",
+        "1",
+        "--json",
+    ]);
+    c.document("crosscheck", "crosscheck", &cc);
+    let tb = run(&["theory", "--block", "140x24x20", "--json"]);
+    c.document("theory-block", "theory --block", &tb);
+    let tt = run(&["theory", "--table", "--json"]);
+    c.document("theory-table", "theory --table", &tt);
+    let bench = run(&["bench", "--rolls", "4", "--threads", "1", "--json"]);
+    c.document("bench", "bench", &bench);
+    c.finish(&["crosscheck", "theory-block", "theory-table", "bench"]);
+}
+
+#[test]
+fn json_md_lists_the_keys_of_paper_converge_and_stability() {
+    let mut c = checker();
+    let (v, f) = study(
+        &["paper", "--rolls", "20", "--threads", "1"],
+        "results.json",
+    );
+    c.document("paper", "paper --json", &v);
+    c.document("paper", "results.json", &f);
+    let (v, f) = study(
+        &[
+            "converge",
+            "--blocks",
+            "140x24x20",
+            "--dts",
+            "1/1000,1/2000",
+            "--engines",
+            "bullet",
+            "--rolls",
+            "20",
+            "--threads",
+            "1",
+        ],
+        "converge.json",
+    );
+    assert!(!v["claims"].as_array().unwrap().is_empty());
+    c.document("converge", "converge --json", &v);
+    c.document("converge", "converge.json", &f);
+    let (v, _) = study(
+        &[
+            "converge",
+            "--blocks",
+            "140x24x20",
+            "--dts",
+            "1/250,1/500",
+            "--engines",
+            "bullet",
+            "--fast",
+            "--precision",
+            "50",
+            "--budget",
+            "1",
+            "--reference-budget",
+            "1",
+            "--threads",
+            "1",
+        ],
+        "converge.json",
+    );
+    c.document("converge", "converge --precision", &v);
+    let (v, f) = study(
+        &[
+            "stability",
+            "--engines",
+            "bullet",
+            "--dts",
+            "1/1000,1/30",
+            "--restitutions",
+            "0,0.95",
+            "--frictions",
+            "0.29",
+            "--blocks",
+            "140x24x20",
+            "--rolls",
+            "10",
+            "--threads",
+            "1",
+        ],
+        "stability.json",
+    );
+    c.document("stability", "stability --json", &v);
+    c.document("stability", "stability.json", &f);
+    c.finish(&["paper", "converge", "stability"]);
+}
+
+#[test]
+fn json_md_lists_the_keys_of_tradeoff_and_validate() {
+    let mut c = checker();
+    // The coarsest steps keep the pilot (1,000 rolls of every method) to a few CPU seconds.
+    let (v, f) = study(
+        &[
+            "tradeoff",
+            "--dts",
+            "1/10",
+            "--rapier-dts",
+            "1/10",
+            "--reference-dt",
+            "1/20",
+            "--max-steps",
+            "2000",
+            "--ladder",
+            "none",
+            "--precision",
+            "50",
+            "--budget",
+            "1",
+            "--reference-budget",
+            "1",
+            "--threads",
+            "2",
+        ],
+        "tradeoff.json",
+    );
+    assert!(v.get("rolls").is_none() && v["modes"][0].get("cheapest_within").is_some());
+    c.document("tradeoff", "tradeoff --json", &v);
+    c.document("tradeoff", "tradeoff.json", &f);
+    let (v, f) = study(
+        &[
+            "validate",
+            "--rolls",
+            "60",
+            "--trend-rolls",
+            "30",
+            "--blocks-2d",
+            "140x22x13",
+            "--blocks-3d",
+            "20x20x20",
+            "--trend",
+            "0:0.1,0.9:1.5",
+            "--flight-dts",
+            "1/250,1/1000",
+            "--threads",
+            "1",
+        ],
+        "validate.json",
+    );
+    c.document("validate", "validate --json", &v);
+    c.document("validate", "validate.json", &f);
+    c.finish(&["tradeoff", "tradeoff-row", "validate"]);
+}
+
+#[test]
+fn the_key_check_finds_an_extra_a_missing_and_a_phantom_key() {
+    let md = "<!-- keys: t -->\n| key | present | meaning |\n|---|---|---|\n\
+              | `a` | | |\n| `b.x`, `b.y` | | |\n| `c` | sometimes | |\n| `d[].e` | | |\n\
+              | `gone` | when asked | |\n| `m.<k>` | | |\n";
+    let mut c = Checker::new(md);
+    let v: Value = serde_json::json!({
+        "a": 1, "b": {"x": 1, "z": 2}, "d": [{"e": 1}, {}], "m": {"any": 1}, "extra": {"q": 1}
+    });
+    c.document("t", "doc", &v);
+    let mut errors = c.errors.clone();
+    errors.sort();
+    assert_eq!(
+        errors,
+        [
+            "doc: t: `b.y` is listed as always present and is missing",
+            "doc: t: `b.z` is in the output, not in docs/json.md",
+            "doc: t: `d[].e` is listed as always present and is missing",
+            "doc: t: `extra` is in the output, not in docs/json.md",
+        ]
+    );
+    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| c.finish(&["t"])));
+    let msg = r.unwrap_err();
+    let msg = msg.downcast_ref::<String>().unwrap();
+    assert!(
+        msg.contains("`c` is in docs/json.md and in none of the outputs"),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("`gone` is in docs/json.md and in none"),
+        "{msg}"
+    );
+}
