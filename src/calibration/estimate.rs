@@ -230,8 +230,8 @@ pub struct Estimate {
     pub chi2: f64,
     /// Its degrees of freedom: independent counts less free parameters.
     pub dof: i64,
-    /// P(χ²_dof ≥ χ²).
-    pub p_value: f64,
+    /// P(χ²_dof ≥ χ²); none with no degrees of freedom left.
+    pub p_value: Option<f64>,
     /// Δ(−2 ln L) bounding the joint 2σ region: χ²'s quantile at 95.45 % for as many
     /// parameters, times the Bartlett factor.
     pub region_delta: f64,
@@ -357,11 +357,7 @@ pub fn estimate(lik: &Likelihood, params: &[Param], search: &Search) -> Result<E
         rows,
         chi2,
         dof,
-        p_value: if dof > 0 {
-            stats::chi_square_p_value(chi2, dof as usize)
-        } else {
-            f64::NAN
-        },
+        p_value: (dof > 0).then(|| stats::chi_square_p_value(chi2, dof as usize)),
         region_delta: b * region_delta(dims, TWO_SIGMA),
         bartlett: b,
         other_maxima,

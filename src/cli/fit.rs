@@ -37,16 +37,16 @@ pub struct FitArgs {
     #[arg(long = "range", value_name = "NAME=LO:HI")]
     pub ranges: Vec<String>,
     /// e where it is not free.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub restitution: f64,
     /// μ where it is not free.
-    #[arg(long, default_value_t = 0.29)]
+    #[arg(long, default_value_t = 0.29, allow_hyphen_values = true)]
     pub friction: f64,
     /// The throw where kappa is not free: "paper" (the paper's throw) or a hand's κ.
-    #[arg(long, default_value = "paper")]
+    #[arg(long, default_value = "paper", allow_hyphen_values = true)]
     pub kappa: String,
     /// The spin scale where spin is not free.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     pub spin_scale: f64,
     /// The engine.
     #[arg(long, default_value = "bullet", value_parser = parse_engine)]
@@ -139,7 +139,7 @@ pub fn parse_kind(s: &str) -> std::result::Result<Kind, dicephys::Error> {
 fn pairs<T>(
     flag: &str,
     items: &[&str],
-    value: impl Fn(&str) -> Option<T>,
+    value: impl Fn(&str) -> std::result::Result<T, String>,
 ) -> Result<Vec<(Kind, T)>> {
     items
         .iter()
@@ -149,9 +149,7 @@ fn pairs<T>(
                 .ok_or_else(|| Error::Usage(format!("{flag} {item}: write NAME=VALUE")))?;
             let kind =
                 parse_kind(k.trim()).map_err(|e| Error::Usage(format!("{flag} {item}: {e}")))?;
-            let v = value(v.trim()).ok_or_else(|| {
-                Error::Usage(format!("{flag} {item}: '{v}' is not a valid value"))
-            })?;
+            let v = value(v.trim()).map_err(|e| Error::Usage(format!("{flag} {item}: {e}")))?;
             Ok((kind, v))
         })
         .collect()
@@ -164,7 +162,9 @@ impl FitArgs {
         free.dedup();
         let mut ranges: Vec<Range> = free.iter().map(|k| k.default_range()).collect();
         let given: Vec<&str> = self.ranges.iter().map(String::as_str).collect();
-        for (kind, r) in pairs("--range", &given, |v| v.parse::<Range>().ok())? {
+        for (kind, r) in pairs("--range", &given, |v| {
+            v.parse::<Range>().map_err(|e| e.to_string())
+        })? {
             let i = free.iter().position(|k| *k == kind).ok_or_else(|| {
                 Error::Usage(format!("--range {kind}=…: {kind} is not among --free"))
             })?;
@@ -251,7 +251,10 @@ pub fn run(a: &FitArgs) -> Result<()> {
 fn truth_values(cfg: &FitConfig, truth: &str) -> Result<Vec<f64>> {
     let given: Vec<&str> = truth.split(',').collect();
     let values = pairs("--recover", &given, |v| {
-        v.parse::<f64>().ok().filter(|x| x.is_finite())
+        v.parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("'{v}' is not a finite number"))
     })?;
     if let Some((k, _)) = values.iter().find(|(k, _)| !cfg.model.free.contains(k)) {
         return Err(Error::Usage(format!(

@@ -125,10 +125,9 @@ pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
          binomial widened by the simulation's noise).\n",
         e.chi2,
         e.dof,
-        if e.p_value.is_finite() {
-            format!("{:.3}", e.p_value)
-        } else {
-            "undefined (no degrees of freedom left)".into()
+        match e.p_value {
+            Some(p) => format!("{p:.3}"),
+            None => "undefined (no degrees of freedom left)".into(),
         }
     );
     let _ = writeln!(s, "| row | surface | outcome | counted | fitted p | z |");

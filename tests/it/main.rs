@@ -6,6 +6,7 @@ mod helpers;
 mod bullet;
 mod cli;
 mod coarse;
+mod fit;
 mod docs;
 mod fuzz;
 mod rapier;
