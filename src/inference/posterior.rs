@@ -81,7 +81,7 @@ pub fn sample(
                     chol = l.l();
                 }
             }
-        } else if (step - burn) % thin.max(1) == 0 {
+        } else if (step - burn).is_multiple_of(thin.max(1)) {
             out.push(x.clone());
         }
     }

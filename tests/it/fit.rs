@@ -27,16 +27,39 @@ fn the_fit_recovers_known_parameters_in_its_2_sigma_region() {
     let dir = Scratch::new("fit-recover");
     let csv = two_blocks(&dir);
     let out = dicephys(&[
-        "fit", "--data", &csv, "--free", "e,mu,kappa", "--points", "24", "--degree", "2",
-        "--rolls", "150", "--dt", "1/250", "--recover", "e=0.5,mu=0.3,kappa=30", "--repeats",
-        "20", "--seed", "11", "--out", dir.to_str().unwrap(), "--json",
+        "fit",
+        "--data",
+        &csv,
+        "--free",
+        "e,mu,kappa",
+        "--points",
+        "24",
+        "--degree",
+        "2",
+        "--rolls",
+        "150",
+        "--dt",
+        "1/250",
+        "--recover",
+        "e=0.5,mu=0.3,kappa=30",
+        "--repeats",
+        "20",
+        "--seed",
+        "11",
+        "--out",
+        dir.to_str().unwrap(),
+        "--json",
     ]);
     let r = json(&out);
     let reps = r["repetitions"].as_array().unwrap();
     assert_eq!(reps.len(), 20);
     let covered = reps.iter().filter(|x| x["covered"] == true).count();
     assert!(covered >= 18, "{covered} of 20 covered: {r}");
-    let mean: f64 = reps.iter().map(|x| x["truth_delta"].as_f64().unwrap()).sum::<f64>() / 20.0;
+    let mean: f64 = reps
+        .iter()
+        .map(|x| x["truth_delta"].as_f64().unwrap())
+        .sum::<f64>()
+        / 20.0;
     assert!(mean < 6.0, "the truth's mean Δ {mean}");
     assert!(dir.join("recovery.json").exists());
 }
@@ -53,9 +76,24 @@ fn a_fit_is_the_same_on_one_thread_and_two_and_predicts_with_errors() {
     let fit = |threads: &str, out: &str| {
         let out_dir = dir.join(out);
         json(&dicephys(&[
-            "fit", "--data", csv.to_str().unwrap(), "--free", "e,mu", "--points", "20",
-            "--degree", "2", "--rolls", "100", "--dt", "1/250", "--threads", threads, "--out",
-            out_dir.to_str().unwrap(), "--json",
+            "fit",
+            "--data",
+            csv.to_str().unwrap(),
+            "--free",
+            "e,mu",
+            "--points",
+            "20",
+            "--degree",
+            "2",
+            "--rolls",
+            "100",
+            "--dt",
+            "1/250",
+            "--threads",
+            threads,
+            "--out",
+            out_dir.to_str().unwrap(),
+            "--json",
         ]))
     };
     let (a, b) = (fit("1", "one"), fit("2", "two"));
@@ -78,11 +116,23 @@ fn a_fit_is_the_same_on_one_thread_and_two_and_predicts_with_errors() {
     // A block the fit did not see, on its surface: probabilities with both errors.
     let fit_json = dir.join("one/fit.json");
     let p = json(&dicephys(&[
-        "predict", "--fit", fit_json.to_str().unwrap(), "--block", "140x27x13", "--2d",
-        "--draws", "4", "--rolls", "200", "--json",
+        "predict",
+        "--fit",
+        fit_json.to_str().unwrap(),
+        "--block",
+        "140x27x13",
+        "--2d",
+        "--draws",
+        "4",
+        "--rolls",
+        "200",
+        "--json",
     ]));
     let ratio = &p["ratio"];
-    assert!(ratio["value"].as_f64().unwrap() > 0.0 && ratio["err"].as_f64().unwrap() > 0.0, "{p}");
+    assert!(
+        ratio["value"].as_f64().unwrap() > 0.0 && ratio["err"].as_f64().unwrap() > 0.0,
+        "{p}"
+    );
     let (ep, es, e) = (
         ratio["err_params"].as_f64().unwrap(),
         ratio["err_sim"].as_f64().unwrap(),
@@ -91,7 +141,12 @@ fn a_fit_is_the_same_on_one_thread_and_two_and_predicts_with_errors() {
     assert!((e * e - ep * ep - es * es).abs() < 1e-12, "{ratio}");
     // An unknown surface is refused with one line.
     let bad = dicephys(&[
-        "predict", "--fit", fit_json.to_str().unwrap(), "--block", "140x27x13", "--surface",
+        "predict",
+        "--fit",
+        fit_json.to_str().unwrap(),
+        "--block",
+        "140x27x13",
+        "--surface",
         "ice",
     ]);
     assert_eq!(bad.status.code(), Some(2));
@@ -102,17 +157,38 @@ fn a_fit_is_the_same_on_one_thread_and_two_and_predicts_with_errors() {
 fn bad_counts_files_name_their_line_and_column() {
     let dir = Scratch::new("fit-bad");
     let cases = [
-        (format!("{HEAD}a,MDF,140,24,20,3d,0,x,639\n"), "line 2, column 8 (breadth_vertical)"),
-        (format!("{HEAD}a,MDF,140,24,20,3d,0,36,-\n"), "line 2, column 7"),
-        (format!("{HEAD}a,MDF,140,24,20,3d,0,36,60\nb,MDF,-1,24,20,3d,0,1,1\n"), "line 3, column 3 (length_mm)"),
-        (format!("{HEAD}a,MDF,140,24,20,5d,0,36,60\n"), "line 2, column 6 (mode)"),
+        (
+            format!("{HEAD}a,MDF,140,24,20,3d,0,x,639\n"),
+            "line 2, column 8 (breadth_vertical)",
+        ),
+        (
+            format!("{HEAD}a,MDF,140,24,20,3d,0,36,-\n"),
+            "line 2, column 7",
+        ),
+        (
+            format!("{HEAD}a,MDF,140,24,20,3d,0,36,60\nb,MDF,-1,24,20,3d,0,1,1\n"),
+            "line 3, column 3 (length_mm)",
+        ),
+        (
+            format!("{HEAD}a,MDF,140,24,20,5d,0,36,60\n"),
+            "line 2, column 6 (mode)",
+        ),
         ("label,surface\n".into(), "line 1: the header"),
-        (format!("{HEAD}a,MDF,140,24,20,2d,0,36,60\n"), "2 free parameters from 1 independent counts"),
+        (
+            format!("{HEAD}a,MDF,140,24,20,2d,0,36,60\n"),
+            "2 free parameters from 1 independent counts",
+        ),
     ];
     for (i, (text, want)) in cases.iter().enumerate() {
         let csv = dir.join(format!("bad{i}.csv"));
         std::fs::write(&csv, text).unwrap();
-        let out = dicephys(&["fit", "--data", csv.to_str().unwrap(), "--out", dir.to_str().unwrap()]);
+        let out = dicephys(&[
+            "fit",
+            "--data",
+            csv.to_str().unwrap(),
+            "--out",
+            dir.to_str().unwrap(),
+        ]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{text}: {err}");
         assert!(err.contains(want), "{err} (wanted {want})");
@@ -135,7 +211,10 @@ fn values_outside_their_physical_ranges_are_refused() {
         (vec!["--kappa", "-3"], "kappa -3"),
         (vec!["--free", "e,size"], "unknown parameter 'size'"),
         (vec!["--points", "5"], "points 5"),
-        (vec!["--recover", "e=0.5"], "give a value for the free parameter mu"),
+        (
+            vec!["--recover", "e=0.5"],
+            "give a value for the free parameter mu",
+        ),
         (vec!["--recover", "e=2,mu=0.3"], "outside its range"),
     ] {
         let mut args = vec!["fit", "--data", &csv, "--out", out_dir];
