@@ -11,6 +11,7 @@
 //! * [`sim`]: one roll: free flight, the rest rule, the exact early stop;
 //! * [`run`]: many rolls: the run's specification, batches, tallies, checkpoints, atomic output;
 //! * [`theory`]: the paper's closed forms, its experimental table, the statistics;
+//! * [`inference`]: fitting parameters to measured counts through a surrogate of the simulator;
 //! * [`report`]: what a run or the paper's table says, as text, JSON, CSV and figures;
 //! * [`studies`]: the paper end to end, the bench, the convergence, trade-off and stability sweeps.
 //!
@@ -18,8 +19,10 @@
 
 #![warn(missing_docs)]
 
+pub mod calibration;
 pub mod engine;
 pub mod error;
+pub mod inference;
 pub mod model;
 pub mod report;
 pub mod run;

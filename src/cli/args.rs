@@ -78,10 +78,16 @@ pub struct ThrowArgs {
     pub drop_height: Range,
     /// How the die is thrown: paper (length along z, spin about it, velocity along x), tumble
     /// (random orientation, spin axis uniform on the sphere, velocity in a random horizontal
-    /// direction; the ranges give the magnitudes) or rest (released at rest in a random
-    /// orientation, its lowest corner touching the floor; no range is used).
+    /// direction; the ranges give the magnitudes), hand (between the two, by --kappa) or rest
+    /// (released at rest in a random orientation, its lowest corner touching the floor; no
+    /// range is used).
     #[arg(long = "throw", default_value = "paper", value_parser = parse_throw_style)]
     pub style: ThrowStyle,
+    /// A hand's throw's concentration κ >= 0: the paper's throw turned by random angles whose
+    /// mean cosine is coth κ − 1/κ (0: the tumble's spread; large: the paper's throw).
+    /// Requires --throw hand.
+    #[arg(long, value_name = "KAPPA", allow_hyphen_values = true)]
+    pub kappa: Option<f64>,
 }
 
 /// What ends a roll, on the command line.
@@ -205,7 +211,20 @@ impl ThrowArgs {
                 drop_height: self.drop_height,
             },
             style: self.style,
+            kappa: self.kappa,
         };
+        if self.kappa.is_some() && self.style != ThrowStyle::Hand {
+            return Err(Error::Usage(format!(
+                "--kappa: only --throw hand takes a concentration, not --throw {}",
+                self.style
+            )));
+        }
+        if self.kappa.is_none() && self.style == ThrowStyle::Hand {
+            return Err(Error::Usage(
+                "--throw hand needs --kappa K (0: the tumble's spread; large: the paper's throw)"
+                    .into(),
+            ));
+        }
         spec.validate()?;
         Ok(spec)
     }

@@ -8,6 +8,7 @@ pub mod args;
 pub mod bench;
 pub mod crosscheck;
 pub mod error;
+pub mod fit;
 pub mod merge;
 pub mod paper;
 pub mod roll;
@@ -38,6 +39,11 @@ pub enum Command {
     Crosscheck(crosscheck::CrosscheckArgs),
     /// The paper's convergence test: the ratio against dt per block, engine, 2D/3D.
     Converge(sweeps::ConvergeArgs),
+    /// Calibrate e, μ and the throw to measured counts (maximum likelihood through a surrogate
+    /// of the simulator), or check that a fit recovers known values (--recover).
+    Fit(fit::FitArgs),
+    /// Predict a block the fit did not see: its outcome probabilities with their errors.
+    Predict(fit::PredictArgs),
     /// Combine the --json outputs of `roll --shard K/N` runs into the unsharded result.
     Merge(merge::MergeArgs),
     /// Where engines fail: unconverged, unknown, non-finite, tunnelled, energy gain by cell.
@@ -106,6 +112,8 @@ pub fn dispatch(command: Command) -> error::Result<()> {
         Command::Crosscheck(a) => crosscheck::run(&a),
         Command::Stability(a) => sweeps::stability(&a),
         Command::Tradeoff(a) => sweeps::tradeoff(&a),
+        Command::Fit(a) => fit::run(&a),
+        Command::Predict(a) => fit::predict(&a),
         Command::Merge(a) => merge::run(&a),
         Command::Paper(a) => paper::run(&a),
         Command::Theory(a) => theory::run(&a),

@@ -89,3 +89,55 @@ fn with_hooks(
         None => Ok(()),
     }
 }
+
+/// Runs `fit`.
+pub fn fit(cfg: &dicephys::calibration::FitConfig, place: &Place) -> Result<()> {
+    let unit = outputs::Unit::Rolls {
+        per_cell: cfg.design.rolls,
+    };
+    with_hooks("fit", unit, true, place.json, |hooks| {
+        dicephys::studies::fit::outputs::fit(cfg, place, hooks)
+    })
+}
+
+/// Runs `fit --recover`.
+pub fn recover(
+    cfg: &dicephys::calibration::FitConfig,
+    truth: &[f64],
+    repeats: usize,
+    place: &Place,
+) -> Result<()> {
+    let unit = outputs::Unit::Rolls {
+        per_cell: cfg.design.rolls,
+    };
+    with_hooks("fit", unit, true, place.json, |hooks| {
+        dicephys::studies::fit::outputs::recover(cfg, truth, repeats, place, hooks)
+    })
+}
+
+/// Runs `predict`.
+pub fn predict(
+    fit: &dicephys::calibration::FitResult,
+    cfg: &dicephys::calibration::predict::PredictConfig,
+    place: &Place,
+) -> Result<()> {
+    let unit = outputs::Unit::Rolls {
+        per_cell: cfg.rolls,
+    };
+    with_hooks("predict", unit, true, place.json, |hooks| {
+        dicephys::studies::fit::outputs::predict(fit, cfg, place, hooks)
+    })
+}
+
+/// Runs `paper --calibrated`.
+pub fn calibrated(
+    cfg: &dicephys::studies::calibrated::CalibratedConfig,
+    place: &Place,
+) -> Result<()> {
+    let unit = outputs::Unit::Rolls {
+        per_cell: cfg.design.rolls,
+    };
+    with_hooks("paper --calibrated", unit, true, place.json, |hooks| {
+        dicephys::studies::fit::outputs::calibrated(cfg, place, hooks)
+    })
+}

@@ -7,11 +7,12 @@
 //! - `dicephys`: the exact sequence DicePhys draws from glibc's `rand()` after `srand(seed)`,
 //!   drawn up front, so that dicephys can be compared with DicePhys throw for throw.
 //!
-//! And in one of three styles ([`ThrowStyle`]): the paper's (the default: length along z, spin
+//! And in one of four styles ([`ThrowStyle`]): the paper's (the default: length along z, spin
 //! about it, velocity along x), a tumble (any orientation, any spin axis, any horizontal
-//! direction), or a release at rest touching the floor (the quasi-static limit). The tumble
-//! and the rest draw their directions from the same keyed stream, so they too are a pure
-//! function of (seed, index).
+//! direction), a hand's throw between the two (the paper's throw turned at random by angles
+//! whose spread a concentration κ sets: κ → ∞ is the paper's throw, κ = 0 the tumble), or a
+//! release at rest touching the floor (the quasi-static limit). Every style draws its
+//! directions from the same keyed stream, so each is a pure function of (seed, index).
 
 use crate::model::glibc::GlibcRand;
 use crate::model::scene::{Mode, Scene};
@@ -155,13 +156,19 @@ pub enum ThrowStyle {
     /// the velocity range along a uniformly random horizontal direction. In 2D: a uniform
     /// angle about z, spin ± about z, velocity ± along x.
     Tumble,
+    /// A hand's throw, between the paper's and the tumble, set by one concentration κ ≥ 0
+    /// ([`hand_turn`]): the paper's throw whose long axis is tilted from z, whose roll about
+    /// that axis is turned, whose spin axis leaves the long axis and whose heading leaves x,
+    /// each by a random angle whose mean cosine is the Langevin function L(κ) = coth κ − 1/κ.
+    /// κ → ∞ is the paper's throw; κ = 0 draws the tumble's distribution.
+    Hand,
     /// Released at rest in a uniformly random orientation (in 2D, angle about z) with its
     /// lowest corner just touching the floor: the quasi-static limit. No range is used.
     Rest,
 }
 
 impl ThrowStyle {
-    /// "paper", "tumble" or "rest".
+    /// "paper", "tumble", "hand" or "rest".
     pub fn name(self) -> &'static str {
         self.into()
     }
@@ -248,14 +255,14 @@ impl Throw {
         let sign = |v: f64| if v < 0.0 { -1.0 } else { 1.0 };
         match (self.style, scene.mode) {
             (ThrowStyle::Paper, _) => paper,
-            (ThrowStyle::Tumble, Mode::ThreeD) => BodyState {
+            (ThrowStyle::Tumble | ThrowStyle::Hand, Mode::ThreeD) => BodyState {
                 rotation,
                 linear_velocity: self.velocity
                     * Vector3::new(turn.heading.cos(), 0.0, turn.heading.sin()),
                 angular_velocity: self.spin * Vector3::new(sx, sy, sz),
                 ..paper
             },
-            (ThrowStyle::Tumble, Mode::TwoD) => BodyState {
+            (ThrowStyle::Tumble | ThrowStyle::Hand, Mode::TwoD) => BodyState {
                 rotation,
                 linear_velocity: Vector3::new(sign(turn.heading.cos()) * self.velocity, 0.0, 0.0),
                 angular_velocity: Vector3::new(0.0, 0.0, sign(sz) * self.spin),
@@ -324,6 +331,8 @@ pub enum Throws {
         ranges: ThrowRanges,
         /// How each die is thrown.
         style: ThrowStyle,
+        /// The hand's concentration κ (used by [`ThrowStyle::Hand`] only).
+        kappa: f64,
     },
     /// DicePhys's sequence. It is sequential, so the generator's state is kept at every
     /// `DICEPHYS_MARK`-th throw (drawn up front, 152 bytes each: 15 MB for 10⁸ throws) and a
@@ -342,14 +351,16 @@ pub const DICEPHYS_MARK: u64 = 1024;
 impl Throws {
     /// A throw source of the paper's throws that can give throws `0..n`.
     pub fn new(kind: ThrowKind, seed: u64, ranges: ThrowRanges, n: u64) -> Throws {
-        Throws::styled(kind, ThrowStyle::Paper, seed, ranges, n)
+        Throws::styled(kind, ThrowStyle::Paper, 0.0, seed, ranges, n)
     }
 
-    /// A throw source that can give throws `0..n` thrown in `style`. DicePhys's sequence has
-    /// the paper's throw only (`ThrowSpec::validate` refuses another style with it).
+    /// A throw source that can give throws `0..n` thrown in `style` (a hand's with
+    /// concentration `kappa`). DicePhys's sequence has the paper's throw only
+    /// (`ThrowSpec::validate` refuses another style with it).
     pub fn styled(
         kind: ThrowKind,
         style: ThrowStyle,
+        kappa: f64,
         seed: u64,
         ranges: ThrowRanges,
         n: u64,
@@ -359,6 +370,7 @@ impl Throws {
                 seed,
                 ranges,
                 style,
+                kappa,
             },
             ThrowKind::Dicephys => {
                 let mut g = GlibcRand::new(seed as u32);
@@ -382,7 +394,8 @@ impl Throws {
                 seed,
                 ranges,
                 style,
-            } => keyed_styled(*style, *seed, ranges, index),
+                kappa,
+            } => keyed_styled(*style, *kappa, *seed, ranges, index),
             Throws::Dicephys { ranges, marks } => {
                 let first = index - index % DICEPHYS_MARK;
                 let mut g = marks[(index / DICEPHYS_MARK) as usize].clone();
@@ -398,27 +411,38 @@ impl Throws {
 /// Throw `index` of the keyed source, the paper's throw: ChaCha8 seeded by `seed`, on stream
 /// `index`.
 pub fn keyed(seed: u64, ranges: &ThrowRanges, index: u64) -> Throw {
-    keyed_styled(ThrowStyle::Paper, seed, ranges, index)
+    keyed_styled(ThrowStyle::Paper, 0.0, seed, ranges, index)
 }
 
-/// Throw `index` of the keyed source in `style`: ChaCha8 seeded by `seed`, on stream `index`.
-/// The paper's throw draws drop height, velocity and spin, in that order; a tumble draws the
-/// same three, then its orientation (three deviates), spin axis (two) and heading (one); a
-/// rest draws only its orientation.
-pub fn keyed_styled(style: ThrowStyle, seed: u64, ranges: &ThrowRanges, index: u64) -> Throw {
+/// Throw `index` of the keyed source in `style` (a hand's with concentration `kappa`):
+/// ChaCha8 seeded by `seed`, on stream `index`. The paper's throw draws drop height, velocity
+/// and spin, in that order; a tumble draws the same three, then its orientation (three
+/// deviates), spin axis (two) and heading (one); a hand's throw draws the same three, then six
+/// deviates for its turn ([`hand_turn`]); a rest draws only its orientation.
+pub fn keyed_styled(
+    style: ThrowStyle,
+    kappa: f64,
+    seed: u64,
+    ranges: &ThrowRanges,
+    index: u64,
+) -> Throw {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(index);
     let mut u = || rng.random::<f64>();
     match style {
-        ThrowStyle::Paper | ThrowStyle::Tumble => {
+        ThrowStyle::Paper | ThrowStyle::Tumble | ThrowStyle::Hand => {
             let drop_height = ranges.drop_height.draw(u());
             let velocity = ranges.velocity.draw(u());
             let spin = ranges.spin.draw(u());
-            let turn = (style == ThrowStyle::Tumble).then(|| Turn {
-                rotation: haar_quaternion(u(), u(), u()),
-                spin_axis: unit_vector(u(), u()),
-                heading: std::f64::consts::TAU * u(),
-            });
+            let turn = match style {
+                ThrowStyle::Tumble => Some(Turn {
+                    rotation: haar_quaternion(u(), u(), u()),
+                    spin_axis: unit_vector(u(), u()),
+                    heading: std::f64::consts::TAU * u(),
+                }),
+                ThrowStyle::Hand => Some(hand_turn(kappa, [u(), u(), u(), u(), u(), u()])),
+                _ => None,
+            };
             Throw {
                 index,
                 drop_height,
@@ -453,6 +477,105 @@ pub fn haar_quaternion(u1: f64, u2: f64, u3: f64) -> [f64; 4] {
     let (s2, c2) = (TAU * u2).sin_cos();
     let (s3, c3) = (TAU * u3).sin_cos();
     [b * c3, a * s2, a * c2, b * s3]
+}
+
+/// The mean cosine of a von Mises–Fisher direction on the sphere with concentration κ about
+/// its mean: the Langevin function L(κ) = coth κ − 1/κ, from 0 (κ = 0, uniform) to 1 (κ → ∞).
+/// A hand's throw's every angle has this mean cosine, so L(κ) is its "alignment" with the
+/// paper's throw.
+pub fn alignment(kappa: f64) -> f64 {
+    if kappa < 1e-4 {
+        kappa / 3.0
+    } else if kappa > 40.0 {
+        1.0 - 1.0 / kappa
+    } else {
+        1.0 / kappa.tanh() - 1.0 / kappa
+    }
+}
+
+/// The concentration κ whose [`alignment`] is `a` in [0, 1) (Newton's method on L, which is
+/// increasing and concave on κ ≥ 0).
+pub fn kappa_of_alignment(a: f64) -> f64 {
+    if a <= 0.0 {
+        return 0.0;
+    }
+    if a >= 1.0 {
+        return f64::INFINITY;
+    }
+    // Start from the larger of the two ends' inverses (3a near 0, 1/(1−a) near 1): above the
+    // root, where Newton on a concave increasing function converges monotonically.
+    let mut k = (3.0 * a).max(1.0 / (1.0 - a));
+    for _ in 0..100 {
+        let slope = if k < 1e-4 {
+            1.0 / 3.0
+        } else {
+            1.0 / (k * k) - 1.0 / k.sinh().powi(2)
+        };
+        let next = (k - (alignment(k) - a) / slope.max(1e-300)).max(0.0);
+        if (next - k).abs() <= 1e-13 * k.max(1.0) {
+            return next;
+        }
+        k = next;
+    }
+    k
+}
+
+/// The cosine to its mean of a von Mises–Fisher direction on the sphere with concentration κ,
+/// by the inverse of its distribution function from one uniform deviate u (Wood, 1994):
+/// w = 1 + ln(u + (1 − u) e^(−2κ))/κ; uniform in [−1, 1] at κ = 0. A smooth function of κ for
+/// a fixed u, so that throws keyed by one stream move smoothly as κ changes.
+fn vmf_cosine(kappa: f64, u: f64) -> f64 {
+    if kappa < 1e-9 {
+        return 2.0 * u - 1.0;
+    }
+    let e = (-2.0 * kappa).exp();
+    (1.0 + (e + u * (-(-2.0 * kappa).exp_m1())).ln() / kappa).clamp(-1.0, 1.0)
+}
+
+/// A von Mises–Fisher unit vector about +z with concentration κ, from two deviates.
+fn vmf_about_z(kappa: f64, u1: f64, u2: f64) -> Vector3<f64> {
+    let w = vmf_cosine(kappa, u1);
+    let r = (1.0 - w * w).max(0.0).sqrt();
+    let (s, c) = (std::f64::consts::TAU * u2).sin_cos();
+    Vector3::new(r * c, r * s, w)
+}
+
+/// An angle in (−π, π] from the wrapped Cauchy distribution about 0 with mean resultant ρ in
+/// [0, 1), by the inverse of its distribution function: 2 atan(((1 − ρ)/(1 + ρ)) tan(π(u − ½))),
+/// uniform at ρ = 0. Its mean cosine is ρ.
+fn wrapped_cauchy(rho: f64, u: f64) -> f64 {
+    use std::f64::consts::PI;
+    2.0 * (((1.0 - rho) / (1.0 + rho)) * (PI * (u - 0.5)).tan()).atan()
+}
+
+/// A hand's turn of the paper's throw, with concentration κ, from six uniform deviates:
+///
+/// - the long axis (body z) points along a von Mises–Fisher direction about the world's z with
+///   concentration κ (u₀, u₁), and the die is rolled about it by a wrapped Cauchy angle with
+///   mean cosine L(κ) (u₂): the orientation is the shortest rotation taking z to that
+///   direction, after the roll;
+/// - the spin axis is a von Mises–Fisher direction about the body's long axis with
+///   concentration κ (u₃, u₄), carried into the world by the orientation;
+/// - the heading leaves +x by a wrapped Cauchy angle with mean cosine L(κ) (u₅).
+///
+/// At κ = 0 the long axis is uniform on the sphere and the roll uniform, so the orientation is
+/// uniform on the rotations (Haar), and the spin axis, uniform in the body, is uniform in the
+/// world: the tumble's distribution. As κ → ∞ every angle goes to 0: the paper's throw.
+pub fn hand_turn(kappa: f64, u: [f64; 6]) -> Turn {
+    let rho = alignment(kappa);
+    let axis = vmf_about_z(kappa, u[0], u[1]);
+    let tilt = UnitQuaternion::rotation_between(&Vector3::z(), &axis).unwrap_or_else(|| {
+        UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
+    });
+    let roll = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), wrapped_cauchy(rho, u[2]));
+    let q = tilt * roll;
+    let spin = q * vmf_about_z(kappa, u[3], u[4]);
+    let qq = q.quaternion();
+    Turn {
+        rotation: [qq.w, qq.i, qq.j, qq.k],
+        spin_axis: [spin.x, spin.y, spin.z],
+        heading: wrapped_cauchy(rho, u[5]),
+    }
 }
 
 /// A unit vector uniform on the sphere from two uniform deviates in [0, 1) (Archimedes: z
@@ -554,17 +677,17 @@ mod tests {
         // The paper's throw draws exactly what it drew before the styles: three deviates.
         let r = ThrowRanges::default();
         let t = keyed(7, &r, 3);
-        assert_eq!(t, keyed_styled(ThrowStyle::Paper, 7, &r, 3));
+        assert_eq!(t, keyed_styled(ThrowStyle::Paper, 0.0, 7, &r, 3));
         assert!(t.turn.is_none());
         let json = serde_json::to_string(&t).unwrap();
         assert!(!json.contains("style") && !json.contains("turn"), "{json}");
         // A tumble shares the paper's first three numbers, then draws its directions.
-        let u = keyed_styled(ThrowStyle::Tumble, 7, &r, 3);
+        let u = keyed_styled(ThrowStyle::Tumble, 0.0, 7, &r, 3);
         assert_eq!(
             (u.drop_height, u.velocity, u.spin),
             (t.drop_height, t.velocity, t.spin)
         );
-        assert_eq!(u, keyed_styled(ThrowStyle::Tumble, 7, &r, 3));
+        assert_eq!(u, keyed_styled(ThrowStyle::Tumble, 0.0, 7, &r, 3));
         let back: Throw = serde_json::from_str(&serde_json::to_string(&u).unwrap()).unwrap();
         assert_eq!(back, u);
     }
@@ -578,7 +701,7 @@ mod tests {
         let r = ThrowRanges::default();
         let (mut sq, mut cos, mut w2) = (Vector3::zeros(), 0.0, 0.0);
         for i in 0..n {
-            let t = keyed_styled(ThrowStyle::Rest, 11, &r, i);
+            let t = keyed_styled(ThrowStyle::Rest, 0.0, 11, &r, i);
             let turn = t.turn.unwrap();
             let q = turn.orientation(Mode::ThreeD);
             let x = q * Vector3::x();
@@ -606,7 +729,7 @@ mod tests {
             let scene = Scene::paper("40x30x20".parse().unwrap(), mode);
             let half = Vector3::from(scene.body_sides()) / 2.0;
             for i in 0..100 {
-                let t = keyed_styled(ThrowStyle::Rest, 5, &ThrowRanges::default(), i);
+                let t = keyed_styled(ThrowStyle::Rest, 0.0, 5, &ThrowRanges::default(), i);
                 let s = t.start(&scene);
                 assert!(crate::model::die::lowest_point(&half, &s).abs() < 1e-15);
                 assert_eq!(s.linear_velocity, Vector3::zeros());
@@ -626,7 +749,7 @@ mod tests {
             let scene = Scene::paper("140x24x20".parse().unwrap(), mode);
             let half = Vector3::from(scene.body_sides()) / 2.0;
             for i in 0..200 {
-                let t = keyed_styled(ThrowStyle::Tumble, 9, &r, i);
+                let t = keyed_styled(ThrowStyle::Tumble, 0.0, 9, &r, i);
                 let s = t.start(&scene);
                 assert!(crate::model::die::lowest_point(&half, &s) > 0.0);
                 assert!((s.angular_velocity.norm() - t.spin).abs() < 1e-9 * t.spin);
@@ -639,6 +762,93 @@ mod tests {
                     assert_eq!((s.angular_velocity.x, s.angular_velocity.y), (0.0, 0.0));
                 }
             }
+        }
+    }
+
+    #[test]
+    fn the_alignment_inverts() {
+        assert_eq!(alignment(0.0), 0.0);
+        for k in [1e-6, 0.01, 0.5, 1.0, 3.0, 10.0, 39.0, 41.0, 1e3, 1e5] {
+            let a = alignment(k);
+            assert!((0.0..1.0).contains(&a), "{k}: {a}");
+            let back = kappa_of_alignment(a);
+            assert!((back - k).abs() <= 1e-7 * k.max(1.0), "{k}: {a} -> {back}");
+        }
+        // L(2) = coth 2 − 1/2.
+        assert!((alignment(2.0) - (1.0 / 2f64.tanh() - 0.5)).abs() < 1e-15);
+        assert_eq!(kappa_of_alignment(1.0), f64::INFINITY);
+    }
+
+    #[test]
+    fn a_hand_spreads_every_angle_with_mean_cosine_l_kappa() {
+        // κ = 2: L(κ) = 0.5373. The long axis's cosine to z, the roll's cosine, the spin
+        // axis's cosine to the long axis and the heading's cosine each average L(κ); 20,000
+        // throws give standard errors under 0.005, and the test allows 4 of them.
+        let (r, kappa, n) = (ThrowRanges::default(), 2.0, 20_000u64);
+        let (mut tilt, mut spin, mut heading) = (0.0, 0.0, 0.0);
+        for i in 0..n {
+            let t = keyed_styled(ThrowStyle::Hand, kappa, 4, &r, i);
+            let turn = t.turn.unwrap();
+            let q = turn.orientation(Mode::ThreeD);
+            let long = q * Vector3::z();
+            tilt += long.z;
+            spin += long.dot(&Vector3::from(turn.spin_axis));
+            heading += turn.heading.cos();
+        }
+        let l = alignment(kappa);
+        for (what, sum) in [("tilt", tilt), ("spin", spin), ("heading", heading)] {
+            let mean = sum / n as f64;
+            assert!((mean - l).abs() < 0.02, "{what}: {mean} against L(κ) = {l}");
+        }
+    }
+
+    #[test]
+    fn a_hand_at_zero_tumbles_and_at_large_kappa_is_the_papers_throw() {
+        let r = ThrowRanges::default();
+        // κ = 0: orientation Haar (each rotated axis uniform: squares 1/3, |cos| to the
+        // vertical 1/2) and spin axis uniform in the world (components average 0).
+        let n = 20_000;
+        let (mut sq, mut cos, mut axis) = (Vector3::zeros(), 0.0, Vector3::zeros());
+        for i in 0..n {
+            let turn = keyed_styled(ThrowStyle::Hand, 0.0, 6, &r, i).turn.unwrap();
+            let q = turn.orientation(Mode::ThreeD);
+            let x = q * Vector3::x();
+            sq += x.component_mul(&x);
+            cos += (q * Vector3::z()).y.abs();
+            axis += Vector3::from(turn.spin_axis);
+        }
+        let nf = n as f64;
+        for v in (sq / nf).iter() {
+            assert!((v - 1.0 / 3.0).abs() < 0.01, "{v}");
+        }
+        assert!((cos / nf - 0.5).abs() < 0.01);
+        for v in (axis / nf).iter() {
+            assert!(v.abs() < 0.02, "{v}");
+        }
+        // κ large: the paper's start to within the angles' spread, 1/√κ.
+        for mode in [Mode::ThreeD, Mode::TwoD] {
+            let scene = Scene::paper("140x24x20".parse().unwrap(), mode);
+            for i in 0..50 {
+                let hand = keyed_styled(ThrowStyle::Hand, 1e8, 8, &r, i).start(&scene);
+                let paper = keyed(8, &r, i).start(&scene);
+                assert_eq!(hand.position, paper.position);
+                assert!(hand.rotation.angle_to(&paper.rotation) < 1e-2);
+                assert!((hand.angular_velocity - paper.angular_velocity).norm() < 1e-2 * 160.0);
+                assert!((hand.linear_velocity - paper.linear_velocity).norm() < 1e-2);
+            }
+        }
+    }
+
+    #[test]
+    fn a_hands_throws_move_smoothly_with_kappa() {
+        // One keyed stream, two nearby κ: every throw moves by a small angle (the throws of a
+        // fit's neighbouring parameter points are the same throws, slightly turned).
+        let r = ThrowRanges::default();
+        let scene = Scene::paper("140x24x20".parse().unwrap(), Mode::ThreeD);
+        for i in 0..200 {
+            let a = keyed_styled(ThrowStyle::Hand, 5.0, 2, &r, i).start(&scene);
+            let b = keyed_styled(ThrowStyle::Hand, 5.05, 2, &r, i).start(&scene);
+            assert!(a.rotation.angle_to(&b.rotation) < 0.05, "throw {i}");
         }
     }
 }

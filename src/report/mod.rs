@@ -4,6 +4,7 @@
 pub mod converge;
 pub mod crosscheck;
 pub mod figures;
+pub mod fit;
 pub mod outcomes;
 pub mod paper;
 pub mod per_roll;

@@ -26,7 +26,14 @@ pub struct ThrowSpec {
     /// specification and its key are as before), a tumble, or at rest.
     #[serde(default, skip_serializing_if = "ThrowStyle::is_paper")]
     pub style: ThrowStyle,
+    /// A hand's throw's concentration κ (`ThrowStyle::Hand` only; left out otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kappa: Option<f64>,
 }
+
+/// The largest concentration κ a hand's throw takes: its angles' spread is then about
+/// 1/√κ ≈ 0.06°, the paper's throw for any purpose (`--throw paper` is the limit itself).
+pub const MAX_KAPPA: f64 = 1e6;
 
 impl ThrowSpec {
     /// Keyed throws from the paper's ranges.
@@ -36,10 +43,12 @@ impl ThrowSpec {
             seed,
             ranges: ThrowRanges::default(),
             style: ThrowStyle::Paper,
+            kappa: None,
         }
     }
 
-    /// Keyed throws from the paper's ranges, thrown in `style`.
+    /// Keyed throws from the paper's ranges, thrown in `style` (not a hand's: see
+    /// [`ThrowSpec::hand`]).
     pub fn keyed_style(seed: u64, style: ThrowStyle) -> ThrowSpec {
         ThrowSpec {
             style,
@@ -47,9 +56,38 @@ impl ThrowSpec {
         }
     }
 
+    /// Keyed throws from the paper's ranges, thrown by a hand with concentration `kappa`.
+    pub fn hand(seed: u64, kappa: f64) -> ThrowSpec {
+        ThrowSpec {
+            style: ThrowStyle::Hand,
+            kappa: Some(kappa),
+            ..ThrowSpec::keyed(seed)
+        }
+    }
+
     /// Checks the ranges, the seed, and that DicePhys's sequence is thrown the paper's way.
     pub fn validate(&self) -> Result<()> {
         self.ranges.validate()?;
+        match (self.style, self.kappa) {
+            (ThrowStyle::Hand, None) => {
+                return Err(Error::Invalid(
+                    "throw hand: give its concentration kappa (0 tumbles, large is the paper's)"
+                        .into(),
+                ))
+            }
+            (ThrowStyle::Hand, Some(k)) if !(0.0..=MAX_KAPPA).contains(&k) => {
+                return Err(Error::Invalid(format!(
+                    "kappa {k}: a hand's concentration is 0 to {MAX_KAPPA:e} (--throw paper is \
+                     the limit of large kappa)"
+                )))
+            }
+            (ThrowStyle::Hand, Some(_)) | (_, None) => {}
+            (s, Some(_)) => {
+                return Err(Error::Invalid(format!(
+                    "kappa: only a hand's throw takes a concentration, not the {s} throw"
+                )))
+            }
+        }
         if self.kind == ThrowKind::Dicephys && !self.style.is_paper() {
             return Err(Error::field(
                 "style",
@@ -70,7 +108,8 @@ impl ThrowSpec {
 
     /// The throw source, able to give throws `0..n`.
     pub fn source(&self, n: u64) -> Throws {
-        Throws::styled(self.kind, self.style, self.seed, self.ranges, n)
+        let kappa = self.kappa.unwrap_or(0.0);
+        Throws::styled(self.kind, self.style, kappa, self.seed, self.ranges, n)
     }
 }
 

@@ -4,9 +4,11 @@
 //! are kept) and returns its results, which `report` renders.
 
 pub mod bench;
+pub mod calibrated;
 pub mod converge;
 pub mod crosscheck;
 pub mod departure;
+pub mod fit;
 pub mod outputs;
 pub mod paper;
 pub mod precision;

@@ -120,13 +120,13 @@ impl Place {
     }
 
     /// A cluster task's share or a dry run: its tallies are partial, for no report.
-    fn partial(&self) -> bool {
+    pub(crate) fn partial(&self) -> bool {
         self.share.is_partial()
     }
 
     /// How the study's cells run: these threads, its share, stopped by `stop`, telling
     /// `progress` the rolls made in the current run.
-    fn study<'a>(&self, stop: &Stop, progress: &'a (dyn Fn(u64) + Sync)) -> Study<'a> {
+    pub(crate) fn study<'a>(&self, stop: &Stop, progress: &'a (dyn Fn(u64) + Sync)) -> Study<'a> {
         Study {
             runner: Runner::new(self.threads, stop.clone())
                 .with_share(self.share.clone())
@@ -136,7 +136,7 @@ impl Place {
     }
 
     /// Creates the output directory and checks that `files` can be written in it.
-    fn outputs(&self, files: &[&str]) -> Result<Vec<Output>> {
+    pub(crate) fn outputs(&self, files: &[&str]) -> Result<Vec<Output>> {
         std::fs::create_dir_all(&self.out).map_err(|e| {
             Error::field("out", self.out.display(), format!("cannot create it ({e})"))
         })?;
@@ -147,7 +147,7 @@ impl Place {
     }
 
     /// The JSON, or the report, to print; the note that says what was written.
-    fn done(&self, json: &str, report: &str, file: &str) -> Done {
+    pub(crate) fn done(&self, json: &str, report: &str, file: &str) -> Done {
         Done {
             stdout: format!("{}\n", if self.json { json } else { report }),
             note: (!self.json)
@@ -375,7 +375,7 @@ pub fn validate(cfg: &studies::validate::Config, place: &Place, hooks: &Hooks) -
     write(place, &outputs, &res, &md, "validate.json")
 }
 
-fn to_json<T: Serialize>(v: &T) -> Result<String> {
+pub(crate) fn to_json<T: Serialize>(v: &T) -> Result<String> {
     serde_json::to_string_pretty(v).map_err(|e| Error::Failed(e.to_string()))
 }
 

@@ -7,6 +7,7 @@ mod bullet;
 mod cli;
 mod coarse;
 mod docs;
+mod fit;
 mod fuzz;
 mod rapier;
 mod redteam;

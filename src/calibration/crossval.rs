@@ -1,0 +1,237 @@
+//! Predictions scored on data the fit did not see: every row predicted by a fit of the others
+//! (leave one out), and the models compared by those scores.
+//!
+//! A row's prediction averages its surrogate over the posterior draws of the fit without it,
+//! so its error holds the parameters' uncertainty (wide when the row was the only one on its
+//! surface: its e and μ are then free over their whole range) and the simulation's. It is
+//! scored three ways: the ratio's z, as the paper scores its theory; the end (length-vertical)
+//! count's z, which the theory cannot predict; and the log predictive probability of its
+//! counts, which sums into a model's cross-validated log score.
+
+use crate::calibration::data::DataRow;
+use crate::calibration::design::Design;
+use crate::calibration::estimate::{maximise_from, Likelihood, Search};
+use crate::calibration::params::{ModelSpec, Param};
+use crate::calibration::predict::{predict_row, Predicted};
+use crate::error::Result;
+use crate::inference::likelihood::ln_dirichlet_multinomial;
+use crate::inference::posterior;
+use crate::theory::stats::{self, Ratio};
+use serde::{Deserialize, Serialize};
+
+/// An end count: a row's length-vertical outcomes, measured and predicted.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct EndCount {
+    /// Counted length vertical.
+    pub counted: u64,
+    /// Throws.
+    pub throws: u64,
+    /// Predicted P(length vertical).
+    pub predicted: Predicted,
+    /// (counted/throws − predicted)/√(p(1 − p)/throws + σ_predicted²).
+    pub z: f64,
+}
+
+/// One row, predicted by the fit of the others.
+#[derive(Clone, Debug, Serialize)]
+pub struct LooRow {
+    /// The row's label.
+    pub label: String,
+    /// Its surface.
+    pub surface: String,
+    /// The only row on its surface: without it the data say nothing of that surface's e and μ.
+    pub alone: bool,
+    /// The outcome groups.
+    pub outcomes: Vec<String>,
+    /// Counted per group.
+    pub counts: Vec<u64>,
+    /// Predicted per group.
+    pub p: Vec<Predicted>,
+    /// The measured ratio ± the paper's binomial error (when breadth and width are counted
+    /// apart).
+    pub measured_ratio: Option<Ratio>,
+    /// The predicted ratio.
+    pub ratio: Option<Predicted>,
+    /// (measured − predicted)/combined error, on the ratio.
+    pub z: Option<f64>,
+    /// The end count (a 3D row with its length outcome apart).
+    pub end: Option<EndCount>,
+    /// ln P(counts | the fit without the row), the multinomial coefficient included.
+    pub log_score: f64,
+    /// The same for the breadth count given the side throws only (comparable between models
+    /// that simulate the row in 2D and in 3D).
+    pub side_log_score: f64,
+}
+
+fn ln_choose(counts: &[u64]) -> f64 {
+    use statrs::function::gamma::ln_gamma;
+    let n: u64 = counts.iter().sum();
+    ln_gamma(n as f64 + 1.0)
+        - counts
+            .iter()
+            .map(|&k| ln_gamma(k as f64 + 1.0))
+            .sum::<f64>()
+}
+
+fn log_mean_exp(v: &[f64]) -> f64 {
+    let m = v.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    if !m.is_finite() {
+        return m;
+    }
+    m + (v.iter().map(|x| (x - m).exp()).sum::<f64>() / v.len() as f64).ln()
+}
+
+/// Every row of `rows` predicted by the fit of the others (in parallel over rows), starting
+/// each fit's search from `start` (the whole fit's maximum) and the centre.
+pub fn leave_one_out(
+    rows: &[DataRow],
+    designs: &[Design],
+    model: &ModelSpec,
+    params: &[Param],
+    search: &Search,
+    start: &[f64],
+) -> Result<Vec<LooRow>> {
+    use rayon::prelude::*;
+    (0..rows.len())
+        .into_par_iter()
+        .map(|r| {
+            let mut lik = Likelihood::new(rows, designs, model, params);
+            lik.include[r] = false;
+            let (best, _) = maximise_from(&lik, &[start.to_vec(), vec![0.5; params.len()]])?;
+            let f = |x: &[f64]| lik.minus_two_ln_l(x);
+            let draws = posterior::sample(
+                &f,
+                &best.x,
+                search.draws.max(50),
+                2000,
+                4,
+                search.seed.wrapping_add(r as u64),
+            );
+            Ok(score_row(&lik, r, &draws))
+        })
+        .collect()
+}
+
+/// Row `r` of `lik` predicted at the posterior `draws` and scored.
+pub fn score_row(lik: &Likelihood, r: usize, draws: &[Vec<f64>]) -> LooRow {
+    let row = &lik.rows()[r];
+    let (p, ratio, outcomes) = predict_row(lik, r, draws);
+    let counts = row.grouped();
+    let n: u64 = counts.iter().sum();
+    let b = outcomes.iter().position(|g| g == "breadth");
+    let w = outcomes.iter().position(|g| g == "width");
+    let measured_ratio = b.zip(w).map(|(b, w)| stats::ratio(counts[b], counts[w]));
+    let z = measured_ratio.zip(ratio).map(|(m, p)| p.z(m.value, m.err));
+    let end = outcomes.iter().position(|g| g == "length").map(|l| {
+        let pred = p[l];
+        let q = counts[l] as f64 / n as f64;
+        let var = pred.value * (1.0 - pred.value) / n as f64 + pred.err * pred.err;
+        EndCount {
+            counted: counts[l],
+            throws: n,
+            predicted: pred,
+            z: (q - pred.value) / var.sqrt(),
+        }
+    });
+    let preds: Vec<_> = draws.iter().map(|x| lik.predict(r, x)).collect();
+    let scores: Vec<f64> = preds
+        .iter()
+        .map(|pr| ln_dirichlet_multinomial(&counts, &pr.p, pr.c))
+        .collect();
+    let log_score = log_mean_exp(&scores) + ln_choose(&counts);
+    let side_log_score = match b.zip(w) {
+        Some((b, w)) => {
+            let side = [counts[b], counts[w]];
+            let s: Vec<f64> = preds
+                .iter()
+                .map(|pr| {
+                    let t = pr.p[b] + pr.p[w];
+                    ln_dirichlet_multinomial(&side, &[pr.p[b] / t, pr.p[w] / t], pr.c)
+                })
+                .collect();
+            log_mean_exp(&s) + ln_choose(&side)
+        }
+        None => f64::NAN,
+    };
+    LooRow {
+        label: row.label.clone(),
+        surface: row.surface.clone(),
+        alone: lik
+            .rows()
+            .iter()
+            .filter(|o| o.surface == row.surface)
+            .count()
+            == 1,
+        outcomes,
+        counts,
+        p,
+        measured_ratio,
+        ratio,
+        z,
+        end,
+        log_score,
+        side_log_score,
+    }
+}
+
+/// One model's scores.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ModelScore {
+    /// Its name.
+    pub name: String,
+    /// What it says, in a line.
+    pub description: String,
+    /// Free parameters.
+    pub params: usize,
+    /// −2 ln L at its maximum (up to a constant shared by models with the same outcomes).
+    pub minus_two_ln_l: f64,
+    /// Akaike's criterion, −2 ln L + 2k.
+    pub aic: f64,
+    /// The sum of its rows' leave-one-out log scores.
+    pub loo_log_score: f64,
+    /// The same on the side outcomes only.
+    pub loo_side_log_score: f64,
+    /// Rows within 1σ (ratio z).
+    pub within_one_sigma: usize,
+    /// Rows within 2σ.
+    pub within_two_sigma: usize,
+    /// Rows with a ratio z.
+    pub rows_scored: usize,
+}
+
+impl ModelScore {
+    /// The scores of a model from its maximum and its leave-one-out rows.
+    pub fn of(
+        name: &str,
+        description: &str,
+        params: usize,
+        minus_two_ln_l: f64,
+        loo: &[LooRow],
+    ) -> ModelScore {
+        let zs: Vec<f64> = loo
+            .iter()
+            .filter_map(|r| r.z)
+            .filter(|z| z.is_finite())
+            .collect();
+        ModelScore {
+            name: name.into(),
+            description: description.into(),
+            params,
+            minus_two_ln_l,
+            aic: minus_two_ln_l + 2.0 * params as f64,
+            loo_log_score: loo.iter().map(|r| r.log_score).sum(),
+            loo_side_log_score: loo.iter().map(|r| r.side_log_score).sum(),
+            within_one_sigma: zs.iter().filter(|z| z.abs() <= 1.0).count(),
+            within_two_sigma: zs.iter().filter(|z| z.abs() <= 2.0).count(),
+            rows_scored: zs.len(),
+        }
+    }
+}
+
+/// The likelihood-ratio test of a model nested in a larger one: −2 ln Λ and its p-value from χ²
+/// with the difference in free parameters.
+pub fn likelihood_ratio(small: &ModelScore, large: &ModelScore) -> (f64, usize, f64) {
+    let stat = (small.minus_two_ln_l - large.minus_two_ln_l).max(0.0);
+    let dof = large.params.saturating_sub(small.params);
+    (stat, dof, stats::chi_square_p_value(stat, dof))
+}

@@ -1,0 +1,346 @@
+//! Measured counts to fit: one row per block thrown on one surface, read from a CSV file.
+//!
+//! ```text
+//! label,surface,length_mm,breadth_mm,width_mm,mode,length_vertical,breadth_vertical,width_vertical[,thrower]
+//! row 7,MDF,140,24,20,3d,0,361,639
+//! cube-ish,felt,50,20,20,3d,12,700,-
+//! ```
+//!
+//! - `mode`: how the row is simulated, `3d` (a free body) or `2d` (DicePhys's plane-locked
+//!   block). A 2D block cannot land on its end: a `2d` row is fitted on its two side outcomes,
+//!   and its length-vertical count is kept but set aside.
+//! - Counts are whole numbers. Where two sides are equal their outcomes land on congruent
+//!   faces and may be counted together: the sum in one column and `-` in the other (the fit
+//!   then merges its simulated outcomes the same way). `-` is refused where the sides differ.
+//! - `thrower` (optional): rows thrown the same way share the throw's parameters; one thrower
+//!   when the column is absent.
+//! - Breadth is the larger side of the cross-section; a row that gives the smaller first has
+//!   its two sides, and their counts, swapped, as `--block` does.
+//! - `#` starts a comment line. Every error names the file, line and column.
+
+use crate::error::{Error, Result};
+use crate::model::block::Block;
+use crate::model::scene::Mode;
+use serde::{Deserialize, Serialize};
+
+/// The outcomes in the order rows and simulations keep them.
+pub const OUTCOMES: [&str; 3] = ["length", "breadth", "width"];
+
+/// The CSV's columns, in order (`thrower` may be left out).
+pub const COLUMNS: [&str; 10] = [
+    "label",
+    "surface",
+    "length_mm",
+    "breadth_mm",
+    "width_mm",
+    "mode",
+    "length_vertical",
+    "breadth_vertical",
+    "width_vertical",
+    "thrower",
+];
+
+/// One row of measured counts.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DataRow {
+    /// The row's name.
+    pub label: String,
+    /// The surface it was thrown on (rows on one surface share its e and μ).
+    pub surface: String,
+    /// Who threw it (rows of one thrower share the throw's parameters).
+    pub thrower: String,
+    /// The block.
+    pub block: Block,
+    /// How it is simulated.
+    pub mode: Mode,
+    /// Counts of length, breadth and width vertical; a merged outcome's count is in its
+    /// group's first member and 0 in the others.
+    pub counts: [u64; 3],
+    /// The outcomes counted apart, as groups of [`OUTCOMES`] indices (a 2D row: breadth and
+    /// width only).
+    pub groups: Vec<Vec<usize>>,
+}
+
+impl DataRow {
+    /// The counts of each group, in the groups' order.
+    pub fn grouped(&self) -> Vec<u64> {
+        self.groups
+            .iter()
+            .map(|g| g.iter().map(|&k| self.counts[k]).sum())
+            .collect()
+    }
+
+    /// Throws counted in the fit (a 2D row: its side outcomes).
+    pub fn n(&self) -> u64 {
+        self.grouped().iter().sum()
+    }
+
+    /// The groups' names: "breadth", "width", "length", or "breadth+width" when merged.
+    pub fn group_names(&self) -> Vec<String> {
+        self.groups
+            .iter()
+            .map(|g| g.iter().map(|&k| OUTCOMES[k]).collect::<Vec<_>>().join("+"))
+            .collect()
+    }
+}
+
+/// The outcome groups of a row: every outcome apart, less a 2D row's length, with each `-`
+/// merged into the congruent outcome that carries the count. `sides`: length, breadth, width.
+fn groups(
+    mode: Mode,
+    sides: [f64; 3],
+    dashed: [bool; 3],
+) -> std::result::Result<Vec<Vec<usize>>, String> {
+    let live: Vec<usize> = match mode {
+        Mode::ThreeD => vec![0, 1, 2],
+        Mode::TwoD => vec![1, 2],
+    };
+    let mut groups: Vec<Vec<usize>> = live
+        .iter()
+        .filter(|&&k| !dashed[k])
+        .map(|&k| vec![k])
+        .collect();
+    for &k in live.iter().filter(|&&k| dashed[k]) {
+        let into = groups
+            .iter_mut()
+            .find(|g| sides[g[0]] == sides[k])
+            .ok_or_else(|| {
+                format!(
+                    "'-' counts {} vertical with a congruent outcome, but no counted side equals \
+                     its {} mm",
+                    OUTCOMES[k], sides[k]
+                )
+            })?;
+        into.push(k);
+    }
+    if groups.len() < 2 {
+        return Err("all outcomes merged into one: the row tells nothing".into());
+    }
+    Ok(groups)
+}
+
+/// Reads a counts CSV; `name` is the file's name for messages.
+pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
+    let bad = |line: u64, col: usize, msg: String| {
+        let column = COLUMNS.get(col).copied().unwrap_or("?");
+        Error::Invalid(format!(
+            "{name}: line {line}, column {} ({column}): {msg}",
+            col + 1
+        ))
+    };
+    let mut reader = csv::ReaderBuilder::new()
+        .comment(Some(b'#'))
+        .trim(csv::Trim::All)
+        .has_headers(true)
+        .flexible(true)
+        .from_reader(text.as_bytes());
+    let header = reader
+        .headers()
+        .map_err(|e| Error::Invalid(format!("{name}: {e}")))?
+        .clone();
+    let have: Vec<&str> = header.iter().collect();
+    let with_thrower = have.len() == COLUMNS.len();
+    if !(9..=10).contains(&have.len()) || have != COLUMNS[..have.len()] {
+        return Err(Error::Invalid(format!(
+            "{name}: line 1: the header must be {}[,thrower], got {}",
+            COLUMNS[..9].join(","),
+            have.join(",")
+        )));
+    }
+    let mut rows: Vec<DataRow> = Vec::new();
+    for rec in reader.records() {
+        let rec = rec.map_err(|e| Error::Invalid(format!("{name}: {e}")))?;
+        let line = rec.position().map_or(0, |p| p.line());
+        if rec.len() != have.len() {
+            return Err(bad(
+                line,
+                rec.len().min(have.len()),
+                format!("{} fields where the header has {}", rec.len(), have.len()),
+            ));
+        }
+        let text = |c: usize| -> Result<String> {
+            let v = rec[c].to_string();
+            if v.is_empty() {
+                return Err(bad(line, c, "empty".into()));
+            }
+            Ok(v)
+        };
+        let label = text(0)?;
+        if rows.iter().any(|r| r.label == label) {
+            return Err(bad(line, 0, format!("label '{label}' is used twice")));
+        }
+        let surface = text(1)?;
+        let mut sides = [0.0; 3];
+        for (i, s) in sides.iter_mut().enumerate() {
+            let c = 2 + i;
+            *s = rec[c]
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .ok_or_else(|| {
+                    bad(
+                        line,
+                        c,
+                        format!("'{}' is not a positive number of mm", &rec[c]),
+                    )
+                })?;
+        }
+        let mode: Mode = rec[5]
+            .parse()
+            .map_err(|_| bad(line, 5, format!("'{}' is not 2d or 3d", &rec[5])))?;
+        let mut counts = [0u64; 3];
+        let mut dashed = [false; 3];
+        for k in 0..3 {
+            let c = 6 + k;
+            match &rec[c] {
+                "-" => dashed[k] = true,
+                v => {
+                    counts[k] = v.parse().map_err(|_| {
+                        bad(
+                            line,
+                            c,
+                            format!("'{v}' is not a count (a whole number, or '-')"),
+                        )
+                    })?
+                }
+            }
+        }
+        // Breadth is the larger side: swap a row given the other way, with its counts.
+        if sides[1] < sides[2] {
+            sides.swap(1, 2);
+            counts.swap(1, 2);
+            dashed.swap(1, 2);
+        }
+        let block = Block::from_mm(sides[0], sides[1], sides[2])
+            .map_err(|e| bad(line, 2, e.to_string()))?;
+        let groups = groups(mode, sides, dashed).map_err(|m| bad(line, 6, m))?;
+        let row = DataRow {
+            label,
+            surface,
+            thrower: if with_thrower { text(9)? } else { "all".into() },
+            block,
+            mode,
+            counts,
+            groups,
+        };
+        if row.n() == 0 {
+            return Err(bad(line, 6, "no throws counted".into()));
+        }
+        if row
+            .counts
+            .iter()
+            .try_fold(0u64, |a, &c| a.checked_add(c))
+            .is_none()
+            || row.n() > 1_000_000_000_000
+        {
+            return Err(bad(line, 6, "counts too large".into()));
+        }
+        rows.push(row);
+    }
+    if rows.is_empty() {
+        return Err(Error::Invalid(format!("{name}: no rows of counts")));
+    }
+    Ok(rows)
+}
+
+/// The paper's 19 rows (its table "sidewaystable"), as a counts file would give them: every
+/// row thrown in 3D by one thrower, labelled "row N", on its surface.
+pub fn paper_rows() -> Result<Vec<DataRow>> {
+    let table = crate::theory::paper_data::load()?;
+    let mut text = COLUMNS[..9].join(",");
+    text.push('\n');
+    for r in &table.rows {
+        text.push_str(&format!(
+            "row {},{},{},{},{},3d,{},{},{}\n",
+            r.row,
+            r.surface.name(),
+            r.length_mm.value,
+            r.breadth_mm.value,
+            r.width_mm.value,
+            r.length_vertical,
+            r.breadth_vertical,
+            r.width_vertical
+        ));
+    }
+    parse(&text, "the paper's table")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEAD: &str = "label,surface,length_mm,breadth_mm,width_mm,mode,length_vertical,breadth_vertical,width_vertical\n";
+
+    #[test]
+    fn rows_read_with_their_groups() {
+        let rows = parse(
+            &format!("{HEAD}a,MDF,140,24,20,3d,0,361,639\n# note\nb,felt,50,20,20,3d,12,700,-\nc,MDF,140,13,22,2d,3,40,160\n"),
+            "f.csv",
+        )
+        .unwrap();
+        assert_eq!(rows[0].groups, vec![vec![0], vec![1], vec![2]]);
+        assert_eq!(rows[1].groups, vec![vec![0], vec![1, 2]]);
+        assert_eq!(rows[1].grouped(), vec![12, 700]);
+        assert_eq!(rows[1].group_names(), vec!["length", "breadth+width"]);
+        // Given the smaller side first: swapped, with its counts; 2D: the sides only.
+        assert_eq!(rows[2].counts, [3, 160, 40]);
+        assert_eq!(rows[2].groups, vec![vec![1], vec![2]]);
+        assert_eq!(rows[2].n(), 200);
+        assert_eq!(rows[0].thrower, "all");
+    }
+
+    #[test]
+    fn bad_files_name_line_and_column() {
+        let cases = [
+            (
+                format!("{HEAD}a,MDF,140,24,20,3d,0,x,639\n"),
+                "line 2, column 8 (breadth_vertical)",
+            ),
+            (
+                format!("{HEAD}a,MDF,140,24,20,3d,0,361,-\n"),
+                "line 2, column 7",
+            ),
+            (
+                format!("{HEAD}a,MDF,140,-2,20,3d,0,361,6\n"),
+                "line 2, column 4 (breadth_mm)",
+            ),
+            (
+                format!("{HEAD}a,MDF,140,24,20,4d,0,361,6\n"),
+                "line 2, column 6 (mode)",
+            ),
+            (format!("{HEAD}a,MDF,140,24,20,3d,0,361\n"), "line 2"),
+            (
+                format!("{HEAD}a,MDF,140,24,20,3d,0,1,1\na,MDF,140,24,20,3d,0,1,1\n"),
+                "line 3, column 1 (label)",
+            ),
+            (
+                format!("{HEAD}a,,140,24,20,3d,0,1,1\n"),
+                "line 2, column 2 (surface)",
+            ),
+            (format!("{HEAD}a,MDF,140,24,20,3d,0,0,0\n"), "no throws"),
+            ("label,surface\n".to_string(), "line 1: the header"),
+            (HEAD.to_string(), "no rows"),
+            (
+                format!("{HEAD}a,MDF,140,24,20,3d,0,-18446744073709551615,1\n"),
+                "column 8",
+            ),
+        ];
+        for (text, want) in cases {
+            let e = parse(&text, "f.csv").unwrap_err().to_string();
+            assert!(
+                e.starts_with("f.csv: ") && e.contains(want),
+                "{e} (wanted {want})"
+            );
+            assert!(!e.contains('\n'), "{e}");
+        }
+    }
+
+    #[test]
+    fn the_papers_rows_are_all_nineteen() {
+        let rows = paper_rows().unwrap();
+        assert_eq!(rows.len(), 19);
+        assert_eq!(rows[6].label, "row 7");
+        assert_eq!(rows[6].counts, [0, 361, 639]);
+        assert_eq!(rows[18].surface, "Tough Carpet");
+    }
+}

@@ -1,0 +1,287 @@
+//! The simulations a fit stands on: for each block (and mode) among the rows, the simulator
+//! run at many parameter points spread over the free parameters' box, and a surrogate
+//! ([`crate::inference::surrogate`]) fitted through them. The rolling itself is
+//! [`crate::studies::fit`]'s; here are the points, the seeds and the result.
+//!
+//! The points are the box's 2^d corners, its centre, then a Halton sequence (bases 2, 3, 5, 7):
+//! fixed in advance, so a run can be split over a cluster, resumed, or checked against another.
+//! Each point rolls its own keyed throws (its seed is a hash of the run's seed, the block and
+//! the point's number), so the points' counts are independent and the surrogate's covariance
+//! is its simulation noise. Common throws across the points (one stream for all) were
+//! measured against this: see [`crate::studies::fit`]'s documentation for why they were not
+//! kept.
+//!
+//! Rows with the same block and mode share one design: their surfaces differ only in which
+//! coordinates the likelihood reads the surrogate at.
+
+use crate::calibration::data::DataRow;
+use crate::calibration::params::{Axes, ModelSpec, Param};
+use crate::error::{Error, Result};
+use crate::inference::surrogate::{DesignPoint, Surrogate};
+use crate::model::block::Block;
+use crate::model::scene::Mode;
+use serde::{Deserialize, Serialize};
+
+/// How densely each block is simulated.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DesignSpec {
+    /// Parameter points per block (at least the corners and the centre).
+    pub points: usize,
+    /// Rolls at each point.
+    pub rolls: u64,
+    /// The surrogate's polynomial degree (raised, up to `max_degree`, while it lacks fit).
+    pub degree: usize,
+    /// The highest degree tried.
+    pub max_degree: usize,
+    /// A second pass: every block simulated afresh over a box narrowed to the first pass's
+    /// region ([`crate::calibration::narrow`]), and the fit made again there.
+    pub refine: bool,
+}
+
+impl Default for DesignSpec {
+    fn default() -> Self {
+        DesignSpec {
+            points: 64,
+            rolls: 500,
+            degree: 3,
+            max_degree: 4,
+            refine: true,
+        }
+    }
+}
+
+impl DesignSpec {
+    /// Checks the sizes.
+    pub fn validate(&self, dims: usize) -> Result<()> {
+        let bad = |m: String| Err(Error::Invalid(m));
+        let corners = 1usize << dims.min(20);
+        if self.points < corners + 1 {
+            return bad(format!(
+                "points {}: a design over {dims} parameters needs at least {} (its corners and centre)",
+                self.points,
+                corners + 1
+            ));
+        }
+        let features = crate::inference::surrogate::exponents(dims, self.degree).len();
+        if self.points < 2 * features {
+            return bad(format!(
+                "points {}: a degree-{} surrogate over {dims} parameters has {features} coefficients \
+                 an outcome, and needs at least twice as many points ({})",
+                self.points,
+                self.degree,
+                2 * features
+            ));
+        }
+        if self.points > 100_000 {
+            return bad(format!("points {}: at most 100000", self.points));
+        }
+        if self.rolls == 0 || self.rolls > crate::run::spec::MAX_ROLLS {
+            return bad(format!(
+                "rolls {}: 1 to {}",
+                self.rolls,
+                crate::run::spec::MAX_ROLLS
+            ));
+        }
+        if !(1..=6).contains(&self.degree) || self.max_degree < self.degree || self.max_degree > 6 {
+            return bad(format!(
+                "degree {}..{}: from 1 to 6, the highest not below the first",
+                self.degree, self.max_degree
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The radical inverse of `i` in `base`: the Halton sequence's coordinate.
+fn halton(mut i: usize, base: usize) -> f64 {
+    let (mut f, mut r) = (1.0, 0.0);
+    while i > 0 {
+        f /= base as f64;
+        r += f * (i % base) as f64;
+        i /= base;
+    }
+    r
+}
+
+/// The first `n` primes, the Halton sequence's bases.
+fn primes(n: usize) -> Vec<usize> {
+    let mut out: Vec<usize> = Vec::with_capacity(n);
+    let mut k = 2;
+    while out.len() < n {
+        if out.iter().all(|p| k % p != 0) {
+            out.push(k);
+        }
+        k += 1;
+    }
+    out
+}
+
+/// Point `i` (from 1) of the Halton sequence in [0, 1)^dims.
+pub fn halton_point(i: usize, dims: usize) -> Vec<f64> {
+    primes(dims).into_iter().map(|b| halton(i, b)).collect()
+}
+
+/// The design's `n` points in [0, 1]^dims: the corners, the centre, then Halton points.
+pub fn points(dims: usize, n: usize) -> Vec<Vec<f64>> {
+    if dims == 0 {
+        return vec![vec![]];
+    }
+    let mut out: Vec<Vec<f64>> = (0..1usize << dims)
+        .map(|c| (0..dims).map(|j| ((c >> j) & 1) as f64).collect())
+        .collect();
+    out.push(vec![0.5; dims]);
+    let mut i = 1;
+    while out.len() < n.max(out.len()) {
+        out.push(halton_point(i, dims));
+        i += 1;
+    }
+    out.truncate(n.max(1 + (1 << dims)));
+    out
+}
+
+/// A block simulated over the design.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Design {
+    /// The block.
+    pub block: Block,
+    /// 2D or 3D.
+    pub mode: Mode,
+    /// Its coordinates: each free kind and its range.
+    pub axes: Axes,
+    /// Each point and its counts of length, breadth and width vertical.
+    pub points: Vec<DesignPoint>,
+    /// Rolls that did not settle on a face (unknown, unconverged or failed), over all points.
+    pub unsettled: u64,
+    /// Rolls made.
+    pub rolls: u64,
+    /// The surrogate through the points.
+    pub surrogate: Surrogate,
+}
+
+impl Design {
+    /// "140x24x20 3d".
+    pub fn name(&self) -> String {
+        format!("{} {}", self.block, self.mode.name())
+    }
+}
+
+/// What one design simulates: a block, a mode, and its axes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Key {
+    /// The block.
+    pub block: Block,
+    /// 2D or 3D.
+    pub mode: Mode,
+    /// The free kinds and their ranges.
+    pub axes: Axes,
+}
+
+impl Key {
+    /// The key of `row` under `model` with its parameters `params`.
+    pub fn of(row: &DataRow, model: &ModelSpec, params: &[Param]) -> Key {
+        Key {
+            block: row.block,
+            mode: row.mode,
+            axes: model.axes(params, &model.row_dims(params, row)),
+        }
+    }
+
+    /// A name for its directory and its seeds: the block, the mode, and a hash of the axes.
+    pub fn tag(&self) -> String {
+        let axes: Vec<String> = self.axes.iter().map(|(k, r)| format!("{k}={r}")).collect();
+        let h = fnv(&axes.join(","));
+        format!("{}-{}-{:08x}", self.block, self.mode.name(), h >> 32)
+    }
+
+    /// The seed of point `point`'s throws.
+    pub fn seed(&self, seed: u64, point: usize) -> u64 {
+        fnv(&format!("{seed}/{}/{point}", self.tag()))
+    }
+
+    /// True if `d` is this key's design.
+    pub fn is(&self, d: &Design) -> bool {
+        d.block == self.block && d.mode == self.mode && d.axes == self.axes
+    }
+}
+
+/// The distinct keys of `rows`, in first-seen order: rows with the same block, mode and
+/// parameter ranges share one design.
+pub fn keys(rows: &[DataRow], model: &ModelSpec) -> Vec<Key> {
+    let params = model.params(rows);
+    let mut out: Vec<Key> = Vec::new();
+    for r in rows {
+        let k = Key::of(r, model, &params);
+        if !out.contains(&k) {
+            out.push(k);
+        }
+    }
+    out
+}
+
+/// The distinct (block, mode) pairs of `rows`, in first-seen order.
+pub fn blocks(rows: &[DataRow]) -> Vec<(Block, Mode)> {
+    let mut out: Vec<(Block, Mode)> = Vec::new();
+    for r in rows {
+        if !out.contains(&(r.block, r.mode)) {
+            out.push((r.block, r.mode));
+        }
+    }
+    out
+}
+
+/// 64-bit FNV-1a of a text.
+fn fnv(text: &str) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in text.bytes() {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+/// The seed of one numbered set of throws of a block: FNV-1a of the run's seed, the block, the
+/// mode and the number.
+pub fn point_seed(seed: u64, block: Block, mode: Mode, point: usize) -> u64 {
+    fnv(&format!("{seed}/{block}/{}/{point}", mode.name()))
+}
+
+/// The surrogate's probabilities over [length, breadth, width] (a 2D design: length 0).
+pub fn three(p: &[f64], mode: Mode) -> Vec<f64> {
+    match mode {
+        Mode::ThreeD => p.to_vec(),
+        Mode::TwoD => vec![0.0, p[0], p[1]],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_design_starts_at_the_corners_and_fills_the_box() {
+        let p = points(2, 20);
+        assert_eq!(p.len(), 20);
+        assert_eq!(
+            &p[..5],
+            &[
+                vec![0.0, 0.0],
+                vec![1.0, 0.0],
+                vec![0.0, 1.0],
+                vec![1.0, 1.0],
+                vec![0.5, 0.5]
+            ]
+        );
+        assert_eq!(p[5], vec![0.5, 1.0 / 3.0]);
+        assert!(p.iter().all(|x| x.iter().all(|v| (0.0..=1.0).contains(v))));
+        assert_eq!(points(0, 10), vec![Vec::<f64>::new()]);
+        let b: Block = "140x24x20".parse().unwrap();
+        assert_ne!(
+            point_seed(1, b, Mode::ThreeD, 0),
+            point_seed(1, b, Mode::ThreeD, 1)
+        );
+        assert_ne!(
+            point_seed(1, b, Mode::ThreeD, 0),
+            point_seed(1, b, Mode::TwoD, 0)
+        );
+    }
+}

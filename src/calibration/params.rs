@@ -1,0 +1,470 @@
+//! What a fit varies: the contact's restitution e and friction μ (per surface, or shared by
+//! all), and the throw's concentration κ and spin scale (per thrower), each within a range,
+//! each mapped onto a unit coordinate in which the surrogate and the search work.
+//!
+//! Coordinates: e and μ linearly; the spin scale logarithmically; κ as log₁₀(1 + κ), which
+//! runs from the tumble (κ = 0) through the hand's throws to nearly the paper's (κ = 10⁴: its
+//! angles' spread is about 1/√κ ≈ 0.6°). The paper's throw itself, κ → ∞, is not a point of
+//! that range but a model of its own (κ fixed: `--kappa paper`): measured, the outcomes jump
+//! there (99.3x43.9x43.2: P(length vertical) 1.2 % with the paper's throw, 1.6 % at κ = 10⁵, 2 to
+//! 3 % from κ = 10⁴ down), because a throw spun exactly about its horizontal long axis lands
+//! flat along its whole length, and any tilt breaks that.
+
+use crate::calibration::data::DataRow;
+use crate::engine::EngineKind;
+use crate::error::{Error, Result};
+use crate::model::block::Block;
+use crate::model::scene::{Mode, Scene};
+use crate::model::throws::{Range, ThrowRanges};
+use crate::run::spec::{RunSpec, ThrowSpec, MAX_KAPPA};
+use crate::sim::roll::{early_stop_exact, RollConfig, Rule};
+use serde::{Deserialize, Serialize};
+
+/// A kind of parameter.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    Serialize,
+    Deserialize,
+    strum::Display,
+    strum::EnumString,
+    strum::IntoStaticStr,
+    strum::VariantNames,
+)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum Kind {
+    /// The contact's coefficient of restitution e (per surface).
+    E,
+    /// The contact's coefficient of friction μ (per surface).
+    Mu,
+    /// The hand's concentration κ (per thrower).
+    Kappa,
+    /// A factor on the paper's spin range, 31 to 160 rad/s (per thrower).
+    Spin,
+}
+
+impl Kind {
+    /// Every kind, in the order a row's coordinates take them.
+    pub const ALL: [Kind; 4] = [Kind::E, Kind::Mu, Kind::Kappa, Kind::Spin];
+
+    /// "e", "mu", "kappa" or "spin".
+    pub fn name(self) -> &'static str {
+        self.into()
+    }
+
+    /// True for the surface's parameters (e, μ); false for the throw's (κ, spin).
+    pub fn of_surface(self) -> bool {
+        matches!(self, Kind::E | Kind::Mu)
+    }
+
+    /// The widest range accepted: e in [0, 1], μ in [0, 5], κ in [0, 10⁶], spin scale in
+    /// [0.05, 20].
+    pub fn limits(self) -> (f64, f64) {
+        match self {
+            Kind::E => (0.0, 1.0),
+            Kind::Mu => (0.0, 5.0),
+            Kind::Kappa => (0.0, MAX_KAPPA),
+            Kind::Spin => (0.05, 20.0),
+        }
+    }
+
+    /// The default range a free parameter is searched in. e stops at 0.8: above it a long
+    /// block bounces end over end for seconds (measured, 782x25x18 at dt = 1/1000: 1 ms a roll
+    /// at e = 0.8, 14–20 ms at 0.9), and no surface in the paper comes near it.
+    pub fn default_range(self) -> Range {
+        match self {
+            Kind::E => Range::new(0.05, 0.8),
+            Kind::Mu => Range::new(0.1, 1.0),
+            Kind::Kappa => Range::new(0.0, 1e4),
+            Kind::Spin => Range::new(0.5, 2.0),
+        }
+    }
+
+    fn warp(self, v: f64) -> f64 {
+        match self {
+            Kind::E | Kind::Mu => v,
+            Kind::Kappa => (1.0 + v).log10(),
+            Kind::Spin => v.ln(),
+        }
+    }
+
+    fn unwarp(self, w: f64) -> f64 {
+        match self {
+            Kind::E | Kind::Mu => w,
+            Kind::Kappa => 10f64.powf(w) - 1.0,
+            Kind::Spin => w.exp(),
+        }
+    }
+
+    /// The value at unit coordinate `u` of `range`.
+    pub fn value(self, range: Range, u: f64) -> f64 {
+        let (a, b) = (self.warp(range.lo), self.warp(range.hi));
+        let v = self.unwarp(a + u.clamp(0.0, 1.0) * (b - a));
+        v.clamp(range.lo, range.hi)
+    }
+
+    /// The unit coordinate of `v` in `range`.
+    pub fn coordinate(self, range: Range, v: f64) -> f64 {
+        let (a, b) = (self.warp(range.lo), self.warp(range.hi));
+        if b == a {
+            return 0.5;
+        }
+        (self.warp(v) - a) / (b - a)
+    }
+}
+
+/// The throw when κ is not free: the paper's, or a hand's with this κ.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FixedThrow {
+    /// The paper's throw (κ → ∞).
+    Paper,
+    /// A hand's throw with this κ.
+    Hand(f64),
+}
+
+/// Values of the parameters that are not free.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Fixed {
+    /// e.
+    pub e: f64,
+    /// μ.
+    pub mu: f64,
+    /// The throw.
+    pub throw: FixedThrow,
+    /// The spin scale.
+    pub spin: f64,
+}
+
+impl Default for Fixed {
+    /// The paper's MDF values (μ = 0.29 measured, e = 0.5 estimated) and its throw.
+    fn default() -> Self {
+        Fixed {
+            e: 0.5,
+            mu: 0.29,
+            throw: FixedThrow::Paper,
+            spin: 1.0,
+        }
+    }
+}
+
+/// Which parameters a fit varies, where, and how they are shared.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelSpec {
+    /// The free kinds, in [`Kind::ALL`]'s order.
+    pub free: Vec<Kind>,
+    /// Surface kinds shared by every surface (one e, or one μ, for all).
+    pub shared: Vec<Kind>,
+    /// The ranges of the free kinds, one per `free` entry.
+    pub ranges: Vec<Range>,
+    /// The values of the kinds not free.
+    pub fixed: Fixed,
+    /// Ranges of single parameters, narrower than their kind's (a refined fit's second pass).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub narrowed: Vec<Narrowed>,
+}
+
+/// One parameter's own range, by its name ("e[MDF]").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Narrowed {
+    /// The parameter's name.
+    pub param: String,
+    /// Its range.
+    pub range: Range,
+}
+
+/// A design's coordinates: each free kind with its range, in [`Kind::ALL`]'s order.
+pub type Axes = Vec<(Kind, Range)>;
+
+/// The physical values at unit coordinates `x` on `axes`, the rest as `fixed`.
+pub fn values(fixed: &Fixed, axes: &[(Kind, Range)], x: &[f64]) -> Fixed {
+    let mut v = *fixed;
+    for ((kind, range), &u) in axes.iter().zip(x) {
+        let value = kind.value(*range, u);
+        match kind {
+            Kind::E => v.e = value,
+            Kind::Mu => v.mu = value,
+            Kind::Kappa => v.throw = FixedThrow::Hand(value),
+            Kind::Spin => v.spin = value,
+        }
+    }
+    v
+}
+
+/// One free parameter: a kind, for one surface or thrower (or "all").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Param {
+    /// Its kind.
+    pub kind: Kind,
+    /// The surface (e, μ) or thrower (κ, spin) it belongs to, or "all" when shared.
+    pub group: String,
+    /// The range it is searched in (its kind's, or narrower after a first pass).
+    pub range: Range,
+    /// Its kind's whole range: a region that reaches a face of `range` inside this was cut by
+    /// the narrowing, not bounded by the physics.
+    pub whole: Range,
+}
+
+impl Param {
+    /// "e[MDF]", "kappa[all]".
+    pub fn name(&self) -> String {
+        format!("{}[{}]", self.kind, self.group)
+    }
+}
+
+impl ModelSpec {
+    /// Checks the model: kinds not repeated, ranges inside their limits and not empty, fixed
+    /// values physical.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| Err(Error::Invalid(m));
+        if self.free.len() != self.ranges.len() {
+            return bad("one range per free parameter".into());
+        }
+        for (i, k) in self.free.iter().enumerate() {
+            if self.free[..i].contains(k) {
+                return bad(format!("free parameter {k} named twice"));
+            }
+            let (lo, hi) = k.limits();
+            let r = self.ranges[i];
+            if !(r.lo >= lo && r.hi <= hi && r.lo < r.hi) {
+                return bad(format!(
+                    "range of {k} {r}: must be LO:HI with {lo} <= LO < HI <= {hi}"
+                ));
+            }
+        }
+        for k in &self.shared {
+            if !k.of_surface() {
+                return bad(format!(
+                    "shared {k}: only the surface's e and mu are per surface or shared"
+                ));
+            }
+        }
+        let f = self.fixed;
+        for (k, v) in [(Kind::E, f.e), (Kind::Mu, f.mu), (Kind::Spin, f.spin)] {
+            let (lo, hi) = k.limits();
+            if !(v >= lo && v <= hi) {
+                return bad(format!("{k} {v}: must be in [{lo}, {hi}]"));
+            }
+        }
+        if let FixedThrow::Hand(k) = f.throw {
+            if !(0.0..=MAX_KAPPA).contains(&k) {
+                return bad(format!("kappa {k}: must be in [0, {MAX_KAPPA:e}]"));
+            }
+        }
+        for n in &self.narrowed {
+            let kind = self
+                .free
+                .iter()
+                .find(|k| n.param.starts_with(&format!("{k}[")))
+                .ok_or_else(|| {
+                    Error::Invalid(format!("narrowed {}: not a free parameter", n.param))
+                })?;
+            let r = self.range(*kind);
+            if !(n.range.lo >= r.lo && n.range.hi <= r.hi && n.range.lo < n.range.hi) {
+                return bad(format!(
+                    "narrowed {} {}: must lie inside {kind}'s range {r}",
+                    n.param, n.range
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// True if `kind` is free.
+    pub fn is_free(&self, kind: Kind) -> bool {
+        self.free.contains(&kind)
+    }
+
+    /// The range of a free kind.
+    pub fn range(&self, kind: Kind) -> Range {
+        let i = self
+            .free
+            .iter()
+            .position(|k| *k == kind)
+            .expect("free kind");
+        self.ranges[i]
+    }
+
+    fn group_of(&self, kind: Kind, row: &DataRow) -> String {
+        if kind.of_surface() {
+            if self.shared.contains(&kind) {
+                "all".into()
+            } else {
+                row.surface.clone()
+            }
+        } else {
+            row.thrower.clone()
+        }
+    }
+
+    /// The free parameters `rows` need, kinds in order, groups in first-seen order.
+    pub fn params(&self, rows: &[DataRow]) -> Vec<Param> {
+        let mut out: Vec<Param> = Vec::new();
+        for &kind in &self.free {
+            for r in rows {
+                let group = self.group_of(kind, r);
+                if out.iter().any(|p| p.kind == kind && p.group == group) {
+                    continue;
+                }
+                let name = format!("{kind}[{group}]");
+                let whole = self.range(kind);
+                let range = self
+                    .narrowed
+                    .iter()
+                    .find(|n| n.param == name)
+                    .map_or(whole, |n| n.range);
+                out.push(Param {
+                    kind,
+                    group,
+                    range,
+                    whole,
+                });
+            }
+        }
+        out
+    }
+
+    /// For `row`, the index into `params` of each of its coordinates (the free kinds, in order).
+    pub fn row_dims(&self, params: &[Param], row: &DataRow) -> Vec<usize> {
+        self.free
+            .iter()
+            .map(|&kind| {
+                let group = self.group_of(kind, row);
+                params
+                    .iter()
+                    .position(|p| p.kind == kind && p.group == group)
+                    .expect("params() covers every row")
+            })
+            .collect()
+    }
+
+    /// A row's axes: its parameters' kinds and ranges, in order.
+    pub fn axes(&self, params: &[Param], dims: &[usize]) -> Axes {
+        dims.iter()
+            .map(|&d| (params[d].kind, params[d].range))
+            .collect()
+    }
+
+    /// The kinds' whole ranges as axes (a design before any narrowing).
+    pub fn whole_axes(&self) -> Axes {
+        self.free
+            .iter()
+            .copied()
+            .zip(self.ranges.iter().copied())
+            .collect()
+    }
+}
+
+/// How each throw is simulated: the engine, the time step, and what ends a roll.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Method {
+    /// The engine.
+    pub engine: EngineKind,
+    /// The time step, s.
+    pub dt: f64,
+    /// The step cap per roll.
+    pub max_steps: u64,
+}
+
+impl Method {
+    /// How each roll is carried out: the fast defaults, ended by the exact early stop where it
+    /// is exact (`roll::EARLY_STOP_MAX_DT`), else by DicePhys's rest rule.
+    pub fn roll(&self) -> RollConfig {
+        RollConfig {
+            max_steps: self.max_steps,
+            rule: if early_stop_exact(self.dt) {
+                Rule::Certificate
+            } else {
+                Rule::Dicephys
+            },
+            ..RollConfig::fast()
+        }
+    }
+
+    /// The run that simulates `block` in `mode` at the values `v`, `rolls` throws keyed by
+    /// `seed`.
+    pub fn spec(&self, block: Block, mode: Mode, v: &Fixed, seed: u64, rolls: u64) -> RunSpec {
+        let mut scene = Scene::paper(block, mode);
+        scene.dt = self.dt;
+        scene.restitution = v.e;
+        scene.friction = v.mu;
+        let mut throws = match v.throw {
+            FixedThrow::Paper => ThrowSpec::keyed(seed),
+            FixedThrow::Hand(k) => ThrowSpec::hand(seed, k),
+        };
+        let paper = ThrowRanges::default().spin;
+        throws.ranges.spin = Range::new(paper.lo * v.spin, paper.hi * v.spin);
+        RunSpec {
+            engine: self.engine,
+            scene,
+            throws,
+            roll: self.roll(),
+            rolls,
+            shard: None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coordinates_invert_and_warp() {
+        for kind in Kind::ALL {
+            let r = kind.default_range();
+            for u in [0.0, 0.25, 0.5, 1.0] {
+                let v = kind.value(r, u);
+                assert!((kind.coordinate(r, v) - u).abs() < 1e-12, "{kind} {u}");
+            }
+            assert_eq!(kind.value(r, 0.0), r.lo);
+        }
+        // κ: the middle of 0..10⁴ in log₁₀(1 + κ) is κ = √10001 − 1 ≈ 99.
+        let r = Kind::Kappa.default_range();
+        assert!((Kind::Kappa.value(r, 0.5) - (10001f64.sqrt() - 1.0)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn rows_map_to_their_surface_and_thrower() {
+        let rows = crate::calibration::data::paper_rows().unwrap();
+        let m = ModelSpec {
+            free: vec![Kind::E, Kind::Mu, Kind::Kappa],
+            shared: vec![],
+            ranges: vec![
+                Kind::E.default_range(),
+                Kind::Mu.default_range(),
+                Kind::Kappa.default_range(),
+            ],
+            fixed: Fixed::default(),
+            narrowed: vec![],
+        };
+        m.validate().unwrap();
+        let params = m.params(&rows);
+        // Five surfaces, each its e and μ, and one κ.
+        assert_eq!(params.len(), 11);
+        let dims = m.row_dims(&params, &rows[6]);
+        assert_eq!(params[dims[0]].name(), "e[MDF]");
+        assert_eq!(params[dims[2]].name(), "kappa[all]");
+        let shared = ModelSpec {
+            shared: vec![Kind::E, Kind::Mu],
+            ..m.clone()
+        };
+        assert_eq!(shared.params(&rows).len(), 3);
+        let bad = ModelSpec {
+            ranges: vec![Range::new(0.5, 1.5), m.ranges[1], m.ranges[2]],
+            ..m
+        };
+        assert!(bad
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("range of e"));
+    }
+}

@@ -1,0 +1,170 @@
+//! Predictions from a fit: outcome probabilities with an error that combines the parameters'
+//! uncertainty (their posterior draws) with the simulation's noise.
+//!
+//! - A row the fit has a surrogate for (a leave-one-out check): the surrogate at every draw.
+//! - A block it has not ([`predict_block`]): the simulator itself at `draws` of the posterior
+//!   draws, `rolls` throws each (fresh keyed throws per draw). With p̂_m the draws' frequencies,
+//!   the law of total variance splits their spread S² into the parameters' part,
+//!   Var_θ = S² − mean p̂(1 − p̂)/n, and the rolls' noise; the mean's own error adds
+//!   (Var_θ + p̄(1 − p̄)/n)/M for M draws.
+
+use crate::calibration::estimate::Likelihood;
+use crate::calibration::FitResult;
+use crate::error::{Error, Result};
+use crate::model::block::Block;
+use crate::model::scene::Mode;
+use crate::theory::stats;
+use serde::{Deserialize, Serialize};
+
+/// A predicted probability.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Predicted {
+    /// The prediction (the posterior mean).
+    pub value: f64,
+    /// Its whole standard error, √(params² + simulation²).
+    pub err: f64,
+    /// The part from the parameters' uncertainty.
+    pub err_params: f64,
+    /// The part from the simulation's noise.
+    pub err_sim: f64,
+}
+
+impl Predicted {
+    /// The mean of `values` with their spread as the parameters' error and `sim_var` as the
+    /// simulation's.
+    pub fn of(values: &[f64], sim_var: f64) -> Predicted {
+        let n = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let var = if values.len() > 1 {
+            values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)
+        } else {
+            0.0
+        };
+        Predicted {
+            value: mean,
+            err: (var + sim_var).sqrt(),
+            err_params: var.sqrt(),
+            err_sim: sim_var.sqrt(),
+        }
+    }
+
+    /// (measured − predicted)/√(σ_measured² + σ_predicted²).
+    pub fn z(&self, measured: f64, measured_err: f64) -> f64 {
+        stats::z_score(measured, measured_err, self.value, self.err)
+    }
+}
+
+/// Row `r`'s predicted group probabilities and ratio (breadth over width, when both are
+/// counted apart) over the posterior `draws` (unit coordinates of the likelihood's parameters).
+pub fn predict_row(
+    lik: &Likelihood,
+    r: usize,
+    draws: &[Vec<f64>],
+) -> (Vec<Predicted>, Option<Predicted>, Vec<String>) {
+    let preds: Vec<_> = draws.iter().map(|x| lik.predict(r, x)).collect();
+    let groups = lik.group_names(r);
+    let k = preds[0].p.len();
+    let m = preds.len() as f64;
+    let probs = (0..k)
+        .map(|g| {
+            let v: Vec<f64> = preds.iter().map(|p| p.p[g]).collect();
+            let sim = preds.iter().map(|p| p.cov[(g, g)].max(0.0)).sum::<f64>() / m;
+            Predicted::of(&v, sim)
+        })
+        .collect();
+    let (b, w) = (
+        groups.iter().position(|g| g == "breadth"),
+        groups.iter().position(|g| g == "width"),
+    );
+    let ratio = b.zip(w).map(|(b, w)| {
+        let v: Vec<f64> = preds.iter().map(|p| p.p[b] / p.p[w]).collect();
+        // The ratio's simulation variance by the delta method.
+        let sim = preds
+            .iter()
+            .map(|p| {
+                let (pb, pw) = (p.p[b], p.p[w]);
+                let (vb, vw, cbw) = (p.cov[(b, b)], p.cov[(w, w)], p.cov[(b, w)]);
+                (vb / (pw * pw) + vw * pb * pb / pw.powi(4) - 2.0 * cbw * pb / pw.powi(3)).max(0.0)
+            })
+            .sum::<f64>()
+            / m;
+        Predicted::of(&v, sim)
+    });
+    (probs, ratio, groups)
+}
+
+/// A prediction for a block the fit did not see.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BlockPrediction {
+    /// The block.
+    pub block: Block,
+    /// 2D or 3D.
+    pub mode: Mode,
+    /// The surface whose e and μ were used ("all" when shared).
+    pub surface: String,
+    /// The thrower whose throw was used.
+    pub thrower: String,
+    /// P(length), P(breadth), P(width) vertical (a 2D block: length 0).
+    pub p: Vec<Predicted>,
+    /// N(breadth vertical)/N(width vertical).
+    pub ratio: Predicted,
+    /// The paper's 2D theory ratio (eq. MasterEqu) for the block.
+    pub theory_ratio: f64,
+    /// Posterior draws simulated.
+    pub draws: usize,
+    /// Rolls per draw.
+    pub rolls: u64,
+    /// Rolls that did not settle on a face, over all draws (left out).
+    pub unsettled: u64,
+}
+
+/// What to predict.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PredictConfig {
+    /// The block.
+    pub block: Block,
+    /// 2D or 3D.
+    pub mode: Mode,
+    /// The surface whose e and μ to use (needed when the fit has them per surface).
+    pub surface: Option<String>,
+    /// The thrower whose throw to use (needed when the fit has several).
+    pub thrower: Option<String>,
+    /// Posterior draws to simulate.
+    pub draws: usize,
+    /// Rolls per draw.
+    pub rolls: u64,
+    /// The throws' seed.
+    pub seed: u64,
+}
+
+/// Which group a new row takes from the fit: the named one, or the only one there is.
+pub fn group(
+    fit: &FitResult,
+    of_surface: bool,
+    asked: &Option<String>,
+    what: &str,
+) -> Result<String> {
+    let known: Vec<String> = fit
+        .params
+        .iter()
+        .filter(|p| p.kind.of_surface() == of_surface)
+        .map(|p| p.group.clone())
+        .fold(Vec::new(), |mut v, g| {
+            if !v.contains(&g) {
+                v.push(g);
+            }
+            v
+        });
+    match asked {
+        Some(s) if known.contains(s) || known.is_empty() || known == ["all"] => Ok(s.clone()),
+        Some(s) => Err(Error::Invalid(format!(
+            "{what} '{s}' is not in the fit (it has: {})",
+            known.join(", ")
+        ))),
+        None if known.len() <= 1 => Ok(known.first().cloned().unwrap_or_else(|| "all".into())),
+        None => Err(Error::Invalid(format!(
+            "name the {what}: the fit has several ({})",
+            known.join(", ")
+        ))),
+    }
+}

@@ -1,0 +1,303 @@
+//! `dicephys fit` (calibrate e, μ and the throw to measured counts, or check that a fit
+//! recovers known values) and `dicephys predict` (a block the fit did not see).
+
+use super::args::{parse_engine, parse_step};
+use super::error::{Error, Result};
+use clap::Args;
+use dicephys::calibration::data;
+use dicephys::calibration::design::DesignSpec;
+use dicephys::calibration::estimate::Search;
+use dicephys::calibration::params::{Fixed, FixedThrow, Kind, Method, ModelSpec};
+use dicephys::calibration::predict::PredictConfig;
+use dicephys::calibration::{FitConfig, FitResult};
+use dicephys::engine::EngineKind;
+use dicephys::model::block::Block;
+use dicephys::model::scene::Mode;
+use dicephys::model::throws::Range;
+use dicephys::sim::roll::DEFAULT_MAX_STEPS;
+use std::path::PathBuf;
+
+/// `dicephys fit`'s arguments.
+#[derive(Args, Debug)]
+pub struct FitArgs {
+    /// The measured counts: a CSV with the columns label, surface, length_mm, breadth_mm,
+    /// width_mm, mode (2d or 3d), length_vertical, breadth_vertical, width_vertical and
+    /// optionally thrower (docs/guide.md, "Calibrating").
+    #[arg(long, value_name = "COUNTS.csv")]
+    pub data: PathBuf,
+    /// The free parameters (comma-separated): e (restitution), mu (friction), kappa (the
+    /// throw's concentration, --throw hand), spin (a factor on the spin range).
+    #[arg(long, value_delimiter = ',', default_value = "e,mu", value_parser = parse_kind)]
+    pub free: Vec<Kind>,
+    /// Surface parameters shared by every surface instead of one per surface (e, mu).
+    #[arg(long, value_delimiter = ',', value_parser = parse_kind)]
+    pub shared: Vec<Kind>,
+    /// A free parameter's range, NAME=LO:HI (repeat for several). Defaults: e=0.05:0.8,
+    /// mu=0.1:1, kappa=0:10000, spin=0.5:2.
+    #[arg(long = "range", value_name = "NAME=LO:HI")]
+    pub ranges: Vec<String>,
+    /// e where it is not free.
+    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
+    pub restitution: f64,
+    /// μ where it is not free.
+    #[arg(long, default_value_t = 0.29, allow_hyphen_values = true)]
+    pub friction: f64,
+    /// The throw where kappa is not free: "paper" (the paper's throw) or a hand's κ.
+    #[arg(long, default_value = "paper", allow_hyphen_values = true)]
+    pub kappa: String,
+    /// The spin scale where spin is not free.
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    pub spin_scale: f64,
+    /// The engine.
+    #[arg(long, default_value = "bullet", value_parser = parse_engine)]
+    pub engine: EngineKind,
+    /// The time step, s or 1/N.
+    #[arg(long, default_value = "1/1000", value_parser = parse_step)]
+    pub dt: f64,
+    /// Steps after which a roll not at rest counts as unconverged.
+    #[arg(long, default_value_t = DEFAULT_MAX_STEPS)]
+    pub max_steps: u64,
+    /// Parameter points each block is simulated at.
+    #[arg(long, default_value_t = 64)]
+    pub points: usize,
+    /// Rolls at each point.
+    #[arg(long, default_value_t = 500)]
+    pub rolls: u64,
+    /// The surrogate's polynomial degree (raised while it lacks fit, up to --max-degree).
+    #[arg(long, default_value_t = 3)]
+    pub degree: usize,
+    /// The highest surrogate degree tried.
+    #[arg(long, default_value_t = 4)]
+    pub max_degree: usize,
+    /// One pass only: no second pass over the box narrowed to the first pass's region.
+    #[arg(long)]
+    pub no_refine: bool,
+    /// Seed of the keyed throws.
+    #[arg(long, default_value_t = 2385)]
+    pub seed: u64,
+    /// Worker threads (0: one per core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Output directory: fit.json, report.md, figures, and the simulations' cells
+    /// [default: fit-out].
+    #[arg(long, value_name = "OUT")]
+    pub out: Option<PathBuf>,
+    /// Instead of fitting the file's counts: simulate counts of its rows (same blocks and
+    /// numbers of throws) at these values, NAME=V,… for every free parameter, fit them back,
+    /// --repeats times, and report how often the 2σ region holds the truth.
+    #[arg(long, value_name = "NAME=V,...")]
+    pub recover: Option<String>,
+    /// With --recover: repetitions (each its own data and simulations).
+    #[arg(long, default_value_t = 20)]
+    pub repeats: usize,
+    /// Print the result's JSON to stdout instead of the report.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `dicephys predict`'s arguments.
+#[derive(Args, Debug)]
+pub struct PredictArgs {
+    /// The fit to predict from (a fit's fit.json).
+    #[arg(long, value_name = "FIT.json")]
+    pub fit: PathBuf,
+    /// The block, LENGTHxBREADTHxWIDTH in mm.
+    #[arg(long)]
+    pub block: Block,
+    /// Simulate it in 2D (DicePhys's plane-locked block).
+    #[arg(long = "2d")]
+    pub two_d: bool,
+    /// The surface whose fitted e and μ to use (when the fit has one per surface).
+    #[arg(long)]
+    pub surface: Option<String>,
+    /// The thrower whose fitted throw to use (when the fit has several).
+    #[arg(long)]
+    pub thrower: Option<String>,
+    /// Posterior draws to simulate the block at.
+    #[arg(long, default_value_t = 16)]
+    pub draws: usize,
+    /// Rolls at each draw.
+    #[arg(long, default_value_t = 2000)]
+    pub rolls: u64,
+    /// Seed of the keyed throws.
+    #[arg(long, default_value_t = 2385)]
+    pub seed: u64,
+    /// Worker threads (0: one per core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Print the prediction's JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// A parameter's name as clap reads it.
+pub fn parse_kind(s: &str) -> std::result::Result<Kind, dicephys::Error> {
+    dicephys::error::parse_name("parameter", s)
+}
+
+/// `NAME=V` pairs, comma-separated, each name a parameter kind.
+fn pairs<T>(
+    flag: &str,
+    items: &[&str],
+    value: impl Fn(&str) -> std::result::Result<T, String>,
+) -> Result<Vec<(Kind, T)>> {
+    items
+        .iter()
+        .map(|item| {
+            let (k, v) = item
+                .split_once('=')
+                .ok_or_else(|| Error::Usage(format!("{flag} {item}: write NAME=VALUE")))?;
+            let kind =
+                parse_kind(k.trim()).map_err(|e| Error::Usage(format!("{flag} {item}: {e}")))?;
+            let v = value(v.trim()).map_err(|e| Error::Usage(format!("{flag} {item}: {e}")))?;
+            Ok((kind, v))
+        })
+        .collect()
+}
+
+impl FitArgs {
+    fn model(&self) -> Result<ModelSpec> {
+        let mut free = self.free.clone();
+        free.sort();
+        free.dedup();
+        let mut ranges: Vec<Range> = free.iter().map(|k| k.default_range()).collect();
+        let given: Vec<&str> = self.ranges.iter().map(String::as_str).collect();
+        for (kind, r) in pairs("--range", &given, |v| {
+            v.parse::<Range>().map_err(|e| e.to_string())
+        })? {
+            let i = free.iter().position(|k| *k == kind).ok_or_else(|| {
+                Error::Usage(format!("--range {kind}=…: {kind} is not among --free"))
+            })?;
+            ranges[i] = r;
+        }
+        let throw = match self.kappa.as_str() {
+            "paper" => FixedThrow::Paper,
+            k => FixedThrow::Hand(k.parse().map_err(|_| {
+                Error::Usage(format!("--kappa {k}: 'paper' or a concentration >= 0"))
+            })?),
+        };
+        let model = ModelSpec {
+            free,
+            shared: self.shared.clone(),
+            ranges,
+            fixed: Fixed {
+                e: self.restitution,
+                mu: self.friction,
+                throw,
+                spin: self.spin_scale,
+            },
+            narrowed: vec![],
+        };
+        model.validate()?;
+        Ok(model)
+    }
+
+    fn config(&self) -> Result<FitConfig> {
+        let text = std::fs::read_to_string(&self.data).map_err(|e| {
+            Error::Usage(format!(
+                "--data {}: cannot read it ({e})",
+                self.data.display()
+            ))
+        })?;
+        let rows = data::parse(&text, &self.data.display().to_string())?;
+        let cfg = FitConfig {
+            rows,
+            model: self.model()?,
+            method: Method {
+                engine: self.engine,
+                dt: self.dt,
+                max_steps: self.max_steps,
+            },
+            design: DesignSpec {
+                points: self.points,
+                rolls: self.rolls,
+                degree: self.degree,
+                max_degree: self.max_degree,
+                refine: !self.no_refine,
+            },
+            search: Search {
+                seed: self.seed,
+                ..Search::default()
+            },
+            seed: self.seed,
+        };
+        cfg.validate()?;
+        Ok(cfg)
+    }
+}
+
+/// Runs `dicephys fit`.
+pub fn run(a: &FitArgs) -> Result<()> {
+    let cfg = a.config()?;
+    if a.recover.is_some() && a.repeats == 0 {
+        return Err(Error::Usage(
+            "--repeats 0: need at least one repetition".into(),
+        ));
+    }
+    let out = a.out.clone().unwrap_or_else(|| "fit-out".into());
+    let mut place = super::study::local(&out, a.threads, a.json)?;
+    // The simulations' cells under --out/cells.
+    place.checkpoint = Some(out.join("cells"));
+    match &a.recover {
+        Some(truth) => {
+            let truth = truth_values(&cfg, truth)?;
+            super::study::recover(&cfg, &truth, a.repeats, &place)
+        }
+        None => super::study::fit(&cfg, &place),
+    }
+}
+
+/// `--recover NAME=V,…`: a value for every free parameter, in the model's order.
+fn truth_values(cfg: &FitConfig, truth: &str) -> Result<Vec<f64>> {
+    let given: Vec<&str> = truth.split(',').collect();
+    let values = pairs("--recover", &given, |v| {
+        v.parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("'{v}' is not a finite number"))
+    })?;
+    if let Some((k, _)) = values.iter().find(|(k, _)| !cfg.model.free.contains(k)) {
+        return Err(Error::Usage(format!(
+            "--recover {k}=…: {k} is not among --free"
+        )));
+    }
+    cfg.model
+        .free
+        .iter()
+        .map(|k| {
+            values
+                .iter()
+                .find(|(kind, _)| kind == k)
+                .map(|v| v.1)
+                .ok_or_else(|| {
+                    Error::Usage(format!(
+                        "--recover: give a value for the free parameter {k}"
+                    ))
+                })
+        })
+        .collect()
+}
+
+/// Runs `dicephys predict`.
+pub fn predict(a: &PredictArgs) -> Result<()> {
+    let text = std::fs::read_to_string(&a.fit)
+        .map_err(|e| Error::Usage(format!("--fit {}: cannot read it ({e})", a.fit.display())))?;
+    let fit: FitResult = serde_json::from_str(&text).map_err(|e| {
+        Error::Usage(format!(
+            "--fit {}: not a fit's fit.json ({e})",
+            a.fit.display()
+        ))
+    })?;
+    let cfg = PredictConfig {
+        block: a.block,
+        mode: if a.two_d { Mode::TwoD } else { Mode::ThreeD },
+        surface: a.surface.clone(),
+        thrower: a.thrower.clone(),
+        draws: a.draws,
+        rolls: a.rolls,
+        seed: a.seed,
+    };
+    let mut place = super::study::local(std::path::Path::new("."), a.threads, a.json)?;
+    place.checkpoint = None;
+    super::study::predict(&fit, &cfg, &place)
+}

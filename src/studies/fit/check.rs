@@ -1,0 +1,88 @@
+//! The method check ([`crate::calibration::check`]): each block rolled at the fitted values by
+//! the fit's method and by a finer reference, on the same keyed throws.
+
+use crate::calibration::check::{BlockCheck, Departure, MethodCheck};
+use crate::calibration::data::DataRow;
+use crate::calibration::design::{blocks, point_seed};
+use crate::calibration::params::{Fixed, Method};
+use crate::error::Result;
+use crate::model::block::Outcome;
+use crate::run::runner::Runner;
+use crate::sim::roll::Fate;
+
+/// Checks `method` against `reference_dt` at the values `at(row)` gives each row's block, with
+/// `rolls` throws a block. `None` if stopped early.
+pub fn run(
+    rows: &[DataRow],
+    method: &Method,
+    reference_dt: f64,
+    at: &dyn Fn(&DataRow) -> Fixed,
+    rolls: u64,
+    seed: u64,
+    runner: &Runner,
+) -> Result<Option<MethodCheck>> {
+    let reference = Method {
+        dt: reference_dt,
+        ..*method
+    };
+    let mut checks = Vec::new();
+    for (block, mode) in blocks(rows) {
+        let block_rows: Vec<&DataRow> = rows
+            .iter()
+            .filter(|r| r.block == block && r.mode == mode)
+            .collect();
+        let values = at(block_rows[0]);
+        let seed = point_seed(seed, block, mode, usize::MAX);
+        let mut fates: [Vec<Fate>; 2] = Default::default();
+        for (i, m) in [method, &reference].iter().enumerate() {
+            let spec = m.spec(block, mode, &values, seed, rolls);
+            spec.validate(false)?;
+            let done = runner.run(&spec, None, &mut |recs| {
+                fates[i].extend(recs.iter().map(|r| r.fate));
+                Ok(())
+            })?;
+            if !done.complete {
+                return Ok(None);
+            }
+        }
+        // Throws settled by both methods, paired.
+        let both: Vec<(Outcome, Outcome)> = fates[0]
+            .iter()
+            .zip(&fates[1])
+            .filter_map(|(a, b)| match (a, b) {
+                (Fate::Settled(a), Fate::Settled(b)) => Some((*a, *b)),
+                _ => None,
+            })
+            .collect();
+        let ind = |o: Outcome, k: usize| -> Vec<bool> {
+            both.iter()
+                .map(|p| if k == 0 { p.0 == o } else { p.1 == o })
+                .collect()
+        };
+        let breadth = Departure::paired(&ind(Outcome::Breadth, 0), &ind(Outcome::Breadth, 1));
+        let length = Departure::paired(&ind(Outcome::Length, 0), &ind(Outcome::Length, 1));
+        let data_err = block_rows
+            .iter()
+            .map(|r| {
+                let n = r.n() as f64;
+                let p = (r.counts[1] as f64 / n).clamp(0.5 / n, 1.0 - 0.5 / n);
+                (p * (1.0 - p) / n).sqrt()
+            })
+            .fold(f64::INFINITY, f64::min);
+        let ok = |d: &Departure| d.value.abs() + 2.0 * d.err <= data_err;
+        checks.push(BlockCheck {
+            block,
+            mode,
+            rolls: both.len() as u64,
+            within: ok(&breadth) && ok(&length),
+            breadth,
+            length,
+            data_err,
+        });
+    }
+    Ok(Some(MethodCheck {
+        dt: method.dt,
+        reference_dt,
+        blocks: checks,
+    }))
+}

@@ -1,0 +1,133 @@
+//! `fit`, `fit --recover`, `predict` and `paper --calibrated` end to end: outputs checked
+//! before anything rolls, the study run with its progress, its results rendered and written
+//! whole (as [`crate::studies::outputs`] does for the other studies).
+
+use crate::calibration::predict::PredictConfig;
+use crate::calibration::{FitConfig, FitResult};
+use crate::error::Result;
+use crate::report::fit as report;
+use crate::studies::calibrated::{self, CalibratedConfig};
+use crate::studies::outputs::{to_json, Done, Hooks, Place};
+
+fn interrupted(place: &Place) -> Done {
+    Done {
+        interrupted: Some(match &place.checkpoint {
+            Some(d) => format!(
+                "interrupted; {} kept what was rolled: run the same command to continue",
+                d.display()
+            ),
+            None => "interrupted before the end".into(),
+        }),
+        ..Done::default()
+    }
+}
+
+/// `fit`: fit.json, report.md and its figures in `place.out`; the simulations' cells under
+/// `place.checkpoint`.
+pub fn fit(cfg: &FitConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
+    cfg.validate()?;
+    let outputs = place.outputs(&["fit.json", "report.md"])?;
+    // Two passes roll about as much as the first twice.
+    let total = cfg.total_rolls() as f64 * if cfg.design.refine { 2.0 } else { 1.0 };
+    let progress = |n: u64| (hooks.progress)(n as f64, total);
+    let study = place.study(&hooks.stop, &progress);
+    let Some(res) = super::run(
+        cfg,
+        place.command_line.clone(),
+        &study.runner,
+        study.checkpoint.as_deref(),
+    )?
+    else {
+        return Ok(interrupted(place));
+    };
+    let figures = report::write_figures(&place.out, &res)?;
+    let md = report::markdown(&res, &figures);
+    let json = to_json(&res)?;
+    outputs[0].write(json.as_bytes())?;
+    outputs[1].write(md.as_bytes())?;
+    Ok(place.done(&json, &md, "fit.json"))
+}
+
+/// `fit --recover`: recovery.json in `place.out`, the coverage printed.
+pub fn recover(
+    cfg: &FitConfig,
+    truth: &[f64],
+    repeats: usize,
+    place: &Place,
+    hooks: &Hooks,
+) -> Result<Done> {
+    cfg.validate()?;
+    let outputs = place.outputs(&["recovery.json"])?;
+    let data: u64 = cfg.rows.iter().map(|r| r.counts.iter().sum::<u64>()).sum();
+    let passes = if cfg.design.refine { 2 } else { 1 };
+    let total = ((passes * cfg.total_rolls() + data) * repeats as u64) as f64;
+    let progress = |n: u64| (hooks.progress)(n as f64, total);
+    let study = place.study(&hooks.stop, &progress);
+    let Some(res) = super::recovery::run(cfg, truth, repeats, &study.runner)? else {
+        return Ok(Done {
+            interrupted: Some("interrupted before the repetitions were done".into()),
+            ..Done::default()
+        });
+    };
+    let json = to_json(&res)?;
+    outputs[0].write(json.as_bytes())?;
+    let text = report::recovery_text(&res);
+    let mut done = place.done(&json, &text, "recovery.json");
+    done.note = done
+        .note
+        .map(|_| format!("wrote {}/recovery.json", place.out.display()));
+    Ok(done)
+}
+
+/// `predict`: the block's probabilities printed (no files).
+pub fn predict(fit: &FitResult, cfg: &PredictConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
+    let total = (cfg.draws as u64 * cfg.rolls) as f64;
+    let progress = |n: u64| (hooks.progress)(n as f64, total);
+    let study = place.study(&hooks.stop, &progress);
+    let Some(p) = super::predict::predict_block(fit, cfg, &study.runner, None)? else {
+        return Ok(Done {
+            interrupted: Some("interrupted before the draws were rolled".into()),
+            ..Done::default()
+        });
+    };
+    Ok(Done {
+        stdout: if place.json {
+            format!("{}\n", to_json(&p)?)
+        } else {
+            report::prediction_text(&p)
+        },
+        ..Done::default()
+    })
+}
+
+/// `paper --calibrated`: calibrated.json, calibrated.md and figures in `place.out`, the cells
+/// under `place.checkpoint`.
+pub fn calibrated(cfg: &CalibratedConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
+    let outputs = place.outputs(&["calibrated.json", "calibrated.md"])?;
+    // Both passes roll about as much as the first.
+    let total = 2.0 * calibrated::first_pass_rolls(cfg)? as f64;
+    let progress = |n: u64| (hooks.progress)(n as f64, total);
+    let study = place.study(&hooks.stop, &progress);
+    let Some(res) = calibrated::run(
+        cfg,
+        place.command_line.clone(),
+        &study.runner,
+        study.checkpoint.as_deref(),
+    )?
+    else {
+        return Ok(interrupted(place));
+    };
+    let figures = report::write_calibrated_figures(&place.out, &res)?;
+    let md = report::calibrated_markdown(&res, &figures);
+    let json = to_json(&res)?;
+    outputs[0].write(json.as_bytes())?;
+    outputs[1].write(md.as_bytes())?;
+    let mut done = place.done(&json, &md, "calibrated.md");
+    done.note = done.note.map(|_| {
+        format!(
+            "wrote {}/calibrated.md, calibrated.json and figures",
+            place.out.display()
+        )
+    });
+    Ok(done)
+}

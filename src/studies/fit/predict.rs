@@ -1,0 +1,114 @@
+//! `dicephys predict`: a block the fit did not see, simulated at the fit's posterior draws.
+
+use crate::calibration::data::DataRow;
+use crate::calibration::design::point_seed;
+use crate::calibration::predict::{group, BlockPrediction, PredictConfig, Predicted};
+use crate::calibration::FitResult;
+use crate::error::{Error, Result};
+use crate::run::runner::Runner;
+use std::path::Path;
+
+/// Simulates `cfg.block` at posterior draws of `fit`. `None` if stopped early.
+pub fn predict_block(
+    fit: &FitResult,
+    cfg: &PredictConfig,
+    runner: &Runner,
+    dir: Option<&Path>,
+) -> Result<Option<BlockPrediction>> {
+    if cfg.draws < 2 || cfg.draws > fit.estimate.draws.len() {
+        return Err(Error::Invalid(format!(
+            "draws {}: from 2 to the fit's {} posterior draws",
+            cfg.draws,
+            fit.estimate.draws.len()
+        )));
+    }
+    if cfg.rolls == 0 || cfg.rolls > crate::run::spec::MAX_ROLLS {
+        return Err(Error::Invalid(format!("rolls {}: at least 1", cfg.rolls)));
+    }
+    let surface = group(fit, true, &cfg.surface, "surface")?;
+    let thrower = group(fit, false, &cfg.thrower, "thrower")?;
+    // The new row's coordinates: the fit's parameters of its surface and thrower.
+    let row = DataRow {
+        label: "predicted".into(),
+        surface: surface.clone(),
+        thrower: thrower.clone(),
+        block: cfg.block,
+        mode: cfg.mode,
+        counts: [0, 1, 1],
+        groups: vec![vec![1], vec![2]],
+    };
+    let model = &fit.config.model;
+    let dims = model.row_dims(&fit.params, &row);
+    let axes = model.axes(&fit.params, &dims);
+    let step = fit.estimate.draws.len() / cfg.draws;
+    let mut freq: [Vec<f64>; 3] = Default::default();
+    let mut ratios = Vec::new();
+    let mut unsettled = 0;
+    for m in 0..cfg.draws {
+        let x = &fit.estimate.draws[m * step];
+        let local: Vec<f64> = dims.iter().map(|&d| x[d]).collect();
+        let values = crate::calibration::params::values(&model.fixed, &axes, &local);
+        let seed = point_seed(cfg.seed, cfg.block, cfg.mode, m);
+        let spec = fit
+            .config
+            .method
+            .spec(cfg.block, cfg.mode, &values, seed, cfg.rolls);
+        spec.validate(false)?;
+        let ck = match dir {
+            Some(d) => Some(runner.open_cell(&d.join(format!("draw-{m:04}")), &spec)?),
+            None => None,
+        };
+        let base = m as u64 * cfg.rolls;
+        let progress = |n| (runner.progress)(base + n);
+        let done = runner
+            .with_progress(&progress)
+            .run(&spec, ck.as_ref(), &mut |_| Ok(()))?;
+        if !done.complete {
+            return Ok(None);
+        }
+        let c = &done.tally.counts;
+        let settled = c.length + c.breadth + c.width;
+        unsettled += done.tally.rolls - settled;
+        for (k, v) in [c.length, c.breadth, c.width].iter().enumerate() {
+            freq[k].push(*v as f64 / settled.max(1) as f64);
+        }
+        ratios.push(c.breadth as f64 / c.width.max(1) as f64);
+    }
+    let n = cfg.rolls as f64;
+    let m = cfg.draws as f64;
+    let combine = |v: &[f64], noise: &dyn Fn(f64) -> f64| -> Predicted {
+        // The draws' spread less the rolls' noise is the parameters' part.
+        let raw = Predicted::of(v, 0.0);
+        let rolls_var = v.iter().map(|&x| noise(x)).sum::<f64>() / m;
+        let params_var = (raw.err_params.powi(2) - rolls_var).max(0.0);
+        let sim_var = (params_var + noise(raw.value)) / m;
+        Predicted {
+            value: raw.value,
+            err: (params_var + sim_var).sqrt(),
+            err_params: params_var.sqrt(),
+            err_sim: sim_var.sqrt(),
+        }
+    };
+    let p: Vec<Predicted> = freq
+        .iter()
+        .map(|v| combine(v, &|q: f64| q * (1.0 - q) / n))
+        .collect();
+    let ratio = combine(&ratios, &|r: f64| {
+        // The paper's binomial error of a ratio r = q/(1 − q) of counts (q the breadth's share
+        // of the side outcomes): Var r = q(1 − q)/(n (1 − q)⁴).
+        let q = r / (1.0 + r);
+        q * (1.0 - q) / n / (1.0 - q).powi(4)
+    });
+    Ok(Some(BlockPrediction {
+        block: cfg.block,
+        mode: cfg.mode,
+        surface,
+        thrower,
+        p,
+        ratio,
+        theory_ratio: crate::theory::ratio_from_r(cfg.block.r()),
+        draws: cfg.draws,
+        rolls: cfg.rolls,
+        unsettled,
+    }))
+}

@@ -1,0 +1,154 @@
+//! Rolling the designs of a fit: each parameter point a cell of its own (resumable, keyed).
+
+use crate::calibration::design::{points, Design, DesignSpec, Key};
+use crate::calibration::params::{self, Method, ModelSpec};
+use crate::error::Result;
+use crate::inference::surrogate::{DesignPoint, Surrogate};
+use crate::model::scene::Mode;
+use crate::run::runner::Runner;
+use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+
+/// What the fits of one command share: the rolls made so far (the progress reported goes on
+/// from one fit to the next) and the designs already simulated, by key (a design is a pure
+/// function of its key and the seed, so a second model that needs it takes it as it is).
+#[derive(Default)]
+pub struct Session {
+    rolled: AtomicU64,
+    cache: Mutex<Vec<(Key, u64, Design)>>,
+}
+
+impl Session {
+    /// Rolls made so far in this session.
+    pub fn rolled(&self) -> u64 {
+        self.rolled.load(Ordering::Relaxed)
+    }
+}
+
+/// Everything `simulate` needs.
+pub struct Plan<'a> {
+    /// The model (which parameters are free, their ranges).
+    pub model: &'a ModelSpec,
+    /// How each throw is simulated.
+    pub method: &'a Method,
+    /// How densely.
+    pub design: &'a DesignSpec,
+    /// The run's seed.
+    pub seed: u64,
+    /// The session it belongs to.
+    pub session: &'a Session,
+}
+
+impl Plan<'_> {
+    /// The rolls `simulate` makes for `keys`.
+    pub fn total_rolls(&self, keys: usize) -> u64 {
+        let dims = self.model.free.len();
+        keys as u64 * points(dims, self.design.points).len() as u64 * self.design.rolls
+    }
+}
+
+/// Simulates every key over the design (each point a cell of its own under `dir`, resumed
+/// from there) and fits its surrogate. `None` if a stop request ended it early: what was rolled
+/// is kept in `dir`.
+pub fn simulate(
+    plan: &Plan,
+    keys: &[Key],
+    runner: &Runner,
+    dir: Option<&Path>,
+) -> Result<Option<Vec<Design>>> {
+    let dims = plan.model.free.len();
+    let xs = points(dims, plan.design.points);
+    let mut out = Vec::new();
+    for key in keys {
+        let cached = plan
+            .session
+            .cache
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .iter()
+            .find(|(k, seed, d)| {
+                k == key
+                    && *seed == plan.seed
+                    && d.points.len() == xs.len()
+                    && d.rolls == xs.len() as u64 * plan.design.rolls
+            })
+            .map(|c| c.2.clone());
+        if let Some(d) = cached {
+            out.push(d);
+            continue;
+        }
+        let (block, mode) = (key.block, key.mode);
+        let mut design_points = Vec::new();
+        let (mut unsettled, mut rolls) = (0u64, 0u64);
+        for (g, x) in xs.iter().enumerate() {
+            let values = params::values(&plan.model.fixed, &key.axes, x);
+            let seed = key.seed(plan.seed, g);
+            let spec = plan
+                .method
+                .spec(block, mode, &values, seed, plan.design.rolls);
+            spec.validate(false)?;
+            let ck = match dir {
+                Some(d) => Some(
+                    runner.open_cell(&d.join(key.tag()).join(format!("point-{g:05}")), &spec)?,
+                ),
+                None => None,
+            };
+            let base = plan.session.rolled();
+            let progress = |n| (runner.progress)(base + n);
+            let done = runner
+                .with_progress(&progress)
+                .run(&spec, ck.as_ref(), &mut |_| Ok(()))?;
+            plan.session
+                .rolled
+                .fetch_add(plan.design.rolls, Ordering::Relaxed);
+            if !done.complete {
+                return Ok(None);
+            }
+            let t = &done.tally;
+            unsettled += t.rolls - (t.counts.length + t.counts.breadth + t.counts.width);
+            rolls += t.rolls;
+            design_points.push(DesignPoint {
+                x: x.clone(),
+                counts: vec![t.counts.length, t.counts.breadth, t.counts.width],
+            });
+        }
+        // A 2D block has no length outcome: its surrogate is over breadth and width.
+        let (outcomes, pts): (usize, Vec<DesignPoint>) = match mode {
+            Mode::ThreeD => (3, design_points.clone()),
+            Mode::TwoD => (
+                2,
+                design_points
+                    .iter()
+                    .map(|p| DesignPoint {
+                        x: p.x.clone(),
+                        counts: p.counts[1..].to_vec(),
+                    })
+                    .collect(),
+            ),
+        };
+        let surrogate = Surrogate::fit_best(
+            &pts,
+            dims,
+            outcomes,
+            plan.design.degree,
+            plan.design.max_degree,
+        );
+        let design = Design {
+            block,
+            mode,
+            axes: key.axes.clone(),
+            points: design_points,
+            unsettled,
+            rolls,
+            surrogate,
+        };
+        plan.session
+            .cache
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push((key.clone(), plan.seed, design.clone()));
+        out.push(design);
+    }
+    Ok(Some(out))
+}

@@ -1,0 +1,240 @@
+//! `fit`, `predict` and the throw family through the binary: a fit recovers known parameters,
+//! bad files and values are refused with one line, the same seed gives the same fit on any
+//! thread count, and a prediction carries its errors.
+
+use crate::helpers::{dicephys, json, Scratch};
+
+const HEAD: &str = "label,surface,length_mm,breadth_mm,width_mm,mode,length_vertical,breadth_vertical,width_vertical\n";
+
+/// Two blocks on one surface: the data's shape for the recovery (their counts are not used).
+fn two_blocks(dir: &Scratch) -> String {
+    let path = dir.join("counts.csv");
+    std::fs::write(
+        &path,
+        format!("{HEAD}a,felt,140,24,20,3d,0,200,400\nb,felt,100,43.9,43.2,3d,10,300,290\n"),
+    )
+    .unwrap();
+    path.display().to_string()
+}
+
+#[test]
+fn the_fit_recovers_known_parameters_in_its_2_sigma_region() {
+    // 20 fixed-seed repetitions: counts simulated at e = 0.5, μ = 0.3, κ = 30 in the shape of
+    // two rows (600 and 600 throws), fitted back with their own simulations (24 points × 150
+    // rolls a block, two passes, dt = 1/250). The joint 2σ region is stated to hold the truth
+    // 95.45 % of the time; the test asks ≥ 90 % (18 of 20). Measured: 20 of 20, the truth's
+    // Δ(−2 ln L) averaging 2.3 (χ²₃'s mean is 3; a weakly identified κ lowers it).
+    let dir = Scratch::new("fit-recover");
+    let csv = two_blocks(&dir);
+    let out = dicephys(&[
+        "fit",
+        "--data",
+        &csv,
+        "--free",
+        "e,mu,kappa",
+        "--points",
+        "24",
+        "--degree",
+        "2",
+        "--rolls",
+        "150",
+        "--dt",
+        "1/250",
+        "--recover",
+        "e=0.5,mu=0.3,kappa=30",
+        "--repeats",
+        "20",
+        "--seed",
+        "11",
+        "--out",
+        dir.to_str().unwrap(),
+        "--json",
+    ]);
+    let r = json(&out);
+    let reps = r["repetitions"].as_array().unwrap();
+    assert_eq!(reps.len(), 20);
+    let covered = reps.iter().filter(|x| x["covered"] == true).count();
+    assert!(covered >= 18, "{covered} of 20 covered: {r}");
+    let mean: f64 = reps
+        .iter()
+        .map(|x| x["truth_delta"].as_f64().unwrap())
+        .sum::<f64>()
+        / 20.0;
+    assert!(mean < 6.0, "the truth's mean Δ {mean}");
+    assert!(dir.join("recovery.json").exists());
+}
+
+#[test]
+fn a_fit_is_the_same_on_one_thread_and_two_and_predicts_with_errors() {
+    let dir = Scratch::new("fit-threads");
+    let csv = dir.join("counts.csv");
+    std::fs::write(
+        &csv,
+        format!("{HEAD}a,MDF,140,24,20,2d,0,361,639\nb,MDF,140,30,10,2d,0,40,460\n"),
+    )
+    .unwrap();
+    let fit = |threads: &str, out: &str| {
+        let out_dir = dir.join(out);
+        json(&dicephys(&[
+            "fit",
+            "--data",
+            csv.to_str().unwrap(),
+            "--free",
+            "e,mu",
+            "--points",
+            "20",
+            "--degree",
+            "2",
+            "--rolls",
+            "100",
+            "--dt",
+            "1/250",
+            "--threads",
+            threads,
+            "--out",
+            out_dir.to_str().unwrap(),
+            "--json",
+        ]))
+    };
+    let (a, b) = (fit("1", "one"), fit("2", "two"));
+    for key in ["estimate", "designs", "params", "first_pass"] {
+        assert_eq!(a[key], b[key], "{key} differs between 1 and 2 threads");
+    }
+    let e = &a["estimate"];
+    assert_eq!(e["params"].as_array().unwrap().len(), 2);
+    for p in e["params"].as_array().unwrap() {
+        let (lo, v, hi) = (
+            p["two_sigma"][0].as_f64().unwrap(),
+            p["value"].as_f64().unwrap(),
+            p["two_sigma"][1].as_f64().unwrap(),
+        );
+        assert!(lo <= v && v <= hi, "{p}");
+    }
+    for f in ["fit.json", "report.md", "fit_profiles.png", "fit_rows.svg"] {
+        assert!(dir.join("one").join(f).exists(), "{f}");
+    }
+    // A block the fit did not see, on its surface: probabilities with both errors.
+    let fit_json = dir.join("one/fit.json");
+    let p = json(&dicephys(&[
+        "predict",
+        "--fit",
+        fit_json.to_str().unwrap(),
+        "--block",
+        "140x27x13",
+        "--2d",
+        "--draws",
+        "4",
+        "--rolls",
+        "200",
+        "--json",
+    ]));
+    let ratio = &p["ratio"];
+    assert!(
+        ratio["value"].as_f64().unwrap() > 0.0 && ratio["err"].as_f64().unwrap() > 0.0,
+        "{p}"
+    );
+    let (ep, es, e) = (
+        ratio["err_params"].as_f64().unwrap(),
+        ratio["err_sim"].as_f64().unwrap(),
+        ratio["err"].as_f64().unwrap(),
+    );
+    assert!((e * e - ep * ep - es * es).abs() < 1e-12, "{ratio}");
+    // An unknown surface is refused with one line.
+    let bad = dicephys(&[
+        "predict",
+        "--fit",
+        fit_json.to_str().unwrap(),
+        "--block",
+        "140x27x13",
+        "--surface",
+        "ice",
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("surface 'ice' is not in the fit"));
+}
+
+#[test]
+fn bad_counts_files_name_their_line_and_column() {
+    let dir = Scratch::new("fit-bad");
+    let cases = [
+        (
+            format!("{HEAD}a,MDF,140,24,20,3d,0,x,639\n"),
+            "line 2, column 8 (breadth_vertical)",
+        ),
+        (
+            format!("{HEAD}a,MDF,140,24,20,3d,0,36,-\n"),
+            "line 2, column 7",
+        ),
+        (
+            format!("{HEAD}a,MDF,140,24,20,3d,0,36,60\nb,MDF,-1,24,20,3d,0,1,1\n"),
+            "line 3, column 3 (length_mm)",
+        ),
+        (
+            format!("{HEAD}a,MDF,140,24,20,5d,0,36,60\n"),
+            "line 2, column 6 (mode)",
+        ),
+        ("label,surface\n".into(), "line 1: the header"),
+        (
+            format!("{HEAD}a,MDF,140,24,20,2d,0,36,60\n"),
+            "2 free parameters from 1 independent counts",
+        ),
+    ];
+    for (i, (text, want)) in cases.iter().enumerate() {
+        let csv = dir.join(format!("bad{i}.csv"));
+        std::fs::write(&csv, text).unwrap();
+        let out = dicephys(&[
+            "fit",
+            "--data",
+            csv.to_str().unwrap(),
+            "--out",
+            dir.to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{text}: {err}");
+        assert!(err.contains(want), "{err} (wanted {want})");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+    }
+}
+
+#[test]
+fn values_outside_their_physical_ranges_are_refused() {
+    let dir = Scratch::new("fit-ranges");
+    let csv = two_blocks(&dir);
+    let out_dir = dir.to_str().unwrap();
+    for (flags, want) in [
+        (vec!["--range", "e=0.2:1.5"], "range of e"),
+        (vec!["--range", "mu=-1:1"], "range of mu"),
+        (vec!["--range", "mu=0.9:0.2"], "high to low"),
+        (vec!["--range", "kappa=0:10"], "kappa is not among --free"),
+        (vec!["--restitution", "1.2"], "e 1.2"),
+        (vec!["--friction", "-0.1"], "mu -0.1"),
+        (vec!["--kappa", "-3"], "kappa -3"),
+        (vec!["--free", "e,size"], "unknown parameter 'size'"),
+        (vec!["--points", "5"], "points 5"),
+        (
+            vec!["--recover", "e=0.5"],
+            "give a value for the free parameter mu",
+        ),
+        (vec!["--recover", "e=2,mu=0.3"], "outside its range"),
+    ] {
+        let mut args = vec!["fit", "--data", &csv, "--out", out_dir];
+        args.extend(flags.iter());
+        let out = dicephys(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flags:?}: {err}");
+        assert!(err.contains(want), "{flags:?}: {err} (wanted {want})");
+    }
+    // The hand's throw needs its κ, and κ needs the hand.
+    for (flags, want) in [
+        (vec!["--throw", "hand"], "--throw hand needs --kappa"),
+        (vec!["--kappa", "3"], "only --throw hand takes"),
+        (vec!["--throw", "hand", "--kappa", "-1"], "kappa -1"),
+    ] {
+        let mut args = vec!["roll", "--block", "140x24x20", "--rolls", "10"];
+        args.extend(flags.iter());
+        let out = dicephys(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flags:?}: {err}");
+        assert!(err.contains(want), "{flags:?}: {err} (wanted {want})");
+    }
+}
