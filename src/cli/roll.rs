@@ -85,7 +85,7 @@ impl RollArgs {
             roll: self.run.roll(scene.dt)?,
             scene,
             throws: self.throw.spec()?,
-            rolls: self.run.rolls,
+            rolls: self.run.rolls(),
             shard: self.shard,
         };
         spec.validate(self.scene.allow_restitution_above_one)?;
@@ -96,6 +96,12 @@ impl RollArgs {
 /// Runs `dicephys roll`.
 pub fn run(a: &RollArgs) -> Result<()> {
     let spec = a.spec()?;
+    if let (Some(_), Some(_)) = (a.run.precision, spec.shard) {
+        return Err(Error::Usage(
+            "--precision with --shard: a shard rolls a fixed share of the throws; give --rolls"
+                .into(),
+        ));
+    }
     let threads = a.run.threads()?;
     let per_roll = a.per_roll.as_deref().map(super::output).transpose()?;
     let dir = a.resume.as_ref().or(a.checkpoint.as_ref());
@@ -105,7 +111,13 @@ pub fn run(a: &RollArgs) -> Result<()> {
     let progress = |n: u64| bar.set(n as f64, total as f64);
     let runner = Runner::new(threads, super::stop().clone());
     let runner = runner.with_progress(&progress);
-    let summary = outputs::roll(&spec, dir.map(PathBuf::as_path), per_roll, &runner)?;
+    let summary = outputs::roll(
+        &spec,
+        dir.map(PathBuf::as_path),
+        per_roll,
+        a.run.precision,
+        &runner,
+    )?;
     let rolled = summary.rolls;
     if a.json {
         outln!(
@@ -119,8 +131,11 @@ pub fn run(a: &RollArgs) -> Result<()> {
         return Err(Error::Interrupted(match dir {
             Some(d) => format!(
                 "interrupted after {rolled} of {total} rolls; continue with: dicephys roll \
-                 --resume {}",
-                d.display()
+                 --resume {}{}",
+                d.display(),
+                a.run
+                    .precision
+                    .map_or(String::new(), |p| format!(" --precision {}", 100.0 * p))
             ),
             None => format!("interrupted after {rolled} of {total} rolls"),
         }));
