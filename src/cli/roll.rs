@@ -10,6 +10,7 @@ use dicephys::run::runner::{Checkpoint, Runner};
 use dicephys::run::spec::{RunSpec, Shard};
 use dicephys::studies::outputs;
 use std::path::PathBuf;
+use std::sync::atomic::Ordering::Relaxed;
 
 /// The options that define a run: `--resume` takes them from the checkpoint instead.
 const DEFINING: [&str; 24] = [
@@ -108,14 +109,17 @@ pub fn run(a: &RollArgs) -> Result<()> {
     let total = spec.indices().len();
     let unit = Unit::Rolls { per_cell: 0 };
     let bar = Progress::new("roll", unit, false, a.json, super::study::every());
-    let progress = |n: u64| bar.set(n as f64, total as f64);
+    // Under --precision the total is the rolls expected so far, not the cap.
+    let expected = std::sync::atomic::AtomicU64::new(total);
+    let progress = |n: u64| bar.set(n as f64, expected.load(Relaxed) as f64);
+    let expect = |n: u64| expected.store(n, Relaxed);
     let runner = Runner::new(threads, super::stop().clone());
     let runner = runner.with_progress(&progress);
     let summary = outputs::roll(
         &spec,
         dir.map(PathBuf::as_path),
         per_roll,
-        a.run.precision,
+        a.run.precision.map(|p| (p, &expect as &dyn Fn(u64))),
         &runner,
     )?;
     let rolled = summary.rolls;

@@ -161,13 +161,14 @@ impl Place {
 /// CSV row per throw into `per_roll` if given (grown chunk by chunk in a temporary file, put
 /// in place at the end). Its summary is partial if a stop request ended it; a resumed run's
 /// cost is the sum over its segments (the resumed chunks carry theirs).
-/// With `precision` (a fraction), the run stops at the first chunk boundary where the ratio's
-/// relative 2σ error is at most that, `spec.rolls` its cap (`studies::precision`).
+/// With `precision` (a fraction, and a hook told the rolls expected in all as it goes), the
+/// run stops at the first chunk boundary where the ratio's relative 2σ error is at most that,
+/// `spec.rolls` its cap (`studies::precision`).
 pub fn roll(
     spec: &RunSpec,
     checkpoint: Option<&Path>,
     per_roll: Option<Output>,
-    precision: Option<f64>,
+    precision: Option<(f64, &dyn Fn(u64))>,
     runner: &Runner,
 ) -> Result<RunSummary> {
     let checkpoint = checkpoint.map(|d| Checkpoint::open(d, spec)).transpose()?;
@@ -184,12 +185,13 @@ pub fn roll(
     let wall = Instant::now();
     let cpu = process_cpu_seconds();
     let (done, reached) = match precision {
-        Some(p) => {
+        Some((p, expect)) => {
             let (done, reached) = studies::precision::roll_to_precision(
                 runner,
                 spec,
                 checkpoint.as_ref(),
                 p,
+                expect,
                 &mut sink,
             )?;
             (done, Some(reached))

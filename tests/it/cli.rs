@@ -387,7 +387,7 @@ fn roll_precision_stops_at_the_first_chunk_where_it_holds_on_any_thread_count() 
     ];
     let one = json(&dicephys(&[&base[..], &["--threads", "1"]].concat()));
     let two = json(&dicephys(&[&base[..], &["--threads", "2"]].concat()));
-    let mut strip = |v: &serde_json::Value| {
+    let strip = |v: &serde_json::Value| {
         let mut v = v.clone();
         for k in ["wall_s", "cpu_s", "cpu_ms_per_roll", "threads"] {
             v.as_object_mut().unwrap().remove(k);
