@@ -112,9 +112,15 @@ pub enum FlightArg {
 /// How many rolls, how.
 #[derive(Args, Debug, Clone)]
 pub struct RunArgs {
-    /// Number of rolls.
-    #[arg(long, default_value_t = 10_000)]
-    pub rolls: u64,
+    /// Number of rolls [default: 10,000]; with --precision, the most it may take [default:
+    /// 10,000,000].
+    #[arg(long)]
+    pub rolls: Option<u64>,
+    /// Roll until the ratio breadth/width is known to this precision: its relative 2σ error
+    /// (per cent, e.g. 2 or 2%) at most this, tested every 1,000 rolls, so that the same seed
+    /// gives the same rolls on any thread count. The summary says how many rolls it took.
+    #[arg(long, value_name = "PERCENT", value_parser = super::sweeps::parse_percent)]
+    pub precision: Option<f64>,
     /// Worker threads (0: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
@@ -231,6 +237,15 @@ impl ThrowArgs {
 }
 
 impl RunArgs {
+    /// The rolls asked, or the cap under --precision.
+    pub fn rolls(&self) -> u64 {
+        self.rolls.unwrap_or(if self.precision.is_some() {
+            10_000_000
+        } else {
+            10_000
+        })
+    }
+
     /// How each roll is carried out and ended, checked, for a scene with time step `dt`: the
     /// early stop by default only where it is exact (`roll::EARLY_STOP_MAX_DT`).
     pub fn roll(&self, dt: f64) -> Result<RollConfig> {

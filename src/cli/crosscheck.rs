@@ -48,10 +48,11 @@ impl CrosscheckArgs {
                 roll: self.run.roll(scene.dt)?,
                 scene,
                 throws: self.throw.spec()?,
-                rolls: self.run.rolls,
+                rolls: self.run.rolls(),
                 shard: None,
             },
             allow_restitution_above_one: self.scene.allow_restitution_above_one,
+            precision: self.run.precision,
         };
         cfg.validate()?;
         Ok(cfg)

@@ -10,6 +10,7 @@ use dicephys::run::runner::{Checkpoint, Runner};
 use dicephys::run::spec::{RunSpec, Shard};
 use dicephys::studies::outputs;
 use std::path::PathBuf;
+use std::sync::atomic::Ordering::Relaxed;
 
 /// The options that define a run: `--resume` takes them from the checkpoint instead.
 const DEFINING: [&str; 24] = [
@@ -85,7 +86,7 @@ impl RollArgs {
             roll: self.run.roll(scene.dt)?,
             scene,
             throws: self.throw.spec()?,
-            rolls: self.run.rolls,
+            rolls: self.run.rolls(),
             shard: self.shard,
         };
         spec.validate(self.scene.allow_restitution_above_one)?;
@@ -96,16 +97,31 @@ impl RollArgs {
 /// Runs `dicephys roll`.
 pub fn run(a: &RollArgs) -> Result<()> {
     let spec = a.spec()?;
+    if let (Some(_), Some(_)) = (a.run.precision, spec.shard) {
+        return Err(Error::Usage(
+            "--precision with --shard: a shard rolls a fixed share of the throws; give --rolls"
+                .into(),
+        ));
+    }
     let threads = a.run.threads()?;
     let per_roll = a.per_roll.as_deref().map(super::output).transpose()?;
     let dir = a.resume.as_ref().or(a.checkpoint.as_ref());
     let total = spec.indices().len();
     let unit = Unit::Rolls { per_cell: 0 };
     let bar = Progress::new("roll", unit, false, a.json, super::study::every());
-    let progress = |n: u64| bar.set(n as f64, total as f64);
+    // Under --precision the total is the rolls expected so far, not the cap.
+    let expected = std::sync::atomic::AtomicU64::new(total);
+    let progress = |n: u64| bar.set(n as f64, expected.load(Relaxed) as f64);
+    let expect = |n: u64| expected.store(n, Relaxed);
     let runner = Runner::new(threads, super::stop().clone());
     let runner = runner.with_progress(&progress);
-    let summary = outputs::roll(&spec, dir.map(PathBuf::as_path), per_roll, &runner)?;
+    let summary = outputs::roll(
+        &spec,
+        dir.map(PathBuf::as_path),
+        per_roll,
+        a.run.precision.map(|p| (p, &expect as &dyn Fn(u64))),
+        &runner,
+    )?;
     let rolled = summary.rolls;
     if a.json {
         outln!(
@@ -119,8 +135,11 @@ pub fn run(a: &RollArgs) -> Result<()> {
         return Err(Error::Interrupted(match dir {
             Some(d) => format!(
                 "interrupted after {rolled} of {total} rolls; continue with: dicephys roll \
-                 --resume {}",
-                d.display()
+                 --resume {}{}",
+                d.display(),
+                a.run
+                    .precision
+                    .map_or(String::new(), |p| format!(" --precision {}", 100.0 * p))
             ),
             None => format!("interrupted after {rolled} of {total} rolls"),
         }));

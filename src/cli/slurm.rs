@@ -139,6 +139,13 @@ fn study_of(c: &SlurmCommand) -> Result<Option<Flags<'_>>> {
         }
         SlurmCommand::Crosscheck(a) => {
             let s = &a.study;
+            if s.run.precision.is_some() {
+                return Err(Error::Usage(
+                    "slurm crosscheck: --precision: tasks split a fixed number of rolls; give \
+                     --rolls (crosscheck --precision on one machine)"
+                        .into(),
+                ));
+            }
             let cfg = StudyConfig::Crosscheck(s.config()?);
             let given = s.checkpoint.is_some().then_some("--checkpoint");
             (cfg, s.run.threads, s.json, given, &a.job)
@@ -226,6 +233,12 @@ fn roll(a: &SlurmRollArgs) -> Result<()> {
     let own = |flag: &str, why: &str| Err(Error::Usage(format!("slurm roll: {flag}: {why}")));
     if r.shard.is_some() {
         return own("--shard", "the tasks are the shards (--tasks N)");
+    }
+    if r.run.precision.is_some() {
+        return own(
+            "--precision",
+            "tasks split a fixed number of rolls; give --rolls (roll --precision on one machine)",
+        );
     }
     if r.checkpoint.is_some() || r.resume.is_some() {
         return own(

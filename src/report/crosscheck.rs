@@ -30,6 +30,9 @@ pub struct Crosscheck {
     pub runs: Vec<RunSummary>,
     /// Each other engine against the baseline.
     pub versus: Vec<Versus>,
+    /// With --precision: asked, reached (the worst engine's) and the rolls each engine made.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub precision: Option<crate::report::summary::Reached>,
 }
 
 /// The report as `crosscheck` prints it: each engine's run, then a line per engine against
@@ -46,6 +49,9 @@ pub fn human(res: &Crosscheck) -> String {
             v.both_settled,
             v.cpu_ratio
         );
+    }
+    if let Some(p) = &res.precision {
+        s += &format!("{} (the worst engine's)\n", p.line());
     }
     s
 }

@@ -125,6 +125,9 @@ pub struct RunSummary {
     /// Present when auditing the early stop (`--audit`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub audit: Option<Audit>,
+    /// Present when rolled to a precision (`--precision`): asked, reached, rolls it took.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub precision: Option<Reached>,
 }
 
 /// How the energy certificate would have done on these rolls.
@@ -213,6 +216,7 @@ impl RunSummary {
                 certified_steps_mean: tally.certified_steps as f64 / tally.certified.max(1) as f64,
                 full_steps_mean: tally.steps as f64 / tally.rolls.max(1) as f64,
             }),
+            precision: None,
         }
     }
 
@@ -317,6 +321,9 @@ impl RunSummary {
                 a.certified_steps_mean,
                 a.full_steps_mean
             );
+        }
+        if let Some(p) = &self.precision {
+            s += &format!("  {}\n", p.line());
         }
         s
     }
@@ -449,5 +456,89 @@ impl RunSummary {
                 threads: first.threads,
             },
         ))
+    }
+}
+
+/// The ratio N_b/N_w's relative 2σ error, 2·sqrt(1/N_b + 1/N_w): the paper's binomial error
+/// of the ratio (`theory::stats::ratio`) over the ratio. `None` while either count is 0.
+pub fn ratio_two_sigma(c: &Counts) -> Option<f64> {
+    let r = crate::theory::stats::ratio(c.breadth, c.width);
+    (c.breadth > 0 && c.width > 0).then(|| 2.0 * r.err / r.value)
+}
+
+/// The rolls that would bring the ratio's relative 2σ error to `precision`, at the
+/// proportions measured in `tally`: 4 (1/p_b + 1/p_w) / precision². `None` while either
+/// outcome is missing.
+pub fn rolls_for_precision(tally: &Tally, precision: f64) -> Option<u64> {
+    let (b, w, n) = (
+        tally.counts.breadth as f64,
+        tally.counts.width as f64,
+        tally.rolls as f64,
+    );
+    (b > 0.0 && w > 0.0).then(|| (4.0 * (n / b + n / w) / (precision * precision)).ceil() as u64)
+}
+
+/// What a run rolled to a precision reached: asked, reached, and the rolls it took.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Reached {
+    /// The precision asked: 2σ of the ratio relative to it, per cent.
+    pub asked_percent: f64,
+    /// 2σ of the ratio relative to it when the run stopped, per cent; null while breadth or
+    /// width has not been seen.
+    pub reached_percent: Option<f64>,
+    /// True when the run stopped at the first chunk boundary where reached ≤ asked; false
+    /// when it met its cap (`--rolls`) or a stop request first.
+    pub resolved: bool,
+    /// Rolls made (chunks of 1,000: the rule is tested only at chunk boundaries, so that the
+    /// same seed and precision give the same rolls on any thread count).
+    pub rolls: u64,
+    /// When not resolved: the rolls that would resolve it at the measured proportions.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rolls_needed: Option<u64>,
+}
+
+impl Reached {
+    /// One line for the human summary.
+    pub fn line(&self) -> String {
+        let reached = self
+            .reached_percent
+            .map_or("undefined (breadth or width not yet seen)".into(), |p| {
+                format!("{p:.2} %")
+            });
+        if self.resolved {
+            format!(
+                "precision: 2σ of the ratio {reached} ≤ {} % asked, after {} rolls (the first \
+                 chunk of 1,000 where it held)",
+                self.asked_percent, self.rolls
+            )
+        } else {
+            format!(
+                "precision NOT reached: 2σ of the ratio {reached} > {} % asked after {} rolls; \
+                 about {} rolls would reach it (raise --rolls, the cap)",
+                self.asked_percent,
+                self.rolls,
+                self.rolls_needed
+                    .map_or("an unknown number of".into(), |n| n.to_string())
+            )
+        }
+    }
+
+    /// What `tallies` (one per engine, all rolled over the same throws) reached at `precision`:
+    /// the worst of them.
+    pub fn of(tallies: &[&Tally], precision: f64) -> Reached {
+        let errs: Vec<Option<f64>> = tallies.iter().map(|t| ratio_two_sigma(&t.counts)).collect();
+        let worst = errs.iter().try_fold(0.0f64, |m, e| e.map(|e| m.max(e)));
+        let resolved = worst.is_some_and(|e| e <= precision);
+        let needed = tallies
+            .iter()
+            .map(|t| rolls_for_precision(t, precision))
+            .try_fold(0u64, |m, n| n.map(|n| m.max(n)));
+        Reached {
+            asked_percent: 100.0 * precision,
+            reached_percent: worst.map(|e| 100.0 * e),
+            resolved,
+            rolls: tallies.first().map_or(0, |t| t.rolls),
+            rolls_needed: (!resolved).then_some(needed).flatten(),
+        }
     }
 }

@@ -5,10 +5,13 @@ use super::Study;
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
 use crate::report::crosscheck::{Crosscheck, Versus};
+use crate::report::summary::Reached;
 use crate::report::summary::{Cost, RunSummary};
 use crate::run::cputime::process_cpu_seconds;
+use crate::run::runner::{Checkpoint, Runner, CHUNK_ROLLS};
 use crate::run::spec::RunSpec;
-use crate::run::tally::Agreement;
+use crate::run::tally::{Agreement, Tally};
+use crate::sim::roll::RollRecord;
 use crate::theory::stats;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -22,6 +25,10 @@ pub struct Config {
     pub spec: RunSpec,
     /// Accept a restitution above 1 (an engine-stability study, not physics).
     pub allow_restitution_above_one: bool,
+    /// Roll every engine chunk by chunk, in step, until each one's ratio has a relative 2σ
+    /// error at most this (a fraction), `spec.rolls` the cap.
+    #[serde(default)]
+    pub precision: Option<f64>,
 }
 
 impl Config {
@@ -45,40 +52,68 @@ impl Config {
 pub fn run(cfg: &Config, study: &Study) -> Result<Crosscheck> {
     cfg.validate()?;
     let runner = &study.runner;
-    let mut runs = Vec::new();
-    let mut records = Vec::new();
+    let mut cells = Vec::new();
     for &engine in &cfg.engines {
         let spec = RunSpec {
             engine,
             ..cfg.spec.clone()
         };
-        let wall = Instant::now();
-        let cpu = process_cpu_seconds();
-        let mut recs = Vec::new();
         let ck = study
             .checkpoint
             .as_ref()
             .map(|d| runner.open_cell(&d.join(format!("{engine}-{}", spec.key())), &spec))
             .transpose()?;
-        let done = runner.run(&spec, ck.as_ref(), &mut |r| {
-            recs.extend_from_slice(r);
-            Ok(())
-        })?;
-        let cost = Cost {
-            wall_s: wall.elapsed().as_secs_f64(),
-            cpu_s: process_cpu_seconds() - cpu,
-            threads: runner.threads,
-        };
-        if !done.complete {
-            return Err(Error::Stopped);
-        }
-        runs.push(RunSummary::new(&spec, &done.tally, cost));
-        records.push(recs);
+        cells.push(Cell {
+            spec,
+            ck,
+            records: Vec::new(),
+            tally: Tally::default(),
+            cpu_s: 0.0,
+            wall_s: 0.0,
+        });
     }
+    let chunks = cfg.spec.indices().len().div_ceil(CHUNK_ROLLS);
+    let mut reached = None;
+    match cfg.precision {
+        // Each engine in turn over all its throws.
+        None => {
+            for cell in &mut cells {
+                cell.roll(runner, 0..chunks)?;
+            }
+        }
+        // The engines in step, a chunk each, until every ratio is resolved: the rule sees
+        // the same throws on every engine, at chunk boundaries only.
+        Some(p) => {
+            for c in 0..chunks {
+                let tallies: Vec<&Tally> = cells.iter().map(|c| &c.tally).collect();
+                if Reached::of(&tallies, p).resolved {
+                    break;
+                }
+                for cell in &mut cells {
+                    cell.roll(runner, c..c + 1)?;
+                }
+            }
+            let tallies: Vec<&Tally> = cells.iter().map(|c| &c.tally).collect();
+            reached = Some(Reached::of(&tallies, p));
+        }
+    }
+    let runs: Vec<RunSummary> = cells
+        .iter()
+        .map(|c| {
+            let cost = Cost {
+                wall_s: c.wall_s,
+                cpu_s: c.cpu_s,
+                threads: runner.threads,
+            };
+            RunSummary::new(&c.spec, &c.tally, cost)
+        })
+        .collect();
+    let records: Vec<Vec<RollRecord>> = cells.into_iter().map(|c| c.records).collect();
     if runner.share.is_partial() {
         return Ok(Crosscheck {
             runs,
             versus: Vec::new(),
+            precision: reached,
         });
     }
     let versus: Vec<Versus> = (1..runs.len())
@@ -99,5 +134,39 @@ pub fn run(cfg: &Config, study: &Study) -> Result<Crosscheck> {
             }
         })
         .collect();
-    Ok(Crosscheck { runs, versus })
+    Ok(Crosscheck {
+        runs,
+        versus,
+        precision: reached,
+    })
+}
+
+/// One engine's run: its spec, its cell, what it has rolled and what that cost.
+struct Cell {
+    spec: RunSpec,
+    ck: Option<Checkpoint>,
+    records: Vec<RollRecord>,
+    tally: Tally,
+    cpu_s: f64,
+    wall_s: f64,
+}
+
+impl Cell {
+    /// Rolls the chunks in `range` (from the cell's checkpoint where kept); a stop request is
+    /// `Error::Stopped`.
+    fn roll(&mut self, runner: &Runner, range: std::ops::Range<u64>) -> Result<()> {
+        let (wall, cpu) = (Instant::now(), process_cpu_seconds());
+        let recs = &mut self.records;
+        let done = runner.run_range(&self.spec, self.ck.as_ref(), range, &mut |r| {
+            recs.extend_from_slice(r);
+            Ok(())
+        })?;
+        self.tally.merge(&done.tally);
+        self.cpu_s += process_cpu_seconds() - cpu;
+        self.wall_s += wall.elapsed().as_secs_f64();
+        if !done.complete {
+            return Err(Error::Stopped);
+        }
+        Ok(())
+    }
 }

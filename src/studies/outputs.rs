@@ -161,10 +161,14 @@ impl Place {
 /// CSV row per throw into `per_roll` if given (grown chunk by chunk in a temporary file, put
 /// in place at the end). Its summary is partial if a stop request ended it; a resumed run's
 /// cost is the sum over its segments (the resumed chunks carry theirs).
+/// With `precision` (a fraction, and a hook told the rolls expected in all as it goes), the
+/// run stops at the first chunk boundary where the ratio's relative 2σ error is at most that,
+/// `spec.rolls` its cap (`studies::precision`).
 pub fn roll(
     spec: &RunSpec,
     checkpoint: Option<&Path>,
     per_roll: Option<Output>,
+    precision: Option<(f64, &dyn Fn(u64))>,
     runner: &Runner,
 ) -> Result<RunSummary> {
     let checkpoint = checkpoint.map(|d| Checkpoint::open(d, spec)).transpose()?;
@@ -180,7 +184,20 @@ pub fn roll(
     };
     let wall = Instant::now();
     let cpu = process_cpu_seconds();
-    let done = runner.run(spec, checkpoint.as_ref(), &mut sink)?;
+    let (done, reached) = match precision {
+        Some((p, expect)) => {
+            let (done, reached) = studies::precision::roll_to_precision(
+                runner,
+                spec,
+                checkpoint.as_ref(),
+                p,
+                expect,
+                &mut sink,
+            )?;
+            (done, Some(reached))
+        }
+        None => (runner.run(spec, checkpoint.as_ref(), &mut sink)?, None),
+    };
     let cost = Cost {
         wall_s: wall.elapsed().as_secs_f64() + done.resumed_wall_s,
         cpu_s: process_cpu_seconds() - cpu + done.resumed_cpu_s,
@@ -191,6 +208,7 @@ pub fn roll(
     }
     let mut summary = RunSummary::new(spec, &done.tally, cost);
     summary.partial = !done.complete;
+    summary.precision = reached;
     Ok(summary)
 }
 

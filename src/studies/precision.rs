@@ -6,7 +6,11 @@ use super::departure::{chunks_to_resolve, paired_departure, rolls_for_ratio};
 use super::stream::{Stream, STREAM_ROLLS};
 use super::Study;
 use crate::error::Result;
-use crate::run::runner::CHUNK_ROLLS;
+use crate::report::summary::{rolls_for_precision, Reached};
+use crate::run::runner::{Checkpoint, Rolled, Runner, CHUNK_ROLLS};
+use crate::run::spec::RunSpec;
+use crate::run::tally::Tally;
+use crate::sim::roll::RollRecord;
 
 /// The chunks a stream may roll in `budget_s` CPU seconds, at its cost so far (at least the
 /// chunks it has).
@@ -141,4 +145,51 @@ pub fn precision_in_an_hour(groups: &[Vec<&Stream>], threads: usize, spent: f64)
         }
     }
     hi
+}
+
+/// Rolls `spec` chunk by chunk (each chunk on all the runner's threads) until the ratio's
+/// relative 2σ error is at most `precision`, tested at chunk boundaries only, or until the
+/// spec's `rolls` (the cap) are made or a stop is requested. Chunks come from and go to
+/// `checkpoint` as in `Runner::run`, so the same command run again continues. `expect` hears,
+/// after each chunk, the rolls the run now expects to make in all (for progress lines).
+pub fn roll_to_precision(
+    runner: &Runner,
+    spec: &RunSpec,
+    checkpoint: Option<&Checkpoint>,
+    precision: f64,
+    expect: &dyn Fn(u64),
+    sink: &mut dyn FnMut(&[RollRecord]) -> Result<()>,
+) -> Result<(Rolled, Reached)> {
+    let chunks = spec.indices().len().div_ceil(CHUNK_ROLLS);
+    let mut all = Rolled {
+        tally: Tally::default(),
+        complete: true,
+        resumed: 0,
+        resumed_cpu_s: 0.0,
+        resumed_wall_s: 0.0,
+    };
+    for c in 0..chunks {
+        if Reached::of(&[&all.tally], precision).resolved {
+            break;
+        }
+        let base = all.tally.rolls;
+        let progress = |n: u64| (runner.progress)(base + n);
+        let r = runner
+            .with_progress(&progress)
+            .run_range(spec, checkpoint, c..c + 1, sink)?;
+        all.tally.merge(&r.tally);
+        if let Some(n) = rolls_for_precision(&all.tally, precision) {
+            let n = n.div_ceil(CHUNK_ROLLS) * CHUNK_ROLLS;
+            expect(n.clamp(all.tally.rolls, spec.indices().len()));
+        }
+        all.resumed += r.resumed;
+        all.resumed_cpu_s += r.resumed_cpu_s;
+        all.resumed_wall_s += r.resumed_wall_s;
+        if !r.complete {
+            all.complete = false;
+            break;
+        }
+    }
+    let reached = Reached::of(&[&all.tally], precision);
+    Ok((all, reached))
 }

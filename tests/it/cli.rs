@@ -362,3 +362,90 @@ fn cargo_install_puts_a_working_binary_in_the_root() {
     assert!(v.status.success());
     assert!(String::from_utf8_lossy(&v.stdout).starts_with("dicephys "));
 }
+
+/// The ratio's relative 2σ error from a `roll --json`'s counts: 2·sqrt(1/N_b + 1/N_w).
+fn two_sigma(v: &serde_json::Value) -> f64 {
+    let (b, w) = (
+        v["counts"]["breadth"].as_f64().unwrap(),
+        v["counts"]["width"].as_f64().unwrap(),
+    );
+    2.0 * (1.0 / b + 1.0 / w).sqrt()
+}
+
+#[test]
+fn roll_precision_stops_at_the_first_chunk_where_it_holds_on_any_thread_count() {
+    // 140x30x10 in 3D lands on its breadth about 1 roll in 20: 10 % takes some 10,000 rolls.
+    let base = [
+        "roll",
+        "--block",
+        "140x30x10",
+        "--precision",
+        "10",
+        "--seed",
+        "3",
+        "--json",
+    ];
+    let one = json(&dicephys(&[&base[..], &["--threads", "1"]].concat()));
+    let two = json(&dicephys(&[&base[..], &["--threads", "2"]].concat()));
+    let strip = |v: &serde_json::Value| {
+        let mut v = v.clone();
+        for k in ["wall_s", "cpu_s", "cpu_ms_per_roll", "threads"] {
+            v.as_object_mut().unwrap().remove(k);
+        }
+        v
+    };
+    assert_eq!(
+        strip(&one),
+        strip(&two),
+        "the same rolls on 1 and 2 threads"
+    );
+    let p = &one["precision"];
+    assert_eq!(p["resolved"], true);
+    assert_eq!(p["asked_percent"], 10.0);
+    let rolls = one["rolls"].as_u64().unwrap();
+    assert_eq!(p["rolls"].as_u64(), Some(rolls));
+    assert_eq!(rolls % 1000, 0, "it stops at a chunk boundary");
+    let reached = two_sigma(&one);
+    assert!((p["reached_percent"].as_f64().unwrap() - 100.0 * reached).abs() < 1e-9);
+    assert!(reached <= 0.10);
+    // One chunk fewer, the same throws: not yet resolved, so it stopped at the first boundary.
+    let cap = (rolls - 1000).to_string();
+    let before = json(&dicephys(
+        &[&base[..], &["--threads", "2", "--rolls", &cap]].concat(),
+    ));
+    assert_eq!(before["precision"]["resolved"], false);
+    assert!(two_sigma(&before) > 0.10, "resolved a chunk earlier");
+    let needed = before["precision"]["rolls_needed"].as_u64().unwrap();
+    assert!(needed > rolls - 1000, "rolls needed {needed} at {cap}");
+}
+
+#[test]
+fn crosscheck_precision_rolls_the_engines_in_step_until_each_is_resolved() {
+    let out = json(&dicephys(&[
+        "crosscheck",
+        "--block",
+        "140x24x20",
+        "--2d",
+        "--engines",
+        "bullet,rapier",
+        "--precision",
+        "25",
+        "--seed",
+        "5",
+        "--json",
+    ]));
+    let p = &out["precision"];
+    assert_eq!(p["resolved"], true);
+    let runs = out["runs"].as_array().unwrap();
+    let rolls = runs[0]["rolls"].as_u64().unwrap();
+    assert_eq!(runs[1]["rolls"].as_u64(), Some(rolls), "in step");
+    assert_eq!(rolls % 1000, 0);
+    let worst = runs.iter().map(two_sigma).fold(0.0, f64::max);
+    assert!(worst <= 0.25);
+    assert!((p["reached_percent"].as_f64().unwrap() - 100.0 * worst).abs() < 1e-9);
+    // A shard or a cluster run rolls a fixed number: --precision there is refused.
+    let bad = dicephys(&["roll", "--precision", "5", "--shard", "0/2"]);
+    assert_eq!(bad.status.code(), Some(2));
+    let bad = dicephys(&["roll", "--precision", "0"]);
+    assert_eq!(bad.status.code(), Some(2));
+}

@@ -489,6 +489,30 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
         "--no-sleep",
     ]);
     let none = roll(&["--block", "140x24x20", "--max-steps", "1"]);
+    let precise = run(&[
+        "roll",
+        "--block",
+        "140x24x20",
+        "--precision",
+        "60",
+        "--rolls",
+        "2000",
+        "--threads",
+        "1",
+        "--json",
+    ]);
+    let short = run(&[
+        "roll",
+        "--block",
+        "140x30x10",
+        "--precision",
+        "1",
+        "--rolls",
+        "1000",
+        "--threads",
+        "1",
+        "--json",
+    ]);
     // The documented absences: 3D has its three outcomes, 2D none, and neither has them when
     // no die came to rest on a face.
     assert!(d3.get("outcomes").is_some());
@@ -519,6 +543,8 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
         ("roll 2D", &d2),
         ("roll --audit --throw tumble, damped", &odd),
         ("roll --max-steps 1", &none),
+        ("roll --precision 60", &precise),
+        ("roll --precision 1 --rolls 1000", &short),
         ("merge", &merged),
     ] {
         c.document("roll", what, v);
@@ -540,6 +566,19 @@ fn json_md_lists_the_keys_of_crosscheck_theory_and_bench() {
         "--json",
     ]);
     c.document("crosscheck", "crosscheck", &cc);
+    let ccp = run(&[
+        "crosscheck",
+        "--block",
+        "140x24x20",
+        "--precision",
+        "1",
+        "--rolls",
+        "1000",
+        "--threads",
+        "1",
+        "--json",
+    ]);
+    c.document("crosscheck", "crosscheck --precision", &ccp);
     let tb = run(&["theory", "--block", "140x24x20", "--json"]);
     c.document("theory-block", "theory --block", &tb);
     let tt = run(&["theory", "--table", "--json"]);
