@@ -71,6 +71,47 @@ pub struct MethodCheck {
     pub blocks: Vec<BlockCheck>,
 }
 
+/// What a block's check resolves.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Verdict {
+    /// |departure| + 2σ within the data's error for both probabilities.
+    Within,
+    /// |departure| − 2σ beyond the data's error for one of them.
+    Outside,
+    /// Neither: the check's own error is too wide. `Some(n)`: the rolls that would resolve it
+    /// if the departures stayed where they are; `None` when a departure is already at the
+    /// data's error (only more rolls showing it smaller would resolve it).
+    Unresolved(Option<u64>),
+}
+
+impl BlockCheck {
+    /// Within, outside, or not resolved by the rolls made.
+    pub fn verdict(&self) -> Verdict {
+        let ds = [self.breadth, self.length];
+        if ds
+            .iter()
+            .all(|d| d.value.abs() + 2.0 * d.err <= self.data_err)
+        {
+            return Verdict::Within;
+        }
+        if ds
+            .iter()
+            .any(|d| d.value.abs() - 2.0 * d.err > self.data_err)
+        {
+            return Verdict::Outside;
+        }
+        // 2σ shrinks as 1/√n: n' = n (2σ / (err − |d|))².
+        let need = ds.iter().try_fold(self.rolls, |m, d| {
+            let room = self.data_err - d.value.abs();
+            (room > 0.0).then(|| {
+                let n = self.rolls as f64 * (2.0 * d.err / room).powi(2);
+                m.max(n.ceil() as u64)
+            })
+        });
+        Verdict::Unresolved(need)
+    }
+}
+
 impl MethodCheck {
     /// Every block within its data's error.
     pub fn passes(&self) -> bool {

@@ -22,7 +22,7 @@ use std::path::PathBuf;
 pub struct FitArgs {
     /// The measured counts: a CSV with the columns label, surface, length_mm, breadth_mm,
     /// width_mm, mode (2d or 3d), length_vertical, breadth_vertical, width_vertical and
-    /// optionally thrower (docs/guide.md, "Calibrating").
+    /// optionally thrower (docs/guide.md, "Calibrating"); or "paper", the paper's 19 rows.
     #[arg(long, value_name = "COUNTS.csv")]
     pub data: PathBuf,
     /// The free parameters (comma-separated): e (restitution), mu (friction), kappa (the
@@ -193,13 +193,17 @@ impl FitArgs {
     }
 
     fn config(&self) -> Result<FitConfig> {
-        let text = std::fs::read_to_string(&self.data).map_err(|e| {
-            Error::Usage(format!(
-                "--data {}: cannot read it ({e})",
-                self.data.display()
-            ))
-        })?;
-        let rows = data::parse(&text, &self.data.display().to_string())?;
+        let rows = if self.data.as_os_str() == "paper" && !self.data.exists() {
+            data::paper_rows()?
+        } else {
+            let text = std::fs::read_to_string(&self.data).map_err(|e| {
+                Error::Usage(format!(
+                    "--data {}: cannot read it ({e})",
+                    self.data.display()
+                ))
+            })?;
+            data::parse(&text, &self.data.display().to_string())?
+        };
         let cfg = FitConfig {
             rows,
             model: self.model()?,

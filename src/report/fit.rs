@@ -1,5 +1,6 @@
 //! What a fit says: `report.md`, its figures, and a prediction's lines.
 
+use crate::calibration::check::Verdict;
 use crate::calibration::paper::CalibratedPaper;
 use crate::calibration::params::{FixedThrow, Kind};
 use crate::calibration::predict::{BlockPrediction, Predicted};
@@ -493,18 +494,25 @@ pub fn calibrated_markdown(c: &CalibratedPaper, figures: &[&str]) -> String {
         "Each block rolled at its fitted e, μ and κ by the fit's method (dt = {} s) and by a \
          reference at dt = {} s, on the same throws; the departures, paired throw by throw, \
          against the data's binomial error on that block. Within: |departure| + 2σ below the \
-         data's error for both probabilities. {}\n",
+         data's error for both probabilities; outside: |departure| − 2σ above it for one; \
+         unresolved: neither, the check's own error too wide (with the rolls that would resolve \
+         it were the departures to stay where they are). {}\n",
         ck.dt,
         ck.reference_dt,
-        if ck.passes() {
-            "Every block is within."
-        } else {
-            "Not every block is within: read the fit's values with the departures below in mind."
+        {
+            let n = |v: fn(&Verdict) -> bool| ck.blocks.iter().filter(|b| v(&b.verdict())).count();
+            format!(
+                "Of {} blocks: {} within, {} outside, {} unresolved.",
+                ck.blocks.len(),
+                n(|v| *v == Verdict::Within),
+                n(|v| *v == Verdict::Outside),
+                n(|v| matches!(v, Verdict::Unresolved(_)))
+            )
         }
     );
     let _ = writeln!(
         s,
-        "| block | rolls | P(breadth) departure | P(length) departure | data's error | within |"
+        "| block | rolls | P(breadth) departure | P(length) departure | data's error | verdict |"
     );
     let _ = writeln!(s, "|---|---:|---|---|---:|---|");
     for b in &ck.blocks {
@@ -519,7 +527,14 @@ pub fn calibrated_markdown(c: &CalibratedPaper, figures: &[&str]) -> String {
             b.length.value,
             b.length.err,
             b.data_err,
-            if b.within { "yes" } else { "no" }
+            match b.verdict() {
+                Verdict::Within => "within".to_string(),
+                Verdict::Outside => "**outside**".to_string(),
+                Verdict::Unresolved(Some(n)) => format!("unresolved (~{n} rolls would resolve it)"),
+                Verdict::Unresolved(None) => {
+                    "unresolved (a departure is at the data's error)".to_string()
+                }
+            }
         );
     }
     if !figures.is_empty() {

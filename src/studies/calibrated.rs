@@ -160,6 +160,12 @@ fn verdict(
         format!("{richer} predicts the rows it did not see better (log score +{gain:.1} ± {err:.1}): it earns its place")
     } else if gain < -2.0 * err {
         format!("{simpler} predicts better ({:+.1} ± {err:.1} for {richer}): {richer}'s extra freedom costs", gain)
+    } else if let Some((_, _, p)) = lr.filter(|l| l.2 < 0.01) {
+        format!(
+            "the rows it did not see do not resolve it ({gain:+.1} ± {err:.1}), though {richer} \
+             fits all rows better (likelihood ratio p = {p:.3}): {richer} is kept as the main \
+             model, {simpler} is as good a predictor"
+        )
     } else {
         format!(
             "no difference the data resolve ({gain:+.1} ± {err:.1}): keep the simpler, {simpler}"
@@ -242,7 +248,9 @@ pub fn run(
             "paper-throw",
             "hand",
             gain(&fits[paper_throw].3, &fits[hand].3, false),
-            None,
+            // Nested at the boundary κ → ∞: the χ²₁ p-value is conservative (twice the
+            // boundary's ½χ²₀ + ½χ²₁ mixture).
+            Some(likelihood_ratio(&models[paper_throw], &models[hand])),
         ),
         verdict(
             "e and μ: one pair per surface, or one pair for all?",

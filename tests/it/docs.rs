@@ -301,6 +301,7 @@ const REFS: &[(&str, &str, &str)] = &[
     ("tradeoff", "modes[].checks[]", "tradeoff-row"),
     ("tradeoff", "modes[].rows[]", "tradeoff-row"),
     ("validate", "cells[].tally", "tally"),
+    ("calibrated", "fit", "fit"),
 ];
 
 fn parent(path: &str) -> &str {
@@ -751,4 +752,99 @@ fn the_key_check_finds_an_extra_a_missing_and_a_phantom_key() {
         msg.contains("`gone` is in docs/json.md and in none"),
         "{msg}"
     );
+}
+
+#[test]
+fn json_md_lists_the_keys_of_fit_recover_and_predict() {
+    let mut c = checker();
+    let dir = Scratch::new("docs-fit");
+    let csv = dir.join("counts.csv");
+    std::fs::write(
+        &csv,
+        "label,surface,length_mm,breadth_mm,width_mm,mode,length_vertical,breadth_vertical,\
+         width_vertical\na,felt,140,24,20,3d,0,200,400\nb,felt,100,43.9,43.2,3d,10,300,290\n",
+    )
+    .unwrap();
+    let (csv, d) = (csv.to_str().unwrap(), dir.to_str().unwrap());
+    let small = [
+        "--points",
+        "12",
+        "--rolls",
+        "60",
+        "--degree",
+        "1",
+        "--dt",
+        "1/250",
+        "--threads",
+        "1",
+    ];
+    let fit_args = |extra: &[&str]| -> Vec<String> {
+        let mut a: Vec<&str> = vec!["fit", "--data", csv, "--free", "e,mu,kappa"];
+        a.extend(small);
+        a.extend(extra);
+        a.extend(["--json"]);
+        a.into_iter().map(String::from).collect()
+    };
+    let run_owned = |a: Vec<String>| run(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let out = format!("{d}/fit");
+    let fit = run_owned(fit_args(&["--out", &out]));
+    c.document("fit", "fit (nothing to narrow)", &fit);
+    // The paper's rows pin κ well enough for a second pass over a narrowed box.
+    let two = run(&[
+        "fit",
+        "--data",
+        "paper",
+        "--free",
+        "kappa",
+        "--points",
+        "8",
+        "--rolls",
+        "100",
+        "--degree",
+        "1",
+        "--dt",
+        "1/250",
+        "--threads",
+        "1",
+        "--out",
+        &format!("{d}/two"),
+        "--json",
+    ]);
+    assert!(two.get("first_pass").is_some(), "a second pass: {two}");
+    c.document("fit", "fit --data paper (two passes)", &two);
+    let file: Value = serde_json::from_str(&read(&dir.join("fit/fit.json"))).unwrap();
+    c.document("fit", "fit.json", &file);
+    let one = run_owned(fit_args(&["--no-refine", "--out", &format!("{d}/one")]));
+    c.document("fit", "fit --no-refine", &one);
+    let rec = run_owned(fit_args(&[
+        "--no-refine",
+        "--recover",
+        "e=0.5,mu=0.3,kappa=30",
+        "--repeats",
+        "2",
+        "--out",
+        &format!("{d}/rec"),
+    ]));
+    c.document("recover", "fit --recover", &rec);
+    let fit_json = format!("{out}/fit.json");
+    for extra in [&[][..], &["--2d"][..]] {
+        let mut a = vec![
+            "predict",
+            "--fit",
+            &fit_json,
+            "--block",
+            "140x30x10",
+            "--draws",
+            "3",
+            "--rolls",
+            "50",
+            "--threads",
+            "1",
+            "--json",
+        ];
+        a.extend(extra);
+        let p = run(&a);
+        c.document("predict", &format!("predict {extra:?}"), &p);
+    }
+    c.finish(&["fit", "recover", "predict"]);
 }

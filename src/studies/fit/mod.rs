@@ -97,6 +97,12 @@ pub fn fit(
         out.first_pass = Some(std::mem::replace(&mut out.estimate, estimate).params);
         out.params = params;
         out.designs = second;
+    } else if cfg.design.refine {
+        // Nothing to narrow: the first pass is the last, so it gets the full search (the
+        // bootstrap's region and the posterior draws `predict` needs).
+        let (params, estimate) = estimate_with(&cfg.rows, &cfg.model, &out.designs, &cfg.search)?;
+        out.params = params;
+        out.estimate = estimate;
     }
     Ok(Some(out))
 }
