@@ -5,7 +5,7 @@ use crate::engine::EngineKind;
 use crate::error::Result;
 use crate::model::block::Block;
 use crate::model::scene::{Floor, Mode};
-use crate::report::figures::sweeps as fig;
+use crate::report::figures::tradeoff as fig;
 use crate::report::text::{dt_label, left, right, Columns};
 use serde::Serialize;
 use std::path::Path;
@@ -379,30 +379,61 @@ pub fn markdown_blocks(res: &TradeoffBlocks, figures: &[&str]) -> String {
     md
 }
 
-/// Draws cost against departure, with the paper's experimental error for `block` (the
-/// study's) and Rapier's converged departure as yardsticks, into `dir`; returns its stem.
-pub fn write_figures(dir: &Path, res: &Tradeoff, block: Block) -> Result<Vec<&'static str>> {
-    let mut pts = Vec::new();
+/// A method's name without its mode: the figures' key, shared by 3D and 2D.
+fn key_name(r: &Row) -> String {
+    format!(
+        "{} {} {} {}",
+        r.engine.name(),
+        dt_label(r.dt),
+        r.rule,
+        match r.floor {
+            Floor::Box => "box",
+            Floor::Plane => "plane",
+        }
+    )
+}
+
+/// Every method of `studies`, numbered from 1 in the order first met: (number, name).
+fn figure_key(studies: &[&Tradeoff]) -> Vec<(String, String)> {
+    let mut names: Vec<String> = Vec::new();
+    for r in studies.iter().flat_map(|t| &t.modes).flat_map(|m| &m.rows) {
+        let n = key_name(r);
+        if !names.contains(&n) {
+            names.push(n);
+        }
+    }
+    names
+        .into_iter()
+        .enumerate()
+        .map(|(i, n)| ((i + 1).to_string(), n))
+        .collect()
+}
+
+/// One block's panel: its methods numbered by `key`, the paper's experimental error on the
+/// block and Rapier's departure at its finest step as bands, and in its caption the cheapest
+/// method within the precision per mode.
+fn panel(res: &Tradeoff, key: &[(String, String)], caption: &str) -> fig::Panel {
+    let mut methods = Vec::new();
     let mut bands = Vec::new();
-    if let Some(row) = crate::theory::paper_data::load().ok().and_then(|t| {
-        t.rows
-            .into_iter()
-            .find(|r| r.simulated && r.block_dims().ok() == Some(block))
-    }) {
-        let m = row.measured_ratio();
-        let rel = 200.0 * m.err / m.value;
+    let number = |r: &Row| {
+        let n = key_name(r);
+        key.iter()
+            .find(|(_, name)| *name == n)
+            .map_or("?".into(), |(k, _)| k.clone())
+    };
+    if let Some(m) = res.block.parse::<Block>().ok().and_then(paper_experiment) {
         bands.push(fig::Band {
-            label: format!("the paper's experiment, {}: ±{rel:.1} % (2σ)", row.label()),
             lo: 0.0,
-            hi: rel,
+            hi: 200.0 * m.err / m.value,
             two_d: None,
         });
     }
+    let mut cheapest = Vec::new();
     for m in &res.modes {
         let two_d = m.mode == Mode::TwoD;
         for r in &m.rows {
-            pts.push(fig::MethodPoint {
-                label: r.method.clone(),
+            methods.push(fig::MethodPoint {
+                key: number(r),
                 cost: r.cpu_s_per_1000,
                 error: 100.0 * r.error.abs(),
                 error_err: 100.0 * r.error_err,
@@ -411,46 +442,99 @@ pub fn write_figures(dir: &Path, res: &Tradeoff, block: Block) -> Result<Vec<&'s
                 on_front: m.pareto_front.contains(&r.method),
                 cheapest: m.cheapest_within.as_ref() == Some(&r.method),
             });
+            if m.cheapest_within.as_ref() == Some(&r.method) {
+                cheapest.push(format!("{} {}", m.mode.name(), number(r)));
+            }
         }
-        // Rapier's converged departure: its box floor, exact levers, at its finest step.
-        if let Some(r) = m
-            .rows
-            .iter()
-            .filter(|r| r.engine == EngineKind::Rapier && r.rule == "fast" && r.floor == Floor::Box)
-            .min_by(|x, y| x.dt.total_cmp(&y.dt))
-        {
+        if let Some(r) = rapier_finest(m) {
             let (d, e) = (100.0 * r.error.abs(), 200.0 * r.error_err);
             bands.push(fig::Band {
-                label: format!(
-                    "Rapier {} {} against Bullet: {:+.1} ± {:.1} % (2σ)",
-                    m.mode.name(),
-                    dt_label(r.dt),
-                    100.0 * r.error,
-                    e
-                ),
                 lo: d - e,
                 hi: d + e,
                 two_d: Some(two_d),
             });
         }
     }
-    fig::tradeoff(
-        dir,
-        "tradeoff",
-        &format!(
+    let cheapest = if cheapest.is_empty() {
+        "none within".to_string()
+    } else {
+        format!("cheapest within: {}", cheapest.join(", "))
+    };
+    fig::Panel {
+        title: format!("{caption}; {cheapest}"),
+        methods,
+        bands,
+    }
+}
+
+/// The paper's measured ratio for `block` (a simulated MDF row), if it has one.
+fn paper_experiment(block: Block) -> Option<crate::theory::stats::Ratio> {
+    crate::theory::paper_data::load().ok().and_then(|t| {
+        t.rows
+            .into_iter()
+            .find(|r| r.simulated && r.block_dims().ok() == Some(block))
+            .map(|r| r.measured_ratio())
+    })
+}
+
+/// Rapier's converged departure: its box floor, exact levers, at its finest step.
+fn rapier_finest(m: &ModeResult) -> Option<&Row> {
+    m.rows
+        .iter()
+        .filter(|r| r.engine == EngineKind::Rapier && r.rule == "fast" && r.floor == Floor::Box)
+        .min_by(|x, y| x.dt.total_cmp(&y.dt))
+}
+
+/// What the bands of the panels are.
+fn band_notes() -> Vec<String> {
+    vec![
+        "grey band: the paper's experiment on the block, 2σ".into(),
+        "tinted bands: Rapier (box, fast, finest step)".into(),
+        "  against Bullet, |departure| ± 2σ, per mode".into(),
+    ]
+}
+
+/// Draws cost against departure for one block, every method numbered and keyed, with the
+/// paper's experimental error on the block and Rapier's converged departure as yardsticks,
+/// into `dir`; returns its stem.
+pub fn write_figures(dir: &Path, res: &Tradeoff) -> Result<Vec<&'static str>> {
+    let key = figure_key(&[res]);
+    let figure = fig::Figure {
+        title: format!(
             "{}: cost against departure from Bullet at {} (±{} % at 2σ asked)",
             res.block,
             dt_label(res.reference_dt),
             100.0 * res.precision
         ),
-        &pts,
-        &bands,
-        100.0 * res.precision,
-    )?;
+        panels: vec![panel(res, &key, &res.block)],
+        key,
+        band_notes: band_notes(),
+        precision: 100.0 * res.precision,
+    };
+    fig::write(dir, "tradeoff", &figure)?;
     Ok(vec!["tradeoff"])
 }
 
-/// The figure of a run on several blocks (none yet: each block's table is in report.md).
-pub fn write_figures_blocks(_dir: &Path, _res: &TradeoffBlocks) -> Result<Vec<&'static str>> {
-    Ok(Vec::new())
+/// The figure of a run on several blocks: a panel per block on shared axes, every method
+/// numbered the same in every panel and keyed beside them.
+pub fn write_figures_blocks(dir: &Path, res: &TradeoffBlocks) -> Result<Vec<&'static str>> {
+    let studies: Vec<&Tradeoff> = res.per_block.iter().collect();
+    let key = figure_key(&studies);
+    let figure = fig::Figure {
+        title: format!(
+            "Cost against departure from Bullet at {}, per block (±{} % at 2σ asked)",
+            dt_label(res.reference_dt),
+            100.0 * res.precision
+        ),
+        panels: res
+            .per_block
+            .iter()
+            .map(|t| panel(t, &key, &t.block))
+            .collect(),
+        key,
+        band_notes: band_notes(),
+        precision: 100.0 * res.precision,
+    };
+    fig::write(dir, "tradeoff", &figure)?;
+    Ok(vec!["tradeoff"])
 }

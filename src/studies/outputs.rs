@@ -347,7 +347,7 @@ pub fn tradeoff(cfg: &studies::tradeoff::Config, place: &Place, hooks: &Hooks) -
     }
     match one {
         Some(one) => {
-            let figures = report::tradeoff::write_figures(&place.out, one, cfg.blocks[0])?;
+            let figures = report::tradeoff::write_figures(&place.out, one)?;
             let md = report::tradeoff::markdown(one, &figures);
             write(place, &outputs, one, &md, "tradeoff.json")
         }

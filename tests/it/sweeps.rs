@@ -343,6 +343,21 @@ fn tradeoff_on_several_blocks_sums_up_each_method_across_them() {
     );
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
     assert!(md.contains("## 3d across the blocks") && md.contains("## 140x30x10"));
+    // The figure: a panel per block, and its key names every method (its name without the
+    // mode, the same number in every panel).
+    svg(&dir, "tradeoff");
+    let fig = std::fs::read_to_string(dir.join("tradeoff.svg")).unwrap();
+    for b in ["140x24x20", "140x30x10"] {
+        assert!(fig.contains(b), "no panel for {b}");
+    }
+    for r in &r0 {
+        let name = r["method"].as_str().unwrap().replacen(" 3d ", " ", 1);
+        // A text element's content is a line of its own.
+        assert!(
+            fig.lines().any(|l| l.trim() == name),
+            "the key lacks {name}"
+        );
+    }
 }
 
 #[test]
