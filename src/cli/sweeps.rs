@@ -8,6 +8,7 @@ use super::study;
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::model::block::Block;
+use dicephys::model::scene::Mode;
 use dicephys::studies::sweep::parse_dt;
 use dicephys::studies::{converge, stability, tradeoff, StudyConfig};
 use std::path::PathBuf;
@@ -62,8 +63,15 @@ pub struct ConvergeArgs {
 
 #[derive(Args, Debug)]
 pub struct TradeoffArgs {
-    #[arg(long, default_value = "140x24x20")]
+    #[arg(long, default_value = "140x24x20", conflicts_with = "blocks")]
     pub block: Block,
+    /// Several blocks (comma-separated), each with its own reference and methods, and a
+    /// summary across them.
+    #[arg(long, value_delimiter = ',')]
+    pub blocks: Vec<Block>,
+    /// The modes (comma-separated): 3d, 2d or both.
+    #[arg(long, value_delimiter = ',', default_value = "3d,2d")]
+    pub modes: Vec<Mode>,
     /// Bullet's time steps (comma-separated).
     #[arg(long, value_delimiter = ',', default_value = "1/100,1/250,1/1000", value_parser = parse_dt)]
     pub dts: Vec<f64>,
@@ -204,8 +212,14 @@ impl TradeoffArgs {
         if self.preroll == Some(0) {
             return Err(Error::Usage("--preroll 0: give at least 1 roll".into()));
         }
+        let blocks = if self.blocks.is_empty() {
+            vec![self.block]
+        } else {
+            self.blocks.clone()
+        };
         Ok(tradeoff::Config {
-            block: self.block,
+            blocks,
+            modes: self.modes.clone(),
             dts: self.dts.clone(),
             rapier_dts: self.rapier_dts.clone(),
             reference_dt: self.reference_dt,

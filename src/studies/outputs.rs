@@ -325,7 +325,8 @@ pub fn converge(cfg: &studies::converge::Config, place: &Place, hooks: &Hooks) -
     write(place, &outputs, &res, &md, "converge.json")
 }
 
-/// `tradeoff`: tradeoff.json, report.md and its figure; or the plan; or the rolls ahead.
+/// `tradeoff`: tradeoff.json, report.md and its figure; or the plan; or the rolls ahead. A run
+/// on one block writes that block's study; on several, each block's and the summary across.
 pub fn tradeoff(cfg: &studies::tradeoff::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
     cfg.validate()?;
     let outputs = place.outputs(&["tradeoff.json", "report.md"])?;
@@ -335,11 +336,15 @@ pub fn tradeoff(cfg: &studies::tradeoff::Config, place: &Place, hooks: &Hooks) -
     else {
         return Ok(Done::default());
     };
+    let one = match res.per_block.as_slice() {
+        [one] => Some(one),
+        _ => None,
+    };
     if cfg.plan_only {
-        let stdout = if place.json {
-            format!("{}\n", to_json(&res)?)
-        } else {
-            String::new()
+        let stdout = match (place.json, one) {
+            (false, _) => String::new(),
+            (true, Some(one)) => format!("{}\n", to_json(one)?),
+            (true, None) => format!("{}\n", to_json(&res)?),
         };
         return Ok(Done {
             stdout,
@@ -358,9 +363,18 @@ pub fn tradeoff(cfg: &studies::tradeoff::Config, place: &Place, hooks: &Hooks) -
             ..Done::default()
         });
     }
-    let figures = report::tradeoff::write_figures(&place.out, &res, cfg.block)?;
-    let md = report::tradeoff::markdown(&res, &figures);
-    write(place, &outputs, &res, &md, "tradeoff.json")
+    match one {
+        Some(one) => {
+            let figures = report::tradeoff::write_figures(&place.out, one)?;
+            let md = report::tradeoff::markdown(one, &figures);
+            write(place, &outputs, one, &md, "tradeoff.json")
+        }
+        None => {
+            let figures = report::tradeoff::write_figures_blocks(&place.out, &res)?;
+            let md = report::tradeoff::markdown_blocks(&res, &figures);
+            write(place, &outputs, &res, &md, "tradeoff.json")
+        }
+    }
 }
 
 /// `stability`: stability.json, report.md and its heat maps.

@@ -25,7 +25,9 @@ use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::scene::{Floor, Mode, Scene};
 use crate::report::text::dt_label;
-use crate::report::tradeoff::{format_row, ModeResult, Role, Row, Tradeoff};
+use crate::report::tradeoff::{
+    format_row, MethodAcross, ModeAcross, ModeResult, Role, Row, Tradeoff, TradeoffBlocks,
+};
 use crate::run::runner::CHUNK_ROLLS;
 use crate::sim::roll::{RollConfig, Rule};
 use serde::{Deserialize, Serialize};
@@ -33,8 +35,10 @@ use serde::{Deserialize, Serialize};
 /// What the trade-off study runs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Config {
-    /// The block.
-    pub block: Block,
+    /// The blocks: each block and mode has its own reference and methods.
+    pub blocks: Vec<Block>,
+    /// The modes run, 3D and/or 2D (3D is run first).
+    pub modes: Vec<Mode>,
     /// Bullet's time steps, s.
     pub dts: Vec<f64>,
     /// Rapier's time steps, s.
@@ -64,6 +68,16 @@ pub struct Config {
 impl Config {
     /// Checks every value before anything runs.
     pub fn validate(&self) -> Result<()> {
+        nonempty(&self.blocks, "blocks")?;
+        if let Some(b) = self
+            .blocks
+            .iter()
+            .enumerate()
+            .find_map(|(i, b)| self.blocks[..i].contains(b).then_some(b))
+        {
+            return Err(Error::field("blocks", b, "named twice"));
+        }
+        nonempty(&self.modes, "modes")?;
         nonempty(&self.dts, "dts")?;
         if self
             .dts
@@ -87,6 +101,14 @@ impl Config {
         check_budget(self.budget_s, "budget_s")?;
         check_budget(self.reference_budget_s, "reference_budget_s")?;
         check_rolls_and_steps(1, self.max_steps)
+    }
+
+    /// The modes asked, 3D first.
+    pub fn modes_in_order(&self) -> Vec<Mode> {
+        [Mode::ThreeD, Mode::TwoD]
+            .into_iter()
+            .filter(|m| self.modes.contains(m))
+            .collect()
     }
 }
 
@@ -117,8 +139,8 @@ impl Method {
         )
     }
 
-    fn stream(&self, cfg: &Config, mode: Mode) -> Stream {
-        let mut scene = Scene::paper(cfg.block, mode);
+    fn stream(&self, cfg: &Config, block: Block, mode: Mode) -> Stream {
+        let mut scene = Scene::paper(block, mode);
         scene.dt = self.dt;
         scene.floor = self.floor;
         let settle = RollConfig {
@@ -200,94 +222,197 @@ pub fn pareto(rows: &[Row]) -> Vec<String> {
     front
 }
 
-/// Measures every method against its reference to the precision asked, logging the plan and
-/// each method as it is resolved, reporting progress in estimated CPU seconds.
+/// One block and mode: its reference first, then its checks, then its methods, each a stream.
+struct Group {
+    block: Block,
+    mode: Mode,
+    streams: Vec<(Method, Stream)>,
+}
+
+impl Group {
+    fn cpu_s(&self) -> f64 {
+        self.streams.iter().map(|(_, s)| s.cpu_s).sum()
+    }
+
+    fn streams(&self) -> Vec<&Stream> {
+        self.streams.iter().map(|(_, s)| s).collect()
+    }
+}
+
+/// What the pilot says the rest costs: at the precision asked (budgets as given), at 1 % (no
+/// budget), and the precision an hour of the run's threads buys.
+#[derive(Clone, Copy)]
+struct Plan {
+    planned: f64,
+    at_one: f64,
+    in_an_hour: f64,
+}
+
+fn plan(cfg: &Config, groups: &[&Group], threads: usize) -> Plan {
+    let streams: Vec<Vec<&Stream>> = groups.iter().map(|g| g.streams()).collect();
+    let spent = groups.iter().map(|g| g.cpu_s()).sum();
+    Plan {
+        planned: plan_cpu(
+            &streams,
+            cfg.precision,
+            Some((cfg.reference_budget_s, cfg.budget_s)),
+        ),
+        at_one: plan_cpu(&streams, 0.01, None),
+        in_an_hour: precision_in_an_hour(&streams, threads, spent),
+    }
+}
+
+/// Measures every method against its reference, block by block and mode by mode, to the
+/// precision asked, logging the plan and each method as it is resolved, reporting progress in
+/// estimated CPU seconds.
 pub fn run(
     cfg: &Config,
     study: &Study,
     log: &dyn Fn(&str),
     progress: Progress,
-) -> Result<Tradeoff> {
+) -> Result<TradeoffBlocks> {
     cfg.validate()?;
-    let modes = [Mode::ThreeD, Mode::TwoD];
-    let mut all: Vec<(Mode, Vec<(Method, Stream)>)> = modes
-        .iter()
-        .map(|&mode| {
-            let v = methods(cfg, mode)
+    let modes = cfg.modes_in_order();
+    let mut groups: Vec<Group> = Vec::new();
+    for &block in &cfg.blocks {
+        for &mode in &modes {
+            let streams = methods(cfg, mode)
                 .into_iter()
-                .map(|m| (m, m.stream(cfg, mode)))
+                .map(|m| (m, m.stream(cfg, block, mode)))
                 .collect();
-            (mode, v)
-        })
-        .collect();
-    let empty = |cpu_s| Tradeoff {
-        block: cfg.block.to_string(),
+            groups.push(Group {
+                block,
+                mode,
+                streams,
+            });
+        }
+    }
+    let threads = study.runner.threads;
+    let one_block = |block: Block, p: Plan, modes: Vec<ModeResult>| {
+        let cpu_s = modes
+            .iter()
+            .flat_map(|m| {
+                m.rows
+                    .iter()
+                    .chain(&m.checks)
+                    .chain(std::iter::once(&m.reference))
+            })
+            .map(|r| r.cpu_s_per_1000 * r.rolls as f64 / 1000.0)
+            .sum();
+        Tradeoff {
+            block: block.to_string(),
+            precision: cfg.precision,
+            budget_s: cfg.budget_s,
+            seed: cfg.seed,
+            reference_dt: cfg.reference_dt,
+            planned_cpu_s: p.planned,
+            planned_cpu_s_at_one_percent: p.at_one,
+            precision_in_an_hour: p.in_an_hour,
+            cpu_s,
+            modes,
+        }
+    };
+    let result = |p: Plan, cpu_s: f64, per_block: Vec<Tradeoff>| TradeoffBlocks {
+        blocks: cfg.blocks.iter().map(|b| b.to_string()).collect(),
         precision: cfg.precision,
         budget_s: cfg.budget_s,
+        reference_budget_s: cfg.reference_budget_s,
         seed: cfg.seed,
         reference_dt: cfg.reference_dt,
-        planned_cpu_s: 0.0,
-        planned_cpu_s_at_one_percent: 0.0,
-        precision_in_an_hour: f64::NAN,
+        planned_cpu_s: p.planned,
+        planned_cpu_s_at_one_percent: p.at_one,
+        precision_in_an_hour: p.in_an_hour,
         cpu_s,
-        modes: Vec::new(),
+        across: modes
+            .iter()
+            .map(|&mode| across(cfg, &per_block, mode))
+            .collect(),
+        per_block,
+    };
+    let nothing = Plan {
+        planned: 0.0,
+        at_one: 0.0,
+        in_an_hour: f64::NAN,
     };
     // Rolling ahead: the same chunks whatever the results, so a cluster's tasks, each seeing
     // only its share, agree on which chunk is whose.
     if let Some(k) = cfg.preroll_chunks {
-        let mut cpu = 0.0;
-        for (_, streams) in all.iter_mut() {
-            for (_, s) in streams.iter_mut() {
+        for g in groups.iter_mut() {
+            for (_, s) in g.streams.iter_mut() {
                 s.extend(k, study, &|_| {})?;
-                cpu += s.cpu_s;
             }
         }
-        return Ok(empty(cpu));
+        let cpu = groups.iter().map(Group::cpu_s).sum();
+        let per_block = cfg
+            .blocks
+            .iter()
+            .map(|&b| one_block(b, nothing, Vec::new()))
+            .collect();
+        return Ok(result(nothing, cpu, per_block));
     }
     // The pilot: a chunk of every stream, its cost and its variance.
-    let mut done_cpu = 0.0;
-    for (_, streams) in all.iter_mut() {
-        for (_, s) in streams.iter_mut() {
+    for g in groups.iter_mut() {
+        for (_, s) in g.streams.iter_mut() {
             s.extend(PILOT_CHUNKS, study, &|_| {})?;
-            done_cpu += s.cpu_s;
         }
     }
-    let groups: Vec<Vec<&Stream>> = all
+    let pilot: f64 = groups.iter().map(Group::cpu_s).sum();
+    let of_block = |b: Block| -> Vec<&Group> { groups.iter().filter(|g| g.block == b).collect() };
+    let block_plans: Vec<Plan> = cfg
+        .blocks
         .iter()
-        .map(|(_, v)| v.iter().map(|(_, s)| s).collect())
+        .map(|&b| plan(cfg, &of_block(b), threads))
         .collect();
-    let budgets = (cfg.reference_budget_s, cfg.budget_s);
-    let planned = plan_cpu(&groups, cfg.precision, Some(budgets));
-    let at_one = plan_cpu(&groups, 0.01, None);
-    let in_an_hour = precision_in_an_hour(&groups, study.runner.threads, done_cpu);
+    let whole = plan(cfg, &groups.iter().collect::<Vec<_>>(), threads);
+    if cfg.blocks.len() > 1 {
+        for (b, p) in cfg.blocks.iter().zip(&block_plans) {
+            log(&format!(
+                "plan for {b}: at ±{:.2} % the rest takes about {:.0} CPU s; ±1 % would take \
+                 {:.0} CPU s",
+                100.0 * cfg.precision,
+                p.planned,
+                p.at_one
+            ));
+        }
+    }
     log(&format!(
         "plan: the pilot took {:.0} CPU s; at ±{:.2} % (2σ, budgets as given) the rest takes \
          about {:.0} CPU s ({:.1} min on {} threads); ±1 % would take {:.0} CPU s ({:.1} h); \
          an hour on {} threads buys ±{:.2} %",
-        done_cpu,
+        pilot,
         100.0 * cfg.precision,
-        planned,
-        planned / 60.0 / study.runner.threads as f64,
-        study.runner.threads,
-        at_one,
-        at_one / 3600.0 / study.runner.threads as f64,
-        study.runner.threads,
-        100.0 * in_an_hour
+        whole.planned,
+        whole.planned / 60.0 / threads as f64,
+        threads,
+        whole.at_one,
+        whole.at_one / 3600.0 / threads as f64,
+        threads,
+        100.0 * whole.in_an_hour
     ));
     if cfg.plan_only {
-        return Ok(Tradeoff {
-            planned_cpu_s: planned,
-            planned_cpu_s_at_one_percent: at_one,
-            precision_in_an_hour: in_an_hour,
-            ..empty(done_cpu)
-        });
+        let per_block = cfg
+            .blocks
+            .iter()
+            .zip(&block_plans)
+            .map(|(&b, &p)| Tradeoff {
+                cpu_s: of_block(b).iter().map(|g| g.cpu_s()).sum(),
+                ..one_block(b, p, Vec::new())
+            })
+            .collect();
+        return Ok(result(whole, pilot, per_block));
     }
     // Progress counts the planned rolls only (the pilot is done), so that the bar's rate, and
     // its ETA, are this run's.
-    let (pilot, total) = (done_cpu, planned);
+    let total = whole.planned;
+    let mut done_cpu = pilot;
     progress(0.0, total);
-    let mut out_modes = Vec::new();
-    for (mode, mut streams) in all {
+    let mut results: Vec<(Block, ModeResult)> = Vec::new();
+    for g in groups {
+        let mode = g.mode;
+        if cfg.blocks.len() > 1 {
+            log(&format!("{} {}:", g.block, mode.name()));
+        }
+        let mut streams = g.streams;
         // The reference, to 2σ ≤ precision/2, in rounds; then every method.
         let (rm, rest) = streams.split_first_mut().expect("the reference is first");
         let reference = &mut rm.1;
@@ -319,46 +444,140 @@ pub fn run(
         let reference_row = row(cfg, mode, &rm.0, reference, None);
         log(&format!("{}  (reference)", format_row(&reference_row)));
         let pareto_front = pareto(&rows);
-        let mut by_cost: Vec<&Row> = rows.iter().collect();
-        by_cost.sort_by(|a, b| a.cpu_s_per_1000.total_cmp(&b.cpu_s_per_1000));
-        let cheapest = by_cost
-            .iter()
-            .find(|r| eligible(r) && r.error.abs() <= cfg.precision)
-            .map(|r| r.method.clone());
-        let note = note(cfg, &reference_row, &rows, &cheapest);
-        out_modes.push(ModeResult {
-            mode,
-            reference: reference_row,
-            checks,
-            rows,
-            pareto_front,
-            cheapest_within: cheapest,
-            note,
-        });
+        let best = cheapest(cfg, rows.iter());
+        let note = note(cfg, &reference_row, &rows, best);
+        let cheapest_within = best.map(|r| r.method.clone());
+        results.push((
+            g.block,
+            ModeResult {
+                mode,
+                reference: reference_row,
+                checks,
+                rows,
+                pareto_front,
+                cheapest_within,
+                note,
+            },
+        ));
     }
     progress(total, total);
-    let cpu_s = out_modes
+    let per_block: Vec<Tradeoff> = cfg
+        .blocks
         .iter()
-        .flat_map(|m| {
-            m.rows
+        .zip(&block_plans)
+        .map(|(&b, &p)| {
+            let modes = results
                 .iter()
-                .chain(&m.checks)
-                .chain(std::iter::once(&m.reference))
+                .filter(|(x, _)| *x == b)
+                .map(|(_, m)| m.clone())
+                .collect();
+            one_block(b, p, modes)
         })
-        .map(|r| r.cpu_s_per_1000 * r.rolls as f64 / 1000.0)
-        .sum();
-    Ok(Tradeoff {
-        block: cfg.block.to_string(),
-        precision: cfg.precision,
-        budget_s: cfg.budget_s,
-        seed: cfg.seed,
-        reference_dt: cfg.reference_dt,
-        planned_cpu_s: planned,
-        planned_cpu_s_at_one_percent: at_one,
-        precision_in_an_hour: in_an_hour,
-        cpu_s,
-        modes: out_modes,
-    })
+        .collect();
+    let cpu_s = per_block.iter().map(|t| t.cpu_s).sum();
+    Ok(result(whole, cpu_s, per_block))
+}
+
+/// The cheapest eligible (resolved) method whose |departure| is within the precision.
+fn cheapest<'a>(cfg: &Config, rows: impl Iterator<Item = &'a Row>) -> Option<&'a Row> {
+    rows.filter(|r| eligible(r) && r.error.abs() <= cfg.precision)
+        .min_by(|a, b| a.cpu_s_per_1000.total_cmp(&b.cpu_s_per_1000))
+}
+
+/// Each method of `mode` across the blocks: its worst departure, on how many blocks it is
+/// resolved, whether it is within the precision on every one, its mean cost; and the cheapest
+/// method within the precision on every block at once.
+fn across(cfg: &Config, per_block: &[Tradeoff], mode: Mode) -> ModeAcross {
+    let rows_of = |t: &Tradeoff| -> Vec<Row> {
+        t.modes
+            .iter()
+            .filter(|m| m.mode == mode)
+            .flat_map(|m| m.rows.clone())
+            .collect()
+    };
+    let names: Vec<String> = per_block
+        .first()
+        .map(|t| rows_of(t).into_iter().map(|r| r.method).collect())
+        .unwrap_or_default();
+    let mut methods = Vec::new();
+    for name in names {
+        let on: Vec<(&str, Row)> = per_block
+            .iter()
+            .filter_map(|t| {
+                rows_of(t)
+                    .into_iter()
+                    .find(|r| r.method == name)
+                    .map(|r| (t.block.as_str(), r))
+            })
+            .collect();
+        // NaN (a ratio with no width-vertical throws) counts as the worst.
+        let size = |r: &Row| {
+            if r.error.is_nan() {
+                f64::INFINITY
+            } else {
+                r.error.abs()
+            }
+        };
+        let Some((block, worst)) = on.iter().max_by(|a, b| size(&a.1).total_cmp(&size(&b.1)))
+        else {
+            continue;
+        };
+        let within = |r: &Row| eligible(r) && r.error.abs() <= cfg.precision;
+        methods.push(MethodAcross {
+            method: name.clone(),
+            worst_error: worst.error,
+            worst_error_err: worst.error_err,
+            worst_block: block.to_string(),
+            resolved_on: on.iter().filter(|(_, r)| eligible(r)).count() as u64,
+            within_everywhere: on.len() == per_block.len() && on.iter().all(|(_, r)| within(r)),
+            cpu_s_per_1000: on.iter().map(|(_, r)| r.cpu_s_per_1000).sum::<f64>() / on.len() as f64,
+        });
+    }
+    let cheapest = methods
+        .iter()
+        .filter(|m| m.within_everywhere)
+        .min_by(|a, b| a.cpu_s_per_1000.total_cmp(&b.cpu_s_per_1000))
+        .map(|m| m.method.clone());
+    let note = across_note(cfg, per_block.len(), &methods, &cheapest);
+    ModeAcross {
+        mode,
+        methods,
+        cheapest_everywhere: cheapest,
+        note,
+    }
+}
+
+fn across_note(
+    cfg: &Config,
+    blocks: usize,
+    methods: &[MethodAcross],
+    cheapest: &Option<String>,
+) -> String {
+    let p = 100.0 * cfg.precision;
+    let within: Vec<&str> = methods
+        .iter()
+        .filter(|m| m.within_everywhere)
+        .map(|m| m.method.as_str())
+        .collect();
+    match cheapest
+        .as_ref()
+        .and_then(|c| methods.iter().find(|m| &m.method == c))
+    {
+        Some(m) => format!(
+            "{} is the cheapest method within ±{p:.2} % of the reference on all {blocks} blocks \
+             (resolved at 2σ), at {:.3} CPU s per 1,000 rolls on average; its worst departure is \
+             {:+.2} ± {:.2} % (2σ) on {}. Within ±{p:.2} % on every block: {}.",
+            m.method,
+            m.cpu_s_per_1000,
+            100.0 * m.worst_error,
+            200.0 * m.worst_error_err,
+            m.worst_block,
+            within.join("; ")
+        ),
+        None => format!(
+            "No method is resolved within ±{p:.2} % of the reference on all {blocks} blocks."
+        ),
+    }
 }
 
 fn row(cfg: &Config, mode: Mode, m: &Method, s: &Stream, reference: Option<&Stream>) -> Row {
@@ -406,9 +625,9 @@ fn row(cfg: &Config, mode: Mode, m: &Method, s: &Stream, reference: Option<&Stre
     }
 }
 
-fn note(cfg: &Config, reference: &Row, rows: &[Row], cheapest: &Option<String>) -> String {
+fn note(cfg: &Config, reference: &Row, rows: &[Row], cheapest: Option<&Row>) -> String {
     let p = 100.0 * cfg.precision;
-    let mut s = match cheapest {
+    let mut s = match cheapest.map(|r| &r.method) {
         Some(m) => format!(
             "{m} is the cheapest method within ±{p:.2} % of the reference (resolved at 2σ)."
         ),

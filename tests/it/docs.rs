@@ -300,6 +300,7 @@ const REFS: &[(&str, &str, &str)] = &[
     ("tradeoff", "modes[].reference", "tradeoff-row"),
     ("tradeoff", "modes[].checks[]", "tradeoff-row"),
     ("tradeoff", "modes[].rows[]", "tradeoff-row"),
+    ("tradeoff-blocks", "per_block[]", "tradeoff"),
     ("validate", "cells[].tally", "tally"),
     ("calibrated", "fit", "fit"),
 ];
@@ -695,6 +696,38 @@ fn json_md_lists_the_keys_of_tradeoff_and_validate() {
     assert!(v.get("rolls").is_none() && v["modes"][0].get("cheapest_within").is_some());
     c.document("tradeoff", "tradeoff --json", &v);
     c.document("tradeoff", "tradeoff.json", &f);
+    // Two blocks, 3D only: each block's study and each method across them.
+    let (v, f) = study(
+        &[
+            "tradeoff",
+            "--blocks",
+            "140x24x20,140x22x13",
+            "--modes",
+            "3d",
+            "--dts",
+            "1/10",
+            "--rapier-dts",
+            "1/10",
+            "--reference-dt",
+            "1/20",
+            "--max-steps",
+            "2000",
+            "--ladder",
+            "none",
+            "--precision",
+            "50",
+            "--budget",
+            "1",
+            "--reference-budget",
+            "1",
+            "--threads",
+            "2",
+        ],
+        "tradeoff.json",
+    );
+    assert_eq!(v["per_block"].as_array().unwrap().len(), 2);
+    c.document("tradeoff-blocks", "tradeoff --blocks --json", &v);
+    c.document("tradeoff-blocks", "tradeoff --blocks tradeoff.json", &f);
     let (v, f) = study(
         &[
             "validate",
@@ -717,7 +750,7 @@ fn json_md_lists_the_keys_of_tradeoff_and_validate() {
     );
     c.document("validate", "validate --json", &v);
     c.document("validate", "validate.json", &f);
-    c.finish(&["tradeoff", "tradeoff-row", "validate"]);
+    c.finish(&["tradeoff", "tradeoff-row", "tradeoff-blocks", "validate"]);
 }
 
 #[test]

@@ -252,6 +252,114 @@ fn tradeoff_resolves_to_the_precision_or_says_what_it_needs() {
     assert_eq!(counts(&again), counts(&w));
 }
 
+/// Two blocks, 3D only, at the coarsest steps (a pilot of a few CPU seconds): each block has
+/// its own reference and methods, and the summary across them is what their rows say.
+#[test]
+fn tradeoff_on_several_blocks_sums_up_each_method_across_them() {
+    let dir = out_dir("tradeoff-blocks");
+    let v = dicephys(&[
+        "tradeoff",
+        "--blocks",
+        "140x24x20,140x30x10",
+        "--modes",
+        "3d",
+        "--dts",
+        "1/10,1/20",
+        "--rapier-dts",
+        "1/10",
+        "--reference-dt",
+        "1/40",
+        "--max-steps",
+        "2000",
+        "--ladder",
+        "none",
+        "--precision",
+        "60",
+        "--budget",
+        "2",
+        "--reference-budget",
+        "2",
+        "--threads",
+        "2",
+        "--out",
+        dir.to_str().unwrap(),
+        "--json",
+    ]);
+    let p = v["precision"].as_f64().unwrap();
+    let blocks = v["per_block"].as_array().unwrap();
+    assert_eq!(blocks.len(), 2);
+    assert_eq!(blocks[1]["block"], "140x30x10");
+    let rows = |b: usize| -> Vec<serde_json::Value> {
+        let modes = blocks[b]["modes"].as_array().unwrap();
+        assert_eq!(modes.len(), 1, "3d only");
+        assert_eq!(modes[0]["mode"], "3d");
+        modes[0]["rows"].as_array().unwrap().clone()
+    };
+    let (r0, r1) = (rows(0), rows(1));
+    // Each block its own reference: other counts, the same throws.
+    assert_ne!(
+        blocks[0]["modes"][0]["reference"]["ratio"],
+        blocks[1]["modes"][0]["reference"]["ratio"]
+    );
+    let across = v["across"].as_array().unwrap();
+    assert_eq!(across.len(), 1);
+    let methods = across[0]["methods"].as_array().unwrap();
+    assert_eq!(methods.len(), r0.len());
+    // null: not a number (a ratio with no width-vertical throws, which these steps give).
+    let f = |r: &serde_json::Value, k: &str| r[k].as_f64().unwrap_or(f64::NAN);
+    let size = |r: &serde_json::Value| {
+        let e = f(r, "error").abs();
+        if e.is_nan() {
+            f64::INFINITY
+        } else {
+            e
+        }
+    };
+    let within = |r: &serde_json::Value| {
+        r["resolved"].as_bool().unwrap()
+            && r["failed"].as_u64().unwrap() + r["unconverged"].as_u64().unwrap()
+                <= r["rolls"].as_u64().unwrap() / 100
+            && f(r, "error").abs() <= p
+    };
+    let mut cheapest: Option<(f64, String)> = None;
+    for (m, (a, b)) in methods.iter().zip(r0.iter().zip(&r1)) {
+        assert_eq!(m["method"], a["method"]);
+        // The worst is the larger |departure| of the two (a tie: the later block's), with its
+        // own error.
+        let worst = if size(a) > size(b) { a } else { b };
+        assert_eq!(m["worst_error"], worst["error"], "{m}");
+        assert_eq!(m["worst_error_err"], worst["error_err"], "{m}");
+        let both = within(a) && within(b);
+        assert_eq!(m["within_everywhere"].as_bool().unwrap(), both, "{m}");
+        let cost = (f(a, "cpu_s_per_1000") + f(b, "cpu_s_per_1000")) / 2.0;
+        assert!((f(m, "cpu_s_per_1000") - cost).abs() <= 1e-9 * cost, "{m}");
+        if both && cheapest.as_ref().is_none_or(|c| cost < c.0) {
+            cheapest = Some((cost, m["method"].as_str().unwrap().to_string()));
+        }
+    }
+    assert_eq!(
+        across[0]["cheapest_everywhere"].as_str(),
+        cheapest.as_ref().map(|c| c.1.as_str())
+    );
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    assert!(md.contains("## 3d across the blocks") && md.contains("## 140x30x10"));
+    // The figure: a panel per block, and its key names every method (its name without the
+    // mode, the same number in every panel).
+    svg(&dir, "tradeoff");
+    let fig = std::fs::read_to_string(dir.join("tradeoff.svg")).unwrap();
+    for b in ["140x24x20", "140x30x10"] {
+        assert!(fig.contains(b), "no panel for {b}");
+    }
+    for r in &r0 {
+        let name = r["method"].as_str().unwrap().replacen(" 3d ", " ", 1);
+        // A text element's content is a line of its own.
+        assert!(
+            fig.lines().any(|l| l.trim() == name),
+            "the key lacks {name}"
+        );
+    }
+}
+
 #[test]
 fn converge_with_a_precision_rolls_each_claim_in_rounds() {
     let dir = out_dir("converge-precision");

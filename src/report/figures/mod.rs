@@ -20,6 +20,7 @@ use plotters::prelude::*;
 pub mod fit;
 pub mod paper;
 pub mod sweeps;
+pub mod tradeoff;
 pub mod validate;
 
 /// One plotted value with its one-standard-error bar (`y_err` 0, negative or non-finite: no bar).
@@ -69,7 +70,7 @@ pub struct LenGroup {
     pub points: Vec<Point>,
 }
 
-/// Pixel size of every figure (the SVG uses the same user units).
+/// Pixel size of a figure unless it says otherwise (the SVG uses the same user units).
 const RATIO_DESC: &str = "P(breadth vertical) / P(width vertical)";
 const R_DESC: &str = "R = width / breadth";
 const SIZE: (u32, u32) = (1000, 720);
@@ -125,6 +126,11 @@ fn plot_err<E: std::fmt::Display>(e: E) -> String {
 
 /// A figure that can draw itself on any plotters backend.
 trait Figure {
+    /// Its size in pixels (the SVG's user units).
+    fn size(&self) -> (u32, u32) {
+        SIZE
+    }
+
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String>;
 }
 
@@ -145,11 +151,11 @@ fn write_both(dir: &Path, stem: &str, fig: &impl Figure) -> crate::Result<()> {
             .tempfile_in(dir)
             .map_err(|e| Error::io(&path, e))?;
         let drawn = if ext == "svg" {
-            let root = SVGBackend::new(tmp.path(), SIZE).into_drawing_area();
+            let root = SVGBackend::new(tmp.path(), fig.size()).into_drawing_area();
             fig.draw(&root)
                 .and_then(|()| root.present().map_err(plot_err))
         } else {
-            let root = BitMapBackend::new(tmp.path(), SIZE).into_drawing_area();
+            let root = BitMapBackend::new(tmp.path(), fig.size()).into_drawing_area();
             fig.draw(&root)
                 .and_then(|()| root.present().map_err(plot_err))
         };

@@ -1,5 +1,5 @@
-//! The sweeps' figures: the ratio against dt (`convergence`), cost against error with the
-//! Pareto front (`tradeoff`), and failure fractions as heat maps (`heatmap`). Log axes are drawn
+//! The sweeps' figures: the ratio against dt (`convergence`) and failure fractions as heat maps
+//! (`heatmap`); cost against error is [`super::tradeoff`]. Log axes are drawn
 //! as log10 of the value with ticks labelled by the value itself.
 
 use super::*;
@@ -11,40 +11,6 @@ pub struct Line {
     pub label: String,
     /// The ratio at each time step (`x` = dt, s).
     pub points: Vec<Point>,
-}
-
-/// One method of the trade-off figure.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MethodPoint {
-    /// The method's name, beside its marker if on the front.
-    pub label: String,
-    /// CPU seconds per 1,000 rolls.
-    pub cost: f64,
-    /// |departure| from the reference, per cent.
-    pub error: f64,
-    /// Its one-standard-error, per cent (the bar drawn is 2σ).
-    pub error_err: f64,
-    /// A 2D method (circle), else 3D (triangle).
-    pub two_d: bool,
-    /// 2σ of the departure is within the precision: drawn filled, else hollow and grey.
-    pub resolved: bool,
-    /// On its mode's Pareto front (over resolved methods): joined by the front's line.
-    pub on_front: bool,
-    /// The cheapest method within the precision: named beside its marker.
-    pub cheapest: bool,
-}
-
-/// A yardstick drawn across the trade-off figure: |departure| from `lo` to `hi`, per cent.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Band {
-    /// Its legend entry.
-    pub label: String,
-    /// Its lower edge, per cent (0 or less: the foot of the chart).
-    pub lo: f64,
-    /// Its upper edge, per cent.
-    pub hi: f64,
-    /// Drawn in the 2D methods' colour, else the 3D ones'; `None`: grey, both modes.
-    pub two_d: Option<bool>,
 }
 
 /// One heat map: `values[y][x]` in [0, 1] (NaN: no data).
@@ -94,7 +60,7 @@ fn log_tick_dt(v: &f64) -> String {
 }
 
 /// A log10 tick: the value to two significant figures.
-fn log_tick(v: &f64) -> String {
+pub(super) fn log_tick(v: &f64) -> String {
     tick(&two_figures(10f64.powf(*v)))
 }
 
@@ -201,190 +167,9 @@ pub fn convergence(dir: &Path, stem: &str, title: &str, lines: &[Line]) -> crate
     write_both(dir, stem, &Convergence { title, lines })
 }
 
-struct Tradeoff<'a> {
-    title: &'a str,
-    methods: &'a [MethodPoint],
-    bands: &'a [Band],
-    precision: f64,
-}
-
-const MODE_COLORS: [(bool, RGBColor, &str); 2] = [
-    (false, RGBColor(128, 0, 128), "3D"),
-    (true, RGBColor(0, 140, 120), "2D"),
-];
-
-impl Figure for Tradeoff<'_> {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let ok: Vec<&MethodPoint> = self
-            .methods
-            .iter()
-            .filter(|m| m.cost > 0.0 && m.cost.is_finite() && m.error.is_finite())
-            .collect();
-        // Both axes are log10; |departure| is drawn no lower than a twentieth of the precision
-        // (a departure resolved at 0 sits on the chart's foot, its bar showing how small).
-        let floor = (self.precision / 20.0).max(1e-6);
-        let ly = |v: f64| v.max(floor).log10();
-        let mut xs = Span::new(f64::INFINITY, f64::NEG_INFINITY);
-        let mut ys = Span::new(floor.log10(), ly(self.precision));
-        for m in &ok {
-            xs.add(m.cost.log10());
-            ys.add(ly(m.error + 2.0 * bar(m.error_err)));
-        }
-        for b in self.bands {
-            ys.add(ly(b.hi));
-        }
-        if !xs.lo.is_finite() {
-            xs = Span::new(0.0, 1.0);
-        }
-        let x = xs.padded(0.08, 0.08);
-        let mut chart = chart_x(
-            root,
-            self.title,
-            x.clone(),
-            // Headroom above the points for the legend.
-            ys.padded(0.02, 0.9),
-            "CPU seconds per 1,000 rolls (log scale)",
-            "|departure from the reference|, % (log scale), 2σ bars",
-            (&log_tick, &log_tick),
-        )?;
-        for b in self.bands {
-            let color = match b.two_d {
-                Some(t) => MODE_COLORS[t as usize].1,
-                None => GREY,
-            };
-            let style = color.mix(0.15).filled();
-            chart
-                .draw_series(std::iter::once(Rectangle::new(
-                    [(x.start, ly(b.lo)), (x.end, ly(b.hi))],
-                    style,
-                )))
-                .map_err(plot_err)?
-                .label(b.label.as_str())
-                .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 24, y + 6)], style));
-        }
-        for (two_d, color, mode) in MODE_COLORS {
-            let of = |resolved: bool| -> Vec<Point> {
-                ok.iter()
-                    .filter(|m| m.two_d == two_d && m.resolved == resolved)
-                    .map(|m| Point {
-                        x: m.cost.log10(),
-                        y: ly(m.error),
-                        y_err: 0.0,
-                    })
-                    .collect()
-            };
-            // 2σ bars, drawn on the log axis from |d| − 2σ (or the foot) to |d| + 2σ.
-            chart
-                .draw_series(ok.iter().filter(|m| m.two_d == two_d).map(|m| {
-                    let e = 2.0 * bar(m.error_err);
-                    let c = if m.resolved { color } else { GREY };
-                    ErrorBar::new_vertical(
-                        m.cost.log10(),
-                        ly(m.error - e),
-                        ly(m.error),
-                        ly(m.error + e),
-                        c.stroke_width(1),
-                        8,
-                    )
-                }))
-                .map_err(plot_err)?;
-            let marker = if two_d {
-                Marker::Circle
-            } else {
-                Marker::Triangle
-            };
-            points(
-                &mut chart,
-                &of(true),
-                color,
-                marker,
-                false,
-                &format!("{mode} methods, resolved"),
-            )?;
-            chart
-                .draw_series(
-                    of(false)
-                        .iter()
-                        .map(|p| Circle::new((p.x, p.y), 5, GREY.stroke_width(1))),
-                )
-                .map_err(plot_err)?;
-            let mut front: Vec<&&MethodPoint> = ok
-                .iter()
-                .filter(|m| m.two_d == two_d && m.on_front)
-                .collect();
-            front.sort_by(|a, b| a.cost.total_cmp(&b.cost));
-            let line: Vec<(f64, f64)> = front
-                .iter()
-                .map(|m| (m.cost.log10(), ly(m.error)))
-                .collect();
-            solid(
-                &mut chart,
-                line,
-                color.stroke_width(2),
-                &format!("{mode}: Pareto front (resolved methods)"),
-            )?;
-            chart
-                .draw_series(
-                    ok.iter()
-                        .filter(|m| m.two_d == two_d && m.cheapest)
-                        .map(|m| {
-                            // The cheapest method within the precision, named a little up and right.
-                            EmptyElement::at((m.cost.log10(), ly(m.error)))
-                                + Text::new(
-                                    format!(
-                                        "cheapest within ±{}: {}",
-                                        pct(self.precision),
-                                        m.label
-                                    ),
-                                    (9, if two_d { -18 } else { 8 }), // 2D above, 3D below: they may sit close
-                                    (FONT, 14).into_font().color(&color),
-                                )
-                        }),
-                )
-                .map_err(plot_err)?;
-        }
-        chart
-            // No marker: a legend entry only.
-            .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
-            .map_err(plot_err)?
-            .label("unresolved (grey, hollow): off the front")
-            .legend(|(x, y)| Circle::new((x + 12, y), 5, GREY.stroke_width(1)));
-        dashed(
-            &mut chart,
-            vec![(x.start, ly(self.precision)), (x.end, ly(self.precision))],
-            GREY.stroke_width(1),
-            &format!("the precision, {}", pct(self.precision)),
-        )?;
-        legend(&mut chart, SeriesLabelPosition::UpperRight)
-    }
-}
-
 /// A percentage to two significant figures: "1 %", "0.5 %".
-fn pct(p: f64) -> String {
+pub(super) fn pct(p: f64) -> String {
     format!("{} %", tick(&two_figures(p)))
-}
-
-/// Cost (log) against |departure| (log), 2σ bars, one marker per method; the Pareto fronts
-/// over resolved methods drawn, the cheapest within the precision named; the yardsticks as
-/// bands and a dashed line at the precision (per cent).
-pub fn tradeoff(
-    dir: &Path,
-    stem: &str,
-    title: &str,
-    methods: &[MethodPoint],
-    bands: &[Band],
-    precision: f64,
-) -> crate::Result<()> {
-    write_both(
-        dir,
-        stem,
-        &Tradeoff {
-            title,
-            methods,
-            bands,
-            precision,
-        },
-    )
 }
 
 struct Heatmap<'a> {
