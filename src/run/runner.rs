@@ -318,6 +318,7 @@ impl Checkpoint {
             ))
         })?;
         let lock = lock(&dir.join(lock_name))?;
+        crate::run::io::clean_temporaries(dir);
         // Written when absent, then read back: tasks of a cluster run that open a new cell at
         // the same moment each write the same whole file (an atomic rename), and the one
         // read back decides.

@@ -10,6 +10,7 @@ mod docs;
 mod fuzz;
 mod rapier;
 mod redteam;
+mod redteam3;
 mod reliability;
 mod slurm;
 mod speed;
