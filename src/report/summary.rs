@@ -433,7 +433,7 @@ impl RunSummary {
                 )));
             }
             seen[s.k as usize] = true;
-            tally.merge(&p.tally);
+            tally.merge(&p.tally)?;
             wall += p.wall_s;
             cpu += p.cpu_s;
         }

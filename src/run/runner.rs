@@ -204,7 +204,7 @@ impl<'a> Runner<'a> {
                 done.resumed += file.records.len() as u64;
                 done.resumed_cpu_s += file.cpu_s;
                 done.resumed_wall_s += file.wall_s;
-                file.records.iter().for_each(|r| done.tally.add(r));
+                file.records.iter().try_for_each(|r| done.tally.add(r))?;
                 sink(&file.records)?;
                 (self.progress)(done.tally.rolls);
                 continue;
@@ -243,10 +243,10 @@ impl<'a> Runner<'a> {
                 let json =
                     serde_json::to_string(&file).map_err(|e| Error::Failed(e.to_string()))?;
                 write_atomic(p, json.as_bytes())?;
-                file.records.iter().for_each(|r| done.tally.add(r));
+                file.records.iter().try_for_each(|r| done.tally.add(r))?;
                 sink(&file.records)?;
             } else {
-                recs.iter().for_each(|r| done.tally.add(r));
+                recs.iter().try_for_each(|r| done.tally.add(r))?;
                 sink(&recs)?;
             }
             if !whole {

@@ -384,13 +384,13 @@ pub fn run(
             let mut faithful: Option<(&[RollRecord], f64)> = None;
             for ((m, (recs, wall_s, cpu_s)), floor) in methods.iter().zip(&best).zip(&floors) {
                 let (wall_s, cpu_s) = (*wall_s, *cpu_s);
-                let t = Tally::of(recs);
+                let t = Tally::of(recs)?;
                 let r = stats::ratio(t.counts.breadth, t.counts.width);
                 let rolls_per_s = rolls as f64 / wall_s;
                 let (speedup, z, same) = match &faithful {
                     None => (1.0, 0.0, 1.0),
                     Some((f, f_rps)) => {
-                        let ft = Tally::of(f);
+                        let ft = Tally::of(f)?;
                         let fr = stats::ratio(ft.counts.breadth, ft.counts.width);
                         (
                             rolls_per_s / f_rps,

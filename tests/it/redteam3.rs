@@ -121,3 +121,32 @@ fn the_temporary_files_a_killed_run_left_are_removed_by_the_next_run_there() {
     assert!(!left.exists(), "a dead run's temporary file was left");
     assert!(held.exists(), "a live run's temporary file was removed");
 }
+
+// Counts.
+
+/// Shard `k` of `n` of a small 2D run, as `roll --shard K/N --json` writes it, parsed.
+fn shard_json(k: u64, n: u64) -> serde_json::Value {
+    let s = format!("{k}/{n}");
+    let out = roll(&["--json", "--shard", &s]).output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn merge_refuses_a_sum_past_2_to_the_64_rather_than_wrapping() {
+    let d = scratch("overflow");
+    let mut a = shard_json(0, 2);
+    let b = shard_json(1, 2);
+    a["tally"]["steps"] = u64::MAX.into();
+    let files = [(d.join("a.json"), a), (d.join("b.json"), b)];
+    for (f, v) in &files {
+        std::fs::write(f, v.to_string()).unwrap();
+    }
+    let out = bin()
+        .arg("merge")
+        .args(files.iter().map(|(f, _)| f))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("overflow"), "{}", stderr(&out));
+}
