@@ -284,8 +284,16 @@ fn prepare(
             .and_then(|p| p.canonicalize())
             .map_err(|e| Error::Run(format!("cannot find this binary's path ({e})")))?,
     };
+    dicephys::run::slurm::script_path("bin", &bin)?;
+    // A run refused by its dry run leaves no directory behind that this call made.
+    let made = !job.dir.exists();
     let lay = Layout::create(&job.dir)?;
-    check(&lay)?;
+    if let Err(e) = check(&lay) {
+        if made {
+            let _ = std::fs::remove_dir_all(&lay.dir);
+        }
+        return Err(e);
+    }
     lay.store(plan).map_err(|e| match e {
         dicephys::Error::Mismatch(m) => Error::Usage(format!("--dir {m}")),
         e => e.into(),

@@ -150,3 +150,142 @@ fn merge_refuses_a_sum_past_2_to_the_64_rather_than_wrapping() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("overflow"), "{}", stderr(&out));
 }
+
+// Generated Slurm scripts.
+
+/// The value of `#SBATCH --NAME=...` in `script`, read as sbatch's own parser reads it
+/// (Slurm's `_get_argument`: a backslash escapes the next character, double quotes group, an
+/// unescaped `#` ends the line; single quotes are plain characters).
+fn sbatch_value(script: &str, name: &str) -> Option<String> {
+    let line = script
+        .lines()
+        .filter_map(|l| l.strip_prefix("#SBATCH "))
+        .find(|l| l.trim_start().starts_with(&format!("--{name}=")))?;
+    let (mut arg, mut escaped, mut quoted) = (String::new(), false, false);
+    for c in line.trim_start().chars() {
+        if escaped {
+            escaped = false;
+            arg.push(c);
+        } else if c == '\\' {
+            escaped = true;
+        } else if c == '"' {
+            quoted = !quoted;
+        } else if c == '#' || (!quoted && c.is_ascii_whitespace()) {
+            break;
+        } else {
+            arg.push(c);
+        }
+    }
+    assert!(!quoted, "sbatch: unmatched quote in {line}");
+    Some(arg.split_once('=').unwrap().1.to_string())
+}
+
+#[test]
+fn a_slurm_dir_name_is_quoted_for_the_shell_and_sbatch_or_refused() {
+    let d = scratch("slurm-names");
+    // A binary that records what it was given and prints a result.
+    let fake = d.join("fake-dicephys");
+    std::fs::write(
+        &fake,
+        "#!/bin/sh\nprintf '%s\\n' \"$@\" >\"$FAKE_ARGS\"\necho '{}'\n",
+    )
+    .unwrap();
+    std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let run = |dir: &Path, extra: &[&str]| {
+        bin()
+            .args([
+                "slurm",
+                "roll",
+                "--block",
+                "140x22x13",
+                "--2d",
+                "--rolls",
+                "20",
+            ])
+            .args(["--tasks", "2", "--bin"])
+            .arg(&fake)
+            .arg("--dir")
+            .arg(dir)
+            .args(extra)
+            .current_dir(&*d)
+            .output()
+            .unwrap()
+    };
+    // A name with everything the shell or sbatch would read: it is written safely.
+    let nasty = d.join("run x#y %j \"q' $(touch pwned) `touch pwned2`");
+    let out = run(&nasty, &["--time", "1:00:00"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let array = std::fs::read_to_string(nasty.join("array.sh")).unwrap();
+    let real = nasty.canonicalize().unwrap();
+    let want = format!(
+        "{}/logs/task-%a.out",
+        real.to_str().unwrap().replace('%', "%%")
+    );
+    assert_eq!(
+        sbatch_value(&array, "output").as_deref(),
+        Some(&*want),
+        "{array}"
+    );
+    assert_eq!(sbatch_value(&array, "time").as_deref(), Some("1:00:00"));
+    let fin = std::fs::read_to_string(nasty.join("finish.sh")).unwrap();
+    let want = format!(
+        "{}/logs/finish.out",
+        real.to_str().unwrap().replace('%', "%%")
+    );
+    assert_eq!(
+        sbatch_value(&fin, "output").as_deref(),
+        Some(&*want),
+        "{fin}"
+    );
+    let args = d.join("args.txt");
+    let task = Command::new("bash")
+        .arg(nasty.join("array.sh"))
+        .env("SLURM_ARRAY_TASK_ID", "1")
+        .env("SLURM_JOB_ID", "7")
+        .env("FAKE_ARGS", &args)
+        .current_dir(&*d)
+        .output()
+        .unwrap();
+    assert_eq!(task.status.code(), Some(0), "{}", stderr(&task));
+    assert!(!d.join("pwned").exists() && !d.join("pwned2").exists());
+    let given = std::fs::read_to_string(&args).unwrap();
+    let ckpt = format!("{}/shard-1", real.to_str().unwrap());
+    assert!(given.lines().any(|l| l == ckpt), "{given}");
+    assert!(nasty.join("shard-1.json").exists());
+    // What cannot be written safely is refused, with one line, before anything is stored.
+    for (dir, extra) in [
+        (d.join("a\nb"), &[][..]),
+        (d.join("a\\b"), &[][..]),
+        (d.join("ok1"), &["--account", "a#b"][..]),
+        (d.join("ok2"), &["--partition", "p\"q"][..]),
+        (d.join("ok3"), &["--time", "1:00 %j"][..]),
+        (d.join("ok4"), &["--time", "1'00"][..]),
+    ] {
+        let out = run(&dir, extra);
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{dir:?} {extra:?}: {}",
+            stderr(&out)
+        );
+        assert_eq!(stderr(&out).lines().count(), 1, "{}", stderr(&out));
+        assert!(!dir.exists(), "{dir:?}: made although refused");
+    }
+    // A study refused by its dry run leaves no directory either.
+    let st = d.join("st");
+    let out = bin()
+        .args([
+            "slurm",
+            "stability",
+            "--rolls",
+            "0",
+            "--tasks",
+            "2",
+            "--dir",
+        ])
+        .arg(&st)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(!st.exists(), "a refused run left its directory");
+}
