@@ -24,9 +24,9 @@ pub fn run(a: &MergeArgs) -> Result<()> {
     for f in &a.files {
         let text = std::fs::read_to_string(f)
             .map_err(|e| Error::Usage(format!("merge: {}: {e}", f.display())))?;
-        let s: ShardResult = serde_json::from_str(&text).map_err(|e| {
+        let s: ShardResult = dicephys::run::seal::open(&text).map_err(|e| {
             Error::Usage(format!(
-                "merge: {}: not a `roll --json` output ({e})",
+                "merge: {}: not a whole `roll --json` output: {e}",
                 f.display()
             ))
         })?;
@@ -34,10 +34,7 @@ pub fn run(a: &MergeArgs) -> Result<()> {
     }
     let out = RunSummary::merge(&parts)?;
     if a.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&out).map_err(|e| Error::Run(e.to_string()))?
-        );
+        outln!("{}", dicephys::run::seal::to_string(&out, true)?);
     } else {
         out!("{}", out.human());
     }

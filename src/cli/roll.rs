@@ -108,10 +108,7 @@ pub fn run(a: &RollArgs) -> Result<()> {
     let summary = outputs::roll(&spec, dir.map(PathBuf::as_path), per_roll, &runner)?;
     let rolled = summary.rolls;
     if a.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&summary).map_err(|e| Error::Run(e.to_string()))?
-        );
+        outln!("{}", dicephys::run::seal::to_string(&summary, true)?);
     } else {
         out!("{}", summary.human());
     }

@@ -362,8 +362,27 @@ fn finish(dir: &Path) -> Result<()> {
             // Every chunk is on disk: the study reads them all and rolls none (but tradeoff,
             // whose tasks rolled ahead, runs here, rolling on where a method needs more).
             let (cfg, place, _) = outputs::planned(&lay)?;
-            let (cfg, share) = cfg.finishing();
-            study::run(&cfg, &Place { share, ..place })?;
+            let (cfg, share) = cfg.finishing(*tasks);
+            let ran = study::run(
+                &cfg,
+                &Place {
+                    share: share.clone(),
+                    ..place
+                },
+            );
+            // A chunk missing or damaged after its task's mark: the mark goes, so that the
+            // task, rerun, rolls it again (a damaged chunk is rolled again and replaced).
+            if let (Err(_), Some((k, why))) = (&ran, share.lacking()) {
+                let mark = lay.task_done(k);
+                if let Err(e) = std::fs::remove_file(&mark) {
+                    if e.kind() != std::io::ErrorKind::NotFound {
+                        return Err(Error::Run(format!("{}: {e}", mark.display())));
+                    }
+                }
+                let why = format!("{why}; its mark {} removed", mark.display());
+                return Err(lay.not_finished(*tasks, &[k.to_string()], &why).into());
+            }
+            ran?;
         }
         Plan::Roll { spec, tasks } => {
             let text = RunSummary::merge_tasks(&lay, spec, *tasks)?;

@@ -103,7 +103,8 @@ impl StudyConfig {
     /// study itself, reading every chunk back and rolling none; but `tradeoff`, whose tasks
     /// only rolled ahead, runs whole (no `preroll_chunks`), reading their chunks back and
     /// rolling on where a method needs more.
-    pub fn finishing(&self) -> (StudyConfig, ChunkShare) {
+    /// The run was split among `tasks` tasks (named when a chunk is missing).
+    pub fn finishing(&self, tasks: u64) -> (StudyConfig, ChunkShare) {
         match self {
             StudyConfig::Tradeoff(t) => (
                 StudyConfig::Tradeoff(tradeoff::Config {
@@ -112,7 +113,7 @@ impl StudyConfig {
                 }),
                 ChunkShare::All,
             ),
-            other => (other.clone(), ChunkShare::Assemble),
+            other => (other.clone(), ChunkShare::assemble(tasks)),
         }
     }
 }

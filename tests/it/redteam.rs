@@ -136,14 +136,18 @@ fn merge_refuses_a_bad_shard_number_and_a_tally_that_does_not_add_up() {
     let text = std::fs::read_to_string(&g).unwrap();
     let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
     v["spec"]["shard"]["k"] = 5.into();
+    // Sealed again (checksum recomputed): refused for its shard number, not its checksum.
+    let v = dicephys::run::seal::sealed(&v).unwrap();
     std::fs::write(&g, v.to_string()).unwrap();
     let out = bin().arg("merge").arg(&f).arg(&g).output().unwrap();
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
     v["tally"]["counts"]["width"] = 1000.into();
+    let v = dicephys::run::seal::sealed(&v).unwrap();
     std::fs::write(&g, v.to_string()).unwrap();
     let out = bin().arg("merge").arg(&f).arg(&g).output().unwrap();
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("checksum"), "{}", stderr(&out));
 }
 
 // 3. A checkpoint holds one run's chunks: see reliability::a_checkpoint_directory_holds_one_run.

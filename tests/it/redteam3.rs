@@ -138,6 +138,8 @@ fn merge_refuses_a_sum_past_2_to_the_64_rather_than_wrapping() {
     let mut a = shard_json(0, 2);
     let b = shard_json(1, 2);
     a["tally"]["steps"] = u64::MAX.into();
+    // Sealed again: a shard whose checksum holds, and whose counts overflow.
+    let a = dicephys::run::seal::sealed(&a).unwrap();
     let files = [(d.join("a.json"), a), (d.join("b.json"), b)];
     for (f, v) in &files {
         std::fs::write(f, v.to_string()).unwrap();
@@ -288,4 +290,210 @@ fn a_slurm_dir_name_is_quoted_for_the_shell_and_sbatch_or_refused() {
         .unwrap();
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(!st.exists(), "a refused run left its directory");
+}
+
+// Checksums on what is stored.
+
+/// The run's tally as `roll --json` prints it.
+fn tally_of(out: &Output) -> serde_json::Value {
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    v["tally"].clone()
+}
+
+#[test]
+fn a_damaged_chunk_is_named_and_rolled_again_on_resume() {
+    let d = scratch("damaged-chunk");
+    let ck = d.join("ck");
+    let run = |flag: &str| {
+        let mut c = bin();
+        c.args(["roll", "--json", flag]).arg(&ck);
+        if flag == "--checkpoint" {
+            c.args(["--block", "140x22x13", "--2d", "--rolls", "2500"]);
+        }
+        c.output().unwrap()
+    };
+    let truth = tally_of(&run("--checkpoint"));
+    let chunk = ck.join("chunk-000000001000-1000.json");
+    let good = std::fs::read(&chunk).unwrap();
+    let text = String::from_utf8(good.clone()).unwrap();
+    let mut flipped = good.clone();
+    flipped[good.len() / 2] ^= 0x04;
+    let damages: [(&str, Vec<u8>); 4] = [
+        (
+            "an outcome edited, still JSON",
+            text.replacen("{\"settled\":\"breadth\"}", "{\"settled\":\"width\"}", 1)
+                .into_bytes(),
+        ),
+        (
+            "a field renamed",
+            text.replacen("\"energy_gain\"", "\"energy_gained\"", 1)
+                .into_bytes(),
+        ),
+        ("a bit flipped", flipped),
+        (
+            "no checksum (an older dicephys's chunk)",
+            text.replacen("\"checksum\":", "\"checksun\":", 1)
+                .into_bytes(),
+        ),
+    ];
+    for (what, bytes) in damages {
+        assert_ne!(bytes, good, "{what}: the damage changed nothing");
+        std::fs::write(&chunk, &bytes).unwrap();
+        let out = run("--resume");
+        assert_eq!(tally_of(&out), truth, "{what}: a damaged chunk was counted");
+        assert!(
+            stderr(&out).contains("chunk-000000001000-1000.json")
+                && stderr(&out).contains("rolling its throws again"),
+            "{what}: {}",
+            stderr(&out)
+        );
+        // Replaced by a whole chunk: the next resume reads it quietly.
+        let again = run("--resume");
+        assert_eq!(tally_of(&again), truth);
+        assert!(!stderr(&again).contains("damaged"), "{}", stderr(&again));
+    }
+}
+
+/// Runs task `k` of the array script in `dir` as Slurm would.
+fn array_task(dir: &Path, k: u64) -> Output {
+    let out = Command::new("bash")
+        .arg(dir.join("array.sh"))
+        .env("SLURM_ARRAY_TASK_ID", k.to_string())
+        .env("SLURM_JOB_ID", "7")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "task {k}: {}", stderr(&out));
+    out
+}
+
+fn slurm(args: &[&std::ffi::OsStr]) -> Output {
+    bin().arg("slurm").args(args).output().unwrap()
+}
+
+#[test]
+fn slurm_finish_names_a_damaged_shard_and_rerunning_its_task_replaces_it() {
+    let d = scratch("damaged-shard");
+    let dir = d.join("run");
+    let out = bin()
+        .args([
+            "slurm",
+            "roll",
+            "--block",
+            "140x22x13",
+            "--2d",
+            "--rolls",
+            "40",
+        ])
+        .args(["--tasks", "2", "--dir"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let finish = || slurm(&["finish".as_ref(), dir.as_os_str()]);
+    array_task(&dir, 0);
+    array_task(&dir, 1);
+    assert_eq!(finish().status.code(), Some(0));
+    let counts = |p: &Path| {
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap();
+        v["tally"].clone()
+    };
+    let truth = counts(&dir.join("result.json"));
+    // A count edited in task 1's result, the file still JSON: named, never merged.
+    let shard = dir.join("shard-1.json");
+    let text = std::fs::read_to_string(&shard).unwrap();
+    let w = text.find("\"width\": ").unwrap() + 9;
+    std::fs::write(&shard, format!("{}1{}", &text[..w], &text[w..])).unwrap();
+    let bad = finish();
+    assert_eq!(bad.status.code(), Some(1), "{}", stderr(&bad));
+    assert!(stderr(&bad).contains("shard-1.json"), "{}", stderr(&bad));
+    assert!(stderr(&bad).contains("--array=1 "), "{}", stderr(&bad));
+    // The advice, followed, works: the task writes its result again, and finish merges.
+    let rerun = array_task(&dir, 1);
+    assert!(
+        !String::from_utf8_lossy(&rerun.stdout).contains("there already"),
+        "the rerun task kept the damaged result"
+    );
+    let ok = finish();
+    assert_eq!(ok.status.code(), Some(0), "{}", stderr(&ok));
+    assert_eq!(counts(&dir.join("result.json")), truth);
+}
+
+#[test]
+fn slurm_finish_names_a_damaged_study_chunk_and_rerunning_its_task_replaces_it() {
+    let d = scratch("damaged-study");
+    let dir = d.join("run");
+    let out = bin()
+        .args([
+            "slurm",
+            "crosscheck",
+            "--block",
+            "140x22x13",
+            "--rolls",
+            "2000",
+        ])
+        .args(["--json", "--tasks", "2", "--dir"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let finish = || slurm(&["finish".as_ref(), dir.as_os_str()]);
+    array_task(&dir, 0);
+    array_task(&dir, 1);
+    let first = finish();
+    let tallies = |o: &Output| {
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        [v["runs"][0]["tally"].clone(), v["runs"][1]["tally"].clone()]
+    };
+    let truth = tallies(&first);
+    // Damage every chunk in turn: finish names it and its task, and rerunning that task
+    // (by the array script, which skips a task marked done) rolls it again.
+    let mut chunks: Vec<_> = walk(&dir.join("checkpoint"))
+        .into_iter()
+        .filter(|p| {
+            p.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("chunk-")
+        })
+        .collect();
+    chunks.sort();
+    assert_eq!(chunks.len(), 4);
+    for chunk in &chunks {
+        let text = std::fs::read_to_string(chunk).unwrap();
+        let bad = text.replacen("{\"settled\":\"breadth\"}", "{\"settled\":\"width\"}", 1);
+        assert_ne!(bad, text);
+        std::fs::write(chunk, bad).unwrap();
+        let refused = finish();
+        assert_eq!(refused.status.code(), Some(1), "{}", stderr(&refused));
+        let e = stderr(&refused);
+        assert!(e.contains(&*chunk.to_string_lossy()), "{e}");
+        let k = e
+            .split("--array=")
+            .nth(1)
+            .and_then(|s| s.split(' ').next())
+            .and_then(|s| s.parse::<u64>().ok())
+            .unwrap_or_else(|| panic!("no task named: {e}"));
+        let rerun = array_task(&dir, k);
+        assert!(
+            !String::from_utf8_lossy(&rerun.stdout).contains("done already"),
+            "the task's mark kept it from rolling the chunk again"
+        );
+        assert_eq!(tallies(&finish()), truth);
+    }
+}
+
+fn walk(dir: &Path) -> Vec<std::path::PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            out.extend(walk(&p));
+        } else {
+            out.push(p);
+        }
+    }
+    out
 }
