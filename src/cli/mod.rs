@@ -192,3 +192,12 @@ pub(crate) use {out, outln};
 pub fn output(path: &std::path::Path) -> error::Result<dicephys::run::io::Output> {
     Ok(dicephys::run::io::Output::check(path)?)
 }
+
+/// This process's command line, to be named in reports (never parsed): its arguments as
+/// given, a byte that is not UTF-8 (in a path, say) shown as U+FFFD rather than a panic.
+pub fn command_line() -> String {
+    std::env::args_os()
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect::<Vec<_>>()
+        .join(" ")
+}

@@ -177,7 +177,7 @@ fn submit_study((cfg, threads, json, given, job): Flags) -> Result<()> {
     // A cluster task takes the threads it asks for; "one per core" means one.
     let threads = threads.max(1);
     super::args::threads(threads)?;
-    let line = std::env::args().collect::<Vec<_>>().join(" ");
+    let line = super::command_line();
     let plan = Plan::Study {
         config: serde_json::to_value(&cfg).map_err(|e| Error::Run(e.to_string()))?,
         json,

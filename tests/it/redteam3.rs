@@ -497,3 +497,39 @@ fn walk(dir: &Path) -> Vec<std::path::PathBuf> {
     }
     out
 }
+
+// Paths that are not UTF-8.
+
+#[test]
+fn a_path_that_is_not_utf8_is_written_to_or_refused_never_a_panic() {
+    use std::os::unix::ffi::OsStrExt;
+    let d = scratch("not-utf8");
+    let name = |s: &[u8]| d.join(std::ffi::OsStr::from_bytes(s));
+    let out_dir = name(b"paper-\xff");
+    let out = bin()
+        .args([
+            "paper",
+            "--rolls",
+            "10",
+            "--engines",
+            "bullet",
+            "--threads",
+            "1",
+            "--out",
+        ])
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(out_dir.join("report.md").exists());
+    // A Slurm run's path goes into its scripts as text: refused, one line, nothing made.
+    let dir = name(b"slurm-\xfe");
+    let out = bin()
+        .args(["slurm", "paper", "--rolls", "10", "--tasks", "2", "--dir"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert_eq!(stderr(&out).lines().count(), 1, "{}", stderr(&out));
+    assert!(!dir.exists());
+}
