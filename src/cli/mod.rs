@@ -133,10 +133,15 @@ pub fn dispatch(command: Command) -> error::Result<()> {
 fn clap_error(e: clap::Error) -> i32 {
     use clap::error::ErrorKind;
     match e.kind() {
-        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
-            let _ = e.print();
-            0
-        }
+        // Written as every output is: a closed pipe ends quietly, a full disk is an error.
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => match stdout(&e.render().to_string())
+        {
+            Ok(()) | Err(Error::Closed) => 0,
+            Err(e) => {
+                eprintln!("dicephys: {e}");
+                e.exit_code()
+            }
+        },
         ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
             let _ = e.print();
             2

@@ -533,3 +533,118 @@ fn a_path_that_is_not_utf8_is_written_to_or_refused_never_a_panic() {
     assert_eq!(stderr(&out).lines().count(), 1, "{}", stderr(&out));
     assert!(!dir.exists());
 }
+
+// Interrupts and floors.
+
+#[test]
+fn validate_stops_on_ctrl_c_in_its_free_flight_stage() {
+    let d = scratch("validate-int");
+    let out = d.join("out");
+    let log = d.join("stderr.txt");
+    let mut child = bin()
+        .args([
+            "validate",
+            "--engines",
+            "bullet",
+            "--blocks-2d",
+            "140x24x20",
+        ])
+        .args([
+            "--blocks-3d",
+            "20x20x20",
+            "--trend",
+            "none",
+            "--rolls",
+            "10",
+        ])
+        .args(["--threads", "1", "--flight-dts", "1e-6", "--out"])
+        .arg(&out)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::fs::File::create(&log).unwrap())
+        .spawn()
+        .unwrap();
+    // The limit cases done (three 3D rows logged), the free flight has begun: 2 s at 1 µs,
+    // two million steps an integrator.
+    let t = std::time::Instant::now();
+    while std::fs::read_to_string(&log)
+        .unwrap_or_default()
+        .matches("3d_quasi_static")
+        .count()
+        < 3
+    {
+        assert!(t.elapsed().as_secs() < 120, "the limit cases never ended");
+        assert!(child.try_wait().unwrap().is_none(), "validate ended early");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let t = std::time::Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if t.elapsed().as_secs() > 5 {
+            let _ = child.kill();
+            panic!("validate ignored Ctrl-C in its free-flight stage");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    assert_eq!(status.code(), Some(130));
+    assert!(
+        !out.join("validate.json").exists(),
+        "a stopped run wrote its outputs"
+    );
+}
+
+#[test]
+fn time_steps_below_the_floor_and_other_endless_values_are_refused() {
+    let cases: [&[&str]; 9] = [
+        &["validate", "--flight-dts", "1e-12"],
+        &["roll", "--block", "140x24x20", "--dt", "1e-9"],
+        &["converge", "--dts", "1/1000,1e-8"],
+        &["stability", "--dts", "1e-7"],
+        &["roll", "--block", "140x24x20", "--density", "1e-300"],
+        &["stability", "--restitutions", "1"],
+        &["tradeoff", "--preroll", "1000000001"],
+        &[
+            "slurm",
+            "stability",
+            "--rolls",
+            "0",
+            "--tasks",
+            "2",
+            "--dir",
+            "/nonexistent/x",
+        ],
+        &["merge", "/dev/zero"],
+    ];
+    for args in cases {
+        let out = bin().args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert_eq!(
+            stderr(&out).lines().count(),
+            1,
+            "{args:?}: {}",
+            stderr(&out)
+        );
+    }
+}
+
+#[test]
+fn help_and_version_into_a_full_stdout_fail() {
+    for arg in ["--help", "--version"] {
+        let out = bin()
+            .arg(arg)
+            .stdout(
+                std::fs::OpenOptions::new()
+                    .write(true)
+                    .open("/dev/full")
+                    .unwrap(),
+            )
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{arg}: {}", stderr(&out));
+    }
+    // Into a pipe it succeeds.
+    let out = bin().arg("--help").output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+}
