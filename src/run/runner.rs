@@ -390,6 +390,7 @@ impl Checkpoint {
                 dir.display()
             ))
         })?;
+        crate::run::owner::check_unowned(dir)?;
         let lock = lock(&dir.join(lock_name))?;
         crate::run::io::clean_temporaries(dir);
         // Written when absent, then read back: tasks of a cluster run that open a new cell at

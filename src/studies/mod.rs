@@ -54,6 +54,34 @@ pub enum StudyConfig {
 }
 
 impl StudyConfig {
+    /// What makes two runs of the study one run, for the directory it owns
+    /// (`run::owner`): its configuration, less what only adds rounds to a study rolled to a
+    /// precision (the precision, the budgets, `plan_only`, `preroll_chunks`, and `rolls`
+    /// where a precision sets them).
+    pub fn identity(&self) -> serde_json::Value {
+        let c = match self {
+            StudyConfig::Tradeoff(t) => StudyConfig::Tradeoff(tradeoff::Config {
+                precision: 0.0,
+                budget_s: 0.0,
+                reference_budget_s: 0.0,
+                plan_only: false,
+                preroll_chunks: None,
+                ..t.clone()
+            }),
+            StudyConfig::Converge(c) if c.precision.is_some() => {
+                StudyConfig::Converge(converge::Config {
+                    precision: Some(0.0),
+                    budget_s: 0.0,
+                    reference_budget_s: 0.0,
+                    rolls: 0,
+                    ..c.clone()
+                })
+            }
+            other => other.clone(),
+        };
+        serde_json::to_value(&c).unwrap_or_default()
+    }
+
     /// The study's name: its command.
     pub fn name(&self) -> &'static str {
         match self {

@@ -237,6 +237,11 @@ fn paper_interrupted_leaves_the_complete_outputs_alone() {
     assert!(full.status.success(), "{}", stderr(&full));
     let before = std::fs::read(d.join("results.json")).unwrap();
     let png = std::fs::read(d.join("prob_2d.png")).unwrap();
+    // The directory is the 20-roll run's: another run is refused there (redteam3), so the
+    // complete outputs are copied into a directory of no run's, and the slow run stopped there.
+    let e = scratch("paper-again");
+    std::fs::write(e.join("results.json"), &before).unwrap();
+    std::fs::write(e.join("prob_2d.png"), &png).unwrap();
     let out = interrupted(
         &[
             "paper",
@@ -245,14 +250,15 @@ fn paper_interrupted_leaves_the_complete_outputs_alone() {
             "--engines",
             "bullet",
             "--out",
-            o,
+            e.to_str().unwrap(),
         ],
         libc::SIGINT,
         1500,
     );
     assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));
-    assert_eq!(std::fs::read(d.join("results.json")).unwrap(), before);
-    assert_eq!(std::fs::read(d.join("prob_2d.png")).unwrap(), png);
+    assert_eq!(std::fs::read(e.join("results.json")).unwrap(), before);
+    assert_eq!(std::fs::read(e.join("prob_2d.png")).unwrap(), png);
+    no_temp_files(&e);
     no_temp_files(&d);
 }
 

@@ -672,3 +672,89 @@ fn bench_stops_on_ctrl_c() {
     };
     assert_eq!(status.code(), Some(130));
 }
+
+// Who owns a directory.
+
+#[test]
+fn a_run_directory_is_refused_to_another_command_and_to_another_run() {
+    let d = scratch("owner");
+    let out = d.join("out");
+    let paper = |rolls: &str| {
+        bin()
+            .args([
+                "paper",
+                "--engines",
+                "bullet",
+                "--threads",
+                "1",
+                "--rolls",
+                rolls,
+            ])
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap()
+    };
+    let first = paper("20");
+    assert_eq!(first.status.code(), Some(0), "{}", stderr(&first));
+    let report = std::fs::read(out.join("report.md")).unwrap();
+    let cells = walk(&out.join("checkpoint"));
+    // Another command's outputs there: refused, nothing replaced.
+    let other = bin()
+        .args(["converge", "--rolls", "5", "--engines", "bullet", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(other.status.code(), Some(2), "{}", stderr(&other));
+    assert!(stderr(&other).contains("`paper`"), "{}", stderr(&other));
+    // The same command with other flags: refused, its cells kept.
+    let again = paper("40");
+    assert_eq!(again.status.code(), Some(2), "{}", stderr(&again));
+    assert_eq!(std::fs::read(out.join("report.md")).unwrap(), report);
+    assert_eq!(
+        walk(&out.join("checkpoint")),
+        cells,
+        "cell checkpoints removed"
+    );
+    // A roll's checkpoint there, and a study into a roll's checkpoint: refused both ways.
+    let roll_ck = bin()
+        .args([
+            "roll",
+            "--block",
+            "140x22x13",
+            "--rolls",
+            "5",
+            "--checkpoint",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(roll_ck.status.code(), Some(2), "{}", stderr(&roll_ck));
+    let ck = d.join("ck");
+    let made = roll(&["--checkpoint", ck.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(made.status.code(), Some(0), "{}", stderr(&made));
+    let into = bin()
+        .args(["stability", "--rolls", "5", "--out"])
+        .arg(&ck)
+        .output()
+        .unwrap();
+    assert_eq!(into.status.code(), Some(2), "{}", stderr(&into));
+    // The same run again continues, whatever its threads.
+    let same = bin()
+        .args([
+            "paper",
+            "--engines",
+            "bullet",
+            "--threads",
+            "2",
+            "--rolls",
+            "20",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(same.status.code(), Some(0), "{}", stderr(&same));
+}
