@@ -5,6 +5,7 @@ pub mod batch;
 pub mod cputime;
 pub mod io;
 pub mod owner;
+pub mod pack;
 pub mod runner;
 pub mod seal;
 pub mod slurm;

@@ -144,10 +144,21 @@ pub struct Rolled {
     pub resumed_wall_s: f64,
 }
 
-/// One chunk file: the run's key, what the chunk cost, and its records.
+/// One chunk file, `chunk-FIRST-LEN.json`: the run's key, what the chunk cost, and its rolls
+/// packed ([`crate::run::pack`], format `rolls-v1`, in base64), under a checksum
+/// ([`crate::run::seal`]). A chunk of the JSON records an older dicephys wrote has no
+/// checksum: it is read as damaged, named, and rolled again.
 #[derive(Serialize, Deserialize)]
 struct ChunkFile {
     key: String,
+    cpu_s: f64,
+    wall_s: f64,
+    format: String,
+    rolls: String,
+}
+
+/// A chunk read back: what it cost, and its records.
+struct Chunked {
     cpu_s: f64,
     wall_s: f64,
     records: Vec<RollRecord>,
@@ -242,7 +253,7 @@ impl<'a> Runner<'a> {
             }
             let assemble = matches!(self.share, ChunkShare::Assemble { .. });
             if let Some(p) = path.as_ref().filter(|p| p.exists()) {
-                match read_chunk(p, &key, &chunk) {
+                match read_chunk(p, &key, &chunk, &throws) {
                     Ok(file) => {
                         done.resumed += file.records.len() as u64;
                         done.resumed_cpu_s += file.cpu_s;
@@ -293,12 +304,13 @@ impl<'a> Runner<'a> {
                     key: key.clone(),
                     cpu_s: process_cpu_seconds() - cpu,
                     wall_s: wall.elapsed().as_secs_f64(),
-                    records: recs,
+                    format: crate::run::pack::FORMAT.into(),
+                    rolls: crate::run::pack::base64(&crate::run::pack::pack(&recs)),
                 };
                 let json = crate::run::seal::to_string(&file, false)?;
                 write_atomic(p, json.as_bytes())?;
-                file.records.iter().try_for_each(|r| done.tally.add(r))?;
-                sink(&file.records)?;
+                recs.iter().try_for_each(|r| done.tally.add(r))?;
+                sink(&recs)?;
             } else {
                 recs.iter().try_for_each(|r| done.tally.add(r))?;
                 sink(&recs)?;
@@ -322,7 +334,12 @@ enum Chunk {
 
 /// The chunk at `p` of the run keyed `key`, holding the throws `chunk`: its checksum checked
 /// ([`crate::run::seal`]), then its key and throws.
-fn read_chunk(p: &Path, key: &str, chunk: &[u64]) -> std::result::Result<ChunkFile, Chunk> {
+fn read_chunk(
+    p: &Path,
+    key: &str,
+    chunk: &[u64],
+    throws: &crate::model::throws::Throws,
+) -> std::result::Result<Chunked, Chunk> {
     use crate::run::seal::{open, Broken};
     let text = match std::fs::read(p) {
         Ok(b) => String::from_utf8(b).map_err(|_| Chunk::Damaged("damaged: not UTF-8".into()))?,
@@ -342,19 +359,22 @@ fn read_chunk(p: &Path, key: &str, chunk: &[u64]) -> std::result::Result<ChunkFi
             file.key
         ))));
     }
-    let ok = file.records.len() == chunk.len()
-        && file
-            .records
-            .iter()
-            .zip(chunk)
-            .all(|(r, &i)| r.throw.index == i);
-    if !ok {
-        return Err(Chunk::Refused(Error::Mismatch(format!(
-            "{}: its throws are not this chunk's",
-            p.display()
-        ))));
+    let refuse = |why: String| Chunk::Refused(Error::Mismatch(format!("{}: {why}", p.display())));
+    if file.format != crate::run::pack::FORMAT {
+        return Err(refuse(format!(
+            "format {:?}, not {:?} (a newer dicephys's?)",
+            file.format,
+            crate::run::pack::FORMAT
+        )));
     }
-    Ok(file)
+    let records = crate::run::pack::unbase64(&file.rolls)
+        .and_then(|b| crate::run::pack::unpack(&b, chunk, throws))
+        .map_err(|e| refuse(format!("its rolls are not this chunk's ({e})")))?;
+    Ok(Chunked {
+        cpu_s: file.cpu_s,
+        wall_s: file.wall_s,
+        records,
+    })
 }
 
 /// A checkpoint directory, held by one run at a time: `spec.json` names the run, `lock` its

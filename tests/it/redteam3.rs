@@ -321,14 +321,12 @@ fn a_damaged_chunk_is_named_and_rolled_again_on_resume() {
     flipped[good.len() / 2] ^= 0x04;
     let damages: [(&str, Vec<u8>); 4] = [
         (
-            "an outcome edited, still JSON",
-            text.replacen("{\"settled\":\"breadth\"}", "{\"settled\":\"width\"}", 1)
-                .into_bytes(),
+            "a roll edited, still JSON and base64",
+            edit_rolls(&text).into_bytes(),
         ),
         (
             "a field renamed",
-            text.replacen("\"energy_gain\"", "\"energy_gained\"", 1)
-                .into_bytes(),
+            text.replacen("\"wall_s\"", "\"wall_t\"", 1).into_bytes(),
         ),
         ("a bit flipped", flipped),
         (
@@ -353,6 +351,15 @@ fn a_damaged_chunk_is_named_and_rolled_again_on_resume() {
         assert_eq!(tally_of(&again), truth);
         assert!(!stderr(&again).contains("damaged"), "{}", stderr(&again));
     }
+}
+
+/// A chunk's text with one character of its packed rolls changed for another base64 one: the
+/// file is still JSON and its rolls still base64.
+fn edit_rolls(text: &str) -> String {
+    let at = text.find("\"rolls\":\"").expect("packed rolls") + 9 + 12;
+    let c = text.as_bytes()[at];
+    let to = if c == b'A' { "B" } else { "A" };
+    format!("{}{to}{}", &text[..at], &text[at + 1..])
 }
 
 /// Runs task `k` of the array script in `dir` as Slurm would.
@@ -448,8 +455,9 @@ fn slurm_finish_names_a_damaged_study_chunk_and_rerunning_its_task_replaces_it()
         [v["runs"][0]["tally"].clone(), v["runs"][1]["tally"].clone()]
     };
     let truth = tallies(&first);
-    // Damage every chunk in turn: finish names it and its task, and rerunning that task
-    // (by the array script, which skips a task marked done) rolls it again.
+    // Damage a chunk of each task in turn (the first and the last of the four): finish names
+    // it and its task, and rerunning that task (by the array script, which skips a task
+    // marked done) rolls it again.
     let mut chunks: Vec<_> = walk(&dir.join("checkpoint"))
         .into_iter()
         .filter(|p| {
@@ -461,9 +469,9 @@ fn slurm_finish_names_a_damaged_study_chunk_and_rerunning_its_task_replaces_it()
         .collect();
     chunks.sort();
     assert_eq!(chunks.len(), 4);
-    for chunk in &chunks {
+    for chunk in [&chunks[0], &chunks[3]] {
         let text = std::fs::read_to_string(chunk).unwrap();
-        let bad = text.replacen("{\"settled\":\"breadth\"}", "{\"settled\":\"width\"}", 1);
+        let bad = edit_rolls(&text);
         assert_ne!(bad, text);
         std::fs::write(chunk, bad).unwrap();
         let refused = finish();
@@ -650,9 +658,26 @@ fn help_and_version_into_a_full_stdout_fail() {
 }
 
 #[test]
-fn bench_stops_on_ctrl_c() {
+fn bench_and_trace_stop_on_ctrl_c() {
+    for args in [
+        &["bench", "--rolls", "100000", "--threads", "1"][..],
+        &[
+            "trace",
+            "--block",
+            "140x24x20",
+            "--dt",
+            "1e-6",
+            "--max-steps",
+            "20000000",
+        ][..],
+    ] {
+        stops_on_ctrl_c(args);
+    }
+}
+
+fn stops_on_ctrl_c(args: &[&str]) {
     let mut child = bin()
-        .args(["bench", "--rolls", "100000", "--threads", "1"])
+        .args(args)
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::null())
         .spawn()
@@ -666,11 +691,11 @@ fn bench_stops_on_ctrl_c() {
         }
         if t.elapsed().as_secs() > 5 {
             let _ = child.kill();
-            panic!("bench ignored Ctrl-C");
+            panic!("{args:?} ignored Ctrl-C");
         }
         std::thread::sleep(std::time::Duration::from_millis(20));
     };
-    assert_eq!(status.code(), Some(130));
+    assert_eq!(status.code(), Some(130), "{args:?}");
 }
 
 // Who owns a directory.
@@ -757,4 +782,29 @@ fn a_run_directory_is_refused_to_another_command_and_to_another_run() {
         .output()
         .unwrap();
     assert_eq!(same.status.code(), Some(0), "{}", stderr(&same));
+}
+
+#[test]
+fn a_chunk_takes_at_most_32_bytes_a_roll() {
+    let d = scratch("compact");
+    for (name, extra) in [("2d", &["--2d"][..]), ("3d", &[][..])] {
+        let ck = d.join(name);
+        let out = bin()
+            .args([
+                "roll",
+                "--block",
+                "140x22x13",
+                "--rolls",
+                "1000",
+                "--checkpoint",
+            ])
+            .arg(&ck)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+        let chunk = ck.join("chunk-000000000000-1000.json");
+        let bytes = std::fs::metadata(&chunk).unwrap().len();
+        assert!(bytes <= 32 * 1000, "{name}: {bytes} bytes for 1000 rolls");
+    }
 }
