@@ -183,7 +183,7 @@ pub fn base64(bytes: &[u8]) -> String {
 /// The bytes of standard base64 `s` (padded), or why not.
 pub fn unbase64(s: &str) -> Result<Vec<u8>, String> {
     let b = s.as_bytes();
-    if b.len() % 4 != 0 {
+    if !b.len().is_multiple_of(4) {
         return Err("base64 of a length not a multiple of 4".into());
     }
     let val = |c: u8| -> Result<u32, String> {

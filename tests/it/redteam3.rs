@@ -625,8 +625,23 @@ fn time_steps_below_the_floor_and_other_endless_values_are_refused() {
         ],
         &["merge", "/dev/zero"],
     ];
+    // Run in a scratch directory, each given a minute: a value let through may never end.
+    let d = scratch("floors");
     for args in cases {
-        let out = bin().args(args).output().unwrap();
+        let child = bin()
+            .args(args)
+            .current_dir(&*d)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let id = child.id();
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || tx.send(child.wait_with_output().unwrap()));
+        let Ok(out) = rx.recv_timeout(std::time::Duration::from_secs(60)) else {
+            unsafe { libc::kill(id as i32, libc::SIGKILL) };
+            panic!("{args:?}: accepted, and still running after a minute");
+        };
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
         assert_eq!(
             stderr(&out).lines().count(),

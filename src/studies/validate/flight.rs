@@ -94,7 +94,7 @@ pub fn fly_until(
     spin: f64,
     stop: &Stop,
 ) -> Result<FlightRun> {
-    let stopped = |i: u64| i % STOP_EVERY == 0 && stop.requested();
+    let stopped = |i: u64| i.is_multiple_of(STOP_EVERY) && stop.requested();
     let preset = match integrator {
         Integrator::BulletGyroscopic => Preset::Bullet3,
         _ => Preset::Dicephys281,
