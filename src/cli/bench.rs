@@ -43,7 +43,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     }
     // A progress line that cannot be written (a closed pipe) is dropped; the result is
     // written, or its failure reported, at the end.
-    let b = bench::run(a.rolls, a.seed, threads, a.repeat, &|line| {
+    let b = bench::run(a.rolls, a.seed, threads, a.repeat, super::stop(), &|line| {
         if !quiet {
             let _ = super::stdout(&format!("{line}\n"));
         }

@@ -22,11 +22,10 @@ pub struct MergeArgs {
 pub fn run(a: &MergeArgs) -> Result<()> {
     let mut parts = Vec::new();
     for f in &a.files {
-        let text = std::fs::read_to_string(f)
-            .map_err(|e| Error::Usage(format!("merge: {}: {e}", f.display())))?;
-        let s: ShardResult = serde_json::from_str(&text).map_err(|e| {
+        let text = read_small(f)?;
+        let s: ShardResult = dicephys::run::seal::open(&text).map_err(|e| {
             Error::Usage(format!(
-                "merge: {}: not a `roll --json` output ({e})",
+                "merge: {}: not a whole `roll --json` output: {e}",
                 f.display()
             ))
         })?;
@@ -34,12 +33,38 @@ pub fn run(a: &MergeArgs) -> Result<()> {
     }
     let out = RunSummary::merge(&parts)?;
     if a.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&out).map_err(|e| Error::Run(e.to_string()))?
-        );
+        outln!("{}", dicephys::run::seal::to_string(&out, true)?);
     } else {
         out!("{}", out.human());
     }
     Ok(())
+}
+
+/// The most a shard's `roll --json` output is read of: it is a few kilobytes.
+const MAX_SHARD_BYTES: u64 = 16 << 20;
+
+/// The text of `f`, read no further than [`MAX_SHARD_BYTES`] (a file larger than that is not
+/// a shard, and is refused without being read whole).
+fn read_small(f: &std::path::Path) -> Result<String> {
+    use std::io::Read;
+    let bad = |e: std::io::Error| Error::Usage(format!("merge: {}: {e}", f.display()));
+    let mut bytes = Vec::new();
+    std::fs::File::open(f)
+        .map_err(bad)?
+        .take(MAX_SHARD_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(bad)?;
+    if bytes.len() as u64 > MAX_SHARD_BYTES {
+        return Err(Error::Usage(format!(
+            "merge: {}: larger than {} MiB, not a `roll --json` output",
+            f.display(),
+            MAX_SHARD_BYTES >> 20
+        )));
+    }
+    String::from_utf8(bytes).map_err(|_| {
+        Error::Usage(format!(
+            "merge: {}: not UTF-8, not a `roll --json` output",
+            f.display()
+        ))
+    })
 }

@@ -141,10 +141,15 @@ pub fn dispatch(command: Command) -> error::Result<()> {
 fn clap_error(e: clap::Error) -> i32 {
     use clap::error::ErrorKind;
     match e.kind() {
-        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
-            let _ = e.print();
-            0
-        }
+        // Written as every output is: a closed pipe ends quietly, a full disk is an error.
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => match stdout(&e.render().to_string())
+        {
+            Ok(()) | Err(Error::Closed) => 0,
+            Err(e) => {
+                eprintln!("dicephys: {e}");
+                e.exit_code()
+            }
+        },
         ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
             let _ = e.print();
             2
@@ -199,4 +204,13 @@ pub(crate) use {out, outln};
 /// Checks an output path before anything runs (exit 2 if it cannot be written).
 pub fn output(path: &std::path::Path) -> error::Result<dicephys::run::io::Output> {
     Ok(dicephys::run::io::Output::check(path)?)
+}
+
+/// This process's command line, to be named in reports (never parsed): its arguments as
+/// given, a byte that is not UTF-8 (in a path, say) shown as U+FFFD rather than a panic.
+pub fn command_line() -> String {
+    std::env::args_os()
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect::<Vec<_>>()
+        .join(" ")
 }

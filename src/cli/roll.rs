@@ -124,10 +124,7 @@ pub fn run(a: &RollArgs) -> Result<()> {
     )?;
     let rolled = summary.rolls;
     if a.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&summary).map_err(|e| Error::Run(e.to_string()))?
-        );
+        outln!("{}", dicephys::run::seal::to_string(&summary, true)?);
     } else {
         out!("{}", summary.human());
     }

@@ -184,7 +184,7 @@ fn submit_study((cfg, threads, json, given, job): Flags) -> Result<()> {
     // A cluster task takes the threads it asks for; "one per core" means one.
     let threads = threads.max(1);
     super::args::threads(threads)?;
-    let line = std::env::args().collect::<Vec<_>>().join(" ");
+    let line = super::command_line();
     let plan = Plan::Study {
         config: serde_json::to_value(&cfg).map_err(|e| Error::Run(e.to_string()))?,
         json,
@@ -297,8 +297,16 @@ fn prepare(
             .and_then(|p| p.canonicalize())
             .map_err(|e| Error::Run(format!("cannot find this binary's path ({e})")))?,
     };
+    dicephys::run::slurm::script_path("bin", &bin)?;
+    // A run refused by its dry run leaves no directory behind that this call made.
+    let made = !job.dir.exists();
     let lay = Layout::create(&job.dir)?;
-    check(&lay)?;
+    if let Err(e) = check(&lay) {
+        if made {
+            let _ = std::fs::remove_dir_all(&lay.dir);
+        }
+        return Err(e);
+    }
     lay.store(plan).map_err(|e| match e {
         dicephys::Error::Mismatch(m) => Error::Usage(format!("--dir {m}")),
         e => e.into(),
@@ -367,8 +375,27 @@ fn finish(dir: &Path) -> Result<()> {
             // Every chunk is on disk: the study reads them all and rolls none (but tradeoff,
             // whose tasks rolled ahead, runs here, rolling on where a method needs more).
             let (cfg, place, _) = outputs::planned(&lay)?;
-            let (cfg, share) = cfg.finishing();
-            study::run(&cfg, &Place { share, ..place })?;
+            let (cfg, share) = cfg.finishing(*tasks);
+            let ran = study::run(
+                &cfg,
+                &Place {
+                    share: share.clone(),
+                    ..place
+                },
+            );
+            // A chunk missing or damaged after its task's mark: the mark goes, so that the
+            // task, rerun, rolls it again (a damaged chunk is rolled again and replaced).
+            if let (Err(_), Some((k, why))) = (&ran, share.lacking()) {
+                let mark = lay.task_done(k);
+                if let Err(e) = std::fs::remove_file(&mark) {
+                    if e.kind() != std::io::ErrorKind::NotFound {
+                        return Err(Error::Run(format!("{}: {e}", mark.display())));
+                    }
+                }
+                let why = format!("{why}; its mark {} removed", mark.display());
+                return Err(lay.not_finished(*tasks, &[k.to_string()], &why).into());
+            }
+            ran?;
         }
         Plan::Roll { spec, tasks } => {
             let text = RunSummary::merge_tasks(&lay, spec, *tasks)?;

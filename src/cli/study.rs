@@ -19,7 +19,7 @@ pub fn local(out: &Path, threads: usize, json: bool) -> Result<Place> {
         threads: super::args::threads(threads)?,
         share: ChunkShare::All,
         json,
-        command_line: std::env::args().collect::<Vec<_>>().join(" "),
+        command_line: super::command_line(),
     })
 }
 

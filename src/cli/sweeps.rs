@@ -209,8 +209,13 @@ impl ConvergeArgs {
 impl TradeoffArgs {
     /// The study's configuration.
     pub fn config(&self) -> Result<tradeoff::Config> {
-        if self.preroll == Some(0) {
-            return Err(Error::Usage("--preroll 0: give at least 1 roll".into()));
+        if let Some(r) = self.preroll {
+            let max = dicephys::run::spec::MAX_ROLLS;
+            if r == 0 || r > max {
+                return Err(Error::Usage(format!(
+                    "--preroll {r}: must be in 1..={max} rolls"
+                )));
+            }
         }
         let blocks = if self.blocks.is_empty() {
             vec![self.block]

@@ -66,6 +66,13 @@ pub fn run(a: &TraceArgs) -> Result<()> {
         ..RollConfig::default()
     };
     let record = roll_observed(engine.as_mut(), &scene, &throw, &settle, |step, s| {
+        // A roll cannot be stopped from its observer: a stop request ends the process here,
+        // the rows so far written, as every command stops (exit 130).
+        if step.is_multiple_of(1024) && super::stop().requested() {
+            let _ = out.flush();
+            eprintln!("dicephys: interrupted at step {step}; the rows up to it are written");
+            std::process::exit(130);
+        }
         let l = line(step, s);
         if step % a.every == 0 {
             if failed.is_none() {

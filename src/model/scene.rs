@@ -167,6 +167,31 @@ fn yes() -> bool {
 /// 30/s, 1 − d = 9.4e-14 is held to 6e-4 of itself: the rate to 2e-5.
 pub const MAX_DAMPING: f64 = 30.0;
 
+/// The finest time step accepted, s: 1 µs. A roll at rest by DicePhys's rule takes about a
+/// second of simulated time, a million steps here; finer steps only multiply the work (a
+/// 1e-12 s step would never end) and lose the motion to rounding in the position update.
+pub const MIN_DT: f64 = 1e-6;
+
+/// The coarsest time step accepted, s.
+pub const MAX_DT: f64 = 0.1;
+
+/// The lightest die accepted, kg/m³ (foam is about 10): far lighter, the mass and inertia
+/// underflow and every roll ends non-finite.
+pub const MIN_DENSITY: f64 = 1.0;
+
+/// Checks a time step `dt` given as `field`: in [`MIN_DT`], [`MAX_DT`] s.
+pub fn check_dt(field: &'static str, dt: f64) -> Result<()> {
+    if dt.is_finite() && (MIN_DT..=MAX_DT).contains(&dt) {
+        Ok(())
+    } else {
+        Err(Error::field(
+            field,
+            dt,
+            format!("must be in [{MIN_DT}, {MAX_DT}] s"),
+        ))
+    }
+}
+
 /// DicePhys's floor box is 100 m thick, its top face at y = 0.
 pub const DICEPHYS_FLOOR_THICKNESS: f64 = 100.0;
 
@@ -175,9 +200,7 @@ impl Scene {
     /// accepted (up to 10) only for engine-stability studies that ask for it.
     pub fn validate(&self, allow_restitution_above_one: bool) -> Result<()> {
         let bad = |field, v: f64, why: String| Err(Error::field(field, v, why));
-        if !(self.dt.is_finite() && self.dt > 0.0 && self.dt <= 0.1) {
-            return bad("dt", self.dt, "must be in (0, 0.1] s".into());
-        }
+        check_dt("dt", self.dt)?;
         if !(self.friction.is_finite() && self.friction >= 0.0) {
             return bad("friction", self.friction, "must be finite and >= 0".into());
         }
@@ -202,11 +225,11 @@ impl Scene {
                 "must be in [0.001, 100] m".into(),
             );
         }
-        if !(self.density.is_finite() && self.density > 0.0 && self.density <= 1e5) {
+        if !(self.density.is_finite() && (MIN_DENSITY..=1e5).contains(&self.density)) {
             return bad(
                 "density",
                 self.density,
-                "must be in (0, 100000] kg/m³".into(),
+                format!("must be in [{MIN_DENSITY}, 100000] kg/m³"),
             );
         }
         for (name, v) in [

@@ -354,11 +354,18 @@ impl RunSummary {
     pub fn merge_tasks(lay: &Layout, spec: &RunSpec, tasks: u64) -> crate::Result<String> {
         let (mut parts, mut missing, mut why) = (Vec::new(), Vec::new(), Vec::new());
         for k in 0..tasks {
-            match ShardResult::read(&lay.shard_result(k), &Plan::shard_spec(spec, k, tasks)) {
+            let p = lay.shard_result(k);
+            match ShardResult::read(&p, &Plan::shard_spec(spec, k, tasks)) {
                 Ok(s) => parts.push(s),
                 Err(e) => {
                     missing.push(k.to_string());
-                    why.push(e);
+                    // A result there but not usable is moved aside, so that the task, rerun,
+                    // writes it again rather than finding it there already.
+                    let aside = p.with_extension("json.damaged");
+                    why.push(match p.exists() && std::fs::rename(&p, &aside).is_ok() {
+                        true => format!("{e}; moved to {}", aside.display()),
+                        false => e,
+                    });
                 }
             }
         }
@@ -366,8 +373,7 @@ impl RunSummary {
             return Err(lay.not_finished(tasks, &missing, &why.join("; ")));
         }
         let merged = RunSummary::merge(&parts)?;
-        let json = serde_json::to_string_pretty(&merged)
-            .map_err(|e| crate::Error::Failed(e.to_string()))?;
+        let json = crate::run::seal::to_string(&merged, true)?;
         let text = merged.human();
         let (j, t) = (
             Output::check(&lay.result_json())?,
@@ -383,9 +389,12 @@ impl ShardResult {
     /// A shard's `roll --json` output from `p`, if it is there, whole, and of the run `want`;
     /// else why not.
     pub fn read(p: &std::path::Path, want: &RunSpec) -> std::result::Result<ShardResult, String> {
-        let text = std::fs::read_to_string(p).map_err(|_| format!("no {}", p.display()))?;
+        let text = std::fs::read_to_string(p).map_err(|e| match e.kind() {
+            std::io::ErrorKind::NotFound => format!("no {}", p.display()),
+            _ => format!("{}: {e}", p.display()),
+        })?;
         let s: ShardResult =
-            serde_json::from_str(&text).map_err(|e| format!("{} is damaged: {e}", p.display()))?;
+            crate::run::seal::open(&text).map_err(|e| format!("{}: {e}", p.display()))?;
         if s.spec != *want {
             return Err(format!("{} is of another run", p.display()));
         }
@@ -440,7 +449,7 @@ impl RunSummary {
                 )));
             }
             seen[s.k as usize] = true;
-            tally.merge(&p.tally);
+            tally.merge(&p.tally)?;
             wall += p.wall_s;
             cpu += p.cpu_s;
         }

@@ -2,16 +2,37 @@
 //! all, is checked before a run starts, and never replaces what is not a regular file.
 //!
 //! * A regular file (or a new one) is written to a temporary file beside it, synced to disk,
-//!   then renamed over it: a reader, a crash or a full disk never sees half of it.
-//! * A symbolic link is followed: its target is written, and the link stays a link.
-//! * A character device or a FIFO (`/dev/stdout`, a pipe) is written in place: there is
-//!   nothing to rename over, and replacing it would destroy it.
+//!   then renamed over it: a reader, a crash or a full disk never sees half of it. The new
+//!   file has the mode a new file gets here (0666 less the umask), or the mode of the file it
+//!   replaces.
+//! * A symbolic link is followed: its target is written, and the link stays a link. A loop of
+//!   links is refused.
+//! * A character device or a FIFO (`/dev/null`, a pipe) is written in place: there is nothing
+//!   to rename over, and replacing it would destroy it. The process's own standard output or
+//!   error (`/dev/stdout`, whether a terminal, a pipe or a redirected file) is written through
+//!   the stream itself, so that what the command prints there after it follows it.
 //! * A directory is refused when the output is checked, before anything runs.
+//!
+//! A temporary file is named `.STEM.RANDOM.dicephys.tmp` (the stem cut short, so that the name
+//! fits in 255 bytes however long the output's), and locked while it is written. One that a
+//! killed run left behind is removed by the next run that checks an output, or opens a
+//! checkpoint, in that directory.
 
 use crate::error::{Error, Result};
+use std::ffi::OsStr;
 use std::fs::File;
 use std::io::{BufWriter, Write};
+use std::os::unix::ffi::OsStrExt;
+use std::os::unix::fs::{MetadataExt, PermissionsExt};
 use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+/// How every temporary file of ours ends.
+pub const TEMP_SUFFIX: &str = ".dicephys.tmp";
+
+/// A leftover temporary file is removed once it is unlocked and this old: a file is locked
+/// within moments of its creation, so a younger one may be another run's, just made.
+const TEMP_STALE: Duration = Duration::from_secs(60);
 
 /// An output path, checked: where the bytes will go and how.
 #[derive(Clone, Debug)]
@@ -20,58 +41,68 @@ pub struct Output {
     pub path: PathBuf,
     /// Where the bytes go: the path, or the end of its chain of links.
     target: PathBuf,
-    /// Written in place (a device or a FIFO), not through a temporary file and a rename.
-    in_place: bool,
+    /// How they go there.
+    how: How,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum How {
+    /// A temporary file beside the target, renamed over it.
+    Replace,
+    /// Opened and written in place (a device or a FIFO).
+    InPlace,
+    /// Through this process's standard output (1) or error (2), which the path names.
+    Stream(i32),
 }
 
 impl Output {
     /// Checks that `path` can be written, before any work is done: its directory exists and
-    /// takes a new file, and it is not a directory.
+    /// takes a new file, it is not a directory, and links lead somewhere. Removes the
+    /// temporary files a killed run left in its directory.
     pub fn check(path: &Path) -> Result<Output> {
         let bad = |why: String| Error::Invalid(format!("{}: {why}", path.display()));
-        // Follow links to the file they name (which may not exist yet).
-        let mut target = path.to_path_buf();
-        for _ in 0..40 {
-            match std::fs::symlink_metadata(&target) {
-                Ok(m) if m.file_type().is_symlink() => {
-                    let link = std::fs::read_link(&target).map_err(|e| bad(e.to_string()))?;
-                    target = match target.parent() {
-                        Some(dir) => dir.join(link),
-                        None => link,
-                    };
-                }
-                _ => break,
-            }
-        }
-        match std::fs::metadata(&target) {
+        let out = |target: PathBuf, how| Output {
+            path: path.to_path_buf(),
+            target,
+            how,
+        };
+        // What the path names, links followed by the system (so `/dev/stdout` is found to be
+        // this process's pipe, terminal or file).
+        match std::fs::metadata(path) {
             Ok(m) if m.is_dir() => return Err(bad("is a directory".into())),
-            Ok(m) if !m.is_file() => {
-                // A device or a FIFO: it must be writable. Not opened to find out: opening a
-                // FIFO waits for its reader, and closing it again ends the reader's input.
-                if !writable(&target) {
-                    return Err(bad("cannot write there (permission denied)".into()));
+            Ok(m) => {
+                if let Some(fd) = standard_stream(&m) {
+                    return Ok(out(path.to_path_buf(), How::Stream(fd)));
                 }
-                return Ok(Output {
-                    path: path.to_path_buf(),
-                    target,
-                    in_place: true,
-                });
+                if !m.is_file() {
+                    // A device or a FIFO: it must be writable. Not opened to find out: opening
+                    // a FIFO waits for its reader, and closing it again ends the reader's input.
+                    if !access(path, libc::W_OK) {
+                        return Err(bad("cannot write there (permission denied)".into()));
+                    }
+                    return Ok(out(path.to_path_buf(), How::InPlace));
+                }
             }
-            _ => {}
+            Err(e) if e.raw_os_error() == Some(libc::ELOOP) => {
+                return Err(bad("a loop of symbolic links".into()))
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(bad(e.to_string())),
         }
+        let target = end_of_links(path).map_err(bad)?;
         let dir = parent(&target);
         if !dir.is_dir() {
             return Err(bad(format!("directory {} does not exist", dir.display())));
         }
-        tempfile::Builder::new()
-            .prefix(".dicephys-probe-")
-            .tempfile_in(dir)
-            .map_err(|e| bad(format!("cannot write there ({e})")))?;
-        Ok(Output {
-            path: path.to_path_buf(),
-            target,
-            in_place: false,
-        })
+        if !access(dir, libc::W_OK | libc::X_OK) {
+            return Err(bad(format!(
+                "cannot write there ({}: {})",
+                dir.display(),
+                std::io::Error::last_os_error()
+            )));
+        }
+        clean_temporaries(dir);
+        Ok(out(target, How::Replace))
     }
 
     /// Writes `bytes` as the whole file.
@@ -84,25 +115,63 @@ impl Output {
     /// A writer that grows the file and puts it in place at `commit`; dropped without a
     /// commit, it leaves the old file (and no temporary file) behind.
     pub fn writer(&self) -> Result<OutputWriter> {
-        let inner = if self.in_place {
-            let f = std::fs::OpenOptions::new()
-                .write(true)
-                .open(&self.target)
-                .map_err(|e| Error::io(&self.path, e))?;
-            Inner::InPlace(BufWriter::new(f))
-        } else {
-            let tmp = tempfile::Builder::new()
-                .prefix(&format!(".{}.", file_name(&self.target)))
-                .suffix(".tmp")
-                .tempfile_in(parent(&self.target))
-                .map_err(|e| Error::io(&self.path, e))?;
-            Inner::Temp(BufWriter::new(tmp))
+        let io = |e| Error::io(&self.path, e);
+        let inner = match self.how {
+            How::Stream(fd) => {
+                use std::os::fd::AsFd;
+                let dup = match fd {
+                    1 => std::io::stdout().as_fd().try_clone_to_owned(),
+                    _ => std::io::stderr().as_fd().try_clone_to_owned(),
+                };
+                Inner::InPlace(BufWriter::new(File::from(dup.map_err(io)?)))
+            }
+            How::InPlace => {
+                let f = std::fs::OpenOptions::new()
+                    .write(true)
+                    .open(&self.target)
+                    .map_err(io)?;
+                Inner::InPlace(BufWriter::new(f))
+            }
+            How::Replace => Inner::Temp(BufWriter::new(temporary(&self.target).map_err(io)?)),
         };
         Ok(OutputWriter {
             out: self.clone(),
             inner,
         })
     }
+}
+
+/// The standard stream (1 or 2) that is the very file `m` describes, if any.
+fn standard_stream(m: &std::fs::Metadata) -> Option<i32> {
+    use std::os::fd::AsFd;
+    let same = |f: std::os::fd::BorrowedFd| {
+        File::from(f.try_clone_to_owned().ok()?)
+            .metadata()
+            .ok()
+            .filter(|s| s.dev() == m.dev() && s.ino() == m.ino())
+    };
+    if same(std::io::stdout().as_fd()).is_some() {
+        Some(1)
+    } else if same(std::io::stderr().as_fd()).is_some() {
+        Some(2)
+    } else {
+        None
+    }
+}
+
+/// Where a path's chain of symbolic links ends (a file that may not exist yet).
+fn end_of_links(path: &Path) -> std::result::Result<PathBuf, String> {
+    let mut target = path.to_path_buf();
+    for _ in 0..40 {
+        match std::fs::symlink_metadata(&target) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let link = std::fs::read_link(&target).map_err(|e| e.to_string())?;
+                target = parent(&target).join(link);
+            }
+            _ => return Ok(target),
+        }
+    }
+    Err("a loop of symbolic links".into())
 }
 
 enum Inner {
@@ -143,10 +212,7 @@ impl OutputWriter {
             }
             Inner::Temp(w) => {
                 let tmp = w.into_inner().map_err(|e| io(e.into_error()))?;
-                tmp.as_file().sync_all().map_err(io)?;
-                tmp.persist(&self.out.target).map_err(|e| io(e.error))?;
-                sync_dir(parent(&self.out.target));
-                Ok(())
+                put_in_place(tmp, &self.out.target).map_err(io)
             }
         }
     }
@@ -155,16 +221,70 @@ impl OutputWriter {
 /// Writes a whole file or nothing, for files dicephys owns (checkpoints, figures): a synced
 /// temporary file beside it, renamed over it.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let mut tmp = tempfile::Builder::new()
-        .prefix(&format!(".{}.", file_name(path)))
-        .suffix(".tmp")
-        .tempfile_in(parent(path))
-        .map_err(|e| Error::io(path, e))?;
-    tmp.write_all(bytes).map_err(|e| Error::io(path, e))?;
-    tmp.as_file().sync_all().map_err(|e| Error::io(path, e))?;
-    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
-    sync_dir(parent(path));
+    let io = |e| Error::io(path, e);
+    let mut tmp = temporary(path).map_err(io)?;
+    tmp.write_all(bytes).map_err(io)?;
+    put_in_place(tmp, path).map_err(io)
+}
+
+/// A new temporary file beside `target`, locked, with the mode `target` will have: its
+/// current one if it exists, else 0666 less the umask.
+fn temporary(target: &Path) -> std::io::Result<tempfile::NamedTempFile> {
+    let name = target.file_name().map_or(&b"out"[..], OsStr::as_bytes);
+    let stem = &name[..name.len().min(40)];
+    let mut prefix = b".".to_vec();
+    prefix.extend_from_slice(stem);
+    prefix.push(b'.');
+    let tmp = tempfile::Builder::new()
+        .prefix(OsStr::from_bytes(&prefix))
+        .suffix(TEMP_SUFFIX)
+        .permissions(std::fs::Permissions::from_mode(0o666))
+        .tempfile_in(parent(target))?;
+    // Held until the file is renamed or removed; a file system without locks leaves it
+    // unlocked, and then no later run removes it (see `clean_temporaries`).
+    let _ = tmp.as_file().try_lock();
+    if let Ok(m) = std::fs::metadata(target) {
+        if m.is_file() {
+            let mode = m.permissions().mode() & 0o7777;
+            tmp.as_file()
+                .set_permissions(std::fs::Permissions::from_mode(mode))?;
+        }
+    }
+    Ok(tmp)
+}
+
+/// Syncs `tmp` and renames it over `target`.
+fn put_in_place(tmp: tempfile::NamedTempFile, target: &Path) -> std::io::Result<()> {
+    tmp.as_file().sync_all()?;
+    tmp.persist(target).map_err(|e| e.error)?;
+    sync_dir(parent(target));
     Ok(())
+}
+
+/// Removes the temporary files of ours in `dir` that a killed run left: those no process
+/// holds locked, older than `TEMP_STALE`. Best effort: what cannot be read is left.
+pub fn clean_temporaries(dir: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let name = name.as_bytes();
+        if !(name.starts_with(b".") && name.ends_with(TEMP_SUFFIX.as_bytes())) {
+            continue;
+        }
+        let path = e.path();
+        let Ok(f) = File::open(&path) else { continue };
+        let old = f
+            .metadata()
+            .and_then(|m| m.modified())
+            .ok()
+            .and_then(|t| t.elapsed().ok())
+            .is_some_and(|age| age >= TEMP_STALE);
+        if old && f.try_lock().is_ok() {
+            let _ = std::fs::remove_file(&path);
+        }
+    }
 }
 
 /// Makes a rename in `dir` durable (best effort: not every file system syncs directories).
@@ -174,14 +294,13 @@ fn sync_dir(dir: &Path) {
     }
 }
 
-/// access(2) with W_OK: may this process write to `path`?
-fn writable(path: &Path) -> bool {
-    use std::os::unix::ffi::OsStrExt;
+/// access(2): may this process do `mode` (W_OK, X_OK) to `path`?
+fn access(path: &Path, mode: i32) -> bool {
     let Ok(c) = std::ffi::CString::new(path.as_os_str().as_bytes()) else {
         return false;
     };
     // SAFETY: `c` is a valid NUL-terminated path that outlives the call.
-    unsafe { libc::access(c.as_ptr(), libc::W_OK) == 0 }
+    unsafe { libc::access(c.as_ptr(), mode) == 0 }
 }
 
 fn parent(path: &Path) -> &Path {
@@ -189,10 +308,4 @@ fn parent(path: &Path) -> &Path {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     }
-}
-
-fn file_name(path: &Path) -> String {
-    path.file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into())
 }

@@ -4,7 +4,10 @@
 pub mod batch;
 pub mod cputime;
 pub mod io;
+pub mod owner;
+pub mod pack;
 pub mod runner;
+pub mod seal;
 pub mod slurm;
 pub mod spec;
 pub mod stop;

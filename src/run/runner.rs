@@ -56,8 +56,17 @@ pub enum ChunkShare {
         /// Chunks met so far.
         met: Arc<AtomicU64>,
     },
-    /// Roll nothing: every chunk must be in the checkpoint already (the finishing job).
-    Assemble,
+    /// Roll nothing: every chunk must be in the checkpoint already (the finishing job of a
+    /// run split among `n` tasks). The first chunk missing or damaged is kept, with the task
+    /// that rolls it (counted as [`ChunkShare::Task`] counts), for the finishing job to name.
+    Assemble {
+        /// How many tasks rolled the chunks.
+        n: u64,
+        /// Chunks met so far.
+        met: Arc<AtomicU64>,
+        /// The first chunk missing or damaged: its task, and why.
+        lacking: Arc<std::sync::Mutex<Option<(u64, String)>>>,
+    },
     /// Roll and read nothing: every run ends at once, incomplete. A study run so checks its
     /// arguments and stops at its first cell (`dicephys slurm` does this before submitting).
     DryRun,
@@ -73,12 +82,43 @@ impl ChunkShare {
         }
     }
 
-    /// Whether this process takes the next chunk it meets.
-    fn take_next(&self) -> bool {
-        match self {
-            ChunkShare::Task { k, n, met } => met.fetch_add(1, Ordering::Relaxed) % n == *k,
-            _ => true,
+    /// The finishing job of a run split among `n` tasks.
+    pub fn assemble(n: u64) -> ChunkShare {
+        ChunkShare::Assemble {
+            n: n.max(1),
+            met: Arc::new(AtomicU64::new(0)),
+            lacking: Arc::default(),
         }
+    }
+
+    /// The finishing job's first chunk missing or damaged: the task that rolls it, and why.
+    pub fn lacking(&self) -> Option<(u64, String)> {
+        match self {
+            ChunkShare::Assemble { lacking, .. } => lacking.lock().ok()?.clone(),
+            _ => None,
+        }
+    }
+
+    /// Whether this process takes the next chunk it meets, and the task that rolls it.
+    fn take_next(&self) -> (bool, u64) {
+        match self {
+            ChunkShare::Task { k, n, met } => {
+                let j = met.fetch_add(1, Ordering::Relaxed) % n;
+                (j == *k, j)
+            }
+            ChunkShare::Assemble { n, met, .. } => (true, met.fetch_add(1, Ordering::Relaxed) % n),
+            _ => (true, 0),
+        }
+    }
+
+    /// The finishing job's refusal of a chunk missing or damaged (rolled by task `task`).
+    fn lack(&self, task: u64, why: String) -> Error {
+        if let ChunkShare::Assemble { lacking, .. } = self {
+            if let Ok(mut l) = lacking.lock() {
+                l.get_or_insert((task, why.clone()));
+            }
+        }
+        Error::Failed(format!("{why} (task {task} rolls it)"))
     }
 
     /// True for a task's share or a dry run: their tallies are partial by design, for no
@@ -104,10 +144,21 @@ pub struct Rolled {
     pub resumed_wall_s: f64,
 }
 
-/// One chunk file: the run's key, what the chunk cost, and its records.
+/// One chunk file, `chunk-FIRST-LEN.json`: the run's key, what the chunk cost, and its rolls
+/// packed ([`crate::run::pack`], format `rolls-v1`, in base64), under a checksum
+/// ([`crate::run::seal`]). A chunk of the JSON records an older dicephys wrote has no
+/// checksum: it is read as damaged, named, and rolled again.
 #[derive(Serialize, Deserialize)]
 struct ChunkFile {
     key: String,
+    cpu_s: f64,
+    wall_s: f64,
+    format: String,
+    rolls: String,
+}
+
+/// A chunk read back: what it cost, and its records.
+struct Chunked {
     cpu_s: f64,
     wall_s: f64,
     records: Vec<RollRecord>,
@@ -196,27 +247,42 @@ impl<'a> Runner<'a> {
         for c in range.start..end {
             let chunk = indices.chunk(c, CHUNK_ROLLS);
             let path = checkpoint.map(|d| d.chunk_path(chunk[0], chunk.len()));
-            if !self.share.take_next() {
+            let (mine, task) = self.share.take_next();
+            if !mine {
                 continue;
             }
+            let assemble = matches!(self.share, ChunkShare::Assemble { .. });
             if let Some(p) = path.as_ref().filter(|p| p.exists()) {
-                let file = read_chunk(p, &key, &chunk)?;
-                done.resumed += file.records.len() as u64;
-                done.resumed_cpu_s += file.cpu_s;
-                done.resumed_wall_s += file.wall_s;
-                file.records.iter().for_each(|r| done.tally.add(r));
-                sink(&file.records)?;
-                (self.progress)(done.tally.rolls);
-                continue;
-            }
-            if let ChunkShare::Assemble = self.share {
+                match read_chunk(p, &key, &chunk, &throws) {
+                    Ok(file) => {
+                        done.resumed += file.records.len() as u64;
+                        done.resumed_cpu_s += file.cpu_s;
+                        done.resumed_wall_s += file.wall_s;
+                        file.records.iter().try_for_each(|r| done.tally.add(r))?;
+                        sink(&file.records)?;
+                        (self.progress)(done.tally.rolls);
+                        continue;
+                    }
+                    // Every throw is a function of (spec, index): a damaged chunk is rolled
+                    // again, and replaced, rather than counted.
+                    Err(Chunk::Damaged(why)) if !assemble => {
+                        eprintln!("dicephys: {}: {why}; rolling its throws again", p.display());
+                    }
+                    Err(Chunk::Damaged(why)) => {
+                        return Err(self.share.lack(task, format!("{}: {why}", p.display())))
+                    }
+                    Err(Chunk::Refused(e)) => return Err(e),
+                }
+            } else if assemble {
                 let first = chunk[0];
-                return Err(Error::Failed(format!(
-                    "{}: throws {first}.. ({} of them) were never rolled; the task that rolls \
-                     them has not finished",
-                    path.map_or_else(|| "no checkpoint".into(), |p| p.display().to_string()),
-                    chunk.len()
-                )));
+                return Err(self.share.lack(
+                    task,
+                    format!(
+                        "{}: throws {first}.. ({} of them) were never rolled",
+                        path.map_or_else(|| "no checkpoint".into(), |p| p.display().to_string()),
+                        chunk.len()
+                    ),
+                ));
             }
             if self.stop.requested() {
                 return Ok(done);
@@ -238,15 +304,15 @@ impl<'a> Runner<'a> {
                     key: key.clone(),
                     cpu_s: process_cpu_seconds() - cpu,
                     wall_s: wall.elapsed().as_secs_f64(),
-                    records: recs,
+                    format: crate::run::pack::FORMAT.into(),
+                    rolls: crate::run::pack::base64(&crate::run::pack::pack(&recs)),
                 };
-                let json =
-                    serde_json::to_string(&file).map_err(|e| Error::Failed(e.to_string()))?;
+                let json = crate::run::seal::to_string(&file, false)?;
                 write_atomic(p, json.as_bytes())?;
-                file.records.iter().for_each(|r| done.tally.add(r));
-                sink(&file.records)?;
+                recs.iter().try_for_each(|r| done.tally.add(r))?;
+                sink(&recs)?;
             } else {
-                recs.iter().for_each(|r| done.tally.add(r));
+                recs.iter().try_for_each(|r| done.tally.add(r))?;
                 sink(&recs)?;
             }
             if !whole {
@@ -258,30 +324,57 @@ impl<'a> Runner<'a> {
     }
 }
 
-fn read_chunk(p: &Path, key: &str, chunk: &[u64]) -> Result<ChunkFile> {
-    let text = std::fs::read_to_string(p).map_err(|e| Error::io(p, e))?;
-    let file: ChunkFile = serde_json::from_str(&text)
-        .map_err(|e| Error::Mismatch(format!("{}: not a chunk of this run ({e})", p.display())))?;
+/// Why a stored chunk is not read.
+enum Chunk {
+    /// Damaged (or of a dicephys before checksums): rolled again where it can be.
+    Damaged(String),
+    /// Whole, but another run's, or of other throws: an error.
+    Refused(Error),
+}
+
+/// The chunk at `p` of the run keyed `key`, holding the throws `chunk`: its checksum checked
+/// ([`crate::run::seal`]), then its key and throws.
+fn read_chunk(
+    p: &Path,
+    key: &str,
+    chunk: &[u64],
+    throws: &crate::model::throws::Throws,
+) -> std::result::Result<Chunked, Chunk> {
+    use crate::run::seal::{open, Broken};
+    let text = match std::fs::read(p) {
+        Ok(b) => String::from_utf8(b).map_err(|_| Chunk::Damaged("damaged: not UTF-8".into()))?,
+        Err(e) => return Err(Chunk::Refused(Error::io(p, e))),
+    };
+    let file: ChunkFile = open(&text).map_err(|b| match b {
+        Broken::Damaged(why) => Chunk::Damaged(why),
+        Broken::Shape(why) => Chunk::Refused(Error::Mismatch(format!(
+            "{}: not a chunk of this run ({why})",
+            p.display()
+        ))),
+    })?;
     if file.key != key {
-        return Err(Error::Mismatch(format!(
+        return Err(Chunk::Refused(Error::Mismatch(format!(
             "{}: a chunk of another run (key {}, this run's {key})",
             p.display(),
             file.key
+        ))));
+    }
+    let refuse = |why: String| Chunk::Refused(Error::Mismatch(format!("{}: {why}", p.display())));
+    if file.format != crate::run::pack::FORMAT {
+        return Err(refuse(format!(
+            "format {:?}, not {:?} (a newer dicephys's?)",
+            file.format,
+            crate::run::pack::FORMAT
         )));
     }
-    let ok = file.records.len() == chunk.len()
-        && file
-            .records
-            .iter()
-            .zip(chunk)
-            .all(|(r, &i)| r.throw.index == i);
-    if !ok {
-        return Err(Error::Mismatch(format!(
-            "{}: its throws are not this chunk's",
-            p.display()
-        )));
-    }
-    Ok(file)
+    let records = crate::run::pack::unbase64(&file.rolls)
+        .and_then(|b| crate::run::pack::unpack(&b, chunk, throws))
+        .map_err(|e| refuse(format!("its rolls are not this chunk's ({e})")))?;
+    Ok(Chunked {
+        cpu_s: file.cpu_s,
+        wall_s: file.wall_s,
+        records,
+    })
 }
 
 /// A checkpoint directory, held by one run at a time: `spec.json` names the run, `lock` its
@@ -317,7 +410,9 @@ impl Checkpoint {
                 dir.display()
             ))
         })?;
+        crate::run::owner::check_unowned(dir)?;
         let lock = lock(&dir.join(lock_name))?;
+        crate::run::io::clean_temporaries(dir);
         // Written when absent, then read back: tasks of a cluster run that open a new cell at
         // the same moment each write the same whole file (an atomic rename), and the one
         // read back decides.

@@ -133,12 +133,22 @@ pub struct Layout {
 impl Layout {
     /// The run's directory `dir`, made if need be, by its absolute path (the scripts run on
     /// other nodes).
+    /// A directory whose absolute path cannot be written into the scripts safely
+    /// ([`script_path`]) is refused before it is made (and, if only its real path is unsafe,
+    /// removed again if this call made it).
     pub fn create(dir: &Path) -> Result<Layout> {
-        let bad = |e: std::io::Error| Error::field("dir", dir.display(), e.to_string());
+        let bad = |e: std::io::Error| Error::field("dir", format!("{dir:?}"), e.to_string());
+        script_path("dir", &std::path::absolute(dir).map_err(bad)?)?;
+        let made = !dir.exists();
         std::fs::create_dir_all(dir).map_err(bad)?;
-        Ok(Layout {
-            dir: dir.canonicalize().map_err(bad)?,
-        })
+        let real = dir.canonicalize().map_err(bad)?;
+        if let Err(e) = script_path("dir", &real) {
+            if made {
+                let _ = std::fs::remove_dir(&real);
+            }
+            return Err(e);
+        }
+        Ok(Layout { dir: real })
     }
 
     /// Writes the two scripts (`array_script`, `finish_script`) whole; returns their text.
@@ -301,19 +311,48 @@ pub struct Options {
 }
 
 impl Options {
-    /// Refuses values that cannot go on an `#SBATCH` line.
+    /// Refuses values that cannot go on an `#SBATCH` line as they are: a partition or an
+    /// account is letters, digits and `_ . , -` (no `#`, which starts a comment for sbatch,
+    /// no quote, no `%`, no space or newline); a time is digits, `:` and `-` (`1:00:00`,
+    /// `2-12`), or `UNLIMITED`/`INFINITE`.
     pub fn validate(&self) -> Result<()> {
-        for (name, v) in [
-            ("partition", &self.partition),
-            ("time", &self.time),
-            ("account", &self.account),
-        ] {
+        fn word(v: &str) -> bool {
+            v.chars()
+                .all(|c| c.is_ascii_alphanumeric() || "_.,-".contains(c))
+        }
+        fn time(v: &str) -> bool {
+            v.starts_with(|c: char| c.is_ascii_digit())
+                && v.chars().all(|c| c.is_ascii_digit() || ":-".contains(c))
+                || ["unlimited", "infinite"].contains(&v.to_ascii_lowercase().as_str())
+        }
+        type Check = fn(&str) -> bool;
+        let rules: [(&'static str, &Option<String>, Check, &str); 3] = [
+            (
+                "partition",
+                &self.partition,
+                word,
+                "letters, digits and _ . , - only",
+            ),
+            (
+                "account",
+                &self.account,
+                word,
+                "letters, digits and _ . , - only",
+            ),
+            (
+                "time",
+                &self.time,
+                time,
+                "minutes or [D-]HH:MM:SS as sbatch takes it (90, 1:00:00, 2-12), or UNLIMITED",
+            ),
+        ];
+        for (name, v, ok, want) in rules {
             if let Some(v) = v {
-                if v.is_empty() || v.chars().any(|c| c.is_whitespace() || c.is_control()) {
+                if v.is_empty() || !ok(v) {
                     return Err(Error::field(
                         name,
-                        format!("'{v}'"),
-                        "one word without spaces",
+                        format!("{v:?}"),
+                        format!("{want} (it is written on an #SBATCH line)"),
                     ));
                 }
             }
@@ -348,9 +387,45 @@ pub fn quote(s: &str) -> String {
     }
 }
 
+/// A path written into the scripts, or the refusal of `field`: it must be UTF-8 and hold no
+/// control character (a newline would end a script line, and the rest of the name run as
+/// shell) and no backslash (sbatch's escape, which in a log name also turns off `%a`).
+/// Anything else is quoted where it is written: for the shell ([`quote`]) and for sbatch's
+/// own parser ([`sbatch_path`]).
+pub fn script_path<'p>(field: &'static str, p: &'p Path) -> Result<&'p str> {
+    let refuse = |why: &str| Err(Error::field(field, format!("{p:?}"), why));
+    match p.to_str() {
+        None => refuse("not UTF-8; a Slurm run's path goes into its scripts as text"),
+        Some(s) if s.chars().any(char::is_control) => refuse(
+            "a control character (a newline?) in the path cannot be written into a script safely",
+        ),
+        Some(s) if s.contains('\\') => {
+            refuse("a backslash in the path cannot be written into an #SBATCH line safely")
+        }
+        Some(s) => Ok(s),
+    }
+}
+
 fn path_str(p: &Path) -> Result<&str> {
-    p.to_str()
-        .ok_or_else(|| Error::Invalid(format!("{}: not a UTF-8 path", p.display())))
+    script_path("dir", p)
+}
+
+/// A file name for an `#SBATCH` line, as sbatch's own parser reads it: `%` doubled (sbatch
+/// expands `%j`, `%a` in a log name), and each space, `"`, `'` and `#` escaped with a
+/// backslash (sbatch splits at spaces, pairs double quotes and ends the line at `#`). The
+/// name holds no backslash or control character ([`script_path`]). `pattern` (e.g.
+/// `task-%a.out`) is appended as it is.
+pub fn sbatch_path(dir: &str, pattern: &str) -> String {
+    let mut s = String::new();
+    for c in dir.chars() {
+        if c == '%' {
+            s.push('%');
+        } else if c.is_ascii_whitespace() || "\"'#".contains(c) {
+            s.push('\\');
+        }
+        s.push(c);
+    }
+    s + pattern
 }
 
 /// The job-array script: task K rolls (or resumes) its shard from `DIR/shard-K` and puts its
@@ -359,7 +434,7 @@ fn path_str(p: &Path) -> Result<&str> {
 /// scheduler requeue a task on a lost node; `--open-mode=append` keeps each attempt's log.
 pub fn array_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Result<String> {
     let dir = path_str(&lay.dir)?;
-    let bin = path_str(bin)?;
+    let bin = script_path("bin", bin)?;
     let n = plan.tasks();
     let logs = lay.logs();
     let logs = path_str(&logs)?;
@@ -393,7 +468,7 @@ pub fn array_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Res
          #SBATCH --cpus-per-task={cpus}\n\
          #SBATCH --requeue\n\
          #SBATCH --open-mode=append\n\
-         #SBATCH --output={logs}/task-%a.out\n\
+         #SBATCH --output={logs}\n\
          {extra}\
          k=${{SLURM_ARRAY_TASK_ID:?not a Slurm array task}}\n\
          echo \"task $k: job ${{SLURM_JOB_ID:-?}} on $(hostname), attempt $((${{SLURM_RESTART_COUNT:-0}} + 1))\"\n\
@@ -401,7 +476,7 @@ pub fn array_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Res
         cmd = plan.command(),
         last = n - 1,
         cpus = opt.cpus,
-        logs = quote(logs),
+        logs = sbatch_path(logs, "/task-%a.out"),
         extra = opt.lines(),
     ))
 }
@@ -410,7 +485,7 @@ pub fn array_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Res
 /// naming the missing tasks, and otherwise writes the merged result (again, if rerun).
 pub fn finish_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Result<String> {
     let d = quote(path_str(&lay.dir)?);
-    let b = quote(path_str(bin)?);
+    let b = quote(script_path("bin", bin)?);
     let logs = lay.logs();
     let logs = path_str(&logs)?;
     Ok(format!(
@@ -419,7 +494,7 @@ pub fn finish_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Re
          #SBATCH --job-name=dicephys-{cmd}-finish\n\
          #SBATCH --cpus-per-task={cpus}\n\
          #SBATCH --open-mode=append\n\
-         #SBATCH --output={logs}/finish.out\n\
+         #SBATCH --output={logs}\n\
          {extra}\
          {run}",
         run = match plan {
@@ -438,7 +513,7 @@ pub fn finish_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Re
         },
         cmd = plan.command(),
         n = plan.tasks(),
-        logs = quote(logs),
+        logs = sbatch_path(logs, "/finish.out"),
         extra = opt.lines(),
         cpus = match plan {
             // The finishing job of `tradeoff` may roll on; the others only read and write.

@@ -60,40 +60,53 @@ pub struct Counts {
 
 impl Counts {
     /// Counts one outcome.
-    pub fn add(&mut self, o: Outcome) {
-        match o {
-            Outcome::Breadth => self.breadth += 1,
-            Outcome::Width => self.width += 1,
-            Outcome::Length => self.length += 1,
-            Outcome::Unknown => self.unknown += 1,
-        }
+    pub fn add(&mut self, o: Outcome) -> crate::Result<()> {
+        let n = match o {
+            Outcome::Breadth => &mut self.breadth,
+            Outcome::Width => &mut self.width,
+            Outcome::Length => &mut self.length,
+            Outcome::Unknown => &mut self.unknown,
+        };
+        plus(n, 1)
     }
 }
 
+/// `*a += b`, or an error if the sum overflows: a tally is exact or refused, never wrapped.
+fn plus(a: &mut u64, b: u64) -> crate::Result<()> {
+    *a = a.checked_add(b).ok_or_else(|| {
+        crate::Error::Mismatch(format!(
+            "a count overflows: {a} + {b} is past 2^64 - 1 (a damaged or forged input?)"
+        ))
+    })?;
+    Ok(())
+}
+
 impl Tally {
-    /// Counts one roll.
-    pub fn add(&mut self, r: &RollRecord) {
-        self.rolls += 1;
-        self.steps += r.steps;
-        self.engine_steps += r.engine_steps;
-        self.energy_gain += r.energy_gain as u64;
-        self.dipped += r.dip.dipped() as u64;
+    /// Counts one roll; an error if a count would overflow.
+    pub fn add(&mut self, r: &RollRecord) -> crate::Result<()> {
+        plus(&mut self.rolls, 1)?;
+        plus(&mut self.steps, r.steps)?;
+        plus(&mut self.engine_steps, r.engine_steps)?;
+        plus(&mut self.energy_gain, r.energy_gain as u64)?;
+        plus(&mut self.dipped, r.dip.dipped() as u64)?;
         self.deepest_dip_nm = self.deepest_dip_nm.max(nanometres(r.dip.penetration));
         if let Some((step, o)) = r.certified {
-            self.certified += 1;
-            self.certified_steps += step;
+            plus(&mut self.certified, 1)?;
+            plus(&mut self.certified_steps, step)?;
             match r.fate {
                 Fate::Settled(Outcome::Unknown) | Fate::Unconverged(Outcome::Unknown) => {
-                    self.certified_unknown += 1
+                    plus(&mut self.certified_unknown, 1)?
                 }
-                Fate::Settled(s) | Fate::Unconverged(s) => self.certified_wrong += (s != o) as u64,
+                Fate::Settled(s) | Fate::Unconverged(s) => {
+                    plus(&mut self.certified_wrong, (s != o) as u64)?
+                }
                 Fate::Failed(_) => {}
             }
         }
         match r.fate {
             Fate::Settled(o) => self.counts.add(o),
-            Fate::Unconverged(_) => self.unconverged += 1,
-            Fate::Failed(f) => *self.failed.entry(f).or_insert(0) += 1,
+            Fate::Unconverged(_) => plus(&mut self.unconverged, 1),
+            Fate::Failed(f) => plus(self.failed.entry(f).or_insert(0), 1),
         }
     }
 
@@ -107,7 +120,10 @@ impl Tally {
             .try_fold(0u64, u64::checked_add);
         let fine = ended == Some(self.rolls)
             && self.certified <= self.rolls
-            && self.certified_wrong + self.certified_unknown <= self.certified
+            && self
+                .certified_wrong
+                .checked_add(self.certified_unknown)
+                .is_some_and(|n| n <= self.certified)
             && self.energy_gain <= self.rolls
             && self.dipped <= self.rolls;
         if fine {
@@ -122,7 +138,7 @@ impl Tally {
 
     /// Rolls that failed, for any reason.
     pub fn failed_total(&self) -> u64 {
-        self.failed.values().sum()
+        self.failed.values().fold(0, |a, &b| a.saturating_add(b))
     }
 
     /// Rolls that failed for this reason.
@@ -130,26 +146,28 @@ impl Tally {
         self.failed.get(&f).copied().unwrap_or(0)
     }
 
-    /// Adds another tally's counts (of other rolls) to this one.
-    pub fn merge(&mut self, o: &Tally) {
-        self.counts.breadth += o.counts.breadth;
-        self.counts.width += o.counts.width;
-        self.counts.length += o.counts.length;
-        self.counts.unknown += o.counts.unknown;
-        self.unconverged += o.unconverged;
+    /// Adds another tally's counts (of other rolls) to this one; an error, and this tally
+    /// left partly added, if a count would overflow.
+    pub fn merge(&mut self, o: &Tally) -> crate::Result<()> {
+        plus(&mut self.counts.breadth, o.counts.breadth)?;
+        plus(&mut self.counts.width, o.counts.width)?;
+        plus(&mut self.counts.length, o.counts.length)?;
+        plus(&mut self.counts.unknown, o.counts.unknown)?;
+        plus(&mut self.unconverged, o.unconverged)?;
         for (k, v) in &o.failed {
-            *self.failed.entry(*k).or_insert(0) += v;
+            plus(self.failed.entry(*k).or_insert(0), *v)?;
         }
-        self.rolls += o.rolls;
-        self.steps += o.steps;
-        self.engine_steps += o.engine_steps;
-        self.certified += o.certified;
-        self.certified_wrong += o.certified_wrong;
-        self.certified_unknown += o.certified_unknown;
-        self.certified_steps += o.certified_steps;
-        self.energy_gain += o.energy_gain;
-        self.dipped += o.dipped;
+        plus(&mut self.rolls, o.rolls)?;
+        plus(&mut self.steps, o.steps)?;
+        plus(&mut self.engine_steps, o.engine_steps)?;
+        plus(&mut self.certified, o.certified)?;
+        plus(&mut self.certified_wrong, o.certified_wrong)?;
+        plus(&mut self.certified_unknown, o.certified_unknown)?;
+        plus(&mut self.certified_steps, o.certified_steps)?;
+        plus(&mut self.energy_gain, o.energy_gain)?;
+        plus(&mut self.dipped, o.dipped)?;
         self.deepest_dip_nm = self.deepest_dip_nm.max(o.deepest_dip_nm);
+        Ok(())
     }
 
     /// `deepest_dip_nm` in metres.
@@ -158,12 +176,12 @@ impl Tally {
     }
 
     /// The tally of these records.
-    pub fn of(records: &[RollRecord]) -> Tally {
+    pub fn of(records: &[RollRecord]) -> crate::Result<Tally> {
         let mut t = Tally::default();
         for r in records {
-            t.add(r);
+            t.add(r)?;
         }
-        t
+        Ok(t)
     }
 }
 
@@ -211,5 +229,25 @@ impl Agreement {
     /// Same outcome, as a fraction of the throws both settled.
     pub fn of_settled(&self) -> f64 {
         self.same as f64 / self.both_settled.max(1) as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_sum_past_u64_max_is_an_error_not_a_wrap() {
+        let mut t = Tally {
+            steps: u64::MAX - 1,
+            rolls: 1,
+            ..Tally::default()
+        };
+        let big = Tally {
+            steps: 2,
+            rolls: 1,
+            ..Tally::default()
+        };
+        assert!(t.merge(&big).is_err());
     }
 }

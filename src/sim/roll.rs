@@ -251,6 +251,16 @@ pub struct Dip {
 }
 
 impl Dip {
+    /// A dip as stored: its steps, its longest run, its depth (m).
+    pub fn of(steps: u64, longest: u64, penetration: f64) -> Dip {
+        Dip {
+            steps,
+            longest,
+            penetration,
+            run: 0,
+        }
+    }
+
     /// Records one step's state.
     pub fn push(&mut self, die: &DieShape, s: &BodyState) {
         let depth = -crate::model::die::lowest_point(&die.half, s);

@@ -243,6 +243,7 @@ pub fn engine_floor(
     throws: &Throws,
     base: &RollConfig,
     rolls: u64,
+    stop: &crate::run::stop::Stop,
 ) -> crate::Result<EngineFloor> {
     let mut e = TimedEngine {
         inner: crate::engine::new_engine(m.engine, scene)?,
@@ -252,6 +253,9 @@ pub fn engine_floor(
     let mut engine_steps = 0u64;
     let wall = Instant::now();
     for i in 0..rolls {
+        if stop.requested() {
+            return Err(crate::Error::Stopped);
+        }
         engine_steps += crate::sim::roll::roll(&mut e, scene, &throws.get(i), &cfg).engine_steps;
     }
     let roll_s = wall.elapsed().as_secs_f64();
@@ -337,6 +341,7 @@ pub fn run(
     seed: u64,
     all_threads: usize,
     repeat: u32,
+    stop: &crate::run::stop::Stop,
     log: &dyn Fn(&str),
 ) -> crate::Result<Bench> {
     let block: crate::model::block::Block = "140x24x20".parse()?;
@@ -349,7 +354,7 @@ pub fn run(
         for m in &methods {
             let mut scene = Scene::paper(block, mode);
             scene.floor = m.floor;
-            floors.push(engine_floor(m, &scene, &throws, &base, rolls)?);
+            floors.push(engine_floor(m, &scene, &throws, &base, rolls, stop)?);
         }
         let mut thread_counts = vec![1];
         if all_threads > 1 {
@@ -366,15 +371,17 @@ pub fn run(
                     scene.floor = m.floor;
                     let wall = Instant::now();
                     let cpu = process_cpu_seconds();
-                    let recs = batch::run(
-                        m.engine,
-                        &scene,
-                        &throws,
-                        &m.settle(&base),
-                        0..rolls,
-                        threads,
-                        &|_| {},
-                    )?;
+                    let job = batch::Job {
+                        engine: m.engine,
+                        scene: &scene,
+                        throws: &throws,
+                        cfg: &m.settle(&base),
+                    };
+                    let list: Vec<u64> = (0..rolls).collect();
+                    let recs = batch::run_indices(&job, &list, threads, stop, &|_| {})?;
+                    if (recs.len() as u64) < rolls {
+                        return Err(crate::Error::Stopped);
+                    }
                     let (c, w) = (process_cpu_seconds() - cpu, wall.elapsed().as_secs_f64());
                     if w < best.1 {
                         *best = (recs, w, c);
@@ -384,13 +391,13 @@ pub fn run(
             let mut faithful: Option<(&[RollRecord], f64)> = None;
             for ((m, (recs, wall_s, cpu_s)), floor) in methods.iter().zip(&best).zip(&floors) {
                 let (wall_s, cpu_s) = (*wall_s, *cpu_s);
-                let t = Tally::of(recs);
+                let t = Tally::of(recs)?;
                 let r = stats::ratio(t.counts.breadth, t.counts.width);
                 let rolls_per_s = rolls as f64 / wall_s;
                 let (speedup, z, same) = match &faithful {
                     None => (1.0, 0.0, 1.0),
                     Some((f, f_rps)) => {
-                        let ft = Tally::of(f);
+                        let ft = Tally::of(f)?;
                         let fr = stats::ratio(ft.counts.breadth, ft.counts.width);
                         (
                             rolls_per_s / f_rps,

@@ -161,7 +161,7 @@ impl Cell {
             recs.extend_from_slice(r);
             Ok(())
         })?;
-        self.tally.merge(&done.tally);
+        self.tally.merge(&done.tally)?;
         self.cpu_s += process_cpu_seconds() - cpu;
         self.wall_s += wall.elapsed().as_secs_f64();
         if !done.complete {

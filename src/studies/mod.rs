@@ -56,6 +56,34 @@ pub enum StudyConfig {
 }
 
 impl StudyConfig {
+    /// What makes two runs of the study one run, for the directory it owns
+    /// (`run::owner`): its configuration, less what only adds rounds to a study rolled to a
+    /// precision (the precision, the budgets, `plan_only`, `preroll_chunks`, and `rolls`
+    /// where a precision sets them).
+    pub fn identity(&self) -> serde_json::Value {
+        let c = match self {
+            StudyConfig::Tradeoff(t) => StudyConfig::Tradeoff(tradeoff::Config {
+                precision: 0.0,
+                budget_s: 0.0,
+                reference_budget_s: 0.0,
+                plan_only: false,
+                preroll_chunks: None,
+                ..t.clone()
+            }),
+            StudyConfig::Converge(c) if c.precision.is_some() => {
+                StudyConfig::Converge(converge::Config {
+                    precision: Some(0.0),
+                    budget_s: 0.0,
+                    reference_budget_s: 0.0,
+                    rolls: 0,
+                    ..c.clone()
+                })
+            }
+            other => other.clone(),
+        };
+        serde_json::to_value(&c).unwrap_or_default()
+    }
+
     /// The study's name: its command.
     pub fn name(&self) -> &'static str {
         match self {
@@ -105,7 +133,8 @@ impl StudyConfig {
     /// study itself, reading every chunk back and rolling none; but `tradeoff`, whose tasks
     /// only rolled ahead, runs whole (no `preroll_chunks`), reading their chunks back and
     /// rolling on where a method needs more.
-    pub fn finishing(&self) -> (StudyConfig, ChunkShare) {
+    /// The run was split among `tasks` tasks (named when a chunk is missing).
+    pub fn finishing(&self, tasks: u64) -> (StudyConfig, ChunkShare) {
         match self {
             StudyConfig::Tradeoff(t) => (
                 StudyConfig::Tradeoff(tradeoff::Config {
@@ -114,7 +143,7 @@ impl StudyConfig {
                 }),
                 ChunkShare::All,
             ),
-            other => (other.clone(), ChunkShare::Assemble),
+            other => (other.clone(), ChunkShare::assemble(tasks)),
         }
     }
 }

@@ -214,6 +214,15 @@ pub fn roll(
 
 /// Runs a study that a cluster can split.
 pub fn run(config: &StudyConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
+    // The directory it writes into (crosscheck: its checkpoint) is this run's, or refused.
+    let owned = match config {
+        StudyConfig::Crosscheck(_) => place.checkpoint.as_deref(),
+        _ => Some(place.out.as_path()),
+    };
+    if let Some(dir) = owned {
+        config.validate()?;
+        crate::run::owner::claim(dir, config.name(), &config.identity())?;
+    }
     match config {
         StudyConfig::Paper(c) => paper(c, place, hooks),
         StudyConfig::Crosscheck(c) => crosscheck(c, place, hooks),
@@ -395,6 +404,8 @@ pub fn stability(cfg: &studies::stability::Config, place: &Place, hooks: &Hooks)
 /// `validate`: validate.json, report.md and its figures.
 pub fn validate(cfg: &studies::validate::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
     cfg.validate()?;
+    let identity = serde_json::to_value(cfg).map_err(|e| Error::Failed(e.to_string()))?;
+    crate::run::owner::claim(&place.out, "validate", &identity)?;
     let outputs = place.outputs(&["validate.json", "report.md"])?;
     let Some(res) = logged(place, hooks, &report::validate::header(), |study, log| {
         studies::validate::run(cfg, study, log, hooks.progress)

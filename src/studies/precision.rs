@@ -177,7 +177,7 @@ pub fn roll_to_precision(
         let r = runner
             .with_progress(&progress)
             .run_range(spec, checkpoint, c..c + 1, sink)?;
-        all.tally.merge(&r.tally);
+        all.tally.merge(&r.tally)?;
         if let Some(n) = rolls_for_precision(&all.tally, precision) {
             let n = n.div_ceil(CHUNK_ROLLS) * CHUNK_ROLLS;
             expect(n.clamp(all.tally.rolls, spec.indices().len()));

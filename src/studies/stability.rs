@@ -51,9 +51,13 @@ impl Config {
         if let Some(e) = self
             .restitutions
             .iter()
-            .find(|e| !(e.is_finite() && (0.0..=1.0).contains(*e)))
+            .find(|e| !(e.is_finite() && (0.0..1.0).contains(*e)))
         {
-            return Err(Error::field("restitutions", e, "must be in [0, 1]"));
+            return Err(Error::field(
+                "restitutions",
+                e,
+                "must be in [0, 1): at e = 1 nothing is lost at a bounce and no roll ever rests",
+            ));
         }
         if let Some(m) = self
             .frictions

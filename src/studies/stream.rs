@@ -103,15 +103,14 @@ impl Stream {
             have..chunks,
             &mut |recs| {
                 outcomes.extend(recs.iter().map(class));
-                recs.iter().for_each(|r| tally.add(r));
-                Ok(())
+                recs.iter().try_for_each(|r| tally.add(r))
             },
         )?;
         if !run.complete {
             return Err(Error::Stopped);
         }
         self.outcomes.extend(outcomes);
-        self.tally.merge(&tally);
+        self.tally.merge(&tally)?;
         // A chunk read back costs what it cost when rolled (stored with it), not the reading.
         let rolled_now = run.tally.rolls > run.resumed;
         self.cpu_s += run.resumed_cpu_s

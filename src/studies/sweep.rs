@@ -131,13 +131,16 @@ pub fn parse_seconds(s: &str) -> Result<f64> {
     })
 }
 
-/// Parses a time step: seconds (0.001) or a fraction (1/1000), in (0, 0.1] s.
+/// Parses a time step: seconds (0.001) or a fraction (1/1000), in [1e-6, 0.1] s.
 pub fn parse_dt(s: &str) -> Result<f64> {
+    use crate::model::scene::{MAX_DT, MIN_DT};
     let v = parse_seconds(s)?;
-    if v.is_finite() && v > 0.0 && v <= 0.1 {
+    if v.is_finite() && (MIN_DT..=MAX_DT).contains(&v) {
         Ok(v)
     } else {
-        Err(Error::Invalid(format!("dt '{s}' must be in (0, 0.1] s")))
+        Err(Error::Invalid(format!(
+            "dt '{s}' must be in [{MIN_DT}, {MAX_DT}] s"
+        )))
     }
 }
 

@@ -98,6 +98,16 @@ impl Config {
                 "the reference's dt is not a rung",
             ));
         }
+        if let Some(k) = self.preroll_chunks {
+            let max = crate::run::spec::MAX_ROLLS / crate::run::runner::CHUNK_ROLLS;
+            if k == 0 || k > max {
+                return Err(Error::field(
+                    "preroll_chunks",
+                    k.saturating_mul(crate::run::runner::CHUNK_ROLLS),
+                    format!("must be in 1..={} rolls", crate::run::spec::MAX_ROLLS),
+                ));
+            }
+        }
         check_budget(self.budget_s, "budget_s")?;
         check_budget(self.reference_budget_s, "reference_budget_s")?;
         check_rolls_and_steps(1, self.max_steps)

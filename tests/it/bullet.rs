@@ -107,7 +107,7 @@ fn same_seed_same_counts_for_any_thread_count() {
     )
     .unwrap();
     assert_eq!(one, two, "records differ between 1 and 2 threads");
-    assert_eq!(Tally::of(&one), Tally::of(&two));
+    assert_eq!(Tally::of(&one).unwrap(), Tally::of(&two).unwrap());
 }
 
 #[test]
@@ -202,7 +202,7 @@ fn keyed_throws_agree_with_dicephys_ratio_within_3_sigma() {
         &|_| {},
     )
     .unwrap();
-    let t = Tally::of(&recs);
+    let t = Tally::of(&recs).unwrap();
     let ours = dicephys::theory::stats::ratio(t.counts.breadth, t.counts.width);
     let theirs = dicephys::theory::stats::ratio(14163, 25837);
     let z = dicephys::theory::stats::z_score(ours.value, ours.err, theirs.value, theirs.err);

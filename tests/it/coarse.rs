@@ -69,7 +69,7 @@ fn against_reference(scene: &Scene, file: &str) -> (usize, usize, Tally) {
         .zip(&want)
         .filter(|(r, (_, s))| r.steps == *s)
         .count();
-    (same, same_steps, Tally::of(&got))
+    (same, same_steps, Tally::of(&got).unwrap())
 }
 
 #[test]

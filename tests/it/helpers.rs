@@ -3,9 +3,13 @@
 use std::path::Path;
 use std::process::Command;
 
-/// The `dicephys` binary cargo built for these tests.
+/// The `dicephys` binary cargo built for these tests; or, to see a probe fail on an older
+/// build, the one `DICEPHYS_TEST_BIN` names (e.g. main's, copied aside before a fix).
 pub fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_dicephys"))
+    match std::env::var_os("DICEPHYS_TEST_BIN") {
+        Some(b) => Command::new(b),
+        None => Command::new(env!("CARGO_BIN_EXE_dicephys")),
+    }
 }
 
 /// Runs the binary with `args` and waits for it.

@@ -11,6 +11,7 @@ mod fit;
 mod fuzz;
 mod rapier;
 mod redteam;
+mod redteam3;
 mod reliability;
 mod slurm;
 mod speed;

@@ -136,14 +136,18 @@ fn merge_refuses_a_bad_shard_number_and_a_tally_that_does_not_add_up() {
     let text = std::fs::read_to_string(&g).unwrap();
     let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
     v["spec"]["shard"]["k"] = 5.into();
+    // Sealed again (checksum recomputed): refused for its shard number, not its checksum.
+    let v = dicephys::run::seal::sealed(&v).unwrap();
     std::fs::write(&g, v.to_string()).unwrap();
     let out = bin().arg("merge").arg(&f).arg(&g).output().unwrap();
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
     v["tally"]["counts"]["width"] = 1000.into();
+    let v = dicephys::run::seal::sealed(&v).unwrap();
     std::fs::write(&g, v.to_string()).unwrap();
     let out = bin().arg("merge").arg(&f).arg(&g).output().unwrap();
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("checksum"), "{}", stderr(&out));
 }
 
 // 3. A checkpoint holds one run's chunks: see reliability::a_checkpoint_directory_holds_one_run.
@@ -233,6 +237,11 @@ fn paper_interrupted_leaves_the_complete_outputs_alone() {
     assert!(full.status.success(), "{}", stderr(&full));
     let before = std::fs::read(d.join("results.json")).unwrap();
     let png = std::fs::read(d.join("prob_2d.png")).unwrap();
+    // The directory is the 20-roll run's: another run is refused there (redteam3), so the
+    // complete outputs are copied into a directory of no run's, and the slow run stopped there.
+    let e = scratch("paper-again");
+    std::fs::write(e.join("results.json"), &before).unwrap();
+    std::fs::write(e.join("prob_2d.png"), &png).unwrap();
     let out = interrupted(
         &[
             "paper",
@@ -241,14 +250,15 @@ fn paper_interrupted_leaves_the_complete_outputs_alone() {
             "--engines",
             "bullet",
             "--out",
-            o,
+            e.to_str().unwrap(),
         ],
         libc::SIGINT,
         1500,
     );
     assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));
-    assert_eq!(std::fs::read(d.join("results.json")).unwrap(), before);
-    assert_eq!(std::fs::read(d.join("prob_2d.png")).unwrap(), png);
+    assert_eq!(std::fs::read(e.join("results.json")).unwrap(), before);
+    assert_eq!(std::fs::read(e.join("prob_2d.png")).unwrap(), png);
+    no_temp_files(&e);
     no_temp_files(&d);
 }
 

@@ -356,12 +356,13 @@ fn a_crosscheck_split_by_hand_into_tasks_assembles_to_the_one_machine_comparison
         whole["versus"][0]["same_outcome_fraction"]
     );
     // A chunk lost after its task was marked done: the finishing step refuses, rolling nothing.
+    // The first cell's directory (beside it, dicephys-run.json names the run).
     let cell = std::fs::read_dir(dir.join("checkpoint"))
         .unwrap()
         .flatten()
-        .next()
-        .unwrap()
-        .path();
+        .map(|e| e.path())
+        .find(|p| p.is_dir())
+        .unwrap();
     let chunk = cell.join("chunk-000000001000-1000.json");
     std::fs::rename(&chunk, dir.join("lost.json")).unwrap();
     let lost = slurm(&["finish", d]);

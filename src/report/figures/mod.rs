@@ -135,7 +135,7 @@ trait Figure {
 }
 
 /// Draws `fig` into `dir/<stem>.svg` and `dir/<stem>.png`, each whole or not at all: drawn
-/// into a temporary file beside it (plotters writes in place), synced, then renamed.
+/// in memory, then written through `run::io` (a temporary file beside it, renamed).
 fn write_both(dir: &Path, stem: &str, fig: &impl Figure) -> crate::Result<()> {
     use crate::Error;
     if stem.is_empty() || stem.contains(['/', '\\']) {
@@ -143,28 +143,35 @@ fn write_both(dir: &Path, stem: &str, fig: &impl Figure) -> crate::Result<()> {
     }
     ensure_font().map_err(Error::Failed)?;
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    for ext in ["svg", "png"] {
-        let path = dir.join(format!("{stem}.{ext}"));
-        let tmp = tempfile::Builder::new()
-            .prefix(&format!(".{stem}."))
-            .suffix(&format!(".{ext}"))
-            .tempfile_in(dir)
-            .map_err(|e| Error::io(&path, e))?;
-        let drawn = if ext == "svg" {
-            let root = SVGBackend::new(tmp.path(), fig.size()).into_drawing_area();
-            fig.draw(&root)
-                .and_then(|()| root.present().map_err(plot_err))
-        } else {
-            let root = BitMapBackend::new(tmp.path(), fig.size()).into_drawing_area();
-            fig.draw(&root)
-                .and_then(|()| root.present().map_err(plot_err))
-        };
-        drawn.map_err(|e| Error::Failed(format!("{}: {e}", path.display())))?;
-        let file = std::fs::File::open(tmp.path()).map_err(|e| Error::io(&path, e))?;
-        file.sync_all().map_err(|e| Error::io(&path, e))?;
-        tmp.persist(&path).map_err(|e| Error::io(&path, e.error))?;
+    let failed = |ext: &str, e: String| {
+        Error::Failed(format!(
+            "{}: {e}",
+            dir.join(format!("{stem}.{ext}")).display()
+        ))
+    };
+    let size = fig.size();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        fig.draw(&root)
+            .and_then(|()| root.present().map_err(plot_err))
+            .map_err(|e| failed("svg", e))?;
     }
-    Ok(())
+    let (w, h) = size;
+    let mut rgb = vec![0u8; 3 * w as usize * h as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        fig.draw(&root)
+            .and_then(|()| root.present().map_err(plot_err))
+            .map_err(|e| failed("png", e))?;
+    }
+    use image::ImageEncoder;
+    let mut png = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut png)
+        .write_image(&rgb, w, h, image::ColorType::Rgb8)
+        .map_err(|e| failed("png", e.to_string()))?;
+    crate::run::io::write_atomic(&dir.join(format!("{stem}.svg")), svg.as_bytes())?;
+    crate::run::io::write_atomic(&dir.join(format!("{stem}.png")), &png)
 }
 
 /// A closed interval grown to hold finite values.

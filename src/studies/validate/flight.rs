@@ -14,7 +14,7 @@
 
 use super::{Config, Rows, DRIFT_PASS, LOSS_TOLERANCE};
 use crate::engine::{new_engine, EngineKind};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::die::DieShape;
 use crate::model::scene::{Mode, Preset, Scene};
@@ -22,6 +22,7 @@ use crate::model::state::BodyState;
 use crate::model::throws::{haar_quaternion, unit_vector};
 use crate::report::text::dt_label;
 use crate::report::validate::{Case, FlightRun, Integrator, Row, Verdict};
+use crate::run::stop::Stop;
 use crate::sim::flight::Flight;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
@@ -77,6 +78,23 @@ pub fn fly(
     time: f64,
     spin: f64,
 ) -> Result<FlightRun> {
+    fly_until(integrator, block, dt, time, spin, &Stop::new())
+}
+
+/// Steps between two looks at the stop flag: about a millisecond's work.
+const STOP_EVERY: u64 = 1024;
+
+/// [`fly`], ended by a stop request as every stage is: [`Error::Stopped`], checked every
+/// [`STOP_EVERY`] steps.
+pub fn fly_until(
+    integrator: Integrator,
+    block: Block,
+    dt: f64,
+    time: f64,
+    spin: f64,
+    stop: &Stop,
+) -> Result<FlightRun> {
+    let stopped = |i: u64| i.is_multiple_of(STOP_EVERY) && stop.requested();
     let preset = match integrator {
         Integrator::BulletGyroscopic => Preset::Bullet3,
         _ => Preset::Dicephys281,
@@ -123,7 +141,10 @@ pub fn fly(
             let f = Flight::of(&scene);
             let dq = f.step_rotation(&s0.angular_velocity);
             let mut s = s0;
-            for _ in 0..steps {
+            for i in 0..steps {
+                if stopped(i) {
+                    return Err(Error::Stopped);
+                }
                 s = f.step(&s, &dq);
                 watch(&s);
             }
@@ -136,7 +157,10 @@ pub fn fly(
             };
             let mut e = new_engine(kind, &scene)?;
             e.reset(&s0)?;
-            for _ in 0..steps {
+            for i in 0..steps {
+                if stopped(i) {
+                    return Err(Error::Stopped);
+                }
                 e.step()?;
                 watch(&e.state());
             }
@@ -149,7 +173,7 @@ pub fn fly(
 
 /// The free-flight case: every integrator standing for the engines asked, at every dt; its
 /// rows pushed as they are measured.
-pub(super) fn cases(cfg: &Config, rows: &mut Rows) -> Result<Vec<FlightRun>> {
+pub(super) fn cases(cfg: &Config, stop: &Stop, rows: &mut Rows) -> Result<Vec<FlightRun>> {
     let mut flights = Vec::new();
     let flight_block = Block::from_mm(140.0, 24.0, 20.0)?;
     for integrator in Integrator::for_engines(&cfg.engines) {
@@ -157,12 +181,13 @@ pub(super) fn cases(cfg: &Config, rows: &mut Rows) -> Result<Vec<FlightRun>> {
             .flight_dts
             .iter()
             .map(|&dt| {
-                fly(
+                fly_until(
                     integrator,
                     flight_block,
                     dt,
                     cfg.flight_time,
                     cfg.flight_spin,
+                    stop,
                 )
             })
             .collect::<Result<_>>()?;

@@ -37,8 +37,8 @@ impl LimitCell {
         }
     }
 
-    pub(super) fn add(&mut self, scene: &Scene, r: &RollRecord) {
-        self.tally.add(r);
+    pub(super) fn add(&mut self, scene: &Scene, r: &RollRecord) -> Result<()> {
+        self.tally.add(r)?;
         let face = match r.fate {
             Fate::Settled(o) => {
                 self.at_rest.add(o);
@@ -54,7 +54,7 @@ impl LimitCell {
             Fate::Failed(_) => {
                 self.failed += 1;
                 self.outcomes.push('x');
-                return;
+                return Ok(());
             }
         };
         if face == Outcome::Unknown {
@@ -69,6 +69,7 @@ impl LimitCell {
             Outcome::Length => 'l',
             Outcome::Unknown => '?',
         });
+        Ok(())
     }
 }
 
@@ -128,8 +129,7 @@ pub fn measure_limit(spec: &RunSpec, study: &Study) -> Result<LimitCell> {
     };
     let mut cell = LimitCell::empty(spec);
     let run = study.runner.run(spec, ck.as_ref(), &mut |recs| {
-        recs.iter().for_each(|r| cell.add(&spec.scene, r));
-        Ok(())
+        recs.iter().try_for_each(|r| cell.add(&spec.scene, r))
     })?;
     if !run.complete {
         return Err(Error::Stopped);

@@ -132,9 +132,7 @@ impl Config {
             }
         }
         for &dt in &self.flight_dts {
-            if !(dt.is_finite() && dt > 0.0 && dt <= 0.1) {
-                return bad("flight_dts", dt.to_string(), "must be in (0, 0.1] s");
-            }
+            crate::model::scene::check_dt("flight_dts", dt)?;
         }
         let scene = limit_scene(self, self.trend_block, Mode::ThreeD, true);
         scene.validate(false)?;
@@ -207,7 +205,7 @@ pub fn run(
     };
     let mut cells = limits::no_bounce_2d(cfg, study, &mut rows)?;
     cells.extend(limits::quasi_static_3d(cfg, study, &mut rows)?);
-    let flights = flight::cases(cfg, &mut rows)?;
+    let flights = flight::cases(cfg, &study.runner.stop, &mut rows)?;
     let trend = trend::points(cfg, study, &mut rows)?;
     let rows = rows.rows;
     let passed = rows.iter().filter(|r| r.verdict == Verdict::Pass).count();
