@@ -7,3 +7,4 @@ pub mod glibc;
 pub mod scene;
 pub mod state;
 pub mod throws;
+pub mod turns;
