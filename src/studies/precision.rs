@@ -131,11 +131,16 @@ pub fn plan_cpu(groups: &[Vec<&Stream>], precision: f64, budgets: Option<(f64, f
     cpu.max(0.0)
 }
 
+/// The coarsest precision `precision_in_an_hour` reports (±50 %).
+pub const PRECISION_SEARCH_MAX: f64 = 0.5;
+
 /// The precision an hour of `threads` buys with `spent` CPU seconds already spent: the plan
 /// (no budgets) falls as 1/precision², so bisect on its log.
+/// The bisection's bounds are 0.01 % and [`PRECISION_SEARCH_MAX`]: at the upper one, an hour
+/// buys that or worse.
 pub fn precision_in_an_hour(groups: &[Vec<&Stream>], threads: usize, spent: f64) -> f64 {
     let hour = 3600.0 * threads as f64 - spent;
-    let (mut lo, mut hi) = (1e-4f64, 0.5f64);
+    let (mut lo, mut hi) = (1e-4f64, PRECISION_SEARCH_MAX);
     for _ in 0..40 {
         let mid = (lo * hi).sqrt();
         if plan_cpu(groups, mid, None) > hour {

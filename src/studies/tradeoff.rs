@@ -16,6 +16,7 @@
 use super::departure::{chunks_to_resolve, paired_departure, rolls_for_ratio, Departure};
 use super::precision::{
     plan_cpu, precision_in_an_hour, resolve_departure, resolve_reference, NO_BUDGET,
+    PRECISION_SEARCH_MAX,
 };
 use super::stream::Stream;
 use super::sweep::{check_budget, check_rolls_and_steps, nonempty};
@@ -388,7 +389,7 @@ pub fn run(
     log(&format!(
         "plan: the pilot took {:.0} CPU s; at ±{:.2} % (2σ, budgets as given) the rest takes \
          about {:.0} CPU s ({:.1} min on {} threads); ±1 % would take {:.0} CPU s ({:.1} h); \
-         an hour on {} threads buys ±{:.2} %",
+         an hour on {} threads buys {}",
         pilot,
         100.0 * cfg.precision,
         whole.planned,
@@ -397,7 +398,7 @@ pub fn run(
         whole.at_one,
         whole.at_one / 3600.0 / threads as f64,
         threads,
-        100.0 * whole.in_an_hour
+        hour_buys(whole.in_an_hour)
     ));
     if cfg.plan_only {
         let per_block = cfg
@@ -666,4 +667,14 @@ fn note(cfg: &Config, reference: &Row, rows: &[Row], cheapest: Option<&Row>) -> 
         );
     }
     s
+}
+
+/// What an hour buys, in words: `precision_in_an_hour` searches up to ±50 %, so at that bound
+/// it means "±50 % or worse", not ±50 %.
+fn hour_buys(p: f64) -> String {
+    if p >= PRECISION_SEARCH_MAX {
+        "no better than ±50 %".into()
+    } else {
+        format!("±{:.2} %", 100.0 * p)
+    }
 }
