@@ -451,6 +451,29 @@ fn checker() -> Checker {
     Checker::new(&read(&root().join("docs/json.md")))
 }
 
+/// `tradeoff`'s flags at its coarsest: the pilot (1,000 rolls of every method) costs a few CPU
+/// seconds.
+const TINY_TRADEOFF: &[&str] = &[
+    "--dts",
+    "1/10",
+    "--rapier-dts",
+    "1/10",
+    "--reference-dt",
+    "1/20",
+    "--max-steps",
+    "2000",
+    "--ladder",
+    "none",
+    "--precision",
+    "50",
+    "--budget",
+    "1",
+    "--reference-budget",
+    "1",
+    "--threads",
+    "2",
+];
+
 /// A command's `--json` document.
 fn run(args: &[&str]) -> Value {
     json(&dicephys(args))
@@ -670,61 +693,21 @@ fn json_md_lists_the_keys_of_tradeoff_and_validate() {
     let mut c = checker();
     // The coarsest steps keep the pilot (1,000 rolls of every method) to a few CPU seconds.
     let (v, f) = study(
-        &[
-            "tradeoff",
-            "--dts",
-            "1/10",
-            "--rapier-dts",
-            "1/10",
-            "--reference-dt",
-            "1/20",
-            "--max-steps",
-            "2000",
-            "--ladder",
-            "none",
-            "--precision",
-            "50",
-            "--budget",
-            "1",
-            "--reference-budget",
-            "1",
-            "--threads",
-            "2",
-        ],
+        &[&["tradeoff"][..], TINY_TRADEOFF].concat(),
         "tradeoff.json",
     );
     assert!(v.get("rolls").is_none() && v["modes"][0].get("cheapest_within").is_some());
     c.document("tradeoff", "tradeoff --json", &v);
     c.document("tradeoff", "tradeoff.json", &f);
     // Two blocks, 3D only: each block's study and each method across them.
-    let (v, f) = study(
-        &[
-            "tradeoff",
-            "--blocks",
-            "140x24x20,140x22x13",
-            "--modes",
-            "3d",
-            "--dts",
-            "1/10",
-            "--rapier-dts",
-            "1/10",
-            "--reference-dt",
-            "1/20",
-            "--max-steps",
-            "2000",
-            "--ladder",
-            "none",
-            "--precision",
-            "50",
-            "--budget",
-            "1",
-            "--reference-budget",
-            "1",
-            "--threads",
-            "2",
-        ],
-        "tradeoff.json",
-    );
+    let blocks = [
+        "tradeoff",
+        "--blocks",
+        "140x24x20,140x22x13",
+        "--modes",
+        "3d",
+    ];
+    let (v, f) = study(&[&blocks[..], TINY_TRADEOFF].concat(), "tradeoff.json");
     assert_eq!(v["per_block"].as_array().unwrap().len(), 2);
     c.document("tradeoff-blocks", "tradeoff --blocks --json", &v);
     c.document("tradeoff-blocks", "tradeoff --blocks tradeoff.json", &f);
