@@ -246,7 +246,7 @@ pub struct Estimate {
 }
 
 /// Settings of the search.
-#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Search {
     /// Starting points of the maximum's search.
     pub starts: usize,

@@ -38,7 +38,7 @@ use params::{Method, ModelSpec, Param};
 use serde::{Deserialize, Serialize};
 
 /// What to fit.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FitConfig {
     /// The measured counts.
     pub rows: Vec<DataRow>,

@@ -192,7 +192,7 @@ impl FitArgs {
         Ok(model)
     }
 
-    fn config(&self) -> Result<FitConfig> {
+    pub fn config(&self) -> Result<FitConfig> {
         let rows = if self.data.as_os_str() == "paper" && !self.data.exists() {
             data::paper_rows()?
         } else {
@@ -247,7 +247,7 @@ pub fn run(a: &FitArgs) -> Result<()> {
             let truth = truth_values(&cfg, truth)?;
             super::study::recover(&cfg, &truth, a.repeats, &place)
         }
-        None => super::study::fit(&cfg, &place),
+        None => super::study::fit(cfg, &place),
     }
 }
 

@@ -1,12 +1,13 @@
 //! `dicephys slurm`: a run as a Slurm job array and a finishing job that merges it exactly
 //! (the scripts: `dicephys::run::slurm`), and `dicephys slurm finish DIR`, the finishing step.
 //! `roll` is split into shards of its throws; the studies (`paper`, `crosscheck`, `converge`,
-//! `tradeoff`, `stability`) chunk by chunk: the plan stores the study's configuration, each
+//! `tradeoff`, `stability`, `fit`) chunk by chunk: the plan stores the study's configuration, each
 //! task runs the library's study from it with its share (`dicephys slurm task DIR K`), and the
-//! finishing job runs it once more.
+//! finishing job runs it once more. A fit of two passes is two such runs, chained.
 
 use super::crosscheck::CrosscheckArgs;
 use super::error::{Error, Result};
+use super::fit::FitArgs;
 use super::paper::PaperArgs;
 use super::roll::RollArgs;
 use super::study;
@@ -16,6 +17,7 @@ use clap::{Args, Subcommand};
 use dicephys::report::summary::RunSummary;
 use dicephys::run::runner::{Checkpoint, ChunkShare};
 use dicephys::run::slurm::{Layout, Options, Plan};
+use dicephys::studies::fit::{FitStudy, Stage, FIRST_PASS};
 use dicephys::studies::outputs::{self, Place};
 use dicephys::studies::StudyConfig;
 use std::path::{Path, PathBuf};
@@ -43,6 +45,9 @@ pub enum SlurmCommand {
     Tradeoff(Box<SlurmStudyArgs<TradeoffArgs>>),
     /// `stability` as a job array; the finishing job writes the study into --dir.
     Stability(Box<SlurmStudyArgs<StabilityArgs>>),
+    /// `fit` as job arrays: the first pass into --dir/first-pass, then (its box narrowed from
+    /// that result) the second into --dir; one array with --no-refine.
+    Fit(Box<SlurmStudyArgs<FitArgs>>),
     /// The finishing job: check that every task has finished, then merge (roll) or assemble
     /// (the studies) into DIR.
     Finish(FinishArgs),
@@ -70,7 +75,7 @@ pub struct TaskArgs {
 }
 
 /// The scheduler's side: how many tasks, where, which queue.
-#[derive(Args, Debug)]
+#[derive(Args, Clone, Debug)]
 pub struct JobArgs {
     /// Array tasks (each takes --threads cores, default 1).
     #[arg(long)]
@@ -115,10 +120,13 @@ pub struct FinishArgs {
 /// Runs `dicephys slurm`.
 pub fn run(a: &SlurmArgs) -> Result<()> {
     if let Some(flags) = study_of(&a.command)? {
-        return submit_study(flags);
+        let submit = flags.4.submit;
+        let (plan, lay) = stage(flags, true)?;
+        return emit(&[(plan, lay)], submit);
     }
     match &a.command {
         SlurmCommand::Roll(r) => roll(r),
+        SlurmCommand::Fit(f) => fit(f),
         SlurmCommand::Finish(f) => finish(&f.dir),
         SlurmCommand::Task(t) => task(&t.dir, t.k),
         _ => Ok(()),
@@ -169,8 +177,9 @@ fn study_of(c: &SlurmCommand) -> Result<Option<Flags<'_>>> {
     }))
 }
 
-/// `dicephys slurm <study>`: the study checked, run dry, its plan stored, the scripts written.
-fn submit_study((cfg, threads, json, given, job): Flags) -> Result<()> {
+/// `dicephys slurm <study>`: the study checked, run dry (`dry`), its plan stored, the scripts
+/// written.
+fn stage((cfg, threads, json, given, job): Flags, dry: bool) -> Result<(Plan, Layout)> {
     if let Some(flag) = given {
         return Err(Error::Usage(format!(
             "slurm {}: {flag}: the study writes into --dir (its outputs, and its chunks under \
@@ -195,6 +204,14 @@ fn submit_study((cfg, threads, json, given, job): Flags) -> Result<()> {
     // Bad input is refused here, before anything is submitted or stored: the study runs dry,
     // checking its arguments and stopping at its first cell.
     let (lay, opt, bin) = prepare(&plan, job, threads, |lay| {
+        if !dry {
+            // A study that cannot run yet (a fit's second pass) only claims the directory.
+            return Ok(dicephys::run::owner::claim(
+                &lay.dir,
+                cfg.name(),
+                &cfg.identity(),
+            )?);
+        }
         let dry = Place::cluster(lay, threads, json, ChunkShare::DryRun, &line);
         match study::run(&cfg, &dry) {
             Ok(()) | Err(Error::Interrupted(_)) => Ok(()),
@@ -203,7 +220,54 @@ fn submit_study((cfg, threads, json, given, job): Flags) -> Result<()> {
     })?;
     std::fs::create_dir_all(lay.tasks())
         .map_err(|e| Error::Run(format!("{}: {e}", lay.tasks().display())))?;
-    emit(&plan, &lay, &opt, &bin, job.submit)
+    lay.write_scripts(&plan, &opt, &bin)?;
+    Ok((plan, lay))
+}
+
+/// `dicephys slurm fit`: one array, or two passes as two: the first pass's tasks, its finishing
+/// job (the first pass's estimate, `first-pass.json`), then the second pass's tasks over the box
+/// narrowed from it, and its finishing job (the fit). The second pass's box is only known when
+/// the first has finished, so its jobs wait for the first's finishing job.
+fn fit(a: &SlurmStudyArgs<FitArgs>) -> Result<()> {
+    let s = &a.study;
+    if s.recover.is_some() {
+        return Err(Error::Usage(
+            "slurm fit: --recover: not available through Slurm (fit --recover on one machine)"
+                .into(),
+        ));
+    }
+    let config = s.config()?;
+    let given = s.out.is_some().then_some("--out");
+    let flags = |stage, job| {
+        let cfg = StudyConfig::Fit(FitStudy {
+            config: config.clone(),
+            stage,
+        });
+        (cfg, s.threads, s.json, given, job)
+    };
+    if !config.design.refine {
+        let one = stage(flags(Stage::Whole, &a.job), true)?;
+        return emit(&[one], a.job.submit);
+    }
+    let made = !a.job.dir.exists();
+    let first_job = JobArgs {
+        dir: a.job.dir.join("first-pass"),
+        ..a.job.clone()
+    };
+    let staged = stage(flags(Stage::First, &first_job), true).and_then(|first| {
+        let from = first.1.dir.join(FIRST_PASS);
+        let second = stage(flags(Stage::Second { first: from }, &a.job), false)?;
+        Ok([first, second])
+    });
+    match staged {
+        Ok(stages) => emit(&stages, a.job.submit),
+        Err(e) => {
+            if made {
+                let _ = std::fs::remove_dir_all(&a.job.dir);
+            }
+            Err(e)
+        }
+    }
 }
 
 /// One array task of a study: the study with this task's share of the chunks, then its mark.
@@ -266,7 +330,8 @@ fn roll(a: &SlurmRollArgs) -> Result<()> {
     for k in 0..a.job.tasks {
         Checkpoint::open(&lay.checkpoint(k), &Plan::shard_spec(&spec, k, a.job.tasks))?;
     }
-    emit(&plan, &lay, &opt, &bin, a.job.submit)
+    lay.write_scripts(&plan, &opt, &bin)?;
+    emit(&[(plan, lay)], a.job.submit)
 }
 
 /// Checks the job options, makes the directory, runs `check` on it, and stores the plan in it
@@ -314,30 +379,52 @@ fn prepare(
     Ok((lay, opt, bin))
 }
 
-/// Writes both scripts; prints them, or submits them and prints the job ids.
-fn emit(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path, submit: bool) -> Result<()> {
-    let [array, fin] = lay.write_scripts(plan, opt, bin)?;
-    let (a, f) = (lay.array_script(), lay.finish_script());
+/// Prints each stage's scripts and how to submit them, or submits them and prints the job ids:
+/// each stage's array, then its finishing job once the array has ended; a later stage's array
+/// once the earlier stage's finishing job has succeeded.
+fn emit(stages: &[(Plan, Layout)], submit: bool) -> Result<()> {
     if !submit {
-        outln!("# {}\n{array}", a.display());
-        outln!("# {}\n{fin}", f.display());
-        out!("{}", lay.instructions(plan));
+        for (_, lay) in stages {
+            for p in [lay.array_script(), lay.finish_script()] {
+                let text = std::fs::read_to_string(&p)
+                    .map_err(|e| Error::Run(format!("{}: {e}", p.display())))?;
+                outln!("# {}\n{text}", p.display());
+            }
+        }
+        out!("{}", Layout::instructions(stages));
         return Ok(());
     }
-    let array_id = sbatch(&[a.as_os_str()])?;
-    let dep = format!("--dependency=afterany:{array_id}");
-    let fin_id = sbatch(&[std::ffi::OsStr::new(&dep), f.as_os_str()])?;
-    outln!(
-        "array job {array_id} ({} tasks), finishing job {fin_id}",
-        plan.tasks()
-    );
-    outln!("result: {}", lay.result_of(plan));
-    outln!("logs: {}", lay.logs().display());
+    let mut after: Option<String> = None;
+    for (i, (plan, lay)) in stages.iter().enumerate() {
+        let mut args: Vec<std::ffi::OsString> = Vec::new();
+        if let Some(prev) = &after {
+            args.push("--kill-on-invalid-dep=yes".into());
+            args.push(format!("--dependency=afterok:{prev}").into());
+        }
+        args.push(lay.array_script().into_os_string());
+        let array_id = sbatch(&args)?;
+        let dep = format!("--dependency=afterany:{array_id}");
+        let fin_id = sbatch(&[dep.into(), lay.finish_script().into_os_string()])?;
+        let pass = match (stages.len(), i) {
+            (1, _) => "",
+            (_, 0) => "first pass: ",
+            _ => "second pass: ",
+        };
+        outln!(
+            "{pass}array job {array_id} ({} tasks), finishing job {fin_id}",
+            plan.tasks()
+        );
+        after = Some(fin_id);
+    }
+    if let Some((plan, lay)) = stages.last() {
+        outln!("result: {}", lay.result_of(plan));
+        outln!("logs: {}", lay.logs().display());
+    }
     Ok(())
 }
 
 /// Runs `sbatch --parsable ARGS` and returns the job id it prints.
-fn sbatch(args: &[&std::ffi::OsStr]) -> Result<String> {
+fn sbatch(args: &[std::ffi::OsString]) -> Result<String> {
     let out = std::process::Command::new("sbatch")
         .arg("--parsable")
         .args(args)

@@ -28,7 +28,10 @@ pub fn run(cfg: &StudyConfig, place: &Place) -> Result<()> {
     // Bars as before: paper's rolls, and the CPU of a study rolled to a precision.
     let bar = matches!(
         cfg,
-        StudyConfig::Paper(_) | StudyConfig::Tradeoff(_) | StudyConfig::Converge(_)
+        StudyConfig::Paper(_)
+            | StudyConfig::Tradeoff(_)
+            | StudyConfig::Converge(_)
+            | StudyConfig::Fit(_)
     ) && cfg.unit() != outputs::Unit::Cells;
     with_hooks(cfg.name(), cfg.unit(), bar, place.json, |hooks| {
         outputs::run(cfg, place, hooks)
@@ -90,13 +93,21 @@ fn with_hooks(
     }
 }
 
-/// Runs `fit`.
-pub fn fit(cfg: &dicephys::calibration::FitConfig, place: &Place) -> Result<()> {
+/// Runs `fit` on one machine.
+pub fn fit(cfg: dicephys::calibration::FitConfig, place: &Place) -> Result<()> {
+    let study = dicephys::studies::fit::FitStudy {
+        config: cfg,
+        stage: dicephys::studies::fit::Stage::Whole,
+    };
+    run_fit(&study, place)
+}
+
+fn run_fit(study: &dicephys::studies::fit::FitStudy, place: &Place) -> Result<()> {
     let unit = outputs::Unit::Rolls {
-        per_cell: cfg.design.rolls,
+        per_cell: study.config.design.rolls,
     };
     with_hooks("fit", unit, true, place.json, |hooks| {
-        dicephys::studies::fit::outputs::fit(cfg, place, hooks)
+        dicephys::studies::fit::outputs::fit(study, place, hooks)
     })
 }
 

@@ -50,6 +50,27 @@ pub fn fixed_text(res: &FitResult) -> String {
     }
 }
 
+/// What a first pass of two prints: each parameter's maximum and profile 2σ interval (under
+/// χ²'s bounds: the bootstrap's factor is the last pass's), from which the second pass's box
+/// is drawn.
+pub fn first_pass_text(res: &FitResult) -> String {
+    let mut s = format!(
+        "First pass of a fit ({} rolls; the second pass narrows its box from it):\n",
+        res.cost.rolls
+    );
+    for p in &res.estimate.params {
+        let _ = writeln!(
+            s,
+            "  {:<16} {:>9}   2σ {} – {}",
+            p.name,
+            num(p.value),
+            num(p.two_sigma[0]),
+            num(p.two_sigma[1])
+        );
+    }
+    s
+}
+
 /// `report.md` for a fit; `figures` are the stems written beside it.
 pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
     let e = &res.estimate;

@@ -8,7 +8,7 @@
 //! [`RunSpec`]. A task runs `dicephys roll --resume DIR/shard-K`, so a task that is requeued
 //! or resubmitted continues from its last whole chunk, and no command line is ever re-parsed.
 //!
-//! A study of several cells (`paper`, `crosscheck`, `converge`, `tradeoff`, `stability`) is
+//! A study of several cells (`paper`, `crosscheck`, `converge`, `tradeoff`, `stability`, `fit`) is
 //! split chunk by chunk instead ([`crate::run::runner::ChunkShare`]): the plan holds the
 //! study's configuration, serialized; task K runs the study from it with its share of the
 //! chunks, into the checkpoint directories under `DIR` that all tasks share, and marks itself
@@ -235,15 +235,28 @@ impl Layout {
         }
     }
 
-    /// How to submit the two scripts by hand, as shell comments.
-    pub fn instructions(&self, plan: &Plan) -> String {
-        let (a, f) = (self.array_script(), self.finish_script());
-        format!(
-            "# submit with:\n#   jid=$(sbatch --parsable {})\n#   sbatch --dependency=afterany:${{jid%%;*}} {}\n# result: {}\n",
-            quote(&a.to_string_lossy()),
-            quote(&f.to_string_lossy()),
-            self.result_of(plan)
-        )
+    /// How to submit the scripts of `stages` by hand, as shell comments: each stage's array,
+    /// its finishing job once the array has ended, and the next stage's array once that
+    /// finishing job has succeeded (a fit's second pass needs its first pass's result).
+    pub fn instructions(stages: &[(Plan, Layout)]) -> String {
+        let mut s = String::from("# submit with:\n");
+        let mut after = String::new();
+        for (i, (_, lay)) in stages.iter().enumerate() {
+            let a = quote(&lay.array_script().to_string_lossy());
+            let f = quote(&lay.finish_script().to_string_lossy());
+            s += &format!("#   a{i}=$(sbatch --parsable {after}{a})\n");
+            let dep = format!("--dependency=afterany:${{a{i}%%;*}}");
+            if i + 1 == stages.len() {
+                s += &format!("#   sbatch {dep} {f}\n");
+            } else {
+                s += &format!("#   f{i}=$(sbatch --parsable {dep} {f})\n");
+                after = format!("--kill-on-invalid-dep=yes --dependency=afterok:${{f{i}%%;*}} ");
+            }
+        }
+        if let Some((plan, lay)) = stages.last() {
+            s += &format!("# result: {}\n", lay.result_of(plan));
+        }
+        s
     }
 
     /// The plan, `slurm.json`.

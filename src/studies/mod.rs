@@ -53,6 +53,8 @@ pub enum StudyConfig {
     Tradeoff(tradeoff::Config),
     /// `stability`.
     Stability(stability::Config),
+    /// `fit`, or one of its two passes.
+    Fit(fit::FitStudy),
 }
 
 impl StudyConfig {
@@ -92,6 +94,7 @@ impl StudyConfig {
             StudyConfig::Converge(_) => "converge",
             StudyConfig::Tradeoff(_) => "tradeoff",
             StudyConfig::Stability(_) => "stability",
+            StudyConfig::Fit(_) => "fit",
         }
     }
 
@@ -103,6 +106,7 @@ impl StudyConfig {
             StudyConfig::Converge(c) => c.validate(),
             StudyConfig::Tradeoff(c) => c.validate(),
             StudyConfig::Stability(c) => c.validate(),
+            StudyConfig::Fit(c) => c.validate(),
         }
     }
 

@@ -72,6 +72,9 @@ impl StudyConfig {
             },
             StudyConfig::Converge(c) if c.precision.is_some() => Unit::Cpu,
             StudyConfig::Tradeoff(_) => Unit::Cpu,
+            StudyConfig::Fit(c) => Unit::Rolls {
+                per_cell: c.config.design.rolls,
+            },
             _ => Unit::Cells,
         }
     }
@@ -229,6 +232,7 @@ pub fn run(config: &StudyConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
         StudyConfig::Converge(c) => converge(c, place, hooks),
         StudyConfig::Tradeoff(c) => tradeoff(c, place, hooks),
         StudyConfig::Stability(c) => stability(c, place, hooks),
+        StudyConfig::Fit(c) => studies::fit::outputs::fit(c, place, hooks),
     }
 }
 

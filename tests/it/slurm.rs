@@ -459,3 +459,139 @@ fn a_tradeoff_rolled_ahead_by_tasks_finishes_as_on_one_machine() {
     let _ = std::fs::remove_dir_all(&dir);
     let _ = std::fs::remove_dir_all(&one);
 }
+
+/// The counts of a small fit (two 2D MDF blocks) and its flags: 20 points × 100 rolls a block.
+fn small_fit(dir: &Path) -> Vec<String> {
+    let csv = dir.join("counts.csv");
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(
+        &csv,
+        "label,surface,length_mm,breadth_mm,width_mm,mode,length_vertical,breadth_vertical,\
+         width_vertical\na,MDF,140,24,20,2d,0,361,639\nb,MDF,140,30,10,2d,0,40,460\n",
+    )
+    .unwrap();
+    let flags = "--free e,mu --points 20 --degree 2 --rolls 100 --dt 1/250 --json";
+    let mut v = vec!["--data".to_string(), csv.display().to_string()];
+    v.extend(flags.split(' ').map(String::from));
+    v
+}
+
+/// What makes two fits the same fit: everything but the cost, the command line and the date.
+fn same_fit(a: &serde_json::Value, b: &serde_json::Value) {
+    for key in ["config", "estimate", "designs", "params", "first_pass"] {
+        assert_eq!(a[key], b[key], "{key} differs");
+    }
+    assert_eq!(a["cost"]["rolls"], b["cost"]["rolls"]);
+}
+
+/// `slurm fit` by hand: the first pass's tasks and finishing step, then the second's (its box
+/// narrowed from the first's result); the fit is the one machine's, bit for bit. The second
+/// pass before the first has finished is refused, saying why.
+#[test]
+fn a_fit_split_by_hand_into_two_passes_is_the_one_machine_fit() {
+    let dir = tmp("fit-by-hand");
+    let (run, one) = (dir.join("run"), dir.join("one"));
+    let fit = small_fit(&dir);
+    let fit: Vec<&str> = fit.iter().map(String::as_str).collect();
+    let slurm = |args: &[&str]| bin().arg("slurm").args(args).output().unwrap();
+    let d = run.to_str().unwrap();
+    let first = format!("{d}/first-pass");
+    let out = slurm(&[&["fit"], &fit[..], &["--tasks", "2", "--dir", d]].concat());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("--dependency=afterok:"), "{text}");
+    let early = slurm(&["task", d, "0"]);
+    assert_eq!(early.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&early.stderr).contains("the first pass has not finished"));
+    for k in ["0", "1"] {
+        assert!(slurm(&["task", &first, k]).status.success(), "task {k}");
+    }
+    let first_pass = json(&slurm(&["finish", &first]));
+    assert!(first_pass["first_pass"].is_null());
+    for k in ["0", "1"] {
+        assert!(slurm(&["task", d, k]).status.success(), "task {k}");
+    }
+    let split = json(&slurm(&["finish", d]));
+    let whole = json(
+        &bin()
+            .arg("fit")
+            .args(&fit)
+            .arg("--out")
+            .arg(&one)
+            .output()
+            .unwrap(),
+    );
+    assert!(whole["first_pass"].is_array(), "the default fit refines");
+    same_fit(&split, &whole);
+    assert!(run.join("report.md").exists() && run.join("fit_rows.svg").exists());
+    // Its own flags are refused: --recover runs on one machine, --out is --dir.
+    for (flag, value) in [("--recover", "e=0.5,mu=0.3"), ("--out", "x")] {
+        let bad = tmp("fit-by-hand-bad");
+        let b = bad.to_str().unwrap();
+        let args = [
+            &["fit"],
+            &fit[..],
+            &[flag, value, "--tasks", "2", "--dir", b],
+        ];
+        let out = slurm(&args.concat());
+        assert_eq!(out.status.code(), Some(2), "{flag}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains(flag));
+        assert!(!bad.exists(), "{flag}: nothing made");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `slurm fit --submit` on the one-node cluster: four jobs chained (each pass's array and its
+/// finishing job, the second pass after the first's); the fit is the one machine's.
+#[test]
+fn a_fit_through_slurm_is_the_one_machine_fit() {
+    let Some(_cluster) = cluster("slurm fit") else {
+        return;
+    };
+    let dir = tmp("fit");
+    let run = dir.join("run");
+    let fit = small_fit(&dir);
+    let out = bin()
+        .args(["slurm", "fit"])
+        .args(&fit)
+        .args(["--tasks", "2", "--dir"])
+        .arg(&run)
+        .arg("--submit")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // "first pass: array job A (2 tasks), finishing job F" and the same for the second pass.
+    let text = String::from_utf8_lossy(&out.stdout);
+    let jobs: Vec<String> = text
+        .lines()
+        .take(2)
+        .flat_map(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            assert!(w.len() == 10 && w[2] == "array", "unexpected: {text}");
+            [w[4].to_string(), w[9].to_string()]
+        })
+        .collect();
+    let jobs: Vec<&str> = jobs.iter().map(String::as_str).collect();
+    let whole = json(
+        &bin()
+            .arg("fit")
+            .args(&fit)
+            .arg("--out")
+            .arg(dir.join("one"))
+            .output()
+            .unwrap(),
+    );
+    wait_gone(&jobs, &run, Duration::from_secs(600));
+    let text = std::fs::read_to_string(run.join("fit.json"))
+        .unwrap_or_else(|e| panic!("no fit.json ({e}):\n{}", diagnose(&jobs, &run)));
+    same_fit(&serde_json::from_str(&text).unwrap(), &whole);
+    let _ = std::fs::remove_dir_all(&dir);
+}

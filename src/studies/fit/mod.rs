@@ -10,9 +10,10 @@ pub mod simulate;
 
 use crate::calibration::design::{self, Design};
 use crate::calibration::{estimate_with, FitConfig, FitCost, FitResult};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::runner::Runner;
+use serde::{Deserialize, Serialize};
 use simulate::Plan;
 pub use simulate::Session;
 use std::path::Path;
@@ -54,8 +55,23 @@ pub struct Fitted {
     pub unsettled: u64,
 }
 
-/// Simulates and estimates, in one pass or two (`cfg.design.refine`). `None` if stopped early.
-pub fn fit(
+/// The search of a first pass that a second will refine: its maximum and profiles only (the
+/// second pass's box is drawn from them; the region and the draws are the last pass's).
+fn first_pass_search(cfg: &FitConfig) -> crate::calibration::estimate::Search {
+    if cfg.design.refine {
+        crate::calibration::estimate::Search {
+            bootstrap: 0,
+            draws: 0,
+            ..cfg.search
+        }
+    } else {
+        cfg.search
+    }
+}
+
+/// The first pass: every row's design simulated over its whole box, and estimated. `None` if
+/// stopped early, or on a cluster task's share (its rolls are for the finishing job).
+pub fn first_pass(
     cfg: &FitConfig,
     runner: &Runner,
     dir: Option<&Path>,
@@ -64,18 +80,9 @@ pub fn fit(
     let Some(designs) = simulate(cfg, runner, dir, session)? else {
         return Ok(None);
     };
-    // A first pass that a second will refine needs only its maximum and profiles.
-    let first_search = if cfg.design.refine {
-        crate::calibration::estimate::Search {
-            bootstrap: 0,
-            draws: 0,
-            ..cfg.search
-        }
-    } else {
-        cfg.search
-    };
-    let (params, estimate) = estimate_with(&cfg.rows, &cfg.model, &designs, &first_search)?;
-    let mut out = Fitted {
+    let (params, estimate) =
+        estimate_with(&cfg.rows, &cfg.model, &designs, &first_pass_search(cfg))?;
+    Ok(Some(Fitted {
         config: cfg.clone(),
         rolls: designs.iter().map(|d| d.rolls).sum(),
         unsettled: designs.iter().map(|d| d.unsettled).sum(),
@@ -83,41 +90,163 @@ pub fn fit(
         designs,
         estimate,
         first_pass: None,
-    };
-    let narrowed = crate::calibration::narrow(&cfg.rows, &cfg.model, &out.params, &out.estimate);
-    if cfg.design.refine && !narrowed.is_empty() {
-        out.config.model.narrowed = narrowed;
-        let Some(second) = simulate(&out.config, runner, dir, session)? else {
-            return Ok(None);
-        };
-        out.rolls += second.iter().map(|d| d.rolls).sum::<u64>();
-        out.unsettled += second.iter().map(|d| d.unsettled).sum::<u64>();
-        let (params, estimate) =
-            estimate_with(&out.config.rows, &out.config.model, &second, &cfg.search)?;
-        out.first_pass = Some(std::mem::replace(&mut out.estimate, estimate).params);
-        out.params = params;
-        out.designs = second;
-    } else if cfg.design.refine {
-        // Nothing to narrow: the first pass is the last, so it gets the full search (the
-        // bootstrap's region and the posterior draws `predict` needs).
-        let (params, estimate) = estimate_with(&cfg.rows, &cfg.model, &out.designs, &cfg.search)?;
-        out.params = params;
-        out.estimate = estimate;
+    }))
+}
+
+/// The second pass over the box narrowed from `first` (a pass with nothing to narrow is the
+/// last: it gets the full search, the bootstrap's region and the posterior draws `predict`
+/// needs). `None` as for [`first_pass`].
+pub fn second_pass(
+    first: Fitted,
+    runner: &Runner,
+    dir: Option<&Path>,
+    session: &Session,
+) -> Result<Option<Fitted>> {
+    let cfg = &first.config;
+    let narrowed =
+        crate::calibration::narrow(&cfg.rows, &cfg.model, &first.params, &first.estimate);
+    if narrowed.is_empty() {
+        let (params, estimate) = estimate_with(&cfg.rows, &cfg.model, &first.designs, &cfg.search)?;
+        return Ok(Some(Fitted {
+            params,
+            estimate,
+            ..first
+        }));
     }
+    let mut out = first;
+    out.config.model.narrowed = narrowed;
+    let Some(second) = simulate(&out.config, runner, dir, session)? else {
+        return Ok(None);
+    };
+    out.rolls += second.iter().map(|d| d.rolls).sum::<u64>();
+    out.unsettled += second.iter().map(|d| d.unsettled).sum::<u64>();
+    let (params, estimate) = estimate_with(
+        &out.config.rows,
+        &out.config.model,
+        &second,
+        &out.config.search,
+    )?;
+    out.first_pass = Some(std::mem::replace(&mut out.estimate, estimate).params);
+    out.params = params;
+    out.designs = second;
     Ok(Some(out))
 }
 
-/// Runs the fit: simulates (resuming from `dir`), then estimates, refining once if asked.
-/// `None` if a stop request ended the simulations early.
-pub fn run(
+/// Simulates and estimates, in one pass or two (`cfg.design.refine`). `None` if stopped early.
+pub fn fit(
     cfg: &FitConfig,
+    runner: &Runner,
+    dir: Option<&Path>,
+    session: &Session,
+) -> Result<Option<Fitted>> {
+    let Some(first) = first_pass(cfg, runner, dir, session)? else {
+        return Ok(None);
+    };
+    if !cfg.design.refine {
+        return Ok(Some(first));
+    }
+    second_pass(first, runner, dir, session)
+}
+
+/// `fit` as a study a cluster splits (`slurm fit`): the whole fit, or one of its two passes.
+/// The second pass's box is narrowed from the first pass's result, so a cluster runs the
+/// passes as two job arrays, the second started when the first has finished.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FitStudy {
+    /// What to fit.
+    pub config: FitConfig,
+    /// Which of it.
+    pub stage: Stage,
+}
+
+/// Which part of a fit a study runs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stage {
+    /// The whole fit, both passes (or its one pass, unrefined).
+    Whole,
+    /// The first of two passes: its designs, and the maximum and profiles the second pass's box
+    /// is drawn from, written as [`FIRST_PASS`].
+    First,
+    /// The second pass, over the box narrowed from the first pass's result in `first`.
+    Second {
+        /// The first pass's [`FIRST_PASS`].
+        first: std::path::PathBuf,
+    },
+}
+
+/// The file a first pass writes (a [`FitResult`] without the region or the draws).
+pub const FIRST_PASS: &str = "first-pass.json";
+
+impl FitStudy {
+    /// Checks every value before anything runs.
+    pub fn validate(&self) -> Result<()> {
+        self.config.validate()?;
+        if self.stage != Stage::Whole && !self.config.design.refine {
+            return Err(Error::field(
+                "stage",
+                "",
+                "a fit of one pass (no `refine`) has no passes to split",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The first pass's result, read back for the second (and checked to be this fit's).
+    fn first(&self, path: &Path) -> Result<Fitted> {
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            Error::Invalid(format!(
+                "{}: the first pass has not finished ({e}): finish it, then run the second",
+                path.display()
+            ))
+        })?;
+        let r: FitResult = serde_json::from_str(&text)
+            .map_err(|e| Error::Invalid(format!("{} is damaged ({e})", path.display())))?;
+        if r.config != self.config {
+            return Err(Error::Invalid(format!(
+                "{} is the first pass of another fit",
+                path.display()
+            )));
+        }
+        Ok(Fitted {
+            config: r.config,
+            params: r.params,
+            designs: r.designs,
+            estimate: r.estimate,
+            first_pass: None,
+            rolls: r.cost.rolls,
+            unsettled: r.cost.unsettled,
+        })
+    }
+
+    /// Runs its part: `None` if stopped early or on a cluster task's share.
+    pub fn fit(&self, runner: &Runner, dir: Option<&Path>) -> Result<Option<Fitted>> {
+        let session = Session::default();
+        match &self.stage {
+            Stage::Whole => fit(&self.config, runner, dir, &session),
+            Stage::First => first_pass(&self.config, runner, dir, &session),
+            Stage::Second { first } => {
+                let first = self.first(first)?;
+                // The first pass's designs are this session's: a key the narrowing left as it
+                // was is taken from them, not rolled again (as on one machine).
+                session.hold(self.config.seed, &first.designs);
+                second_pass(first, runner, dir, &session)
+            }
+        }
+    }
+}
+
+/// Runs the fit, or its part: simulates (resuming from `dir`), then estimates, refining once
+/// if asked. `None` if a stop request ended the simulations early, or on a cluster task's share.
+pub fn run(
+    study: &FitStudy,
     command_line: String,
     runner: &Runner,
     dir: Option<&Path>,
 ) -> Result<Option<FitResult>> {
-    cfg.validate()?;
+    study.validate()?;
     let (wall, cpu) = (Instant::now(), process_cpu_seconds());
-    let Some(f) = fit(cfg, runner, dir, &Session::default())? else {
+    let Some(f) = study.fit(runner, dir)? else {
         return Ok(None);
     };
     Ok(Some(FitResult {

@@ -2,6 +2,7 @@
 //! before anything rolls, the study run with its progress, its results rendered and written
 //! whole (as [`crate::studies::outputs`] does for the other studies).
 
+use super::{FitStudy, Stage, FIRST_PASS};
 use crate::calibration::predict::PredictConfig;
 use crate::calibration::{FitConfig, FitResult};
 use crate::error::Result;
@@ -23,26 +24,48 @@ fn interrupted(place: &Place) -> Done {
 }
 
 /// `fit`: fit.json, report.md and its figures in `place.out`; the simulations' cells under
-/// `place.checkpoint`.
-pub fn fit(cfg: &FitConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
-    cfg.validate()?;
-    let outputs = place.outputs(&["fit.json", "report.md"])?;
+/// `place.checkpoint`. A first pass of two writes only `first-pass.json`; a cluster task's
+/// share writes nothing.
+pub fn fit(study: &FitStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
+    study.validate()?;
+    let first = study.stage == Stage::First;
+    let files: &[&str] = if first {
+        &[FIRST_PASS]
+    } else {
+        &["fit.json", "report.md"]
+    };
+    let outputs = place.outputs(files)?;
+    let cfg = &study.config;
     // Two passes roll about as much as the first twice.
-    let total = cfg.total_rolls() as f64 * if cfg.design.refine { 2.0 } else { 1.0 };
+    let passes = match study.stage {
+        Stage::Whole if cfg.design.refine => 2.0,
+        _ => 1.0,
+    };
+    let total = cfg.total_rolls() as f64 * passes;
     let progress = |n: u64| (hooks.progress)(n as f64, total);
-    let study = place.study(&hooks.stop, &progress);
-    let Some(res) = super::run(
-        cfg,
-        place.command_line.clone(),
-        &study.runner,
-        study.checkpoint.as_deref(),
-    )?
-    else {
+    let sim = place.study(&hooks.stop, &progress);
+    let dir = sim.checkpoint.as_deref();
+    let res = super::run(study, place.command_line.clone(), &sim.runner, dir)?;
+    if place.partial() {
+        return Ok(Done::default());
+    }
+    let Some(res) = res else {
         return Ok(interrupted(place));
     };
+    let json = to_json(&res)?;
+    if first {
+        outputs[0].write(json.as_bytes())?;
+        let mut done = place.done(&json, &report::first_pass_text(&res), FIRST_PASS);
+        done.note = done.note.map(|_| {
+            format!(
+                "wrote {}/{FIRST_PASS}: the first pass, which the second narrows its box from",
+                place.out.display()
+            )
+        });
+        return Ok(done);
+    }
     let figures = report::write_figures(&place.out, &res)?;
     let md = report::markdown(&res, &figures);
-    let json = to_json(&res)?;
     outputs[0].write(json.as_bytes())?;
     outputs[1].write(md.as_bytes())?;
     Ok(place.done(&json, &md, "fit.json"))

@@ -24,6 +24,19 @@ impl Session {
     pub fn rolled(&self) -> u64 {
         self.rolled.load(Ordering::Relaxed)
     }
+
+    /// Holds `designs`, simulated with `seed`, as this session's own.
+    pub fn hold(&self, seed: u64, designs: &[Design]) {
+        let mut cache = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        for d in designs {
+            let key = Key {
+                block: d.block,
+                mode: d.mode,
+                axes: d.axes.clone(),
+            };
+            cache.push((key, seed, d.clone()));
+        }
+    }
 }
 
 /// Everything `simulate` needs.
@@ -49,8 +62,9 @@ impl Plan<'_> {
 }
 
 /// Simulates every key over the design (each point a cell of its own under `dir`, resumed
-/// from there) and fits its surrogate. `None` if a stop request ended it early: what was rolled
-/// is kept in `dir`.
+/// from there) and fits its surrogate. `None` if a stop request ended it early (what was rolled
+/// is kept in `dir`), or on a cluster task's share: its rolls are kept for the finishing job,
+/// which reads them all back.
 pub fn simulate(
     plan: &Plan,
     keys: &[Key],
@@ -105,6 +119,9 @@ pub fn simulate(
             if !done.complete {
                 return Ok(None);
             }
+            if runner.share.is_partial() {
+                continue;
+            }
             let t = &done.tally;
             unsettled += t.rolls - (t.counts.length + t.counts.breadth + t.counts.width);
             rolls += t.rolls;
@@ -112,6 +129,9 @@ pub fn simulate(
                 x: x.clone(),
                 counts: vec![t.counts.length, t.counts.breadth, t.counts.width],
             });
+        }
+        if runner.share.is_partial() {
+            continue;
         }
         // A 2D block has no length outcome: its surrogate is over breadth and width.
         let (outcomes, pts): (usize, Vec<DesignPoint>) = match mode {
@@ -150,5 +170,5 @@ pub fn simulate(
             .push((key.clone(), plan.seed, design.clone()));
         out.push(design);
     }
-    Ok(Some(out))
+    Ok((!runner.share.is_partial()).then_some(out))
 }
