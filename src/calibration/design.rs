@@ -36,6 +36,10 @@ pub struct DesignSpec {
     /// A second pass: every block simulated afresh over a box narrowed to the first pass's
     /// region ([`crate::calibration::narrow`]), and the fit made again there.
     pub refine: bool,
+    /// Common random numbers: the same keyed throws at every point of a block, instead of
+    /// independent ones (kept for comparison: docs/results/calibration.md measures both).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub common: bool,
 }
 
 impl Default for DesignSpec {
@@ -46,6 +50,7 @@ impl Default for DesignSpec {
             degree: 3,
             max_degree: 4,
             refine: true,
+            common: false,
         }
     }
 }

@@ -72,6 +72,10 @@ pub struct FitArgs {
     /// One pass only: no second pass over the box narrowed to the first pass's region.
     #[arg(long)]
     pub no_refine: bool,
+    /// The same throws at every design point (common random numbers) rather than independent
+    /// ones, to compare the two (docs/results/calibration.md).
+    #[arg(long)]
+    pub common_throws: bool,
     /// Seed of the keyed throws.
     #[arg(long, default_value_t = 2385)]
     pub seed: u64,
@@ -218,6 +222,7 @@ impl FitArgs {
                 degree: self.degree,
                 max_degree: self.max_degree,
                 refine: !self.no_refine,
+                common: self.common_throws,
             },
             search: Search {
                 seed: self.seed,

@@ -97,7 +97,8 @@ pub fn simulate(
         let (mut unsettled, mut rolls) = (0u64, 0u64);
         for (g, x) in xs.iter().enumerate() {
             let values = params::values(&plan.model.fixed, &key.axes, x);
-            let seed = key.seed(plan.seed, g);
+            // Common random numbers: every point the throws of the first.
+            let seed = key.seed(plan.seed, if plan.design.common { 0 } else { g });
             let spec = plan
                 .method
                 .spec(block, mode, &values, seed, plan.design.rolls);
