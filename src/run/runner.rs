@@ -91,6 +91,14 @@ impl ChunkShare {
         }
     }
 
+    /// The tasks the run is split among (1 when it is not split).
+    pub fn tasks(&self) -> u64 {
+        match self {
+            ChunkShare::Task { n, .. } | ChunkShare::Assemble { n, .. } => *n,
+            _ => 1,
+        }
+    }
+
     /// The finishing job's first chunk missing or damaged: the task that rolls it, and why.
     pub fn lacking(&self) -> Option<(u64, String)> {
         match self {

@@ -5,6 +5,7 @@
 
 pub mod bench;
 pub mod calibrated;
+pub mod cluster;
 pub mod converge;
 pub mod crosscheck;
 pub mod departure;
