@@ -280,7 +280,7 @@ pub fn mark(dir: &Path, k: u64, tasks: u64) -> Result<String> {
 pub enum Finishing {
     /// Run the study once more (the caller, with its hooks), reading every chunk; then
     /// [`finished`].
-    Study(StudyConfig, Place, u64),
+    Study(Box<StudyConfig>, Place, u64),
     /// A `roll`'s shards merged: the text to print (the JSON and the text are written).
     Roll(String),
 }
@@ -298,7 +298,7 @@ pub fn finishing(dir: &Path) -> Result<Finishing> {
             // whose tasks rolled ahead, runs here, rolling on where a method needs more).
             let (cfg, place, _) = outputs::planned(&lay)?;
             let (cfg, share) = cfg.finishing(tasks);
-            Ok(Finishing::Study(cfg, Place { share, ..place }, tasks))
+            Ok(Finishing::Study(Box::new(cfg), Place { share, ..place }, tasks))
         }
         Plan::Roll { spec, tasks } => {
             let text = crate::report::summary::RunSummary::merge_tasks(&lay, &spec, tasks)?;
