@@ -298,7 +298,11 @@ pub fn finishing(dir: &Path) -> Result<Finishing> {
             // whose tasks rolled ahead, runs here, rolling on where a method needs more).
             let (cfg, place, _) = outputs::planned(&lay)?;
             let (cfg, share) = cfg.finishing(tasks);
-            Ok(Finishing::Study(Box::new(cfg), Place { share, ..place }, tasks))
+            Ok(Finishing::Study(
+                Box::new(cfg),
+                Place { share, ..place },
+                tasks,
+            ))
         }
         Plan::Roll { spec, tasks } => {
             let text = crate::report::summary::RunSummary::merge_tasks(&lay, &spec, tasks)?;
