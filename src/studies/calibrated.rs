@@ -108,8 +108,15 @@ pub fn models(rows: &[DataRow]) -> Vec<(&'static str, &'static str, ModelSpec, V
     ]
 }
 
-/// The rolls the first passes make (the second passes roll about as many again).
-pub fn first_pass_rolls(cfg: &CalibratedConfig) -> Result<u64> {
+/// The rolls the study makes, about: the first passes twice (the second passes roll about as
+/// many again), and the method check's two methods on every block.
+pub fn total_rolls(cfg: &CalibratedConfig) -> Result<u64> {
+    let blocks = crate::calibration::design::blocks(&paper_rows()?).len() as u64;
+    Ok(2 * first_pass_rolls(cfg)? + 2 * cfg.check_rolls * blocks)
+}
+
+/// The rolls the first passes make.
+fn first_pass_rolls(cfg: &CalibratedConfig) -> Result<u64> {
     let rows = paper_rows()?;
     Ok(models(&rows)
         .into_iter()
@@ -283,6 +290,7 @@ pub fn run(
         cfg.check_rolls,
         cfg.seed,
         runner,
+        session.rolled(),
     )?
     else {
         return Ok(None);

@@ -11,7 +11,9 @@ use crate::run::runner::Runner;
 use crate::sim::roll::Fate;
 
 /// Checks `method` against `reference_dt` at the values `at(row)` gives each row's block, with
-/// `rolls` throws a block. `None` if stopped early.
+/// `rolls` throws a block; the progress it reports goes on from `rolled`, the rolls made
+/// before it. `None` if stopped early.
+#[allow(clippy::too_many_arguments)]
 pub fn run(
     rows: &[DataRow],
     method: &Method,
@@ -20,6 +22,7 @@ pub fn run(
     rolls: u64,
     seed: u64,
     runner: &Runner,
+    mut rolled: u64,
 ) -> Result<Option<MethodCheck>> {
     let reference = Method {
         dt: reference_dt,
@@ -37,10 +40,15 @@ pub fn run(
         for (i, m) in [method, &reference].iter().enumerate() {
             let spec = m.spec(block, mode, &values, seed, rolls);
             spec.validate(false)?;
-            let done = runner.run(&spec, None, &mut |recs| {
-                fates[i].extend(recs.iter().map(|r| r.fate));
-                Ok(())
-            })?;
+            let before = rolled;
+            let progress = |n| (runner.progress)(before + n);
+            let done = runner
+                .with_progress(&progress)
+                .run(&spec, None, &mut |recs| {
+                    fates[i].extend(recs.iter().map(|r| r.fate));
+                    Ok(())
+                })?;
+            rolled += done.tally.rolls;
             if !done.complete {
                 return Ok(None);
             }

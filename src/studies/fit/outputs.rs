@@ -127,8 +127,7 @@ pub fn predict(fit: &FitResult, cfg: &PredictConfig, place: &Place, hooks: &Hook
 /// under `place.checkpoint`.
 pub fn calibrated(cfg: &CalibratedConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
     let outputs = place.outputs(&["calibrated.json", "calibrated.md"])?;
-    // Both passes roll about as much as the first.
-    let total = 2.0 * calibrated::first_pass_rolls(cfg)? as f64;
+    let total = calibrated::total_rolls(cfg)? as f64;
     let progress = |n: u64| (hooks.progress)(n as f64, total);
     let study = place.study(&hooks.stop, &progress);
     let Some(res) = calibrated::run(
