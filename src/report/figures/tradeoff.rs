@@ -340,9 +340,13 @@ impl Figure {
                 chart
                     .draw_series(std::iter::once(Circle::new(at, 5, style)))
                     .map_err(plot_err)?;
-            } else {
+            } else if m.resolved {
                 chart
                     .draw_series(std::iter::once(TriangleMarker::new(at, 6, style)))
+                    .map_err(plot_err)?;
+            } else {
+                chart
+                    .draw_series(std::iter::once(EmptyElement::at(at) + hollow_triangle(6)))
                     .map_err(plot_err)?;
             }
             if m.cheapest {
@@ -438,8 +442,11 @@ impl Figure {
             };
             if two_d {
                 area.draw(&Circle::new(at, 5, style)).map_err(plot_err)?;
-            } else {
+            } else if resolved {
                 area.draw(&TriangleMarker::new(at, 6, style))
+                    .map_err(plot_err)?;
+            } else {
+                area.draw(&(EmptyElement::at(at) + hollow_triangle(6)))
                     .map_err(plot_err)?;
             }
             area.draw(&Text::new(
@@ -449,13 +456,27 @@ impl Figure {
             ))
             .map_err(plot_err)
         };
-        mark(y, "3D method, resolved (2σ ≤ precision)", false, true)?;
+        // Only the modes the figure draws.
+        let has = |two_d: bool| {
+            self.panels
+                .iter()
+                .any(|p| p.methods.iter().any(|m| m.two_d == two_d))
+        };
+        let (three, two) = (has(false), has(true));
+        if three {
+            mark(y, "3D method, resolved (2σ ≤ precision)", false, true)?;
+            y += line;
+        }
+        if two {
+            mark(y, "2D method, resolved", true, true)?;
+            y += line;
+        }
+        mark(y, "unresolved within its budget (hollow)", two, false)?;
         y += line;
-        mark(y, "2D method, resolved", true, true)?;
-        y += line;
-        mark(y, "unresolved within its budget (hollow)", true, false)?;
-        y += line;
-        for (_, color, mode) in MODE_COLORS {
+        for (two_d, color, mode) in MODE_COLORS {
+            if !has(two_d) {
+                continue;
+            }
             area.draw(&PathElement::new(
                 vec![(6, y + 7), (26, y + 7)],
                 color.stroke_width(2),
@@ -514,6 +535,16 @@ impl Figure {
         }
         Ok(())
     }
+}
+
+/// An unresolved 3D method's marker: plotters' `TriangleMarker` is always filled, so the hollow
+/// triangle is its outline, in pixels about the point (the same size and shape).
+fn hollow_triangle(size: i32) -> PathElement<(i32, i32)> {
+    let (h, w) = (size / 2, size * 866 / 1000);
+    PathElement::new(
+        vec![(0, -size), (w, h), (-w, h), (0, -size)],
+        GREY.stroke_width(1),
+    )
 }
 
 #[cfg(test)]
