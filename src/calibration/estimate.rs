@@ -505,7 +505,7 @@ mod tests {
     use super::*;
     use crate::calibration::data::DataRow;
     use crate::calibration::design::{points, Design};
-    use crate::calibration::params::{Fixed, Kind};
+    use crate::calibration::params::Kind;
     use crate::inference::surrogate::{DesignPoint, Surrogate};
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
@@ -576,17 +576,7 @@ mod tests {
                 rolls: 64 * 500,
             });
         }
-        let model = ModelSpec {
-            free: vec![Kind::E, Kind::Mu, Kind::Kappa],
-            shared: vec![],
-            ranges: vec![
-                Kind::E.default_range(),
-                Kind::Mu.default_range(),
-                Kind::Kappa.default_range(),
-            ],
-            fixed: Fixed::default(),
-            narrowed: vec![],
-        };
+        let model = ModelSpec::free(&[Kind::E, Kind::Mu, Kind::Kappa]);
         let params = model.params(&rows);
         let lik = Likelihood::new(&rows, &designs, &model, &params);
         let (best, _) = maximise(&lik, 3, 4).unwrap();

@@ -220,6 +220,18 @@ impl Param {
 }
 
 impl ModelSpec {
+    /// `kinds` free over their default ranges, one per surface and thrower, the rest at
+    /// [`Fixed::default`].
+    pub fn free(kinds: &[Kind]) -> ModelSpec {
+        ModelSpec {
+            free: kinds.to_vec(),
+            shared: vec![],
+            ranges: kinds.iter().map(|k| k.default_range()).collect(),
+            fixed: Fixed::default(),
+            narrowed: vec![],
+        }
+    }
+
     /// Checks the model: kinds not repeated, ranges inside their limits and not empty, fixed
     /// values physical.
     pub fn validate(&self) -> Result<()> {
@@ -434,17 +446,7 @@ mod tests {
     #[test]
     fn rows_map_to_their_surface_and_thrower() {
         let rows = crate::calibration::data::paper_rows().unwrap();
-        let m = ModelSpec {
-            free: vec![Kind::E, Kind::Mu, Kind::Kappa],
-            shared: vec![],
-            ranges: vec![
-                Kind::E.default_range(),
-                Kind::Mu.default_range(),
-                Kind::Kappa.default_range(),
-            ],
-            fixed: Fixed::default(),
-            narrowed: vec![],
-        };
+        let m = ModelSpec::free(&[Kind::E, Kind::Mu, Kind::Kappa]);
         m.validate().unwrap();
         let params = m.params(&rows);
         // Five surfaces, each its e and μ, and one κ.

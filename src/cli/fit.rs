@@ -164,7 +164,7 @@ impl FitArgs {
         let mut free = self.free.clone();
         free.sort();
         free.dedup();
-        let mut ranges: Vec<Range> = free.iter().map(|k| k.default_range()).collect();
+        let mut model = ModelSpec::free(&free);
         let given: Vec<&str> = self.ranges.iter().map(String::as_str).collect();
         for (kind, r) in pairs("--range", &given, |v| {
             v.parse::<Range>().map_err(|e| e.to_string())
@@ -172,7 +172,7 @@ impl FitArgs {
             let i = free.iter().position(|k| *k == kind).ok_or_else(|| {
                 Error::Usage(format!("--range {kind}=…: {kind} is not among --free"))
             })?;
-            ranges[i] = r;
+            model.ranges[i] = r;
         }
         let throw = match self.kappa.as_str() {
             "paper" => FixedThrow::Paper,
@@ -180,17 +180,12 @@ impl FitArgs {
                 Error::Usage(format!("--kappa {k}: 'paper' or a concentration >= 0"))
             })?),
         };
-        let model = ModelSpec {
-            free,
-            shared: self.shared.clone(),
-            ranges,
-            fixed: Fixed {
-                e: self.restitution,
-                mu: self.friction,
-                throw,
-                spin: self.spin_scale,
-            },
-            narrowed: vec![],
+        model.shared = self.shared.clone();
+        model.fixed = Fixed {
+            e: self.restitution,
+            mu: self.friction,
+            throw,
+            spin: self.spin_scale,
         };
         model.validate()?;
         Ok(model)

@@ -146,7 +146,7 @@ pub fn run(a: &SlurmArgs) -> Result<()> {
                 json,
                 command_line: &line,
             };
-            (cluster::fit(&s, &job.job())?, job)
+            (cluster::stages(&s, &job.job())?, job)
         }
     };
     if job.submit {

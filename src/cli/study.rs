@@ -99,15 +99,11 @@ pub fn fit(cfg: dicephys::calibration::FitConfig, place: &Place) -> Result<()> {
         config: cfg,
         stage: dicephys::studies::fit::Stage::Whole,
     };
-    run_fit(&study, place)
-}
-
-fn run_fit(study: &dicephys::studies::fit::FitStudy, place: &Place) -> Result<()> {
     let unit = outputs::Unit::Rolls {
         per_cell: study.config.design.rolls,
     };
     with_hooks("fit", unit, true, place.json, |hooks| {
-        dicephys::studies::fit::outputs::fit(study, place, hooks)
+        dicephys::studies::fit::outputs::fit(&study, place, hooks)
     })
 }
 

@@ -15,7 +15,7 @@ use crate::calibration::data::{paper_rows, DataRow};
 use crate::calibration::design::DesignSpec;
 use crate::calibration::estimate::Search;
 use crate::calibration::paper::{CalibratedPaper, Decision, TheoryRow};
-use crate::calibration::params::{self, Fixed, Kind, Method, ModelSpec};
+use crate::calibration::params::{self, Kind, Method, ModelSpec};
 use crate::calibration::{FitConfig, FitCost, FitResult};
 use crate::error::Result;
 use crate::model::scene::Mode;
@@ -48,20 +48,8 @@ pub const LONG_MM: f64 = 300.0;
 
 /// The models compared: name, description, model, rows.
 pub fn models(rows: &[DataRow]) -> Vec<(&'static str, &'static str, ModelSpec, Vec<DataRow>)> {
-    let kinds = |k: &[Kind]| k.to_vec();
-    let ranges = |k: &[Kind]| k.iter().map(|k| k.default_range()).collect();
-    let hand = ModelSpec {
-        free: kinds(&[Kind::E, Kind::Mu, Kind::Kappa]),
-        shared: vec![],
-        ranges: ranges(&[Kind::E, Kind::Mu, Kind::Kappa]),
-        fixed: Fixed::default(),
-        narrowed: vec![],
-    };
-    let paper_throw = ModelSpec {
-        free: kinds(&[Kind::E, Kind::Mu]),
-        ranges: ranges(&[Kind::E, Kind::Mu]),
-        ..hand.clone()
-    };
+    let hand = ModelSpec::free(&[Kind::E, Kind::Mu, Kind::Kappa]);
+    let paper_throw = ModelSpec::free(&[Kind::E, Kind::Mu]);
     let shared = ModelSpec {
         shared: vec![Kind::E, Kind::Mu],
         ..hand.clone()

@@ -43,12 +43,6 @@ pub struct Submitted<'a> {
 /// A stage of a cluster run: its plan, in its directory.
 pub type Staged = (Plan, Layout);
 
-/// A study as one run: checked, run dry (it stops at its first cell, so that bad input is
-/// refused here rather than in a failed array), its plan stored, its scripts written.
-pub fn study(s: &Submitted, job: &Job) -> Result<Staged> {
-    stage(s, job, true)
-}
-
 /// `s` as a stage; `dry`: run it dry first (a stage that cannot run yet, a fit's second pass,
 /// only claims its directory).
 fn stage(s: &Submitted, job: &Job, dry: bool) -> Result<Staged> {
@@ -82,16 +76,17 @@ fn stage(s: &Submitted, job: &Job, dry: bool) -> Result<Staged> {
     Ok((plan, lay))
 }
 
-/// `fit` as one run, or its two passes as two: the first into `DIR/first-pass` (its estimate,
-/// [`FIRST_PASS`]), the second into `DIR`, its box narrowed from the first's result, so that
-/// it can only start when the first has finished ([`submit`] chains them).
-pub fn fit(s: &Submitted, job: &Job) -> Result<Vec<Staged>> {
-    let StudyConfig::Fit(f) = &s.config else {
-        return study(s, job).map(|one| vec![one]);
+/// A study as the runs a cluster makes of it, each checked, run dry (it stops at its first
+/// cell, so that bad input is refused here rather than in a failed array), its plan stored,
+/// its scripts written. One run; but a refined `fit` is two: the first pass into
+/// `DIR/first-pass` (its estimate, [`FIRST_PASS`]), the second into `DIR`, its box narrowed
+/// from the first's result, so that it can only start when the first has finished ([`submit`]
+/// chains them).
+pub fn stages(s: &Submitted, job: &Job) -> Result<Vec<Staged>> {
+    let f = match &s.config {
+        StudyConfig::Fit(f) if f.config.design.refine => f,
+        _ => return stage(s, job, true).map(|one| vec![one]),
     };
-    if !f.config.design.refine {
-        return study(s, job).map(|one| vec![one]);
-    }
     let pass = |stage| Submitted {
         config: StudyConfig::Fit(FitStudy {
             config: f.config.clone(),
