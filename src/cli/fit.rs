@@ -139,13 +139,13 @@ pub fn parse_kind(s: &str) -> std::result::Result<Kind, dicephys::Error> {
     dicephys::error::parse_name("parameter", s)
 }
 
-/// `NAME=V` pairs, comma-separated, each name a parameter kind.
+/// `NAME=V` pairs, comma-separated, each name a parameter kind given once.
 fn pairs<T>(
     flag: &str,
     items: &[&str],
     value: impl Fn(&str) -> std::result::Result<T, String>,
 ) -> Result<Vec<(Kind, T)>> {
-    items
+    let out: Vec<(Kind, T)> = items
         .iter()
         .map(|item| {
             let (k, v) = item
@@ -156,14 +156,31 @@ fn pairs<T>(
             let v = value(v.trim()).map_err(|e| Error::Usage(format!("{flag} {item}: {e}")))?;
             Ok((kind, v))
         })
-        .collect()
+        .collect::<Result<_>>()?;
+    once(flag, out.iter().map(|p| p.0))?;
+    Ok(out)
+}
+
+/// Refuses a parameter named twice in one flag (which of the two was meant?).
+fn once(flag: &str, kinds: impl Iterator<Item = Kind>) -> Result<()> {
+    let mut seen = Vec::new();
+    for k in kinds {
+        if seen.contains(&k) {
+            return Err(Error::Usage(format!(
+                "{flag}: {k} is given twice; give each parameter once"
+            )));
+        }
+        seen.push(k);
+    }
+    Ok(())
 }
 
 impl FitArgs {
     fn model(&self) -> Result<ModelSpec> {
+        once("--free", self.free.iter().copied())?;
+        once("--shared", self.shared.iter().copied())?;
         let mut free = self.free.clone();
         free.sort();
-        free.dedup();
         let mut model = ModelSpec::free(&free);
         let given: Vec<&str> = self.ranges.iter().map(String::as_str).collect();
         for (kind, r) in pairs("--range", &given, |v| {
@@ -195,13 +212,10 @@ impl FitArgs {
         let rows = if self.data.as_os_str() == "paper" && !self.data.exists() {
             data::paper_rows()?
         } else {
-            let text = std::fs::read_to_string(&self.data).map_err(|e| {
-                Error::Usage(format!(
-                    "--data {}: cannot read it ({e})",
-                    self.data.display()
-                ))
-            })?;
-            data::parse(&text, &self.data.display().to_string())?
+            data::read(&self.data, super::stop()).map_err(|e| match e {
+                dicephys::Error::Stopped => Error::Interrupted("interrupted; nothing read".into()),
+                e => Error::Usage(format!("--data {e}")),
+            })?
         };
         let cfg = FitConfig {
             rows,
@@ -284,14 +298,11 @@ fn truth_values(cfg: &FitConfig, truth: &str) -> Result<Vec<f64>> {
 
 /// Runs `dicephys predict`.
 pub fn predict(a: &PredictArgs) -> Result<()> {
-    let text = std::fs::read_to_string(&a.fit)
-        .map_err(|e| Error::Usage(format!("--fit {}: cannot read it ({e})", a.fit.display())))?;
-    let fit: FitResult = serde_json::from_str(&text).map_err(|e| {
-        Error::Usage(format!(
-            "--fit {}: not a fit's fit.json ({e})",
-            a.fit.display()
-        ))
-    })?;
+    let fit: FitResult =
+        dicephys::calibration::read_fit(&a.fit, super::stop()).map_err(|e| match e {
+            dicephys::Error::Stopped => Error::Interrupted("interrupted; nothing read".into()),
+            e => Error::Usage(format!("--fit {e}")),
+        })?;
     let cfg = PredictConfig {
         block: a.block,
         mode: if a.two_d { Mode::TwoD } else { Mode::ThreeD },
@@ -301,7 +312,14 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
         rolls: a.rolls,
         seed: a.seed,
     };
-    let mut place = super::study::local(std::path::Path::new("."), a.threads, a.json)?;
-    place.checkpoint = None;
+    // It writes nothing: no directory of its own.
+    let place = dicephys::studies::outputs::Place {
+        out: ".".into(),
+        checkpoint: None,
+        threads: super::args::threads(a.threads)?,
+        share: dicephys::run::runner::ChunkShare::All,
+        json: a.json,
+        command_line: super::command_line(),
+    };
     super::study::predict(&fit, &cfg, &place)
 }

@@ -152,6 +152,9 @@ pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
             None => "undefined (no degrees of freedom left)".into(),
         }
     );
+    if let Some(b) = &e.bootstrap {
+        let _ = writeln!(s, "{}\n", bootstrap_line(b, e.chi2));
+    }
     let _ = writeln!(s, "| row | surface | outcome | counted | fitted p | z |");
     let _ = writeln!(s, "|---|---|---|---:|---|---:|");
     for r in &e.rows {
@@ -268,6 +271,22 @@ fn predicted(p: &Predicted) -> String {
     )
 }
 
+/// What the parametric bootstrap says of the fit's errors, in a sentence.
+pub fn bootstrap_line(b: &crate::calibration::estimate::Bootstrap, chi2: f64) -> String {
+    let sigma = (b.coverage * (1.0 - b.coverage) / b.sets as f64).sqrt();
+    format!(
+        "Parametric bootstrap ({} data sets drawn from the fitted model and fitted back): χ² \
+         at least the data's {chi2:.2} in a share p = {:.3} of them (their mean χ² {:.2}); the \
+         joint 2σ region held the values they were drawn at in {:.1} % ± {:.1} % of them \
+         (stated 95.45 %).",
+        b.sets,
+        b.chi2_p,
+        b.chi2_mean,
+        100.0 * b.coverage,
+        100.0 * sigma
+    )
+}
+
 /// A prediction's lines for the terminal.
 pub fn prediction_text(p: &BlockPrediction) -> String {
     let mut s = String::new();
@@ -296,6 +315,9 @@ pub fn prediction_text(p: &BlockPrediction) -> String {
             "  {} rolls did not settle on a face (left out)",
             p.unsettled
         );
+    }
+    if let Some(x) = &p.extrapolation {
+        let _ = writeln!(s, "  an extrapolation: {x}");
     }
     s
 }

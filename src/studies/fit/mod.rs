@@ -80,8 +80,14 @@ pub fn first_pass(
     let Some(designs) = simulate(cfg, runner, dir, session)? else {
         return Ok(None);
     };
-    let (params, estimate) =
-        estimate_with(&cfg.rows, &cfg.model, &designs, &first_pass_search(cfg))?;
+    settled_enough(&designs)?;
+    let (params, estimate) = estimate_with(
+        &cfg.rows,
+        &cfg.model,
+        &designs,
+        &first_pass_search(cfg),
+        &runner.watch(),
+    )?;
     Ok(Some(Fitted {
         config: cfg.clone(),
         rolls: designs.iter().map(|d| d.rolls).sum(),
@@ -91,6 +97,26 @@ pub fn first_pass(
         estimate,
         first_pass: None,
     }))
+}
+
+/// The most of a fit's rolls that may end on no face (unconverged, failed) before its estimate
+/// is refused: the rest are too few, and too odd a sample of the throws, to stand for the
+/// block.
+pub const MAX_UNSETTLED_SHARE: f64 = 0.1;
+
+/// Refuses designs whose rolls mostly did not settle (`Error::Failed`, what to change).
+fn settled_enough(designs: &[Design]) -> Result<()> {
+    let rolls: u64 = designs.iter().map(|d| d.rolls).sum();
+    let unsettled: u64 = designs.iter().map(|d| d.unsettled).sum();
+    if rolls > 0 && unsettled as f64 > MAX_UNSETTLED_SHARE * rolls as f64 {
+        return Err(Error::Failed(format!(
+            "{unsettled} of the fit's {rolls} rolls ({:.1} %) did not settle on a face (more \
+             than {:.0} %): no estimate from them; raise `max_steps` or use a finer `dt`",
+            100.0 * unsettled as f64 / rolls as f64,
+            100.0 * MAX_UNSETTLED_SHARE
+        )));
+    }
+    Ok(())
 }
 
 /// The second pass over the box narrowed from `first` (a pass with nothing to narrow is the
@@ -106,7 +132,13 @@ pub fn second_pass(
     let narrowed =
         crate::calibration::narrow(&cfg.rows, &cfg.model, &first.params, &first.estimate);
     if narrowed.is_empty() {
-        let (params, estimate) = estimate_with(&cfg.rows, &cfg.model, &first.designs, &cfg.search)?;
+        let (params, estimate) = estimate_with(
+            &cfg.rows,
+            &cfg.model,
+            &first.designs,
+            &cfg.search,
+            &runner.watch(),
+        )?;
         return Ok(Some(Fitted {
             params,
             estimate,
@@ -118,6 +150,7 @@ pub fn second_pass(
     let Some(second) = simulate(&out.config, runner, dir, session)? else {
         return Ok(None);
     };
+    settled_enough(&second)?;
     out.rolls += second.iter().map(|d| d.rolls).sum::<u64>();
     out.unsettled += second.iter().map(|d| d.unsettled).sum::<u64>();
     let (params, estimate) = estimate_with(
@@ -125,6 +158,7 @@ pub fn second_pass(
         &out.config.model,
         &second,
         &out.config.search,
+        &runner.watch(),
     )?;
     out.first_pass = Some(std::mem::replace(&mut out.estimate, estimate).params);
     out.params = params;
@@ -200,8 +234,8 @@ impl FitStudy {
                 path.display()
             ))
         })?;
-        let r: FitResult = serde_json::from_str(&text)
-            .map_err(|e| Error::Invalid(format!("{} is damaged ({e})", path.display())))?;
+        let r: FitResult = crate::run::seal::open(&text)
+            .map_err(|e| Error::Invalid(format!("{}: {e}", path.display())))?;
         if r.config != self.config {
             return Err(Error::Invalid(format!(
                 "{} is the first pass of another fit",
