@@ -26,6 +26,7 @@ pub mod crossval;
 pub mod data;
 pub mod design;
 pub mod estimate;
+pub mod heldout;
 pub mod paper;
 pub mod params;
 pub mod predict;

@@ -106,8 +106,17 @@ pub struct PredictArgs {
     #[arg(long, value_name = "FIT.json")]
     pub fit: PathBuf,
     /// The block, LENGTHxBREADTHxWIDTH in mm.
-    #[arg(long)]
-    pub block: Block,
+    #[arg(long, required_unless_present = "blocks", conflicts_with = "blocks")]
+    pub block: Option<Block>,
+    /// Many blocks at once: a CSV with the columns label, block, mode and optionally surface,
+    /// thrower and the three counts (length_vertical, breadth_vertical, width_vertical), or a
+    /// counts file; writes the table, its figure and, where counted, each row's z and the χ²
+    /// of the whole into --out.
+    #[arg(long, value_name = "BLOCKS.csv", conflicts_with_all = ["two_d", "surface", "thrower"])]
+    pub blocks: Option<PathBuf>,
+    /// With --blocks: the output directory [default: predict-out].
+    #[arg(long, value_name = "OUT", requires = "blocks")]
+    pub out: Option<PathBuf>,
     /// Simulate it in 2D (DicePhys's plane-locked block).
     #[arg(long = "2d")]
     pub two_d: bool,
@@ -303,8 +312,12 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
             dicephys::Error::Stopped => Error::Interrupted("interrupted; nothing read".into()),
             e => Error::Usage(format!("--fit {e}")),
         })?;
+    if let Some(file) = &a.blocks {
+        return predict_blocks(a, &fit, file);
+    }
+    let block = a.block.expect("clap requires --block without --blocks");
     let cfg = PredictConfig {
-        block: a.block,
+        block,
         mode: if a.two_d { Mode::TwoD } else { Mode::ThreeD },
         surface: a.surface.clone(),
         thrower: a.thrower.clone(),
@@ -322,4 +335,31 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
         command_line: super::command_line(),
     };
     super::study::predict(&fit, &cfg, &place)
+}
+
+/// Runs `dicephys predict --blocks`.
+fn predict_blocks(a: &PredictArgs, fit: &FitResult, file: &std::path::Path) -> Result<()> {
+    use dicephys::calibration::heldout;
+    let bytes =
+        dicephys::run::io::read_capped(file, data::MAX_DATA_BYTES, super::stop()).map_err(|e| {
+            match e {
+                dicephys::Error::Stopped => Error::Interrupted("interrupted; nothing read".into()),
+                e => Error::Usage(format!("--blocks {e}")),
+            }
+        })?;
+    let text = std::str::from_utf8(&bytes)
+        .map_err(|_| Error::Usage(format!("--blocks {}: not UTF-8", file.display())))?;
+    let rows = heldout::parse(text, &file.display().to_string())
+        .map_err(|e| Error::Usage(format!("--blocks {e}")))?;
+    let cfg = dicephys::studies::fit::outputs::BlocksConfig {
+        rows,
+        draws: a.draws,
+        rolls: a.rolls,
+        seed: a.seed,
+        fit: a.fit.display().to_string(),
+    };
+    let out = a.out.clone().unwrap_or_else(|| "predict-out".into());
+    let mut place = super::study::local(&out, a.threads, a.json)?;
+    place.checkpoint = None;
+    super::study::predict_blocks(fit, &cfg, &place)
 }

@@ -137,6 +137,20 @@ pub fn predict(
     })
 }
 
+/// Runs `predict --blocks`.
+pub fn predict_blocks(
+    fit: &dicephys::calibration::FitResult,
+    cfg: &dicephys::studies::fit::outputs::BlocksConfig,
+    place: &Place,
+) -> Result<()> {
+    let unit = outputs::Unit::Rolls {
+        per_cell: cfg.rolls,
+    };
+    with_hooks("predict", unit, true, place.json, |hooks| {
+        dicephys::studies::fit::outputs::predict_blocks(fit, cfg, place, hooks)
+    })
+}
+
 /// Runs `paper --calibrated`.
 pub fn calibrated(
     cfg: &dicephys::studies::calibrated::CalibratedConfig,

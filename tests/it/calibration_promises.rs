@@ -673,3 +673,41 @@ fn a_lock_holder_is_named_and_huge_numbers_stay_short() {
     refused(&o, 2, "1e300");
     assert!(stderr(&o).len() < 200, "{}", stderr(&o));
 }
+
+/// Class 2: a named pipe with no writer as `--data` does not hold off a SIGTERM.
+#[test]
+fn sigterm_while_waiting_on_a_pipe_ends_the_fit() {
+    let dir = Scratch::new("promise-fifo");
+    let fifo = dir.join("counts.csv");
+    let path = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    assert_eq!(unsafe { libc::mkfifo(path.as_ptr(), 0o600) }, 0);
+    let out = dir.join("out");
+    let mut child = bin()
+        .args([
+            "fit",
+            "--data",
+            fifo.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(300));
+    unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+    let t = Instant::now();
+    let code = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s.code();
+        }
+        if t.elapsed() > Duration::from_secs(3) {
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert_eq!(code, Some(130));
+    assert!(!out.exists());
+}

@@ -161,6 +161,83 @@ pub fn predict(fit: &FitResult, cfg: &PredictConfig, place: &Place, hooks: &Hook
     })
 }
 
+/// What `predict --blocks` predicts: the blocks, and the draws and rolls of each.
+#[derive(Clone, Debug, Serialize)]
+pub struct BlocksConfig {
+    /// The blocks, with their counts where measured.
+    pub rows: Vec<crate::calibration::heldout::BlockRow>,
+    /// Posterior draws a block.
+    pub draws: usize,
+    /// Rolls a draw.
+    pub rolls: u64,
+    /// The throws' seed.
+    pub seed: u64,
+    /// The fit's file, as given.
+    pub fit: String,
+}
+
+/// `predict --blocks`: predictions.json, predictions.csv, report.md and the figure
+/// `predictions` in `place.out` (claimed as a study's); the table printed.
+pub fn predict_blocks(
+    fit: &FitResult,
+    cfg: &BlocksConfig,
+    place: &Place,
+    hooks: &Hooks,
+) -> Result<Done> {
+    let (stem, files) = (
+        "predictions",
+        ["predictions.json", "predictions.csv", "report.md"],
+    );
+    // Every row checked (by predict_blocks, before it rolls) before the directory is claimed.
+    for r in &cfg.rows {
+        super::predict::check(
+            fit,
+            &PredictConfig {
+                block: r.block,
+                mode: r.mode,
+                surface: r.surface.clone(),
+                thrower: r.thrower.clone(),
+                draws: cfg.draws,
+                rolls: cfg.rolls,
+                seed: cfg.seed,
+            },
+        )
+        .map_err(|e| Error::Invalid(format!("row '{}': {e}", r.label)))?;
+    }
+    let identity = (cfg, &fit.config, &fit.estimate.x);
+    claim(place, "predict --blocks", &identity)?;
+    let outputs = place.outputs(&files)?;
+    let total = (cfg.rows.len() as u64 * cfg.draws as u64 * cfg.rolls) as f64;
+    let progress = |n: u64| (hooks.progress)(n as f64, total);
+    let study = place.study(&hooks.stop, &progress);
+    let runner = &study.runner;
+    let rows = unless_stopped(runner.install(|| {
+        super::predict::predict_blocks(fit, &cfg.rows, cfg.draws, cfg.rolls, cfg.seed, runner)
+    })?)?;
+    let Some(rows) = rows else {
+        return Ok(Done {
+            interrupted: Some("interrupted before every block was rolled; nothing written".into()),
+            ..Done::default()
+        });
+    };
+    let res =
+        crate::calibration::heldout::collect(rows, cfg.fit.clone(), place.command_line.clone());
+    report::predictions_figure(&place.out, stem, &res)?;
+    let md = report::predictions_markdown(&res, stem);
+    let json = to_json(&res)?;
+    outputs[0].write(json.as_bytes())?;
+    outputs[1].write(report::predictions_csv(&res).as_bytes())?;
+    outputs[2].write(md.as_bytes())?;
+    let mut done = place.done(&json, &md, "predictions.json");
+    done.note = done.note.map(|_| {
+        format!(
+            "wrote {}/predictions.json, predictions.csv, report.md and the figure",
+            place.out.display()
+        )
+    });
+    Ok(done)
+}
+
 /// `paper --calibrated`: calibrated.json, calibrated.md and figures in `place.out`, the cells
 /// under `place.checkpoint`.
 pub fn calibrated(cfg: &CalibratedConfig, place: &Place, hooks: &Hooks) -> Result<Done> {

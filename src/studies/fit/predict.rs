@@ -184,3 +184,45 @@ pub fn predict_block(
         extrapolation: extrapolation(fit, &cfg.block),
     }))
 }
+
+/// Each of `rows` predicted from `fit` (`draws` posterior draws × `rolls` throws a block), and
+/// tested against its counts where it has them. Every row is checked before any rolls. `None`
+/// if stopped early.
+pub fn predict_blocks(
+    fit: &FitResult,
+    rows: &[crate::calibration::heldout::BlockRow],
+    draws: usize,
+    rolls: u64,
+    seed: u64,
+    runner: &Runner,
+) -> Result<Option<Vec<crate::calibration::heldout::PredictedRow>>> {
+    let cfg = |r: &crate::calibration::heldout::BlockRow| PredictConfig {
+        block: r.block,
+        mode: r.mode,
+        surface: r.surface.clone(),
+        thrower: r.thrower.clone(),
+        draws,
+        rolls,
+        seed,
+    };
+    for r in rows {
+        check(fit, &cfg(r)).map_err(|e| Error::Invalid(format!("row '{}': {e}", r.label)))?;
+    }
+    let per_row = draws as u64 * rolls;
+    let mut out = Vec::new();
+    for (i, r) in rows.iter().enumerate() {
+        let base = i as u64 * per_row;
+        let progress = |n| (runner.progress)(base + n);
+        let Some(p) = predict_block(fit, &cfg(r), &runner.with_progress(&progress), None).map_err(
+            |e| match e {
+                Error::Failed(m) => Error::Failed(format!("row '{}': {m}", r.label)),
+                e => e,
+            },
+        )?
+        else {
+            return Ok(None);
+        };
+        out.push(crate::calibration::heldout::test(r, p));
+    }
+    Ok(Some(out))
+}
