@@ -33,36 +33,37 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// Speed of each engine and lever against the faithful configuration, side by side.
-    Bench(bench::BenchArgs),
+    /// Reproduce the paper: its table, theory, simulations and figures, into --out.
+    Paper(paper::PaperArgs),
+    /// Roll one block many times on one engine: counts, ratio, theory, cost.
+    Roll(roll::RollArgs),
+    /// Calibrate e, μ and the throw to measured counts (maximum likelihood through a surrogate
+    /// of the simulator), or check that a fit recovers known values (--recover).
+    Fit(fit::FitArgs),
+    /// Predict a block the fit did not see (or many, --blocks): its outcome probabilities with
+    /// their errors, and a held-out test where they were counted.
+    Predict(fit::PredictArgs),
+    /// The paper's closed-form theory for a block, or its whole experimental table.
+    Theory(theory::TheoryArgs),
     /// The same throws on several engines: counts, ratios, σ apart, per-throw agreement, cost.
     Crosscheck(crosscheck::CrosscheckArgs),
     /// The paper's convergence test: the ratio against dt per block, engine, 2D/3D.
     Converge(sweeps::ConvergeArgs),
-    /// Calibrate e, μ and the throw to measured counts (maximum likelihood through a surrogate
-    /// of the simulator), or check that a fit recovers known values (--recover).
-    Fit(fit::FitArgs),
-    /// Predict a block the fit did not see: its outcome probabilities with their errors.
-    Predict(fit::PredictArgs),
-    /// Combine the --json outputs of `roll --shard K/N` runs into the unsharded result.
-    Merge(merge::MergeArgs),
-    /// Where engines fail: unconverged, unknown, non-finite, tunnelled, energy gain by cell.
-    Stability(sweeps::StabilityArgs),
     /// Accuracy against cost across methods, with the Pareto front.
     Tradeoff(sweeps::TradeoffArgs),
-    /// Reproduce the paper: its table, theory, simulations and figures, into --out.
-    Paper(paper::PaperArgs),
-    /// The paper's closed-form theory for a block, or its whole experimental table.
-    Theory(theory::TheoryArgs),
-    /// Roll one block many times on one engine: counts, ratio, theory, cost.
-    Roll(roll::RollArgs),
-    /// A run as a Slurm job array and a finishing job that merges it into the one-machine result.
-    Slurm(slurm::SlurmArgs),
-    /// One throw's trajectory as CSV (step, time, position, orientation, velocities, energy).
-    Trace(trace::TraceArgs),
+    /// Where engines fail: unconverged, unknown, non-finite, tunnelled, energy gain by cell.
+    Stability(sweeps::StabilityArgs),
     /// The engines against the limits known in closed form: no bounce (2D), solid angles (3D),
     /// free flight, and the trend towards the paper's theory.
     Validate(validate::ValidateArgs),
+    /// Speed of each engine and lever against the faithful configuration, side by side.
+    Bench(bench::BenchArgs),
+    /// One throw's trajectory as CSV (step, time, position, orientation, velocities, energy).
+    Trace(trace::TraceArgs),
+    /// Combine the --json outputs of `roll --shard K/N` runs into the unsharded result.
+    Merge(merge::MergeArgs),
+    /// A run as a Slurm job array and a finishing job that merges it into the one-machine result.
+    Slurm(slurm::SlurmArgs),
     /// A shell's completions for dicephys, on stdout (e.g. `dicephys completions bash >
     /// ~/.local/share/bash-completion/completions/dicephys`).
     Completions {
