@@ -36,6 +36,9 @@ pub struct Decision {
     /// The likelihood-ratio test where the simpler is nested in the richer: −2 ln Λ, degrees
     /// of freedom, p.
     pub lr_test: Option<(f64, usize, f64)>,
+    /// `richer` or `simpler` when the held-out gain stands 3σ from nothing, else
+    /// `unresolved`.
+    pub outcome: String,
     /// The verdict, in a sentence.
     pub verdict: String,
 }
