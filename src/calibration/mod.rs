@@ -122,6 +122,11 @@ pub struct FitResult {
     /// The first pass's parameters, when a second pass refined them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub first_pass: Option<Vec<estimate::ParamFit>>,
+    /// Every pass, in order: the first over the whole ranges, a second over the box narrowed
+    /// from it, and any that widened a box that cut a parameter (a fit.json from before passes
+    /// were recorded has none).
+    #[serde(default)]
+    pub passes: Vec<Pass>,
     /// The blocks simulated, with their surrogates.
     pub designs: Vec<Design>,
     /// The estimate.
@@ -134,6 +139,125 @@ pub struct FitResult {
     pub dicephys_version: String,
     /// When it ended, UTC.
     pub date_utc: String,
+}
+
+/// One pass of a fit: the box its designs were simulated over, and what it rolled.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Pass {
+    /// Each free parameter's range in this pass, by name.
+    #[serde(rename = "box")]
+    pub bounds: Vec<params::Narrowed>,
+    /// Rolls made for it (or read back from the checkpoints). A design an earlier pass already
+    /// simulated (its block's parameters' ranges unchanged) is taken from that pass, not rolled
+    /// again, and costs none.
+    pub rolls: u64,
+    /// The parameters whose maximum or 2σ interval reached a face of this pass's box that is
+    /// not their range's own (the next pass widened them there; the last pass's, after
+    /// [`MAX_WIDENINGS`], were left cut).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cut: Vec<Cut>,
+}
+
+impl Pass {
+    /// A pass over `params`' ranges that rolled `rolls`, nothing cut (yet).
+    pub fn over(params: &[Param], rolls: u64) -> Pass {
+        Pass {
+            bounds: params
+                .iter()
+                .map(|p| params::Narrowed {
+                    param: p.name(),
+                    range: p.range,
+                })
+                .collect(),
+            rolls,
+            cut: vec![],
+        }
+    }
+}
+
+/// A parameter a narrowed box cut, and on which side.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Cut {
+    /// The parameter's name.
+    pub param: String,
+    /// Cut at the box's lower face (which is above its range's lower end).
+    pub lower: bool,
+    /// Cut at the box's upper face (which is below its range's upper end).
+    pub upper: bool,
+}
+
+/// Passes after the second at most, each widening the boxes that cut a parameter. In unit
+/// coordinates of the range, [`widen`] moves a cut face out by the old box's width plus at
+/// least 0.05, and the box grows by at least 0.1 a pass (unless it reaches an end of the
+/// range); so four passes move a cut face by at least 0.8 plus four times the second pass's
+/// box width (at least 0.05 wide as [`narrow`] draws it), which takes it to the range's end:
+/// a region that lies off one face is met within four. One that jumps from face to face (a
+/// surrogate too poor to place it) may not be; the fit then says it is still cut.
+pub const MAX_WIDENINGS: usize = 4;
+
+/// How close, in a box's unit coordinate, a maximum or an interval's end must come to a face
+/// to be on it (the search clamps to the faces, and an open side of a profile interval ends on
+/// its grid's end point, so on a face they sit within rounding of it).
+const ON_FACE: f64 = 1e-6;
+
+/// The parameters of a refined pass's estimate that its box cut: their maximum, or an end of
+/// their 2σ profile interval, on a face of a narrowed range that is not their kind's own face.
+/// There the likelihood may go on rising, or the region on, past the face: the value or the
+/// interval printed would be the box's, not the data's.
+pub fn cuts(est: &Estimate) -> Vec<Cut> {
+    let mut out = Vec::new();
+    for (fit, &x) in est.params.iter().zip(&est.x) {
+        let p = &fit.param;
+        let u = |v: f64| p.kind.coordinate(p.range, v);
+        let lower = p.range.lo > p.whole.lo && (x <= ON_FACE || u(fit.two_sigma[0]) <= ON_FACE);
+        let upper =
+            p.range.hi < p.whole.hi && (x >= 1.0 - ON_FACE || u(fit.two_sigma[1]) >= 1.0 - ON_FACE);
+        if lower || upper {
+            out.push(Cut {
+                param: p.name(),
+                lower,
+                upper,
+            });
+        }
+    }
+    out
+}
+
+/// The next pass's box after `est`, whose box (`model`'s narrowed ranges) cut the parameters
+/// in `cut`. A parameter not cut keeps its range exactly, so that the designs of the blocks
+/// that only it and others like it touch keep their keys and are not rolled again. A cut one
+/// gets the box [`narrow`] would draw around its new 2σ interval (which holds its new
+/// maximum: the box is recentred on it), pushed out on each cut side by the old box's width
+/// as well: past a cut face the region's end is unseen, and looking as far again beyond as the
+/// box spans doubles the reach each pass, so a region any distance off is met in a few passes
+/// (and the range's own end stops it). A box that then covers 80 % of the range takes it all,
+/// as in [`narrow`].
+pub fn widen(model: &ModelSpec, est: &Estimate, cut: &[Cut]) -> Vec<params::Narrowed> {
+    let mut out = model.narrowed.clone();
+    for c in cut {
+        let Some(fit) = est.params.iter().find(|f| f.name == c.param) else {
+            continue;
+        };
+        let p = &fit.param;
+        // Coordinates on the kind's whole range, where the boxes are drawn.
+        let w = |v: f64| p.kind.coordinate(p.whole, v).clamp(0.0, 1.0);
+        let (lo, hi) = (w(fit.two_sigma[0]), w(fit.two_sigma[1]));
+        let width = w(p.range.hi) - w(p.range.lo);
+        let pad = (0.5 * (hi - lo)).max(0.05);
+        let a = (lo - pad - if c.lower { width } else { 0.0 }).max(0.0);
+        let b = (hi + pad + if c.upper { width } else { 0.0 }).min(1.0);
+        out.retain(|n| n.param != c.param);
+        if b - a < 0.8 {
+            out.push(params::Narrowed {
+                param: c.param.clone(),
+                range: crate::model::throws::Range::new(
+                    p.kind.value(p.whole, a),
+                    p.kind.value(p.whole, b),
+                ),
+            });
+        }
+    }
+    out
 }
 
 /// The second pass's box: each parameter's first-pass 2σ profile interval, widened by half its
