@@ -97,7 +97,7 @@ fn a_fit_is_the_same_on_one_thread_and_two_and_predicts_with_errors() {
         ]))
     };
     let (a, b) = (fit("1", "one"), fit("2", "two"));
-    for key in ["estimate", "designs", "params", "first_pass"] {
+    for key in ["estimate", "designs", "params", "first_pass", "passes"] {
         assert_eq!(a[key], b[key], "{key} differs between 1 and 2 threads");
     }
     let e = &a["estimate"];
