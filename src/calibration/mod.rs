@@ -312,3 +312,100 @@ pub fn estimate_with(
     let est = estimate::estimate(&lik, &params, search)?;
     Ok((params, est))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::throws::Range;
+    use estimate::{Identified, ParamFit};
+    use params::{Kind, Narrowed};
+
+    /// A fit of e on surface `group` at `value`, 2σ `two`, searched in `range`.
+    fn fit_of(group: &str, range: Range, value: f64, two: [f64; 2]) -> (ParamFit, f64) {
+        let param = Param {
+            kind: Kind::E,
+            group: group.into(),
+            range,
+            whole: Kind::E.default_range(),
+        };
+        let x = Kind::E.coordinate(range, value);
+        let fit = ParamFit {
+            name: param.name(),
+            param,
+            value,
+            one_sigma: two,
+            two_sigma: two,
+            identified: Identified::Yes,
+            profile: vec![],
+        };
+        (fit, x)
+    }
+
+    fn estimate_of(fits: Vec<(ParamFit, f64)>) -> Estimate {
+        Estimate {
+            x: fits.iter().map(|f| f.1).collect(),
+            minus_two_ln_l: 0.0,
+            params: fits.into_iter().map(|f| f.0).collect(),
+            rows: vec![],
+            chi2: 0.0,
+            dof: 0,
+            p_value: None,
+            region_delta: 0.0,
+            bartlett: 1.0,
+            other_maxima: vec![],
+            draws: vec![],
+        }
+    }
+
+    #[test]
+    fn a_box_that_cut_a_parameter_is_widened_on_that_side_and_no_other_box_moves() {
+        let boxed = Range::new(0.6125, 0.7575);
+        let own_end = Range::new(0.05, 0.3);
+        let model = ModelSpec {
+            narrowed: vec![
+                Narrowed {
+                    param: "e[A]".into(),
+                    range: boxed,
+                },
+                Narrowed {
+                    param: "e[C]".into(),
+                    range: own_end,
+                },
+            ],
+            ..ModelSpec::free(&[Kind::E])
+        };
+        let est = estimate_of(vec![
+            // On the box's lower edge, which is inside the range: cut.
+            fit_of("A", boxed, 0.6125, [0.6125, 0.62]),
+            // Interior, on the whole range: not cut.
+            fit_of("B", Kind::E.default_range(), 0.3, [0.2, 0.4]),
+            // On the lower edge of a box that is the range's own: bounded by the range, not cut.
+            fit_of("C", own_end, 0.05, [0.05, 0.2]),
+        ]);
+        let cut = cuts(&est);
+        assert_eq!(
+            cut,
+            vec![Cut {
+                param: "e[A]".into(),
+                lower: true,
+                upper: false
+            }]
+        );
+        let wider = widen(&model, &est, &cut);
+        // e[C] as it was; e[A] moved down by its old width (0.145) and the pad (0.05 of the
+        // range's 0.75) past its cut edge, and up to its interval plus the pad.
+        assert_eq!(wider.len(), 2);
+        assert!(wider.contains(&model.narrowed[1]), "{wider:?}");
+        let a = wider.iter().find(|n| n.param == "e[A]").unwrap().range;
+        assert!((a.lo - (0.6125 - 0.145 - 0.0375)).abs() < 1e-9, "{a}");
+        assert!((a.hi - (0.62 + 0.0375)).abs() < 1e-9, "{a}");
+        // A region that runs past both edges of a wide box: widened to 80 % of the range or
+        // more, the box takes the whole range.
+        let wide = Range::new(0.2, 0.6);
+        let both = estimate_of(vec![fit_of("A", wide, 0.4, [0.2, 0.6])]);
+        let cut = cuts(&both);
+        assert!(cut.len() == 1 && cut[0].lower && cut[0].upper, "{cut:?}");
+        let wider = widen(&model, &both, &cut);
+        assert!(!wider.iter().any(|n| n.param == "e[A]"), "{wider:?}");
+    }
+}
