@@ -3,6 +3,16 @@
 //! thread count, and a prediction carries its errors.
 
 use crate::helpers::{dicephys, json, Scratch};
+use dicephys::calibration::data::DataRow;
+use dicephys::calibration::design::DesignSpec;
+use dicephys::calibration::estimate::{Identified, Search};
+use dicephys::calibration::params::{Fixed, Kind, Method, ModelSpec};
+use dicephys::calibration::FitConfig;
+use dicephys::engine::EngineKind;
+use dicephys::model::scene::Mode;
+use dicephys::run::runner::Runner;
+use dicephys::run::stop::Stop;
+use dicephys::studies::fit::{first_pass, recovery, second_pass, Session};
 
 const HEAD: &str = "label,surface,length_mm,breadth_mm,width_mm,mode,length_vertical,breadth_vertical,width_vertical\n";
 
@@ -239,27 +249,14 @@ fn values_outside_their_physical_ranges_are_refused() {
     }
 }
 
-/// Counts at e = 0.3 on two surfaces (2D blocks, whose outcomes move with e: 140x30x10 falls
-/// on its breadth 1.4 % of the time at e = 0.05, 2.3 % at 0.3, 4.2 % at 0.6), and a first pass
-/// made to miss: its 2σ interval of e[A] put at 0.65–0.72, so that the second pass's box,
-/// e[A] 0.61–0.76, leaves the truth out. The fit must widen that box until e[A]'s maximum and
-/// 2σ interval are inside it, rolling again only the blocks whose box moved: e[B] (one row, never
-/// narrowed) keeps its range, and its block's design is the first pass's throughout. Before
-/// the widening, the fit stopped at the second pass with e[A] on the box's lower edge, 0.6125.
-/// About 40,000 rolls.
-#[test]
-fn a_box_that_cut_a_parameter_is_widened_until_it_does_not() {
-    use dicephys::calibration::data::DataRow;
-    use dicephys::calibration::design::DesignSpec;
-    use dicephys::calibration::estimate::{Identified, Search};
-    use dicephys::calibration::params::{Fixed, Kind, Method, ModelSpec};
-    use dicephys::calibration::FitConfig;
-    use dicephys::engine::EngineKind;
-    use dicephys::model::scene::Mode;
-    use dicephys::run::runner::Runner;
-    use dicephys::run::stop::Stop;
-    use dicephys::studies::fit::{first_pass, recovery, second_pass, Session};
+/// Points a block in [`counted_at_e_03`]'s fit.
+const POINTS: usize = 8;
+/// Rolls a point.
+const ROLLS: u64 = 500;
 
+/// Rows on surfaces A and B counted at e = 0.3, and a fit of e on them: [`POINTS`] × [`ROLLS`]
+/// a block, dt = 1/250.
+fn counted_at_e_03(runner: &Runner) -> FitConfig {
     let row = |label: &str, surface: &str, block: &str, n: u64| DataRow {
         label: label.into(),
         surface: surface.into(),
@@ -274,7 +271,6 @@ fn a_box_that_cut_a_parameter_is_widened_until_it_does_not() {
         row("a2", "A", "140x24x20", 2000),
         row("b1", "B", "140x30x10", 2000),
     ];
-    let (points, rolls) = (8, 500);
     let cfg = FitConfig {
         rows: shape,
         model: ModelSpec::free(&[Kind::E]),
@@ -284,8 +280,8 @@ fn a_box_that_cut_a_parameter_is_widened_until_it_does_not() {
             max_steps: dicephys::sim::roll::DEFAULT_MAX_STEPS,
         },
         design: DesignSpec {
-            points,
-            rolls,
+            points: POINTS,
+            rolls: ROLLS,
             degree: 2,
             max_degree: 3,
             ..DesignSpec::default()
@@ -296,15 +292,28 @@ fn a_box_that_cut_a_parameter_is_widened_until_it_does_not() {
         },
         seed: 35,
     };
-    let runner = Runner::new(2, Stop::new());
     let truth = Fixed {
         e: 0.3,
         ..Fixed::default()
     };
-    let rows = recovery::simulate_data(&cfg, &truth, 3535, &runner)
+    let rows = recovery::simulate_data(&cfg, &truth, 3535, runner)
         .unwrap()
         .unwrap();
-    let cfg = FitConfig { rows, ..cfg };
+    FitConfig { rows, ..cfg }
+}
+
+/// Counts at e = 0.3 on two surfaces (2D blocks, whose outcomes move with e: 140x30x10 falls
+/// on its breadth 1.4 % of the time at e = 0.05, 2.3 % at 0.3, 4.2 % at 0.6), and a first pass
+/// made to miss: its 2σ interval of e[A] put at 0.65–0.72, so that the second pass's box,
+/// e[A] 0.61–0.76, leaves the truth out. The fit must widen that box until e[A]'s maximum and
+/// 2σ interval are inside it, rolling again only the blocks whose box moved: e[B] (one row, never
+/// narrowed) keeps its range, and its block's design is the first pass's throughout. Before
+/// the widening, the fit stopped at the second pass with e[A] on the box's lower edge, 0.6125.
+/// About 40,000 rolls.
+#[test]
+fn a_box_that_cut_a_parameter_is_widened_until_it_does_not() {
+    let runner = Runner::new(2, Stop::new());
+    let cfg = counted_at_e_03(&runner);
     let session = Session::default();
     let mut first = first_pass(&cfg, &runner, None, &session).unwrap().unwrap();
     let a = first
@@ -358,7 +367,7 @@ fn a_box_that_cut_a_parameter_is_widened_until_it_does_not() {
     assert!(fitted.passes.last().unwrap().cut.is_empty(), "{said}");
     // e[B] keeps its whole range in every pass, and its block's design is never rolled again:
     // each pass after the first rolls only the two blocks of surface A.
-    let per_design = points as u64 * rolls;
+    let per_design = POINTS as u64 * ROLLS;
     assert_eq!(fitted.passes[0].rolls, 2 * per_design, "{said}");
     for pass in &fitted.passes[1..] {
         assert_eq!(pass.rolls, 2 * per_design, "{said}");
