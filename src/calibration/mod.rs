@@ -32,6 +32,7 @@ pub mod predict;
 pub mod recovery;
 
 use crate::error::{Error, Result};
+use crate::model::throws::Range;
 use data::DataRow;
 use design::{Design, DesignSpec};
 use estimate::{Estimate, Likelihood, Search};
@@ -209,9 +210,12 @@ pub fn cuts(est: &Estimate) -> Vec<Cut> {
     for (fit, &x) in est.params.iter().zip(&est.x) {
         let p = &fit.param;
         let u = |v: f64| p.kind.coordinate(p.range, v);
-        let lower = p.range.lo > p.whole.lo && (x <= ON_FACE || u(fit.two_sigma[0]) <= ON_FACE);
-        let upper =
-            p.range.hi < p.whole.hi && (x >= 1.0 - ON_FACE || u(fit.two_sigma[1]) >= 1.0 - ON_FACE);
+        // Where the box's faces are on the whole range: a face within rounding of the range's
+        // end is that end (a fit.json whose narrowed κ ends at 9999.999999999998).
+        let w = |v: f64| p.kind.coordinate(p.whole, v);
+        let lower = w(p.range.lo) > ON_FACE && (x <= ON_FACE || u(fit.two_sigma[0]) <= ON_FACE);
+        let upper = w(p.range.hi) < 1.0 - ON_FACE
+            && (x >= 1.0 - ON_FACE || u(fit.two_sigma[1]) >= 1.0 - ON_FACE);
         if lower || upper {
             out.push(Cut {
                 param: p.name(),
@@ -250,10 +254,7 @@ pub fn widen(model: &ModelSpec, est: &Estimate, cut: &[Cut]) -> Vec<params::Narr
         if b - a < 0.8 {
             out.push(params::Narrowed {
                 param: c.param.clone(),
-                range: crate::model::throws::Range::new(
-                    p.kind.value(p.whole, a),
-                    p.kind.value(p.whole, b),
-                ),
+                range: sub_range(p.kind, p.whole, a, b),
             });
         }
     }
@@ -291,13 +292,23 @@ pub fn narrow(
         }
         out.push(params::Narrowed {
             param: p.name(),
-            range: crate::model::throws::Range::new(
-                p.kind.value(p.range, a),
-                p.kind.value(p.range, b),
-            ),
+            range: sub_range(p.kind, p.range, a, b),
         });
     }
     out
+}
+
+/// The part of `whole` from unit coordinate `a` to `b`, its ends `whole`'s own, to the bit, at 0
+/// and 1: κ's and the spin's warped coordinates do not give them back exactly (κ's upper end
+/// came back 9999.999999999998), and a box's edge a rounding inside its range's end would pass
+/// for an edge the narrowing drew, which cuts.
+fn sub_range(kind: params::Kind, whole: Range, a: f64, b: f64) -> Range {
+    let at = |u: f64| match u {
+        u if u <= 0.0 => whole.lo,
+        u if u >= 1.0 => whole.hi,
+        u => kind.value(whole, u),
+    };
+    Range::new(at(a), at(b))
 }
 
 /// Fits `rows` with the designs already simulated (the cheap part: no rolls).
@@ -316,19 +327,28 @@ pub fn estimate_with(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::throws::Range;
     use estimate::{Identified, ParamFit};
     use params::{Kind, Narrowed};
 
     /// A fit of e on surface `group` at `value`, 2σ `two`, searched in `range`.
     fn fit_of(group: &str, range: Range, value: f64, two: [f64; 2]) -> (ParamFit, f64) {
+        fit_kind(Kind::E, group, range, value, two)
+    }
+
+    fn fit_kind(
+        kind: Kind,
+        group: &str,
+        range: Range,
+        value: f64,
+        two: [f64; 2],
+    ) -> (ParamFit, f64) {
         let param = Param {
-            kind: Kind::E,
+            kind,
             group: group.into(),
             range,
-            whole: Kind::E.default_range(),
+            whole: kind.default_range(),
         };
-        let x = Kind::E.coordinate(range, value);
+        let x = kind.coordinate(range, value);
         let fit = ParamFit {
             name: param.name(),
             param,
@@ -407,5 +427,29 @@ mod tests {
         assert!(cut.len() == 1 && cut[0].lower && cut[0].upper, "{cut:?}");
         let wider = widen(&model, &both, &cut);
         assert!(!wider.iter().any(|n| n.param == "e[A]"), "{wider:?}");
+        // κ's warp does not give its range's end back to the bit (9999.999999999998): a box
+        // that reaches it is not cut there, and a widened one ends on it exactly.
+        let top = Kind::Kappa.value(Kind::Kappa.default_range(), 1.0);
+        let near_top = Range::new(1000.0, top);
+        let k = estimate_of(vec![fit_kind(
+            Kind::Kappa,
+            "all",
+            near_top,
+            top,
+            [3000.0, top],
+        )]);
+        assert!(cuts(&k).is_empty(), "{:?}", cuts(&k));
+        let low = Range::new(1000.0, 3000.0);
+        let k = estimate_of(vec![fit_kind(
+            Kind::Kappa,
+            "all",
+            low,
+            3000.0,
+            [2000.0, 3000.0],
+        )]);
+        let cut = cuts(&k);
+        let kappa = ModelSpec::free(&[Kind::Kappa]);
+        let wider = widen(&kappa, &k, &cut);
+        assert_eq!(wider[0].range.hi, 1e4, "{wider:?}");
     }
 }
