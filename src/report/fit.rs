@@ -96,6 +96,12 @@ fn parameters(res: &FitResult) -> String {
                  box, after {} widenings; the value is that box's, not the data's",
                 res.passes.len() - 2
             ),
+            // At the range's own end, not a box's: the range asked for bounds it.
+            Identified::UpperBoundOnly | Identified::LowerBoundOnly => format!(
+                "{}: the range's own end, not a narrowed box's (a wider --range, where the \
+                 physics allows, shows where it ends)",
+                p.identified.says()
+            ),
             other => other.says().into(),
         };
         let _ = writeln!(
