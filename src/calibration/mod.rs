@@ -232,10 +232,10 @@ pub fn cuts(est: &Estimate) -> Vec<Cut> {
 /// that only it and others like it touch keep their keys and are not rolled again. A cut one
 /// gets the box [`narrow`] would draw around its new 2σ interval (which holds its new
 /// maximum: the box is recentred on it), pushed out on each cut side by the old box's width
-/// as well: past a cut face the region's end is unseen, and looking as far again beyond as the
-/// box spans doubles the reach each pass, so a region any distance off is met in a few passes
-/// (and the range's own end stops it). A box that then covers 80 % of the range takes it all,
-/// as in [`narrow`].
+/// as well: past a cut face the region's end is unseen, so the next pass looks as far again
+/// beyond it as the box spanned, and each pass reaches further than the last (the bound is at
+/// [`MAX_WIDENINGS`]) until the range's own end stops it. A box that then covers 80 % of the
+/// range takes it all, as in [`narrow`].
 pub fn widen(model: &ModelSpec, est: &Estimate, cut: &[Cut]) -> Vec<params::Narrowed> {
     let mut out = model.narrowed.clone();
     for c in cut {
