@@ -17,7 +17,8 @@ for block in 140x24x20 140x22x13 140x27x13 140x29x11 140x30x10; do
   for mode in 3d 2d; do
     flag=""; [ "$mode" = 2d ] && flag="--2d"
     for b in old new; do
-      eval bin=\$$b
+      if [ "$b" = old ]; then bin=$old; else bin=$new; fi
+      # shellcheck disable=SC2086 # $flag is empty or one word
       "$bin" roll --block "$block" $flag --rolls "$rolls" --seed 10 --engine "$engine" \
         --threads 1 --per-roll "$dir/$b.csv" "$@" > /dev/null
     done

@@ -43,6 +43,15 @@ pub enum Error {
     Failed(String),
 }
 
+/// A value as a message shows it: a number of many digits (1e300 prints as 301 of them) in
+/// scientific notation, anything else as it is.
+fn shown_value(v: String) -> String {
+    match v.parse::<f64>() {
+        Ok(x) if v.len() > 20 => format!("{x:e}"),
+        _ => v,
+    }
+}
+
 /// "field value: why", or "field: why" without a value.
 fn field_line(field: &str, value: &str, why: &str) -> String {
     if value.is_empty() {
@@ -57,7 +66,7 @@ impl Error {
     pub fn field(field: &'static str, value: impl ToString, why: impl Into<String>) -> Error {
         Error::Field {
             field,
-            value: value.to_string(),
+            value: shown_value(value.to_string()),
             why: why.into(),
         }
     }

@@ -90,12 +90,17 @@ pub fn leave_one_out(
     params: &[Param],
     search: &Search,
     start: &[f64],
+    watch: &crate::run::stop::Watch,
 ) -> Result<Vec<LooRow>> {
     use rayon::prelude::*;
-    (0..rows.len())
+    (watch.say)(&format!(
+        "fit: each of {} rows predicted by a fit without it",
+        rows.len()
+    ));
+    let out = (0..rows.len())
         .into_par_iter()
         .map(|r| {
-            let mut lik = Likelihood::new(rows, designs, model, params);
+            let mut lik = Likelihood::new(rows, designs, model, params).stopped_by(watch.stop);
             lik.include[r] = false;
             let (best, _) = maximise_from(&lik, &[start.to_vec(), vec![0.5; params.len()]])?;
             let f = |x: &[f64]| lik.minus_two_ln_l(x);
@@ -109,7 +114,9 @@ pub fn leave_one_out(
             );
             Ok(score_row(&lik, r, &draws))
         })
-        .collect()
+        .collect();
+    watch.check()?;
+    out
 }
 
 /// Row `r` of `lik` predicted at the posterior `draws` and scored.

@@ -119,14 +119,100 @@ fn groups(
     Ok(groups)
 }
 
-/// Reads a counts CSV; `name` is the file's name for messages.
+/// The largest counts file read: a row is a few dozen bytes, so 16 MiB is hundreds of
+/// thousands of rows. A larger file (or `/dev/zero`) is refused without being read whole.
+pub const MAX_DATA_BYTES: u64 = 16 << 20;
+
+/// The most throws one row may count: 10¹² (the estimate's cost does not grow with them, but
+/// no table of real throws comes near).
+pub const MAX_ROW_THROWS: u64 = 1_000_000_000_000;
+
+/// Reads a counts CSV from `path`, no further than [`MAX_DATA_BYTES`], honouring `stop` while
+/// it waits (a named pipe with no writer blocks in `open`). Invalid UTF-8 is located by line
+/// and column.
+pub fn read(path: &std::path::Path, stop: &crate::run::stop::Stop) -> Result<Vec<DataRow>> {
+    let name = path.display().to_string();
+    let bytes = crate::run::io::read_capped(path, MAX_DATA_BYTES, stop)?;
+    let text = std::str::from_utf8(&bytes).map_err(|e| {
+        let (line, col) = line_col(&bytes, e.valid_up_to());
+        Error::Invalid(format!(
+            "{name}: line {line}, byte {col}: not UTF-8 (save the file as UTF-8 text)"
+        ))
+    })?;
+    parse(text, &name)
+}
+
+/// The 1-based line and column (in bytes) of byte `at`.
+fn line_col(bytes: &[u8], at: usize) -> (usize, usize) {
+    let before = &bytes[..at];
+    let line = 1 + before.iter().filter(|&&b| b == b'\n').count();
+    let start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |i| i + 1);
+    (line, at - start + 1)
+}
+
+/// A field's text as an error message shows it: control characters escaped (a quoted field
+/// may hold a newline or a terminal's escape sequence), and cut after 40 characters.
+pub fn shown(v: &str) -> String {
+    let mut out = String::new();
+    for (i, c) in v.chars().enumerate() {
+        if i == 40 {
+            out.push('…');
+            break;
+        }
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// Reads a counts CSV; `name` is the file's name for messages. Linear in the file's size.
 pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
-    let bad = |line: u64, col: usize, msg: String| {
+    let bad = |line: usize, col: usize, msg: String| {
         let column = COLUMNS.get(col).copied().unwrap_or("?");
         Error::Invalid(format!(
             "{name}: line {line}, column {} ({column}): {msg}",
             col + 1
         ))
+    };
+    // The line of a byte offset, counted forward as the records come (CRLF, blank lines and
+    // quoted newlines all count as the file's own lines).
+    let mut counted = (0usize, 1usize);
+    let bytes = text.as_bytes();
+    let mut line_of = |mut byte: usize| {
+        // A record's position may sit before the line ends, blank lines and comments that
+        // precede it: step over them to its first character.
+        loop {
+            while byte < bytes.len() && matches!(bytes[byte], b'\r' | b'\n') {
+                byte += 1;
+            }
+            if bytes.get(byte) != Some(&b'#') {
+                break;
+            }
+            while byte < bytes.len() && bytes[byte] != b'\n' {
+                byte += 1;
+            }
+        }
+        let byte = byte.max(counted.0);
+        let (from, line) = counted;
+        let line = line
+            + text.as_bytes()[from..byte]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count();
+        counted = (byte, line);
+        line
+    };
+    let csv_error = |e: csv::Error| {
+        let line = e
+            .position()
+            .map_or(String::new(), |p| format!(" line {},", p.line()));
+        Error::Invalid(shown(&format!("{name}:{line} {e}")))
     };
     let mut reader = csv::ReaderBuilder::new()
         .comment(Some(b'#'))
@@ -134,23 +220,21 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
         .has_headers(true)
         .flexible(true)
         .from_reader(text.as_bytes());
-    let header = reader
-        .headers()
-        .map_err(|e| Error::Invalid(format!("{name}: {e}")))?
-        .clone();
+    let header = reader.headers().map_err(csv_error)?.clone();
     let have: Vec<&str> = header.iter().collect();
     let with_thrower = have.len() == COLUMNS.len();
     if !(9..=10).contains(&have.len()) || have != COLUMNS[..have.len()] {
         return Err(Error::Invalid(format!(
             "{name}: line 1: the header must be {}[,thrower], got {}",
             COLUMNS[..9].join(","),
-            have.join(",")
+            shown(&have.join(","))
         )));
     }
     let mut rows: Vec<DataRow> = Vec::new();
+    let mut labels = std::collections::HashSet::new();
     for rec in reader.records() {
-        let rec = rec.map_err(|e| Error::Invalid(format!("{name}: {e}")))?;
-        let line = rec.position().map_or(0, |p| p.line());
+        let rec = rec.map_err(csv_error)?;
+        let line = line_of(rec.position().map_or(0, |p| p.byte() as usize));
         if rec.len() != have.len() {
             return Err(bad(
                 line,
@@ -163,11 +247,22 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
             if v.is_empty() {
                 return Err(bad(line, c, "empty".into()));
             }
+            if v.chars().any(char::is_control) {
+                return Err(bad(
+                    line,
+                    c,
+                    format!("'{}' holds a control character", shown(&v)),
+                ));
+            }
             Ok(v)
         };
         let label = text(0)?;
-        if rows.iter().any(|r| r.label == label) {
-            return Err(bad(line, 0, format!("label '{label}' is used twice")));
+        if !labels.insert(label.clone()) {
+            return Err(bad(
+                line,
+                0,
+                format!("label '{}' is used twice", shown(&label)),
+            ));
         }
         let surface = text(1)?;
         let mut sides = [0.0; 3];
@@ -181,13 +276,13 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
                     bad(
                         line,
                         c,
-                        format!("'{}' is not a positive number of mm", &rec[c]),
+                        format!("'{}' is not a positive number of mm", shown(&rec[c])),
                     )
                 })?;
         }
         let mode: Mode = rec[5]
             .parse()
-            .map_err(|_| bad(line, 5, format!("'{}' is not 2d or 3d", &rec[5])))?;
+            .map_err(|_| bad(line, 5, format!("'{}' is not 2d or 3d", shown(&rec[5]))))?;
         let mut counts = [0u64; 3];
         let mut dashed = [false; 3];
         for k in 0..3 {
@@ -199,7 +294,7 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
                         bad(
                             line,
                             c,
-                            format!("'{v}' is not a count (a whole number, or '-')"),
+                            format!("'{}' is not a count (a whole number, or '-')", shown(v)),
                         )
                     })?
                 }
@@ -223,17 +318,16 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
             counts,
             groups,
         };
+        let total = row.counts.iter().try_fold(0u64, |a, &c| a.checked_add(c));
+        if total.is_none_or(|t| t > MAX_ROW_THROWS) {
+            return Err(bad(
+                line,
+                6,
+                format!("counts too large: at most {MAX_ROW_THROWS} throws a row"),
+            ));
+        }
         if row.n() == 0 {
             return Err(bad(line, 6, "no throws counted".into()));
-        }
-        if row
-            .counts
-            .iter()
-            .try_fold(0u64, |a, &c| a.checked_add(c))
-            .is_none()
-            || row.n() > 1_000_000_000_000
-        {
-            return Err(bad(line, 6, "counts too large".into()));
         }
         rows.push(row);
     }

@@ -10,6 +10,7 @@ use crate::inference::likelihood::{concentration, ln_dirichlet_multinomial, merg
 use crate::inference::optimize::{interval, minimize, profile, Interval, Minimum};
 use crate::inference::posterior;
 use crate::model::scene::Mode;
+use crate::run::stop::{Stop, Watch};
 use crate::theory::stats;
 use nalgebra::DMatrix;
 use rand::{Rng, SeedableRng};
@@ -38,6 +39,9 @@ pub struct Likelihood<'a> {
     row_dims: Vec<Vec<usize>>,
     /// Rows counted (a leave-one-out fit leaves one out).
     pub include: Vec<bool>,
+    /// Once raised, the likelihood is +∞ everywhere, so that every search over it (a
+    /// maximum, a profile, a chain) runs out at once and its caller sees the stop.
+    pub stop: Stop,
 }
 
 /// One row's probabilities at a point, over its outcome groups, with the simulation's noise.
@@ -76,6 +80,15 @@ impl<'a> Likelihood<'a> {
             row_design,
             row_dims: rows.iter().map(|r| model.row_dims(params, r)).collect(),
             include: vec![true; rows.len()],
+            stop: Stop::new(),
+        }
+    }
+
+    /// The same likelihood, stopped by `stop`.
+    pub fn stopped_by(self, stop: &Stop) -> Likelihood<'a> {
+        Likelihood {
+            stop: stop.clone(),
+            ..self
         }
     }
 
@@ -112,6 +125,9 @@ impl<'a> Likelihood<'a> {
 
     /// −2 ln L at `x` (unit coordinates), up to a constant.
     pub fn minus_two_ln_l(&self, x: &[f64]) -> f64 {
+        if self.stop.requested() {
+            return f64::INFINITY;
+        }
         let mut ll = 0.0;
         for r in 0..self.rows.len() {
             if !self.include[r] {
@@ -243,6 +259,28 @@ pub struct Estimate {
     pub other_maxima: Vec<f64>,
     /// Posterior draws (flat prior on the box), unit coordinates.
     pub draws: Vec<Vec<f64>>,
+    /// What the parametric bootstrap behind the Bartlett factor says of the errors (`null`
+    /// when none was drawn).
+    #[serde(default)]
+    pub bootstrap: Option<Bootstrap>,
+}
+
+/// The parametric bootstrap's verdict on the fit's errors: data sets drawn from the fitted
+/// model (each row's probabilities from the surrogate's noise about its prediction, then its
+/// counts multinomial), each fitted back with the same surrogates.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Bootstrap {
+    /// Data sets fitted.
+    pub sets: usize,
+    /// The share of sets whose Pearson χ² at their own maximum is at least the data's
+    /// ((k + 1)/(sets + 1)): the goodness of fit's p without χ²'s asymptotics. Near 1, the
+    /// errors are wider than the data's scatter; near 0, narrower (or the model is wrong).
+    pub chi2_p: f64,
+    /// The sets' mean χ², to set beside the data's and its degrees of freedom.
+    pub chi2_mean: f64,
+    /// The share of sets whose joint 2σ region (the threshold reported, Bartlett factor
+    /// included) holds the values they were drawn at: stated 95.45 %.
+    pub coverage: f64,
 }
 
 /// Settings of the search.
@@ -289,6 +327,9 @@ pub fn maximise_from(lik: &Likelihood, starts: &[Vec<f64>]) -> Result<(Minimum, 
     for s in starts {
         found.push(minimize(&f, s, 0.15, 1e-7));
     }
+    if lik.stop.requested() {
+        return Err(Error::Stopped);
+    }
     found.sort_by(|a, b| a.f.total_cmp(&b.f));
     let best = found[0].clone();
     if !best.f.is_finite() {
@@ -316,18 +357,38 @@ pub fn maximise_from(lik: &Likelihood, starts: &[Vec<f64>]) -> Result<(Minimum, 
     Ok((best, others))
 }
 
-/// Fits `rows`: the maximum, the profiles, the goodness of fit and posterior draws.
-pub fn estimate(lik: &Likelihood, params: &[Param], search: &Search) -> Result<Estimate> {
+/// Fits `rows`: the maximum, the profiles, the goodness of fit and posterior draws. Each
+/// stage says its line to `watch` and ends at once on a stop request (`Error::Stopped`).
+pub fn estimate(
+    lik: &Likelihood,
+    params: &[Param],
+    search: &Search,
+    watch: &Watch,
+) -> Result<Estimate> {
     let dims = params.len();
     let f = |x: &[f64]| lik.minus_two_ln_l(x);
+    (watch.say)(&format!(
+        "fit: the maximum over {dims} parameters, from {} starts",
+        search.starts.max(1)
+    ));
     let (best, other_maxima) = maximise(lik, dims, search.starts)?;
-    let b = bartlett(lik, &best.x, dims, search.bootstrap, search.seed);
-    // The profiles are independent: one per thread.
+    if search.bootstrap > 0 && dims > 0 {
+        (watch.say)(&format!(
+            "fit: the likelihood ratio's scale from {} simulated data sets",
+            search.bootstrap
+        ));
+    }
+    let sets = bootstrap_sets(lik, &best.x, dims, search.bootstrap, search.seed);
+    let b = factor(&sets, dims);
+    watch.check()?;
+    (watch.say)(&format!("fit: the profiles of {dims} parameters"));
+    // The profiles are independent: one per thread (of the caller's pool).
     use rayon::prelude::*;
     let profiles: Vec<Vec<(f64, f64)>> = (0..params.len())
         .into_par_iter()
         .map(|j| profile(&f, &best, j, search.profile_points, 1e-6))
         .collect();
+    watch.check()?;
     let mut fits = Vec::new();
     for ((j, param), prof) in params.iter().enumerate().zip(profiles) {
         // A profile point below the maximum means the search missed it: take the lower.
@@ -347,9 +408,14 @@ pub fn estimate(lik: &Likelihood, params: &[Param], search: &Search) -> Result<E
     }
     let rows = row_fits(lik, &best.x);
     let chi2: f64 = rows.iter().map(|r| r.chi2).sum();
+    let bootstrap = verdict(&sets, chi2, b * region_delta(dims, TWO_SIGMA));
     let cells: i64 = rows.iter().map(|r| r.counts.len() as i64 - 1).sum();
     let dof = cells - dims as i64;
+    if search.draws > 0 {
+        (watch.say)(&format!("fit: {} posterior draws", search.draws));
+    }
     let draws = posterior::sample(&f, &best.x, search.draws, 2000, 4, search.seed);
+    watch.check()?;
     Ok(Estimate {
         x: best.x.clone(),
         minus_two_ln_l: best.f,
@@ -362,6 +428,7 @@ pub fn estimate(lik: &Likelihood, params: &[Param], search: &Search) -> Result<E
         bartlett: b,
         other_maxima,
         draws,
+        bootstrap,
     })
 }
 
@@ -383,20 +450,7 @@ fn bootstrap_rows(lik: &Likelihood, x: &[f64], rng: &mut ChaCha8Rng) -> Vec<Data
             let s: f64 = g.iter().sum();
             g.iter().map(|v| v / s).collect()
         };
-        let mut grouped = vec![0u64; p.len()];
-        for _ in 0..n {
-            let u: f64 = rng.random();
-            let mut acc = 0.0;
-            let mut k = p.len() - 1;
-            for (i, q) in p.iter().enumerate() {
-                acc += q;
-                if u < acc {
-                    k = i;
-                    break;
-                }
-            }
-            grouped[k] += 1;
-        }
+        let grouped = multinomial(n, &p, rng);
         let mut counts = [0u64; 3];
         for (g, c) in row.groups.iter().zip(&grouped) {
             counts[g[0]] = *c;
@@ -405,6 +459,29 @@ fn bootstrap_rows(lik: &Likelihood, x: &[f64], rng: &mut ChaCha8Rng) -> Vec<Data
             counts,
             ..row.clone()
         });
+    }
+    out
+}
+
+/// `n` throws shared among outcomes of probabilities `p`: each outcome's count binomial given
+/// the throws left (BTPE, so the cost does not grow with `n`).
+fn multinomial(n: u64, p: &[f64], rng: &mut ChaCha8Rng) -> Vec<u64> {
+    use rand_distr::{Binomial, Distribution};
+    let mut out = vec![0u64; p.len()];
+    let (mut left, mut mass) = (n, p.iter().sum::<f64>());
+    for (k, &q) in p.iter().enumerate() {
+        if left == 0 {
+            break;
+        }
+        if k + 1 == p.len() || mass <= 0.0 {
+            out[k] = left;
+            break;
+        }
+        let share = (q / mass).clamp(0.0, 1.0);
+        let x = Binomial::new(left, share).map_or(0, |b| b.sample(rng));
+        out[k] = x;
+        left -= x;
+        mass -= q;
     }
     out
 }
@@ -440,32 +517,65 @@ fn gamma(shape: f64, rng: &mut ChaCha8Rng) -> f64 {
 /// Never below 1 (a flat or bounded direction makes it smaller than χ²'s; the χ² bound then
 /// stays, conservative).
 pub fn bartlett(lik: &Likelihood, x: &[f64], dims: usize, sets: usize, seed: u64) -> f64 {
-    use rayon::prelude::*;
-    if dims == 0 || sets == 0 {
+    factor(&bootstrap_sets(lik, x, dims, sets, seed), dims)
+}
+
+/// The Bartlett factor of the sets' Δ(−2 ln L) ([`bartlett`]).
+fn factor(sets: &[(f64, f64)], dims: usize) -> f64 {
+    if sets.is_empty() || dims == 0 {
         return 1.0;
     }
-    let deltas: Vec<f64> = (0..sets)
+    (sets.iter().map(|s| s.0).sum::<f64>() / sets.len() as f64 / dims as f64).max(1.0)
+}
+
+/// `sets` data sets drawn from the fitted model at `x` ([`bootstrap_rows`]), each fitted
+/// back: Δ(−2 ln L) of `x` above the set's maximum, and the set's Pearson χ² there.
+fn bootstrap_sets(
+    lik: &Likelihood,
+    x: &[f64],
+    dims: usize,
+    sets: usize,
+    seed: u64,
+) -> Vec<(f64, f64)> {
+    use rayon::prelude::*;
+    if dims == 0 || sets == 0 {
+        return Vec::new();
+    }
+    (0..sets)
         .into_par_iter()
         .filter_map(|b| {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             rng.set_stream(b as u64);
             let rows = bootstrap_rows(lik, x, &mut rng);
-            let mut boot = Likelihood {
+            let boot = Likelihood {
                 rows: &rows,
                 designs: lik.designs,
                 row_design: lik.row_design.clone(),
                 row_dims: lik.row_dims.clone(),
                 include: lik.include.clone(),
+                stop: lik.stop.clone(),
             };
-            boot.include = lik.include.clone();
             let (best, _) = maximise_from(&boot, &[x.to_vec(), vec![0.5; dims]]).ok()?;
-            Some((boot.minus_two_ln_l(x) - best.f).max(0.0))
+            let chi2 = row_fits(&boot, &best.x).iter().map(|r| r.chi2).sum();
+            Some(((boot.minus_two_ln_l(x) - best.f).max(0.0), chi2))
         })
-        .collect();
-    if deltas.is_empty() {
-        return 1.0;
+        .collect()
+}
+
+/// The bootstrap's verdict ([`Bootstrap`]) on a fit whose χ² is `chi2` and whose region's
+/// threshold is `region`.
+fn verdict(sets: &[(f64, f64)], chi2: f64, region: f64) -> Option<Bootstrap> {
+    if sets.is_empty() {
+        return None;
     }
-    (deltas.iter().sum::<f64>() / deltas.len() as f64 / dims as f64).max(1.0)
+    let n = sets.len() as f64;
+    let above = sets.iter().filter(|s| s.1 >= chi2).count() as f64;
+    Some(Bootstrap {
+        sets: sets.len(),
+        chi2_p: (above + 1.0) / (n + 1.0),
+        chi2_mean: sets.iter().map(|s| s.1).sum::<f64>() / n,
+        coverage: sets.iter().filter(|s| s.0 <= region).count() as f64 / n,
+    })
 }
 
 /// Each counted row's fit at `x`.
@@ -509,6 +619,32 @@ mod tests {
     use crate::inference::surrogate::{DesignPoint, Surrogate};
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn the_bootstraps_multinomial_has_the_right_moments_at_any_size() {
+        // 4,000 draws of n = 1000 over p = (0.1, 0.3, 0.6): each count's mean within 4 standard
+        // errors of n p, its variance within 10 % of n p (1 − p) (the sample variance's own
+        // relative error is about √(2/4000) = 2.2 %); every draw sums to n.
+        let p = [0.1, 0.3, 0.6];
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let draws: Vec<Vec<u64>> = (0..4000).map(|_| multinomial(1000, &p, &mut rng)).collect();
+        for (k, q) in p.iter().enumerate() {
+            let x: Vec<f64> = draws.iter().map(|d| d[k] as f64).collect();
+            let mean = x.iter().sum::<f64>() / 4000.0;
+            let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / 3999.0;
+            let want = 1000.0 * q * (1.0 - q);
+            assert!(
+                (mean - 1000.0 * q).abs() < 4.0 * (want / 4000.0).sqrt(),
+                "{k}: {mean}"
+            );
+            assert!((var / want - 1.0).abs() < 0.1, "{k}: {var} against {want}");
+        }
+        assert!(draws.iter().all(|d| d.iter().sum::<u64>() == 1000));
+        // 10¹² throws cost what 10 do.
+        let big = multinomial(1_000_000_000_000, &p, &mut rng);
+        assert_eq!(big.iter().sum::<u64>(), 1_000_000_000_000);
+        assert!((big[2] as f64 / 1e12 - 0.6).abs() < 1e-4, "{big:?}");
+    }
 
     /// A synthetic simulator: three outcomes over three parameters, a different smooth law per
     /// block (curved, so a straight surrogate would not do).

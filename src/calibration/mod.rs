@@ -26,6 +26,7 @@ pub mod crossval;
 pub mod data;
 pub mod design;
 pub mod estimate;
+pub mod heldout;
 pub mod paper;
 pub mod params;
 pub mod predict;
@@ -317,11 +318,61 @@ pub fn estimate_with(
     model: &ModelSpec,
     designs: &[Design],
     search: &Search,
+    watch: &crate::run::stop::Watch,
 ) -> Result<(Vec<Param>, Estimate)> {
     let params = model.params(rows);
-    let lik = Likelihood::new(rows, designs, model, &params);
-    let est = estimate::estimate(&lik, &params, search)?;
+    let lik = Likelihood::new(rows, designs, model, &params).stopped_by(watch.stop);
+    let est = estimate::estimate(&lik, &params, search, watch)?;
     Ok((params, est))
+}
+
+/// The largest `fit.json` read (a fit of hundreds of rows is a few megabytes).
+pub const MAX_FIT_BYTES: u64 = 64 << 20;
+
+/// Reads a fit's `fit.json` and checks it: sealed (a damaged or edited file is refused, by
+/// name), of a fit this version can use, and whole (its draws in its parameters' box).
+pub fn read_fit(path: &std::path::Path, stop: &crate::run::stop::Stop) -> Result<FitResult> {
+    let name = path.display();
+    let bytes = crate::run::io::read_capped(path, MAX_FIT_BYTES, stop)?;
+    let text = std::str::from_utf8(&bytes)
+        .map_err(|_| Error::Invalid(format!("{name}: not UTF-8, not a fit's fit.json")))?;
+    let fit: FitResult = crate::run::seal::open(text)
+        .map_err(|e| Error::Invalid(format!("{name}: not a fit's fit.json as written: {e}")))?;
+    fit.check()
+        .map_err(|e| Error::Invalid(format!("{name}: {e}")))?;
+    Ok(fit)
+}
+
+impl FitResult {
+    /// Checks that the fit is whole: its configuration valid, its parameters those of its
+    /// model, its posterior draws there and inside the unit box.
+    pub fn check(&self) -> Result<()> {
+        self.config.validate()?;
+        let dims = self.params.len();
+        if self.config.model.params(&self.config.rows).len() != dims {
+            return Err(Error::Invalid(format!(
+                "{dims} parameters where its model has {}",
+                self.config.model.params(&self.config.rows).len()
+            )));
+        }
+        let d = &self.estimate.draws;
+        if d.is_empty() {
+            return Err(Error::Invalid(
+                "no posterior draws (a first pass, or a damaged fit): nothing to predict from"
+                    .into(),
+            ));
+        }
+        let bad = d
+            .iter()
+            .chain(std::iter::once(&self.estimate.x))
+            .any(|x| x.len() != dims || x.iter().any(|u| !(0.0..=1.0).contains(u)));
+        if bad {
+            return Err(Error::Invalid(format!(
+                "its draws are not points of its {dims} parameters' box"
+            )));
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]
@@ -374,6 +425,7 @@ mod tests {
             bartlett: 1.0,
             other_maxima: vec![],
             draws: vec![],
+            bootstrap: None,
         }
     }
 

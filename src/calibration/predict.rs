@@ -116,6 +116,10 @@ pub struct BlockPrediction {
     pub rolls: u64,
     /// Rolls that did not settle on a face, over all draws (left out).
     pub unsettled: u64,
+    /// Where the block lies outside the blocks the fit saw (a prediction there extrapolates);
+    /// `null` inside.
+    #[serde(default)]
+    pub extrapolation: Option<String>,
 }
 
 /// What to predict.
@@ -155,13 +159,29 @@ pub fn group(
             }
             v
         });
+    let shared = known.is_empty() || known == ["all"];
+    // The rows' own names: a fit with one set of values for all still saw only these.
+    let seen: Vec<String> = fit
+        .config
+        .rows
+        .iter()
+        .map(|r| if of_surface { &r.surface } else { &r.thrower }.clone())
+        .fold(Vec::new(), |mut v, g| {
+            if !v.contains(&g) {
+                v.push(g);
+            }
+            v
+        });
     match asked {
-        Some(s) if known.contains(s) || known.is_empty() || known == ["all"] => Ok(s.clone()),
+        Some(s) if !shared && known.contains(s) => Ok(s.clone()),
+        Some(s) if shared && (s == "all" || seen.contains(s)) => Ok("all".into()),
         Some(s) => Err(Error::Invalid(format!(
-            "{what} '{s}' is not in the fit (it has: {})",
-            known.join(", ")
+            "{what} '{}' is not in the fit (it has: {})",
+            crate::calibration::data::shown(s),
+            if shared { &seen } else { &known }.join(", ")
         ))),
-        None if known.len() <= 1 => Ok(known.first().cloned().unwrap_or_else(|| "all".into())),
+        None if shared => Ok("all".into()),
+        None if known.len() == 1 => Ok(known[0].clone()),
         None => Err(Error::Invalid(format!(
             "name the {what}: the fit has several ({})",
             known.join(", ")

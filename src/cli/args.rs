@@ -225,6 +225,22 @@ impl ThrowArgs {
                 self.style
             )));
         }
+        if self.style == ThrowStyle::Rest {
+            // A die released at rest has no velocity, spin or drop: a range given is a mistake.
+            let default = ThrowRanges::default();
+            for (flag, given, dflt) in [
+                ("--velocity", self.velocity, default.velocity),
+                ("--spin", self.spin, default.spin),
+                ("--drop-height", self.drop_height, default.drop_height),
+            ] {
+                if given != dflt {
+                    return Err(Error::Usage(format!(
+                        "{flag} {given}: --throw rest releases the die at rest and uses no \
+                         range; leave {flag} out"
+                    )));
+                }
+            }
+        }
         if self.kappa.is_none() && self.style == ThrowStyle::Hand {
             return Err(Error::Usage(
                 "--throw hand needs --kappa K (0: the tumble's spread; large: the paper's throw)"

@@ -51,6 +51,9 @@ impl From<dicephys::Error> for Error {
             Error::Usage(line)
         } else if e.is_input() {
             Error::Usage(e.to_string())
+        } else if let dicephys::Error::Failed(m) = &e {
+            // A failure may name what to change, as a field in backquotes.
+            Error::Run(flags_in(m))
         } else {
             Error::Run(e.to_string())
         }

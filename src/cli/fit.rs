@@ -106,8 +106,17 @@ pub struct PredictArgs {
     #[arg(long, value_name = "FIT.json")]
     pub fit: PathBuf,
     /// The block, LENGTHxBREADTHxWIDTH in mm.
-    #[arg(long)]
-    pub block: Block,
+    #[arg(long, required_unless_present = "blocks", conflicts_with = "blocks")]
+    pub block: Option<Block>,
+    /// Many blocks at once: a CSV with the columns label, block, mode and optionally surface,
+    /// thrower and the three counts (length_vertical, breadth_vertical, width_vertical), or a
+    /// counts file; writes the table, its figure and, where counted, each row's z and the χ²
+    /// of the whole into --out.
+    #[arg(long, value_name = "BLOCKS.csv", conflicts_with_all = ["two_d", "surface", "thrower"])]
+    pub blocks: Option<PathBuf>,
+    /// With --blocks: the output directory [default: predict-out].
+    #[arg(long, value_name = "OUT", requires = "blocks")]
+    pub out: Option<PathBuf>,
     /// Simulate it in 2D (DicePhys's plane-locked block).
     #[arg(long = "2d")]
     pub two_d: bool,
@@ -139,13 +148,13 @@ pub fn parse_kind(s: &str) -> std::result::Result<Kind, dicephys::Error> {
     dicephys::error::parse_name("parameter", s)
 }
 
-/// `NAME=V` pairs, comma-separated, each name a parameter kind.
+/// `NAME=V` pairs, comma-separated, each name a parameter kind given once.
 fn pairs<T>(
     flag: &str,
     items: &[&str],
     value: impl Fn(&str) -> std::result::Result<T, String>,
 ) -> Result<Vec<(Kind, T)>> {
-    items
+    let out: Vec<(Kind, T)> = items
         .iter()
         .map(|item| {
             let (k, v) = item
@@ -156,14 +165,31 @@ fn pairs<T>(
             let v = value(v.trim()).map_err(|e| Error::Usage(format!("{flag} {item}: {e}")))?;
             Ok((kind, v))
         })
-        .collect()
+        .collect::<Result<_>>()?;
+    once(flag, out.iter().map(|p| p.0))?;
+    Ok(out)
+}
+
+/// Refuses a parameter named twice in one flag (which of the two was meant?).
+fn once(flag: &str, kinds: impl Iterator<Item = Kind>) -> Result<()> {
+    let mut seen = Vec::new();
+    for k in kinds {
+        if seen.contains(&k) {
+            return Err(Error::Usage(format!(
+                "{flag}: {k} is given twice; give each parameter once"
+            )));
+        }
+        seen.push(k);
+    }
+    Ok(())
 }
 
 impl FitArgs {
     fn model(&self) -> Result<ModelSpec> {
+        once("--free", self.free.iter().copied())?;
+        once("--shared", self.shared.iter().copied())?;
         let mut free = self.free.clone();
         free.sort();
-        free.dedup();
         let mut model = ModelSpec::free(&free);
         let given: Vec<&str> = self.ranges.iter().map(String::as_str).collect();
         for (kind, r) in pairs("--range", &given, |v| {
@@ -195,13 +221,10 @@ impl FitArgs {
         let rows = if self.data.as_os_str() == "paper" && !self.data.exists() {
             data::paper_rows()?
         } else {
-            let text = std::fs::read_to_string(&self.data).map_err(|e| {
-                Error::Usage(format!(
-                    "--data {}: cannot read it ({e})",
-                    self.data.display()
-                ))
-            })?;
-            data::parse(&text, &self.data.display().to_string())?
+            data::read(&self.data, super::stop()).map_err(|e| match e {
+                dicephys::Error::Stopped => Error::Interrupted("interrupted; nothing read".into()),
+                e => Error::Usage(format!("--data {e}")),
+            })?
         };
         let cfg = FitConfig {
             rows,
@@ -284,16 +307,17 @@ fn truth_values(cfg: &FitConfig, truth: &str) -> Result<Vec<f64>> {
 
 /// Runs `dicephys predict`.
 pub fn predict(a: &PredictArgs) -> Result<()> {
-    let text = std::fs::read_to_string(&a.fit)
-        .map_err(|e| Error::Usage(format!("--fit {}: cannot read it ({e})", a.fit.display())))?;
-    let fit: FitResult = serde_json::from_str(&text).map_err(|e| {
-        Error::Usage(format!(
-            "--fit {}: not a fit's fit.json ({e})",
-            a.fit.display()
-        ))
-    })?;
+    let fit: FitResult =
+        dicephys::calibration::read_fit(&a.fit, super::stop()).map_err(|e| match e {
+            dicephys::Error::Stopped => Error::Interrupted("interrupted; nothing read".into()),
+            e => Error::Usage(format!("--fit {e}")),
+        })?;
+    if let Some(file) = &a.blocks {
+        return predict_blocks(a, &fit, file);
+    }
+    let block = a.block.expect("clap requires --block without --blocks");
     let cfg = PredictConfig {
-        block: a.block,
+        block,
         mode: if a.two_d { Mode::TwoD } else { Mode::ThreeD },
         surface: a.surface.clone(),
         thrower: a.thrower.clone(),
@@ -301,7 +325,41 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
         rolls: a.rolls,
         seed: a.seed,
     };
-    let mut place = super::study::local(std::path::Path::new("."), a.threads, a.json)?;
-    place.checkpoint = None;
+    // It writes nothing: no directory of its own.
+    let place = dicephys::studies::outputs::Place {
+        out: ".".into(),
+        checkpoint: None,
+        threads: super::args::threads(a.threads)?,
+        share: dicephys::run::runner::ChunkShare::All,
+        json: a.json,
+        command_line: super::command_line(),
+    };
     super::study::predict(&fit, &cfg, &place)
+}
+
+/// Runs `dicephys predict --blocks`.
+fn predict_blocks(a: &PredictArgs, fit: &FitResult, file: &std::path::Path) -> Result<()> {
+    use dicephys::calibration::heldout;
+    let bytes =
+        dicephys::run::io::read_capped(file, data::MAX_DATA_BYTES, super::stop()).map_err(|e| {
+            match e {
+                dicephys::Error::Stopped => Error::Interrupted("interrupted; nothing read".into()),
+                e => Error::Usage(format!("--blocks {e}")),
+            }
+        })?;
+    let text = std::str::from_utf8(&bytes)
+        .map_err(|_| Error::Usage(format!("--blocks {}: not UTF-8", file.display())))?;
+    let rows = heldout::parse(text, &file.display().to_string())
+        .map_err(|e| Error::Usage(format!("--blocks {e}")))?;
+    let cfg = dicephys::studies::fit::outputs::BlocksConfig {
+        rows,
+        draws: a.draws,
+        rolls: a.rolls,
+        seed: a.seed,
+        fit: a.fit.display().to_string(),
+    };
+    let out = a.out.clone().unwrap_or_else(|| "predict-out".into());
+    let mut place = super::study::local(&out, a.threads, a.json)?;
+    place.checkpoint = None;
+    super::study::predict_blocks(fit, &cfg, &place)
 }

@@ -12,7 +12,11 @@ use std::path::Path;
 use std::time::Duration;
 
 /// A study run here, on all its chunks, writing into `out` (its cells under `out/checkpoint`).
+/// A Slurm run's directory is refused: its tasks and finishing job write there.
 pub fn local(out: &Path, threads: usize, json: bool) -> Result<Place> {
+    if !out.as_os_str().is_empty() {
+        dicephys::run::owner::refuse_cluster_run(out)?;
+    }
     Ok(Place {
         out: out.to_path_buf(),
         checkpoint: Some(out.join("checkpoint")),
@@ -93,18 +97,15 @@ fn with_hooks(
     }
 }
 
-/// Runs `fit` on one machine.
+/// Runs `fit` on one machine: the study a Slurm run splits, run whole.
 pub fn fit(cfg: dicephys::calibration::FitConfig, place: &Place) -> Result<()> {
-    let study = dicephys::studies::fit::FitStudy {
-        config: cfg,
-        stage: dicephys::studies::fit::Stage::Whole,
-    };
-    let unit = outputs::Unit::Rolls {
-        per_cell: study.config.design.rolls,
-    };
-    with_hooks("fit", unit, true, place.json, |hooks| {
-        dicephys::studies::fit::outputs::fit(&study, place, hooks)
-    })
+    run(
+        &StudyConfig::Fit(dicephys::studies::fit::FitStudy {
+            config: cfg,
+            stage: dicephys::studies::fit::Stage::Whole,
+        }),
+        place,
+    )
 }
 
 /// Runs `fit --recover`.
@@ -133,6 +134,20 @@ pub fn predict(
     };
     with_hooks("predict", unit, true, place.json, |hooks| {
         dicephys::studies::fit::outputs::predict(fit, cfg, place, hooks)
+    })
+}
+
+/// Runs `predict --blocks`.
+pub fn predict_blocks(
+    fit: &dicephys::calibration::FitResult,
+    cfg: &dicephys::studies::fit::outputs::BlocksConfig,
+    place: &Place,
+) -> Result<()> {
+    let unit = outputs::Unit::Rolls {
+        per_cell: cfg.rolls,
+    };
+    with_hooks("predict", unit, true, place.json, |hooks| {
+        dicephys::studies::fit::outputs::predict_blocks(fit, cfg, place, hooks)
     })
 }
 

@@ -239,6 +239,9 @@ pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
             None => "undefined (no degrees of freedom left)".into(),
         }
     );
+    if let Some(b) = &e.bootstrap {
+        let _ = writeln!(s, "{}\n", bootstrap_line(b, e.chi2));
+    }
     let _ = writeln!(s, "| row | surface | outcome | counted | fitted p | z |");
     let _ = writeln!(s, "|---|---|---|---:|---|---:|");
     for r in &e.rows {
@@ -300,11 +303,11 @@ pub fn row_ratios(res: &FitResult) -> Vec<RowRatio> {
             let err = ((r.p_err[b] / pw).powi(2) + (r.p_err[w] * pb / (pw * pw)).powi(2)).sqrt();
             Some(RowRatio {
                 label: r.label.clone(),
-                measured: Point {
+                measured: Some(Point {
                     x: 0.0,
                     y: m.value,
                     y_err: m.err,
-                },
+                }),
                 simulated: Point {
                     x: 0.0,
                     y: pb / pw,
@@ -355,6 +358,22 @@ fn predicted(p: &Predicted) -> String {
     )
 }
 
+/// What the parametric bootstrap says of the fit's errors, in a sentence.
+pub fn bootstrap_line(b: &crate::calibration::estimate::Bootstrap, chi2: f64) -> String {
+    let sigma = (b.coverage * (1.0 - b.coverage) / b.sets as f64).sqrt();
+    format!(
+        "Parametric bootstrap ({} data sets drawn from the fitted model and fitted back): χ² \
+         at least the data's {chi2:.2} in a share p = {:.3} of them (their mean χ² {:.2}); the \
+         joint 2σ region held the values they were drawn at in {:.1} % ± {:.1} % of them \
+         (stated 95.45 %).",
+        b.sets,
+        b.chi2_p,
+        b.chi2_mean,
+        100.0 * b.coverage,
+        100.0 * sigma
+    )
+}
+
 /// A prediction's lines for the terminal.
 pub fn prediction_text(p: &BlockPrediction) -> String {
     let mut s = String::new();
@@ -383,6 +402,9 @@ pub fn prediction_text(p: &BlockPrediction) -> String {
             "  {} rolls did not settle on a face (left out)",
             p.unsettled
         );
+    }
+    if let Some(x) = &p.extrapolation {
+        let _ = writeln!(s, "  an extrapolation: {x}");
     }
     s
 }
@@ -666,11 +688,11 @@ pub fn write_calibrated_figures(dir: &Path, c: &CalibratedPaper) -> Result<Vec<&
             let t = c.theory.iter().find(|t| t.label == r.label)?;
             Some(RowRatio {
                 label: r.label.clone(),
-                measured: Point {
+                measured: Some(Point {
                     x: 0.0,
                     y: m.value,
                     y_err: m.err,
-                },
+                }),
                 simulated: Point {
                     x: 0.0,
                     y: p.value,
@@ -694,4 +716,158 @@ pub fn write_calibrated_figures(dir: &Path, c: &CalibratedPaper) -> Result<Vec<&
     let mut stems = vec!["calibrated_rows"];
     stems.extend(write_figures(dir, &c.fit)?);
     Ok(stems)
+}
+
+/// `predict --blocks`: the table of every block's predicted probabilities and ratio, with its
+/// measurement and z where the file has counts, and the χ² of the whole.
+pub fn predictions_markdown(p: &crate::calibration::heldout::Predictions, stem: &str) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# Predictions from {}\n", p.fit);
+    let _ = writeln!(s, "`{}`\n", p.command_line);
+    let _ = writeln!(
+        s,
+        "| row | block | surface | P(length) | P(breadth) | P(width) | ratio | theory | measured | z |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---:|---|---:|");
+    for r in &p.rows {
+        let q = &r.prediction;
+        let _ = writeln!(
+            s,
+            "| {} | {} {} | {} | {} | {} | {} | {} | {:.3} | {} | {} |",
+            r.label,
+            q.block,
+            q.mode.name(),
+            q.surface,
+            short(&q.p[0]),
+            short(&q.p[1]),
+            short(&q.p[2]),
+            short(&q.ratio),
+            q.theory_ratio,
+            r.measured_ratio
+                .map_or("–".into(), |m| format!("{:.3} ± {:.3}", m.value, m.err)),
+            r.z.map_or("–".into(), |z| format!("{z:+.2}")),
+        );
+    }
+    if let (Some(c), Some(d)) = (p.chi2, p.dof) {
+        let _ = writeln!(
+            s,
+            "\nHeld-out test over the measured rows: Pearson's χ² = {c:.2} on {d} degrees of \
+             freedom{} (each count's variance the multinomial's widened by the prediction's \
+             error).",
+            p.p_value.map_or(String::new(), |v| format!(", p = {v:.3}"))
+        );
+    }
+    let far: Vec<String> = p
+        .rows
+        .iter()
+        .filter_map(|r| {
+            r.prediction
+                .extrapolation
+                .as_ref()
+                .map(|x| format!("{}: {x}", r.label))
+        })
+        .collect();
+    if !far.is_empty() {
+        let _ = writeln!(s, "\nExtrapolations:\n");
+        for f in far {
+            let _ = writeln!(s, "- {f}");
+        }
+    }
+    let _ = writeln!(s, "\n![{stem}]({stem}.svg)");
+    s
+}
+
+/// A prediction as a table cell: value ± whole error.
+fn short(p: &Predicted) -> String {
+    format!("{:.4} ± {:.4}", p.value, p.err)
+}
+
+/// `predict --blocks`'s table as CSV: one row a block.
+pub fn predictions_csv(p: &crate::calibration::heldout::Predictions) -> String {
+    let mut s = String::from(
+        "label,length_mm,breadth_mm,width_mm,mode,surface,thrower,p_length,p_length_err,\
+         p_breadth,p_breadth_err,p_width,p_width_err,ratio,ratio_err,theory_ratio,\
+         length_vertical,breadth_vertical,width_vertical,measured_ratio,measured_ratio_err,z,\
+         chi2,dof,extrapolation\n",
+    );
+    let opt = |v: Option<String>| v.unwrap_or_default();
+    let quote = |v: &str| {
+        if v.contains([',', '"', '\n']) {
+            format!("\"{}\"", v.replace('"', "\"\""))
+        } else {
+            v.to_string()
+        }
+    };
+    for r in &p.rows {
+        let q = &r.prediction;
+        let b = q.block;
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            quote(&r.label),
+            b.length * 1000.0,
+            b.breadth * 1000.0,
+            b.width * 1000.0,
+            q.mode.name(),
+            quote(&q.surface),
+            quote(&q.thrower),
+            q.p[0].value,
+            q.p[0].err,
+            q.p[1].value,
+            q.p[1].err,
+            q.p[2].value,
+            q.p[2].err,
+            q.ratio.value,
+            q.ratio.err,
+            q.theory_ratio,
+            opt(r.counts.map(|c| c[0].to_string())),
+            opt(r.counts.map(|c| c[1].to_string())),
+            opt(r.counts.map(|c| c[2].to_string())),
+            opt(r.measured_ratio.map(|m| m.value.to_string())),
+            opt(r.measured_ratio.map(|m| m.err.to_string())),
+            opt(r.z.map(|z| z.to_string())),
+            opt(r.chi2.map(|c| c.to_string())),
+            opt(r.dof.map(|d| d.to_string())),
+            quote(q.extrapolation.as_deref().unwrap_or("")),
+        );
+    }
+    s
+}
+
+/// `predict --blocks`'s figure: each block's predicted ratio with its error, beside its
+/// measurement (where counted) and the paper's theory.
+pub fn predictions_figure(
+    dir: &Path,
+    stem: &str,
+    p: &crate::calibration::heldout::Predictions,
+) -> Result<()> {
+    let rows: Vec<RowRatio> = p
+        .rows
+        .iter()
+        .map(|r| RowRatio {
+            label: r.label.clone(),
+            measured: r.measured_ratio.map(|m| Point {
+                x: 0.0,
+                y: m.value,
+                y_err: m.err,
+            }),
+            simulated: Point {
+                x: 0.0,
+                y: r.prediction.ratio.value,
+                y_err: r.prediction.ratio.err,
+            },
+            theory: Some(Point {
+                x: 0.0,
+                y: r.prediction.theory_ratio,
+                y_err: 0.0,
+            }),
+        })
+        .collect();
+    fig::rows(
+        dir,
+        stem,
+        "Blocks predicted from the fit, beside their measurement and the theory",
+        "predicted (posterior draws)",
+        &rows,
+    )
 }

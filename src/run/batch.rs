@@ -101,7 +101,7 @@ pub fn run_indices(
 
 /// A pool per thread count, kept for the process: its threads, and the worlds they keep, live
 /// from one batch (or chunk) to the next.
-fn pool(threads: usize) -> Result<std::sync::Arc<rayon::ThreadPool>> {
+pub(crate) fn pool(threads: usize) -> Result<std::sync::Arc<rayon::ThreadPool>> {
     static POOLS: Mutex<Vec<(usize, std::sync::Arc<rayon::ThreadPool>)>> = Mutex::new(Vec::new());
     let mut pools = POOLS.lock().unwrap_or_else(|e| e.into_inner());
     if let Some((_, p)) = pools.iter().find(|(t, _)| *t == threads) {

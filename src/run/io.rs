@@ -309,3 +309,43 @@ fn parent(path: &Path) -> &Path {
         _ => Path::new("."),
     }
 }
+
+/// The bytes of `path`, read no further than `max` (a larger file is refused without being
+/// read whole: `/dev/zero` is not a data file). Read on a thread of its own, so that a stop
+/// request is honoured within a tenth of a second even while the read blocks (a named pipe
+/// with no writer blocks in `open`); the blocked thread ends with the process.
+pub fn read_capped(path: &Path, max: u64, stop: &crate::run::stop::Stop) -> Result<Vec<u8>> {
+    use std::io::Read;
+    let (tx, rx) = std::sync::mpsc::channel();
+    let file = path.to_path_buf();
+    std::thread::spawn(move || {
+        let read = || -> std::io::Result<Vec<u8>> {
+            let mut bytes = Vec::new();
+            std::fs::File::open(&file)?
+                .take(max + 1)
+                .read_to_end(&mut bytes)?;
+            Ok(bytes)
+        };
+        let _ = tx.send(read());
+    });
+    let bytes = loop {
+        match rx.recv_timeout(std::time::Duration::from_millis(100)) {
+            Ok(r) => break r.map_err(|e| Error::Invalid(format!("{}: {e}", path.display())))?,
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) if stop.requested() => {
+                return Err(Error::Stopped)
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                return Err(Error::Failed(format!("{}: the read ended", path.display())))
+            }
+        }
+    };
+    if bytes.len() as u64 > max {
+        return Err(Error::Invalid(format!(
+            "{}: larger than {} MiB; refused without reading it whole",
+            path.display(),
+            max >> 20
+        )));
+    }
+    Ok(bytes)
+}

@@ -7,7 +7,6 @@
 //! rolled to a precision (`--precision`, `--budget`, `--plan`, `--preroll`) do not count.
 
 use crate::error::{Error, Result};
-use crate::run::io::write_atomic;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::path::Path;
@@ -86,10 +85,40 @@ pub fn claim(dir: &Path, command: &str, config: &Value) -> Result<()> {
             };
             let json =
                 serde_json::to_string_pretty(&owner).map_err(|e| Error::Failed(e.to_string()))?;
-            write_atomic(&file, format!("{json}\n").as_bytes())
+            // Put in place only if still absent (a hard link fails on an existing name), so
+            // that of two runs claiming one directory at the same moment one wins, and the
+            // other reads the winner's claim and is refused unless it is the same run.
+            let mut tmp = tempfile::Builder::new()
+                .prefix(".dicephys-run.")
+                .tempfile_in(dir)
+                .map_err(|e| Error::io(dir, e))?;
+            std::io::Write::write_all(&mut tmp, format!("{json}\n").as_bytes())
+                .and_then(|()| tmp.as_file().sync_all())
+                .map_err(|e| Error::io(tmp.path(), e))?;
+            match std::fs::hard_link(tmp.path(), &file) {
+                Ok(()) => Ok(()),
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    claim(dir, command, config)
+                }
+                Err(e) => Err(Error::io(&file, e)),
+            }
         }
         Err(e) => Err(Error::io(&file, e)),
     }
+}
+
+/// Refuses `dir` for a run on this machine if a Slurm run lives there (its `slurm.json`):
+/// its tasks and finishing job write there.
+pub fn refuse_cluster_run(dir: &Path) -> Result<()> {
+    let file = dir.join("slurm.json");
+    if file.exists() {
+        return Err(Error::Mismatch(format!(
+            "{}: it holds a Slurm run ({}); give a run on this machine a directory of its own",
+            dir.display(),
+            file.display()
+        )));
+    }
+    Ok(())
 }
 
 /// Refuses `dir` as a checkpoint of `roll` if a study owns it.

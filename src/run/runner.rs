@@ -33,6 +33,8 @@ pub struct Runner<'a> {
     pub progress: &'a (dyn Fn(u64) + Sync),
     /// Which chunks this process rolls: all of them, except on a cluster.
     pub share: ChunkShare,
+    /// A stage's line of progress from work that rolls nothing (a fit's estimate).
+    pub say: &'a (dyn Fn(&str) + Sync),
 }
 
 /// Which of its runs' chunks a process rolls. On one machine, all. On a cluster, a study of
@@ -180,7 +182,27 @@ impl<'a> Runner<'a> {
             stop,
             progress: &|_| {},
             share: ChunkShare::All,
+            say: &|_| {},
         }
+    }
+
+    /// The same runner, saying its stages' lines to `say`.
+    pub fn with_say(self, say: &'a (dyn Fn(&str) + Sync)) -> Runner<'a> {
+        Runner { say, ..self }
+    }
+
+    /// What a computation between rolls hears: this runner's stop flag and stage lines.
+    pub fn watch(&self) -> crate::run::stop::Watch<'_> {
+        crate::run::stop::Watch {
+            stop: &self.stop,
+            say: self.say,
+        }
+    }
+
+    /// Runs `f` in this runner's pool of `threads` threads, so that whatever it does in
+    /// parallel (a fit's profiles, bootstrap, leave-one-out) uses those threads and no others.
+    pub fn install<R: Send>(&self, f: impl FnOnce() -> R + Send) -> Result<R> {
+        Ok(crate::run::batch::pool(self.threads)?.install(f))
     }
 
     /// The same runner, rolling only its share of the chunks.
@@ -199,12 +221,16 @@ impl<'a> Runner<'a> {
     }
 
     /// The same runner, reporting progress to `progress`.
-    pub fn with_progress<'b>(&self, progress: &'b (dyn Fn(u64) + Sync)) -> Runner<'b> {
+    pub fn with_progress<'b>(&self, progress: &'b (dyn Fn(u64) + Sync)) -> Runner<'b>
+    where
+        'a: 'b,
+    {
         Runner {
             threads: self.threads,
             stop: self.stop.clone(),
             progress,
             share: self.share.clone(),
+            say: self.say,
         }
     }
 
@@ -453,6 +479,10 @@ impl Checkpoint {
     pub fn open_fresh(dir: &Path, spec: &RunSpec) -> Result<Checkpoint> {
         let ours = Checkpoint::spec_in(dir).is_ok_and(|s| s == *spec);
         if !ours && dir.exists() {
+            // Never empty a cell another live process is rolling: its lock says so.
+            if dir.join("lock").exists() {
+                drop(lock(&dir.join("lock"))?);
+            }
             std::fs::remove_dir_all(dir).map_err(|e| Error::io(dir, e))?;
         }
         Checkpoint::open(dir, spec)
@@ -498,12 +528,24 @@ fn lock(path: &Path) -> Result<File> {
             Ok(f)
         }
         Err(std::fs::TryLockError::WouldBlock) => {
+            // The holder writes its id just after taking the lock: give it a moment.
             let mut holder = String::new();
-            let _ = f.read_to_string(&mut holder);
+            for _ in 0..20 {
+                holder.clear();
+                let _ = f.rewind();
+                let _ = f.read_to_string(&mut holder);
+                if !holder.trim().is_empty() {
+                    break;
+                }
+                std::thread::sleep(std::time::Duration::from_millis(25));
+            }
+            let holder = match holder.trim() {
+                "" => "a process that has not yet written its id".to_string(),
+                h => h.to_string(),
+            };
             Err(Error::Mismatch(format!(
-                "checkpoint {}: in use by another run ({})",
+                "checkpoint {}: in use by another run ({holder})",
                 dir.display(),
-                holder.trim()
             )))
         }
         Err(std::fs::TryLockError::Error(e)) => Err(Error::io(path, e)),

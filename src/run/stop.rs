@@ -25,3 +25,29 @@ impl Stop {
         self.0.load(Ordering::Relaxed)
     }
 }
+
+/// What a long computation that rolls nothing (a fit's estimate) hears: the stop flag, and
+/// where to say which stage it has reached.
+#[derive(Clone, Copy)]
+pub struct Watch<'a> {
+    /// Checked between stages, and by the likelihood at every evaluation.
+    pub stop: &'a Stop,
+    /// A stage's line of progress ("fit: profiles of 5 parameters").
+    pub say: &'a (dyn Fn(&str) + Sync),
+}
+
+impl<'a> Watch<'a> {
+    /// Watching `stop`, saying nothing.
+    pub fn quiet(stop: &'a Stop) -> Watch<'a> {
+        Watch { stop, say: &|_| {} }
+    }
+
+    /// `Err(Stopped)` once a stop was requested.
+    pub fn check(&self) -> crate::Result<()> {
+        if self.stop.requested() {
+            Err(crate::Error::Stopped)
+        } else {
+            Ok(())
+        }
+    }
+}

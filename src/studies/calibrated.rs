@@ -17,7 +17,7 @@ use crate::calibration::estimate::Search;
 use crate::calibration::paper::{CalibratedPaper, Decision, TheoryRow};
 use crate::calibration::params::{self, Kind, Method, ModelSpec};
 use crate::calibration::{FitConfig, FitCost, FitResult};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::scene::Mode;
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::runner::Runner;
@@ -41,6 +41,55 @@ pub struct CalibratedConfig {
     pub check_rolls: u64,
     /// The method check's reference time step, s.
     pub reference_dt: f64,
+}
+
+impl CalibratedConfig {
+    /// Checks every value before anything runs, each named by its field (`point_rolls`,
+    /// `points`, `reference_dt`, `check_rolls`, `dt`, `max_steps`).
+    pub fn validate(&self) -> Result<()> {
+        let max = crate::run::spec::MAX_ROLLS;
+        if self.design.rolls == 0 || self.design.rolls > max {
+            return Err(Error::field(
+                "point_rolls",
+                self.design.rolls,
+                format!("from 1 to {max}"),
+            ));
+        }
+        if self.check_rolls == 0 || self.check_rolls > max {
+            return Err(Error::field(
+                "check_rolls",
+                self.check_rolls,
+                format!("from 1 to {max}"),
+            ));
+        }
+        crate::model::scene::check_dt("reference_dt", self.reference_dt)?;
+        crate::model::scene::check_dt("dt", self.method.dt)?;
+        if self.method.max_steps == 0 {
+            return Err(Error::field("max_steps", 0, "need at least one step"));
+        }
+        let rows = paper_rows()?;
+        for (_, _, model, rows) in models(&rows) {
+            let dims = model.free.len();
+            self.design.validate(dims).map_err(|e| match e {
+                Error::Invalid(m) if m.starts_with("points ") => Error::field(
+                    "points",
+                    self.design.points,
+                    m.split_once(": ").map_or(m.clone(), |p| p.1.to_string()),
+                ),
+                e => e,
+            })?;
+            FitConfig {
+                rows,
+                model,
+                method: self.method,
+                design: self.design,
+                search: self.search,
+                seed: self.seed,
+            }
+            .validate()?;
+        }
+        Ok(())
+    }
 }
 
 /// Rows of this length or longer are the "long blocks" the `long-2d` model simulates in 2D.
@@ -219,6 +268,7 @@ pub fn run(
             &f.params,
             &cfg.search,
             &f.estimate.x,
+            &runner.watch(),
         )?;
         fits.push((name, description, f, loo));
     }

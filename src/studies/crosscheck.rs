@@ -41,6 +41,15 @@ impl Config {
                 "name at least two engines to compare",
             ));
         }
+        for (i, e) in self.engines.iter().enumerate() {
+            if self.engines[..i].contains(e) {
+                return Err(Error::field(
+                    "engines",
+                    e,
+                    "named twice: name each engine once, at least two different ones",
+                ));
+            }
+        }
         self.spec.validate(self.allow_restitution_above_one)
     }
 }

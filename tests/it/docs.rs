@@ -890,5 +890,29 @@ fn json_md_lists_the_keys_of_fit_recover_and_predict() {
         let p = run(&a);
         c.document("predict", &format!("predict {extra:?}"), &p);
     }
-    c.finish(&["fit", "recover", "predict"]);
+    let blocks = dir.join("blocks.csv");
+    std::fs::write(
+        &blocks,
+        "label,block,mode,surface,length_vertical,breadth_vertical,width_vertical\n\
+         a,140x24x20,3d,felt,0,200,400\nb,140x30x10,2d,,,,\n",
+    )
+    .unwrap();
+    let many = run(&[
+        "predict",
+        "--fit",
+        &fit_json,
+        "--blocks",
+        blocks.to_str().unwrap(),
+        "--draws",
+        "2",
+        "--rolls",
+        "40",
+        "--threads",
+        "1",
+        "--out",
+        &format!("{d}/blocks"),
+        "--json",
+    ]);
+    c.document("predict-blocks", "predict --blocks", &many);
+    c.finish(&["fit", "recover", "predict", "predict-blocks"]);
 }

@@ -249,6 +249,79 @@ fn values_outside_their_physical_ranges_are_refused() {
     }
 }
 
+#[test]
+fn predict_blocks_tests_held_out_counts_in_one_command() {
+    // A tiny 2D fit of two MDF rows; then three blocks at once: one measured as the fit's own
+    // row (its z within 3), one measured far from any prediction (all 1000 throws on the
+    // width: the held-out χ² rejects it, p < 1e-6), one not measured.
+    let dir = Scratch::new("fit-blocks");
+    let csv = dir.join("counts.csv");
+    std::fs::write(
+        &csv,
+        format!("{HEAD}a,MDF,140,24,20,2d,0,361,639\nb,MDF,140,30,10,2d,0,40,460\n"),
+    )
+    .unwrap();
+    let out = dir.join("fit");
+    json(&dicephys(&[
+        "fit",
+        "--data",
+        csv.to_str().unwrap(),
+        "--free",
+        "e",
+        "--points",
+        "8",
+        "--degree",
+        "2",
+        "--max-degree",
+        "2",
+        "--rolls",
+        "100",
+        "--dt",
+        "1/250",
+        "--no-refine",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    let blocks = dir.join("blocks.csv");
+    std::fs::write(
+        &blocks,
+        "label,block,mode,length_vertical,breadth_vertical,width_vertical\n\
+         same,140x24x20,2d,0,361,639\nfar,140x27x13,2d,0,0,1000\nnew,140x26x12,2d,,,\n",
+    )
+    .unwrap();
+    let p = json(&dicephys(&[
+        "predict",
+        "--fit",
+        out.join("fit.json").to_str().unwrap(),
+        "--blocks",
+        blocks.to_str().unwrap(),
+        "--draws",
+        "4",
+        "--rolls",
+        "200",
+        "--out",
+        dir.join("pred").to_str().unwrap(),
+        "--json",
+    ]));
+    let rows = p["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 3);
+    assert!(rows[0]["z"].as_f64().unwrap().abs() < 3.0, "{}", rows[0]);
+    assert!(rows[2]["z"].is_null() && rows[2]["chi2"].is_null());
+    assert_eq!(p["dof"], 2);
+    assert!(p["p_value"].as_f64().unwrap() < 1e-6, "{p}");
+    for f in [
+        "predictions.csv",
+        "predictions.json",
+        "report.md",
+        "predictions.svg",
+    ] {
+        assert!(dir.join("pred").join(f).exists(), "{f}");
+    }
+    let csv_text = std::fs::read_to_string(dir.join("pred/predictions.csv")).unwrap();
+    assert_eq!(csv_text.lines().count(), 4);
+}
+
 /// Points a block in [`counted_at_e_03`]'s fit.
 const POINTS: usize = 8;
 /// Rolls a point.

@@ -4,6 +4,7 @@
 mod helpers;
 
 mod bullet;
+mod calibration_promises;
 mod cli;
 mod coarse;
 mod docs;

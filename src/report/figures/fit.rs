@@ -102,8 +102,8 @@ pub fn profiles(dir: &Path, title: &str, profiles: &[Profile]) -> crate::Result<
 pub struct RowRatio {
     /// The row's label.
     pub label: String,
-    /// Measured N(breadth vertical)/N(width vertical) ± binomial error.
-    pub measured: Point,
+    /// Measured N(breadth vertical)/N(width vertical) ± binomial error, if measured.
+    pub measured: Option<Point>,
     /// The fit's (or the leave-one-out prediction's) ratio ± its error.
     pub simulated: Point,
     /// The paper's theory (eq. MasterEqu), if drawn.
@@ -121,7 +121,9 @@ impl Figure for Rows<'_> {
         let n = self.rows.len();
         let mut ys = Span::new(0.0, 0.0);
         for r in self.rows {
-            ys.add_point(&r.measured);
+            if let Some(m) = &r.measured {
+                ys.add_point(m);
+            }
             ys.add_point(&r.simulated);
             if let Some(t) = &r.theory {
                 ys.add_point(t);
@@ -143,7 +145,7 @@ impl Figure for Rows<'_> {
             .rows
             .iter()
             .enumerate()
-            .map(|(i, r)| at(i, &r.measured, -0.12))
+            .filter_map(|(i, r)| r.measured.map(|m| at(i, &m, -0.12)))
             .collect();
         let simulated: Vec<Point> = self
             .rows

@@ -125,8 +125,14 @@ pub fn first_pass(
     let Some(sim) = simulate_pass(cfg, runner, dir, session)? else {
         return Ok(None);
     };
-    let (params, estimate) =
-        estimate_with(&cfg.rows, &cfg.model, &sim.designs, &first_pass_search(cfg))?;
+    settled_enough(&sim.designs)?;
+    let (params, estimate) = estimate_with(
+        &cfg.rows,
+        &cfg.model,
+        &sim.designs,
+        &first_pass_search(cfg),
+        &runner.watch(),
+    )?;
     Ok(Some(Fitted {
         config: cfg.clone(),
         rolls: sim.rolls,
@@ -137,6 +143,26 @@ pub fn first_pass(
         estimate,
         first_pass: None,
     }))
+}
+
+/// The most of a fit's rolls that may end on no face (unconverged, failed) before its estimate
+/// is refused: the rest are too few, and too odd a sample of the throws, to stand for the
+/// block.
+pub const MAX_UNSETTLED_SHARE: f64 = 0.1;
+
+/// Refuses designs whose rolls mostly did not settle (`Error::Failed`, what to change).
+fn settled_enough(designs: &[Design]) -> Result<()> {
+    let rolls: u64 = designs.iter().map(|d| d.rolls).sum();
+    let unsettled: u64 = designs.iter().map(|d| d.unsettled).sum();
+    if rolls > 0 && unsettled as f64 > MAX_UNSETTLED_SHARE * rolls as f64 {
+        return Err(Error::Failed(format!(
+            "{unsettled} of the fit's {rolls} rolls ({:.1} %) did not settle on a face (more \
+             than {:.0} %): no estimate from them; raise `max_steps` or use a finer `dt`",
+            100.0 * unsettled as f64 / rolls as f64,
+            100.0 * MAX_UNSETTLED_SHARE
+        )));
+    }
+    Ok(())
 }
 
 /// The second pass over the box narrowed from `first` (a pass with nothing to narrow is the
@@ -152,7 +178,13 @@ pub fn second_pass(
     let cfg = &first.config;
     let narrowed = narrow(&cfg.rows, &cfg.model, &first.params, &first.estimate);
     if narrowed.is_empty() {
-        let (params, estimate) = estimate_with(&cfg.rows, &cfg.model, &first.designs, &cfg.search)?;
+        let (params, estimate) = estimate_with(
+            &cfg.rows,
+            &cfg.model,
+            &first.designs,
+            &cfg.search,
+            &runner.watch(),
+        )?;
         return Ok(Some(Fitted {
             params,
             estimate,
@@ -193,6 +225,7 @@ fn refined_pass(
     let Some(sim) = simulate_pass(&out.config, runner, dir, session)? else {
         return Ok(None);
     };
+    settled_enough(&sim.designs)?;
     out.rolls += sim.rolls;
     out.unsettled += sim.unsettled;
     let (params, estimate) = estimate_with(
@@ -200,6 +233,7 @@ fn refined_pass(
         &out.config.model,
         &sim.designs,
         &out.config.search,
+        &runner.watch(),
     )?;
     out.passes.push(Pass::over(&params, sim.rolls));
     let before = std::mem::replace(&mut out.estimate, estimate).params;
@@ -294,8 +328,8 @@ impl FitStudy {
                 path.display()
             ))
         })?;
-        let r: FitResult = serde_json::from_str(&text)
-            .map_err(|e| Error::Invalid(format!("{} is damaged ({e})", path.display())))?;
+        let r: FitResult = crate::run::seal::open(&text)
+            .map_err(|e| Error::Invalid(format!("{}: {e}", path.display())))?;
         if r.config != self.config {
             return Err(Error::Invalid(format!(
                 "{} is the first pass of another fit",

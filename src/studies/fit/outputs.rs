@@ -5,10 +5,30 @@
 use super::{FitStudy, Stage, FIRST_PASS};
 use crate::calibration::predict::PredictConfig;
 use crate::calibration::{FitConfig, FitResult};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::report::fit as report;
+use crate::run::seal;
 use crate::studies::calibrated::{self, CalibratedConfig};
 use crate::studies::outputs::{to_json, Done, Hooks, Place};
+use serde::Serialize;
+
+/// Claims `place.out` for this run (`run::owner`), once every value has been checked: refused
+/// if another command or another run owns it, or if a Slurm run does (neither `fit --recover`
+/// nor `paper --calibrated` runs on a cluster).
+fn claim<T: Serialize>(place: &Place, command: &str, identity: &T) -> Result<()> {
+    let identity = serde_json::to_value(identity).map_err(|e| Error::Failed(e.to_string()))?;
+    crate::run::owner::refuse_cluster_run(&place.out)?;
+    crate::run::owner::claim(&place.out, command, &identity)
+}
+
+/// A stop request met in the estimate (no rolls to keep there) ends the study as one met
+/// between rolls does.
+fn unless_stopped<T>(r: Result<Option<T>>) -> Result<Option<T>> {
+    match r {
+        Err(Error::Stopped) => Ok(None),
+        r => r,
+    }
+}
 
 fn interrupted(place: &Place) -> Done {
     Done {
@@ -43,16 +63,23 @@ pub fn fit(study: &FitStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
     };
     let total = cfg.total_rolls() as f64 * passes;
     let progress = |n: u64| (hooks.progress)(n as f64, total);
-    let sim = place.study(&hooks.stop, &progress);
+    let mut sim = place.study(&hooks.stop, &progress);
+    sim.runner = sim.runner.with_say(hooks.log);
     let dir = sim.checkpoint.as_deref();
-    let res = super::run(study, place.command_line.clone(), &sim.runner, dir)?;
+    let runner = &sim.runner;
+    let res = unless_stopped(
+        runner.install(|| super::run(study, place.command_line.clone(), runner, dir))?,
+    )?;
     if place.partial() {
         return Ok(Done::default());
     }
     let Some(res) = res else {
         return Ok(interrupted(place));
     };
-    let json = to_json(&res)?;
+    (hooks.progress)(total, total);
+    // Sealed: `predict`, a Slurm fit's second pass and anything else that reads it refuses
+    // a damaged or edited file.
+    let json = seal::to_string(&res, true)?;
     if first {
         outputs[0].write(json.as_bytes())?;
         let mut done = place.done(&json, &report::first_pass_text(&res), FIRST_PASS);
@@ -80,18 +107,25 @@ pub fn recover(
     hooks: &Hooks,
 ) -> Result<Done> {
     cfg.validate()?;
+    super::recovery::check_truth(cfg, truth, repeats)?;
+    claim(place, "fit --recover", &(cfg, truth, repeats))?;
     let outputs = place.outputs(&["recovery.json"])?;
     let data: u64 = cfg.rows.iter().map(|r| r.counts.iter().sum::<u64>()).sum();
     let passes = if cfg.design.refine { 2 } else { 1 };
     let total = ((passes * cfg.total_rolls() + data) * repeats as u64) as f64;
     let progress = |n: u64| (hooks.progress)(n as f64, total);
-    let study = place.study(&hooks.stop, &progress);
-    let Some(res) = super::recovery::run(cfg, truth, repeats, &study.runner)? else {
+    let mut study = place.study(&hooks.stop, &progress);
+    study.runner = study.runner.with_say(hooks.log);
+    let runner = &study.runner;
+    let res =
+        unless_stopped(runner.install(|| super::recovery::run(cfg, truth, repeats, runner))?)?;
+    let Some(res) = res else {
         return Ok(Done {
             interrupted: Some("interrupted before the repetitions were done".into()),
             ..Done::default()
         });
     };
+    (hooks.progress)(total, total);
     let json = to_json(&res)?;
     outputs[0].write(json.as_bytes())?;
     let text = report::recovery_text(&res);
@@ -104,10 +138,14 @@ pub fn recover(
 
 /// `predict`: the block's probabilities printed (no files).
 pub fn predict(fit: &FitResult, cfg: &PredictConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
+    super::predict::check(fit, cfg)?;
     let total = (cfg.draws as u64 * cfg.rolls) as f64;
     let progress = |n: u64| (hooks.progress)(n as f64, total);
     let study = place.study(&hooks.stop, &progress);
-    let Some(p) = super::predict::predict_block(fit, cfg, &study.runner, None)? else {
+    let runner = &study.runner;
+    let p =
+        unless_stopped(runner.install(|| super::predict::predict_block(fit, cfg, runner, None))?)?;
+    let Some(p) = p else {
         return Ok(Done {
             interrupted: Some("interrupted before the draws were rolled".into()),
             ..Done::default()
@@ -123,22 +161,101 @@ pub fn predict(fit: &FitResult, cfg: &PredictConfig, place: &Place, hooks: &Hook
     })
 }
 
+/// What `predict --blocks` predicts: the blocks, and the draws and rolls of each.
+#[derive(Clone, Debug, Serialize)]
+pub struct BlocksConfig {
+    /// The blocks, with their counts where measured.
+    pub rows: Vec<crate::calibration::heldout::BlockRow>,
+    /// Posterior draws a block.
+    pub draws: usize,
+    /// Rolls a draw.
+    pub rolls: u64,
+    /// The throws' seed.
+    pub seed: u64,
+    /// The fit's file, as given.
+    pub fit: String,
+}
+
+/// `predict --blocks`: predictions.json, predictions.csv, report.md and the figure
+/// `predictions` in `place.out` (claimed as a study's); the table printed.
+pub fn predict_blocks(
+    fit: &FitResult,
+    cfg: &BlocksConfig,
+    place: &Place,
+    hooks: &Hooks,
+) -> Result<Done> {
+    let (stem, files) = (
+        "predictions",
+        ["predictions.json", "predictions.csv", "report.md"],
+    );
+    // Every row checked (by predict_blocks, before it rolls) before the directory is claimed.
+    for r in &cfg.rows {
+        super::predict::check(
+            fit,
+            &PredictConfig {
+                block: r.block,
+                mode: r.mode,
+                surface: r.surface.clone(),
+                thrower: r.thrower.clone(),
+                draws: cfg.draws,
+                rolls: cfg.rolls,
+                seed: cfg.seed,
+            },
+        )
+        .map_err(|e| Error::Invalid(format!("row '{}': {e}", r.label)))?;
+    }
+    let identity = (cfg, &fit.config, &fit.estimate.x);
+    claim(place, "predict --blocks", &identity)?;
+    let outputs = place.outputs(&files)?;
+    let total = (cfg.rows.len() as u64 * cfg.draws as u64 * cfg.rolls) as f64;
+    let progress = |n: u64| (hooks.progress)(n as f64, total);
+    let study = place.study(&hooks.stop, &progress);
+    let runner = &study.runner;
+    let rows = unless_stopped(runner.install(|| {
+        super::predict::predict_blocks(fit, &cfg.rows, cfg.draws, cfg.rolls, cfg.seed, runner)
+    })?)?;
+    let Some(rows) = rows else {
+        return Ok(Done {
+            interrupted: Some("interrupted before every block was rolled; nothing written".into()),
+            ..Done::default()
+        });
+    };
+    let res =
+        crate::calibration::heldout::collect(rows, cfg.fit.clone(), place.command_line.clone());
+    report::predictions_figure(&place.out, stem, &res)?;
+    let md = report::predictions_markdown(&res, stem);
+    let json = to_json(&res)?;
+    outputs[0].write(json.as_bytes())?;
+    outputs[1].write(report::predictions_csv(&res).as_bytes())?;
+    outputs[2].write(md.as_bytes())?;
+    let mut done = place.done(&json, &md, "predictions.json");
+    done.note = done.note.map(|_| {
+        format!(
+            "wrote {}/predictions.json, predictions.csv, report.md and the figure",
+            place.out.display()
+        )
+    });
+    Ok(done)
+}
+
 /// `paper --calibrated`: calibrated.json, calibrated.md and figures in `place.out`, the cells
 /// under `place.checkpoint`.
 pub fn calibrated(cfg: &CalibratedConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
+    cfg.validate()?;
+    claim(place, "paper --calibrated", cfg)?;
     let outputs = place.outputs(&["calibrated.json", "calibrated.md"])?;
     let total = calibrated::total_rolls(cfg)? as f64;
     let progress = |n: u64| (hooks.progress)(n as f64, total);
-    let study = place.study(&hooks.stop, &progress);
-    let Some(res) = calibrated::run(
-        cfg,
-        place.command_line.clone(),
-        &study.runner,
-        study.checkpoint.as_deref(),
-    )?
-    else {
+    let mut study = place.study(&hooks.stop, &progress);
+    study.runner = study.runner.with_say(hooks.log);
+    let (runner, dir) = (&study.runner, study.checkpoint.as_deref());
+    let res = unless_stopped(
+        runner.install(|| calibrated::run(cfg, place.command_line.clone(), runner, dir))?,
+    )?;
+    let Some(res) = res else {
         return Ok(interrupted(place));
     };
+    (hooks.progress)(total, total);
     let figures = report::write_calibrated_figures(&place.out, &res)?;
     let md = report::calibrated_markdown(&res, &figures);
     let json = to_json(&res)?;

@@ -8,6 +8,61 @@ use crate::error::{Error, Result};
 use crate::run::runner::Runner;
 use std::path::Path;
 
+/// Checks a prediction before anything rolls: the fit whole, the draws and rolls in range, the
+/// surface and thrower the fit's.
+pub fn check(fit: &FitResult, cfg: &PredictConfig) -> Result<()> {
+    fit.check()?;
+    if cfg.draws < 2 || cfg.draws > fit.estimate.draws.len() {
+        return Err(Error::field(
+            "draws",
+            cfg.draws,
+            format!(
+                "from 2 to the fit's {} posterior draws",
+                fit.estimate.draws.len()
+            ),
+        ));
+    }
+    if cfg.rolls == 0 || cfg.rolls > crate::run::spec::MAX_ROLLS {
+        return Err(Error::field(
+            "rolls",
+            cfg.rolls,
+            format!("from 1 to {}", crate::run::spec::MAX_ROLLS),
+        ));
+    }
+    group(fit, true, &cfg.surface, "surface")?;
+    group(fit, false, &cfg.thrower, "thrower")?;
+    Ok(())
+}
+
+/// Where `block` lies outside what the fit's rows saw (each side's length, and the aspect
+/// ratios width/breadth and breadth/length), by more than 1 %: a prediction there extrapolates.
+pub fn extrapolation(fit: &FitResult, block: &crate::model::block::Block) -> Option<String> {
+    let measures = |b: &crate::model::block::Block| {
+        [
+            ("length", b.length * 1000.0, "mm"),
+            ("breadth", b.breadth * 1000.0, "mm"),
+            ("width", b.width * 1000.0, "mm"),
+            ("width/breadth", b.width / b.breadth, ""),
+            ("breadth/length", b.breadth / b.length, ""),
+        ]
+    };
+    let seen: Vec<_> = fit.config.rows.iter().map(|r| measures(&r.block)).collect();
+    let out: Vec<String> = measures(block)
+        .iter()
+        .enumerate()
+        .filter_map(|(i, (name, v, unit))| {
+            let lo = seen.iter().map(|m| m[i].1).fold(f64::INFINITY, f64::min);
+            let hi = seen
+                .iter()
+                .map(|m| m[i].1)
+                .fold(f64::NEG_INFINITY, f64::max);
+            (*v < lo * 0.99 || *v > hi * 1.01)
+                .then(|| format!("{name} {v:.3}{unit} (the fit saw {lo:.3}–{hi:.3}{unit})"))
+        })
+        .collect();
+    (!out.is_empty()).then(|| format!("outside the blocks the fit saw: {}", out.join(", ")))
+}
+
 /// Simulates `cfg.block` at posterior draws of `fit`. `None` if stopped early.
 pub fn predict_block(
     fit: &FitResult,
@@ -15,6 +70,7 @@ pub fn predict_block(
     runner: &Runner,
     dir: Option<&Path>,
 ) -> Result<Option<BlockPrediction>> {
+    check(fit, cfg)?;
     if cfg.draws < 2 || cfg.draws > fit.estimate.draws.len() {
         return Err(Error::Invalid(format!(
             "draws {}: from 2 to the fit's {} posterior draws",
@@ -69,10 +125,25 @@ pub fn predict_block(
         let c = &done.tally.counts;
         let settled = c.length + c.breadth + c.width;
         unsettled += done.tally.rolls - settled;
+        let sides = c.breadth + c.width;
+        if sides == 0 || settled == 0 {
+            return Err(Error::Failed(format!(
+                "none of the {} rolls at posterior draw {m} settled on a side: no probabilities \
+                 to give; raise `max_steps` in the fit, or use a finer `dt`",
+                done.tally.rolls
+            )));
+        }
         for (k, v) in [c.length, c.breadth, c.width].iter().enumerate() {
-            freq[k].push(*v as f64 / settled.max(1) as f64);
+            freq[k].push(*v as f64 / settled as f64);
         }
         ratios.push(c.breadth as f64 / c.width.max(1) as f64);
+    }
+    let all = cfg.draws as u64 * cfg.rolls;
+    if unsettled as f64 > super::MAX_UNSETTLED_SHARE * all as f64 {
+        return Err(Error::Failed(format!(
+            "{unsettled} of the prediction's {all} rolls did not settle on a face: no \
+             probabilities from them; raise `max_steps` in the fit, or use a finer `dt`"
+        )));
     }
     let n = cfg.rolls as f64;
     let m = cfg.draws as f64;
@@ -110,5 +181,48 @@ pub fn predict_block(
         draws: cfg.draws,
         rolls: cfg.rolls,
         unsettled,
+        extrapolation: extrapolation(fit, &cfg.block),
     }))
+}
+
+/// Each of `rows` predicted from `fit` (`draws` posterior draws × `rolls` throws a block), and
+/// tested against its counts where it has them. Every row is checked before any rolls. `None`
+/// if stopped early.
+pub fn predict_blocks(
+    fit: &FitResult,
+    rows: &[crate::calibration::heldout::BlockRow],
+    draws: usize,
+    rolls: u64,
+    seed: u64,
+    runner: &Runner,
+) -> Result<Option<Vec<crate::calibration::heldout::PredictedRow>>> {
+    let cfg = |r: &crate::calibration::heldout::BlockRow| PredictConfig {
+        block: r.block,
+        mode: r.mode,
+        surface: r.surface.clone(),
+        thrower: r.thrower.clone(),
+        draws,
+        rolls,
+        seed,
+    };
+    for r in rows {
+        check(fit, &cfg(r)).map_err(|e| Error::Invalid(format!("row '{}': {e}", r.label)))?;
+    }
+    let per_row = draws as u64 * rolls;
+    let mut out = Vec::new();
+    for (i, r) in rows.iter().enumerate() {
+        let base = i as u64 * per_row;
+        let progress = |n| (runner.progress)(base + n);
+        let Some(p) = predict_block(fit, &cfg(r), &runner.with_progress(&progress), None).map_err(
+            |e| match e {
+                Error::Failed(m) => Error::Failed(format!("row '{}': {m}", r.label)),
+                e => e,
+            },
+        )?
+        else {
+            return Ok(None);
+        };
+        out.push(crate::calibration::heldout::test(r, p));
+    }
+    Ok(Some(out))
 }

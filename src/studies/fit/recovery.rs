@@ -52,16 +52,13 @@ pub fn simulate_data(
     Ok(Some(out))
 }
 
-/// Runs `repeats` repetitions at `truth` (the free parameters' values, one per kind in
-/// `cfg.model.free`'s order, shared by every surface and thrower). `None` if stopped early.
-pub fn run(
-    cfg: &FitConfig,
-    truth: &[f64],
-    repeats: usize,
-    runner: &Runner,
-) -> Result<Option<Recovery>> {
-    cfg.validate()?;
+/// Checks the truth (a value for every free parameter, inside its range) and the repeats,
+/// before anything is written or rolled.
+pub fn check_truth(cfg: &FitConfig, truth: &[f64], repeats: usize) -> Result<()> {
     let model = &cfg.model;
+    if repeats == 0 {
+        return Err(Error::field("repeats", 0, "need at least one repetition"));
+    }
     if truth.len() != model.free.len() {
         return Err(Error::Invalid(format!(
             "the truth gives {} values for {} free parameters",
@@ -71,11 +68,27 @@ pub fn run(
     }
     for ((kind, range), v) in model.free.iter().zip(&model.ranges).zip(truth) {
         if !(range.lo..=range.hi).contains(v) {
-            return Err(Error::Invalid(format!(
-                "the truth's {kind} {v} is outside its range {range}"
-            )));
+            return Err(Error::field(
+                "recover",
+                format!("{kind}={v}"),
+                format!("outside its range {range} (`range` sets it)"),
+            ));
         }
     }
+    Ok(())
+}
+
+/// Runs `repeats` repetitions at `truth` (the free parameters' values, one per kind in
+/// `cfg.model.free`'s order, shared by every surface and thrower). `None` if stopped early.
+pub fn run(
+    cfg: &FitConfig,
+    truth: &[f64],
+    repeats: usize,
+    runner: &Runner,
+) -> Result<Option<Recovery>> {
+    cfg.validate()?;
+    check_truth(cfg, truth, repeats)?;
+    let model = &cfg.model;
     let coords: Vec<f64> = model
         .free
         .iter()
