@@ -33,6 +33,7 @@ pub mod predict;
 pub mod recovery;
 
 use crate::error::{Error, Result};
+use crate::model::throws::Range;
 use data::DataRow;
 use design::{Design, DesignSpec};
 use estimate::{Estimate, Likelihood, Search};
@@ -123,6 +124,11 @@ pub struct FitResult {
     /// The first pass's parameters, when a second pass refined them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub first_pass: Option<Vec<estimate::ParamFit>>,
+    /// Every pass, in order: the first over the whole ranges, a second over the box narrowed
+    /// from it, and any that widened a box that cut a parameter (a fit.json from before passes
+    /// were recorded has none).
+    #[serde(default)]
+    pub passes: Vec<Pass>,
     /// The blocks simulated, with their surrogates.
     pub designs: Vec<Design>,
     /// The estimate.
@@ -135,6 +141,125 @@ pub struct FitResult {
     pub dicephys_version: String,
     /// When it ended, UTC.
     pub date_utc: String,
+}
+
+/// One pass of a fit: the box its designs were simulated over, and what it rolled.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Pass {
+    /// Each free parameter's range in this pass, by name.
+    #[serde(rename = "box")]
+    pub bounds: Vec<params::Narrowed>,
+    /// Rolls made for it (or read back from the checkpoints). A design an earlier pass already
+    /// simulated (its block's parameters' ranges unchanged) is taken from that pass, not rolled
+    /// again, and costs none.
+    pub rolls: u64,
+    /// The parameters whose maximum or 2σ interval reached a face of this pass's box that is
+    /// not their range's own (the next pass widened them there; the last pass's, after
+    /// [`MAX_WIDENINGS`], were left cut).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cut: Vec<Cut>,
+}
+
+impl Pass {
+    /// A pass over `params`' ranges that rolled `rolls`, nothing cut (yet).
+    pub fn over(params: &[Param], rolls: u64) -> Pass {
+        Pass {
+            bounds: params
+                .iter()
+                .map(|p| params::Narrowed {
+                    param: p.name(),
+                    range: p.range,
+                })
+                .collect(),
+            rolls,
+            cut: vec![],
+        }
+    }
+}
+
+/// A parameter a narrowed box cut, and on which side.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Cut {
+    /// The parameter's name.
+    pub param: String,
+    /// Cut at the box's lower face (which is above its range's lower end).
+    pub lower: bool,
+    /// Cut at the box's upper face (which is below its range's upper end).
+    pub upper: bool,
+}
+
+/// Passes after the second at most, each widening the boxes that cut a parameter. In unit
+/// coordinates of the range, [`widen`] moves a cut face out by the old box's width plus at
+/// least 0.05, and the box grows by at least 0.1 a pass (unless it reaches an end of the
+/// range); so four passes move a cut face by at least 0.8 plus four times the second pass's
+/// box width (at least 0.05 wide as [`narrow`] draws it), which takes it to the range's end:
+/// a region that lies off one face is met within four. One that jumps from face to face (a
+/// surrogate too poor to place it) may not be; the fit then says it is still cut.
+pub const MAX_WIDENINGS: usize = 4;
+
+/// How close, in a box's unit coordinate, a maximum or an interval's end must come to a face
+/// to be on it (the search clamps to the faces, and an open side of a profile interval ends on
+/// its grid's end point, so on a face they sit within rounding of it).
+const ON_FACE: f64 = 1e-6;
+
+/// The parameters of a refined pass's estimate that its box cut: their maximum, or an end of
+/// their 2σ profile interval, on a face of a narrowed range that is not their kind's own face.
+/// There the likelihood may go on rising, or the region on, past the face: the value or the
+/// interval printed would be the box's, not the data's.
+pub fn cuts(est: &Estimate) -> Vec<Cut> {
+    let mut out = Vec::new();
+    for (fit, &x) in est.params.iter().zip(&est.x) {
+        let p = &fit.param;
+        let u = |v: f64| p.kind.coordinate(p.range, v);
+        // Where the box's faces are on the whole range: a face within rounding of the range's
+        // end is that end (a fit.json whose narrowed κ ends at 9999.999999999998).
+        let w = |v: f64| p.kind.coordinate(p.whole, v);
+        let lower = w(p.range.lo) > ON_FACE && (x <= ON_FACE || u(fit.two_sigma[0]) <= ON_FACE);
+        let upper = w(p.range.hi) < 1.0 - ON_FACE
+            && (x >= 1.0 - ON_FACE || u(fit.two_sigma[1]) >= 1.0 - ON_FACE);
+        if lower || upper {
+            out.push(Cut {
+                param: p.name(),
+                lower,
+                upper,
+            });
+        }
+    }
+    out
+}
+
+/// The next pass's box after `est`, whose box (`model`'s narrowed ranges) cut the parameters
+/// in `cut`. A parameter not cut keeps its range exactly, so that the designs of the blocks
+/// that only it and others like it touch keep their keys and are not rolled again. A cut one
+/// gets the box [`narrow`] would draw around its new 2σ interval (which holds its new
+/// maximum: the box is recentred on it), pushed out on each cut side by the old box's width
+/// as well: past a cut face the region's end is unseen, so the next pass looks as far again
+/// beyond it as the box spanned, and each pass reaches further than the last (the bound is at
+/// [`MAX_WIDENINGS`]) until the range's own end stops it. A box that then covers 80 % of the
+/// range takes it all, as in [`narrow`].
+pub fn widen(model: &ModelSpec, est: &Estimate, cut: &[Cut]) -> Vec<params::Narrowed> {
+    let mut out = model.narrowed.clone();
+    for c in cut {
+        let Some(fit) = est.params.iter().find(|f| f.name == c.param) else {
+            continue;
+        };
+        let p = &fit.param;
+        // Coordinates on the kind's whole range, where the boxes are drawn.
+        let w = |v: f64| p.kind.coordinate(p.whole, v).clamp(0.0, 1.0);
+        let (lo, hi) = (w(fit.two_sigma[0]), w(fit.two_sigma[1]));
+        let width = w(p.range.hi) - w(p.range.lo);
+        let pad = (0.5 * (hi - lo)).max(0.05);
+        let a = (lo - pad - if c.lower { width } else { 0.0 }).max(0.0);
+        let b = (hi + pad + if c.upper { width } else { 0.0 }).min(1.0);
+        out.retain(|n| n.param != c.param);
+        if b - a < 0.8 {
+            out.push(params::Narrowed {
+                param: c.param.clone(),
+                range: sub_range(p.kind, p.whole, a, b),
+            });
+        }
+    }
+    out
 }
 
 /// The second pass's box: each parameter's first-pass 2σ profile interval, widened by half its
@@ -168,13 +293,23 @@ pub fn narrow(
         }
         out.push(params::Narrowed {
             param: p.name(),
-            range: crate::model::throws::Range::new(
-                p.kind.value(p.range, a),
-                p.kind.value(p.range, b),
-            ),
+            range: sub_range(p.kind, p.range, a, b),
         });
     }
     out
+}
+
+/// The part of `whole` from unit coordinate `a` to `b`, its ends `whole`'s own, to the bit, at 0
+/// and 1: κ's and the spin's warped coordinates do not give them back exactly (κ's upper end
+/// came back 9999.999999999998), and a box's edge a rounding inside its range's end would pass
+/// for an edge the narrowing drew, which cuts.
+fn sub_range(kind: params::Kind, whole: Range, a: f64, b: f64) -> Range {
+    let at = |u: f64| match u {
+        u if u <= 0.0 => whole.lo,
+        u if u >= 1.0 => whole.hi,
+        u => kind.value(whole, u),
+    };
+    Range::new(at(a), at(b))
 }
 
 /// Fits `rows` with the designs already simulated (the cheap part: no rolls).
@@ -237,5 +372,136 @@ impl FitResult {
             )));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use estimate::{Identified, ParamFit};
+    use params::{Kind, Narrowed};
+
+    /// A fit of e on surface `group` at `value`, 2σ `two`, searched in `range`.
+    fn fit_of(group: &str, range: Range, value: f64, two: [f64; 2]) -> (ParamFit, f64) {
+        fit_kind(Kind::E, group, range, value, two)
+    }
+
+    fn fit_kind(
+        kind: Kind,
+        group: &str,
+        range: Range,
+        value: f64,
+        two: [f64; 2],
+    ) -> (ParamFit, f64) {
+        let param = Param {
+            kind,
+            group: group.into(),
+            range,
+            whole: kind.default_range(),
+        };
+        let x = kind.coordinate(range, value);
+        let fit = ParamFit {
+            name: param.name(),
+            param,
+            value,
+            one_sigma: two,
+            two_sigma: two,
+            identified: Identified::Yes,
+            profile: vec![],
+        };
+        (fit, x)
+    }
+
+    fn estimate_of(fits: Vec<(ParamFit, f64)>) -> Estimate {
+        Estimate {
+            x: fits.iter().map(|f| f.1).collect(),
+            minus_two_ln_l: 0.0,
+            params: fits.into_iter().map(|f| f.0).collect(),
+            rows: vec![],
+            chi2: 0.0,
+            dof: 0,
+            p_value: None,
+            region_delta: 0.0,
+            bartlett: 1.0,
+            other_maxima: vec![],
+            draws: vec![],
+            bootstrap: None,
+        }
+    }
+
+    #[test]
+    fn a_box_that_cut_a_parameter_is_widened_on_that_side_and_no_other_box_moves() {
+        let boxed = Range::new(0.6125, 0.7575);
+        let own_end = Range::new(0.05, 0.3);
+        let model = ModelSpec {
+            narrowed: vec![
+                Narrowed {
+                    param: "e[A]".into(),
+                    range: boxed,
+                },
+                Narrowed {
+                    param: "e[C]".into(),
+                    range: own_end,
+                },
+            ],
+            ..ModelSpec::free(&[Kind::E])
+        };
+        let est = estimate_of(vec![
+            // On the box's lower edge, which is inside the range: cut.
+            fit_of("A", boxed, 0.6125, [0.6125, 0.62]),
+            // Interior, on the whole range: not cut.
+            fit_of("B", Kind::E.default_range(), 0.3, [0.2, 0.4]),
+            // On the lower edge of a box that is the range's own: bounded by the range, not cut.
+            fit_of("C", own_end, 0.05, [0.05, 0.2]),
+        ]);
+        let cut = cuts(&est);
+        assert_eq!(
+            cut,
+            vec![Cut {
+                param: "e[A]".into(),
+                lower: true,
+                upper: false
+            }]
+        );
+        let wider = widen(&model, &est, &cut);
+        // e[C] as it was; e[A] moved down by its old width (0.145) and the pad (0.05 of the
+        // range's 0.75) past its cut edge, and up to its interval plus the pad.
+        assert_eq!(wider.len(), 2);
+        assert!(wider.contains(&model.narrowed[1]), "{wider:?}");
+        let a = wider.iter().find(|n| n.param == "e[A]").unwrap().range;
+        assert!((a.lo - (0.6125 - 0.145 - 0.0375)).abs() < 1e-9, "{a}");
+        assert!((a.hi - (0.62 + 0.0375)).abs() < 1e-9, "{a}");
+        // A region that runs past both edges of a wide box: widened to 80 % of the range or
+        // more, the box takes the whole range.
+        let wide = Range::new(0.2, 0.6);
+        let both = estimate_of(vec![fit_of("A", wide, 0.4, [0.2, 0.6])]);
+        let cut = cuts(&both);
+        assert!(cut.len() == 1 && cut[0].lower && cut[0].upper, "{cut:?}");
+        let wider = widen(&model, &both, &cut);
+        assert!(!wider.iter().any(|n| n.param == "e[A]"), "{wider:?}");
+        // κ's warp does not give its range's end back to the bit (9999.999999999998): a box
+        // that reaches it is not cut there, and a widened one ends on it exactly.
+        let top = Kind::Kappa.value(Kind::Kappa.default_range(), 1.0);
+        let near_top = Range::new(1000.0, top);
+        let k = estimate_of(vec![fit_kind(
+            Kind::Kappa,
+            "all",
+            near_top,
+            top,
+            [3000.0, top],
+        )]);
+        assert!(cuts(&k).is_empty(), "{:?}", cuts(&k));
+        let low = Range::new(1000.0, 3000.0);
+        let k = estimate_of(vec![fit_kind(
+            Kind::Kappa,
+            "all",
+            low,
+            3000.0,
+            [2000.0, 3000.0],
+        )]);
+        let cut = cuts(&k);
+        let kappa = ModelSpec::free(&[Kind::Kappa]);
+        let wider = widen(&kappa, &k, &cut);
+        assert_eq!(wider[0].range.hi, 1e4, "{wider:?}");
     }
 }

@@ -1,11 +1,12 @@
 //! What a fit says: `report.md`, its figures, and a prediction's lines.
 
 use crate::calibration::check::Verdict;
+use crate::calibration::estimate::Identified;
 use crate::calibration::paper::CalibratedPaper;
 use crate::calibration::params::{FixedThrow, Kind};
 use crate::calibration::predict::{BlockPrediction, Predicted};
 use crate::calibration::recovery::Recovery;
-use crate::calibration::FitResult;
+use crate::calibration::{FitResult, MAX_WIDENINGS};
 use crate::error::Result;
 use crate::report::figures::fit::{self as fig, Profile, RowRatio};
 use crate::report::figures::Point;
@@ -71,6 +72,129 @@ pub fn first_pass_text(res: &FitResult) -> String {
     s
 }
 
+/// The report's parameters: each one's value and intervals, and what bounds them.
+fn parameters(res: &FitResult) -> String {
+    let e = &res.estimate;
+    let mut s = String::new();
+    let _ = writeln!(s, "## Parameters\n");
+    let _ = writeln!(
+        s,
+        "Maximum likelihood, with profile-likelihood intervals (Δ(−2 ln L) = 1 for 1σ, 4 for 2σ) \
+         inside the searched range. The joint 2σ region of all {} is Δ(−2 ln L) ≤ {:.2} (χ² at \
+         95.45 %).\n",
+        res.params.len(),
+        e.region_delta
+    );
+    let _ = writeln!(s, "| parameter | range | fitted | 1σ | 2σ | |");
+    let _ = writeln!(s, "|---|---|---:|---|---|---|");
+    for p in &e.params {
+        let r = p.param.range;
+        let r = format!("{}–{}", num(r.lo), num(r.hi));
+        let says = match p.identified {
+            Identified::Cut if res.passes.len() > 2 => format!(
+                "still cut: its maximum or 2σ region reaches an edge of the last pass's narrowed \
+                 box, after {} widenings; the value is that box's, not the data's",
+                res.passes.len() - 2
+            ),
+            // At the range's own end, not a box's: the range asked for bounds it.
+            Identified::UpperBoundOnly | Identified::LowerBoundOnly => format!(
+                "{}: the range's own end, not a narrowed box's (a wider --range, where the \
+                 physics allows, shows where it ends)",
+                p.identified.says()
+            ),
+            other => other.says().into(),
+        };
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} – {} | {} – {} | {} |",
+            p.name,
+            r,
+            num(p.value),
+            num(p.one_sigma[0]),
+            num(p.one_sigma[1]),
+            num(p.two_sigma[0]),
+            num(p.two_sigma[1]),
+            says
+        );
+    }
+    if !e.other_maxima.is_empty() {
+        let _ = writeln!(
+            s,
+            "\nThe search also ended at other local maxima, −2 ln L higher by {}: the region may \
+             be more than one island.",
+            e.other_maxima
+                .iter()
+                .map(|f| format!("{:.2}", f - e.minus_two_ln_l))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    s
+}
+
+/// The passes a refined fit took: each one's box and rolls, the parameters its box cut, and,
+/// if the last one still cuts some, what to do (nothing for a fit of one pass).
+fn passes(res: &FitResult) -> String {
+    let mut s = String::new();
+    if res.passes.len() < 2 {
+        return s;
+    }
+    let _ = writeln!(
+        s,
+        "\n### Passes\n\nThe first pass simulates the whole ranges; the second, the box narrowed \
+         to the first's 2σ intervals. A pass whose box cuts a parameter (its maximum or 2σ \
+         interval on an edge of the box that is not its range's) is followed by one over a box \
+         moved and widened on that side, at most {MAX_WIDENINGS} times; a block whose parameters' \
+         ranges stay as they were is not rolled again.\n"
+    );
+    let _ = writeln!(s, "| pass | box | rolls | cut by its box |");
+    let _ = writeln!(s, "|---:|---|---:|---|");
+    for (i, p) in res.passes.iter().enumerate() {
+        let bounds: Vec<String> = p
+            .bounds
+            .iter()
+            .map(|b| format!("{} {}–{}", b.param, num(b.range.lo), num(b.range.hi)))
+            .collect();
+        let cut: Vec<String> = p
+            .cut
+            .iter()
+            .map(|c| {
+                let side = match (c.lower, c.upper) {
+                    (true, true) => "both edges",
+                    (true, false) => "lower edge",
+                    _ => "upper edge",
+                };
+                format!("{} ({side})", c.param)
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} |",
+            i + 1,
+            bounds.join(", "),
+            p.rolls,
+            if cut.is_empty() {
+                "—".into()
+            } else {
+                cut.join(", ")
+            }
+        );
+    }
+    if let Some(last) = res.passes.last().filter(|p| !p.cut.is_empty()) {
+        let names: Vec<&str> = last.cut.iter().map(|c| c.param.as_str()).collect();
+        let _ = writeln!(
+            s,
+            "\n**Still cut** after {} passes: {}. The narrowed box, not the data, bounds {}: \
+             rerun with more `--points` or `--rolls` (a surer first pass), or with `--no-refine` \
+             (one pass over the whole `--range`).",
+            res.passes.len(),
+            names.join(", "),
+            if names.len() == 1 { "it" } else { "them" }
+        );
+    }
+    s
+}
+
 /// `report.md` for a fit; `figures` are the stems written beside it.
 pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
     let e = &res.estimate;
@@ -100,45 +224,8 @@ pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
         res.cost.cpu_s,
         fixed_text(res),
     );
-    let _ = writeln!(s, "## Parameters\n");
-    let _ = writeln!(
-        s,
-        "Maximum likelihood, with profile-likelihood intervals (Δ(−2 ln L) = 1 for 1σ, 4 for 2σ) \
-         inside the searched range. The joint 2σ region of all {} is Δ(−2 ln L) ≤ {:.2} (χ² at \
-         95.45 %).\n",
-        res.params.len(),
-        e.region_delta
-    );
-    let _ = writeln!(s, "| parameter | range | fitted | 1σ | 2σ | |");
-    let _ = writeln!(s, "|---|---|---:|---|---|---|");
-    for p in &e.params {
-        let r = p.param.range;
-        let r = format!("{}–{}", num(r.lo), num(r.hi));
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} | {} – {} | {} – {} | {} |",
-            p.name,
-            r,
-            num(p.value),
-            num(p.one_sigma[0]),
-            num(p.one_sigma[1]),
-            num(p.two_sigma[0]),
-            num(p.two_sigma[1]),
-            p.identified.says()
-        );
-    }
-    if !e.other_maxima.is_empty() {
-        let _ = writeln!(
-            s,
-            "\nThe search also ended at other local maxima, −2 ln L higher by {}: the region may \
-             be more than one island.",
-            e.other_maxima
-                .iter()
-                .map(|f| format!("{:.2}", f - e.minus_two_ln_l))
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-    }
+    s += &parameters(res);
+    s += &passes(res);
     let _ = writeln!(s, "\n## Goodness of fit\n");
     let _ = writeln!(
         s,
@@ -382,7 +469,8 @@ pub fn calibrated_markdown(c: &CalibratedPaper, figures: &[&str]) -> String {
         f.config.design.points,
         f.config.design.rolls,
         if f.config.design.refine {
-            ", two passes (the second over the box the first narrowed to)"
+            ", two passes or more (the second over the box the first narrowed to, any later one \
+             widening a box that cut a parameter)"
         } else {
             ""
         }

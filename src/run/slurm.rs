@@ -529,7 +529,8 @@ pub fn finish_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Re
         logs = sbatch_path(logs, "/finish.out"),
         extra = opt.lines(),
         cpus = match plan {
-            // The finishing job of `tradeoff` may roll on; the others only read and write.
+            // The finishing jobs of `tradeoff` and of a fit's second stage (its widening
+            // passes) may roll on; the others only read and write.
             Plan::Study { threads, .. } => *threads,
             Plan::Roll { .. } => 1,
         },

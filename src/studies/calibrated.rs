@@ -401,6 +401,7 @@ pub fn run(
             config: main.config,
             params: main.params,
             first_pass: main.first_pass,
+            passes: main.passes,
             designs: main.designs,
             estimate: main.estimate,
             command_line,

@@ -828,6 +828,34 @@ fn json_md_lists_the_keys_of_fit_recover_and_predict() {
     ]);
     assert!(two.get("first_pass").is_some(), "a second pass: {two}");
     c.document("fit", "fit --data paper (two passes)", &two);
+    // Two 2D blocks whose second pass's box cuts μ (at its upper edge): a widening pass.
+    let cut_csv = dir.join("cut.csv");
+    std::fs::write(
+        &cut_csv,
+        "label,surface,length_mm,breadth_mm,width_mm,mode,length_vertical,breadth_vertical,\
+         width_vertical\na,MDF,140,24,20,2d,0,361,639\nb,MDF,140,30,10,2d,0,40,460\n",
+    )
+    .unwrap();
+    let widened = run(&[
+        "fit",
+        "--data",
+        cut_csv.to_str().unwrap(),
+        "--free",
+        "e,mu",
+        "--points",
+        "20",
+        "--degree",
+        "2",
+        "--rolls",
+        "100",
+        "--dt",
+        "1/250",
+        "--out",
+        &format!("{d}/widened"),
+        "--json",
+    ]);
+    assert!(widened["passes"][1].get("cut").is_some(), "{widened}");
+    c.document("fit", "fit (a box widened)", &widened);
     let file: Value = serde_json::from_str(&read(&dir.join("fit/fit.json"))).unwrap();
     c.document("fit", "fit.json", &file);
     let one = run_owned(fit_args(&["--no-refine", "--out", &format!("{d}/one")]));

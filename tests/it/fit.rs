@@ -3,6 +3,16 @@
 //! thread count, and a prediction carries its errors.
 
 use crate::helpers::{dicephys, json, Scratch};
+use dicephys::calibration::data::DataRow;
+use dicephys::calibration::design::DesignSpec;
+use dicephys::calibration::estimate::{Identified, Search};
+use dicephys::calibration::params::{Fixed, Kind, Method, ModelSpec};
+use dicephys::calibration::FitConfig;
+use dicephys::engine::EngineKind;
+use dicephys::model::scene::Mode;
+use dicephys::run::runner::Runner;
+use dicephys::run::stop::Stop;
+use dicephys::studies::fit::{first_pass, recovery, second_pass, Session};
 
 const HEAD: &str = "label,surface,length_mm,breadth_mm,width_mm,mode,length_vertical,breadth_vertical,width_vertical\n";
 
@@ -97,7 +107,7 @@ fn a_fit_is_the_same_on_one_thread_and_two_and_predicts_with_errors() {
         ]))
     };
     let (a, b) = (fit("1", "one"), fit("2", "two"));
-    for key in ["estimate", "designs", "params", "first_pass"] {
+    for key in ["estimate", "designs", "params", "first_pass", "passes"] {
         assert_eq!(a[key], b[key], "{key} differs between 1 and 2 threads");
     }
     let e = &a["estimate"];
@@ -310,4 +320,134 @@ fn predict_blocks_tests_held_out_counts_in_one_command() {
     }
     let csv_text = std::fs::read_to_string(dir.join("pred/predictions.csv")).unwrap();
     assert_eq!(csv_text.lines().count(), 4);
+}
+
+/// Points a block in [`counted_at_e_03`]'s fit.
+const POINTS: usize = 8;
+/// Rolls a point.
+const ROLLS: u64 = 500;
+
+/// Rows on surfaces A and B counted at e = 0.3, and a fit of e on them: [`POINTS`] × [`ROLLS`]
+/// a block, dt = 1/250.
+fn counted_at_e_03(runner: &Runner) -> FitConfig {
+    let row = |label: &str, surface: &str, block: &str, n: u64| DataRow {
+        label: label.into(),
+        surface: surface.into(),
+        thrower: "all".into(),
+        block: block.parse().unwrap(),
+        mode: Mode::TwoD,
+        counts: [0, 0, n],
+        groups: vec![vec![1], vec![2]],
+    };
+    let shape = vec![
+        row("a1", "A", "140x30x10", 4000),
+        row("a2", "A", "140x24x20", 2000),
+        row("b1", "B", "140x30x10", 2000),
+    ];
+    let cfg = FitConfig {
+        rows: shape,
+        model: ModelSpec::free(&[Kind::E]),
+        method: Method {
+            engine: EngineKind::Bullet,
+            dt: 1.0 / 250.0,
+            max_steps: dicephys::sim::roll::DEFAULT_MAX_STEPS,
+        },
+        design: DesignSpec {
+            points: POINTS,
+            rolls: ROLLS,
+            degree: 2,
+            max_degree: 3,
+            ..DesignSpec::default()
+        },
+        search: Search {
+            seed: 35,
+            ..Search::default()
+        },
+        seed: 35,
+    };
+    let truth = Fixed {
+        e: 0.3,
+        ..Fixed::default()
+    };
+    let rows = recovery::simulate_data(&cfg, &truth, 3535, runner)
+        .unwrap()
+        .unwrap();
+    FitConfig { rows, ..cfg }
+}
+
+/// Counts at e = 0.3 on two surfaces (2D blocks, whose outcomes move with e: 140x30x10 falls
+/// on its breadth 1.4 % of the time at e = 0.05, 2.3 % at 0.3, 4.2 % at 0.6), and a first pass
+/// made to miss: its 2σ interval of e[A] put at 0.65–0.72, so that the second pass's box,
+/// e[A] 0.61–0.76, leaves the truth out. The fit must widen that box until e[A]'s maximum and
+/// 2σ interval are inside it, rolling again only the blocks whose box moved: e[B] (one row, never
+/// narrowed) keeps its range, and its block's design is the first pass's throughout. Before
+/// the widening, the fit stopped at the second pass with e[A] on the box's lower edge, 0.6125.
+/// About 40,000 rolls.
+#[test]
+fn a_box_that_cut_a_parameter_is_widened_until_it_does_not() {
+    let runner = Runner::new(2, Stop::new());
+    let cfg = counted_at_e_03(&runner);
+    let session = Session::default();
+    let mut first = first_pass(&cfg, &runner, None, &session).unwrap().unwrap();
+    let a = first
+        .estimate
+        .params
+        .iter_mut()
+        .find(|p| p.name == "e[A]")
+        .unwrap();
+    a.two_sigma = [0.65, 0.72];
+    let fitted = second_pass(first, &runner, None, &session)
+        .unwrap()
+        .unwrap();
+
+    let p = fitted
+        .estimate
+        .params
+        .iter()
+        .find(|p| p.name == "e[A]")
+        .unwrap();
+    let (r, whole) = (p.param.range, p.param.whole);
+    let u = Kind::E.coordinate(r, p.value);
+    let passes: Vec<String> = fitted.passes.iter().map(|p| format!("{p:?}")).collect();
+    let said = format!(
+        "e[A] {} in {r} (2σ {:?}); passes {passes:#?}",
+        p.value, p.two_sigma
+    );
+    // Interior: not on an edge of its box that is not its range's own.
+    assert!(
+        r.lo == whole.lo || u > 0.02,
+        "on the box's lower edge: {said}"
+    );
+    assert!(
+        r.hi == whole.hi || u < 0.98,
+        "on the box's upper edge: {said}"
+    );
+    assert_ne!(p.identified, Identified::Cut, "{said}");
+    assert!(
+        p.two_sigma[0] <= 0.3 && 0.3 <= p.two_sigma[1],
+        "the truth: {said}"
+    );
+    // The second pass's box cut e[A] below; the last pass's cut nothing.
+    let second = &fitted.passes[1];
+    assert!(
+        second.cut.len() == 1 && second.cut[0].param == "e[A]" && second.cut[0].lower,
+        "{said}"
+    );
+    assert!(
+        fitted.passes.len() >= 3 && fitted.passes.len() <= 6,
+        "{said}"
+    );
+    assert!(fitted.passes.last().unwrap().cut.is_empty(), "{said}");
+    // e[B] keeps its whole range in every pass, and its block's design is never rolled again:
+    // each pass after the first rolls only the two blocks of surface A.
+    let per_design = POINTS as u64 * ROLLS;
+    assert_eq!(fitted.passes[0].rolls, 2 * per_design, "{said}");
+    for pass in &fitted.passes[1..] {
+        assert_eq!(pass.rolls, 2 * per_design, "{said}");
+        let b = pass.bounds.iter().find(|b| b.param == "e[B]").unwrap();
+        assert_eq!(b.range, Kind::E.default_range(), "{said}");
+    }
+    assert_eq!(fitted.designs.len(), 3);
+    let total: u64 = fitted.passes.iter().map(|p| p.rolls).sum();
+    assert_eq!(fitted.rolls, total);
 }

@@ -478,7 +478,14 @@ fn small_fit(dir: &Path) -> Vec<String> {
 
 /// What makes two fits the same fit: everything but the cost, the command line and the date.
 fn same_fit(a: &serde_json::Value, b: &serde_json::Value) {
-    for key in ["config", "estimate", "designs", "params", "first_pass"] {
+    for key in [
+        "config",
+        "estimate",
+        "designs",
+        "params",
+        "first_pass",
+        "passes",
+    ] {
         assert_eq!(a[key], b[key], "{key} differs");
     }
     assert_eq!(a["cost"]["rolls"], b["cost"]["rolls"]);
@@ -526,6 +533,13 @@ fn a_fit_split_by_hand_into_two_passes_is_the_one_machine_fit() {
             .unwrap(),
     );
     assert!(whole["first_pass"].is_array(), "the default fit refines");
+    // The second pass's box cuts μ (its 2σ interval reaches the box's upper edge, 0.34): a
+    // third pass widens it, which the second stage's finishing job rolls itself.
+    let passes = whole["passes"].as_array().unwrap();
+    assert!(
+        passes.len() > 2 && passes[1]["cut"].is_array(),
+        "{passes:?}"
+    );
     same_fit(&split, &whole);
     assert!(run.join("report.md").exists() && run.join("fit_rows.svg").exists());
     // Its own flags are refused: --recover runs on one machine, --out is --dir.

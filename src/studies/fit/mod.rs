@@ -9,10 +9,12 @@ pub mod recovery;
 pub mod simulate;
 
 use crate::calibration::design::{self, Design};
-use crate::calibration::{estimate_with, FitConfig, FitCost, FitResult};
+use crate::calibration::params::Narrowed;
+use crate::calibration::{cuts, estimate_with, widen, FitConfig, FitCost, FitResult, Pass};
+use crate::calibration::{narrow, MAX_WIDENINGS};
 use crate::error::{Error, Result};
 use crate::run::cputime::process_cpu_seconds;
-use crate::run::runner::Runner;
+use crate::run::runner::{ChunkShare, Runner};
 use serde::{Deserialize, Serialize};
 use simulate::Plan;
 pub use simulate::Session;
@@ -37,6 +39,47 @@ pub fn simulate(
     simulate::simulate(&plan, &design::keys(&cfg.rows, &cfg.model), runner, dir)
 }
 
+/// What one pass simulated: its designs, and the rolls (and the unsettled rolls) of those the
+/// session did not hold before it, which this pass made or read back from the checkpoints.
+struct Simulated {
+    designs: Vec<Design>,
+    rolls: u64,
+    unsettled: u64,
+}
+
+/// [`simulate`], counting what the pass itself cost. `None` as for [`simulate`].
+fn simulate_pass(
+    cfg: &FitConfig,
+    runner: &Runner,
+    dir: Option<&Path>,
+    session: &Session,
+) -> Result<Option<Simulated>> {
+    let points = design::points(cfg.model.free.len(), cfg.design.points).len();
+    let held: Vec<bool> = design::keys(&cfg.rows, &cfg.model)
+        .iter()
+        .map(|k| {
+            session
+                .held(k, cfg.seed, points, cfg.design.rolls)
+                .is_some()
+        })
+        .collect();
+    let Some(designs) = simulate(cfg, runner, dir, session)? else {
+        return Ok(None);
+    };
+    // One design per key, in the keys' order.
+    let new: Vec<&Design> = designs
+        .iter()
+        .zip(&held)
+        .filter(|(_, &h)| !h)
+        .map(|(d, _)| d)
+        .collect();
+    Ok(Some(Simulated {
+        rolls: new.iter().map(|d| d.rolls).sum(),
+        unsettled: new.iter().map(|d| d.unsettled).sum(),
+        designs,
+    }))
+}
+
 /// A fit's pieces before they are dressed as a [`FitResult`].
 pub struct Fitted {
     /// The configuration of the last pass (its model carries the narrowed ranges).
@@ -49,7 +92,9 @@ pub struct Fitted {
     pub estimate: crate::calibration::estimate::Estimate,
     /// The first pass's parameters, when a second refined them.
     pub first_pass: Option<Vec<crate::calibration::estimate::ParamFit>>,
-    /// Rolls made, over both passes.
+    /// Every pass: its box, its rolls, the parameters its box cut.
+    pub passes: Vec<Pass>,
+    /// Rolls made, over all passes.
     pub rolls: u64,
     /// Of which did not settle on a face.
     pub unsettled: u64,
@@ -77,23 +122,24 @@ pub fn first_pass(
     dir: Option<&Path>,
     session: &Session,
 ) -> Result<Option<Fitted>> {
-    let Some(designs) = simulate(cfg, runner, dir, session)? else {
+    let Some(sim) = simulate_pass(cfg, runner, dir, session)? else {
         return Ok(None);
     };
-    settled_enough(&designs)?;
+    settled_enough(&sim.designs)?;
     let (params, estimate) = estimate_with(
         &cfg.rows,
         &cfg.model,
-        &designs,
+        &sim.designs,
         &first_pass_search(cfg),
         &runner.watch(),
     )?;
     Ok(Some(Fitted {
         config: cfg.clone(),
-        rolls: designs.iter().map(|d| d.rolls).sum(),
-        unsettled: designs.iter().map(|d| d.unsettled).sum(),
+        rolls: sim.rolls,
+        unsettled: sim.unsettled,
+        passes: vec![Pass::over(&params, sim.rolls)],
         params,
-        designs,
+        designs: sim.designs,
         estimate,
         first_pass: None,
     }))
@@ -121,7 +167,8 @@ fn settled_enough(designs: &[Design]) -> Result<()> {
 
 /// The second pass over the box narrowed from `first` (a pass with nothing to narrow is the
 /// last: it gets the full search, the bootstrap's region and the posterior draws `predict`
-/// needs). `None` as for [`first_pass`].
+/// needs), then as many passes again as it takes, up to [`MAX_WIDENINGS`], to widen every box
+/// that cut a parameter ([`cuts`], [`widen`]). `None` as for [`first_pass`].
 pub fn second_pass(
     first: Fitted,
     runner: &Runner,
@@ -129,8 +176,7 @@ pub fn second_pass(
     session: &Session,
 ) -> Result<Option<Fitted>> {
     let cfg = &first.config;
-    let narrowed =
-        crate::calibration::narrow(&cfg.rows, &cfg.model, &first.params, &first.estimate);
+    let narrowed = narrow(&cfg.rows, &cfg.model, &first.params, &first.estimate);
     if narrowed.is_empty() {
         let (params, estimate) = estimate_with(
             &cfg.rows,
@@ -145,28 +191,72 @@ pub fn second_pass(
             ..first
         }));
     }
-    let mut out = first;
-    out.config.model.narrowed = narrowed;
-    let Some(second) = simulate(&out.config, runner, dir, session)? else {
+    let Some(mut out) = refined_pass(first, narrowed, runner, dir, session)? else {
         return Ok(None);
     };
-    settled_enough(&second)?;
-    out.rolls += second.iter().map(|d| d.rolls).sum::<u64>();
-    out.unsettled += second.iter().map(|d| d.unsettled).sum::<u64>();
-    let (params, estimate) = estimate_with(
-        &out.config.rows,
-        &out.config.model,
-        &second,
-        &out.config.search,
-        &runner.watch(),
-    )?;
-    out.first_pass = Some(std::mem::replace(&mut out.estimate, estimate).params);
-    out.params = params;
-    out.designs = second;
+    let own = own_rolls(runner);
+    for widened in 0..=MAX_WIDENINGS {
+        let cut = cuts(&out.estimate);
+        out.passes.last_mut().expect("a pass").cut = cut.clone();
+        if cut.is_empty() || widened == MAX_WIDENINGS {
+            break;
+        }
+        let wider = widen(&out.config.model, &out.estimate, &cut);
+        let Some(next) = refined_pass(out, wider, &own, dir, session)? else {
+            return Ok(None);
+        };
+        out = next;
+    }
     Ok(Some(out))
 }
 
-/// Simulates and estimates, in one pass or two (`cfg.design.refine`). `None` if stopped early.
+/// One refined pass: `prev`'s fit simulated again over the box `narrowed` (a design whose key
+/// it leaves as it was is the session's already, not rolled again) and estimated with the full
+/// search. `None` as for [`first_pass`].
+fn refined_pass(
+    prev: Fitted,
+    narrowed: Vec<Narrowed>,
+    runner: &Runner,
+    dir: Option<&Path>,
+    session: &Session,
+) -> Result<Option<Fitted>> {
+    let mut out = prev;
+    out.config.model.narrowed = narrowed;
+    let Some(sim) = simulate_pass(&out.config, runner, dir, session)? else {
+        return Ok(None);
+    };
+    settled_enough(&sim.designs)?;
+    out.rolls += sim.rolls;
+    out.unsettled += sim.unsettled;
+    let (params, estimate) = estimate_with(
+        &out.config.rows,
+        &out.config.model,
+        &sim.designs,
+        &out.config.search,
+        &runner.watch(),
+    )?;
+    out.passes.push(Pass::over(&params, sim.rolls));
+    let before = std::mem::replace(&mut out.estimate, estimate).params;
+    out.first_pass.get_or_insert(before);
+    out.params = params;
+    out.designs = sim.designs;
+    Ok(Some(out))
+}
+
+/// The runner the widening passes roll with: `runner`, but in a cluster's finishing job, which
+/// reads back what its tasks rolled and rolls nothing, one that rolls every chunk itself. A
+/// widened box is drawn from the pass before it, which no task saw: the finishing job of the
+/// second pass's stage rolls those passes on its own cores.
+fn own_rolls<'a>(runner: &Runner<'a>) -> Runner<'a> {
+    let own = runner.with_progress(runner.progress);
+    match own.share {
+        ChunkShare::Assemble { .. } => own.with_share(ChunkShare::All),
+        _ => own,
+    }
+}
+
+/// Simulates and estimates, in one pass or, refined (`cfg.design.refine`), two and as many
+/// widening passes as the second needs. `None` if stopped early.
 pub fn fit(
     cfg: &FitConfig,
     runner: &Runner,
@@ -182,9 +272,11 @@ pub fn fit(
     second_pass(first, runner, dir, session)
 }
 
-/// `fit` as a study a cluster splits (`slurm fit`): the whole fit, or one of its two passes.
+/// `fit` as a study a cluster splits (`slurm fit`): the whole fit, or one of its two stages.
 /// The second pass's box is narrowed from the first pass's result, so a cluster runs the
-/// passes as two job arrays, the second started when the first has finished.
+/// passes as two job arrays, the second started when the first has finished. The passes that
+/// widen a box the second pass's cut are drawn from the pass before each: the second stage's
+/// finishing job rolls them itself, after assembling the second pass.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FitStudy {
     /// What to fit.
@@ -197,12 +289,14 @@ pub struct FitStudy {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Stage {
-    /// The whole fit, both passes (or its one pass, unrefined).
+    /// The whole fit, every pass (or its one pass, unrefined).
     Whole,
     /// The first of two passes: its designs, and the maximum and profiles the second pass's box
     /// is drawn from, written as [`FIRST_PASS`].
     First,
-    /// The second pass, over the box narrowed from the first pass's result in `first`.
+    /// The second pass, over the box narrowed from the first pass's result in `first` (its
+    /// tasks roll it), and the passes that widen it where it cut a parameter (its finishing
+    /// job rolls those).
     Second {
         /// The first pass's [`FIRST_PASS`].
         first: std::path::PathBuf,
@@ -242,12 +336,19 @@ impl FitStudy {
                 path.display()
             )));
         }
+        // A first pass written before passes were recorded: its one pass, over the whole box.
+        let passes = if r.passes.is_empty() {
+            vec![Pass::over(&r.params, r.cost.rolls)]
+        } else {
+            r.passes
+        };
         Ok(Fitted {
             config: r.config,
             params: r.params,
             designs: r.designs,
             estimate: r.estimate,
             first_pass: None,
+            passes,
             rolls: r.cost.rolls,
             unsettled: r.cost.unsettled,
         })
@@ -270,8 +371,8 @@ impl FitStudy {
     }
 }
 
-/// Runs the fit, or its part: simulates (resuming from `dir`), then estimates, refining once
-/// if asked. `None` if a stop request ended the simulations early, or on a cluster task's share.
+/// Runs the fit, or its part: simulates (resuming from `dir`), then estimates, refining if
+/// asked. `None` if a stop request ended the simulations early, or on a cluster task's share.
 pub fn run(
     study: &FitStudy,
     command_line: String,
@@ -293,6 +394,7 @@ pub fn run(
         config: f.config,
         params: f.params,
         first_pass: f.first_pass,
+        passes: f.passes,
         designs: f.designs,
         estimate: f.estimate,
         command_line,

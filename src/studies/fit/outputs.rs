@@ -62,7 +62,8 @@ pub fn fit(study: &FitStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
         _ => 1.0,
     };
     let total = cfg.total_rolls() as f64 * passes;
-    let progress = |n: u64| (hooks.progress)(n as f64, total);
+    // Passes that widen a cut box roll beyond the two reckoned: the total then grows with them.
+    let progress = |n: u64| (hooks.progress)(n as f64, total.max(n as f64));
     let mut sim = place.study(&hooks.stop, &progress);
     sim.runner = sim.runner.with_say(hooks.log);
     let dir = sim.checkpoint.as_deref();
@@ -245,7 +246,7 @@ pub fn calibrated(cfg: &CalibratedConfig, place: &Place, hooks: &Hooks) -> Resul
     claim(place, "paper --calibrated", cfg)?;
     let outputs = place.outputs(&["calibrated.json", "calibrated.md"])?;
     let total = calibrated::total_rolls(cfg)? as f64;
-    let progress = |n: u64| (hooks.progress)(n as f64, total);
+    let progress = |n: u64| (hooks.progress)(n as f64, total.max(n as f64));
     let mut study = place.study(&hooks.stop, &progress);
     study.runner = study.runner.with_say(hooks.log);
     let (runner, dir) = (&study.runner, study.checkpoint.as_deref());

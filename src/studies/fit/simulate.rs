@@ -37,6 +37,22 @@ impl Session {
             cache.push((key, seed, d.clone()));
         }
     }
+
+    /// The design of `key` this session holds, simulated with `seed` at `points` points of
+    /// `rolls` throws each.
+    pub fn held(&self, key: &Key, seed: u64, points: usize, rolls: u64) -> Option<Design> {
+        self.cache
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .iter()
+            .find(|(k, s, d)| {
+                k == key
+                    && *s == seed
+                    && d.points.len() == points
+                    && d.rolls == points as u64 * rolls
+            })
+            .map(|c| c.2.clone())
+    }
 }
 
 /// Everything `simulate` needs.
@@ -75,20 +91,10 @@ pub fn simulate(
     let xs = points(dims, plan.design.points);
     let mut out = Vec::new();
     for key in keys {
-        let cached = plan
+        if let Some(d) = plan
             .session
-            .cache
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .iter()
-            .find(|(k, seed, d)| {
-                k == key
-                    && *seed == plan.seed
-                    && d.points.len() == xs.len()
-                    && d.rolls == xs.len() as u64 * plan.design.rolls
-            })
-            .map(|c| c.2.clone());
-        if let Some(d) = cached {
+            .held(key, plan.seed, xs.len(), plan.design.rolls)
+        {
             out.push(d);
             continue;
         }
