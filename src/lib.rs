@@ -11,9 +11,15 @@
 //! * [`sim`]: one roll: free flight, the rest rule, the exact early stop;
 //! * [`run`]: many rolls: the run's specification, batches, tallies, checkpoints, atomic output;
 //! * [`theory`]: the paper's closed forms, its experimental table, the statistics;
-//! * [`inference`]: fitting parameters to measured counts through a surrogate of the simulator;
+//! * [`inference`]: the pure mathematics of a fit: the surrogate (a multinomial logit), the
+//!   likelihood, the optimiser, the posterior sampler;
+//! * [`calibration`]: the statistics of a fit to measured counts, with no rolling: the counts
+//!   file, the free parameters and their boxes, the designs, the estimate, predictions and the
+//!   held-out test;
 //! * [`report`]: what a run or the paper's table says, as text, JSON, CSV and figures;
-//! * [`studies`]: the paper end to end, the bench, the convergence, trade-off and stability sweeps.
+//! * [`studies`]: the paper end to end, the bench, the convergence, trade-off and stability
+//!   sweeps, and the rolling behind a fit (`studies::fit`: a design simulated, a fit's passes,
+//!   the recovery check, a prediction) and the calibrated paper.
 //!
 //! The command line lives in the binary (`src/main.rs`, `src/cli/`), on top of all of these.
 

@@ -357,6 +357,34 @@ pub fn maximise_from(lik: &Likelihood, starts: &[Vec<f64>]) -> Result<(Minimum, 
     Ok((best, others))
 }
 
+/// Each parameter's profile about `best` (one per thread of the caller's pool).
+fn profiles_at(
+    f: &(dyn Fn(&[f64]) -> f64 + Sync),
+    best: &Minimum,
+    points: usize,
+) -> Vec<Vec<(f64, f64)>> {
+    use rayon::prelude::*;
+    (0..best.x.len())
+        .into_par_iter()
+        .map(|j| profile(f, best, j, points, 1e-6))
+        .collect()
+}
+
+/// A start where some profile went more than 1e-6 below `best`: `best.x` with that
+/// coordinate moved to the profile's lowest point.
+fn lower_point(profiles: &[Vec<(f64, f64)>], best: &Minimum) -> Option<Vec<f64>> {
+    let (j, u, v) = profiles
+        .iter()
+        .enumerate()
+        .flat_map(|(j, p)| p.iter().map(move |&(u, v)| (j, u, v)))
+        .min_by(|a, b| a.2.total_cmp(&b.2))?;
+    (v < best.f - 1e-6).then(|| {
+        let mut x = best.x.clone();
+        x[j] = u;
+        x
+    })
+}
+
 /// Fits `rows`: the maximum, the profiles, the goodness of fit and posterior draws. Each
 /// stage says its line to `watch` and ends at once on a stop request (`Error::Stopped`).
 pub fn estimate(
@@ -371,7 +399,30 @@ pub fn estimate(
         "fit: the maximum over {dims} parameters, from {} starts",
         search.starts.max(1)
     ));
-    let (best, other_maxima) = maximise(lik, dims, search.starts)?;
+    let (mut best, other_maxima) = maximise(lik, dims, search.starts)?;
+    let mut rounds = 0;
+    let (best, profiles) = loop {
+        rounds += 1;
+        watch.check()?;
+        (watch.say)(&format!("fit: the profiles of {dims} parameters"));
+        let profiles = profiles_at(&f, &best, search.profile_points);
+        watch.check()?;
+        // A profile point below the maximum means the search missed a higher one: search
+        // again from there, so that the value printed is the maximum its intervals are
+        // measured from (at 3d27856 a fit printed e = 0.428 beside a 1σ interval 0.050–0.081).
+        match lower_point(&profiles, &best) {
+            Some(x) if best.f.is_finite() && rounds <= 5 => {
+                (watch.say)("fit: a profile went below the maximum: searching again from there");
+                let (again, _) = maximise_from(lik, &[x, best.x.clone()])?;
+                if again.f < best.f - 1e-6 {
+                    best = again;
+                    continue;
+                }
+                break (best, profiles);
+            }
+            _ => break (best, profiles),
+        }
+    };
     if search.bootstrap > 0 && dims > 0 {
         (watch.say)(&format!(
             "fit: the likelihood ratio's scale from {} simulated data sets",
@@ -380,14 +431,6 @@ pub fn estimate(
     }
     let sets = bootstrap_sets(lik, &best.x, dims, search.bootstrap, search.seed);
     let b = factor(&sets, dims);
-    watch.check()?;
-    (watch.say)(&format!("fit: the profiles of {dims} parameters"));
-    // The profiles are independent: one per thread (of the caller's pool).
-    use rayon::prelude::*;
-    let profiles: Vec<Vec<(f64, f64)>> = (0..params.len())
-        .into_par_iter()
-        .map(|j| profile(&f, &best, j, search.profile_points, 1e-6))
-        .collect();
     watch.check()?;
     let mut fits = Vec::new();
     for ((j, param), prof) in params.iter().enumerate().zip(profiles) {
