@@ -54,6 +54,22 @@ fn run(args: &[String]) -> Output {
     bin().args(args).output().expect("run dicephys")
 }
 
+/// Waits for `child`, killing it after `limit` (then its exit code is `None`).
+fn wait_at_most(child: &mut std::process::Child, limit: Duration) -> Option<i32> {
+    let t = Instant::now();
+    loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            return s.code();
+        }
+        if t.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
 /// Runs the binary, killed after `limit` (then its exit code is `None`).
 fn timed(args: &[&str], limit: Duration) -> (Option<i32>, String, Duration) {
     let mut child = bin()
@@ -63,17 +79,7 @@ fn timed(args: &[&str], limit: Duration) -> (Option<i32>, String, Duration) {
         .spawn()
         .unwrap();
     let t = Instant::now();
-    let code = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s.code();
-        }
-        if t.elapsed() > limit {
-            let _ = child.kill();
-            let _ = child.wait();
-            break None;
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
+    let code = wait_at_most(&mut child, limit);
     let mut err = String::new();
     if let Some(mut e) = child.stderr.take() {
         use std::io::Read;
@@ -696,18 +702,7 @@ fn sigterm_while_waiting_on_a_pipe_ends_the_fit() {
         .unwrap();
     std::thread::sleep(Duration::from_millis(300));
     unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
-    let t = Instant::now();
-    let code = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s.code();
-        }
-        if t.elapsed() > Duration::from_secs(3) {
-            let _ = child.kill();
-            let _ = child.wait();
-            break None;
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
+    let code = wait_at_most(&mut child, Duration::from_secs(3));
     assert_eq!(code, Some(130));
     assert!(!out.exists());
 }

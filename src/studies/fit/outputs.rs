@@ -189,22 +189,8 @@ pub fn predict_blocks(
         "predictions",
         ["predictions.json", "predictions.csv", "report.md"],
     );
-    // Every row checked (by predict_blocks, before it rolls) before the directory is claimed.
-    for r in &cfg.rows {
-        super::predict::check(
-            fit,
-            &PredictConfig {
-                block: r.block,
-                mode: r.mode,
-                surface: r.surface.clone(),
-                thrower: r.thrower.clone(),
-                draws: cfg.draws,
-                rolls: cfg.rolls,
-                seed: cfg.seed,
-            },
-        )
-        .map_err(|e| Error::Invalid(format!("row '{}': {e}", r.label)))?;
-    }
+    // Every row checked before the directory is claimed.
+    super::predict::check_blocks(fit, &cfg.rows, cfg.draws, cfg.rolls, cfg.seed)?;
     let identity = (cfg, &fit.config, &fit.estimate.x);
     claim(place, "predict --blocks", &identity)?;
     let outputs = place.outputs(&files)?;

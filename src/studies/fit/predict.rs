@@ -185,6 +185,39 @@ pub fn predict_block(
     }))
 }
 
+/// What to predict for `row` of a blocks file.
+fn block_config(
+    r: &crate::calibration::heldout::BlockRow,
+    draws: usize,
+    rolls: u64,
+    seed: u64,
+) -> PredictConfig {
+    PredictConfig {
+        block: r.block,
+        mode: r.mode,
+        surface: r.surface.clone(),
+        thrower: r.thrower.clone(),
+        draws,
+        rolls,
+        seed,
+    }
+}
+
+/// Checks every row of a blocks file ([`check`]) before anything is written or rolled.
+pub fn check_blocks(
+    fit: &FitResult,
+    rows: &[crate::calibration::heldout::BlockRow],
+    draws: usize,
+    rolls: u64,
+    seed: u64,
+) -> Result<()> {
+    for r in rows {
+        check(fit, &block_config(r, draws, rolls, seed))
+            .map_err(|e| Error::Invalid(format!("row '{}': {e}", r.label)))?;
+    }
+    Ok(())
+}
+
 /// Each of `rows` predicted from `fit` (`draws` posterior draws × `rolls` throws a block), and
 /// tested against its counts where it has them. Every row is checked before any rolls. `None`
 /// if stopped early.
@@ -196,18 +229,8 @@ pub fn predict_blocks(
     seed: u64,
     runner: &Runner,
 ) -> Result<Option<Vec<crate::calibration::heldout::PredictedRow>>> {
-    let cfg = |r: &crate::calibration::heldout::BlockRow| PredictConfig {
-        block: r.block,
-        mode: r.mode,
-        surface: r.surface.clone(),
-        thrower: r.thrower.clone(),
-        draws,
-        rolls,
-        seed,
-    };
-    for r in rows {
-        check(fit, &cfg(r)).map_err(|e| Error::Invalid(format!("row '{}': {e}", r.label)))?;
-    }
+    check_blocks(fit, rows, draws, rolls, seed)?;
+    let cfg = |r| block_config(r, draws, rolls, seed);
     let per_row = draws as u64 * rolls;
     let mut out = Vec::new();
     for (i, r) in rows.iter().enumerate() {
