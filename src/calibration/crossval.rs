@@ -10,12 +10,13 @@
 
 use crate::calibration::data::DataRow;
 use crate::calibration::design::Design;
-use crate::calibration::estimate::{maximise_from, Likelihood, Search};
+use crate::calibration::estimate::{
+    draws_from, maximise_from, Estimate, Likelihood, Maximum, Search,
+};
 use crate::calibration::params::{ModelSpec, Param};
 use crate::calibration::predict::{predict_row, Predicted};
 use crate::error::Result;
 use crate::inference::likelihood::ln_dirichlet_multinomial;
-use crate::inference::posterior;
 use crate::theory::stats::{self, Ratio};
 use serde::{Deserialize, Serialize};
 
@@ -82,14 +83,16 @@ fn log_mean_exp(v: &[f64]) -> f64 {
 }
 
 /// Every row of `rows` predicted by the fit of the others (in parallel over rows), starting
-/// each fit's search from `start` (the whole fit's maximum) and the centre.
+/// each fit's search from the whole fit's maximum, its islands and the centre; its draws come
+/// from every maximum within the whole fit's joint 2σ threshold of its best, as the whole
+/// fit's do.
 pub fn leave_one_out(
     rows: &[DataRow],
     designs: &[Design],
     model: &ModelSpec,
     params: &[Param],
     search: &Search,
-    start: &[f64],
+    whole: &Estimate,
     watch: &crate::run::stop::Watch,
 ) -> Result<Vec<LooRow>> {
     use rayon::prelude::*;
@@ -102,14 +105,18 @@ pub fn leave_one_out(
         .map(|r| {
             let mut lik = Likelihood::new(rows, designs, model, params).stopped_by(watch.stop);
             lik.include[r] = false;
-            let (best, _) = maximise_from(&lik, &[start.to_vec(), vec![0.5; params.len()]])?;
+            let mut from = whole.starts();
+            from.push(vec![0.5; params.len()]);
+            let (best, maxima) = maximise_from(&lik, &from)?;
+            let islands: Vec<Maximum> = maxima
+                .into_iter()
+                .filter(|m| m.minus_two_ln_l - best.f <= whole.region_delta)
+                .collect();
             let f = |x: &[f64]| lik.minus_two_ln_l(x);
-            let draws = posterior::sample(
+            let draws = draws_from(
                 &f,
-                &best.x,
+                &islands,
                 search.draws.max(50),
-                2000,
-                4,
                 search.seed.wrapping_add(r as u64),
             );
             Ok(score_row(&lik, r, &draws))

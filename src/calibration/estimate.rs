@@ -257,12 +257,31 @@ pub struct Estimate {
     /// Local maxima the search met besides the best, with their −2 ln L (a second maximum
     /// within the region makes the region two islands).
     pub other_maxima: Vec<f64>,
+    /// Every distinct maximum the search's starts ended at, the best first, with how many
+    /// starts ended at each.
+    #[serde(default)]
+    pub maxima: Vec<Maximum>,
+    /// The other maxima inside the joint 2σ region: the region is their union with the
+    /// best's, and the draws come from each; the profiles are traced from those within 4 × the
+    /// Bartlett factor of the best (the only ones that can reach a 2σ interval), the nearest
+    /// [`MAX_TRACED`], so the intervals span them.
+    #[serde(default)]
+    pub islands: Vec<Maximum>,
     /// Posterior draws (flat prior on the box), unit coordinates.
     pub draws: Vec<Vec<f64>>,
     /// What the parametric bootstrap behind the Bartlett factor says of the errors (`null`
     /// when none was drawn).
     #[serde(default)]
     pub bootstrap: Option<Bootstrap>,
+}
+
+impl Estimate {
+    /// Where a search that should find this fit's region starts: its maximum and its islands.
+    pub fn starts(&self) -> Vec<Vec<f64>> {
+        std::iter::once(self.x.clone())
+            .chain(self.islands.iter().map(|m| m.x.clone()))
+            .collect()
+    }
 }
 
 /// The parametric bootstrap's verdict on the fit's errors: data sets drawn from the fitted
@@ -312,7 +331,7 @@ impl Default for Search {
 
 /// The maximum of `lik` over the unit box, from `starts` starting points (the centre and a
 /// Halton sequence).
-pub fn maximise(lik: &Likelihood, dims: usize, starts: usize) -> Result<(Minimum, Vec<f64>)> {
+pub fn maximise(lik: &Likelihood, dims: usize, starts: usize) -> Result<(Minimum, Vec<Maximum>)> {
     let mut start_points = vec![vec![0.5; dims]];
     start_points
         .extend((1..starts.max(1)).map(|i| crate::calibration::design::halton_point(i, dims)));
@@ -320,8 +339,8 @@ pub fn maximise(lik: &Likelihood, dims: usize, starts: usize) -> Result<(Minimum
 }
 
 /// The maximum of `lik` from each of `starts` (unit coordinates); also the other local maxima
-/// met.
-pub fn maximise_from(lik: &Likelihood, starts: &[Vec<f64>]) -> Result<(Minimum, Vec<f64>)> {
+/// met, best first, each with the starts that ended there.
+pub fn maximise_from(lik: &Likelihood, starts: &[Vec<f64>]) -> Result<(Minimum, Vec<Maximum>)> {
     let f = |x: &[f64]| lik.minus_two_ln_l(x);
     let mut found: Vec<Minimum> = Vec::new();
     for s in starts {
@@ -345,16 +364,97 @@ pub fn maximise_from(lik: &Likelihood, starts: &[Vec<f64>]) -> Result<(Minimum, 
             best.f
         )));
     }
-    // Other maxima: distinct ends (in value by more than 0.1, in place by more than 0.05).
-    let mut others: Vec<f64> = Vec::new();
-    for m in &found[1..] {
-        let far = m.x.iter().zip(&best.x).any(|(a, b)| (a - b).abs() > 0.05);
-        if m.converged && far && m.f - best.f > 0.1 && !others.iter().any(|o| (o - m.f).abs() < 0.1)
-        {
-            others.push(m.f);
+    let ends: Vec<Maximum> = found
+        .iter()
+        .filter(|m| m.converged && m.f.is_finite())
+        .map(|m| Maximum {
+            x: m.x.clone(),
+            minus_two_ln_l: m.f,
+            starts: 1,
+        })
+        .collect();
+    Ok((best, distinct(&f, ends)))
+}
+
+/// A local maximum the search found, and the starts that ended there.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Maximum {
+    /// Where, in unit coordinates.
+    pub x: Vec<f64>,
+    /// −2 ln L there.
+    pub minus_two_ln_l: f64,
+    /// Starts of the search that ended here.
+    pub starts: usize,
+}
+
+/// Two ends of the search are one maximum if they lie within 0.05 of each other in every
+/// parameter (unit coordinates), or if no valley parts them: −2 ln L along the segment
+/// between them (at its quarter points) never rises 0.5 above the higher end (a flat ridge,
+/// where an unidentified parameter leaves the ends wherever they stopped, is one maximum).
+fn same_maximum(f: &dyn Fn(&[f64]) -> f64, a: &Maximum, b: &Maximum) -> bool {
+    let far = a.x.iter().zip(&b.x).any(|(p, q)| (p - q).abs() > 0.05);
+    if !far {
+        return true;
+    }
+    let top = a.minus_two_ln_l.max(b.minus_two_ln_l);
+    [0.25, 0.5, 0.75].iter().all(|t| {
+        let x: Vec<f64> = a.x.iter().zip(&b.x).map(|(p, q)| p + t * (q - p)).collect();
+        f(&x) < top + 0.5
+    })
+}
+
+/// The distinct maxima among `ends` (best first), each with the starts of all that it stands
+/// for.
+fn distinct(f: &dyn Fn(&[f64]) -> f64, mut ends: Vec<Maximum>) -> Vec<Maximum> {
+    ends.sort_by(|a, b| a.minus_two_ln_l.total_cmp(&b.minus_two_ln_l));
+    let mut out: Vec<Maximum> = Vec::new();
+    for m in ends {
+        match out.iter_mut().find(|o| same_maximum(f, &m, o)) {
+            Some(o) => o.starts += m.starts,
+            None => out.push(m),
         }
     }
-    Ok((best, others))
+    out
+}
+
+/// The most islands a fit traces its profiles from besides the best (the nearest first).
+pub const MAX_TRACED: usize = 3;
+
+/// Posterior draws about each maximum in `maxima` (the best first), `draws` in all: each
+/// island's chain gets its share in proportion to its likelihood at its maximum,
+/// exp(−Δ(−2 ln L)/2), so that a region of two islands is drawn from both (a chain started in
+/// one rarely crosses the valley to the other). Each chain seeded from `seed` and its island.
+pub fn draws_from(
+    f: &dyn Fn(&[f64]) -> f64,
+    maxima: &[Maximum],
+    draws: usize,
+    seed: u64,
+) -> Vec<Vec<f64>> {
+    let Some(best) = maxima.first() else {
+        return Vec::new();
+    };
+    let w: Vec<f64> = maxima
+        .iter()
+        .map(|m| (-(m.minus_two_ln_l - best.minus_two_ln_l) / 2.0).exp())
+        .collect();
+    let total: f64 = w.iter().sum();
+    let mut shares: Vec<usize> = w
+        .iter()
+        .map(|v| (draws as f64 * v / total).floor() as usize)
+        .collect();
+    shares[0] += draws - shares.iter().sum::<usize>();
+    let mut out = Vec::with_capacity(draws);
+    for (i, (m, n)) in maxima.iter().zip(shares).enumerate() {
+        if n > 0 {
+            let s = if i == 0 {
+                seed
+            } else {
+                seed.wrapping_add(0x9e37_79b9 * i as u64)
+            };
+            out.extend(posterior::sample(f, &m.x, n, 2000, 4, s));
+        }
+    }
+    out
 }
 
 /// Each parameter's profile about `best` (one per thread of the caller's pool).
@@ -399,7 +499,7 @@ pub fn estimate(
         "fit: the maximum over {dims} parameters, from {} starts",
         search.starts.max(1)
     ));
-    let (mut best, other_maxima) = maximise(lik, dims, search.starts)?;
+    let (mut best, mut maxima) = maximise(lik, dims, search.starts)?;
     let mut rounds = 0;
     let (best, profiles) = loop {
         rounds += 1;
@@ -413,9 +513,11 @@ pub fn estimate(
         match lower_point(&profiles, &best) {
             Some(x) if best.f.is_finite() && rounds <= 5 => {
                 (watch.say)("fit: a profile went below the maximum: searching again from there");
-                let (again, _) = maximise_from(lik, &[x, best.x.clone()])?;
+                let (again, more) = maximise_from(lik, &[x, best.x.clone()])?;
                 if again.f < best.f - 1e-6 {
                     best = again;
+                    // The restarts' ends count among the maxima as starts of their own.
+                    maxima = distinct(&f, maxima.into_iter().chain(more).collect());
                     continue;
                 }
                 break (best, profiles);
@@ -432,6 +534,48 @@ pub fn estimate(
     let sets = bootstrap_sets(lik, &best.x, dims, search.bootstrap, search.seed);
     let b = factor(&sets, dims);
     watch.check()?;
+    // Islands: other maxima inside the joint 2σ region. The region is their union: each
+    // parameter's profile is also traced from every island and the lower of the two taken,
+    // so that its intervals span them all.
+    let region = b * region_delta(dims, TWO_SIGMA);
+    let islands: Vec<Maximum> = maxima
+        .iter()
+        .skip(1)
+        .filter(|m| m.minus_two_ln_l - best.f <= region)
+        .cloned()
+        .collect();
+    // Only an island within 4b of the best can reach a parameter's 2σ interval (the
+    // profile's threshold); the rest are in the joint region only, drawn from but not traced.
+    // At most MAX_TRACED islands are traced: each costs a full set of profiles.
+    let traced: Vec<&Maximum> = islands
+        .iter()
+        .filter(|m| m.minus_two_ln_l - best.f <= 4.0 * b)
+        .take(MAX_TRACED)
+        .collect();
+    let mut profiles = profiles;
+    if !islands.is_empty() {
+        (watch.say)(&format!(
+            "fit: the region is {} islands: the profiles traced from {} of them",
+            islands.len() + 1,
+            traced.len()
+        ));
+    }
+    for m in traced {
+        let at = Minimum {
+            x: m.x.clone(),
+            f: m.minus_two_ln_l,
+            ..best.clone()
+        };
+        for (p, q) in profiles
+            .iter_mut()
+            .zip(profiles_at(&f, &at, search.profile_points))
+        {
+            for (a, b) in p.iter_mut().zip(q) {
+                a.1 = a.1.min(b.1);
+            }
+        }
+        watch.check()?;
+    }
     let mut fits = Vec::new();
     for ((j, param), prof) in params.iter().enumerate().zip(profiles) {
         // A profile point below the maximum means the search missed it: take the lower.
@@ -457,8 +601,15 @@ pub fn estimate(
     if search.draws > 0 {
         (watch.say)(&format!("fit: {} posterior draws", search.draws));
     }
-    let draws = posterior::sample(&f, &best.x, search.draws, 2000, 4, search.seed);
+    let mut chains = vec![Maximum {
+        x: best.x.clone(),
+        minus_two_ln_l: best.f,
+        starts: 0,
+    }];
+    chains.extend(islands.iter().cloned());
+    let draws = draws_from(&f, &chains, search.draws, search.seed);
     watch.check()?;
+    let other_maxima = maxima.iter().skip(1).map(|m| m.minus_two_ln_l).collect();
     Ok(Estimate {
         x: best.x.clone(),
         minus_two_ln_l: best.f,
@@ -467,9 +618,11 @@ pub fn estimate(
         chi2,
         dof,
         p_value: (dof > 0).then(|| stats::chi_square_p_value(chi2, dof as usize)),
-        region_delta: b * region_delta(dims, TWO_SIGMA),
+        region_delta: region,
         bartlett: b,
         other_maxima,
+        maxima,
+        islands,
         draws,
         bootstrap,
     })
@@ -714,6 +867,82 @@ mod tests {
             }] += 1;
         }
         c
+    }
+
+    /// A law of one parameter that is nearly the same at x and 1 − x: data at x = 0.2 have a
+    /// second maximum near 0.8, a little lower (the tilt), inside the joint 2σ region. The
+    /// region must be reported as the union of the two: the 2σ interval spans both maxima, the
+    /// draws come from both islands, and the search's starts are counted at each maximum.
+    #[test]
+    fn two_islands_inside_the_region_are_one_region_drawn_from_both() {
+        let law = |x: &[f64]| -> Vec<f64> {
+            let d = (x[0] - 0.5).powi(2);
+            let (l, a) = (-2.0 + 6.0 * d + 0.01 * x[0], -0.5 - 3.0 * d);
+            let m = l.max(a).max(0.0);
+            let (el, ea, ew) = ((l - m).exp(), (a - m).exp(), (-m).exp());
+            let s = el + ea + ew;
+            vec![el / s, ea / s, ew / s]
+        };
+        let expected =
+            |p: &[f64], n: f64| -> Vec<u64> { p.iter().map(|q| (q * n).round() as u64).collect() };
+        let block = "140x24x20".parse().unwrap();
+        let c = expected(&law(&[0.2]), 400.0);
+        let rows = vec![DataRow {
+            label: "r".into(),
+            surface: "S".into(),
+            thrower: "all".into(),
+            block,
+            mode: crate::model::scene::Mode::ThreeD,
+            counts: [c[0], c[1], c[2]],
+            groups: vec![vec![0], vec![1], vec![2]],
+        }];
+        let pts: Vec<DesignPoint> = points(1, 24)
+            .into_iter()
+            .map(|x| DesignPoint {
+                counts: expected(&law(&x), 1e7),
+                x,
+            })
+            .collect();
+        let designs = vec![Design {
+            block,
+            mode: crate::model::scene::Mode::ThreeD,
+            axes: vec![(Kind::E, Kind::E.default_range())],
+            surrogate: Surrogate::fit_best(&pts, 1, 3, 4, 6),
+            points: pts,
+            unsettled: 0,
+            rolls: 24 * 10_000_000,
+        }];
+        let model = ModelSpec::free(&[Kind::E]);
+        let params = model.params(&rows);
+        let lik = Likelihood::new(&rows, &designs, &model, &params);
+        let search = Search {
+            starts: 8,
+            profile_points: 41,
+            draws: 2000,
+            seed: 1,
+            bootstrap: 0,
+        };
+        let e = estimate(&lik, &params, &search, &Watch::quiet(&Stop::new())).unwrap();
+        let said = format!("{:?} {:?} {:?}", e.x, e.maxima, e.params[0].two_sigma);
+        assert_eq!(e.islands.len(), 1, "{said}");
+        assert!((e.x[0] - 0.2).abs() < 0.05, "{said}");
+        assert!((e.islands[0].x[0] - 0.8).abs() < 0.05, "{said}");
+        let delta = e.islands[0].minus_two_ln_l - e.minus_two_ln_l;
+        assert!(delta >= 0.0 && delta < e.region_delta, "{said}");
+        assert_eq!(
+            e.maxima.iter().map(|m| m.starts).sum::<usize>(),
+            8,
+            "{said}"
+        );
+        // The interval spans both islands.
+        let u = |v: f64| Kind::E.coordinate(params[0].range, v);
+        let two = e.params[0].two_sigma;
+        assert!(u(two[0]) < 0.2 && u(two[1]) > 0.8, "{said}");
+        // Draws from both, in proportion to exp(−Δ/2) (the chains' shares are set, not
+        // sampled: within a draw of it).
+        let far = e.draws.iter().filter(|x| x[0] > 0.5).count() as f64 / e.draws.len() as f64;
+        let want = (-delta / 2.0).exp() / (1.0 + (-delta / 2.0).exp());
+        assert!((far - want).abs() < 0.01, "{far} against {want}: {said}");
     }
 
     /// One repetition: data at `truth`, designs of 64 × 500 draws, the fit; returns the truth's

@@ -424,6 +424,8 @@ mod tests {
             region_delta: 0.0,
             bartlett: 1.0,
             other_maxima: vec![],
+            maxima: vec![],
+            islands: vec![],
             draws: vec![],
             bootstrap: None,
         }

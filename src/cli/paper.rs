@@ -58,33 +58,16 @@ pub struct PaperArgs {
     /// With --calibrated: throws per block in the method check.
     #[arg(long, default_value_t = 4000)]
     pub check_rolls: u64,
+    /// With --calibrated: data sets of the parametric bootstrap (the main fit's data simulated
+    /// from its values and fitted again), which measures the goodness of fit's p-value, the
+    /// region's coverage and the likelihood ratio's scale (0: none, χ²'s own).
+    #[arg(long, default_value_t = 100)]
+    pub bootstrap: usize,
 }
 
 /// Runs `dicephys paper --calibrated`.
 fn calibrated(a: &PaperArgs) -> Result<()> {
-    use dicephys::calibration::design::DesignSpec;
-    use dicephys::calibration::estimate::Search;
-    use dicephys::calibration::params::Method;
-    use dicephys::studies::calibrated::CalibratedConfig;
-    let cfg = CalibratedConfig {
-        method: Method {
-            engine: EngineKind::Bullet,
-            dt: a.dt,
-            max_steps: a.max_steps,
-        },
-        design: DesignSpec {
-            points: a.points,
-            rolls: a.point_rolls,
-            ..DesignSpec::default()
-        },
-        search: Search {
-            seed: a.seed,
-            ..Search::default()
-        },
-        seed: a.seed,
-        check_rolls: a.check_rolls,
-        reference_dt: a.reference_dt,
-    };
+    let cfg = a.calibrated_config();
     let out = a.out.clone().unwrap_or_else(|| "paper-out".into());
     let mut place = study::local(&out, a.threads, a.json)?;
     // Its cells beside paper's own, apart.
@@ -93,6 +76,34 @@ fn calibrated(a: &PaperArgs) -> Result<()> {
 }
 
 impl PaperArgs {
+    /// `paper --calibrated`'s configuration.
+    pub fn calibrated_config(&self) -> dicephys::studies::calibrated::CalibratedConfig {
+        use dicephys::calibration::design::DesignSpec;
+        use dicephys::calibration::estimate::Search;
+        use dicephys::calibration::params::Method;
+        let a = self;
+        dicephys::studies::calibrated::CalibratedConfig {
+            method: Method {
+                engine: EngineKind::Bullet,
+                dt: a.dt,
+                max_steps: a.max_steps,
+            },
+            design: DesignSpec {
+                points: a.points,
+                rolls: a.point_rolls,
+                ..DesignSpec::default()
+            },
+            search: Search {
+                seed: a.seed,
+                bootstrap: a.bootstrap,
+                ..Search::default()
+            },
+            seed: a.seed,
+            check_rolls: a.check_rolls,
+            reference_dt: a.reference_dt,
+        }
+    }
+
     /// The study's configuration.
     pub fn config(&self) -> PaperConfig {
         let mut engines = self.engines.clone();

@@ -15,6 +15,7 @@ use super::study;
 use super::sweeps::{ConvergeArgs, StabilityArgs, TradeoffArgs};
 use clap::{Args, Subcommand};
 use dicephys::run::slurm::Options;
+use dicephys::studies::calibrated::CalibratedStudy;
 use dicephys::studies::cluster::{self, Finishing, Job, Staged, Submitted};
 use dicephys::studies::fit::{FitStudy, Stage};
 use dicephys::studies::StudyConfig;
@@ -33,7 +34,9 @@ pub enum SlurmCommand {
     /// `roll` as a job array: task K of N rolls shard K/N; the finishing job merges them.
     Roll(Box<SlurmRollArgs>),
     /// `paper` as a job array: the tasks share the cells' chunks; the finishing job writes
-    /// the report into --dir.
+    /// the report into --dir. `paper --calibrated` as two chained arrays: every model's first
+    /// pass into --dir/first-pass, then every model's second pass into --dir, whose finishing
+    /// job rolls any widening passes and the method check and writes calibrated.md.
     Paper(Box<SlurmStudyArgs<PaperArgs>>),
     /// `crosscheck` as a job array; the finishing job's comparison is DIR/result.txt.
     Crosscheck(Box<SlurmStudyArgs<CrosscheckArgs>>),
@@ -183,7 +186,14 @@ fn study_of(c: &SlurmCommand) -> Result<Flags<'_>> {
     Ok(match c {
         SlurmCommand::Paper(a) => {
             let s = &a.study;
-            let cfg = StudyConfig::Paper(s.config());
+            let cfg = if s.calibrated {
+                StudyConfig::Calibrated(CalibratedStudy {
+                    config: s.calibrated_config(),
+                    stage: Stage::Whole,
+                })
+            } else {
+                StudyConfig::Paper(s.config())
+            };
             (cfg, s.threads, s.json, out(s.out.is_some()), &a.job)
         }
         SlurmCommand::Crosscheck(a) => {

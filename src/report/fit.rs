@@ -1,7 +1,7 @@
 //! What a fit says: `report.md`, its figures, and a prediction's lines.
 
 use crate::calibration::check::Verdict;
-use crate::calibration::estimate::Identified;
+use crate::calibration::estimate::{Estimate, Identified};
 use crate::calibration::paper::CalibratedPaper;
 use crate::calibration::params::{FixedThrow, Kind};
 use crate::calibration::predict::{BlockPrediction, Predicted};
@@ -117,16 +117,61 @@ fn parameters(res: &FitResult) -> String {
             says
         );
     }
-    if !e.other_maxima.is_empty() {
+    let _ = write!(s, "{}", maxima_text(e));
+    s
+}
+
+/// What the search's starts found: how many ended at each maximum; the islands of the region
+/// (other maxima within its threshold), which its intervals span and its draws come from; or
+/// the global maximum's margin over the next.
+pub fn maxima_text(e: &Estimate) -> String {
+    let mut s = String::new();
+    let starts: usize = e.maxima.iter().map(|m| m.starts).sum();
+    if e.maxima.len() > 1 {
         let _ = writeln!(
             s,
-            "\nThe search also ended at other local maxima, −2 ln L higher by {}: the region may \
-             be more than one island.",
-            e.other_maxima
+            "\nThe search's {starts} starts ended at {} distinct maxima (starts at each, best \
+             first: {}).",
+            e.maxima.len(),
+            e.maxima
                 .iter()
-                .map(|f| format!("{:.2}", f - e.minus_two_ln_l))
+                .map(|m| m.starts.to_string())
                 .collect::<Vec<_>>()
                 .join(", ")
+        );
+    }
+    let delta = |f: f64| format!("{:.2}", f - e.minus_two_ln_l);
+    if !e.islands.is_empty() {
+        let _ = writeln!(
+            s,
+            "The joint 2σ region is {} islands: the best maximum and {} more within its \
+             threshold Δ(−2 ln L) ≤ {:.2} (at Δ {}). The intervals above span every island \
+             that can reach them (each profile is also traced from the islands within 4 × \
+             the Bartlett factor of the best, the nearest three), and the posterior draws, so \
+             the predictions, come from each island in proportion to exp(−Δ/2).",
+            e.islands.len() + 1,
+            e.islands.len(),
+            e.region_delta,
+            e.islands
+                .iter()
+                .map(|m| delta(m.minus_two_ln_l))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    let outside: Vec<String> = e
+        .other_maxima
+        .iter()
+        .filter(|&&f| f - e.minus_two_ln_l > e.region_delta)
+        .map(|&f| delta(f))
+        .collect();
+    if !outside.is_empty() {
+        let _ = writeln!(
+            s,
+            "Other local maxima lie outside the region (Δ(−2 ln L) {}, above its {:.2}): the \
+             region is the global maximum's, by that margin.",
+            outside.join(", "),
+            e.region_delta
         );
     }
     s

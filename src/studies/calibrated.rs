@@ -16,18 +16,18 @@ use crate::calibration::design::DesignSpec;
 use crate::calibration::estimate::Search;
 use crate::calibration::paper::{CalibratedPaper, Decision, TheoryRow};
 use crate::calibration::params::{self, Kind, Method, ModelSpec};
-use crate::calibration::{FitConfig, FitCost, FitResult};
+use crate::calibration::{FitConfig, FitResult};
 use crate::error::{Error, Result};
 use crate::model::scene::Mode;
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::runner::Runner;
-use crate::studies::fit::{self, Fitted, Session};
-use serde::Serialize;
+use crate::studies::fit::{self, Fitted, Session, Stage};
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::time::Instant;
 
 /// What to simulate.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CalibratedConfig {
     /// How each throw is simulated.
     pub method: Method,
@@ -62,6 +62,13 @@ impl CalibratedConfig {
                 format!("from 1 to {max}"),
             ));
         }
+        if self.search.bootstrap > MAX_BOOTSTRAP {
+            return Err(Error::field(
+                "bootstrap",
+                self.search.bootstrap,
+                format!("from 0 to {MAX_BOOTSTRAP}"),
+            ));
+        }
         crate::model::scene::check_dt("reference_dt", self.reference_dt)?;
         crate::model::scene::check_dt("dt", self.method.dt)?;
         if self.method.max_steps == 0 {
@@ -91,6 +98,9 @@ impl CalibratedConfig {
         Ok(())
     }
 }
+
+/// The most data sets the bootstrap draws (each a fit of every parameter).
+pub const MAX_BOOTSTRAP: usize = 100_000;
 
 /// Rows of this length or longer are the "long blocks" the `long-2d` model simulates in 2D.
 pub const LONG_MM: f64 = 300.0;
@@ -153,7 +163,7 @@ pub fn total_rolls(cfg: &CalibratedConfig) -> Result<u64> {
 }
 
 /// The rolls the first passes make.
-fn first_pass_rolls(cfg: &CalibratedConfig) -> Result<u64> {
+pub fn first_pass_rolls(cfg: &CalibratedConfig) -> Result<u64> {
     let rows = paper_rows()?;
     Ok(models(&rows)
         .into_iter()
@@ -262,6 +272,38 @@ fn verdict(
     }
 }
 
+/// The fit of one model, as the study runs it: the models compared need their maxima and
+/// leave-one-out scores, not the main model's bootstrap and posterior draws.
+fn fit_config(
+    cfg: &CalibratedConfig,
+    name: &str,
+    model: ModelSpec,
+    rows: Vec<DataRow>,
+) -> Result<FitConfig> {
+    let search = if name == "hand" {
+        cfg.search
+    } else {
+        Search {
+            bootstrap: 0,
+            draws: 0,
+            ..cfg.search
+        }
+    };
+    let fc = FitConfig {
+        rows,
+        model,
+        method: cfg.method,
+        design: cfg.design,
+        search,
+        seed: cfg.seed,
+    };
+    fc.validate()?;
+    Ok(fc)
+}
+
+/// A model's fit: its name, its description, the fit.
+type ModelFit = (&'static str, &'static str, Fitted);
+
 /// Runs everything; `dir` keeps the simulations' cells (resumable). `None` if stopped early.
 pub fn run(
     cfg: &CalibratedConfig,
@@ -269,45 +311,178 @@ pub fn run(
     runner: &Runner,
     dir: Option<&Path>,
 ) -> Result<Option<CalibratedPaper>> {
-    let (wall, cpu) = (Instant::now(), process_cpu_seconds());
-    let rows = paper_rows()?;
+    let began = (Instant::now(), process_cpu_seconds());
     let session = Session::default();
-    let mut fits: Vec<(&str, &str, Fitted, Vec<LooRow>)> = Vec::new();
-    for (name, description, model, model_rows) in models(&rows) {
-        // The models compared need their maxima and leave-one-out scores, not the main
-        // model's bootstrap and posterior draws.
-        let search = if name == "hand" {
-            cfg.search
-        } else {
-            Search {
-                bootstrap: 0,
-                draws: 0,
-                ..cfg.search
-            }
-        };
-        let fc = FitConfig {
-            rows: model_rows,
-            model,
-            method: cfg.method,
-            design: cfg.design,
-            search,
-            seed: cfg.seed,
-        };
-        fc.validate()?;
+    let mut fits = Vec::new();
+    for (name, description, model, rows) in models(&paper_rows()?) {
+        let fc = fit_config(cfg, name, model, rows)?;
         let Some(f) = fit::fit(&fc, runner, dir, &session)? else {
             return Ok(None);
         };
+        fits.push((name, description, f));
+    }
+    conclude(cfg, fits, command_line, runner, began)
+}
+
+/// `paper --calibrated` as a cluster runs it (`slurm paper --calibrated`): the whole study on
+/// one machine, or one of its two stages. A model's second pass narrows its box from its first
+/// pass's result, so a cluster rolls every model's first pass as one job array
+/// ([`Stage::First`], written as [`FIRST_PASSES`]), then every model's second pass as another
+/// ([`Stage::Second`]), whose finishing job rolls the passes that widen a cut box and the
+/// method check itself (both are drawn from results no task saw), and runs the leave-one-out
+/// fits and the comparisons. The result is the one machine's, bit for bit: every design is a
+/// pure function of its key and the seed, and the models are fitted in the same order.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CalibratedStudy {
+    /// What to run.
+    pub config: CalibratedConfig,
+    /// Which part of it.
+    pub stage: Stage,
+}
+
+/// The file the first stage writes: every model's first pass.
+pub const FIRST_PASSES: &str = "first-passes.json";
+
+/// The first stage's result: the study it belongs to, and each model's first pass.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct FirstPasses {
+    /// The study's configuration (the second stage refuses another's).
+    pub config: CalibratedConfig,
+    /// Each model's first pass, by name, in the models' order.
+    pub passes: Vec<(String, FitResult)>,
+}
+
+impl CalibratedStudy {
+    /// Checks every value before anything runs.
+    pub fn validate(&self) -> Result<()> {
+        self.config.validate()?;
+        if self.stage != Stage::Whole && !self.config.design.refine {
+            return Err(Error::field(
+                "stage",
+                "",
+                "a study of one pass (no `refine`) has no passes to split",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Every model's first pass (`None` if stopped early, or on a cluster task's share, which
+    /// rolls its share of every model's cells).
+    pub fn first_passes(
+        &self,
+        command_line: &str,
+        runner: &Runner,
+        dir: Option<&Path>,
+    ) -> Result<Option<FirstPasses>> {
+        let cfg = &self.config;
+        let session = Session::default();
+        let mut passes = Vec::new();
+        for (name, _, model, rows) in models(&paper_rows()?) {
+            let (wall, cpu) = (Instant::now(), process_cpu_seconds());
+            let fc = fit_config(cfg, name, model, rows)?;
+            match fit::first_pass(&fc, runner, dir, &session)? {
+                Some(f) => passes.push((name.to_string(), fit::result(f, command_line, wall, cpu))),
+                // A task's share: on to the next model's cells.
+                None if runner.share.is_partial() && !runner.stop.requested() => continue,
+                None => return Ok(None),
+            }
+        }
+        Ok((!runner.share.is_partial()).then(|| FirstPasses {
+            config: cfg.clone(),
+            passes,
+        }))
+    }
+
+    /// The first stage's result, read back and checked to be this study's.
+    fn read_first(&self, path: &Path) -> Result<Vec<Fitted>> {
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            Error::Invalid(format!(
+                "{}: the first passes have not finished ({e}): finish them, then run the second",
+                path.display()
+            ))
+        })?;
+        let first: FirstPasses = crate::run::seal::open(&text)
+            .map_err(|e| Error::Invalid(format!("{}: {e}", path.display())))?;
+        let names: Vec<&str> = models(&paper_rows()?).iter().map(|m| m.0).collect();
+        let theirs: Vec<&str> = first.passes.iter().map(|p| p.0.as_str()).collect();
+        if first.config != self.config || names != theirs {
+            return Err(Error::Invalid(format!(
+                "{} is the first stage of another study",
+                path.display()
+            )));
+        }
+        first
+            .passes
+            .into_iter()
+            .map(|(_, r)| Fitted::from_result(r))
+            .collect()
+    }
+
+    /// Runs its part: `None` if stopped early or on a cluster task's share (the first stage
+    /// comes back through [`CalibratedStudy::first_passes`]).
+    pub fn run(
+        &self,
+        command_line: String,
+        runner: &Runner,
+        dir: Option<&Path>,
+    ) -> Result<Option<CalibratedPaper>> {
+        let first = match &self.stage {
+            Stage::Whole => return run(&self.config, command_line, runner, dir),
+            Stage::First => {
+                return Err(Error::Invalid(
+                    "the first stage writes first passes, not the study".into(),
+                ))
+            }
+            Stage::Second { first } => first,
+        };
+        let began = (Instant::now(), process_cpu_seconds());
+        let firsts = self.read_first(first)?;
+        let session = Session::default();
+        let mut fits = Vec::new();
+        for ((name, description, ..), first) in models(&paper_rows()?).into_iter().zip(firsts) {
+            // As on one machine, where this model's first pass was rolled just before its
+            // second: its designs are the session's (a key the narrowing left as it was is
+            // taken from them, not rolled again).
+            session.hold(self.config.seed, &first.designs);
+            match fit::second_pass(first, runner, dir, &session)? {
+                Some(f) => fits.push((name, description, f)),
+                None if runner.share.is_partial() && !runner.stop.requested() => continue,
+                None => return Ok(None),
+            }
+        }
+        if runner.share.is_partial() {
+            return Ok(None);
+        }
+        conclude(&self.config, fits, command_line, runner, began)
+    }
+}
+
+/// Everything after the fits: each model's leave-one-out scores, the decisions, the method
+/// check at the main fit's values (rolled here, on all of this process's cores, even in a
+/// cluster's finishing job: it is drawn from the fit's result, which no task saw), the theory
+/// beside it. `None` if stopped early.
+fn conclude(
+    cfg: &CalibratedConfig,
+    fits: Vec<ModelFit>,
+    command_line: String,
+    runner: &Runner,
+    (wall, cpu): (Instant, f64),
+) -> Result<Option<CalibratedPaper>> {
+    let rows = paper_rows()?;
+    let mut scored: Vec<(&str, &str, Fitted, Vec<LooRow>)> = Vec::new();
+    for (name, description, f) in fits {
         let loo = leave_one_out(
             &f.config.rows,
             &f.designs,
             &f.config.model,
             &f.params,
             &cfg.search,
-            &f.estimate.x,
+            &f.estimate,
             &runner.watch(),
         )?;
-        fits.push((name, description, f, loo));
+        scored.push((name, description, f, loo));
     }
+    let mut fits = scored;
     let models: Vec<ModelScore> = fits
         .iter()
         .map(|(name, description, f, loo)| {
@@ -356,6 +531,7 @@ pub fn run(
         let x: Vec<f64> = dims.iter().map(|&d| main.estimate.x[d]).collect();
         params::values(&main.config.model.fixed, &axes, &x)
     };
+    let fitted: u64 = fits.iter().map(|f| f.2.rolls).sum();
     let Some(check) = fit::check::run(
         &main.config.rows,
         &cfg.method,
@@ -363,8 +539,8 @@ pub fn run(
         &at,
         cfg.check_rolls,
         cfg.seed,
-        runner,
-        session.rolled(),
+        &fit::own_rolls(runner),
+        fitted,
     )?
     else {
         return Ok(None);
@@ -385,29 +561,13 @@ pub fn run(
             single.push(r.surface.clone());
         }
     }
-    let rolls = session.rolled() + check.blocks.iter().map(|b| 2 * b.rolls).sum::<u64>();
-    let (name, _, main, loo) = fits.swap_remove(hand);
-    let _ = name;
-    let wall_s = wall.elapsed().as_secs_f64();
-    let cpu_s = process_cpu_seconds() - cpu;
+    let rolls = fitted + check.blocks.iter().map(|b| 2 * b.rolls).sum::<u64>();
+    let (_, _, main, loo) = fits.swap_remove(hand);
+    let fit = fit::result(main, &command_line, wall, cpu);
     Ok(Some(CalibratedPaper {
-        fit: FitResult {
-            cost: FitCost {
-                rolls: main.rolls,
-                unsettled: main.unsettled,
-                wall_s,
-                cpu_s,
-            },
-            config: main.config,
-            params: main.params,
-            first_pass: main.first_pass,
-            passes: main.passes,
-            designs: main.designs,
-            estimate: main.estimate,
-            command_line,
-            dicephys_version: env!("CARGO_PKG_VERSION").into(),
-            date_utc: crate::report::paper::utc_now(),
-        },
+        wall_s: fit.cost.wall_s,
+        cpu_s: fit.cost.cpu_s,
+        fit,
         loo,
         theory,
         models,
@@ -415,7 +575,5 @@ pub fn run(
         check,
         single_row_surfaces: single,
         rolls,
-        wall_s,
-        cpu_s,
     }))
 }

@@ -56,6 +56,8 @@ pub enum StudyConfig {
     Stability(stability::Config),
     /// `fit`, or one of its two passes.
     Fit(fit::FitStudy),
+    /// `paper --calibrated`, or one of its two stages.
+    Calibrated(calibrated::CalibratedStudy),
 }
 
 impl StudyConfig {
@@ -96,6 +98,7 @@ impl StudyConfig {
             StudyConfig::Tradeoff(_) => "tradeoff",
             StudyConfig::Stability(_) => "stability",
             StudyConfig::Fit(_) => "fit",
+            StudyConfig::Calibrated(_) => "paper --calibrated",
         }
     }
 
@@ -108,6 +111,7 @@ impl StudyConfig {
             StudyConfig::Tradeoff(c) => c.validate(),
             StudyConfig::Stability(c) => c.validate(),
             StudyConfig::Fit(c) => c.validate(),
+            StudyConfig::Calibrated(c) => c.validate(),
         }
     }
 

@@ -75,6 +75,9 @@ impl StudyConfig {
             StudyConfig::Fit(c) => Unit::Rolls {
                 per_cell: c.config.design.rolls,
             },
+            StudyConfig::Calibrated(c) => Unit::Rolls {
+                per_cell: c.config.design.rolls,
+            },
             _ => Unit::Cells,
         }
     }
@@ -233,6 +236,7 @@ pub fn run(config: &StudyConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
         StudyConfig::Tradeoff(c) => tradeoff(c, place, hooks),
         StudyConfig::Stability(c) => stability(c, place, hooks),
         StudyConfig::Fit(c) => studies::fit::outputs::fit(c, place, hooks),
+        StudyConfig::Calibrated(c) => studies::fit::outputs::calibrated_study(c, place, hooks),
     }
 }
 

@@ -609,3 +609,83 @@ fn a_fit_through_slurm_is_the_one_machine_fit() {
     same_fit(&serde_json::from_str(&text).unwrap(), &whole);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// What makes two calibrated papers the same: everything but the costs, the command line and
+/// the date.
+fn same_calibrated(a: &serde_json::Value, b: &serde_json::Value) {
+    for key in ["loo", "theory", "models", "decisions", "check", "rolls"] {
+        assert_eq!(a[key], b[key], "{key} differs");
+    }
+    same_fit(&a["fit"], &b["fit"]);
+}
+
+/// `slurm paper --calibrated --submit` on the one-node cluster: two chained stages (every
+/// model's first pass, then every model's second pass, whose finishing job rolls the widening
+/// passes and the method check and runs the leave-one-out fits); the study is the one
+/// machine's, bit for bit. At a tiny size (40 points × 10 rolls a block, dt = 1/250 s, no
+/// bootstrap): about 40,000 rolls and 150 s of CPU each way.
+#[test]
+fn the_calibrated_paper_through_slurm_is_the_one_machine_paper() {
+    let Some(_cluster) = cluster("slurm paper --calibrated") else {
+        return;
+    };
+    let dir = tmp("calibrated");
+    let run = dir.join("run");
+    let flags = [
+        "--calibrated",
+        "--points",
+        "40",
+        "--point-rolls",
+        "10",
+        "--check-rolls",
+        "10",
+        "--dt",
+        "1/250",
+        "--bootstrap",
+        "0",
+        "--seed",
+        "3",
+        "--threads",
+        "1",
+    ];
+    let out = bin()
+        .args(["slurm", "paper"])
+        .args(flags)
+        .args(["--tasks", "2", "--dir"])
+        .arg(&run)
+        .arg("--submit")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let jobs: Vec<String> = text
+        .lines()
+        .take(2)
+        .flat_map(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            assert!(w.len() == 10 && w[2] == "array", "unexpected: {text}");
+            [w[4].to_string(), w[9].to_string()]
+        })
+        .collect();
+    let jobs: Vec<&str> = jobs.iter().map(String::as_str).collect();
+    let one = bin()
+        .arg("paper")
+        .args(flags)
+        .arg("--json")
+        .arg("--out")
+        .arg(dir.join("one"))
+        .output()
+        .unwrap();
+    let whole = json(&one);
+    wait_gone(&jobs, &run, Duration::from_secs(1200));
+    let text = std::fs::read_to_string(run.join("calibrated.json"))
+        .unwrap_or_else(|e| panic!("no calibrated.json ({e}):\n{}", diagnose(&jobs, &run)));
+    same_calibrated(&serde_json::from_str(&text).unwrap(), &whole);
+    assert!(run.join("first-pass").join("first-passes.json").exists());
+    assert!(run.join("calibrated.md").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

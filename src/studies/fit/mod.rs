@@ -100,6 +100,49 @@ pub struct Fitted {
     pub unsettled: u64,
 }
 
+impl Fitted {
+    /// A first pass's result, read back as the fit the second pass goes on from.
+    pub fn from_result(r: FitResult) -> Result<Fitted> {
+        // A first pass written before passes were recorded: its one pass, over the whole box.
+        let passes = if r.passes.is_empty() {
+            vec![Pass::over(&r.params, r.cost.rolls)]
+        } else {
+            r.passes
+        };
+        Ok(Fitted {
+            config: r.config,
+            params: r.params,
+            designs: r.designs,
+            estimate: r.estimate,
+            first_pass: None,
+            passes,
+            rolls: r.cost.rolls,
+            unsettled: r.cost.unsettled,
+        })
+    }
+}
+
+/// `f` dressed as a [`FitResult`], its cost measured from `wall` and `cpu` (CPU seconds).
+pub fn result(f: Fitted, command_line: &str, wall: Instant, cpu: f64) -> FitResult {
+    FitResult {
+        cost: FitCost {
+            rolls: f.rolls,
+            unsettled: f.unsettled,
+            wall_s: wall.elapsed().as_secs_f64(),
+            cpu_s: process_cpu_seconds() - cpu,
+        },
+        config: f.config,
+        params: f.params,
+        first_pass: f.first_pass,
+        passes: f.passes,
+        designs: f.designs,
+        estimate: f.estimate,
+        command_line: command_line.to_string(),
+        dicephys_version: env!("CARGO_PKG_VERSION").into(),
+        date_utc: crate::report::paper::utc_now(),
+    }
+}
+
 /// The search of a first pass that a second will refine: its maximum and profiles only (the
 /// second pass's box is drawn from them; the region and the draws are the last pass's).
 fn first_pass_search(cfg: &FitConfig) -> crate::calibration::estimate::Search {
@@ -247,7 +290,7 @@ fn refined_pass(
 /// reads back what its tasks rolled and rolls nothing, one that rolls every chunk itself. A
 /// widened box is drawn from the pass before it, which no task saw: the finishing job of the
 /// second pass's stage rolls those passes on its own cores.
-fn own_rolls<'a>(runner: &Runner<'a>) -> Runner<'a> {
+pub fn own_rolls<'a>(runner: &Runner<'a>) -> Runner<'a> {
     let own = runner.with_progress(runner.progress);
     match own.share {
         ChunkShare::Assemble { .. } => own.with_share(ChunkShare::All),
@@ -336,22 +379,7 @@ impl FitStudy {
                 path.display()
             )));
         }
-        // A first pass written before passes were recorded: its one pass, over the whole box.
-        let passes = if r.passes.is_empty() {
-            vec![Pass::over(&r.params, r.cost.rolls)]
-        } else {
-            r.passes
-        };
-        Ok(Fitted {
-            config: r.config,
-            params: r.params,
-            designs: r.designs,
-            estimate: r.estimate,
-            first_pass: None,
-            passes,
-            rolls: r.cost.rolls,
-            unsettled: r.cost.unsettled,
-        })
+        Fitted::from_result(r)
     }
 
     /// Runs its part: `None` if stopped early or on a cluster task's share.
@@ -384,21 +412,5 @@ pub fn run(
     let Some(f) = study.fit(runner, dir)? else {
         return Ok(None);
     };
-    Ok(Some(FitResult {
-        cost: FitCost {
-            rolls: f.rolls,
-            unsettled: f.unsettled,
-            wall_s: wall.elapsed().as_secs_f64(),
-            cpu_s: process_cpu_seconds() - cpu,
-        },
-        config: f.config,
-        params: f.params,
-        first_pass: f.first_pass,
-        passes: f.passes,
-        designs: f.designs,
-        estimate: f.estimate,
-        command_line,
-        dicephys_version: env!("CARGO_PKG_VERSION").into(),
-        date_utc: crate::report::paper::utc_now(),
-    }))
+    Ok(Some(result(f, &command_line, wall, cpu)))
 }

@@ -8,7 +8,7 @@ use crate::calibration::{FitConfig, FitResult};
 use crate::error::{Error, Result};
 use crate::report::fit as report;
 use crate::run::seal;
-use crate::studies::calibrated::{self, CalibratedConfig};
+use crate::studies::calibrated::{self, CalibratedConfig, CalibratedStudy, FIRST_PASSES};
 use crate::studies::outputs::{to_json, Done, Hooks, Place};
 use serde::Serialize;
 
@@ -225,20 +225,74 @@ pub fn predict_blocks(
     Ok(done)
 }
 
-/// `paper --calibrated`: calibrated.json, calibrated.md and figures in `place.out`, the cells
-/// under `place.checkpoint`.
+/// `paper --calibrated` on one machine: its directory claimed (refused if a Slurm run owns
+/// it), then [`calibrated_study`], whole.
 pub fn calibrated(cfg: &CalibratedConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
     cfg.validate()?;
     claim(place, "paper --calibrated", cfg)?;
-    let outputs = place.outputs(&["calibrated.json", "calibrated.md"])?;
-    let total = calibrated::total_rolls(cfg)? as f64;
+    let study = CalibratedStudy {
+        config: cfg.clone(),
+        stage: Stage::Whole,
+    };
+    calibrated_study(&study, place, hooks)
+}
+
+/// `paper --calibrated`, or a stage of it on a cluster: calibrated.json, calibrated.md and
+/// figures in `place.out`, the cells under `place.checkpoint`; the first stage writes only
+/// every model's first pass ([`FIRST_PASSES`]); a cluster task's share writes nothing.
+pub fn calibrated_study(study: &CalibratedStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
+    study.validate()?;
+    let cfg = &study.config;
+    let first = study.stage == Stage::First;
+    let files: &[&str] = if first {
+        &[FIRST_PASSES]
+    } else {
+        &["calibrated.json", "calibrated.md"]
+    };
+    let outputs = place.outputs(files)?;
+    let all = calibrated::total_rolls(cfg)? as f64;
+    let firsts = calibrated::first_pass_rolls(cfg)? as f64;
+    let total = match study.stage {
+        Stage::Whole => all,
+        Stage::First => firsts,
+        Stage::Second { .. } => all - firsts,
+    };
     let progress = |n: u64| (hooks.progress)(n as f64, total.max(n as f64));
-    let mut study = place.study(&hooks.stop, &progress);
-    study.runner = study.runner.with_say(hooks.log);
-    let (runner, dir) = (&study.runner, study.checkpoint.as_deref());
-    let res = unless_stopped(
-        runner.install(|| calibrated::run(cfg, place.command_line.clone(), runner, dir))?,
-    )?;
+    let mut sim = place.study(&hooks.stop, &progress);
+    sim.runner = sim.runner.with_say(hooks.log);
+    let (runner, dir) = (&sim.runner, sim.checkpoint.as_deref());
+    let command_line = place.command_line.clone();
+    if first {
+        let res =
+            unless_stopped(runner.install(|| study.first_passes(&command_line, runner, dir))?)?;
+        if place.partial() {
+            return Ok(Done::default());
+        }
+        let Some(res) = res else {
+            return Ok(interrupted(place));
+        };
+        (hooks.progress)(total, total);
+        let json = seal::to_string(&res, true)?;
+        outputs[0].write(json.as_bytes())?;
+        let text: String = res
+            .passes
+            .iter()
+            .map(|(name, r)| format!("model {name}:\n{}", report::first_pass_text(r)))
+            .collect();
+        let mut done = place.done(&json, &text, FIRST_PASSES);
+        done.note = done.note.map(|_| {
+            format!(
+                "wrote {}/{FIRST_PASSES}: every model's first pass, which its second narrows \
+                 its box from",
+                place.out.display()
+            )
+        });
+        return Ok(done);
+    }
+    let res = unless_stopped(runner.install(|| study.run(command_line, runner, dir))?)?;
+    if place.partial() {
+        return Ok(Done::default());
+    }
     let Some(res) = res else {
         return Ok(interrupted(place));
     };
