@@ -80,9 +80,9 @@ pub struct ThrowArgs {
     /// (random orientation, spin axis uniform on the sphere, velocity in a random horizontal
     /// direction; the ranges give the magnitudes), hand (between the two, by --kappa) or rest
     /// (released at rest in a random orientation, its lowest corner touching the floor; no
-    /// range is used).
-    #[arg(long = "throw", default_value = "paper", value_parser = parse_throw_style)]
-    pub style: ThrowStyle,
+    /// range is used). [default: paper; `fair`: tumble]
+    #[arg(long = "throw", value_parser = parse_throw_style)]
+    pub style: Option<ThrowStyle>,
     /// A hand's throw's concentration κ >= 0: the paper's throw turned by random angles whose
     /// mean cosine is coth κ − 1/κ (0: the tumble's spread; large: the paper's throw).
     /// Requires --throw hand.
@@ -206,8 +206,14 @@ impl SceneArgs {
 }
 
 impl ThrowArgs {
-    /// The throws, checked.
+    /// The throws, checked (the paper's throw unless `--throw` says otherwise).
     pub fn spec(&self) -> Result<ThrowSpec> {
+        self.spec_or(ThrowStyle::Paper)
+    }
+
+    /// The throws, checked, in the style `default` unless `--throw` gives one.
+    pub fn spec_or(&self, default: ThrowStyle) -> Result<ThrowSpec> {
+        let style = self.style.unwrap_or(default);
         let spec = ThrowSpec {
             kind: self.throws,
             seed: self.seed,
@@ -216,16 +222,15 @@ impl ThrowArgs {
                 spin: self.spin,
                 drop_height: self.drop_height,
             },
-            style: self.style,
+            style,
             kappa: self.kappa,
         };
-        if self.kappa.is_some() && self.style != ThrowStyle::Hand {
+        if self.kappa.is_some() && style != ThrowStyle::Hand {
             return Err(Error::Usage(format!(
-                "--kappa: only --throw hand takes a concentration, not --throw {}",
-                self.style
+                "--kappa: only --throw hand takes a concentration, not --throw {style}"
             )));
         }
-        if self.style == ThrowStyle::Rest {
+        if style == ThrowStyle::Rest {
             // A die released at rest has no velocity, spin or drop: a range given is a mistake.
             let default = ThrowRanges::default();
             for (flag, given, dflt) in [
@@ -241,7 +246,7 @@ impl ThrowArgs {
                 }
             }
         }
-        if self.kappa.is_none() && self.style == ThrowStyle::Hand {
+        if self.kappa.is_none() && style == ThrowStyle::Hand {
             return Err(Error::Usage(
                 "--throw hand needs --kappa K (0: the tumble's spread; large: the paper's throw)"
                     .into(),

@@ -8,6 +8,7 @@ pub mod args;
 pub mod bench;
 pub mod crosscheck;
 pub mod error;
+pub mod fair;
 pub mod fit;
 pub mod merge;
 pub mod paper;
@@ -43,6 +44,9 @@ pub enum Command {
     /// Predict a block the fit did not see (or many, --blocks): its outcome probabilities with
     /// their errors, and a held-out test where they were counted.
     Predict(fit::PredictArgs),
+    /// Is this die fair? Roll it (thrown in a tumble by default) and set each face against a
+    /// fair die's: its probability and departure in σ, χ², and the throws a tester would need.
+    Fair(fair::FairArgs),
     /// The paper's closed-form theory for a block, or its whole experimental table.
     Theory(theory::TheoryArgs),
     /// The same throws on several engines: counts, ratios, σ apart, per-throw agreement, cost.
@@ -115,6 +119,7 @@ pub fn dispatch(command: Command) -> error::Result<()> {
         Command::Tradeoff(a) => sweeps::tradeoff(&a),
         Command::Fit(a) => fit::run(&a),
         Command::Predict(a) => fit::predict(&a),
+        Command::Fair(a) => fair::run(&a),
         Command::Merge(a) => merge::run(&a),
         Command::Paper(a) => paper::run(&a),
         Command::Theory(a) => theory::run(&a),

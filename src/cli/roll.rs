@@ -59,6 +59,11 @@ pub struct RollArgs {
     /// Write one CSV row per throw to this file.
     #[arg(long, value_name = "FILE.csv")]
     pub per_roll: Option<PathBuf>,
+    /// How the numbers sit on the faces, for `faces` and the per-roll `face` column: right
+    /// (western dice: 1 on +z, 6 on −z, 2 on +x, 3 on +y; 1, 2, 3 counter-clockwise about
+    /// their corner) or left (its mirror image).
+    #[arg(long, default_value = "right")]
+    pub layout: dicephys::model::faces::Layout,
     /// Keep a checkpoint here as the run goes (chunks of 1,000 rolls, written atomically);
     /// `dicephys roll --resume DIR` continues it, bit for bit.
     #[arg(long, value_name = "DIR", conflicts_with = "resume")]
@@ -76,6 +81,11 @@ pub struct RollArgs {
 impl RollArgs {
     /// The run's specification: from the command line, or from the checkpoint it resumes.
     pub fn spec(&self) -> Result<RunSpec> {
+        self.spec_or(dicephys::model::throws::ThrowStyle::Paper)
+    }
+
+    /// The run's specification, thrown in the style `default` unless `--throw` gives one.
+    pub fn spec_or(&self, default: dicephys::model::throws::ThrowStyle) -> Result<RunSpec> {
         if let Some(dir) = &self.resume {
             return Checkpoint::spec_in(dir)
                 .map_err(|e| Error::Usage(format!("--resume {}: {e}", dir.display())));
@@ -85,7 +95,7 @@ impl RollArgs {
             engine: self.engine,
             roll: self.run.roll(scene.dt)?,
             scene,
-            throws: self.throw.spec()?,
+            throws: self.throw.spec_or(default)?,
             rolls: self.run.rolls(),
             shard: self.shard,
         };
@@ -97,6 +107,23 @@ impl RollArgs {
 /// Runs `dicephys roll`.
 pub fn run(a: &RollArgs) -> Result<()> {
     let spec = a.spec()?;
+    let (summary, done) = rolled(a, &spec, "roll")?;
+    if a.json {
+        outln!("{}", dicephys::run::seal::to_string(&summary, true)?);
+    } else {
+        out!("{}", summary.human());
+    }
+    done
+}
+
+/// Rolls `spec` as `roll` does (its checkpoint, per-roll CSV, precision and progress bar,
+/// named `command`): its summary, numbered by `--layout`, and what to end with once it is
+/// printed (a stop request's interruption, with how to continue).
+pub fn rolled(
+    a: &RollArgs,
+    spec: &RunSpec,
+    command: &'static str,
+) -> Result<(dicephys::report::summary::RunSummary, Result<()>)> {
     if let (Some(_), Some(_)) = (a.run.precision, spec.shard) {
         return Err(Error::Usage(
             "--precision with --shard: a shard rolls a fixed share of the throws; give --rolls"
@@ -104,11 +131,15 @@ pub fn run(a: &RollArgs) -> Result<()> {
         ));
     }
     let threads = a.run.threads()?;
-    let per_roll = a.per_roll.as_deref().map(super::output).transpose()?;
+    let per_roll = a
+        .per_roll
+        .as_deref()
+        .map(|p| super::output(p).map(|o| (o, a.layout)))
+        .transpose()?;
     let dir = a.resume.as_ref().or(a.checkpoint.as_ref());
     let total = spec.indices().len();
     let unit = Unit::Rolls { per_cell: 0 };
-    let bar = Progress::new("roll", unit, false, a.json, super::study::every());
+    let bar = Progress::new(command, unit, false, a.json, super::study::every());
     // Under --precision the total is the rolls expected so far, not the cap.
     let expected = std::sync::atomic::AtomicU64::new(total);
     let progress = |n: u64| bar.set(n as f64, expected.load(Relaxed) as f64);
@@ -116,22 +147,18 @@ pub fn run(a: &RollArgs) -> Result<()> {
     let runner = Runner::new(threads, super::stop().clone());
     let runner = runner.with_progress(&progress);
     let summary = outputs::roll(
-        &spec,
+        spec,
         dir.map(PathBuf::as_path),
         per_roll,
         a.run.precision.map(|p| (p, &expect as &dyn Fn(u64))),
         &runner,
-    )?;
+    )?
+    .with_layout(a.layout);
     let rolled = summary.rolls;
-    if a.json {
-        outln!("{}", dicephys::run::seal::to_string(&summary, true)?);
-    } else {
-        out!("{}", summary.human());
-    }
     if summary.partial {
-        return Err(Error::Interrupted(match dir {
+        let why = Error::Interrupted(match dir {
             Some(d) => format!(
-                "interrupted after {rolled} of {total} rolls; continue with: dicephys roll \
+                "interrupted after {rolled} of {total} rolls; continue with: dicephys {command} \
                  --resume {}{}",
                 d.display(),
                 a.run
@@ -139,7 +166,8 @@ pub fn run(a: &RollArgs) -> Result<()> {
                     .map_or(String::new(), |p| format!(" --precision {}", 100.0 * p))
             ),
             None => format!("interrupted after {rolled} of {total} rolls"),
-        }));
+        });
+        return Ok((summary, Err(why)));
     }
-    Ok(())
+    Ok((summary, Ok(())))
 }

@@ -2,6 +2,7 @@
 //! ended, written with the `csv` crate as the records arrive.
 
 use crate::error::{Error, Result};
+use crate::model::faces::Layout;
 use crate::sim::roll::{Fate, RollRecord};
 use serde::Serialize;
 use std::io::Write;
@@ -32,6 +33,8 @@ struct Row<'a> {
     /// The deepest any point of the die went below that face, m (`roll::Dip`).
     #[serde(serialize_with = "shortest")]
     penetration_m: f64,
+    /// The number on the face up (under the run's layout); empty unless settled on a side.
+    face: String,
 }
 
 /// A float as Rust writes it (`{:?}`: the shortest text that reads back to the same double,
@@ -42,7 +45,7 @@ fn shortest<S: serde::Serializer>(v: &f64, s: S) -> std::result::Result<S::Ok, S
 }
 
 /// The columns, as the header names them.
-pub const COLUMNS: [&str; 12] = [
+pub const COLUMNS: [&str; 13] = [
     "index",
     "drop_height_m",
     "velocity_m_s",
@@ -55,12 +58,14 @@ pub const COLUMNS: [&str; 12] = [
     "dip_steps",
     "longest_dip_steps",
     "penetration_m",
+    "face",
 ];
 
 /// A per-roll CSV being written.
 pub struct PerRoll<W: Write> {
     csv: csv::Writer<W>,
     dt: f64,
+    numbers: [u8; 6],
 }
 
 fn failed(e: csv::Error) -> Error {
@@ -68,13 +73,18 @@ fn failed(e: csv::Error) -> Error {
 }
 
 impl<W: Write> PerRoll<W> {
-    /// Starts the CSV on `out` with its header; `dt` turns steps into simulated time.
-    pub fn new(out: W, dt: f64) -> Result<PerRoll<W>> {
+    /// Starts the CSV on `out` with its header; `dt` turns steps into simulated time, and
+    /// `layout` numbers the faces.
+    pub fn new(out: W, dt: f64, layout: Layout) -> Result<PerRoll<W>> {
         let mut csv = csv::WriterBuilder::new()
             .has_headers(false)
             .from_writer(out);
         csv.write_record(COLUMNS).map_err(failed)?;
-        Ok(PerRoll { csv, dt })
+        Ok(PerRoll {
+            csv,
+            dt,
+            numbers: layout.numbers(),
+        })
     }
 
     /// Writes one row per record, in order.
@@ -100,6 +110,9 @@ impl<W: Write> PerRoll<W> {
                     dip_steps: r.dip.steps,
                     longest_dip_steps: r.dip.longest,
                     penetration_m: r.dip.penetration,
+                    face: r.up.map_or(String::new(), |d| {
+                        self.numbers[usize::from(d).min(5)].to_string()
+                    }),
                 })
                 .map_err(failed)?;
         }

@@ -2,6 +2,7 @@
 //! the theory beside it, and what it cost.
 
 use crate::engine::EngineKind;
+use crate::model::faces;
 use crate::model::scene::{Floor, Mode, Preset};
 use crate::model::throws::{ThrowKind, ThrowRanges};
 use crate::run::io::Output;
@@ -98,6 +99,14 @@ pub struct RunSummary {
     pub outcomes: Option<crate::report::outcomes::Outcomes3d>,
     /// (ratio − theory) / ratio_err.
     pub z_theory: f64,
+    /// How the numbers sit on the faces (`faces`' keys).
+    #[serde(default)]
+    pub layout: faces::Layout,
+    /// Settled rolls by the number on the face up, `"1"`…`"6"` (in 2D the four sides'
+    /// numbers), under `layout`: each pair of opposite faces adds up to its side's count.
+    /// Absent when some rolls came from chunks written before faces were kept.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub faces: Option<BTreeMap<String, u64>>,
     /// Steps simulated over all rolls.
     pub steps_total: u64,
     /// Steps simulated per roll.
@@ -148,6 +157,24 @@ pub struct Audit {
     pub full_steps_mean: f64,
 }
 
+/// Settled rolls by the number on the face up, under `layout` (the faces a 2D die can show
+/// only); `None` if some were read from chunks written before faces were kept.
+pub fn faces_up(tally: &Tally, mode: Mode, layout: faces::Layout) -> Option<BTreeMap<String, u64>> {
+    if !tally.faces_complete() {
+        return None;
+    }
+    let numbers = layout.numbers();
+    let shown = match mode {
+        Mode::ThreeD => 6,
+        Mode::TwoD => 4,
+    };
+    Some(
+        (0..shown)
+            .map(|d| (numbers[d].to_string(), tally.up[d]))
+            .collect(),
+    )
+}
+
 impl RunSummary {
     /// The report of a run of `spec` that made the rolls in `tally`.
     pub fn new(spec: &RunSpec, tally: &Tally, cost: Cost) -> RunSummary {
@@ -196,6 +223,8 @@ impl RunSummary {
                 Mode::TwoD => None,
             },
             z_theory: (ratio - theory_ratio) / ratio_err,
+            layout: faces::Layout::default(),
+            faces: faces_up(tally, scene.mode, faces::Layout::default()),
             steps_total: tally.steps,
             steps_mean: tally.steps as f64 / tally.rolls.max(1) as f64,
             engine_steps_mean: tally.engine_steps as f64 / tally.rolls.max(1) as f64,
@@ -218,6 +247,13 @@ impl RunSummary {
             }),
             precision: None,
         }
+    }
+
+    /// The same summary with its faces numbered by `layout`.
+    pub fn with_layout(mut self, layout: faces::Layout) -> RunSummary {
+        self.layout = layout;
+        self.faces = faces_up(&self.tally, self.mode, layout);
+        self
     }
 
     /// The human summary: counts, the ratio with its error, theory and σ, failures, cost.
@@ -275,6 +311,10 @@ impl RunSummary {
         );
         if let Some(o) = &self.outcomes {
             s += &format!("  {}\n", o.line());
+        }
+        if let Some(f) = &self.faces {
+            let each: Vec<String> = f.iter().map(|(k, v)| format!("{k}: {v}")).collect();
+            s += &format!("  face up ({} layout)  {}\n", self.layout, each.join("   "));
         }
         let failed: Vec<String> = self
             .failed

@@ -152,6 +152,7 @@ fn roll_one(
         certified: None,
         energy_gain: false,
         dip: Default::default(),
+        up: None,
     };
     let Some(w) = world.as_mut() else {
         return failed;

@@ -6,7 +6,10 @@
 //! - a tag, a LEB128 varint: bits 0-1 the fate (0 settled, 1 unconverged, 2 failed); bits
 //!   2-3 its outcome (0 breadth, 1 width, 2 length, 3 unknown) or failure (0 non_finite,
 //!   1 tunnelled, 2 engine_error); bit 4 certified; bit 5 the energy-gain flag; bit 6 a
-//!   non-zero dip depth; bits 7-8 the certified outcome;
+//!   non-zero dip depth; bits 7-8 the certified outcome; bit 9 a face kept (a settled roll
+//!   from this version on), bit 10 its end of the axis (0 positive, 1 negative), so that
+//!   the face up is direction 2 × outcome + bit 10 of `faces::DIRECTIONS` (chunks written
+//!   before faces were kept have neither bit, and their rolls no face);
 //! - `steps`, `engine_steps`, varints; if certified, its step, a varint;
 //! - the dip's `steps` and `longest`, varints; if bit 6, its depth `penetration`, the 8
 //!   bytes of the f64, little-endian (exact).
@@ -68,6 +71,9 @@ pub fn pack(records: &[RollRecord]) -> Vec<u8> {
         if let Some((_, o)) = r.certified {
             tag |= 1 << 4 | outcome_bits(o) << 7;
         }
+        if let Some(d) = r.up {
+            tag |= 1 << 9 | u64::from(d & 1) << 10;
+        }
         varint(&mut out, tag);
         varint(&mut out, r.steps);
         varint(&mut out, r.engine_steps);
@@ -120,7 +126,7 @@ pub fn unpack(bytes: &[u8], indices: &[u64], throws: &Throws) -> Result<Vec<Roll
     let mut out = Vec::with_capacity(indices.len());
     for &i in indices {
         let tag = r.varint()?;
-        if tag >> 9 != 0 {
+        if tag >> 11 != 0 {
             return Err(format!("roll {i}: unknown tag bits"));
         }
         let what = tag >> 2 & 3;
@@ -144,6 +150,13 @@ pub fn unpack(bytes: &[u8], indices: &[u64], throws: &Throws) -> Result<Vec<Roll
         };
         let (dip_steps, longest) = (r.varint()?, r.varint()?);
         let penetration = if tag >> 6 & 1 == 1 { r.f64()? } else { 0.0 };
+        let up = match (tag >> 9 & 1, fate) {
+            (1, Fate::Settled(o)) if o != crate::model::block::Outcome::Unknown => {
+                Some(2 * outcome_bits(o) as u8 + (tag >> 10 & 1) as u8)
+            }
+            (1, _) => return Err(format!("roll {i}: a face on a roll not settled on a side")),
+            _ => None,
+        };
         out.push(RollRecord {
             throw: throws.get(i),
             fate,
@@ -152,6 +165,7 @@ pub fn unpack(bytes: &[u8], indices: &[u64], throws: &Throws) -> Result<Vec<Roll
             certified,
             energy_gain: tag >> 5 & 1 == 1,
             dip: Dip::of(dip_steps, longest, penetration),
+            up,
         });
     }
     if !r.0.is_empty() {

@@ -43,6 +43,11 @@ pub struct Tally {
     /// nanometres, rounded up (an integer, so that tallies merge exactly, by the maximum).
     #[serde(default)]
     pub deepest_dip_nm: u64,
+    /// Settled rolls by the face up: the direction of `faces::DIRECTIONS` (+x, −x, +y, −y,
+    /// +z, −z). They add up to the settled rolls on a side, except in a tally that holds
+    /// rolls from chunks written before faces were kept ([`Tally::faces_complete`]).
+    #[serde(default)]
+    pub up: [u64; 6],
 }
 
 /// Settled rolls by the side standing vertical.
@@ -103,6 +108,9 @@ impl Tally {
                 Fate::Failed(_) => {}
             }
         }
+        if let (Fate::Settled(_), Some(d)) = (r.fate, r.up) {
+            plus(&mut self.up[usize::from(d).min(5)], 1)?;
+        }
         match r.fate {
             Fate::Settled(o) => self.counts.add(o),
             Fate::Unconverged(_) => plus(&mut self.unconverged, 1),
@@ -125,7 +133,16 @@ impl Tally {
                 .checked_add(self.certified_unknown)
                 .is_some_and(|n| n <= self.certified)
             && self.energy_gain <= self.rolls
-            && self.dipped <= self.rolls;
+            && self.dipped <= self.rolls
+            && self
+                .up
+                .iter()
+                .try_fold(0u64, |a, &b| a.checked_add(b))
+                .is_some_and(|n| n <= c.breadth.saturating_add(c.width).saturating_add(c.length))
+            && (0..3).all(|k| {
+                let side = [c.breadth, c.width, c.length][k];
+                self.up[2 * k].saturating_add(self.up[2 * k + 1]) <= side
+            });
         if fine {
             Ok(())
         } else {
@@ -167,7 +184,17 @@ impl Tally {
         plus(&mut self.energy_gain, o.energy_gain)?;
         plus(&mut self.dipped, o.dipped)?;
         self.deepest_dip_nm = self.deepest_dip_nm.max(o.deepest_dip_nm);
+        for (a, b) in self.up.iter_mut().zip(o.up) {
+            plus(a, b)?;
+        }
         Ok(())
+    }
+
+    /// True if every roll settled on a side has its face counted (none came from a chunk
+    /// written before faces were kept).
+    pub fn faces_complete(&self) -> bool {
+        let c = &self.counts;
+        self.up.iter().sum::<u64>() == c.breadth.saturating_add(c.width).saturating_add(c.length)
     }
 
     /// `deepest_dip_nm` in metres.

@@ -4,6 +4,7 @@
 use crate::engine::Engine;
 use crate::model::block::Outcome;
 use crate::model::die::DieShape;
+use crate::model::faces::up_direction;
 use crate::model::scene::Scene;
 use crate::model::state::BodyState;
 use crate::model::throws::Throw;
@@ -94,6 +95,11 @@ pub struct RollRecord {
     /// The die's dips into the floor (`DipWatch`): a flag, not a failure.
     #[serde(default)]
     pub dip: Dip,
+    /// Settled on a face: the direction whose face is up (`faces::DIRECTIONS`; in 2D one of
+    /// the four sides). `None` for a roll of any other fate, or read from a chunk written
+    /// before faces were kept.
+    #[serde(default)]
+    pub up: Option<u8>,
 }
 
 impl RollRecord {
@@ -350,6 +356,7 @@ fn record_of(throw: &Throw, end: End) -> RollRecord {
         certified: end.certified,
         energy_gain: end.energy_gain,
         dip: end.dip,
+        up: end.up,
     }
 }
 
@@ -449,6 +456,8 @@ pub struct End {
     pub energy_gain: bool,
     /// See `RollRecord::dip`.
     pub dip: Dip,
+    /// See `RollRecord::up`.
+    pub up: Option<u8>,
 }
 
 /// Steps the die from `start` until it is at rest (or certain), reaches the step cap, or
@@ -486,6 +495,7 @@ fn run(
         certified: None,
         energy_gain: false,
         dip: Dip::default(),
+        up: None,
     };
     if engine.reset(start).is_err() {
         return end;
@@ -611,7 +621,10 @@ fn run(
             if let Some(o) = certificate.certain(&die, &state) {
                 end.certified = Some((end.steps, o));
                 if stop_early {
+                    // Certain of its side, and so of its face: the die cannot leave the
+                    // face region it is in (the barrier it cannot climb is the edge between).
                     end.fate = Fate::Settled(o);
+                    end.up = up_direction(&state.rotation, o);
                     return end;
                 }
             }
@@ -620,7 +633,9 @@ fn run(
             end.fate = if under {
                 Fate::Failed(Failure::Tunnelled)
             } else {
-                Fate::Settled(classify(&state))
+                let o = classify(&state);
+                end.up = up_direction(&state.rotation, o);
+                Fate::Settled(o)
             };
             return end;
         }

@@ -9,6 +9,7 @@ pub mod cluster;
 pub mod converge;
 pub mod crosscheck;
 pub mod departure;
+pub mod fair;
 pub mod fit;
 pub mod outputs;
 pub mod paper;

@@ -173,13 +173,13 @@ impl Place {
 pub fn roll(
     spec: &RunSpec,
     checkpoint: Option<&Path>,
-    per_roll: Option<Output>,
+    per_roll: Option<(Output, crate::model::faces::Layout)>,
     precision: Option<(f64, &dyn Fn(u64))>,
     runner: &Runner,
 ) -> Result<RunSummary> {
     let checkpoint = checkpoint.map(|d| Checkpoint::open(d, spec)).transpose()?;
     let mut csv = match &per_roll {
-        Some(out) => Some(PerRoll::new(out.writer()?, spec.scene.dt)?),
+        Some((out, layout)) => Some(PerRoll::new(out.writer()?, spec.scene.dt, *layout)?),
         None => None,
     };
     let mut sink = |recs: &[RollRecord]| -> Result<()> {

@@ -303,6 +303,7 @@ const REFS: &[(&str, &str, &str)] = &[
     ("tradeoff-blocks", "per_block[]", "tradeoff"),
     ("validate", "cells[].tally", "tally"),
     ("calibrated", "fit", "fit"),
+    ("fair", "summary", "roll"),
 ];
 
 fn parent(path: &str) -> &str {
@@ -488,6 +489,25 @@ fn study(args: &[&str], file: &str) -> (Value, Value) {
     let v = run(&a);
     let f: Value = serde_json::from_str(&read(&out.join(file))).unwrap();
     (v, f)
+}
+
+#[test]
+fn json_md_lists_the_keys_of_fair() {
+    let mut c = checker();
+    let v = run(&[
+        "fair",
+        "--block",
+        "16x16x15",
+        "--rolls",
+        "300",
+        "--seed",
+        "1",
+        "--threads",
+        "1",
+        "--json",
+    ]);
+    c.document("fair", "fair", &v);
+    c.finish(&["fair"]);
 }
 
 #[test]

@@ -8,6 +8,7 @@ mod calibration_promises;
 mod cli;
 mod coarse;
 mod docs;
+mod faces;
 mod fit;
 mod fuzz;
 mod rapier;

@@ -1,0 +1,124 @@
+//! The six faces of a die: which end of which body axis points up when it has come to rest,
+//! and the numbers the faces carry. The three outcomes of the paper (which side stands
+//! vertical) are the faces taken in opposite pairs; a face tells which of the pair is up.
+
+use crate::model::block::Outcome;
+use crate::model::die::up_in_body;
+use nalgebra::UnitQuaternion;
+use serde::{Deserialize, Serialize};
+
+/// The body directions whose faces can be up, in the order every count of faces keeps:
+/// +x, −x (the breadth axis), +y, −y (width), +z, −z (length).
+pub const DIRECTIONS: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
+
+/// How the numbers 1 to 6 sit on the faces.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Serialize,
+    Deserialize,
+    strum::Display,
+    strum::EnumString,
+    strum::VariantNames,
+)]
+#[serde(rename_all = "kebab-case")]
+#[strum(serialize_all = "kebab-case")]
+pub enum Layout {
+    /// Western dice: 1 on +z, 6 on −z, 2 on +x, 5 on −x, 3 on +y, 4 on −y. Opposite faces sum
+    /// to seven, and 1, 2, 3 run counter-clockwise about their shared corner (+x, +y, +z) seen
+    /// from outside it (the body axes are right-handed: seen down the diagonal, x, y and z
+    /// follow each other counter-clockwise).
+    #[default]
+    Right,
+    /// Its mirror image (2 and 3 swapped, so 5 and 4): 1, 2, 3 clockwise, as on some dice.
+    Left,
+}
+
+impl Layout {
+    /// The number on each direction's face, in [`DIRECTIONS`]' order.
+    pub fn numbers(self) -> [u8; 6] {
+        match self {
+            Layout::Right => [2, 5, 3, 4, 1, 6],
+            Layout::Left => [3, 4, 2, 5, 1, 6],
+        }
+    }
+
+    /// The direction (index into [`DIRECTIONS`]) whose face carries `number`.
+    pub fn direction_of(self, number: u8) -> Option<usize> {
+        self.numbers().iter().position(|&n| n == number)
+    }
+}
+
+/// The direction (index into [`DIRECTIONS`]) whose face is up on a die at `rotation` whose
+/// `side` axis stands vertical: that axis's positive end if it points up, else its negative
+/// end. `None` when no side is vertical.
+pub fn up_direction(rotation: &UnitQuaternion<f64>, side: Outcome) -> Option<u8> {
+    let axis = match side {
+        Outcome::Breadth => 0,
+        Outcome::Width => 1,
+        Outcome::Length => 2,
+        Outcome::Unknown => return None,
+    };
+    let up = up_in_body(rotation);
+    Some(2 * axis + u8::from(up[axis as usize] < 0.0))
+}
+
+/// The side standing vertical when the face of direction `d` is up.
+pub fn side_of(d: usize) -> Outcome {
+    match d / 2 {
+        0 => Outcome::Breadth,
+        1 => Outcome::Width,
+        _ => Outcome::Length,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector3;
+
+    #[test]
+    fn opposite_faces_sum_to_seven_and_one_two_three_turn_as_the_layout_says() {
+        for layout in [Layout::Right, Layout::Left] {
+            let n = layout.numbers();
+            let mut sorted = n;
+            sorted.sort();
+            assert_eq!(sorted, [1, 2, 3, 4, 5, 6]);
+            for k in 0..3 {
+                assert_eq!(n[2 * k] + n[2 * k + 1], 7, "{layout}");
+            }
+            // The outward normals of 1, 2 and 3: their triple product is positive when they
+            // run counter-clockwise seen from outside their shared corner.
+            let normal = |number: u8| {
+                let d = layout.direction_of(number).unwrap();
+                let mut v = Vector3::zeros();
+                v[d / 2] = if d % 2 == 0 { 1.0 } else { -1.0 };
+                v
+            };
+            let turn = normal(1).dot(&normal(2).cross(&normal(3)));
+            assert_eq!(turn > 0.0, layout == Layout::Right, "{layout}: {turn}");
+        }
+    }
+
+    #[test]
+    fn the_face_up_is_the_end_of_the_vertical_axis_that_points_up() {
+        // At the identity, body y is world up: the +y face (3) is up.
+        let id = UnitQuaternion::identity();
+        assert_eq!(up_direction(&id, Outcome::Width), Some(2));
+        // Turned half a turn about x: −y up (4).
+        let flip = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI);
+        assert_eq!(up_direction(&flip, Outcome::Width), Some(3));
+        // A quarter turn about x takes +z to world +y... (R ẑ = −ŷ for +90°, so −z is up).
+        let quarter =
+            UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2);
+        let up_z = (quarter * Vector3::z()).y;
+        let d = up_direction(&quarter, Outcome::Length).unwrap();
+        assert_eq!(d == 4, up_z > 0.0, "{d} {up_z}");
+        assert_eq!(up_direction(&id, Outcome::Unknown), None);
+        assert_eq!(side_of(5), Outcome::Length);
+    }
+}

@@ -1,0 +1,194 @@
+//! Six numbered faces: `roll`'s `faces`, `--layout`, the per-roll `face` column, and `fair`,
+//! on real Bullet and Rapier through the binary.
+
+use crate::helpers::{dicephys, json, Scratch};
+
+/// A face count from `roll --json`'s `faces`.
+fn face(v: &serde_json::Value, k: &str) -> u64 {
+    v["faces"][k]
+        .as_u64()
+        .unwrap_or_else(|| panic!("face {k}: {}", v["faces"]))
+}
+
+/// Each pair of opposite faces adds up to its side's count: 1 + 6 the length (z), 2 + 5 the
+/// breadth (x), 3 + 4 the width (y), under the right-handed layout.
+fn pairs_add_up(v: &serde_json::Value) {
+    let c = &v["counts"];
+    assert_eq!(face(v, "1") + face(v, "6"), c["length"].as_u64().unwrap());
+    assert_eq!(face(v, "2") + face(v, "5"), c["breadth"].as_u64().unwrap());
+    assert_eq!(face(v, "3") + face(v, "4"), c["width"].as_u64().unwrap());
+}
+
+/// A uniform cube thrown in a tumble (no preferred axis) shows each face 1/6 of the time
+/// within 3σ (σ = √(p(1 − p)/n), about 0.0034 at n = 12,000), on Bullet and on Rapier; the
+/// faces add up to the sides, and `--layout left` is the same rolls with 2 and 3 (5 and 4)
+/// swapped. 12,000 throws on Bullet, 3,000 on Rapier (σ 0.0068).
+#[test]
+fn a_tumbled_cube_shows_every_face_a_sixth_of_the_time_on_both_engines() {
+    for (engine, rolls) in [("bullet", "12000"), ("rapier", "3000")] {
+        let args = [
+            "roll", "--block", "16x16x16", "--throw", "tumble", "--rolls", rolls, "--seed", "11",
+            "--engine", engine, "--json",
+        ];
+        let v = json(&dicephys(&args));
+        pairs_add_up(&v);
+        let n: u64 = (1..=6).map(|k| face(&v, &k.to_string())).sum();
+        assert!(
+            n as f64 > 0.99 * rolls.parse::<f64>().unwrap(),
+            "{engine}: {n} at rest"
+        );
+        let sigma = (1.0 / 6.0 * 5.0 / 6.0 / n as f64).sqrt();
+        for k in 1..=6 {
+            let p = face(&v, &k.to_string()) as f64 / n as f64;
+            assert!(
+                (p - 1.0 / 6.0).abs() < 3.0 * sigma,
+                "{engine}: face {k} {p:.4} against 1/6 ± {sigma:.4}"
+            );
+        }
+        let left = json(&dicephys(&[&args[..], &["--layout", "left"]].concat()));
+        assert_eq!(left["layout"], "left");
+        for (r, l) in [
+            ("1", "1"),
+            ("6", "6"),
+            ("2", "3"),
+            ("3", "2"),
+            ("5", "4"),
+            ("4", "5"),
+        ] {
+            assert_eq!(
+                face(&v, r),
+                face(&left, l),
+                "{engine}: right {r} against left {l}"
+            );
+        }
+    }
+}
+
+/// In 2D the die turns about z only: its four sides' numbers (2, 3, 4, 5) and no 1 or 6. The
+/// per-roll CSV's `face` column counts to the same faces, and is empty where no face settled.
+#[test]
+fn two_d_shows_four_faces_and_the_per_roll_column_counts_to_them() {
+    let dir = Scratch::new("faces-2d");
+    let csv = dir.join("rolls.csv");
+    let v = json(&dicephys(&[
+        "roll",
+        "--block",
+        "140x24x20",
+        "--2d",
+        "--rolls",
+        "2000",
+        "--json",
+        "--per-roll",
+        csv.to_str().unwrap(),
+    ]));
+    let faces = v["faces"].as_object().unwrap();
+    let keys: Vec<&str> = faces.keys().map(String::as_str).collect();
+    assert_eq!(keys, ["2", "3", "4", "5"]);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = header
+        .iter()
+        .position(|h| *h == "face")
+        .expect("a face column");
+    let mut counted = std::collections::BTreeMap::<String, u64>::new();
+    for l in lines {
+        let f = l.split(',').nth(col).unwrap().to_string();
+        if !f.is_empty() {
+            *counted.entry(f).or_default() += 1;
+        }
+    }
+    for (k, c) in faces {
+        assert_eq!(
+            counted.get(k).copied().unwrap_or(0),
+            c.as_u64().unwrap(),
+            "face {k}"
+        );
+    }
+    let c = &v["counts"];
+    assert_eq!(
+        faces["2"].as_u64().unwrap() + faces["5"].as_u64().unwrap(),
+        c["breadth"].as_u64().unwrap()
+    );
+}
+
+/// `fair`: a cube thrown in a tumble is not found biased (its χ² p above 2σ's 0.0455, every
+/// face "unresolved"), and the throws a tester would need are not printed as if known; a die
+/// 2 mm short along z (14x16x16: its two 16 × 16 faces, 1 and 6, are the large ones) is found
+/// biased, 1 and 6 up more often than 1/6, with the throws a tester needs to see it. (Sides
+/// are LENGTHxBREADTHxWIDTH, the length along z: 14x16x16 is short along z.)
+#[test]
+fn fair_finds_the_short_die_biased_and_the_cube_not() {
+    let run = |block: &str| {
+        json(&dicephys(&[
+            "fair", "--block", block, "--rolls", "6000", "--seed", "5", "--json",
+        ]))
+    };
+    let cube = run("16x16x16");
+    let f = &cube["fairness"];
+    assert_eq!(f["resolved"], false, "{f}");
+    assert!(f["p_value"].as_f64().unwrap() > 0.0455, "{f}");
+    assert!(
+        f["verdict"].as_str().unwrap().starts_with("unresolved"),
+        "{f}"
+    );
+    let numbers: Vec<u64> = f["faces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x["number"].as_u64().unwrap())
+        .collect();
+    assert_eq!(numbers, [1, 2, 3, 4, 5, 6]);
+    assert_eq!(cube["summary"]["spec"]["throws"]["style"], "tumble");
+    let short = run("14x16x16");
+    let f = &short["fairness"];
+    assert_eq!(f["resolved"], true, "{f}");
+    for face in f["faces"].as_array().unwrap() {
+        let n = face["number"].as_u64().unwrap();
+        let d = face["departure"].as_f64().unwrap();
+        if n == 1 || n == 6 {
+            assert!(d > 0.0 && face["z"].as_f64().unwrap() > 2.0, "{face}");
+        } else {
+            assert!(d < 0.0, "{face}");
+        }
+    }
+    let t2 = f["throws_2sigma"].as_f64().unwrap();
+    let t5 = f["throws_5sigma"].as_f64().unwrap();
+    assert!(t2 > 0.0 && t2 < 6000.0 && t5 > t2, "{t2} {t5}");
+}
+
+/// `fair`'s own bad input: one line, exit 2, before anything rolls.
+#[test]
+fn fair_refuses_what_it_cannot_judge() {
+    for (args, says) in [
+        (
+            vec![
+                "fair",
+                "--block",
+                "140x24x20",
+                "--2d",
+                "--null",
+                "solid-angle",
+            ],
+            "--null solid-angle",
+        ),
+        (
+            vec!["fair", "--block", "16x16x16", "--precision", "2"],
+            "--precision",
+        ),
+        (
+            vec!["fair", "--block", "16x16x16", "--null", "fairish"],
+            "fairish",
+        ),
+        (
+            vec!["roll", "--block", "16x16x16", "--layout", "upside"],
+            "upside",
+        ),
+    ] {
+        let out = dicephys(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(out.stdout.is_empty(), "{args:?}");
+    }
+}
