@@ -19,6 +19,10 @@ pub struct FairArgs {
     /// released at rest; 3D).
     #[arg(long, default_value = "uniform")]
     pub null: Null,
+    /// Also write fairness.json (the --json document) and the die map (die_map.svg, .png:
+    /// the six faces as a net, each with its probability and departure) into this directory.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<std::path::PathBuf>,
 }
 
 /// Runs `dicephys fair`.
@@ -37,11 +41,28 @@ pub fn run(a: &FairArgs) -> Result<()> {
             "--null solid-angle: the solid angle is the 3D theory; in 2D give uniform".into(),
         ));
     }
+    if let Some(dir) = &a.out {
+        std::fs::create_dir_all(dir).map_err(|e| {
+            Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
+        })?;
+        let identity = serde_json::json!({ "spec": spec, "null": a.null, "layout": a.roll.layout });
+        dicephys::studies::fair::claim(dir, &identity)?;
+    }
     let (summary, done) = rolled(&a.roll, &spec, "fair")?;
     let fair = assess(&summary, a.null)?;
+    let doc = serde_json::json!({ "fairness": fair, "summary": summary });
+    let json = dicephys::run::seal::to_string(&doc, true)?;
+    if let (Some(dir), false) = (&a.out, summary.partial) {
+        dicephys::studies::fair::write(dir, &json, &fair, &summary)?;
+        if !a.roll.json {
+            eprintln!(
+                "wrote {}/fairness.json and die_map.svg, .png",
+                dir.display()
+            );
+        }
+    }
     if a.roll.json {
-        let doc = serde_json::json!({ "fairness": fair, "summary": summary });
-        outln!("{}", dicephys::run::seal::to_string(&doc, true)?);
+        outln!("{}", json);
     } else {
         out!("{}", fair.text(&summary));
     }

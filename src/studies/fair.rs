@@ -258,6 +258,43 @@ impl Fairness {
     }
 }
 
+/// Claims `dir` for this `fair` run (`run::owner`): refused if another command or another run
+/// owns it.
+pub fn claim(dir: &std::path::Path, identity: &serde_json::Value) -> Result<()> {
+    crate::run::owner::refuse_cluster_run(dir)?;
+    crate::run::owner::claim(dir, "fair", identity)
+}
+
+/// Writes `fairness.json` (the document `json`, as `--json` prints it) and the die map
+/// (`die_map.svg`, `die_map.png`) into `dir`, each whole or not at all.
+pub fn write(dir: &std::path::Path, json: &str, fair: &Fairness, s: &RunSummary) -> Result<()> {
+    let title = format!(
+        "{} mm, {} {}, throw {}: {} rolls at rest; {}",
+        s.block_mm.map(|v| v.to_string()).join("x"),
+        s.engine,
+        s.mode,
+        s.spec.throws.style,
+        fair.n,
+        if fair.resolved {
+            format!("biased (χ² p = {:.1e})", fair.p_value)
+        } else {
+            format!("no bias resolved (χ² p = {:.2})", fair.p_value)
+        }
+    );
+    let faces: Vec<crate::report::figures::die::MapFace> = fair
+        .faces
+        .iter()
+        .map(|f| crate::report::figures::die::MapFace {
+            number: f.number,
+            p: f.p,
+            err: f.err,
+            z: f.z,
+        })
+        .collect();
+    crate::report::figures::die::die_map(dir, "die_map", &title, &faces)?;
+    crate::run::io::write_atomic(&dir.join("fairness.json"), json.as_bytes())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

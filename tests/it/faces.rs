@@ -157,6 +157,32 @@ fn fair_finds_the_short_die_biased_and_the_cube_not() {
     assert!(t2 > 0.0 && t2 < 6000.0 && t5 > t2, "{t2} {t5}");
 }
 
+/// `fair --out DIR` writes the `--json` document as `fairness.json` and the die map; the
+/// directory is the run's: the same run again rewrites it, another is refused and nothing of
+/// it is written.
+#[test]
+fn fair_out_writes_its_document_and_the_die_map_into_a_directory_of_its_own() {
+    let dir = Scratch::absent("fair-out");
+    let d = dir.to_str().unwrap();
+    let args = [
+        "fair", "--block", "16x16x15", "--rolls", "500", "--seed", "3", "--out", d,
+    ];
+    let v = json(&dicephys(&[&args[..], &["--json"]].concat()));
+    let file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("fairness.json")).unwrap()).unwrap();
+    assert_eq!(file, v);
+    for f in ["die_map.svg", "die_map.png"] {
+        assert!(std::fs::metadata(dir.join(f)).unwrap().len() > 1000, "{f}");
+    }
+    assert!(dicephys(&args).status.success(), "the same run again");
+    let other = dicephys(&[&args[..], &["--null", "solid-angle"]].concat());
+    assert_eq!(other.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&other.stderr).contains("another `fair` run"));
+    let after: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("fairness.json")).unwrap()).unwrap();
+    assert_eq!(after["fairness"]["null"], "uniform");
+}
+
 /// `fair`'s own bad input: one line, exit 2, before anything rolls.
 #[test]
 fn fair_refuses_what_it_cannot_judge() {

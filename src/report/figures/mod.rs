@@ -17,6 +17,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+pub mod die;
 pub mod fit;
 pub mod paper;
 pub mod sweeps;

@@ -1,0 +1,119 @@
+//! The die map (`die_map`): the six faces laid out as a net, each with its number, its
+//! probability and its departure from a fair die's in σ, shaded red where it comes up more
+//! often and blue where less, as the paper's DiceMap figure sets a fair die beside a biased
+//! one.
+
+use super::*;
+
+/// One face on the map.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MapFace {
+    /// Its number.
+    pub number: u8,
+    /// Its probability and binomial error.
+    pub p: f64,
+    /// Its error.
+    pub err: f64,
+    /// Its departure from the null in σ.
+    pub z: f64,
+}
+
+struct DieMap<'a> {
+    title: &'a str,
+    faces: &'a [MapFace],
+}
+
+/// Where each number sits on the net (column, row): 1 in the middle, 5 and 2 either side,
+/// 3 above, 4 below, 6 beyond 2, so that the net folds into the right-handed die (for the
+/// left layout, 2 and 3 swap with 5 and 4's sides, as on that die).
+fn cell(number: u8) -> (u32, u32) {
+    match number {
+        1 => (1, 1),
+        5 => (0, 1),
+        2 => (2, 1),
+        6 => (3, 1),
+        3 => (1, 0),
+        _ => (1, 2),
+    }
+}
+
+/// The shade of a departure: white at 0, full red (more often) or blue (less) at 5σ.
+fn shade(z: f64) -> RGBColor {
+    let t = (z.abs() / 5.0).clamp(0.0, 1.0);
+    let fade = |full: u8| (255.0 - t * (255.0 - full as f64)).round() as u8;
+    if z >= 0.0 {
+        RGBColor(255, fade(90), fade(90))
+    } else {
+        RGBColor(fade(90), fade(140), 255)
+    }
+}
+
+impl Figure for DieMap<'_> {
+    fn size(&self) -> (u32, u32) {
+        (880, 720)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        root.fill(&WHITE).map_err(plot_err)?;
+        let (top, body) = root.split_vertically(60);
+        top.titled(self.title, (FONT, 19)).map_err(plot_err)?;
+        let side = 200i32;
+        let (x0, y0) = (40i32, 20i32);
+        for f in self.faces {
+            let (c, r) = cell(f.number);
+            let (x, y) = (x0 + c as i32 * side, y0 + r as i32 * side);
+            body.draw(&Rectangle::new(
+                [(x, y), (x + side, y + side)],
+                shade(f.z).filled(),
+            ))
+            .map_err(plot_err)?;
+            body.draw(&Rectangle::new(
+                [(x, y), (x + side, y + side)],
+                BLACK.stroke_width(2),
+            ))
+            .map_err(plot_err)?;
+            let text = |s: String, dy: i32, size: i32| {
+                Text::new(s, (x + 16, y + dy), (FONT, size).into_font())
+            };
+            body.draw(&text(f.number.to_string(), 14, 48))
+                .map_err(plot_err)?;
+            body.draw(&text(format!("{:.4}", f.p), 90, 24))
+                .map_err(plot_err)?;
+            body.draw(&text(format!("± {:.4}", f.err), 120, 20))
+                .map_err(plot_err)?;
+            body.draw(&text(format!("{:+.1} σ", f.z), 152, 24))
+                .map_err(plot_err)?;
+        }
+        Ok(())
+    }
+}
+
+/// Writes the die map as `dir/<stem>.svg` and `.png`.
+pub fn die_map(dir: &Path, stem: &str, title: &str, faces: &[MapFace]) -> crate::Result<()> {
+    write_both(dir, stem, &DieMap { title, faces })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_net_folds_into_a_die_whose_opposite_faces_never_touch() {
+        // On a cross-shaped net, two faces are opposite on the folded cube when they share a
+        // row or a column two cells apart (the one between them folds up between them).
+        let opposite = |a: u8, b: u8| {
+            let ((ca, ra), (cb, rb)) = (cell(a), cell(b));
+            (ra == rb && ca.abs_diff(cb) == 2) || (ca == cb && ra.abs_diff(rb) == 2)
+        };
+        for (a, b) in [(1, 6), (2, 5), (3, 4)] {
+            assert!(opposite(a, b), "{a} and {b}");
+        }
+        // Every cell distinct.
+        let mut cells: Vec<(u32, u32)> = (1..=6).map(cell).collect();
+        cells.sort();
+        cells.dedup();
+        assert_eq!(cells.len(), 6);
+        assert_eq!(shade(0.0), RGBColor(255, 255, 255));
+        assert_eq!(shade(9.0), RGBColor(255, 90, 90));
+    }
+}
