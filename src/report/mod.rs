@@ -3,6 +3,7 @@
 
 pub mod converge;
 pub mod crosscheck;
+pub mod fair;
 pub mod figures;
 pub mod fit;
 pub mod outcomes;

@@ -8,91 +8,9 @@
 use crate::error::{Error, Result};
 use crate::model::faces::{side_of, DIRECTIONS};
 use crate::model::scene::Mode;
+pub use crate::report::fair::{FaceVerdict, Fairness, Null};
 use crate::report::summary::RunSummary;
 use crate::theory::{self, stats};
-use serde::{Deserialize, Serialize};
-
-/// What a fair die's faces would show.
-#[derive(
-    Clone,
-    Copy,
-    Debug,
-    Default,
-    PartialEq,
-    Eq,
-    Serialize,
-    Deserialize,
-    strum::Display,
-    strum::EnumString,
-    strum::VariantNames,
-)]
-#[serde(rename_all = "kebab-case")]
-#[strum(serialize_all = "kebab-case")]
-pub enum Null {
-    /// Every face it can show equally often: 1/6 (in 2D, 1/4 for each side).
-    #[default]
-    Uniform,
-    /// Each face the solid angle it subtends from the centre over 4π (Simpson's quasi-static
-    /// theory, eq. after (InElasK), split evenly between a side's two faces): what an ideal
-    /// block of these sides would show were it released at rest. 3D only.
-    SolidAngle,
-}
-
-/// One face's verdict.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct FaceVerdict {
-    /// Its number, under the run's layout.
-    pub number: u8,
-    /// Its outward direction in body axes (`+x` … `-z`).
-    pub direction: String,
-    /// Rolls that came to rest with it up.
-    pub count: u64,
-    /// Its probability, count / rolls at rest on a face.
-    pub p: f64,
-    /// Its binomial error, √(p(1 − p)/n).
-    pub err: f64,
-    /// The null's probability.
-    pub null: f64,
-    /// p − null.
-    pub departure: f64,
-    /// The departure over the null's own error √(q(1 − q)/n).
-    pub z: f64,
-    /// The throws at which a tester counting this face alone sees its departure at 2σ
-    /// (z² q(1 − q)/departure²); `None` where the simulation does not resolve the departure
-    /// itself (|departure| < 2 err).
-    pub throws_2sigma: Option<f64>,
-    /// The same at 5σ.
-    pub throws_5sigma: Option<f64>,
-}
-
-/// Is the die fair?
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct Fairness {
-    /// The null the faces are set against.
-    pub null: Null,
-    /// Rolls at rest on a face: the denominator.
-    pub n: u64,
-    /// Each face the die can show (six in 3D, four in 2D), in the order of their numbers.
-    pub faces: Vec<FaceVerdict>,
-    /// Pearson's χ² of the face counts against the null.
-    pub chi2: f64,
-    /// Its degrees of freedom: faces − 1.
-    pub dof: usize,
-    /// P(χ²_dof ≥ chi2).
-    pub p_value: f64,
-    /// The bias per throw, λ = Σ (p − q)²/q less its noise Σ p(1 − p)/(n q) (never below 0):
-    /// after N throws a tester's χ² exceeds its degrees of freedom by about N λ.
-    pub lambda: f64,
-    /// The throws at which a tester's expected χ² reaches the 2σ critical value (p = 0.0455):
-    /// about even odds of seeing the bias. `None` when no bias is resolved (λ = 0).
-    pub throws_2sigma: Option<f64>,
-    /// The same at 5σ (p = 5.7 × 10⁻⁷).
-    pub throws_5sigma: Option<f64>,
-    /// The simulation's own χ² rejects the null at 2σ.
-    pub resolved: bool,
-    /// The verdict, in a sentence.
-    pub verdict: String,
-}
 
 /// Two-sided tail of the normal beyond `z` σ: the p-value a "zσ" result stands for.
 fn two_sided(z: f64) -> f64 {
@@ -225,37 +143,6 @@ pub fn assess(s: &RunSummary, null: Null) -> Result<Fairness> {
         resolved,
         verdict,
     })
-}
-
-impl Fairness {
-    /// The human report.
-    pub fn text(&self, s: &RunSummary) -> String {
-        let mut out = format!(
-            "Is this die fair? {} mm, {} {}, throw {}, {} rolls ({} at rest on a face), {} \
-             layout, against {}\n",
-            s.block_mm.map(|v| v.to_string()).join("x"),
-            s.engine,
-            s.mode,
-            s.spec.throws.style,
-            s.rolls,
-            self.n,
-            s.layout,
-            self.null
-        );
-        out += "  face  up  count      p        ± 1σ     null     departure      z   throws to see it (2σ / 5σ)\n";
-        for f in &self.faces {
-            let see = match (f.throws_2sigma, f.throws_5sigma) {
-                (Some(a), Some(b)) => format!("{a:.0} / {b:.0}"),
-                _ => "unresolved".into(),
-            };
-            out += &format!(
-                "  {:>4}  {:<2} {:>7}  {:.5}  {:.5}  {:.5}  {:+.5}  {:+6.2}   {see}\n",
-                f.number, f.direction, f.count, f.p, f.err, f.null, f.departure, f.z
-            );
-        }
-        out += &format!("  {}\n", self.verdict);
-        out
-    }
 }
 
 /// Claims `dir` for this `fair` run (`run::owner`): refused if another command or another run
