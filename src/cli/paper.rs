@@ -63,6 +63,13 @@ pub struct PaperArgs {
     /// region's coverage and the likelihood ratio's scale (0: none, χ²'s own).
     #[arg(long, default_value_t = 100)]
     pub bootstrap: usize,
+    /// With --calibrated: starting points of each fit's search for its maximum (the centre and
+    /// a Halton sequence; the report says where each ended).
+    #[arg(long, default_value_t = 8)]
+    pub starts: usize,
+    /// With --calibrated: grid points of each parameter's profile likelihood across its box.
+    #[arg(long, default_value_t = 21)]
+    pub profile_points: usize,
 }
 
 /// Runs `dicephys paper --calibrated`.

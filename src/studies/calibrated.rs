@@ -69,6 +69,20 @@ impl CalibratedConfig {
                 format!("from 0 to {MAX_BOOTSTRAP}"),
             ));
         }
+        if !(1..=MAX_STARTS).contains(&self.search.starts) {
+            return Err(Error::field(
+                "starts",
+                self.search.starts,
+                format!("from 1 to {MAX_STARTS}"),
+            ));
+        }
+        if !(5..=MAX_PROFILE_POINTS).contains(&self.search.profile_points) {
+            return Err(Error::field(
+                "profile_points",
+                self.search.profile_points,
+                format!("from 5 to {MAX_PROFILE_POINTS}"),
+            ));
+        }
         crate::model::scene::check_dt("reference_dt", self.reference_dt)?;
         crate::model::scene::check_dt("dt", self.method.dt)?;
         if self.method.max_steps == 0 {
@@ -101,6 +115,12 @@ impl CalibratedConfig {
 
 /// The most data sets the bootstrap draws (each a fit of every parameter).
 pub const MAX_BOOTSTRAP: usize = 100_000;
+
+/// The most starting points a search may take.
+pub const MAX_STARTS: usize = 1000;
+
+/// The most grid points a profile may take.
+pub const MAX_PROFILE_POINTS: usize = 1001;
 
 /// Rows of this length or longer are the "long blocks" the `long-2d` model simulates in 2D.
 pub const LONG_MM: f64 = 300.0;

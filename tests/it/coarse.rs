@@ -371,7 +371,7 @@ fn dips_are_reported_in_json_and_per_roll_csv() {
     assert_eq!(
         lines.next().unwrap(),
         "index,drop_height_m,velocity_m_s,spin_rad_s,status,outcome,steps,sim_time_s,\
-         energy_gain,dip_steps,longest_dip_steps,penetration_m"
+         energy_gain,dip_steps,longest_dip_steps,penetration_m,face"
     );
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 50);

@@ -623,8 +623,12 @@ fn same_calibrated(a: &serde_json::Value, b: &serde_json::Value) {
 /// model's first pass, then every model's second pass, whose finishing job rolls the widening
 /// passes and the method check and runs the leave-one-out fits); the study is the one
 /// machine's, bit for bit. At a tiny size (40 points × 10 rolls a block, dt = 1/250 s, no
-/// bootstrap): about 40,000 rolls and 150 s of CPU each way.
+/// bootstrap, 2 starts, profiles of 5 points): about 40,000 rolls each way, but about five CPU
+/// minutes each (the four models' estimates and 76 leave-one-out fits on designs this noisy),
+/// which CI's time cannot hold: run it with `cargo test --release -- --ignored` beside the
+/// one-node cluster (it passed at the commit that added it).
 #[test]
+#[ignore = "ten CPU minutes: cargo test --release -- --ignored, with scripts/slurm-local.sh"]
 fn the_calibrated_paper_through_slurm_is_the_one_machine_paper() {
     let Some(_cluster) = cluster("slurm paper --calibrated") else {
         return;
@@ -643,6 +647,10 @@ fn the_calibrated_paper_through_slurm_is_the_one_machine_paper() {
         "1/250",
         "--bootstrap",
         "0",
+        "--starts",
+        "2",
+        "--profile-points",
+        "5",
         "--seed",
         "3",
         "--threads",
