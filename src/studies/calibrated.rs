@@ -376,14 +376,7 @@ impl CalibratedStudy {
     /// Checks every value before anything runs.
     pub fn validate(&self) -> Result<()> {
         self.config.validate()?;
-        if self.stage != Stage::Whole && !self.config.design.refine {
-            return Err(Error::field(
-                "stage",
-                "",
-                "a study of one pass (no `refine`) has no passes to split",
-            ));
-        }
-        Ok(())
+        self.stage.check(self.config.design.refine)
     }
 
     /// Every model's first pass (`None` if stopped early, or on a cluster task's share, which
@@ -415,14 +408,7 @@ impl CalibratedStudy {
 
     /// The first stage's result, read back and checked to be this study's.
     fn read_first(&self, path: &Path) -> Result<Vec<Fitted>> {
-        let text = std::fs::read_to_string(path).map_err(|e| {
-            Error::Invalid(format!(
-                "{}: the first passes have not finished ({e}): finish them, then run the second",
-                path.display()
-            ))
-        })?;
-        let first: FirstPasses = crate::run::seal::open(&text)
-            .map_err(|e| Error::Invalid(format!("{}: {e}", path.display())))?;
+        let first: FirstPasses = fit::read_first(path)?;
         let names: Vec<&str> = models(&paper_rows()?).iter().map(|m| m.0).collect();
         let theirs: Vec<&str> = first.passes.iter().map(|p| p.0.as_str()).collect();
         if first.config != self.config || names != theirs {

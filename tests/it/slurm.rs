@@ -559,6 +559,20 @@ fn a_fit_split_by_hand_into_two_passes_is_the_one_machine_fit() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The job ids a two-stage submission prints: "first pass: array job A (2 tasks), finishing
+/// job F" and the same for the second pass.
+fn two_stage_jobs(stdout: &[u8]) -> Vec<String> {
+    let text = String::from_utf8_lossy(stdout);
+    text.lines()
+        .take(2)
+        .flat_map(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            assert!(w.len() == 10 && w[2] == "array", "unexpected: {text}");
+            [w[4].to_string(), w[9].to_string()]
+        })
+        .collect()
+}
+
 /// `slurm fit --submit` on the one-node cluster: four jobs chained (each pass's array and its
 /// finishing job, the second pass after the first's); the fit is the one machine's.
 #[test]
@@ -582,17 +596,7 @@ fn a_fit_through_slurm_is_the_one_machine_fit() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    // "first pass: array job A (2 tasks), finishing job F" and the same for the second pass.
-    let text = String::from_utf8_lossy(&out.stdout);
-    let jobs: Vec<String> = text
-        .lines()
-        .take(2)
-        .flat_map(|l| {
-            let w: Vec<&str> = l.split_whitespace().collect();
-            assert!(w.len() == 10 && w[2] == "array", "unexpected: {text}");
-            [w[4].to_string(), w[9].to_string()]
-        })
-        .collect();
+    let jobs = two_stage_jobs(&out.stdout);
     let jobs: Vec<&str> = jobs.iter().map(String::as_str).collect();
     let whole = json(
         &bin()
@@ -669,16 +673,7 @@ fn the_calibrated_paper_through_slurm_is_the_one_machine_paper() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let text = String::from_utf8_lossy(&out.stdout);
-    let jobs: Vec<String> = text
-        .lines()
-        .take(2)
-        .flat_map(|l| {
-            let w: Vec<&str> = l.split_whitespace().collect();
-            assert!(w.len() == 10 && w[2] == "array", "unexpected: {text}");
-            [w[4].to_string(), w[9].to_string()]
-        })
-        .collect();
+    let jobs = two_stage_jobs(&out.stdout);
     let jobs: Vec<&str> = jobs.iter().map(String::as_str).collect();
     let one = bin()
         .arg("paper")

@@ -346,6 +346,32 @@ pub enum Stage {
     },
 }
 
+impl Stage {
+    /// Refuses a stage of a study that has one pass (no `refine`): nothing to split.
+    pub fn check(&self, refine: bool) -> Result<()> {
+        if *self != Stage::Whole && !refine {
+            return Err(Error::field(
+                "stage",
+                "",
+                "a study of one pass (no `refine`) has no passes to split",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A first stage's sealed result, read back for the second: refused, saying why, if that
+/// stage has not finished or the file is damaged.
+pub fn read_first<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        Error::Invalid(format!(
+            "{}: the first pass has not finished ({e}): finish it, then run the second",
+            path.display()
+        ))
+    })?;
+    crate::run::seal::open(&text).map_err(|e| Error::Invalid(format!("{}: {e}", path.display())))
+}
+
 /// The file a first pass writes (a [`FitResult`] without the region or the draws).
 pub const FIRST_PASS: &str = "first-pass.json";
 
@@ -353,26 +379,12 @@ impl FitStudy {
     /// Checks every value before anything runs.
     pub fn validate(&self) -> Result<()> {
         self.config.validate()?;
-        if self.stage != Stage::Whole && !self.config.design.refine {
-            return Err(Error::field(
-                "stage",
-                "",
-                "a fit of one pass (no `refine`) has no passes to split",
-            ));
-        }
-        Ok(())
+        self.stage.check(self.config.design.refine)
     }
 
     /// The first pass's result, read back for the second (and checked to be this fit's).
     fn first(&self, path: &Path) -> Result<Fitted> {
-        let text = std::fs::read_to_string(path).map_err(|e| {
-            Error::Invalid(format!(
-                "{}: the first pass has not finished ({e}): finish it, then run the second",
-                path.display()
-            ))
-        })?;
-        let r: FitResult = crate::run::seal::open(&text)
-            .map_err(|e| Error::Invalid(format!("{}: {e}", path.display())))?;
+        let r: FitResult = read_first(path)?;
         if r.config != self.config {
             return Err(Error::Invalid(format!(
                 "{} is the first pass of another fit",
