@@ -1,6 +1,7 @@
 #include "dicephys/cpp/shim.h"
 
 #include <BulletCollision/CollisionDispatch/btSimulationIslandManager.h>
+#include <BulletCollision/CollisionShapes/btMultiSphereShape.h>
 #include <btBulletDynamicsCommon.h>
 
 #include <cmath>
@@ -555,6 +556,8 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
 BulletWorld::BulletWorld(const BulletScene& s)
     : dt_(s.dt),
       mass_(s.mass),
+      made_(s.made),
+      moments_(s.moments),
       die_friction_(s.die_friction),
       die_restitution_(s.die_restitution),
       planar_(s.planar),
@@ -614,8 +617,44 @@ BulletWorld::BulletWorld(const BulletScene& s)
   floor_ = std::make_unique<btRigidBody>(floor_info);
   world_->addRigidBody(floor_.get());
 
-  die_shape_ = std::make_unique<btBoxShape>(
-      btVector3(0.5 * s.sides[0], 0.5 * s.sides[1], 0.5 * s.sides[2]));
+  const btVector3 half(0.5 * s.sides[0], 0.5 * s.sides[1], 0.5 * s.sides[2]);
+  if (!made_) {
+    die_shape_ = std::make_unique<btBoxShape>(half);
+    return;
+  }
+  // A made die: its solid in body axes, centred, and the body in its principal frame at the
+  // centre of mass c, rotated by P from the body axes. The solid sits at Pᵀ(−c), turned by Pᵀ.
+  const double r = s.edge_radius;
+  if (r > 0) {
+    // The box swept by a ball of radius r is the convex hull of eight balls of radius r at
+    // the inner box's corners: exactly btMultiSphereShape's shape. Its margin is r, so that
+    // Bullet's shape without margin is the inner box's corners themselves.
+    const btVector3 core = half - btVector3(r, r, r);
+    btVector3 corners[8];
+    btScalar radii[8];
+    for (int n = 0; n < 8; ++n) {
+      corners[n] = btVector3(n & 1 ? core.x() : -core.x(), n & 2 ? core.y() : -core.y(),
+                             n & 4 ? core.z() : -core.z());
+      radii[n] = r;
+    }
+    auto hull = std::make_unique<btMultiSphereShape>(corners, radii, 8);
+    hull->setMargin(r);
+    die_solid_ = std::move(hull);
+  } else {
+    die_solid_ = std::make_unique<btBoxShape>(half);
+  }
+  if (!s.offset) {
+    // Centred and aligned: the body's frame is the solid's own.
+    die_shape_ = std::move(die_solid_);
+    return;
+  }
+  const btQuaternion p(s.principal[0], s.principal[1], s.principal[2], s.principal[3]);
+  btTransform solid_at;
+  solid_at.setRotation(p.inverse());
+  solid_at.setOrigin(quatRotate(p.inverse(), -vec(s.com)));
+  auto compound = std::make_unique<btCompoundShape>(false, 1);
+  compound->addChildShape(solid_at, die_solid_.get());
+  die_shape_ = std::move(compound);
 }
 
 BulletWorld::~BulletWorld() {
@@ -631,7 +670,11 @@ void BulletWorld::reset(const BodyStateFfi& start) {
     die_.reset();
   }
   btVector3 inertia(0, 0, 0);
-  die_shape_->calculateLocalInertia(mass_, inertia);
+  if (made_) {
+    inertia = vec(moments_);  // the principal moments, computed exactly in Rust
+  } else {
+    die_shape_->calculateLocalInertia(mass_, inertia);
+  }
   btRigidBody::btRigidBodyConstructionInfo info(mass_, nullptr, die_shape_.get(), inertia);
   btTransform at;
   at.setRotation(btQuaternion(start.rotation[0], start.rotation[1], start.rotation[2],

@@ -2,6 +2,7 @@
 // static floor and one box body; reset the box to a throw, step, read its state. Every
 // setting comes from Rust (BulletScene); all logic (throws, settling, outcomes) lives there.
 #pragma once
+#include <array>
 #include <memory>
 
 #include "rust/cxx.h"
@@ -43,10 +44,16 @@ class BulletWorld {
   std::unique_ptr<btDiscreteDynamicsWorld> world_;
   std::unique_ptr<btCollisionShape> floor_shape_;
   std::unique_ptr<btRigidBody> floor_;
+  // A made die's own shape (box or rounded box), held by die_shape_, a compound that puts
+  // it off the body's frame (the principal frame at the centre of mass); unused for the
+  // paper's block, whose shape is die_shape_ itself.
+  std::unique_ptr<btCollisionShape> die_solid_;
   std::unique_ptr<btCollisionShape> die_shape_;
   std::unique_ptr<btRigidBody> die_;
   double dt_;
   double mass_;
+  bool made_;
+  std::array<double, 3> moments_;
   double die_friction_;
   double die_restitution_;
   bool planar_;

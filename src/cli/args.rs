@@ -6,6 +6,7 @@ use clap::{Args, ValueEnum};
 use dicephys::engine::EngineKind;
 use dicephys::error::parse_name;
 use dicephys::model::block::Block;
+use dicephys::model::mass::{DieFile, PipShape, Pips};
 use dicephys::model::scene::{Floor, Mode, Preset, Scene};
 use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
 use dicephys::run::batch::MAX_THREADS;
@@ -33,9 +34,9 @@ pub struct SceneArgs {
     /// Allow a restitution above 1 (an engine-stability study, not physics).
     #[arg(long)]
     pub allow_restitution_above_one: bool,
-    /// The die's density, kg/m³.
-    #[arg(long, default_value_t = 800.0)]
-    pub density: f64,
+    /// The die's density, kg/m³ [default: 800, or the --die file's].
+    #[arg(long)]
+    pub density: Option<f64>,
     /// Bullet solver settings: dicephys281 (Bullet 2.81 as the paper ran it) or bullet3.
     #[arg(long, default_value = "dicephys281", value_parser = parse_preset)]
     pub preset: Preset,
@@ -56,6 +57,47 @@ pub struct SceneArgs {
     /// freeze mid-fall).
     #[arg(long)]
     pub no_sleep: bool,
+    /// The die's centre of mass, X,Y,Z in mm from its geometric centre along the body axes
+    /// (x breadth, y width, z length): 0,0,-2 is a weight toward the −z face (6 on a western
+    /// die). The inertia about the centre stays the solid's. 3D only.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = parse_com)]
+    pub com: Option<[f64; 3]>,
+    /// Pips drilled in the standard pattern (one to six, as the faces' numbers), DIAMETER,DEPTH
+    /// in mm, as spherical caps: they lighten the die (its mass, centre and inertia), not its
+    /// surface. Paint, cylinders, spacing: in a --die file. 3D only.
+    #[arg(long, value_name = "D,H", value_parser = parse_pips)]
+    pub pips: Option<[f64; 2]>,
+    /// Round the die's edges and corners with this radius, mm (0, the default: sharp). 3D only.
+    #[arg(long, value_name = "MM")]
+    pub edge_radius: Option<f64>,
+    /// A die file (TOML, lengths in mm): com, edge_radius, density, and [pips]
+    /// diameter, depth, shape (cap or cylinder), fill_density, spacing. Flags given beside it
+    /// override its values.
+    #[arg(long, value_name = "FILE.toml")]
+    pub die: Option<std::path::PathBuf>,
+}
+
+/// Two or three numbers separated by commas.
+fn numbers<const N: usize>(what: &str, s: &str) -> std::result::Result<[f64; N], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let mut out = [0.0; N];
+    if parts.len() != N {
+        return Err(format!("'{s}' is not {what}"));
+    }
+    for (o, p) in out.iter_mut().zip(parts) {
+        *o = p
+            .parse::<f64>()
+            .map_err(|_| format!("'{s}': '{p}' is not a number of mm"))?;
+    }
+    Ok(out)
+}
+
+fn parse_com(s: &str) -> std::result::Result<[f64; 3], String> {
+    numbers("X,Y,Z in mm (e.g. 0,0,-2)", s)
+}
+
+fn parse_pips(s: &str) -> std::result::Result<[f64; 2], String> {
+    numbers("DIAMETER,DEPTH in mm (e.g. 3,1)", s)
 }
 
 /// Where the throws come from.
@@ -186,12 +228,41 @@ impl SceneArgs {
         scene.dt = self.dt;
         scene.friction = self.friction;
         scene.restitution = self.restitution;
-        scene.density = self.density;
         scene.preset = self.preset;
         scene.floor = self.floor;
         scene.linear_damping = self.linear_damping;
         scene.angular_damping = self.angular_damping;
         scene.sleeping = !self.no_sleep;
+        if let Some(path) = &self.die {
+            let file = DieFile::read(path)?;
+            if let Some(d) = file.density {
+                scene.density = d;
+            }
+            scene.features = file.features();
+        }
+        let f = &mut scene.features;
+        if let Some(c) = self.com {
+            f.com = Some(c.map(|x| x / 1000.0));
+        }
+        if let Some([d, h]) = self.pips {
+            f.pips = Some(Pips {
+                diameter: d / 1000.0,
+                depth: h / 1000.0,
+                ..f.pips.clone().unwrap_or(Pips {
+                    diameter: 0.0,
+                    depth: 0.0,
+                    shape: PipShape::Cap,
+                    fill_density: 0.0,
+                    spacing: 0.25,
+                })
+            });
+        }
+        if let Some(r) = self.edge_radius {
+            f.edge_radius = r / 1000.0;
+        }
+        if let Some(d) = self.density {
+            scene.density = d;
+        }
         if let Some(t) = self.floor_thickness {
             if self.floor == Floor::Plane {
                 return Err(Error::Usage(

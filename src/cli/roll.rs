@@ -13,7 +13,11 @@ use std::path::PathBuf;
 use std::sync::atomic::Ordering::Relaxed;
 
 /// The options that define a run: `--resume` takes them from the checkpoint instead.
-const DEFINING: [&str; 24] = [
+const DEFINING: [&str; 28] = [
+    "com",
+    "pips",
+    "edge_radius",
+    "die",
     "floor_thickness",
     "engine",
     "block",
@@ -90,7 +94,11 @@ impl RollArgs {
             return Checkpoint::spec_in(dir)
                 .map_err(|e| Error::Usage(format!("--resume {}: {e}", dir.display())));
         }
-        let scene = self.scene.scene()?;
+        let mut scene = self.scene.scene()?;
+        if scene.features.pips.is_some() {
+            // The pips follow the numbers: the layout places them.
+            scene.features.layout = self.layout;
+        }
         let spec = RunSpec {
             engine: self.engine,
             roll: self.run.roll(scene.dt)?,

@@ -1,6 +1,7 @@
 //! Bullet (Debian's libbullet, double precision) through the C++ shim in `cpp/`.
 
 use super::{BodyState, Engine};
+use crate::model::mass::MassProps;
 use crate::model::scene::{Floor, Mode, Preset, Scene};
 use cxx::UniquePtr;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -12,6 +13,21 @@ mod ffi {
         /// Full side lengths along the body's x, y, z axes, m.
         sides: [f64; 3],
         mass: f64,
+        /// A made die (`model::mass`): the body is its principal frame at its centre of mass
+        /// and its solid (box, or rounded box) a compound's child off it. False: the paper's
+        /// block, a box shape whose inertia Bullet computes.
+        made: bool,
+        /// A made die's centre of mass from its geometric centre, body axes, m.
+        com: [f64; 3],
+        /// Its principal frame in body axes (x, y, z, w).
+        principal: [f64; 4],
+        /// Its principal moments, kg m².
+        moments: [f64; 3],
+        /// Its edges' rounding radius, m.
+        edge_radius: f64,
+        /// Its centre of mass is off the centre or its principal frame off the body axes:
+        /// the solid is a compound's child (else the body's shape itself).
+        offset: bool,
         /// DicePhys's 2D mode: linear factor (1,1,0), angular factor (0,0,1).
         planar: bool,
         die_friction: f64,
@@ -109,6 +125,9 @@ pub struct Bullet {
     gyroscopic: bool,
     /// Damping slows the die in flight too, so its flight is not ballistic.
     damped: bool,
+    /// A made die's principal frame in body axes, when it is not the body axes: the engine's
+    /// body turns by it (`to_ffi`, `state`).
+    principal: Option<UnitQuaternion<f64>>,
     /// The die's state as the world last reported it (after reset, set_state or a step).
     now: ffi::BodyStateFfi,
 }
@@ -130,9 +149,18 @@ impl Bullet {
     fn build(scene: &Scene, stock_world: bool) -> crate::Result<Bullet> {
         let s = solver(scene.preset);
         let (linear_damping, angular_damping) = scene.bullet_damping();
+        let made = !scene.features.plain();
+        let mp = MassProps::of(scene)?;
+        let p = mp.principal.quaternion();
         let desc = ffi::BulletScene {
             sides: scene.body_sides(),
-            mass: scene.mass(),
+            mass: mp.mass,
+            made,
+            com: mp.com.into(),
+            principal: [p.i, p.j, p.k, p.w],
+            moments: mp.moments.into(),
+            edge_radius: scene.features.edge_radius,
+            offset: mp.com != Vector3::zeros() || !mp.aligned(),
             planar: scene.mode == Mode::TwoD,
             die_friction: scene.friction,
             die_restitution: scene.restitution,
@@ -158,6 +186,7 @@ impl Bullet {
             world,
             gyroscopic: s.gyroscopic_implicit,
             damped: scene.damped(),
+            principal: (!mp.aligned()).then_some(mp.principal),
             now,
         })
     }
@@ -172,8 +201,14 @@ impl Bullet {
     }
 }
 
-fn to_ffi(s: &BodyState) -> ffi::BodyStateFfi {
-    let q = s.rotation.quaternion();
+/// The engine's state of the body from the die's: the orientation turned by the principal
+/// frame when it is not the body axes (the centre of mass and velocities are the same).
+fn to_ffi(s: &BodyState, principal: Option<&UnitQuaternion<f64>>) -> ffi::BodyStateFfi {
+    let r = match principal {
+        Some(p) => s.rotation * p,
+        None => s.rotation,
+    };
+    let q = r.quaternion();
     ffi::BodyStateFfi {
         position: s.position.into(),
         rotation: [q.i, q.j, q.k, q.w],
@@ -187,7 +222,7 @@ impl Engine for Bullet {
     fn reset(&mut self, start: &BodyState) -> crate::Result<()> {
         self.world
             .pin_mut()
-            .reset(&to_ffi(start))
+            .reset(&to_ffi(start, self.principal.as_ref()))
             .map_err(|e| crate::Error::Engine(e.to_string()))?;
         self.now = self.world.state();
         Ok(())
@@ -196,16 +231,17 @@ impl Engine for Bullet {
     fn set_state(&mut self, now: &BodyState) -> crate::Result<()> {
         self.world
             .pin_mut()
-            .set_state(&to_ffi(now))
+            .set_state(&to_ffi(now, self.principal.as_ref()))
             .map_err(|e| crate::Error::Engine(e.to_string()))?;
         self.now = self.world.state();
         Ok(())
     }
 
     /// Free flight is ballistic unless Bullet's implicit gyroscopic force turns ω or damping
-    /// slows the die.
+    /// slows the die; and it is integrated as the die's own state only when the body's frame
+    /// is the die's axes (a die whose principal frame is turned off them is stepped).
     fn ballistic_flight(&self) -> bool {
-        !self.gyroscopic && !self.damped
+        !self.gyroscopic && !self.damped && self.principal.is_none()
     }
 
     fn contact_free(&self) -> bool {
@@ -222,11 +258,15 @@ impl Engine for Bullet {
     fn state(&self) -> BodyState {
         let s = &self.now;
         let [x, y, z, w] = s.rotation;
+        // Bullet keeps the orientation as a matrix; its quaternion is already unit length
+        // to rounding, so take it as it is rather than renormalising.
+        let body = UnitQuaternion::new_unchecked(Quaternion::new(w, x, y, z));
         BodyState {
             position: Vector3::from(s.position),
-            // Bullet keeps the orientation as a matrix; its quaternion is already unit length
-            // to rounding, so take it as it is rather than renormalising.
-            rotation: UnitQuaternion::new_unchecked(Quaternion::new(w, x, y, z)),
+            rotation: match &self.principal {
+                Some(p) => body * p.inverse(),
+                None => body,
+            },
             linear_velocity: Vector3::from(s.linear_velocity),
             angular_velocity: Vector3::from(s.angular_velocity),
             sleeping: s.sleeping,

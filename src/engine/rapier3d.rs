@@ -5,6 +5,7 @@
 //! the components across, exactly.
 
 use super::{BodyState, Engine};
+use crate::model::mass::MassProps;
 use crate::model::scene::{Floor, Mode, Scene};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use rapier3d_f64::prelude::*;
@@ -34,6 +35,13 @@ pub struct Rapier3d {
     can_sleep: bool,
     /// What the die's own free flight needs (`Engine::own_flight`); `None` if not flown.
     flight: Option<Flight>,
+    /// A made die (`model::mass`): the body is its principal frame at its centre of mass, the
+    /// collider off it.
+    made: bool,
+    /// A made die's principal frame in body axes, when it is not the body axes.
+    principal: Option<UnitQuaternion<f64>>,
+    /// A made die's mass properties, about the body's frame.
+    mass_props: MassProperties,
 }
 
 /// The die's free flight, flown here exactly as Rapier steps it (see `fly`), and what Rapier's
@@ -212,9 +220,30 @@ impl Rapier3d {
         );
 
         let [bx, by, bz] = scene.body_sides();
-        let die_collider = multiply(
+        let made = !scene.features.plain();
+        let mp = MassProps::of(scene)?;
+        let die_collider = if made {
+            // The solid in body axes, centred; the body in its principal frame P at the centre
+            // of mass c: the solid sits at Pᵀ(−c), turned by Pᵀ, and weighs nothing itself (the
+            // body carries the exact mass properties).
+            let r = scene.features.edge_radius;
+            let (hx, hy, hz) = (0.5 * bx, 0.5 * by, 0.5 * bz);
+            let solid = if r > 0.0 {
+                ColliderBuilder::round_cuboid(hx - r, hy - r, hz - r, r)
+            } else {
+                ColliderBuilder::cuboid(hx, hy, hz)
+            };
+            let p = mp.principal.quaternion();
+            let turn = Rotation::from_xyzw(p.i, p.j, p.k, p.w).inverse();
+            solid
+                .position(Pose::from_parts(turn * -from_na(&mp.com), turn))
+                .density(0.0)
+        } else {
             ColliderBuilder::cuboid(0.5 * bx, 0.5 * by, 0.5 * bz)
                 .mass_properties(box_mass_properties(scene.mass(), [bx, by, bz]))
+        };
+        let die_collider = multiply(
+            die_collider
                 .friction(scene.friction)
                 .restitution(scene.restitution),
         );
@@ -236,7 +265,20 @@ impl Rapier3d {
             damping: scene.rapier_damping(),
             can_sleep: scene.sleeping,
             flight: None,
+            made,
+            principal: (!mp.aligned()).then_some(mp.principal),
+            mass_props: MassProperties::new(Vector::ZERO, mp.mass, from_na(&mp.moments)),
         })
+    }
+
+    /// The body's orientation from the die's (turned by the principal frame if need be).
+    fn body_rotation(&self, q: &UnitQuaternion<f64>) -> Rotation {
+        let r = match &self.principal {
+            Some(p) => q * p,
+            None => *q,
+        };
+        let q = r.quaternion();
+        Rotation::from_xyzw(q.i, q.j, q.k, q.w)
     }
 
     /// Sets up the die's own flight after a reset: its constants from the body as Rapier
@@ -340,12 +382,11 @@ impl Engine for Rapier3d {
         if let Some(h) = self.die.take() {
             self.world.remove_body(h);
         }
-        let q = start.rotation.quaternion();
         let pose = Pose::from_parts(
             from_na(&start.position),
-            Rotation::from_xyzw(q.i, q.j, q.k, q.w),
+            self.body_rotation(&start.rotation),
         );
-        let body = RigidBodyBuilder::dynamic()
+        let mut body = RigidBodyBuilder::dynamic()
             .pose(pose)
             .linvel(from_na(&start.linear_velocity))
             .angvel(from_na(&start.angular_velocity))
@@ -353,9 +394,23 @@ impl Engine for Rapier3d {
             .linear_damping(self.damping.0)
             .angular_damping(self.damping.1)
             .can_sleep(self.can_sleep);
+        if self.made {
+            body = body.additional_mass_properties(self.mass_props);
+        }
         let (h, _) = self.world.insert(body, self.die_collider.clone());
+        if self.made {
+            // Rapier sums a body's mass properties at its next step; the flight below reads
+            // them now.
+            let w = &mut self.world;
+            w.bodies[h].recompute_mass_properties_from_colliders(&w.colliders);
+        }
         self.die = Some(h);
-        self.flight = self.flight_of(h);
+        // The own flight flies the body's frame; it is the die's axes unless turned.
+        self.flight = if self.principal.is_some() {
+            None
+        } else {
+            self.flight_of(h)
+        };
         Ok(())
     }
 
@@ -443,10 +498,14 @@ impl Engine for Rapier3d {
         };
         let b = &self.world.bodies[h];
         let q = b.rotation();
+        // Rapier renormalises the quaternion after every integration; take it as it is.
+        let body = UnitQuaternion::new_unchecked(Quaternion::new(q.w, q.x, q.y, q.z));
         BodyState {
             position: to_na(b.translation()),
-            // Rapier renormalises the quaternion after every integration; take it as it is.
-            rotation: UnitQuaternion::new_unchecked(Quaternion::new(q.w, q.x, q.y, q.z)),
+            rotation: match &self.principal {
+                Some(p) => body * p.inverse(),
+                None => body,
+            },
             linear_velocity: to_na(b.linvel()),
             angular_velocity: to_na(b.angvel()),
             sleeping: b.is_sleeping(),

@@ -6,6 +6,7 @@ pub mod block;
 pub mod die;
 pub mod faces;
 pub mod glibc;
+pub mod mass;
 pub mod scene;
 pub mod state;
 pub mod throws;

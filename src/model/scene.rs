@@ -3,6 +3,7 @@
 
 use crate::error::{Error, Result};
 use crate::model::block::Block;
+use crate::model::mass::{Features, MassProps};
 use serde::{Deserialize, Serialize};
 
 /// Gravity, m/s², along −y.
@@ -147,6 +148,10 @@ pub struct Scene {
     /// which sleeping would freeze mid-fall). Written into a specification only when false.
     #[serde(default = "yes", skip_serializing_if = "is_true")]
     pub sleeping: bool,
+    /// How the die departs from the ideal block: its centre of mass, pips, rounded edges
+    /// (`model::mass`). Written into a specification only when it does.
+    #[serde(default, skip_serializing_if = "Features::plain")]
+    pub features: Features,
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -244,6 +249,7 @@ impl Scene {
                 );
             }
         }
+        MassProps::of(self)?;
         Ok(())
     }
 
@@ -265,6 +271,7 @@ impl Scene {
             linear_damping: 0.0,
             angular_damping: 0.0,
             sleeping: true,
+            features: Features::default(),
         }
     }
 

@@ -243,8 +243,6 @@ impl Throw {
                 ..paper
             },
             (ThrowStyle::Rest, _) => {
-                let [a, b, c] = scene.body_sides();
-                let half = Vector3::new(a, b, c) / 2.0;
                 let at_zero = BodyState {
                     position: Vector3::zeros(),
                     rotation,
@@ -252,8 +250,9 @@ impl Throw {
                     angular_velocity: Vector3::zeros(),
                     sleeping: false,
                 };
-                // In 2D the rotation is about z only, so the 1 m depth adds nothing here.
-                let touching = -crate::model::die::lowest_point(&half, &at_zero);
+                // In 2D the rotation is about z only, so the 1 m depth adds nothing here. The
+                // position is the centre of mass's (`DieShape::lowest_point`).
+                let touching = -crate::model::die::DieShape::of(scene).lowest_point(&at_zero);
                 BodyState {
                     position: Vector3::new(0.0, touching, 0.0),
                     ..at_zero

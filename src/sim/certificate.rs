@@ -4,7 +4,6 @@
 use crate::model::block::Outcome;
 use crate::model::die::{up_in_body, DieShape};
 use crate::model::state::BodyState;
-use nalgebra::Vector3;
 
 /// The paper's "static" states made exact: once the die's mechanical energy is below the
 /// lowest barrier out of the face region it is in, its outcome can no longer change.
@@ -32,33 +31,31 @@ pub struct Certificate {
 }
 const SIDES: [Outcome; 3] = [Outcome::Breadth, Outcome::Width, Outcome::Length];
 
-/// The face region the die is in, given the world's up direction in body axes: the axis i
-/// whose face the downward ray from the centre leaves through, |gᵢ|/sᵢ largest (in 2D, x or y).
-pub fn face_region(die: &DieShape, up: &Vector3<f64>) -> usize {
-    let n = if die.planar { 2 } else { 3 };
-    (0..n)
-        .max_by(|&p, &q| (up[p].abs() / die.half[p]).total_cmp(&(up[q].abs() / die.half[q])))
-        .unwrap_or(0)
-}
-
 impl Certificate {
     /// The height E/(mg) must be below for the certificate to hold in any face region: the
-    /// largest over regions i of rest height + (1 − margin) × (barrier − rest height). A state
+    /// largest over faces of rest height + (1 − margin) × (barrier − rest height). A state
     /// whose energy is above it (`DieShape::energy_height_at_least`) is never certain, so
     /// the check can be skipped there (`flight::Flight::jump`).
     pub fn energy_ceiling(&self, die: &DieShape) -> f64 {
         let n = if die.planar { 2 } else { 3 };
         (0..n)
-            .map(|i| die.half[i] + (1.0 - self.margin) * (die.barrier[i] - die.half[i]))
+            .flat_map(|i| [(i, 0), (i, 1)])
+            .map(|(i, k)| {
+                let rest = die.rest[i][k];
+                rest + (1.0 - self.margin) * (die.barrier[i][k] - rest)
+            })
             .fold(f64::NEG_INFINITY, f64::max)
     }
 
     /// The outcome, if it is already certain.
     pub fn certain(&self, die: &DieShape, s: &BodyState) -> Option<Outcome> {
         let up = up_in_body(&s.rotation);
-        let i = face_region(die, &up);
-        let rest = die.half[i];
-        let allowed = (1.0 - self.margin) * (die.barrier[i] - rest);
+        let (i, k) = die.face_region(&up);
+        let rest = die.rest[i][k];
+        let allowed = (1.0 - self.margin) * (die.barrier[i][k] - rest);
+        if !(allowed > 0.0) {
+            return None;
+        }
         // The height plus the translational energy's worth of height is a lower bound of E/mg:
         // most states fail on it without the rotational energy being computed.
         // A die that has sunk into the floor (a corner or more, at a coarse step) holds less
@@ -66,7 +63,7 @@ impl Certificate {
         // the height it will be pushed back to, its lowest point on the floor's top face.
         // Without this the certificate fired on dips and was wrong on up to 3 % of rolls at
         // dt = 1/60 (docs/results/coarse-steps.md).
-        let sunk = (-(s.position.y - up.abs().dot(&die.half))).max(0.0);
+        let sunk = (-die.lowest_point(s)).max(0.0);
         let g = die.gravity;
         if s.position.y + sunk + 0.5 * s.linear_velocity.norm_squared() / g - rest >= allowed {
             return None;

@@ -24,6 +24,7 @@
 //! (`Engine::own_flight`; `engine::rapier3d::Flight` says when a Rapier step is pure flight),
 //! and the roll walks and jumps it as it does this one (`roll::jump_own`).
 
+use crate::model::die::{up_in_body, DieShape};
 use crate::model::scene::{Floor, Scene};
 use crate::model::state::BodyState;
 use crate::sim::rest::{RestDetector, REST_WINDOW};
@@ -54,6 +55,13 @@ pub struct Flight {
     pub gravity: f64,
     /// Half the sides along body x, y, z, m.
     pub half: Vector3<f64>,
+    /// The die's shape below its centre of mass, as `DieShape` has it: its inner box (for the
+    /// plain block, `half`)...
+    pub core: Vector3<f64>,
+    /// ... its rounding radius (0)...
+    pub radius: f64,
+    /// ... and its centre of mass from its centre (0).
+    pub com: Vector3<f64>,
     /// How far above the floor the die's lowest point must be for a step to be pure flight
     /// (`CLEAR` or `CLEAR_OF_PLANE`).
     pub clear: f64,
@@ -63,23 +71,30 @@ impl Flight {
     /// The flight of a scene's die: its time step, gravity, half sides, and the clearance its
     /// floor needs.
     pub fn of(scene: &Scene) -> Flight {
-        let [a, b, c] = scene.body_sides();
+        let die = DieShape::of(scene);
         Flight {
             dt: scene.dt,
             gravity: scene.gravity,
             // In 2D the box is 1 m deep but turns about z only, so its reach below the
             // centre comes from x and y alone; the support function below handles both.
-            half: Vector3::new(a, b, c) / 2.0,
+            half: die.half,
+            core: die.core,
+            radius: die.radius,
+            com: die.com,
+            // A rounded die meets the floor through Bullet's convex test (GJK), which, as
+            // the plane's, reports points up to the breaking threshold away.
             clear: match scene.floor {
-                Floor::Box => CLEAR,
-                Floor::Plane => CLEAR_OF_PLANE,
+                Floor::Box if die.radius == 0.0 => CLEAR,
+                _ => CLEAR_OF_PLANE,
             },
         }
     }
 
-    /// Height of the die's lowest point above the floor: y − Σ hᵢ |(Rᵀ ŷ)ᵢ|.
+    /// Height of the die's lowest point above the floor: y − Σ hᵢ |(Rᵀ ŷ)ᵢ| for the centred
+    /// sharp block (`DieShape::lowest_point`).
     pub fn lowest_point(&self, s: &BodyState) -> f64 {
-        crate::model::die::lowest_point(&self.half, s)
+        let up = up_in_body(&s.rotation);
+        s.position.y - (up.abs().dot(&self.core) + self.radius) - self.com.dot(&up)
     }
 
     /// True if a flight may start from `s`, the state after the engine's last step: the die
@@ -154,11 +169,13 @@ impl Flight {
         // half diagonal. With room for rounding.
         let (q, d) = (s.rotation.quaternion(), dq.quaternion());
         let planar = q.i == 0.0 && q.j == 0.0 && d.i == 0.0 && d.j == 0.0;
-        let reach = if planar {
-            self.half.x.hypot(self.half.y)
+        let reach = (if planar {
+            self.core.x.hypot(self.core.y)
         } else {
-            self.half.norm()
-        } * (1.0 + 1e-9);
+            self.core.norm()
+        } + self.radius
+            + self.com.norm())
+            * (1.0 + 1e-9);
         // Flight changes only the vertical velocity (x, z and ω are copied), so the last
         // states' velocities are kept as that one number.
         let mut vy = [0.0; REST_WINDOW];

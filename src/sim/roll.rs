@@ -269,7 +269,7 @@ impl Dip {
 
     /// Records one step's state.
     pub fn push(&mut self, die: &DieShape, s: &BodyState) {
-        let depth = -crate::model::die::lowest_point(&die.half, s);
+        let depth = -die.lowest_point(s);
         // max() keeps the old value if depth is NaN (a non-finite state fails in `check`).
         self.penetration = self.penetration.max(depth);
         if s.position.y < 0.0 {
@@ -298,7 +298,7 @@ impl Dip {
     /// docs/results/coarse-steps.md).
     /// A die at rest with its centre below the top face is a failure too (`run_from`).
     pub fn through(&self, die: &DieShape, s: &BodyState, floor_bottom: f64) -> bool {
-        let reach = s.position.y - crate::model::die::lowest_point(&die.half, s);
+        let reach = s.position.y - die.lowest_point(s);
         s.position.y + reach < floor_bottom || self.run > MAX_DIP_STEPS
     }
 }

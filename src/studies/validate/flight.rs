@@ -112,7 +112,7 @@ pub fn fly_until(
     let trans = |s: &BodyState| die.energy(s) - rot(s);
     let momentum = |s: &BodyState| {
         let wb = s.rotation.inverse_transform_vector(&s.angular_velocity);
-        s.rotation * die.inertia.component_mul(&wb)
+        s.rotation * (die.inertia * wb)
     };
     let (e0, r0, l0) = (trans(&s0), rot(&s0), momentum(&s0));
     let substeps = match integrator {

@@ -152,10 +152,7 @@ pub fn measure_limit(spec: &RunSpec, study: &Study) -> Result<LimitCell> {
 pub fn start_face(scene: &Scene, s: &crate::model::state::BodyState) -> Outcome {
     let die = crate::model::die::DieShape::of(scene);
     let up = crate::model::die::up_in_body(&s.rotation);
-    let n = if scene.mode == Mode::TwoD { 2 } else { 3 };
-    let i = (0..n)
-        .max_by(|&p, &q| (up[p].abs() / die.half[p]).total_cmp(&(up[q].abs() / die.half[q])))
-        .unwrap_or(0);
+    let (i, _) = die.face_region(&up);
     [Outcome::Breadth, Outcome::Width, Outcome::Length][i]
 }
 

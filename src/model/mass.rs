@@ -1,0 +1,805 @@
+//! The die as it is made: a centre of mass moved off the centre, drilled pips, rounded edges
+//! (`Features`), and the mass properties of the solid that results (`MassProps`): its mass,
+//! centre of mass and inertia tensor, computed exactly.
+//!
+//! Every part is a box, a slab, a quarter cylinder, an eighth of a sphere, a spherical cap or a
+//! cylinder, whose mass and first and second moments are closed forms (the cavities' are
+//! polynomials of degree 4 along their axis, integrated exactly by 3-point Gauss–Legendre,
+//! which avoids the cancellation of the antiderivatives for shallow pips). The parts add up
+//! as moments about the geometric centre; the tensor about the centre of mass follows from
+//! the parallel-axis theorem, and its eigenvectors are the body's principal frame.
+
+use crate::error::{Error, Result};
+use crate::model::faces::Layout;
+use crate::model::scene::{Mode, Scene};
+use nalgebra::{Matrix3, Rotation3, SymmetricEigen, UnitQuaternion, Vector3};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// How the die departs from the paper's ideal block: uniform, sharp, plain. Each is off by
+/// default, and a die with none of them is rolled on exactly the paper's path.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Features {
+    /// The centre of mass, given outright: its offset from the geometric centre, m, in body
+    /// axes (x breadth, y width, z length). The second moments about the geometric centre
+    /// stay the solid's (a weight hidden inside moves the centre; what it does to the
+    /// inertia is the die file's business). `None`: the solid's own.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub com: Option<[f64; 3]>,
+    /// Pips drilled in the standard pattern, one to six on the faces the layout numbers.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pips: Option<Pips>,
+    /// Edges and corners rounded with this radius, m (0: sharp).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub edge_radius: f64,
+    /// Which number is on which face (it decides where the pips are): `roll --layout`.
+    #[serde(default, skip_serializing_if = "is_right")]
+    pub layout: Layout,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
+fn is_right(l: &Layout) -> bool {
+    *l == Layout::Right
+}
+
+/// The shape of a pip's cavity.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PipShape {
+    /// A spherical cap: the drill's round end (depth at most half the diameter).
+    #[default]
+    Cap,
+    /// A flat-bottomed cylinder.
+    Cylinder,
+}
+
+/// Drilled pips. They change the mass, not the collision surface: a pip is narrower than
+/// anything the floor could reach into.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Pips {
+    /// The pip's diameter on the face, m.
+    pub diameter: f64,
+    /// Its depth, m.
+    pub depth: f64,
+    /// Cap or cylinder.
+    #[serde(default)]
+    pub shape: PipShape,
+    /// The paint filling the pips, kg/m³ (0: empty).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub fill_density: f64,
+    /// The off-centre pips sit this fraction of the face's side from its centre along each
+    /// face axis (standard dice: about a quarter).
+    #[serde(default = "quarter")]
+    pub spacing: f64,
+}
+
+fn quarter() -> f64 {
+    0.25
+}
+
+/// The pips on a face carrying `n`, in units of the spacing along the face's two axes.
+pub fn pattern(n: u8) -> &'static [(f64, f64)] {
+    match n {
+        1 => &[(0.0, 0.0)],
+        2 => &[(1.0, 1.0), (-1.0, -1.0)],
+        3 => &[(1.0, 1.0), (0.0, 0.0), (-1.0, -1.0)],
+        4 => &[(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)],
+        5 => &[
+            (1.0, 1.0),
+            (1.0, -1.0),
+            (0.0, 0.0),
+            (-1.0, 1.0),
+            (-1.0, -1.0),
+        ],
+        _ => &[
+            (1.0, -1.0),
+            (1.0, 0.0),
+            (1.0, 1.0),
+            (-1.0, -1.0),
+            (-1.0, 0.0),
+            (-1.0, 1.0),
+        ],
+    }
+}
+
+/// The solid's mass properties.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MassProps {
+    /// kg.
+    pub mass: f64,
+    /// The centre of mass in body axes from the geometric centre, m.
+    pub com: Vector3<f64>,
+    /// The inertia tensor about the centre of mass, body axes, kg m².
+    pub inertia: Matrix3<f64>,
+    /// The principal frame in body axes: a body vector is `principal` × its principal
+    /// coordinates. The identity when the tensor is diagonal in body axes.
+    pub principal: UnitQuaternion<f64>,
+    /// The principal moments, in the principal frame's axes.
+    pub moments: Vector3<f64>,
+}
+
+impl MassProps {
+    /// True if the principal frame is the body's own axes (no rotation between them).
+    pub fn aligned(&self) -> bool {
+        self.principal == UnitQuaternion::identity()
+    }
+}
+
+/// Moments of a part about the geometric centre: its mass, Σ m r, and Σ m r rᵀ.
+#[derive(Clone, Copy, Debug)]
+struct Moments {
+    mass: f64,
+    first: Vector3<f64>,
+    second: Matrix3<f64>,
+}
+
+impl Moments {
+    fn add(&mut self, w: f64, o: &Moments) {
+        self.mass += w * o.mass;
+        self.first += w * o.first;
+        self.second += w * o.second;
+    }
+}
+
+/// ∫ x² dx over [−b, b].
+fn line2(b: f64) -> f64 {
+    2.0 * b * b * b / 3.0
+}
+
+/// The volume and ∫ xᵢ² dV of a box with half sides `a` whose edges are rounded with radius
+/// `r` (the inner box of half sides a − r swept by a ball of radius r), taken apart into the
+/// inner box, six slabs, twelve quarter cylinders and eight eighths of a ball.
+pub fn rounded_box(a: &Vector3<f64>, r: f64) -> (f64, Vector3<f64>) {
+    let b = a.map(|x| x - r);
+    let volume = 8.0 * b.x * b.y * b.z
+        + 8.0 * r * (b.y * b.z + b.x * b.z + b.x * b.y)
+        + 2.0 * PI * r * r * (b.x + b.y + b.z)
+        + 4.0 * PI * r * r * r / 3.0;
+    // ∫ (b + u)² dA over a quarter disc of radius r in u, v ≥ 0: πr²/4 b² + 2b r³/3 + πr⁴/16.
+    let quarter_disc =
+        |b: f64| PI * r * r / 4.0 * b * b + 2.0 * b * r * r * r / 3.0 + PI * r.powi(4) / 16.0;
+    // ∫ (b + u)² dV over an eighth of a ball: πr³/6 b² + 2b πr⁴/16 + πr⁵/30.
+    let eighth_ball =
+        |b: f64| PI * r.powi(3) / 6.0 * b * b + b * PI * r.powi(4) / 8.0 + PI * r.powi(5) / 30.0;
+    let second = Vector3::from_fn(|i, _| {
+        let (bi, bj, bk) = (b[i], b[(i + 1) % 3], b[(i + 2) % 3]);
+        line2(bi) * 4.0 * bj * bk
+            + 2.0 * ((bi + r).powi(3) - bi.powi(3)) / 3.0 * 4.0 * bj * bk
+            + 2.0 * line2(bi) * r * 2.0 * (bj + bk)
+            + 4.0 * line2(bi) * PI * r * r / 4.0
+            + 4.0 * 2.0 * (bj + bk) * quarter_disc(bi)
+            + 8.0 * eighth_ball(bi)
+    });
+    (volume, second)
+}
+
+/// A pip's cavity along its axis z (0 at the face, inward): volume, ∫z dV, ∫z² dV and
+/// ∫u² dV for either transverse axis u. The slice at depth z is a disc of radius s(z):
+/// for a cap of a ball of radius ρ whose rim is the pip's circle, s² = ρ² − (z + ρ − h)².
+/// Each integrand is a polynomial of degree at most 4 in z, so 3-point Gauss–Legendre is exact.
+pub fn cavity(p: &Pips) -> [f64; 4] {
+    let (h, half_d) = (p.depth, 0.5 * p.diameter);
+    let rho = (half_d * half_d + h * h) / (2.0 * h);
+    let s2 = |z: f64| match p.shape {
+        PipShape::Cap => {
+            // ρ² − (z + ρ − h)² = (h − z)(2ρ − h + z): no cancellation near the rim.
+            (h - z) * (2.0 * rho - h + z)
+        }
+        PipShape::Cylinder => half_d * half_d,
+    };
+    let nodes = [-(0.6f64).sqrt(), 0.0, (0.6f64).sqrt()];
+    let weights = [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0];
+    let mut out = [0.0; 4];
+    for (x, w) in nodes.iter().zip(weights) {
+        let z = 0.5 * h * (1.0 + x);
+        let s = s2(z);
+        let dv = PI * s * w * 0.5 * h;
+        out[0] += dv;
+        out[1] += z * dv;
+        out[2] += z * z * dv;
+        out[3] += 0.25 * s * dv;
+    }
+    out
+}
+
+/// Every pip's place: its face's axis i, the face's sign (+1, −1), and its centre's
+/// coordinates along the face's other two axes j = i+1, k = i+2 (mod 3), m.
+pub fn pip_places(half: &Vector3<f64>, p: &Pips, layout: Layout) -> Vec<(usize, f64, f64, f64)> {
+    let numbers = layout.numbers();
+    let mut out = Vec::new();
+    for (d, &n) in numbers.iter().enumerate() {
+        let (i, sign) = (d / 2, if d % 2 == 0 { 1.0 } else { -1.0 });
+        let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+        for &(u, v) in pattern(n) {
+            out.push((
+                i,
+                sign,
+                u * p.spacing * 2.0 * half[j],
+                v * p.spacing * 2.0 * half[k],
+            ));
+        }
+    }
+    out
+}
+
+/// The moments of one pip's cavity (unit density) about the geometric centre.
+fn pip_moments(
+    half: &Vector3<f64>,
+    c: &[f64; 4],
+    (i, sign, pj, pk): (usize, f64, f64, f64),
+) -> Moments {
+    let [v, z1, z2, u2] = *c;
+    let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+    // A point of the cavity: xᵢ = sign (hᵢ − z), xⱼ = pⱼ + u, xₖ = pₖ + w.
+    let hi = half[i];
+    let mut first = Vector3::zeros();
+    first[i] = sign * (hi * v - z1);
+    first[j] = pj * v;
+    first[k] = pk * v;
+    let mut second = Matrix3::zeros();
+    second[(i, i)] = hi * hi * v - 2.0 * hi * z1 + z2;
+    second[(j, j)] = pj * pj * v + u2;
+    second[(k, k)] = pk * pk * v + u2;
+    second[(j, k)] = pj * pk * v;
+    second[(i, j)] = pj * first[i];
+    second[(i, k)] = pk * first[i];
+    for (a, b) in [(i, j), (i, k), (j, k)] {
+        second[(b, a)] = second[(a, b)];
+    }
+    Moments {
+        mass: v,
+        first,
+        second,
+    }
+}
+
+/// A die file (TOML), every length in mm, every key optional:
+///
+/// ```toml
+/// com = [0.0, 0.0, -2.0]   # the centre of mass from the geometric centre, body axes
+/// edge_radius = 1.0        # edges and corners rounded
+/// density = 1180.0         # kg/m³ (the solid's)
+/// [pips]
+/// diameter = 3.0
+/// depth = 1.0
+/// shape = "cap"            # or "cylinder"
+/// fill_density = 1400.0    # paint, kg/m³ (0: empty)
+/// spacing = 0.25           # off-centre pips' distance from the face's centre / its side
+/// ```
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DieFile {
+    /// mm.
+    pub com: Option<[f64; 3]>,
+    /// mm.
+    pub edge_radius: Option<f64>,
+    /// kg/m³.
+    pub density: Option<f64>,
+    /// Pips, in mm.
+    pub pips: Option<Pips>,
+}
+
+impl DieFile {
+    /// Reads and parses a die file: a key it does not know, a value of the wrong kind, or a
+    /// file that is not TOML is one line naming it.
+    pub fn read(path: &std::path::Path) -> Result<DieFile> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
+            path: path.into(),
+            source: e,
+        })?;
+        toml::from_str(&text).map_err(|e| {
+            let line = e
+                .span()
+                .map(|s| format!(" (line {})", text[..s.start].matches('\n').count() + 1))
+                .unwrap_or_default();
+            Error::Invalid(format!(
+                "die file {}{line}: {}",
+                path.display(),
+                e.message().trim()
+            ))
+        })
+    }
+
+    /// The features it describes, lengths in metres.
+    pub fn features(&self) -> Features {
+        Features {
+            com: self.com.map(|c| c.map(|x| x / 1000.0)),
+            pips: self.pips.as_ref().map(|p| Pips {
+                diameter: p.diameter / 1000.0,
+                depth: p.depth / 1000.0,
+                ..p.clone()
+            }),
+            edge_radius: self.edge_radius.unwrap_or(0.0) / 1000.0,
+            layout: Layout::Right,
+        }
+    }
+}
+
+impl Features {
+    /// True if the die is the paper's ideal block.
+    pub fn plain(&self) -> bool {
+        self.com.is_none() && self.pips.is_none() && self.edge_radius == 0.0
+    }
+
+    /// Checks the features against the die's half sides: one line naming the field.
+    pub fn validate(&self, half: &Vector3<f64>, mode: Mode) -> Result<()> {
+        if self.plain() {
+            return Ok(());
+        }
+        if mode == Mode::TwoD {
+            return Err(Error::Invalid(
+                "a centre of mass off the centre, pips and rounded edges are modelled in 3D only \
+                 (2D is the paper's ideal block): add --mode 3d"
+                    .into(),
+            ));
+        }
+        let mm = |v: f64| format!("{}", (v * 1e9).round() / 1e6);
+        let min_half = half.min();
+        let r = self.edge_radius;
+        if !(r.is_finite() && r >= 0.0 && r < min_half) {
+            return Err(Error::field(
+                "edge_radius",
+                mm(r),
+                format!(
+                    "must be at least 0 and under half the shortest side ({} mm)",
+                    mm(min_half)
+                ),
+            ));
+        }
+        if let Some(c) = self.com {
+            let c = Vector3::from(c);
+            // Inside the rounded box: within r of the inner box of half sides h − r.
+            let out = (c.abs() - half.map(|h| h - r)).map(|x| x.max(0.0)).norm();
+            let inside = if r > 0.0 {
+                out < r
+            } else {
+                (c.abs() - half).max() < 0.0
+            };
+            if !(c.iter().all(|x| x.is_finite()) && inside) {
+                return Err(Error::field(
+                    "com",
+                    format!("{},{},{}", mm(c.x), mm(c.y), mm(c.z)),
+                    "must lie inside the die (mm from its centre, body axes)",
+                ));
+            }
+        }
+        if let Some(p) = &self.pips {
+            let bad =
+                |field: &'static str, v: f64, why: String| Err(Error::field(field, mm(v), why));
+            if !(p.diameter.is_finite() && p.diameter > 0.0) {
+                return bad(
+                    "pips.diameter",
+                    p.diameter,
+                    "must be a positive number of mm".into(),
+                );
+            }
+            let deepest = match p.shape {
+                PipShape::Cap => 0.5 * p.diameter,
+                PipShape::Cylinder => min_half,
+            };
+            if !(p.depth.is_finite() && p.depth > 0.0 && p.depth <= deepest && p.depth < min_half) {
+                return bad(
+                    "pips.depth",
+                    p.depth,
+                    format!(
+                        "must be positive, at most {} mm ({})",
+                        mm(deepest.min(min_half)),
+                        match p.shape {
+                            PipShape::Cap => "a cap is at most a hemisphere",
+                            PipShape::Cylinder => "under half the shortest side",
+                        }
+                    ),
+                );
+            }
+            if !(p.fill_density.is_finite() && (0.0..=1e5).contains(&p.fill_density)) {
+                return Err(Error::field(
+                    "pips.fill_density",
+                    p.fill_density,
+                    "must be in [0, 100000] kg/m³",
+                ));
+            }
+            if !(p.spacing.is_finite() && p.spacing > 0.0 && p.spacing < 0.5) {
+                return Err(Error::field(
+                    "pips.spacing",
+                    p.spacing,
+                    "must be in (0, 0.5): a fraction of the face's side",
+                ));
+            }
+            let places = pip_places(half, p, self.layout);
+            let rad = 0.5 * p.diameter;
+            for &(i, _, pj, pk) in &places {
+                let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+                if pj.abs() + rad > half[j] - r || pk.abs() + rad > half[k] - r {
+                    return bad(
+                        "pips.diameter",
+                        p.diameter,
+                        "pips cross an edge of their face (or its rounding): smaller pips or a smaller spacing".into(),
+                    );
+                }
+            }
+            for (n, a) in places.iter().enumerate() {
+                for b in &places[n + 1..] {
+                    if a.0 == b.0 && a.1 == b.1 && (a.2 - b.2).hypot(a.3 - b.3) <= p.diameter {
+                        return bad(
+                            "pips.diameter",
+                            p.diameter,
+                            "pips on a face overlap each other: smaller pips or a larger spacing"
+                                .into(),
+                        );
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl MassProps {
+    /// The mass properties of the scene's die: a solid of its density, rounded with
+    /// `edge_radius`, less its pips (plus their fill), with its centre of mass where
+    /// `com` puts it if given. The plain block's are the closed forms the engines use.
+    pub fn of(scene: &Scene) -> Result<MassProps> {
+        let [a, b, c] = scene.body_sides();
+        scene
+            .features
+            .validate(&(Vector3::new(a, b, c) / 2.0), scene.mode)?;
+        let m = MassProps::compute(scene);
+        let ok = m.moments.iter().all(|&x| x > 0.0)
+            && (0..3).all(|i| m.moments[i] <= m.moments[(i + 1) % 3] + m.moments[(i + 2) % 3]);
+        if !ok {
+            let c = m.com * 1e3;
+            return Err(Error::field(
+                "com",
+                format!("{},{},{}", c.x, c.y, c.z),
+                "is too far from the centre for this die's inertia (no solid has these moments)",
+            ));
+        }
+        Ok(m)
+    }
+
+    /// `of` for a scene already checked (`Scene::validate` calls `of`).
+    pub fn compute(scene: &Scene) -> MassProps {
+        let f = &scene.features;
+        let [a, b, c] = scene.body_sides();
+        let half = Vector3::new(a, b, c) / 2.0;
+        let rho = scene.density;
+        if f.plain() {
+            let m = scene.mass();
+            let inertia = Vector3::new(b * b + c * c, a * a + c * c, a * a + b * b) * (m / 12.0);
+            return MassProps {
+                mass: m,
+                com: Vector3::zeros(),
+                inertia: Matrix3::from_diagonal(&inertia),
+                principal: UnitQuaternion::identity(),
+                moments: inertia,
+            };
+        }
+        let (volume, second) = rounded_box(&half, f.edge_radius);
+        let mut total = Moments {
+            mass: rho * volume,
+            first: Vector3::zeros(),
+            second: Matrix3::from_diagonal(&(second * rho)),
+        };
+        if let Some(p) = &f.pips {
+            let cav = cavity(p);
+            for place in pip_places(&half, p, f.layout) {
+                total.add(p.fill_density - rho, &pip_moments(&half, &cav, place));
+            }
+        }
+        let m = total.mass;
+        let com = match f.com {
+            Some(c) => Vector3::from(c),
+            None => total.first / m,
+        };
+        // About the centre: I = tr(S) 1 − S; about the centre of mass (parallel axes):
+        // I − m (|c|² 1 − c cᵀ).
+        let s = total.second;
+        let about_centre = Matrix3::identity() * s.trace() - s;
+        let inertia =
+            about_centre - m * (Matrix3::identity() * com.norm_squared() - com * com.transpose());
+        let (principal, moments) = principal_frame(&inertia);
+        MassProps {
+            mass: m,
+            com,
+            inertia,
+            principal,
+            moments,
+        }
+    }
+}
+
+/// The principal frame and moments of a symmetric tensor: the identity and its diagonal
+/// when it is diagonal already (so that an aligned die keeps its body axes exactly), else its
+/// eigenvectors made a right-handed rotation.
+fn principal_frame(t: &Matrix3<f64>) -> (UnitQuaternion<f64>, Vector3<f64>) {
+    let off = t[(0, 1)].abs() + t[(0, 2)].abs() + t[(1, 2)].abs();
+    if off == 0.0 {
+        return (UnitQuaternion::identity(), t.diagonal());
+    }
+    let e = SymmetricEigen::new(*t);
+    let mut v = e.eigenvectors;
+    if v.determinant() < 0.0 {
+        v.column_mut(2).neg_mut();
+    }
+    let r = Rotation3::from_matrix_unchecked(v);
+    (UnitQuaternion::from_rotation_matrix(&r), e.eigenvalues)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::block::Block;
+
+    fn cube_scene(side_mm: f64) -> Scene {
+        let b = Block::from_mm(side_mm, side_mm, side_mm).unwrap();
+        Scene::paper(b, Mode::ThreeD)
+    }
+
+    fn rel(a: f64, b: f64) -> f64 {
+        ((a - b) / b).abs()
+    }
+
+    #[test]
+    fn a_rounded_box_is_a_box_at_radius_zero_and_a_ball_at_the_largest() {
+        let a = Vector3::new(0.012, 0.010, 0.07);
+        let (v, s) = rounded_box(&a, 0.0);
+        assert!(rel(v, 8.0 * a.x * a.y * a.z) < 1e-15);
+        for i in 0..3 {
+            // ∫xᵢ² dV = V aᵢ²/3.
+            assert!(rel(s[i], v * a[i] * a[i] / 3.0) < 1e-14);
+        }
+        let r = 0.008;
+        let (v, s) = rounded_box(&Vector3::repeat(r), r);
+        assert!(rel(v, 4.0 * PI * r.powi(3) / 3.0) < 1e-15);
+        for i in 0..3 {
+            assert!(rel(s[i], 4.0 * PI * r.powi(5) / 15.0) < 1e-14);
+        }
+    }
+
+    #[test]
+    fn a_rounded_box_matches_a_fine_quadrature() {
+        // A midpoint sum over a fine grid of the inside test: slow but independent.
+        let a = Vector3::new(0.008, 0.007, 0.006);
+        let r = 0.002;
+        let (v, s) = rounded_box(&a, r);
+        let n = 240;
+        let (mut qv, mut qs) = (0.0, Vector3::zeros());
+        let h = a * 2.0 / n as f64;
+        for ix in 0..n {
+            for iy in 0..n {
+                for iz in 0..n {
+                    let p = Vector3::new(
+                        -a.x + (ix as f64 + 0.5) * h.x,
+                        -a.y + (iy as f64 + 0.5) * h.y,
+                        -a.z + (iz as f64 + 0.5) * h.z,
+                    );
+                    let out = (p.abs() - a.map(|x| x - r)).map(|x| x.max(0.0)).norm();
+                    if out <= r {
+                        let dv = h.x * h.y * h.z;
+                        qv += dv;
+                        qs += p.component_mul(&p) * dv;
+                    }
+                }
+            }
+        }
+        // The grid resolves the curved boundary to about h/a ≈ 1/n in volume.
+        assert!(rel(qv, v) < 2e-3, "{qv} {v}");
+        for i in 0..3 {
+            assert!(rel(qs[i], s[i]) < 3e-3, "{i}");
+        }
+    }
+
+    #[test]
+    fn a_caps_moments_are_the_textbook_ones() {
+        for (d, h) in [
+            (0.003, 0.0015),
+            (0.003, 0.0005),
+            (0.002, 0.00001),
+            (0.004, 0.001),
+        ] {
+            let p = Pips {
+                diameter: d,
+                depth: h,
+                shape: PipShape::Cap,
+                fill_density: 0.0,
+                spacing: 0.25,
+            };
+            let [v, z1, z2, u2] = cavity(&p);
+            let rho = ((d / 2.0) * (d / 2.0) + h * h) / (2.0 * h);
+            // V = πh²(3ρ − h)/3; centroid 3(2ρ − h)²/(4(3ρ − h)) from the ball's centre.
+            let want_v = PI * h * h * (3.0 * rho - h) / 3.0;
+            assert!(rel(v, want_v) < 1e-12, "{d} {h}");
+            let from_centre = 3.0 * (2.0 * rho - h).powi(2) / (4.0 * (3.0 * rho - h));
+            // z is measured inward from the face, which is ρ − h from the ball's centre.
+            assert!(rel(z1 / v, from_centre - (rho - h)) < 1e-9, "{d} {h}");
+            let _ = (z2, u2);
+        }
+        // A hemisphere: about the centre of its flat face, ∫(u² + w²) dV = (2/5) V ρ² (half a
+        // ball's), and ∫z² dV = ∫u² dV = V ρ²/5.
+        let r = 0.0015;
+        let p = Pips {
+            diameter: 2.0 * r,
+            depth: r,
+            shape: PipShape::Cap,
+            fill_density: 0.0,
+            spacing: 0.25,
+        };
+        let [v, _, z2, u2] = cavity(&p);
+        assert!(rel(v, 2.0 * PI * r.powi(3) / 3.0) < 1e-14);
+        assert!(rel(z2, v * r * r / 5.0) < 1e-13);
+        assert!(rel(u2, v * r * r / 5.0) < 1e-13);
+        // A cylinder: V = π a² h, ∫z dV = V h/2, ∫z² dV = V h²/3, ∫u² dV = V a²/4.
+        let p = Pips {
+            diameter: 0.003,
+            depth: 0.001,
+            shape: PipShape::Cylinder,
+            fill_density: 0.0,
+            spacing: 0.25,
+        };
+        let [v, z1, z2, u2] = cavity(&p);
+        let a = 0.0015;
+        assert!(rel(v, PI * a * a * 0.001) < 1e-14);
+        assert!(rel(z1, v * 0.0005) < 1e-14);
+        assert!(rel(z2, v * 1e-6 / 3.0) < 1e-13);
+        assert!(rel(u2, v * a * a / 4.0) < 1e-13);
+    }
+
+    #[test]
+    fn a_plain_die_has_the_boxes_mass_properties_and_a_moved_centre_the_parallel_axes() {
+        let mut s = cube_scene(16.0);
+        let plain = MassProps::of(&s).unwrap();
+        assert!(plain.aligned() && plain.com == Vector3::zeros());
+        // Rounded with radius 0 by the general path: the same to rounding.
+        s.features.com = Some([0.0, 0.0, 0.0]);
+        let general = MassProps::of(&s).unwrap();
+        assert!(rel(general.mass, plain.mass) < 1e-15);
+        for i in 0..3 {
+            assert!(rel(general.moments[i], plain.moments[i]) < 1e-14);
+        }
+        // A centre 2 mm down z: I_xx and I_yy less m c², I_zz unchanged, axes kept.
+        s.features.com = Some([0.0, 0.0, -0.002]);
+        let moved = MassProps::of(&s).unwrap();
+        assert!(moved.aligned());
+        let m = plain.mass;
+        assert!(rel(moved.moments.x, plain.moments.x - m * 4e-6) < 1e-14);
+        assert!(rel(moved.moments.z, plain.moments.z) < 1e-14);
+    }
+
+    #[test]
+    fn pips_lighten_the_die_by_their_volume_and_move_its_centre_toward_one() {
+        let mut s = cube_scene(16.0);
+        let p = Pips {
+            diameter: 0.003,
+            depth: 0.001,
+            shape: PipShape::Cap,
+            fill_density: 0.0,
+            spacing: 0.25,
+        };
+        s.features.pips = Some(p.clone());
+        let m = MassProps::of(&s).unwrap();
+        let v = cavity(&p)[0];
+        let solid = s.mass();
+        assert!(rel(m.mass, solid - 21.0 * v * s.density) < 1e-14);
+        // Face n has n pips: the centre of mass moves toward the faces with fewer, each axis
+        // by (pips on − face − pips on + face) × V × (h − z̄) / m... in sign: toward 1 (+z),
+        // 2 (+x), 3 (+y), the faces opposite 6, 5, 4.
+        assert!(
+            m.com.x > 0.0 && m.com.y > 0.0 && m.com.z > 0.0,
+            "{:?}",
+            m.com
+        );
+        let [vv, z1, _, _] = cavity(&p);
+        let h = 0.008;
+        // Along z: 1 pip on +z, 6 on −z: Σ m x = −ρ (1·(h V − z̄V) − 6·(h V − z̄V)).
+        let want_z = s.density * 5.0 * (h * vv - z1) / m.mass;
+        assert!(rel(m.com.z, want_z) < 1e-12, "{} {want_z}", m.com.z);
+        // The diagonal pips of 2 and 3 tilt the principal frame off the body axes.
+        assert!(!m.aligned());
+        let back = m.principal.to_rotation_matrix().matrix()
+            * Matrix3::from_diagonal(&m.moments)
+            * m.principal.to_rotation_matrix().matrix().transpose();
+        assert!((back - m.inertia).norm() < 1e-12 * m.inertia.norm());
+        // Filled with the die's own density, nothing is drilled.
+        s.features.pips = Some(Pips {
+            fill_density: s.density,
+            ..p
+        });
+        let full = MassProps::of(&s).unwrap();
+        assert!(rel(full.mass, solid) < 1e-15 && full.com.norm() < 1e-18);
+    }
+
+    #[test]
+    fn bad_dice_are_refused_by_field() {
+        let half = Vector3::repeat(0.008);
+        let field = |f: Features| match f.validate(&half, Mode::ThreeD) {
+            Err(Error::Field { field, .. }) => field,
+            other => panic!("{other:?}"),
+        };
+        let pips = |d: f64, h: f64| {
+            Some(Pips {
+                diameter: d,
+                depth: h,
+                shape: PipShape::Cap,
+                fill_density: 0.0,
+                spacing: 0.25,
+            })
+        };
+        assert_eq!(
+            field(Features {
+                edge_radius: 0.008,
+                ..Default::default()
+            }),
+            "edge_radius"
+        );
+        assert_eq!(
+            field(Features {
+                edge_radius: -1e-3,
+                ..Default::default()
+            }),
+            "edge_radius"
+        );
+        assert_eq!(
+            field(Features {
+                com: Some([0.0, 0.0, 0.009]),
+                ..Default::default()
+            }),
+            "com"
+        );
+        assert_eq!(
+            field(Features {
+                com: Some([0.0, f64::NAN, 0.0]),
+                ..Default::default()
+            }),
+            "com"
+        );
+        // Inside the sharp box's corner but outside the rounded one.
+        assert_eq!(
+            field(Features {
+                com: Some([0.0079, 0.0079, 0.0079]),
+                edge_radius: 0.002,
+                ..Default::default()
+            }),
+            "com"
+        );
+        assert_eq!(
+            field(Features {
+                pips: pips(0.003, 0.002),
+                ..Default::default()
+            }),
+            "pips.depth"
+        );
+        // 5 mm pips 4 mm apart overlap; 7 mm pips at 4 mm from the centre cross the edge.
+        assert_eq!(
+            field(Features {
+                pips: pips(0.0045, 0.001),
+                ..Default::default()
+            }),
+            "pips.diameter"
+        );
+        assert_eq!(
+            field(Features {
+                pips: pips(-1.0, 0.001),
+                ..Default::default()
+            }),
+            "pips.diameter"
+        );
+        assert!(Features {
+            pips: pips(0.003, 0.001),
+            edge_radius: 0.001,
+            ..Default::default()
+        }
+        .validate(&half, Mode::ThreeD)
+        .is_ok());
+        assert!(Features {
+            com: Some([0.0, 0.0, 0.001]),
+            ..Default::default()
+        }
+        .validate(&half, Mode::TwoD)
+        .is_err());
+    }
+}
