@@ -566,6 +566,10 @@ BulletWorld::BulletWorld(const BulletScene& s)
       linear_damping_(s.linear_damping),
       angular_damping_(s.angular_damping) {
   config_ = std::make_unique<btDefaultCollisionConfiguration>();
+  // A rounded die meets the floor through the convex-convex test (GJK), one point per step:
+  // resting on a face it would rock and slide until its manifold held enough. Perturbed
+  // tests give it the whole face's points at once, as the box-box test does the sharp die.
+  if (s.made && s.edge_radius > 0) config_->setConvexConvexMultipointIterations();
   dispatcher_ = std::make_unique<btCollisionDispatcher>(config_.get());
   // Two bodies: the simplest broadphase does (the pair is the same; measured identical).
   broadphase_ = std::make_unique<btSimpleBroadphase>(4);
@@ -622,36 +626,41 @@ BulletWorld::BulletWorld(const BulletScene& s)
     die_shape_ = std::make_unique<btBoxShape>(half);
     return;
   }
-  // A made die: its solid in body axes, centred, and the body in its principal frame at the
-  // centre of mass c, rotated by P from the body axes. The solid sits at Pᵀ(−c), turned by Pᵀ.
+  // A made die: the body is its principal frame at its centre of mass c, turned by P from the
+  // body axes; a point x of the solid in body axes is Pᵀ(x − c) in the body's frame.
   const double r = s.edge_radius;
+  const btQuaternion p(s.principal[0], s.principal[1], s.principal[2], s.principal[3]);
+  const btVector3 c = vec(s.com);
   if (r > 0) {
     // The box swept by a ball of radius r is the convex hull of eight balls of radius r at
-    // the inner box's corners: exactly btMultiSphereShape's shape. Its margin is r, so that
-    // Bullet's shape without margin is the inner box's corners themselves.
+    // the inner box's corners: exactly btMultiSphereShape's shape, whose balls may sit
+    // anywhere, so they are put straight into the body's frame (a compound around it let the
+    // die creep as it came to rest). Its margin is r, so that Bullet's shape without margin
+    // is the inner box's corners themselves.
     const btVector3 core = half - btVector3(r, r, r);
     btVector3 corners[8];
     btScalar radii[8];
     for (int n = 0; n < 8; ++n) {
-      corners[n] = btVector3(n & 1 ? core.x() : -core.x(), n & 2 ? core.y() : -core.y(),
-                             n & 4 ? core.z() : -core.z());
+      const btVector3 x(n & 1 ? core.x() : -core.x(), n & 2 ? core.y() : -core.y(),
+                        n & 4 ? core.z() : -core.z());
+      corners[n] = quatRotate(p.inverse(), x - c);
       radii[n] = r;
     }
     auto hull = std::make_unique<btMultiSphereShape>(corners, radii, 8);
     hull->setMargin(r);
-    die_solid_ = std::move(hull);
-  } else {
-    die_solid_ = std::make_unique<btBoxShape>(half);
-  }
-  if (!s.offset) {
-    // Centred and aligned: the body's frame is the solid's own.
-    die_shape_ = std::move(die_solid_);
+    die_shape_ = std::move(hull);
     return;
   }
-  const btQuaternion p(s.principal[0], s.principal[1], s.principal[2], s.principal[3]);
+  if (!s.offset) {
+    // Centred and aligned: the body's frame is the box's own.
+    die_shape_ = std::make_unique<btBoxShape>(half);
+    return;
+  }
+  // The box as a compound's child, at Pᵀ(−c), turned by Pᵀ.
+  die_solid_ = std::make_unique<btBoxShape>(half);
   btTransform solid_at;
   solid_at.setRotation(p.inverse());
-  solid_at.setOrigin(quatRotate(p.inverse(), -vec(s.com)));
+  solid_at.setOrigin(quatRotate(p.inverse(), -c));
   auto compound = std::make_unique<btCompoundShape>(false, 1);
   compound->addChildShape(solid_at, die_solid_.get());
   die_shape_ = std::move(compound);

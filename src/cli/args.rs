@@ -68,7 +68,7 @@ pub struct SceneArgs {
     #[arg(long, value_name = "D,H", value_parser = parse_pips)]
     pub pips: Option<[f64; 2]>,
     /// Round the die's edges and corners with this radius, mm (0, the default: sharp). 3D only.
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     pub edge_radius: Option<f64>,
     /// A die file (TOML, lengths in mm): com, edge_radius, density, and [pips]
     /// diameter, depth, shape (cap or cylinder), fill_density, spacing. Flags given beside it

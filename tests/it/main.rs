@@ -11,6 +11,7 @@ mod docs;
 mod faces;
 mod fit;
 mod fuzz;
+mod made;
 mod rapier;
 mod redteam;
 mod redteam3;
