@@ -13,7 +13,6 @@ use dicephys::model::die::{up_in_body, DieShape};
 use dicephys::model::scene::{Mode, Scene};
 use dicephys::model::state::BodyState;
 use dicephys::model::throws::{ThrowKind, ThrowRanges, Throws};
-use dicephys::sim::certificate::face_region;
 use dicephys::sim::roll::{roll, roll_observed, RollConfig, Rule, DEFAULT_MARGIN};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
@@ -90,15 +89,16 @@ fn main() {
         let (mut region, mut last_change) = (usize::MAX, 0u64);
         let (mut h, mut t) = (Loose::default(), Loose::default());
         roll_observed(&mut engine, &scene, &throw, &settle_fully, |_, s| {
-            let i = face_region(&die, &up_in_body(&s.rotation));
+            let (i, side) = die.face_region(&up_in_body(&s.rotation));
             let k = counter.load(Ordering::Relaxed);
             if i != region {
                 (region, last_change) = (i, k);
             }
             if s.position.y > 0.0 {
                 let g = die.gravity;
-                let allowed = (1.0 - DEFAULT_MARGIN) * (die.barrier[i] - die.half[i]);
-                let excess = die.energy(s) / (die.mass * g) - die.half[i];
+                let rest = die.rest[i][side];
+                let allowed = (1.0 - DEFAULT_MARGIN) * (die.barrier[i][side] - rest);
+                let excess = die.energy(s) / (die.mass * g) - rest;
                 let v = s.linear_velocity;
                 let hor = 0.5 * (v.x * v.x + v.z * v.z) / g;
                 h.push(k, i, excess, hor, allowed);

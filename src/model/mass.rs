@@ -213,7 +213,7 @@ pub fn pip_places(half: &Vector3<f64>, p: &Pips, layout: Layout) -> Vec<(usize, 
     let numbers = layout.numbers();
     let mut out = Vec::new();
     for (d, &n) in numbers.iter().enumerate() {
-        let (i, sign) = (d / 2, if d % 2 == 0 { 1.0 } else { -1.0 });
+        let (i, sign) = (d / 2, if d.is_multiple_of(2) { 1.0 } else { -1.0 });
         let (j, k) = ((i + 1) % 3, (i + 2) % 3);
         for &(u, v) in pattern(n) {
             out.push((

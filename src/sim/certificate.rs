@@ -53,7 +53,8 @@ impl Certificate {
         let (i, k) = die.face_region(&up);
         let rest = die.rest[i][k];
         let allowed = (1.0 - self.margin) * (die.barrier[i][k] - rest);
-        if !(allowed > 0.0) {
+        // No barrier known (−∞), or none left above the rest height: nothing is certain.
+        if allowed.is_nan() || allowed <= 0.0 {
             return None;
         }
         // The height plus the translational energy's worth of height is a lower bound of E/mg:

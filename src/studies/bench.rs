@@ -4,6 +4,7 @@
 //! in the same run. Speed is reported as ratios measured side by side: this machine is noisy.
 
 use crate::engine::EngineKind;
+use crate::model::faces::Layout;
 use crate::model::scene::{Floor, Mode, Scene};
 use crate::model::throws::{ThrowKind, ThrowRanges, Throws};
 use crate::report::text::{left, right, Columns};
@@ -330,14 +331,165 @@ pub struct Bench {
     pub seed: u64,
     /// Runs per measurement; the fastest counts.
     pub repeat: u32,
+    /// What each feature of a made die costs against the sharp uniform die (`dice_costs`).
+    pub dice: Vec<DiceCost>,
 }
 
-/// Runs the benchmark: `rolls` throws per method, mode and thread count; `log` gets a line per
-/// measurement. With `repeat` > 1, every method of a mode and thread count is run in turn,
+/// What a made die's features cost: a 16 mm cube thrown in a tumble, rolled by default
+/// (early stop, fast flight) on one thread, against the sharp uniform cube on the same
+/// engine, the same throws, in the same run.
+#[derive(Clone, Debug, Serialize)]
+pub struct DiceCost {
+    /// The engine's name.
+    pub engine: String,
+    /// The die: "sharp uniform", or its features as flags.
+    pub die: String,
+    /// Rolls made.
+    pub rolls: u64,
+    /// Process CPU ms per roll (the fastest run of the repeats).
+    pub cpu_ms_per_roll: f64,
+    /// Over the sharp uniform die's on the same engine.
+    pub vs_sharp: f64,
+    /// Engine steps per roll.
+    pub engine_steps_per_roll: f64,
+    /// Face counts, 1 to 6.
+    pub faces: [u64; 6],
+}
+
+/// The made dice `dice_costs` times, each as flags would give it: a weight 2 mm toward
+/// face 6, 3 mm pips 1 mm deep, edges rounded 1 mm, and all three.
+pub fn made_dice() -> Vec<(&'static str, crate::model::mass::Features)> {
+    use crate::model::mass::{Features, PipShape, Pips};
+    let com = Some([0.0, 0.0, -0.002]);
+    let pips = Some(Pips {
+        diameter: 0.003,
+        depth: 0.001,
+        shape: PipShape::Cap,
+        fill_density: 0.0,
+        spacing: 0.25,
+    });
+    vec![
+        ("sharp uniform", Features::default()),
+        (
+            "--com 0,0,-2",
+            Features {
+                com,
+                ..Default::default()
+            },
+        ),
+        (
+            "--pips 3,1",
+            Features {
+                pips: pips.clone(),
+                ..Default::default()
+            },
+        ),
+        (
+            "--edge-radius 1",
+            Features {
+                edge_radius: 0.001,
+                ..Default::default()
+            },
+        ),
+        (
+            "all three",
+            Features {
+                com,
+                pips,
+                edge_radius: 0.001,
+                ..Default::default()
+            },
+        ),
+    ]
+}
+
+/// Times every made die of `made_dice` on both engines (`rolls` each on Bullet, a quarter as
+/// many on Rapier, which is slower), one thread, the dice of an engine run in turn `repeat`
+/// rounds over, each keeping its fastest run.
+pub fn dice_costs(
+    rolls: u64,
+    seed: u64,
+    repeat: u32,
+    stop: &crate::run::stop::Stop,
+    log: &dyn Fn(&str),
+) -> crate::Result<Vec<DiceCost>> {
+    use crate::model::throws::ThrowStyle;
+    let block: crate::model::block::Block = "16x16x16".parse()?;
+    let throws = Throws::styled(
+        ThrowKind::Keyed,
+        ThrowStyle::Tumble,
+        0.0,
+        seed,
+        ThrowRanges::default(),
+        0,
+    );
+    // As `roll` rolls by default at this step: the early stop, free flight flown.
+    let cfg = RollConfig {
+        rule: Rule::Certificate,
+        fast_flight: true,
+        ..RollConfig::default()
+    };
+    let dice = made_dice();
+    let mut out = Vec::new();
+    for (engine, n) in [
+        (EngineKind::Bullet, rolls),
+        (EngineKind::Rapier, (rolls / 4).max(1)),
+    ] {
+        let mut best = vec![(f64::INFINITY, Vec::new()); dice.len()];
+        for _ in 0..repeat.max(1) {
+            for ((_, features), best) in dice.iter().zip(best.iter_mut()) {
+                let mut scene = Scene::paper(block, Mode::ThreeD);
+                scene.features = features.clone();
+                let job = batch::Job {
+                    engine,
+                    scene: &scene,
+                    throws: &throws,
+                    cfg: &cfg,
+                };
+                let list: Vec<u64> = (0..n).collect();
+                let cpu = process_cpu_seconds();
+                let recs = batch::run_indices(&job, &list, 1, stop, &|_| {})?;
+                let c = process_cpu_seconds() - cpu;
+                if (recs.len() as u64) < n {
+                    return Err(crate::Error::Stopped);
+                }
+                if c < best.0 {
+                    *best = (c, recs);
+                }
+            }
+        }
+        let sharp_ms = 1000.0 * best[0].0 / n as f64;
+        for ((name, _), (cpu_s, recs)) in dice.iter().zip(&best) {
+            let t = Tally::of(recs)?;
+            let ms = 1000.0 * cpu_s / n as f64;
+            let row = DiceCost {
+                engine: engine.name().into(),
+                die: name.to_string(),
+                rolls: n,
+                cpu_ms_per_roll: ms,
+                vs_sharp: ms / sharp_ms,
+                engine_steps_per_roll: t.engine_steps as f64 / n as f64,
+                faces: Layout::Right
+                    .numbers()
+                    .map(|k| t.up[Layout::Right.direction_of(k).unwrap_or(0)]),
+            };
+            log(&format!(
+                "made die, {:<6} {:<16} {:>6} rolls  {:.3} ms/roll  {:.2}x the sharp uniform die  {:.0} engine steps/roll",
+                row.engine, row.die, row.rolls, row.cpu_ms_per_roll, row.vs_sharp, row.engine_steps_per_roll
+            ));
+            out.push(row);
+        }
+    }
+    Ok(out)
+}
+
+/// Runs the benchmark: `rolls` throws per method, mode and thread count, then the made dice's
+/// costs on `dice_rolls` (0: none, `dice_costs`); `log` gets a line per measurement. With `repeat` > 1, every method of a mode and thread count is run in turn,
 /// `repeat` rounds over, and each keeps its fastest run: a spell of load from elsewhere then
 /// falls on different methods in different rounds, not on one method's every run.
 pub fn run(
     rolls: u64,
+    dice_rolls: u64,
     seed: u64,
     all_threads: usize,
     repeat: u32,
@@ -484,6 +636,11 @@ pub fn run(
             v.mode, v.method, v.threads, v.rolls_per_s, v.speedup, v.threads, v.speedup_vs_faithful_1_thread, v.vs_dicephys, v.vs_dicephys_cpu, v.vs_dicephys_at_floor
         ));
     }
+    let dice = if dice_rolls > 0 {
+        dice_costs(dice_rolls, seed, repeat, stop, log)?
+    } else {
+        Vec::new()
+    };
     Ok(Bench {
         rows,
         verdicts,
@@ -491,6 +648,7 @@ pub fn run(
         peak_rss_mb: peak_rss_bytes() as f64 / 1e6,
         seed,
         repeat: repeat.max(1),
+        dice,
     })
 }
 

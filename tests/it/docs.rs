@@ -628,7 +628,16 @@ fn json_md_lists_the_keys_of_crosscheck_theory_and_bench() {
     c.document("theory-block", "theory --block", &tb);
     let tt = run(&["theory", "--table", "--json"]);
     c.document("theory-table", "theory --table", &tt);
-    let bench = run(&["bench", "--rolls", "4", "--threads", "1", "--json"]);
+    let bench = run(&[
+        "bench",
+        "--rolls",
+        "4",
+        "--dice-rolls",
+        "4",
+        "--threads",
+        "1",
+        "--json",
+    ]);
     c.document("bench", "bench", &bench);
     c.finish(&["crosscheck", "theory-block", "theory-table", "bench"]);
 }

@@ -103,7 +103,7 @@ fn the_early_stop_and_every_step_agree_face_for_face_for_made_dice() {
 /// The rotation that puts the face of direction `d` (+x, −x, +y, −y, +z, −z) on the floor.
 fn face_down(d: usize) -> UnitQuaternion<f64> {
     let mut n = Vector3::zeros();
-    n[d / 2] = if d % 2 == 0 { 1.0 } else { -1.0 };
+    n[d / 2] = if d.is_multiple_of(2) { 1.0 } else { -1.0 };
     UnitQuaternion::rotation_between(&n, &-Vector3::y()).unwrap_or_else(|| {
         UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
     })
@@ -154,7 +154,7 @@ fn a_made_die_released_at_rest_on_a_face_stays_there() {
             let end = engine.state();
             let up = up_in_body(&end.rotation);
             let mut want = Vector3::zeros();
-            want[d / 2] = if d % 2 == 0 { -1.0 } else { 1.0 };
+            want[d / 2] = if d.is_multiple_of(2) { -1.0 } else { 1.0 };
             assert!(
                 up.angle(&want) < 5e-3,
                 "{kind:?} face {d}: up {up:?} (angle {})",
