@@ -14,9 +14,10 @@ use dicephys::studies::fair::{assess, Null};
 pub struct FairArgs {
     #[command(flatten)]
     pub roll: RollArgs,
-    /// What fair means: uniform (each face 1/6; in 2D each side 1/4) or solid-angle (each
-    /// face the solid angle it subtends from the centre: an ideal block of these sides
-    /// released at rest; 3D).
+    /// What fair means: uniform (each face 1/6; in 2D each side 1/4) or solid-angle (the
+    /// quasi-static theory: each face the solid angle the face opposite subtends from the
+    /// centre of mass, what the die would show released at rest and rolling without a bounce;
+    /// 3D).
     #[arg(long, default_value = "uniform")]
     pub null: Null,
     /// Also write fairness.json (the --json document) and the die map (die_map.svg, .png:

@@ -26,7 +26,9 @@ pub enum Null {
     Uniform,
     /// Each face the solid angle it subtends from the centre over 4π (Simpson's quasi-static
     /// theory, eq. after (InElasK), split evenly between a side's two faces): what an ideal
-    /// block of these sides would show were it released at rest. 3D only.
+    /// block of these sides would show were it released at rest. For a made die, the solid
+    /// angle of the opposite face of its inner box from its centre of mass
+    /// (`theory::quasi_static`). 3D only.
     SolidAngle,
 }
 

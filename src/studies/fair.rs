@@ -1,6 +1,6 @@
 //! `dicephys fair`: is this die fair, face by face? A run's face counts set against a null
-//! (each face 1/6, or each face the solid angle it subtends from the centre, the quasi-static
-//! theory of a centred cuboid): each face's probability with its error and its departure in σ,
+//! (each face 1/6, or each face the solid angle it subtends from the centre of mass, the
+//! quasi-static theory, `theory::quasi_static`): each face's probability with its error and its departure in σ,
 //! Pearson's χ² over the faces, and the throws a tester would need to see the bias at 2σ and at
 //! 5σ. The simulation is itself such a tester: a bias it cannot resolve at 2σ is reported as
 //! unresolved, with the rolls that would resolve it.
@@ -30,6 +30,11 @@ fn null_probabilities(s: &RunSummary, null: Null) -> Result<Vec<f64>> {
     let shown = if s.mode == Mode::ThreeD { 6 } else { 4 };
     match (null, s.mode) {
         (Null::Uniform, _) => Ok(vec![1.0 / shown as f64; shown]),
+        (Null::SolidAngle, Mode::ThreeD) if !s.spec.scene.features.plain() => {
+            // A made die: each face's solid angle from the centre of mass, of the inner box.
+            let die = crate::model::die::DieShape::of(&s.spec.scene);
+            Ok(theory::quasi_static::faces_up(&die).to_vec())
+        }
         (Null::SolidAngle, Mode::ThreeD) => {
             let (p, _) = theory::simpson_3d(&s.spec.scene.block);
             Ok((0..6)

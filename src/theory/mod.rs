@@ -21,6 +21,7 @@ pub mod dreidel;
 pub mod markov;
 pub mod paper_data;
 pub mod propagation;
+pub mod quasi_static;
 pub mod stats;
 
 fn valid(r: f64) -> bool {
