@@ -161,6 +161,8 @@ pub struct RunArgs {
     /// Roll until the ratio breadth/width is known to this precision: its relative 2σ error
     /// (per cent, e.g. 2 or 2%) at most this, tested every 1,000 rolls, so that the same seed
     /// gives the same rolls on any thread count. The summary says how many rolls it took.
+    /// In `fair`: every face's probability to 2σ of this many percentage points (0.5: each
+    /// face known to ±0.005).
     #[arg(long, value_name = "PERCENT", value_parser = super::sweeps::parse_percent)]
     pub precision: Option<f64>,
     /// Worker threads (0: one per core).

@@ -28,13 +28,6 @@ pub struct FairArgs {
 
 /// Runs `dicephys fair`.
 pub fn run(a: &FairArgs) -> Result<()> {
-    if a.roll.run.precision.is_some() {
-        return Err(Error::Usage(
-            "fair: --precision rolls to the ratio breadth/width's precision, not the faces'; \
-             give --rolls (the report says the rolls a bias would need)"
-                .into(),
-        ));
-    }
     let spec = a.roll.spec_or(ThrowStyle::Tumble)?;
     // The null is checked before anything rolls.
     if a.null == Null::SolidAngle && spec.scene.mode == dicephys::model::scene::Mode::TwoD {
@@ -49,7 +42,13 @@ pub fn run(a: &FairArgs) -> Result<()> {
         let identity = serde_json::json!({ "spec": spec, "null": a.null, "layout": a.roll.layout });
         dicephys::studies::fair::claim(dir, &identity)?;
     }
-    let (summary, done) = rolled(&a.roll, &spec, "fair")?;
+    // --precision here is every face's probability's.
+    let (summary, done) = rolled(
+        &a.roll,
+        &spec,
+        "fair",
+        dicephys::report::summary::Target::Faces,
+    )?;
     let fair = assess(&summary, a.null)?;
     let doc = serde_json::json!({ "fairness": fair, "summary": summary });
     let json = dicephys::run::seal::to_string(&doc, true)?;

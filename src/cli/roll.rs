@@ -6,6 +6,7 @@ use super::{out, outln};
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::report::progress::{Progress, Unit};
+use dicephys::report::summary::Target;
 use dicephys::run::runner::{Checkpoint, Runner};
 use dicephys::run::spec::{RunSpec, Shard};
 use dicephys::studies::outputs;
@@ -115,7 +116,7 @@ impl RollArgs {
 /// Runs `dicephys roll`.
 pub fn run(a: &RollArgs) -> Result<()> {
     let spec = a.spec()?;
-    let (summary, done) = rolled(a, &spec, "roll")?;
+    let (summary, done) = rolled(a, &spec, "roll", Target::Ratio)?;
     if a.json {
         outln!("{}", dicephys::run::seal::to_string(&summary, true)?);
     } else {
@@ -131,6 +132,7 @@ pub fn rolled(
     a: &RollArgs,
     spec: &RunSpec,
     command: &'static str,
+    target: dicephys::report::summary::Target,
 ) -> Result<(dicephys::report::summary::RunSummary, Result<()>)> {
     if let (Some(_), Some(_)) = (a.run.precision, spec.shard) {
         return Err(Error::Usage(
@@ -158,7 +160,9 @@ pub fn rolled(
         spec,
         dir.map(PathBuf::as_path),
         per_roll,
-        a.run.precision.map(|p| (p, &expect as &dyn Fn(u64))),
+        a.run
+            .precision
+            .map(|p| (p, target, &expect as &dyn Fn(u64))),
         &runner,
     )?
     .with_layout(a.layout);

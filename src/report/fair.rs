@@ -115,6 +115,9 @@ impl Fairness {
             );
         }
         out += &format!("  {}\n", self.verdict);
+        if let Some(r) = &s.precision {
+            out += &format!("  {}\n", r.line());
+        }
         out
     }
 }

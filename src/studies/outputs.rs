@@ -167,14 +167,14 @@ impl Place {
 /// CSV row per throw into `per_roll` if given (grown chunk by chunk in a temporary file, put
 /// in place at the end). Its summary is partial if a stop request ended it; a resumed run's
 /// cost is the sum over its segments (the resumed chunks carry theirs).
-/// With `precision` (a fraction, and a hook told the rolls expected in all as it goes), the
-/// run stops at the first chunk boundary where the ratio's relative 2σ error is at most that,
-/// `spec.rolls` its cap (`studies::precision`).
+/// With `precision` (a fraction, what it is of, and a hook told the rolls expected in all as it
+/// goes), the run stops at the first chunk boundary where the ratio's relative 2σ error (or
+/// every face's 2σ) is at most that, `spec.rolls` its cap (`studies::precision`).
 pub fn roll(
     spec: &RunSpec,
     checkpoint: Option<&Path>,
     per_roll: Option<(Output, crate::model::faces::Layout)>,
-    precision: Option<(f64, &dyn Fn(u64))>,
+    precision: Option<(f64, crate::report::summary::Target, &dyn Fn(u64))>,
     runner: &Runner,
 ) -> Result<RunSummary> {
     let checkpoint = checkpoint.map(|d| Checkpoint::open(d, spec)).transpose()?;
@@ -191,12 +191,13 @@ pub fn roll(
     let wall = Instant::now();
     let cpu = process_cpu_seconds();
     let (done, reached) = match precision {
-        Some((p, expect)) => {
+        Some((p, target, expect)) => {
             let (done, reached) = studies::precision::roll_to_precision(
                 runner,
                 spec,
                 checkpoint.as_ref(),
                 p,
+                target,
                 expect,
                 &mut sink,
             )?;

@@ -6,7 +6,7 @@ use super::departure::{chunks_to_resolve, paired_departure, rolls_for_ratio};
 use super::stream::{Stream, STREAM_ROLLS};
 use super::Study;
 use crate::error::Result;
-use crate::report::summary::{rolls_for_precision, Reached};
+use crate::report::summary::{Reached, Target};
 use crate::run::runner::{Checkpoint, Rolled, Runner, CHUNK_ROLLS};
 use crate::run::spec::RunSpec;
 use crate::run::tally::Tally;
@@ -162,6 +162,7 @@ pub fn roll_to_precision(
     spec: &RunSpec,
     checkpoint: Option<&Checkpoint>,
     precision: f64,
+    target: Target,
     expect: &dyn Fn(u64),
     sink: &mut dyn FnMut(&[RollRecord]) -> Result<()>,
 ) -> Result<(Rolled, Reached)> {
@@ -174,7 +175,7 @@ pub fn roll_to_precision(
         resumed_wall_s: 0.0,
     };
     for c in 0..chunks {
-        if Reached::of(&[&all.tally], precision).resolved {
+        if Reached::of_target(&all.tally, target, precision).resolved {
             break;
         }
         let base = all.tally.rolls;
@@ -183,7 +184,7 @@ pub fn roll_to_precision(
             .with_progress(&progress)
             .run_range(spec, checkpoint, c..c + 1, sink)?;
         all.tally.merge(&r.tally)?;
-        if let Some(n) = rolls_for_precision(&all.tally, precision) {
+        if let Some(n) = target.rolls_for(&all.tally, precision) {
             let n = n.div_ceil(CHUNK_ROLLS) * CHUNK_ROLLS;
             expect(n.clamp(all.tally.rolls, spec.indices().len()));
         }
@@ -195,6 +196,6 @@ pub fn roll_to_precision(
             break;
         }
     }
-    let reached = Reached::of(&[&all.tally], precision);
+    let reached = Reached::of_target(&all.tally, target, precision);
     Ok((all, reached))
 }
