@@ -163,6 +163,10 @@ impl Place {
     }
 }
 
+/// A precision to roll to: the fraction, what it is of, and a hook told the rolls expected in
+/// all as the run goes.
+pub type Precision<'a> = (f64, crate::report::summary::Target, &'a dyn Fn(u64));
+
 /// `roll`: one run, its chunks kept in `checkpoint` if given (a run there is continued), one
 /// CSV row per throw into `per_roll` if given (grown chunk by chunk in a temporary file, put
 /// in place at the end). Its summary is partial if a stop request ended it; a resumed run's
@@ -174,7 +178,7 @@ pub fn roll(
     spec: &RunSpec,
     checkpoint: Option<&Path>,
     per_roll: Option<(Output, crate::model::faces::Layout)>,
-    precision: Option<(f64, crate::report::summary::Target, &dyn Fn(u64))>,
+    precision: Option<Precision>,
     runner: &Runner,
 ) -> Result<RunSummary> {
     let checkpoint = checkpoint.map(|d| Checkpoint::open(d, spec)).transpose()?;
