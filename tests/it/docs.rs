@@ -583,7 +583,39 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
             .unwrap(),
     );
     assert!(merged["spec"]["shard"].is_null());
+    // A made die, every feature (its spec carries them), and fair's precision of the faces.
+    let dir2 = Scratch::new("docs-die");
+    let die = dir2.join("die.toml");
+    std::fs::write(
+        &die,
+        "com = [0.0, 0.0, -1.0]\nedge_radius = 1.0\n[pips]\ndiameter = 3.0\ndepth = 1.0\nfill_density = 1200.0\n",
+    )
+    .unwrap();
+    let made = roll(&[
+        "--block",
+        "16x16x16",
+        "--throw",
+        "tumble",
+        "--die",
+        die.to_str().unwrap(),
+        "--layout",
+        "left",
+    ]);
+    let faces = run(&[
+        "fair",
+        "--block",
+        "16x16x16",
+        "--precision",
+        "10",
+        "--rolls",
+        "2000",
+        "--threads",
+        "1",
+        "--json",
+    ]);
     for (what, v) in [
+        ("roll --die (every feature)", &made),
+        ("fair --precision 10 (its summary)", &faces["summary"]),
         ("roll 3D", &d3),
         ("roll 2D", &d2),
         ("roll --audit --throw tumble, damped", &odd),
