@@ -203,6 +203,15 @@ impl Bullet {
 
 /// The engine's state of the body from the die's: the orientation turned by the principal
 /// frame when it is not the body axes (the centre of mass and velocities are the same).
+impl Bullet {
+    /// The body's orientation as Bullet holds it. Bullet keeps it as a matrix; its quaternion
+    /// is already unit length to rounding, so it is taken as it is rather than renormalised.
+    fn raw_rotation(&self) -> UnitQuaternion<f64> {
+        let [x, y, z, w] = self.now.rotation;
+        UnitQuaternion::new_unchecked(Quaternion::new(w, x, y, z))
+    }
+}
+
 fn to_ffi(s: &BodyState, principal: Option<&UnitQuaternion<f64>>) -> ffi::BodyStateFfi {
     let r = match principal {
         Some(p) => s.rotation * p,
@@ -238,14 +247,30 @@ impl Engine for Bullet {
     }
 
     /// Free flight is ballistic unless Bullet's implicit gyroscopic force turns ω or damping
-    /// slows the die; and it is integrated as the die's own state only when the body's frame
-    /// is the die's axes (a die whose principal frame is turned off them is stepped).
+    /// slows the die (a body turned off the die's axes is flown in its own frame,
+    /// `body_state`).
     fn ballistic_flight(&self) -> bool {
-        !self.gyroscopic && !self.damped && self.principal.is_none()
+        !self.gyroscopic && !self.damped
     }
 
     fn contact_free(&self) -> bool {
         self.world.contact_points() == 0
+    }
+
+    fn body_state(&self) -> BodyState {
+        BodyState {
+            rotation: self.raw_rotation(),
+            ..self.state()
+        }
+    }
+
+    fn set_body_state(&mut self, now: &BodyState) -> crate::Result<()> {
+        self.world
+            .pin_mut()
+            .set_state(&to_ffi(now, None))
+            .map_err(|e| crate::Error::Engine(e.to_string()))?;
+        self.now = self.world.state();
+        Ok(())
     }
 
     fn step(&mut self) -> crate::Result<()> {
@@ -257,10 +282,7 @@ impl Engine for Bullet {
 
     fn state(&self) -> BodyState {
         let s = &self.now;
-        let [x, y, z, w] = s.rotation;
-        // Bullet keeps the orientation as a matrix; its quaternion is already unit length
-        // to rounding, so take it as it is rather than renormalising.
-        let body = UnitQuaternion::new_unchecked(Quaternion::new(w, x, y, z));
+        let body = self.raw_rotation();
         BodyState {
             position: Vector3::from(s.position),
             rotation: match &self.principal {

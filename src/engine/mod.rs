@@ -51,6 +51,16 @@ pub trait Engine: Send {
     fn own_flight_step(&mut self, _s: &BodyState) -> Option<BodyState> {
         None
     }
+    /// The engine's own body state, when its body's frame is turned off the die's axes (a
+    /// made die's principal frame, `model::mass`): what `flight::Flight` flies, bit for bit as
+    /// the engine would. Otherwise, and by default, `state`.
+    fn body_state(&self) -> BodyState {
+        self.state()
+    }
+    /// `set_state` from the engine's own body state (`body_state`).
+    fn set_body_state(&mut self, now: &BodyState) -> Result<()> {
+        self.set_state(now)
+    }
     /// Advances the world by one fixed time step.
     fn step(&mut self) -> Result<()>;
     /// The die's state now, as the engine last left it.

@@ -62,6 +62,10 @@ pub struct Flight {
     pub radius: f64,
     /// ... and its centre of mass from its centre (0).
     pub com: Vector3<f64>,
+    /// A made die's body turned off its axes (`model::mass::MassProps::principal`): the body
+    /// state flown (`next`, `jump`: the engine's, `Engine::body_state`) turned back by this
+    /// into the die's (`to_die`). `None`: the body is the die.
+    pub turn: Option<UnitQuaternion<f64>>,
     /// How far above the floor the die's lowest point must be for a step to be pure flight
     /// (`CLEAR` or `CLEAR_OF_PLANE`).
     pub clear: f64,
@@ -81,6 +85,10 @@ impl Flight {
             core: die.core,
             radius: die.radius,
             com: die.com,
+            turn: {
+                let mp = crate::model::mass::MassProps::compute(scene);
+                (!mp.aligned()).then(|| mp.principal.inverse())
+            },
             // A rounded die meets the floor through Bullet's convex test (GJK), which, as
             // the plane's, reports points up to the breaking threshold away.
             clear: match scene.floor {
@@ -95,6 +103,25 @@ impl Flight {
     pub fn lowest_point(&self, s: &BodyState) -> f64 {
         let up = up_in_body(&s.rotation);
         s.position.y - (up.abs().dot(&self.core) + self.radius) - self.com.dot(&up)
+    }
+
+    /// The die's state from a flown body state (the engine's `state` from its `body_state`).
+    pub fn to_die(&self, body: &BodyState) -> BodyState {
+        match &self.turn {
+            Some(t) => BodyState {
+                rotation: body.rotation * t,
+                ..*body
+            },
+            None => *body,
+        }
+    }
+
+    /// The lowest point of a flown body state.
+    fn body_lowest(&self, body: &BodyState) -> f64 {
+        match self.turn {
+            Some(_) => self.lowest_point(&self.to_die(body)),
+            None => self.lowest_point(body),
+        }
     }
 
     /// True if a flight may start from `s`, the state after the engine's last step: the die
@@ -158,7 +185,7 @@ impl Flight {
         max: u64,
         rest: &mut RestDetector,
     ) -> u64 {
-        if max == 0 || self.lowest_point(s) <= self.clear {
+        if max == 0 || self.body_lowest(s) <= self.clear {
             return 0;
         }
         // ω is constant in flight, so whether it keeps the die awake is decided once (the
@@ -186,7 +213,7 @@ impl Flight {
                 break;
             }
             // The step that lands is left to the walk, with every check a landing can fire.
-            if next.position.y - reach <= self.clear && self.lowest_point(&next) <= self.clear {
+            if next.position.y - reach <= self.clear && self.body_lowest(&next) <= self.clear {
                 break;
             }
             *s = next;
@@ -208,7 +235,7 @@ impl Flight {
     /// die fast enough that the step resets the sleeping timer); `None` if the engine must
     /// take it.
     pub fn next(&self, s: &BodyState, dq: &UnitQuaternion<f64>) -> Option<BodyState> {
-        if self.lowest_point(s) <= self.clear {
+        if self.body_lowest(s) <= self.clear {
             return None;
         }
         let next = self.step(s, dq);

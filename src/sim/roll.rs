@@ -511,6 +511,9 @@ fn run(
     // the state is handed back.
     let mut flying = Flying::No;
     let mut behind = false;
+    // The body state a ballistic flight flies: the engine's own (`Engine::body_state`), the
+    // die's `state` turned back from it at each step (`Flight::to_die`).
+    let mut body = state;
     // Flown steps in a row so far, and what a jumped state must be above for the certificate
     // to be out of reach (when it is checked at all).
     let mut flown_in_a_row = 0u64;
@@ -531,6 +534,7 @@ fn run(
             } else {
                 match &flight {
                     Some(f) if f.may_start(&state, || engine.contact_free()) => {
+                        body = engine.body_state();
                         Flying::Ballistic(f.step_rotation(&state.angular_velocity))
                     }
                     _ => Flying::No,
@@ -550,7 +554,9 @@ fn run(
                 let n = match (&flying, &flight) {
                     (Flying::Ballistic(dq), Some(f)) => {
                         let max = quiet_steps(&die, &state, ceiling, f).min(left);
-                        f.jump(&mut state, dq, max, &mut rest)
+                        let n = f.jump(&mut body, dq, max, &mut rest);
+                        state = f.to_die(&body);
+                        n
                     }
                     _ => {
                         let max = quiet_steps_own(&state, ceiling, scene).min(left);
@@ -575,14 +581,23 @@ fn run(
                 }
             }
             next = match (&flying, &flight) {
-                (Flying::Ballistic(dq), Some(f)) => f.next(&state, dq),
+                (Flying::Ballistic(dq), Some(f)) => f.next(&body, dq).map(|b| {
+                    body = b;
+                    f.to_die(&b)
+                }),
                 _ => engine.own_flight_step(&state),
             };
             if next.is_none() {
-                flying = Flying::No;
-                if behind && engine.set_state(&state).is_err() {
-                    return end;
+                if behind {
+                    let handed = match flying {
+                        Flying::Ballistic(_) => engine.set_body_state(&body),
+                        _ => engine.set_state(&state),
+                    };
+                    if handed.is_err() {
+                        return end;
+                    }
                 }
+                flying = Flying::No;
                 behind = false;
             } else {
                 behind = true;
