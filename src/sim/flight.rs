@@ -364,6 +364,52 @@ mod tests {
         }
     }
 
+    /// A die drilled with pips has its body turned off its axes; the flight flies Bullet's own
+    /// body state, so 100 flown steps are Bullet's 100 steps to rounding (as
+    /// `coasting_matches_bullet_stepping` for the plain die: Bullet adds gravity as a force
+    /// times the inverse mass), and the die's state turned back from it is the one Bullet
+    /// reports for its own.
+    #[test]
+    fn a_turned_body_flies_as_bullet_steps_it() {
+        let mut scene = Scene::paper("16x16x16".parse().unwrap(), Mode::ThreeD);
+        scene.features.pips = Some(crate::model::mass::Pips {
+            diameter: 0.003,
+            depth: 0.001,
+            shape: crate::model::mass::PipShape::Cap,
+            fill_density: 0.0,
+            spacing: 0.25,
+        });
+        let f = Flight::of(&scene);
+        assert!(f.turn.is_some());
+        let start = BodyState {
+            position: Vector3::new(0.0, 0.5, 0.0),
+            rotation: UnitQuaternion::from_euler_angles(0.3, 0.1, 0.2),
+            linear_velocity: Vector3::new(0.1, 0.5, 0.0),
+            angular_velocity: Vector3::new(5.0, -3.0, 120.0),
+            sleeping: false,
+        };
+        let mut engine = new_engine(EngineKind::Bullet, &scene).unwrap();
+        engine.reset(&start).unwrap();
+        let dq = f.step_rotation(&start.angular_velocity);
+        let mut body = engine.body_state();
+        for _ in 0..100 {
+            body = f.next(&body, &dq).expect("in flight");
+            engine.step().unwrap();
+        }
+        let close = |a: &BodyState, b: &BodyState| {
+            (a.position - b.position).norm() < 1e-12
+                && (a.linear_velocity - b.linear_velocity).norm() < 1e-12
+                && a.angular_velocity == b.angular_velocity
+                && a.rotation.angle_to(&b.rotation) < 1e-12
+        };
+        assert!(close(&engine.body_state(), &body), "{body:?}");
+        let die = engine.state();
+        assert!(close(&die, &f.to_die(&body)), "{die:?}");
+        // The die's axes, not the body's: turned by the principal frame.
+        assert!(die.rotation.angle_to(&body.rotation) > 1e-6);
+        assert_eq!(die.rotation, engine.body_state().rotation * f.turn.unwrap());
+    }
+
     #[test]
     fn a_jump_reaches_the_states_of_the_walk_bit_for_bit() {
         for mode in [Mode::ThreeD, Mode::TwoD] {
