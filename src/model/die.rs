@@ -29,6 +29,8 @@ pub struct DieShape {
     pub inertia_min: f64,
     /// Gravity's magnitude, m/s², along −y.
     pub gravity: f64,
+    /// The centred sharp block: `lowest_point` and `face_region` take the paper's short forms.
+    plain: bool,
     /// Rotation about z only (2D): region and barrier over the x and y axes.
     pub planar: bool,
     /// The centre of mass's height at rest on each face, by the face on the floor:
@@ -96,6 +98,7 @@ impl DieShape {
             diagonal,
             inertia_min: mp.moments.min(),
             gravity: scene.gravity,
+            plain: radius == 0.0 && com == Vector3::zeros(),
             planar,
             rest,
             barrier,
@@ -136,25 +139,45 @@ impl DieShape {
     /// Height above the floor of the die's lowest point, its centre of mass at `s`: the
     /// support function in the downward direction from the centre of mass,
     /// y − (Σ kᵢ |uᵢ| + r) − c·u with u = Rᵀŷ (for the centred sharp block `lowest_point`).
+    #[inline]
     pub fn lowest_point(&self, s: &BodyState) -> f64 {
-        let up = up_in_body(&s.rotation);
-        s.position.y - (up.abs().dot(&self.core) + self.radius) - self.com.dot(&up)
+        self.lowest_point_up(s, &up_in_body(&s.rotation))
+    }
+
+    /// `lowest_point` given the world's up direction in body axes (`up_in_body`).
+    #[inline]
+    pub fn lowest_point_up(&self, s: &BodyState, up: &Vector3<f64>) -> f64 {
+        if self.plain {
+            s.position.y - up.abs().dot(&self.half)
+        } else {
+            s.position.y - (up.abs().dot(&self.core) + self.radius) - self.com.dot(up)
+        }
     }
 
     /// The face on the floor, as (axis i, 0 for +i or 1 for −i), given the world's up
     /// direction in body axes: the face the downward ray from the centre of mass leaves the
     /// inner box through, |gᵢ| / (kᵢ − sᵢ cᵢ) largest (in 2D, over x and y).
+    #[inline]
     pub fn face_region(&self, up: &Vector3<f64>) -> (usize, usize) {
         let n = if self.planar { 2 } else { 3 };
         let down = |i: usize| usize::from(up[i] > 0.0);
         let key = |i: usize| {
-            let s = if down(i) == 0 { 1.0 } else { -1.0 };
-            up[i].abs() / (self.core[i] - s * self.com[i])
+            if self.plain {
+                up[i].abs() / self.half[i]
+            } else {
+                let s = if down(i) == 0 { 1.0 } else { -1.0 };
+                up[i].abs() / (self.core[i] - s * self.com[i])
+            }
         };
-        let i = (0..n)
-            .max_by(|&p, &q| key(p).total_cmp(&key(q)))
-            .unwrap_or(0);
-        (i, down(i))
+        // The largest key, the last of equals (as `Iterator::max_by`).
+        let (mut best, mut best_key) = (0, key(0));
+        for i in 1..n {
+            let k = key(i);
+            if k.total_cmp(&best_key).is_ge() {
+                (best, best_key) = (i, k);
+            }
+        }
+        (best, down(best))
     }
 }
 

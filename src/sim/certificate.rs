@@ -64,7 +64,7 @@ impl Certificate {
         // the height it will be pushed back to, its lowest point on the floor's top face.
         // Without this the certificate fired on dips and was wrong on up to 3 % of rolls at
         // dt = 1/60 (docs/results/coarse-steps.md).
-        let sunk = (-die.lowest_point(s)).max(0.0);
+        let sunk = (-die.lowest_point_up(s, &up)).max(0.0);
         let g = die.gravity;
         if s.position.y + sunk + 0.5 * s.linear_velocity.norm_squared() / g - rest >= allowed {
             return None;

@@ -100,9 +100,14 @@ impl Flight {
 
     /// Height of the die's lowest point above the floor: y − Σ hᵢ |(Rᵀ ŷ)ᵢ| for the centred
     /// sharp block (`DieShape::lowest_point`).
+    #[inline]
     pub fn lowest_point(&self, s: &BodyState) -> f64 {
         let up = up_in_body(&s.rotation);
-        s.position.y - (up.abs().dot(&self.core) + self.radius) - self.com.dot(&up)
+        if self.radius == 0.0 && self.com == Vector3::zeros() {
+            s.position.y - up.abs().dot(&self.half)
+        } else {
+            s.position.y - (up.abs().dot(&self.core) + self.radius) - self.com.dot(&up)
+        }
     }
 
     /// The die's state from a flown body state (the engine's `state` from its `body_state`).
@@ -117,6 +122,7 @@ impl Flight {
     }
 
     /// The lowest point of a flown body state.
+    #[inline]
     fn body_lowest(&self, body: &BodyState) -> f64 {
         match self.turn {
             Some(_) => self.lowest_point(&self.to_die(body)),
