@@ -1,7 +1,7 @@
 //! Bullet (Debian's libbullet, double precision) through the C++ shim in `cpp/`.
 
 use super::{BodyState, Engine};
-use crate::model::mass::MassProps;
+use crate::model::mass::{MassProps, Turn};
 use crate::model::scene::{Floor, Mode, Preset, Scene};
 use cxx::UniquePtr;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -125,9 +125,8 @@ pub struct Bullet {
     gyroscopic: bool,
     /// Damping slows the die in flight too, so its flight is not ballistic.
     damped: bool,
-    /// A made die's principal frame in body axes, when it is not the body axes: the engine's
-    /// body turns by it (`to_ffi`, `state`).
-    principal: Option<UnitQuaternion<f64>>,
+    /// How the body is turned from the die's axes (`to_ffi`, `state`).
+    turn: Turn,
     /// The die's state as the world last reported it (after reset, set_state or a step).
     now: ffi::BodyStateFfi,
 }
@@ -186,7 +185,7 @@ impl Bullet {
             world,
             gyroscopic: s.gyroscopic_implicit,
             damped: scene.damped(),
-            principal: (!mp.aligned()).then_some(mp.principal),
+            turn: mp.turn(),
             now,
         })
     }
@@ -201,8 +200,6 @@ impl Bullet {
     }
 }
 
-/// The engine's state of the body from the die's: the orientation turned by the principal
-/// frame when it is not the body axes (the centre of mass and velocities are the same).
 impl Bullet {
     /// The body's orientation as Bullet holds it. Bullet keeps it as a matrix; its quaternion
     /// is already unit length to rounding, so it is taken as it is rather than renormalised.
@@ -212,11 +209,10 @@ impl Bullet {
     }
 }
 
-fn to_ffi(s: &BodyState, principal: Option<&UnitQuaternion<f64>>) -> ffi::BodyStateFfi {
-    let r = match principal {
-        Some(p) => s.rotation * p,
-        None => s.rotation,
-    };
+/// The engine's state of the body from the die's: the orientation turned by `turn` (the
+/// centre of mass and velocities are the same).
+fn to_ffi(s: &BodyState, turn: &Turn) -> ffi::BodyStateFfi {
+    let r = turn.to_body(&s.rotation);
     let q = r.quaternion();
     ffi::BodyStateFfi {
         position: s.position.into(),
@@ -231,7 +227,7 @@ impl Engine for Bullet {
     fn reset(&mut self, start: &BodyState) -> crate::Result<()> {
         self.world
             .pin_mut()
-            .reset(&to_ffi(start, self.principal.as_ref()))
+            .reset(&to_ffi(start, &self.turn))
             .map_err(|e| crate::Error::Engine(e.to_string()))?;
         self.now = self.world.state();
         Ok(())
@@ -240,7 +236,7 @@ impl Engine for Bullet {
     fn set_state(&mut self, now: &BodyState) -> crate::Result<()> {
         self.world
             .pin_mut()
-            .set_state(&to_ffi(now, self.principal.as_ref()))
+            .set_state(&to_ffi(now, &self.turn))
             .map_err(|e| crate::Error::Engine(e.to_string()))?;
         self.now = self.world.state();
         Ok(())
@@ -267,7 +263,7 @@ impl Engine for Bullet {
     fn set_body_state(&mut self, now: &BodyState) -> crate::Result<()> {
         self.world
             .pin_mut()
-            .set_state(&to_ffi(now, None))
+            .set_state(&to_ffi(now, &Turn::default()))
             .map_err(|e| crate::Error::Engine(e.to_string()))?;
         self.now = self.world.state();
         Ok(())
@@ -282,13 +278,9 @@ impl Engine for Bullet {
 
     fn state(&self) -> BodyState {
         let s = &self.now;
-        let body = self.raw_rotation();
         BodyState {
             position: Vector3::from(s.position),
-            rotation: match &self.principal {
-                Some(p) => body * p.inverse(),
-                None => body,
-            },
+            rotation: self.turn.to_die(&self.raw_rotation()),
             linear_velocity: Vector3::from(s.linear_velocity),
             angular_velocity: Vector3::from(s.angular_velocity),
             sleeping: s.sleeping,

@@ -5,7 +5,7 @@
 //! the components across, exactly.
 
 use super::{BodyState, Engine};
-use crate::model::mass::MassProps;
+use crate::model::mass::{MassProps, Turn};
 use crate::model::scene::{Floor, Mode, Scene};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use rapier3d_f64::prelude::*;
@@ -38,8 +38,8 @@ pub struct Rapier3d {
     /// A made die (`model::mass`): the body is its principal frame at its centre of mass, the
     /// collider off it.
     made: bool,
-    /// A made die's principal frame in body axes, when it is not the body axes.
-    principal: Option<UnitQuaternion<f64>>,
+    /// How the body is turned from the die's axes.
+    turn: Turn,
     /// A made die's mass properties, about the body's frame.
     mass_props: MassProperties,
 }
@@ -266,18 +266,15 @@ impl Rapier3d {
             can_sleep: scene.sleeping,
             flight: None,
             made,
-            principal: (!mp.aligned()).then_some(mp.principal),
+            turn: mp.turn(),
             mass_props: MassProperties::new(Vector::ZERO, mp.mass, from_na(&mp.moments)),
         })
     }
 
     /// The body's orientation from the die's (turned by the principal frame if need be).
     fn body_rotation(&self, q: &UnitQuaternion<f64>) -> Rotation {
-        let r = match &self.principal {
-            Some(p) => q * p,
-            None => *q,
-        };
-        let q = r.quaternion();
+        let q = self.turn.to_body(q);
+        let q = q.quaternion();
         Rotation::from_xyzw(q.i, q.j, q.k, q.w)
     }
 
@@ -406,7 +403,7 @@ impl Engine for Rapier3d {
         }
         self.die = Some(h);
         // The own flight flies the body's frame; it is the die's axes unless turned.
-        self.flight = if self.principal.is_some() {
+        self.flight = if self.turn.turned() {
             None
         } else {
             self.flight_of(h)
@@ -502,10 +499,7 @@ impl Engine for Rapier3d {
         let body = UnitQuaternion::new_unchecked(Quaternion::new(q.w, q.x, q.y, q.z));
         BodyState {
             position: to_na(b.translation()),
-            rotation: match &self.principal {
-                Some(p) => body * p.inverse(),
-                None => body,
-            },
+            rotation: self.turn.to_die(&body),
             linear_velocity: to_na(b.linvel()),
             angular_velocity: to_na(b.angvel()),
             sleeping: b.is_sleeping(),

@@ -1,7 +1,7 @@
 //! The die as a rigid body: its half sides, mass, inertia and barriers, its energies, and
 //! where its lowest point is.
 
-use crate::model::mass::MassProps;
+use crate::model::mass::{MassProps, Turn};
 use crate::model::scene::{Mode, Scene};
 use crate::model::state::BodyState;
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
@@ -31,6 +31,8 @@ pub struct DieShape {
     pub gravity: f64,
     /// The centred sharp block: `lowest_point` and `face_region` take the paper's short forms.
     plain: bool,
+    /// How an engine's body is turned from the die's axes (`MassProps::turn`).
+    pub turn: Turn,
     /// Rotation about z only (2D): region and barrier over the x and y axes.
     pub planar: bool,
     /// The centre of mass's height at rest on each face, by the face on the floor:
@@ -99,6 +101,7 @@ impl DieShape {
             inertia_min: mp.moments.min(),
             gravity: scene.gravity,
             plain: radius == 0.0 && com == Vector3::zeros(),
+            turn: mp.turn(),
             planar,
             rest,
             barrier,

@@ -24,7 +24,7 @@
 //! (`Engine::own_flight`; `engine::rapier3d::Flight` says when a Rapier step is pure flight),
 //! and the roll walks and jumps it as it does this one (`roll::jump_own`).
 
-use crate::model::die::{up_in_body, DieShape};
+use crate::model::die::DieShape;
 use crate::model::scene::{Floor, Scene};
 use crate::model::state::BodyState;
 use crate::sim::rest::{RestDetector, REST_WINDOW};
@@ -53,19 +53,10 @@ pub struct Flight {
     pub dt: f64,
     /// Gravity's magnitude, m/s², along −y.
     pub gravity: f64,
-    /// Half the sides along body x, y, z, m.
-    pub half: Vector3<f64>,
-    /// The die's shape below its centre of mass, as `DieShape` has it: its inner box (for the
-    /// plain block, `half`)...
-    pub core: Vector3<f64>,
-    /// ... its rounding radius (0)...
-    pub radius: f64,
-    /// ... and its centre of mass from its centre (0).
-    pub com: Vector3<f64>,
-    /// A made die's body turned off its axes (`model::mass::MassProps::principal`): the body
-    /// state flown (`next`, `jump`: the engine's, `Engine::body_state`) turned back by this
-    /// into the die's (`to_die`). `None`: the body is the die.
-    pub turn: Option<UnitQuaternion<f64>>,
+    /// The die: its lowest point, reach, and how the engine's body is turned from its axes
+    /// (`DieShape::turn`: the body state flown, `next` and `jump`, is the engine's,
+    /// `Engine::body_state`, turned back into the die's by `to_die`).
+    pub die: DieShape,
     /// How far above the floor the die's lowest point must be for a step to be pure flight
     /// (`CLEAR` or `CLEAR_OF_PLANE`).
     pub clear: f64,
@@ -75,20 +66,15 @@ impl Flight {
     /// The flight of a scene's die: its time step, gravity, half sides, and the clearance its
     /// floor needs.
     pub fn of(scene: &Scene) -> Flight {
-        let die = DieShape::of(scene);
+        Flight::of_die(scene, DieShape::of(scene))
+    }
+
+    /// `of`, given the scene's die (`DieShape::of`) already made.
+    pub fn of_die(scene: &Scene, die: DieShape) -> Flight {
         Flight {
             dt: scene.dt,
             gravity: scene.gravity,
-            // In 2D the box is 1 m deep but turns about z only, so its reach below the
-            // centre comes from x and y alone; the support function below handles both.
-            half: die.half,
-            core: die.core,
-            radius: die.radius,
-            com: die.com,
-            turn: {
-                let mp = crate::model::mass::MassProps::compute(scene);
-                (!mp.aligned()).then(|| mp.principal.inverse())
-            },
+            die,
             // A rounded die meets the floor through Bullet's convex test (GJK), which, as
             // the plane's, reports points up to the breaking threshold away.
             clear: match scene.floor {
@@ -98,35 +84,31 @@ impl Flight {
         }
     }
 
-    /// Height of the die's lowest point above the floor: y − Σ hᵢ |(Rᵀ ŷ)ᵢ| for the centred
-    /// sharp block (`DieShape::lowest_point`).
+    /// Height of the die's lowest point above the floor (`DieShape::lowest_point`: for the
+    /// centred sharp block y − Σ hᵢ |(Rᵀ ŷ)ᵢ|).
     #[inline]
     pub fn lowest_point(&self, s: &BodyState) -> f64 {
-        let up = up_in_body(&s.rotation);
-        if self.radius == 0.0 && self.com == Vector3::zeros() {
-            s.position.y - up.abs().dot(&self.half)
-        } else {
-            s.position.y - (up.abs().dot(&self.core) + self.radius) - self.com.dot(&up)
-        }
+        self.die.lowest_point(s)
     }
 
     /// The die's state from a flown body state (the engine's `state` from its `body_state`).
     pub fn to_die(&self, body: &BodyState) -> BodyState {
-        match &self.turn {
-            Some(t) => BodyState {
-                rotation: body.rotation * t,
-                ..*body
-            },
-            None => *body,
+        if !self.die.turn.turned() {
+            return *body;
+        }
+        BodyState {
+            rotation: self.die.turn.to_die(&body.rotation),
+            ..*body
         }
     }
 
     /// The lowest point of a flown body state.
     #[inline]
     fn body_lowest(&self, body: &BodyState) -> f64 {
-        match self.turn {
-            Some(_) => self.lowest_point(&self.to_die(body)),
-            None => self.lowest_point(body),
+        if self.die.turn.turned() {
+            self.lowest_point(&self.to_die(body))
+        } else {
+            self.lowest_point(body)
         }
     }
 
@@ -202,12 +184,13 @@ impl Flight {
         // half diagonal. With room for rounding.
         let (q, d) = (s.rotation.quaternion(), dq.quaternion());
         let planar = q.i == 0.0 && q.j == 0.0 && d.i == 0.0 && d.j == 0.0;
+        let d = &self.die;
         let reach = (if planar {
-            self.core.x.hypot(self.core.y)
+            d.core.x.hypot(d.core.y)
         } else {
-            self.core.norm()
-        } + self.radius
-            + self.com.norm())
+            d.core.norm()
+        } + d.radius
+            + d.com.norm())
             * (1.0 + 1e-9);
         // Flight changes only the vertical velocity (x, z and ω are copied), so the last
         // states' velocities are kept as that one number.
@@ -386,7 +369,7 @@ mod tests {
             spacing: 0.25,
         });
         let f = Flight::of(&scene);
-        assert!(f.turn.is_some());
+        assert!(f.die.turn.turned());
         let start = BodyState {
             position: Vector3::new(0.0, 0.5, 0.0),
             rotation: UnitQuaternion::from_euler_angles(0.3, 0.1, 0.2),
@@ -413,7 +396,10 @@ mod tests {
         assert!(close(&die, &f.to_die(&body)), "{die:?}");
         // The die's axes, not the body's: turned by the principal frame.
         assert!(die.rotation.angle_to(&body.rotation) > 1e-6);
-        assert_eq!(die.rotation, engine.body_state().rotation * f.turn.unwrap());
+        assert_eq!(
+            die.rotation,
+            f.die.turn.to_die(&engine.body_state().rotation)
+        );
     }
 
     #[test]

@@ -486,7 +486,7 @@ fn run(
     let certificate = Certificate { margin: cfg.margin };
     let stop_early = cfg.rule == Rule::Certificate;
     let watch = stop_early || cfg.audit;
-    let flight = (cfg.fast_flight && engine.ballistic_flight()).then(|| Flight::of(scene));
+    let flight = (cfg.fast_flight && engine.ballistic_flight()).then(|| Flight::of_die(scene, die));
     let floor_bottom = scene.floor_bottom();
     let mut end = End {
         fate: Fate::Failed(Failure::Engine),
