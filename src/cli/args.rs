@@ -6,7 +6,7 @@ use clap::{Args, ValueEnum};
 use dicephys::engine::EngineKind;
 use dicephys::error::parse_name;
 use dicephys::model::block::Block;
-use dicephys::model::mass::{DieFile, PipShape, Pips};
+use dicephys::model::mass::{DieFile, Pips};
 use dicephys::model::scene::{Floor, Mode, Preset, Scene};
 use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
 use dicephys::run::batch::MAX_THREADS;
@@ -247,16 +247,15 @@ impl SceneArgs {
             f.com = Some(c.map(|x| x / 1000.0));
         }
         if let Some([d, h]) = self.pips {
-            f.pips = Some(Pips {
-                diameter: d / 1000.0,
-                depth: h / 1000.0,
-                ..f.pips.clone().unwrap_or(Pips {
-                    diameter: 0.0,
-                    depth: 0.0,
-                    shape: PipShape::Cap,
-                    fill_density: 0.0,
-                    spacing: 0.25,
-                })
+            // The flags' size on the file's pips (shape, paint, spacing), if it has any.
+            let (d, h) = (d / 1000.0, h / 1000.0);
+            f.pips = Some(match f.pips.take() {
+                Some(p) => Pips {
+                    diameter: d,
+                    depth: h,
+                    ..p
+                },
+                None => Pips::caps(d, h),
             });
         }
         if let Some(r) = self.edge_radius {

@@ -82,6 +82,20 @@ fn quarter() -> f64 {
     0.25
 }
 
+impl Pips {
+    /// Empty spherical caps `diameter` across and `depth` deep (m), at the standard spacing:
+    /// what `--pips D,H` drills.
+    pub fn caps(diameter: f64, depth: f64) -> Pips {
+        Pips {
+            diameter,
+            depth,
+            shape: PipShape::Cap,
+            fill_density: 0.0,
+            spacing: quarter(),
+        }
+    }
+}
+
 /// The pips on a face carrying `n`, in units of the spacing along the face's two axes.
 pub fn pattern(n: u8) -> &'static [(f64, f64)] {
     match n {

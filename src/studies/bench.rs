@@ -359,15 +359,9 @@ pub struct DiceCost {
 /// The made dice `dice_costs` times, each as flags would give it: a weight 2 mm toward
 /// face 6, 3 mm pips 1 mm deep, edges rounded 1 mm, and all three.
 pub fn made_dice() -> Vec<(&'static str, crate::model::mass::Features)> {
-    use crate::model::mass::{Features, PipShape, Pips};
+    use crate::model::mass::{Features, Pips};
     let com = Some([0.0, 0.0, -0.002]);
-    let pips = Some(Pips {
-        diameter: 0.003,
-        depth: 0.001,
-        shape: PipShape::Cap,
-        fill_density: 0.0,
-        spacing: 0.25,
-    });
+    let pips = Some(Pips::caps(0.003, 0.001));
     vec![
         ("sharp uniform", Features::default()),
         (
