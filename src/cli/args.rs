@@ -11,7 +11,7 @@ use dicephys::model::scene::{Floor, Mode, Preset, Scene};
 use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
 use dicephys::run::batch::MAX_THREADS;
 use dicephys::run::spec::ThrowSpec;
-use dicephys::sim::roll::{early_stop_exact, RollConfig, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
+use dicephys::sim::roll::{RollConfig, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
 
 /// The scene: the block, the surface, the time step.
 #[derive(Args, Debug, Clone)]
@@ -302,22 +302,6 @@ impl ThrowArgs {
                 "--kappa: only --throw hand takes a concentration, not --throw {style}"
             )));
         }
-        if style == ThrowStyle::Rest {
-            // A die released at rest has no velocity, spin or drop: a range given is a mistake.
-            let default = ThrowRanges::default();
-            for (flag, given, dflt) in [
-                ("--velocity", self.velocity, default.velocity),
-                ("--spin", self.spin, default.spin),
-                ("--drop-height", self.drop_height, default.drop_height),
-            ] {
-                if given != dflt {
-                    return Err(Error::Usage(format!(
-                        "{flag} {given}: --throw rest releases the die at rest and uses no \
-                         range; leave {flag} out"
-                    )));
-                }
-            }
-        }
         if self.kappa.is_none() && style == ThrowStyle::Hand {
             return Err(Error::Usage(
                 "--throw hand needs --kappa K (0: the tumble's spread; large: the paper's throw)"
@@ -342,25 +326,19 @@ impl RunArgs {
     /// How each roll is carried out and ended, checked, for a scene with time step `dt`: the
     /// early stop by default only where it is exact (`roll::EARLY_STOP_MAX_DT`).
     pub fn roll(&self, dt: f64) -> Result<RollConfig> {
-        // An audit compares the certificate with the full settle, so it settles fully.
-        let certificate = match self.settle {
-            Some(s) => s == SettleArg::Certificate,
-            None => early_stop_exact(dt),
-        };
-        let rule = if certificate && !self.faithful && !self.audit {
-            Rule::Certificate
-        } else {
-            Rule::Dicephys
-        };
-        let cfg = RollConfig {
-            max_steps: self.max_steps,
-            rule,
-            margin: self.margin,
-            audit: self.audit,
-            fast_flight: self.flight == FlightArg::Fast && !self.faithful,
-        };
-        cfg.validate()?;
-        Ok(cfg)
+        let settle = self.settle.map(|s| match s {
+            SettleArg::Certificate => Rule::Certificate,
+            SettleArg::Dicephys => Rule::Dicephys,
+        });
+        Ok(RollConfig::chosen(
+            dt,
+            settle,
+            self.flight == FlightArg::Fast,
+            self.faithful,
+            self.audit,
+            self.max_steps,
+            self.margin,
+        )?)
     }
 
     /// The worker threads, checked (0: one per core).

@@ -88,6 +88,26 @@ impl ThrowSpec {
                 )))
             }
         }
+        if self.style == ThrowStyle::Rest {
+            // A die released at rest has no velocity, spin or drop: a range given is a mistake.
+            let (given, paper) = (self.ranges, ThrowRanges::default());
+            for (field, g, p) in [
+                ("velocity", given.velocity, paper.velocity),
+                ("spin", given.spin, paper.spin),
+                ("drop_height", given.drop_height, paper.drop_height),
+            ] {
+                if g != p {
+                    return Err(Error::field(
+                        field,
+                        g,
+                        format!(
+                            "`style` rest releases the die at rest and uses no range; leave \
+                             `{field}` out"
+                        ),
+                    ));
+                }
+            }
+        }
         if self.kind == ThrowKind::Dicephys && !self.style.is_paper() {
             return Err(Error::field(
                 "style",

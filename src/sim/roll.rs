@@ -180,6 +180,35 @@ impl RollConfig {
         }
     }
 
+    /// The roll at time step `dt`, ended by `settle` (default: the early stop where it is
+    /// audited exact, [`early_stop_exact`], else DicePhys's rule), its flight `fast` or
+    /// stepped; `faithful` is DicePhys as the paper ran it (its rule, every step stepped) and
+    /// an audit settles fully, so both take DicePhys's rule. Checked.
+    pub fn chosen(
+        dt: f64,
+        settle: Option<Rule>,
+        fast: bool,
+        faithful: bool,
+        audit: bool,
+        max_steps: u64,
+        margin: f64,
+    ) -> crate::Result<RollConfig> {
+        let certificate = settle.map_or(early_stop_exact(dt), |r| r == Rule::Certificate);
+        let cfg = RollConfig {
+            max_steps,
+            rule: if certificate && !faithful && !audit {
+                Rule::Certificate
+            } else {
+                Rule::Dicephys
+            },
+            margin,
+            audit,
+            fast_flight: fast && !faithful,
+        };
+        cfg.validate()?;
+        Ok(cfg)
+    }
+
     /// Checks every value before anything runs.
     pub fn validate(&self) -> crate::Result<()> {
         use crate::Error;

@@ -181,7 +181,6 @@ pub fn roll(
     precision: Option<Precision>,
     runner: &Runner,
 ) -> Result<RunSummary> {
-    let checkpoint = checkpoint.map(|d| Checkpoint::open(d, spec)).transpose()?;
     let mut csv = match &per_roll {
         Some((out, layout)) => Some(PerRoll::new(out.writer()?, spec.scene.dt, *layout)?),
         None => None,
@@ -192,6 +191,23 @@ pub fn roll(
             None => Ok(()),
         }
     };
+    let summary = roll_into(spec, checkpoint, &mut sink, precision, runner)?;
+    if let Some(c) = csv {
+        c.finish()?.commit()?;
+    }
+    Ok(summary)
+}
+
+/// `roll` with every finished chunk's records, in throw order, handed to `sink` (the per-roll
+/// CSV, or a caller's own table: the Python package's arrays are these same rows).
+pub fn roll_into(
+    spec: &RunSpec,
+    checkpoint: Option<&Path>,
+    sink: &mut dyn FnMut(&[RollRecord]) -> Result<()>,
+    precision: Option<Precision>,
+    runner: &Runner,
+) -> Result<RunSummary> {
+    let checkpoint = checkpoint.map(|d| Checkpoint::open(d, spec)).transpose()?;
     let wall = Instant::now();
     let cpu = process_cpu_seconds();
     let (done, reached) = match precision {
@@ -203,20 +219,17 @@ pub fn roll(
                 p,
                 target,
                 expect,
-                &mut sink,
+                sink,
             )?;
             (done, Some(reached))
         }
-        None => (runner.run(spec, checkpoint.as_ref(), &mut sink)?, None),
+        None => (runner.run(spec, checkpoint.as_ref(), sink)?, None),
     };
     let cost = Cost {
         wall_s: wall.elapsed().as_secs_f64() + done.resumed_wall_s,
         cpu_s: process_cpu_seconds() - cpu + done.resumed_cpu_s,
         threads: runner.threads,
     };
-    if let Some(c) = csv {
-        c.finish()?.commit()?;
-    }
     let mut summary = RunSummary::new(spec, &done.tally, cost);
     summary.partial = !done.complete;
     summary.precision = reached;

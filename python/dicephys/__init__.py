@@ -1,0 +1,588 @@
+"""dicephys from Python: the same engines, the same library and the same numbers as the CLI.
+
+Every function here calls the Rust library the ``dicephys`` program is built on, with the
+library's own types; the same seed gives the same counts as the command line. What comes back
+is the JSON document the command line prints with ``--json`` (docs/json.md names its fields),
+as an object whose fields read as attributes, plus NumPy arrays where a run has rows.
+
+Runs release the GIL and can be stopped with Ctrl-C (``KeyboardInterrupt``, nothing
+half-written). Progress goes to ``progress``: a callable ``progress(done, total)``, ``True``
+for a tqdm bar (when tqdm is installed), ``False`` for none; the default ``None`` shows a tqdm
+bar when tqdm is installed and standard error is a terminal or a notebook.
+
+    >>> import dicephys
+    >>> r = dicephys.roll("140x24x20", rolls=2000, seed=1)
+    >>> r.counts
+    {'breadth': 657, 'length': 0, 'unknown': 0, 'width': 1343}
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json as _json
+import os
+import sys
+import tempfile
+from typing import Any, Callable, Dict, Iterable, List, Mapping, NamedTuple, Optional, Sequence, Tuple, Union
+
+from . import _native
+
+__all__ = [
+    "Document",
+    "Fit",
+    "Roll",
+    "Value",
+    "fair",
+    "fit",
+    "paper",
+    "per_roll_dtype",
+    "predict",
+    "recover",
+    "roll",
+    "study",
+    "theory",
+    "__version__",
+]
+
+__version__: str = _native.version()
+
+PathLike = Union[str, "os.PathLike[str]"]
+Progress = Union[None, bool, Callable[[float, float], Any]]
+RangeArg = Union[None, float, Tuple[float, float]]
+
+# The library's defaults, as the command line's.
+DEFAULT_MAX_STEPS: int = _native.DEFAULT_MAX_STEPS
+DEFAULT_MARGIN: float = _native.DEFAULT_MARGIN
+
+
+class Value(NamedTuple):
+    """A number with its one-standard-error uncertainty."""
+
+    value: float
+    error: float
+
+
+class Document:
+    """A JSON document the library wrote (the ``--json`` output of the matching command).
+
+    Its top-level fields read as attributes (``doc.rolls``) or items (``doc["rolls"]``);
+    ``doc.data`` is the whole parsed document and ``doc.json()`` its text.
+    """
+
+    def __init__(self, text: str) -> None:
+        self._text = text
+        self.data: Dict[str, Any] = _json.loads(text)
+
+    def json(self) -> str:
+        """The document's text, as the command line prints it."""
+        return self._text
+
+    def __getitem__(self, key: str) -> Any:
+        return self.data[key]
+
+    def __getattr__(self, key: str) -> Any:
+        try:
+            return self.__dict__["data"][key]
+        except KeyError:
+            raise AttributeError(key) from None
+
+    def __contains__(self, key: str) -> bool:
+        return key in self.data
+
+    def keys(self) -> Iterable[str]:
+        """The document's top-level fields."""
+        return self.data.keys()
+
+    def __dir__(self) -> List[str]:
+        return sorted(set(super().__dir__()) | set(self.data))
+
+    def __repr__(self) -> str:
+        shown = ", ".join(f"{k}=…" for k in list(self.data)[:6])
+        return f"{type(self).__name__}({shown})"
+
+
+def per_roll_dtype() -> Any:
+    """The NumPy dtype of a roll's per-roll array: the ``--per-roll`` CSV's columns.
+
+    ``outcome`` is the side vertical (empty for a failed roll), ``face`` the number up
+    (0 where the CSV leaves it empty: not settled on a side).
+    """
+    import numpy as np
+
+    return np.dtype(
+        [
+            ("index", np.uint64),
+            ("drop_height_m", np.float64),
+            ("velocity_m_s", np.float64),
+            ("spin_rad_s", np.float64),
+            ("status", "U16"),
+            ("outcome", "U8"),
+            ("steps", np.uint64),
+            ("sim_time_s", np.float64),
+            ("energy_gain", np.uint8),
+            ("dip_steps", np.uint64),
+            ("longest_dip_steps", np.uint64),
+            ("penetration_m", np.float64),
+            ("face", np.uint8),
+        ]
+    )
+
+
+def _rows(csv_bytes: bytes) -> Any:
+    """The per-roll CSV as a NumPy structured array (``per_roll_dtype``)."""
+    import numpy as np
+
+    dtype = per_roll_dtype()
+    reader = csv.reader(io.StringIO(csv_bytes.decode("utf-8")))
+    header = next(reader)
+    if tuple(header) != dtype.names:
+        raise RuntimeError(f"per-roll columns {header} are not {dtype.names}")
+    kinds = [dtype.fields[n][0].kind for n in dtype.names]
+    rows = []
+    for row in reader:
+        rows.append(
+            tuple(
+                (int(v) if v else 0) if k in "ui" else float(v) if k == "f" else v
+                for v, k in zip(row, kinds)
+            )
+        )
+    return np.array(rows, dtype=dtype)
+
+
+class Roll(Document):
+    """A roll's result: ``dicephys roll --json``'s document (docs/json.md, "roll").
+
+    ``counts`` (which side ended vertical), ``faces`` (the number up), ``ratio`` with its
+    error; with ``per_roll=True``, ``per_roll`` is a NumPy structured array of every throw (the
+    ``--per-roll`` CSV's columns, ``per_roll_dtype()``) and ``per_roll_csv`` its bytes.
+    """
+
+    def __init__(self, text: str, csv_bytes: Optional[bytes]) -> None:
+        super().__init__(text)
+        summary = self.data.get("summary", self.data)
+        self.summary: Dict[str, Any] = summary
+        self.per_roll_csv: Optional[bytes] = csv_bytes
+        self.per_roll: Any = _rows(csv_bytes) if csv_bytes is not None else None
+
+    @property
+    def counts(self) -> Dict[str, int]:
+        """Rolls by the side that ended vertical (length, breadth, width, unknown)."""
+        return dict(self.summary["counts"])
+
+    @property
+    def faces(self) -> Dict[str, int]:
+        """Rolls by the number up, ``"1"``…``"6"`` (in 2D the four sides' numbers)."""
+        return dict(self.summary.get("faces", {}))
+
+    @property
+    def ratio(self) -> Value:
+        """N(breadth vertical) / N(width vertical), the paper's ratio, with its error."""
+        return Value(self.summary["ratio"], self.summary["ratio_err"])
+
+    @property
+    def theory_ratio(self) -> float:
+        """The paper's 2D theory of the ratio for this block (its eq. MasterEqu)."""
+        return float(self.summary["theory_ratio"])
+
+
+class Fit(Document):
+    """A fit's result: ``dicephys fit --json``'s document (docs/json.md, "fit"), written with
+    its report and figures into ``out``."""
+
+    def __init__(self, text: str, out: str) -> None:
+        super().__init__(text)
+        self.out: str = out
+
+    @property
+    def path(self) -> str:
+        """The fit's ``fit.json``, which ``predict`` and ``dicephys predict --fit`` read."""
+        return os.path.join(self.out, "fit.json")
+
+
+def _progress(progress: Progress, what: str) -> Tuple[Optional[Callable[[float, float], Any]], Callable[[], None]]:
+    """The callback a run reports to, and what closes it."""
+    if callable(progress):
+        return progress, lambda: None
+    if progress is False:
+        return None, lambda: None
+    try:
+        from tqdm.auto import tqdm  # type: ignore[import-not-found]
+    except ImportError:
+        return None, lambda: None
+    if progress is None and not (sys.stderr.isatty() or "ipykernel" in sys.modules):
+        return None, lambda: None
+    bar = tqdm(total=0, desc=what, unit="roll" if what in ("roll", "fair") else "")
+
+    def tell(done: float, total: float) -> None:
+        bar.total = total
+        bar.n = done
+        bar.refresh()
+
+    return tell, bar.close
+
+
+def _pair(name: str, x: RangeArg) -> Any:
+    if x is None or isinstance(x, (int, float)):
+        return x
+    try:
+        lo, hi = x  # type: ignore[misc]
+        return (float(lo), float(hi))
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}={x!r}: give a number or (low, high)") from None
+
+
+def _triple(name: str, x: Optional[Sequence[float]], n: int) -> Optional[List[float]]:
+    if x is None:
+        return None
+    values = [float(v) for v in x]
+    if len(values) != n:
+        raise ValueError(f"{name}={tuple(x)}: give {n} numbers of mm")
+    return values
+
+
+def roll(
+    block: str,
+    *,
+    rolls: Optional[int] = None,
+    seed: int = 2385,
+    mode: str = "3d",
+    engine: str = "bullet",
+    dt: float = 1e-3,
+    restitution: float = 0.5,
+    friction: float = 0.29,
+    density: Optional[float] = None,
+    throw: str = "paper",
+    kappa: Optional[float] = None,
+    source: str = "keyed",
+    velocity: RangeArg = None,
+    spin: RangeArg = None,
+    drop_height: RangeArg = None,
+    preset: str = "dicephys281",
+    floor: str = "box",
+    floor_thickness: Optional[float] = None,
+    linear_damping: float = 0.0,
+    angular_damping: float = 0.0,
+    sleep: bool = True,
+    settle: Optional[str] = None,
+    flight: str = "fast",
+    faithful: bool = False,
+    max_steps: int = DEFAULT_MAX_STEPS,
+    margin: float = DEFAULT_MARGIN,
+    com: Optional[Sequence[float]] = None,
+    pips: Optional[Sequence[float]] = None,
+    edge_radius: Optional[float] = None,
+    die: Optional[PathLike] = None,
+    layout: str = "right",
+    threads: int = 0,
+    per_roll: bool = False,
+    precision: Optional[float] = None,
+    progress: Progress = None,
+) -> Roll:
+    """Throws one block many times on one engine: ``dicephys roll``.
+
+    block: LENGTHxBREADTHxWIDTH in mm, the paper's order ("140x24x20").
+    rolls: throws (default 10,000; with ``precision``, the most it may take, 10,000,000).
+    seed: the keyed throws' seed; the same seed gives the same counts on any thread count.
+    mode: "3d" or "2d" (DicePhys's plane-locked block).
+    engine: "bullet", "rapier" or "rapier-locked".
+    dt: the fixed time step, s.  restitution, friction: the die's e and μ (the floor's are 1).
+    density: kg/m³ (default 800, or the ``die`` file's).
+    throw: "paper", "tumble", "hand" (needs ``kappa``) or "rest".
+    source: "keyed" (each throw from (seed, index)) or "dicephys" (DicePhys's rand()).
+    velocity, spin, drop_height: the throw's ranges, one number or (low, high)
+        (m/s, rad/s, m; defaults the paper's).
+    preset, floor, floor_thickness, linear_damping, angular_damping, sleep: the scene
+        (as ``dicephys roll --help`` says).
+    settle: None (the exact early stop where it is audited exact), "certificate" or
+        "dicephys".  flight: "fast" or "stepped".  faithful: DicePhys as the paper ran it.
+    com: the centre of mass (x, y, z) in mm from the geometric centre; pips: (diameter,
+        depth) in mm; edge_radius: mm; die: a die file (TOML) — a die as it is made.
+    layout: "right" or "left": how the numbers sit on the faces.
+    threads: worker threads (0: one per core).
+    per_roll: also return every throw as a NumPy structured array (``Roll.per_roll``).
+    precision: roll until the ratio's relative 2σ error is at most this fraction
+        (0.02 is 2 %), tested every 1,000 rolls.
+    progress: see the module's help.
+    """
+    tell, close = _progress(progress, "roll")
+    try:
+        text, csv_bytes = _native.roll(
+            block, rolls=rolls, seed=seed, mode=mode, engine=engine, dt=dt,
+            restitution=restitution, friction=friction, density=density, preset=preset,
+            floor=floor, floor_thickness=floor_thickness, linear_damping=linear_damping,
+            angular_damping=angular_damping, sleep=sleep, throw=throw, kappa=kappa,
+            source=source, velocity=_pair("velocity", velocity), spin=_pair("spin", spin),
+            drop_height=_pair("drop_height", drop_height), settle=settle, flight=flight, faithful=faithful,
+            max_steps=max_steps, margin=margin, com=_triple("com", com, 3),
+            pips=_triple("pips", pips, 2), edge_radius=edge_radius,
+            die=None if die is None else os.fspath(die), layout=layout, threads=threads,
+            per_roll=per_roll, precision=precision, progress=tell,
+        )
+    finally:
+        close()
+    return Roll(text, None if csv_bytes is None else bytes(csv_bytes))
+
+
+def fair(
+    block: str,
+    *,
+    null: str = "uniform",
+    throw: str = "tumble",
+    precision: Optional[float] = None,
+    progress: Progress = None,
+    **options: Any,
+) -> Roll:
+    """Is this die fair, face by face: ``dicephys fair --json``.
+
+    Rolls the die as ``roll`` does (any of its options; thrown in a tumble unless ``throw``
+    says otherwise) and sets each face against ``null``: "uniform" (each face 1/6) or
+    "solid-angle" (the quasi-static theory, 3D). The result's ``fairness`` is the fair
+    report (each face's probability, its departure in σ, χ², the throws a tester needs);
+    ``precision`` here is every face's probability's 2σ, a fraction (0.005: ±0.005).
+    """
+    tell, close = _progress(progress, "fair")
+    opts = dict(options)
+    for k in ("velocity", "spin", "drop_height"):
+        if k in opts:
+            opts[k] = _pair(k, opts[k])
+    if "com" in opts:
+        opts["com"] = _triple("com", opts["com"], 3)
+    if "pips" in opts:
+        opts["pips"] = _triple("pips", opts["pips"], 2)
+    if "die" in opts and opts["die"] is not None:
+        opts["die"] = os.fspath(opts["die"])
+    try:
+        text, csv_bytes = _native.roll(
+            block, throw=throw, precision=precision, fair=null, progress=tell, **opts
+        )
+    finally:
+        close()
+    return Roll(text, None if csv_bytes is None else bytes(csv_bytes))
+
+
+def theory(block: Optional[str] = None, *, tolerance: float = 0.1) -> Document:
+    """The paper's closed forms for one block (``dicephys theory --block B --json``), or,
+    without a block, its whole experimental table against the theory (``--table --json``).
+
+    tolerance: the uncertainty of each measured side, mm, carried into R and the ratio.
+    """
+    return Document(_native.theory(block, tolerance))
+
+
+def _out(out: Optional[PathLike], what: str) -> str:
+    if out is None:
+        return tempfile.mkdtemp(prefix=f"dicephys-{what}-")
+    return os.fspath(out)
+
+
+def _run_study(config: str, out: str, threads: int, progress: Progress, what: str) -> Document:
+    tell, close = _progress(progress, what)
+    try:
+        text = _native.study(config, out, threads=threads, progress=tell, log=_log)
+    finally:
+        close()
+    return Document(text)
+
+
+def _log(line: str) -> None:
+    import logging
+
+    logging.getLogger("dicephys").info(line)
+
+
+def paper(
+    out: PathLike = "paper-out",
+    *,
+    rolls: int = 10_000,
+    seed: int = 2385,
+    engines: Sequence[str] = ("bullet", "rapier"),
+    dt: float = 1e-3,
+    max_steps: int = DEFAULT_MAX_STEPS,
+    faithful: bool = False,
+    threads: int = 0,
+    progress: Progress = None,
+) -> Document:
+    """The paper end to end (``dicephys paper``): writes results.json, results.csv, report.md
+    and the figures into ``out`` and returns results.json's document. Run again with the same
+    arguments, it continues where it stopped."""
+    config = _native.paper_config(rolls, seed, list(engines), dt, max_steps, faithful)
+    return _run_study(config, os.fspath(out), threads, progress, "paper")
+
+
+def study(config: Mapping[str, Any], out: PathLike, *, threads: int = 0, progress: Progress = None) -> Document:
+    """Any study the command line runs (``paper``, ``crosscheck``, ``converge``,
+    ``tradeoff``, ``stability``, ``fit``, ``paper --calibrated``) from its configuration as a
+    Slurm plan stores it: a mapping tagged by ``"study"`` (``dicephys slurm … --plan`` writes
+    one to read). Writes its files into ``out``; returns its JSON result."""
+    return _run_study(_json.dumps(dict(config)), os.fspath(out), threads, progress, str(config.get("study", "study")))
+
+
+def _data(data: Any) -> str:
+    """The counts as the library reads them: a path, "paper", or CSV text."""
+    if isinstance(data, (str, os.PathLike)):
+        return os.fspath(data)
+    if hasattr(data, "to_csv"):  # a pandas DataFrame
+        return str(data.to_csv(index=False))
+    rows = list(data)
+    if not rows:
+        raise ValueError("data=[]: no rows")
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    return buf.getvalue()
+
+
+def _fit_config(
+    data: Any,
+    free: Sequence[str],
+    shared: Sequence[str],
+    ranges: Optional[Mapping[str, Tuple[float, float]]],
+    restitution: float,
+    friction: float,
+    kappa: Union[None, str, float],
+    spin_scale: float,
+    engine: str,
+    dt: float,
+    max_steps: int,
+    points: int,
+    rolls: int,
+    degree: int,
+    max_degree: int,
+    refine: bool,
+    common_throws: bool,
+    seed: int,
+) -> str:
+    if kappa == "paper":
+        kappa = None
+    rs = [(k, float(lo), float(hi)) for k, (lo, hi) in (ranges or {}).items()]
+    return _native.fit_config(
+        _data(data), list(free), list(shared), rs, restitution, friction,
+        None if kappa is None else float(kappa), spin_scale, engine, dt, max_steps, points,
+        rolls, degree, max_degree, refine, common_throws, seed,
+    )
+
+
+def fit(
+    data: Any,
+    free: Sequence[str] = ("e", "mu"),
+    *,
+    shared: Sequence[str] = (),
+    ranges: Optional[Mapping[str, Tuple[float, float]]] = None,
+    restitution: float = 0.5,
+    friction: float = 0.29,
+    kappa: Union[None, str, float] = "paper",
+    spin_scale: float = 1.0,
+    engine: str = "bullet",
+    dt: float = 1e-3,
+    max_steps: int = DEFAULT_MAX_STEPS,
+    points: int = 64,
+    rolls: int = 500,
+    degree: int = 3,
+    max_degree: int = 4,
+    refine: bool = True,
+    common_throws: bool = False,
+    seed: int = 2385,
+    out: Optional[PathLike] = None,
+    threads: int = 0,
+    progress: Progress = None,
+) -> Fit:
+    """Calibrates e, μ and the throw to measured counts: ``dicephys fit``.
+
+    data: the counts — a CSV path (docs/guide.md, "Calibrating"), "paper" (the paper's 19
+        rows), a pandas DataFrame or a list of dicts with the CSV's columns.
+    free: the free parameters, among "e", "mu", "kappa", "spin".
+    shared: surface parameters shared by every surface instead of one per surface.
+    ranges: a free parameter's box, {"e": (0.05, 0.8)}.
+    restitution, friction, kappa, spin_scale: the values where a parameter is not free
+        (kappa "paper": the paper's throw).
+    points, rolls: the design (points per block per pass, rolls per point).
+    out: where fit.json, report.md, the figures and the simulations' cells are written
+        (default: a new temporary directory, ``Fit.out``).
+    """
+    config = _fit_config(
+        data, free, shared, ranges, restitution, friction, kappa, spin_scale, engine, dt,
+        max_steps, points, rolls, degree, max_degree, refine, common_throws, seed,
+    )
+    where = _out(out, "fit")
+    tell, close = _progress(progress, "fit")
+    try:
+        text = _native.fit(config, where, threads=threads, progress=tell, log=_log)
+    finally:
+        close()
+    return Fit(text, where)
+
+
+def recover(
+    data: Any,
+    truth: Mapping[str, float],
+    *,
+    repeats: int = 20,
+    free: Optional[Sequence[str]] = None,
+    out: Optional[PathLike] = None,
+    threads: int = 0,
+    progress: Progress = None,
+    **options: Any,
+) -> Document:
+    """Checks that a fit recovers known values: ``dicephys fit --recover``.
+
+    Counts of ``data``'s rows (the same blocks and numbers of throws) are simulated at
+    ``truth`` ({"e": 0.5, "mu": 0.3}: a value for every free parameter) and fitted back,
+    ``repeats`` times; the result says how often the 2σ region held the truth. The other
+    options are ``fit``'s.
+    """
+    free = list(free) if free is not None else list(truth)
+    fit_options: Dict[str, Any] = dict(
+        shared=(), ranges=None, restitution=0.5, friction=0.29, kappa="paper", spin_scale=1.0,
+        engine="bullet", dt=1e-3, max_steps=DEFAULT_MAX_STEPS, points=64, rolls=500, degree=3,
+        max_degree=4, refine=True, common_throws=False, seed=2385,
+    )
+    unknown = set(options) - set(fit_options)
+    if unknown:
+        raise TypeError(f"recover() got unexpected options {sorted(unknown)}")
+    fit_options.update(options)
+    config = _fit_config(data, free, **fit_options)
+    where = _out(out, "recover")
+    tell, close = _progress(progress, "recover")
+    try:
+        text = _native.recover(
+            config, [(k, float(v)) for k, v in truth.items()], repeats, where,
+            threads=threads, progress=tell, log=_log,
+        )
+    finally:
+        close()
+    return Document(text)
+
+
+def predict(
+    fit: Union[Fit, PathLike],
+    block: str,
+    *,
+    mode: str = "3d",
+    surface: Optional[str] = None,
+    thrower: Optional[str] = None,
+    draws: int = 16,
+    rolls: int = 2000,
+    seed: int = 2385,
+    threads: int = 0,
+    progress: Progress = None,
+) -> Document:
+    """A block the fit did not see, simulated at the fit's posterior draws:
+    ``dicephys predict --json`` (docs/json.md, "predict").
+
+    fit: a ``Fit``, or the path of a fit's fit.json.
+    surface, thrower: whose fitted values to use, when the fit has several.
+    """
+    path = fit.path if isinstance(fit, Fit) else os.fspath(fit)
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    tell, close = _progress(progress, "predict")
+    try:
+        out = _native.predict(
+            text, block, mode=mode, surface=surface, thrower=thrower, draws=draws,
+            rolls=rolls, seed=seed, threads=threads, progress=tell,
+        )
+    finally:
+        close()
+    return Document(out)

@@ -1,0 +1,854 @@
+//! `dicephys._native`: the library's runs, fits and studies for Python (PyO3).
+//!
+//! Each function takes Python's values, builds the library's own types (the scene, the
+//! throws, the roll, a fit's configuration) and hands them to the same library function the
+//! command line calls, so the same seed gives the same counts. What comes back is the JSON
+//! document the command line prints with `--json` (and, for a roll, its per-roll CSV bytes),
+//! which the package around this module (`python/dicephys/`) turns into objects and arrays.
+//!
+//! Every run works on its own thread with Python's lock released; the calling thread wakes
+//! ten times a second to pass progress and log lines to Python and to let Python handle
+//! signals: Ctrl-C asks the run to stop at its next roll, and the call raises
+//! `KeyboardInterrupt` once the run has ended, with nothing half-written.
+
+use dicephys::calibration::{self, FitConfig};
+use dicephys::engine::EngineKind;
+use dicephys::error::parse_name;
+use dicephys::model::block::Block;
+use dicephys::model::faces::Layout;
+use dicephys::model::mass::{DieFile, Pips};
+use dicephys::model::scene::{Floor, Mode, Preset, Scene};
+use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
+use dicephys::report::per_roll::PerRoll;
+use dicephys::report::summary::Target;
+use dicephys::run::runner::{ChunkShare, Runner};
+use dicephys::run::spec::{RunSpec, ThrowSpec};
+use dicephys::run::stop::Stop;
+use dicephys::sim::roll::{RollConfig, RollRecord, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
+use dicephys::studies::outputs::{self, Done, Hooks, Place};
+use dicephys::studies::StudyConfig;
+use dicephys::Error;
+use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyBytes;
+use std::path::PathBuf;
+use std::sync::{Condvar, Mutex};
+use std::time::Duration;
+
+/// The Python argument that sets a field of the library's configurations: most are the
+/// field's own name; these are spelt otherwise.
+fn argument(field: &str) -> &str {
+    match field {
+        "style" => "throw",
+        "kind" => "source",
+        f => f.split('.').next().unwrap_or(f),
+    }
+}
+
+/// A library message with each field it names in backquotes named by its argument.
+fn arguments_in(why: &str) -> String {
+    why.split('`')
+        .enumerate()
+        .map(|(i, part)| if i % 2 == 1 { argument(part) } else { part })
+        .collect()
+}
+
+/// The library's error as Python's: bad input a `ValueError` naming the argument, a stop
+/// `KeyboardInterrupt`, a file `OSError`, anything else `RuntimeError`.
+fn py_err(e: Error) -> PyErr {
+    match &e {
+        Error::Stopped => PyKeyboardInterrupt::new_err("stopped before the end"),
+        Error::Field { field, value, why } => {
+            let why = arguments_in(why);
+            PyValueError::new_err(if value.is_empty() {
+                format!("{}: {why}", argument(field))
+            } else {
+                format!("{}={value}: {why}", argument(field))
+            })
+        }
+        Error::Io { .. } => PyOSError::new_err(e.to_string()),
+        e if e.is_input() => PyValueError::new_err(arguments_in(&e.to_string())),
+        e => PyRuntimeError::new_err(arguments_in(&e.to_string())),
+    }
+}
+
+/// A bad value of the argument `arg`.
+fn bad(arg: &str, value: impl std::fmt::Display, why: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(format!("{arg}={value}: {why}"))
+}
+
+/// A name the library knows (`engine`, `preset`, …), read for the argument `arg`.
+fn named<T>(arg: &str, what: &str, s: &str) -> PyResult<T>
+where
+    T: std::str::FromStr + strum::VariantNames,
+{
+    parse_name(what, s).map_err(|e| bad(arg, format!("'{s}'"), e))
+}
+
+fn block(s: &str) -> PyResult<Block> {
+    s.parse::<Block>()
+        .map_err(|e| bad("block", format!("'{s}'"), e))
+}
+
+fn mode(s: &str) -> PyResult<Mode> {
+    match s.to_ascii_lowercase().as_str() {
+        "3d" => Ok(Mode::ThreeD),
+        "2d" => Ok(Mode::TwoD),
+        _ => Err(bad("mode", format!("'{s}'"), "give '3d' or '2d'")),
+    }
+}
+
+fn threads(asked: usize) -> PyResult<usize> {
+    use dicephys::run::batch::MAX_THREADS;
+    if asked > MAX_THREADS {
+        return Err(bad("threads", asked, format!("at most {MAX_THREADS}")));
+    }
+    Ok(dicephys::run::batch::threads(asked))
+}
+
+/// A range of the throw: one number, or (low, high).
+fn range(arg: &str, given: Option<&Bound<'_, PyAny>>, default: Range) -> PyResult<Range> {
+    let Some(v) = given else { return Ok(default) };
+    if let Ok(x) = v.extract::<f64>() {
+        return Ok(Range { lo: x, hi: x });
+    }
+    let (lo, hi) = v
+        .extract::<(f64, f64)>()
+        .map_err(|_| bad(arg, v, "give a number or (low, high)"))?;
+    Ok(Range { lo, hi })
+}
+
+/// A run as Python sees it: the stop it can request, and what it has to say while it goes.
+struct Session {
+    stop: Stop,
+    /// Done and in all, in the run's unit.
+    progress: Mutex<(f64, f64)>,
+    /// Log lines not yet passed on.
+    log: Mutex<Vec<String>>,
+    /// The run has ended.
+    over: (Mutex<bool>, Condvar),
+}
+
+impl Session {
+    fn set(&self, done: f64, total: f64) {
+        *self.progress.lock().unwrap() = (done, total);
+    }
+
+    fn say(&self, line: &str) {
+        self.log.lock().unwrap().push(line.to_string());
+    }
+
+    /// Runs `f` with the hooks a study reports to.
+    fn hooked<T>(&self, f: impl FnOnce(&Hooks) -> T) -> T {
+        let log = |l: &str| self.say(l);
+        let progress = |d, t| self.set(d, t);
+        f(&Hooks {
+            log: &log,
+            progress: &progress,
+            stop: self.stop.clone(),
+        })
+    }
+
+    /// Passes progress and log lines to Python's callbacks.
+    fn report(
+        &self,
+        py: Python<'_>,
+        progress: Option<&Bound<'_, PyAny>>,
+        log: Option<&Bound<'_, PyAny>>,
+        last: &mut (f64, f64),
+    ) -> PyResult<()> {
+        let now = *self.progress.lock().unwrap();
+        if let Some(cb) = progress {
+            if now != *last && now.1 > 0.0 {
+                cb.call1((now.0, now.1))?;
+                *last = now;
+            }
+        }
+        let lines = std::mem::take(&mut *self.log.lock().unwrap());
+        if let Some(cb) = log {
+            for l in lines {
+                cb.call1((arguments_in(&l),))?;
+            }
+        }
+        let _ = py;
+        Ok(())
+    }
+}
+
+/// Runs `work` on its own thread with Python's lock released, passing its progress and log
+/// to the callbacks, and stopping it when Python has a signal to raise (Ctrl-C) or a callback
+/// raises: that exception is raised once the run has ended.
+fn detached<T: Send>(
+    py: Python<'_>,
+    progress: Option<&Bound<'_, PyAny>>,
+    log: Option<&Bound<'_, PyAny>>,
+    work: impl FnOnce(&Session) -> dicephys::Result<T> + Send,
+) -> PyResult<T> {
+    let session = Session {
+        stop: Stop::new(),
+        progress: Mutex::new((0.0, 0.0)),
+        log: Mutex::new(Vec::new()),
+        over: (Mutex::new(false), Condvar::new()),
+    };
+    let mut raised: Option<PyErr> = None;
+    let mut last = (-1.0, -1.0);
+    let result = std::thread::scope(|s| {
+        let worker = s.spawn(|| {
+            let r = work(&session);
+            *session.over.0.lock().unwrap() = true;
+            session.over.1.notify_all();
+            r
+        });
+        loop {
+            let over = py.detach(|| {
+                let (lock, cv) = &session.over;
+                let g = lock.lock().unwrap();
+                let (g, _) = cv
+                    .wait_timeout_while(g, Duration::from_millis(100), |o| !*o)
+                    .unwrap();
+                *g
+            });
+            let said = py
+                .check_signals()
+                .and_then(|()| session.report(py, progress, log, &mut last));
+            if let (Err(e), None) = (said, &raised) {
+                session.stop.request();
+                raised = Some(e);
+            }
+            if over {
+                break;
+            }
+        }
+        worker.join()
+    });
+    if let Some(e) = raised {
+        return Err(e);
+    }
+    match result {
+        Ok(r) => r.map_err(py_err),
+        Err(_) => Err(PyRuntimeError::new_err(
+            "the run failed inside (a panic); nothing was returned",
+        )),
+    }
+}
+
+/// The scene, the throws and the roll of `roll` and `fair`, checked by the library.
+#[allow(clippy::too_many_arguments)]
+fn spec(
+    block_: &str,
+    rolls: u64,
+    seed: u64,
+    mode_: &str,
+    engine: &str,
+    dt: f64,
+    restitution: f64,
+    friction: f64,
+    density: Option<f64>,
+    preset: &str,
+    floor: &str,
+    floor_thickness: Option<f64>,
+    linear_damping: f64,
+    angular_damping: f64,
+    sleep: bool,
+    throw: &str,
+    kappa: Option<f64>,
+    source: &str,
+    velocity: Option<&Bound<'_, PyAny>>,
+    spin: Option<&Bound<'_, PyAny>>,
+    drop_height: Option<&Bound<'_, PyAny>>,
+    settle: Option<&str>,
+    flight: &str,
+    faithful: bool,
+    max_steps: u64,
+    margin: f64,
+    com: Option<[f64; 3]>,
+    pips: Option<[f64; 2]>,
+    edge_radius: Option<f64>,
+    die: Option<PathBuf>,
+    layout: Layout,
+) -> PyResult<RunSpec> {
+    let mut scene = Scene::paper(block(block_)?, mode(mode_)?);
+    scene.dt = dt;
+    scene.friction = friction;
+    scene.restitution = restitution;
+    scene.preset = named::<Preset>("preset", "preset", preset)?;
+    scene.floor = named::<Floor>("floor", "floor", floor)?;
+    scene.linear_damping = linear_damping;
+    scene.angular_damping = angular_damping;
+    scene.sleeping = sleep;
+    if let Some(path) = &die {
+        let file = DieFile::read(path).map_err(py_err)?;
+        if let Some(d) = file.density {
+            scene.density = d;
+        }
+        scene.features = file.features();
+    }
+    let f = &mut scene.features;
+    if let Some(c) = com {
+        f.com = Some(c.map(|x| x / 1000.0));
+    }
+    if let Some([d, h]) = pips {
+        let (d, h) = (d / 1000.0, h / 1000.0);
+        f.pips = Some(match f.pips.take() {
+            Some(p) => Pips {
+                diameter: d,
+                depth: h,
+                ..p
+            },
+            None => Pips::caps(d, h),
+        });
+    }
+    if let Some(r) = edge_radius {
+        f.edge_radius = r / 1000.0;
+    }
+    if f.pips.is_some() {
+        // The pips follow the numbers: the layout places them.
+        f.layout = layout;
+    }
+    if let Some(d) = density {
+        scene.density = d;
+    }
+    if let Some(t) = floor_thickness {
+        if scene.floor == Floor::Plane {
+            return Err(bad(
+                "floor_thickness",
+                t,
+                "the plane floor is a half-space; use floor='box'",
+            ));
+        }
+        scene.floor_thickness = t;
+    }
+    let paper = ThrowRanges::default();
+    let throws = ThrowSpec {
+        kind: named::<ThrowKind>("source", "throw source", source)?,
+        seed,
+        ranges: ThrowRanges {
+            velocity: range("velocity", velocity, paper.velocity)?,
+            spin: range("spin", spin, paper.spin)?,
+            drop_height: range("drop_height", drop_height, paper.drop_height)?,
+        },
+        style: named::<ThrowStyle>("throw", "throw style", throw)?,
+        kappa,
+    };
+    let settle =
+        match settle {
+            None => None,
+            Some("certificate") => Some(Rule::Certificate),
+            Some("dicephys") => Some(Rule::Dicephys),
+            Some(s) => return Err(bad(
+                "settle",
+                format!("'{s}'"),
+                "give 'certificate' (the exact early stop) or 'dicephys' (DicePhys's rest rule)",
+            )),
+        };
+    let fast = match flight {
+        "fast" => true,
+        "stepped" => false,
+        s => return Err(bad("flight", format!("'{s}'"), "give 'fast' or 'stepped'")),
+    };
+    let roll =
+        RollConfig::chosen(dt, settle, fast, faithful, false, max_steps, margin).map_err(py_err)?;
+    let spec = RunSpec {
+        engine: named::<EngineKind>("engine", "engine", engine)?,
+        roll,
+        scene,
+        throws,
+        rolls,
+        shard: None,
+    };
+    spec.validate(false).map_err(py_err)?;
+    Ok(spec)
+}
+
+/// Rolls `spec` as `dicephys roll` does: its summary's JSON document (numbered by `layout`)
+/// and, if asked, the per-roll CSV's bytes.
+fn rolled(
+    py: Python<'_>,
+    spec: &RunSpec,
+    layout: Layout,
+    threads_: usize,
+    per_roll: bool,
+    precision: Option<(f64, Target)>,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<(dicephys::report::summary::RunSummary, Option<Vec<u8>>)> {
+    let threads = threads(threads_)?;
+    if let Some((p, _)) = precision {
+        if !(p > 0.0 && p < 1.0) {
+            return Err(bad(
+                "precision",
+                p,
+                "a fraction in (0, 1): 0.02 is a relative 2σ of 2 %",
+            ));
+        }
+    }
+    detached(py, progress, None, |session| {
+        let expected = std::sync::atomic::AtomicU64::new(spec.indices().len());
+        let tell = |n: u64| {
+            let all = expected.load(std::sync::atomic::Ordering::Relaxed);
+            session.set(n as f64, all as f64)
+        };
+        let expect = |n: u64| expected.store(n, std::sync::atomic::Ordering::Relaxed);
+        let runner = Runner::new(threads, session.stop.clone());
+        let runner = runner.with_progress(&tell);
+        let mut csv = match per_roll {
+            true => Some(PerRoll::new(Vec::new(), spec.scene.dt, layout)?),
+            false => None,
+        };
+        let mut sink = |recs: &[RollRecord]| match csv.as_mut() {
+            Some(c) => c.write(recs),
+            None => Ok(()),
+        };
+        let precision = precision.map(|(p, t)| (p, t, &expect as &dyn Fn(u64)));
+        let summary = outputs::roll_into(spec, None, &mut sink, precision, &runner)?;
+        if summary.partial {
+            return Err(Error::Stopped);
+        }
+        let bytes = csv.map(PerRoll::finish).transpose()?;
+        Ok((summary.with_layout(layout), bytes))
+    })
+}
+
+/// `dicephys roll`: many throws of one block on one engine. Returns the `roll --json`
+/// document and, with `per_roll`, the `--per-roll` CSV's bytes.
+#[pyfunction]
+#[pyo3(signature = (block, *, rolls=None, seed=2385, mode="3d", engine="bullet", dt=0.001,
+    restitution=0.5, friction=0.29, density=None, preset="dicephys281", floor="box",
+    floor_thickness=None, linear_damping=0.0, angular_damping=0.0, sleep=true, throw="paper",
+    kappa=None, source="keyed", velocity=None, spin=None, drop_height=None, settle=None,
+    flight="fast", faithful=false, max_steps=DEFAULT_MAX_STEPS, margin=DEFAULT_MARGIN,
+    com=None, pips=None, edge_radius=None, die=None, layout="right", threads=0,
+    per_roll=false, precision=None, fair=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn roll<'py>(
+    py: Python<'py>,
+    block: &str,
+    rolls: Option<u64>,
+    seed: u64,
+    mode: &str,
+    engine: &str,
+    dt: f64,
+    restitution: f64,
+    friction: f64,
+    density: Option<f64>,
+    preset: &str,
+    floor: &str,
+    floor_thickness: Option<f64>,
+    linear_damping: f64,
+    angular_damping: f64,
+    sleep: bool,
+    throw: &str,
+    kappa: Option<f64>,
+    source: &str,
+    velocity: Option<&Bound<'py, PyAny>>,
+    spin: Option<&Bound<'py, PyAny>>,
+    drop_height: Option<&Bound<'py, PyAny>>,
+    settle: Option<&str>,
+    flight: &str,
+    faithful: bool,
+    max_steps: u64,
+    margin: f64,
+    com: Option<[f64; 3]>,
+    pips: Option<[f64; 2]>,
+    edge_radius: Option<f64>,
+    die: Option<PathBuf>,
+    layout: &str,
+    threads: usize,
+    per_roll: bool,
+    precision: Option<f64>,
+    fair: Option<&str>,
+    progress: Option<&Bound<'py, PyAny>>,
+) -> PyResult<(String, Option<Bound<'py, PyBytes>>)> {
+    let layout = named::<Layout>("layout", "layout", layout)?;
+    let null = fair
+        .map(|n| named::<dicephys::studies::fair::Null>("null", "null", n))
+        .transpose()?;
+    let rolls = rolls.unwrap_or(if precision.is_some() {
+        10_000_000
+    } else {
+        10_000
+    });
+    let spec = spec(
+        block,
+        rolls,
+        seed,
+        mode,
+        engine,
+        dt,
+        restitution,
+        friction,
+        density,
+        preset,
+        floor,
+        floor_thickness,
+        linear_damping,
+        angular_damping,
+        sleep,
+        throw,
+        kappa,
+        source,
+        velocity,
+        spin,
+        drop_height,
+        settle,
+        flight,
+        faithful,
+        max_steps,
+        margin,
+        com,
+        pips,
+        edge_radius,
+        die,
+        layout,
+    )?;
+    if null == Some(dicephys::studies::fair::Null::SolidAngle) && spec.scene.mode == Mode::TwoD {
+        return Err(bad(
+            "null",
+            "'solid-angle'",
+            "the solid angle is the 3D theory; in 2D give 'uniform'",
+        ));
+    }
+    let target = if null.is_some() {
+        Target::Faces
+    } else {
+        Target::Ratio
+    };
+    let precision = precision.map(|p| (p, target));
+    let (summary, csv) = rolled(py, &spec, layout, threads, per_roll, precision, progress)?;
+    let json = match null {
+        None => dicephys::run::seal::to_string(&summary, true),
+        Some(null) => {
+            let fair = dicephys::studies::fair::assess(&summary, null).map_err(py_err)?;
+            let doc = serde_json::json!({ "fairness": fair, "summary": summary });
+            dicephys::run::seal::to_string(&doc, true)
+        }
+    }
+    .map_err(py_err)?;
+    Ok((json, csv.map(|b| PyBytes::new(py, &b))))
+}
+
+/// `dicephys theory --block … --json` (or `--table --json` without a block).
+#[pyfunction]
+#[pyo3(signature = (block=None, tolerance=0.1))]
+fn theory(block: Option<&str>, tolerance: f64) -> PyResult<String> {
+    use dicephys::report::table::{block_report, table_report};
+    if !(tolerance.is_finite() && tolerance >= 0.0) {
+        return Err(bad("tolerance", tolerance, "a number of mm, 0 or more"));
+    }
+    let json = match block {
+        Some(b) => serde_json::to_string_pretty(&block_report(&self::block(b)?, tolerance)),
+        None => serde_json::to_string_pretty(&table_report().map_err(py_err)?),
+    };
+    json.map_err(|e| PyRuntimeError::new_err(e.to_string()))
+}
+
+/// Where a study writes: `out` (its cells under `out/cells`), or nothing if `out` is None.
+fn place(out: Option<PathBuf>, cells: &str, threads_: usize, call: &str) -> PyResult<Place> {
+    let threads = threads(threads_)?;
+    Ok(match out {
+        Some(out) => {
+            dicephys::run::owner::refuse_cluster_run(&out).map_err(py_err)?;
+            Place {
+                checkpoint: Some(out.join(cells)),
+                out,
+                threads,
+                share: ChunkShare::All,
+                json: true,
+                command_line: format!("python: dicephys.{call}"),
+            }
+        }
+        None => Place {
+            out: ".".into(),
+            checkpoint: None,
+            threads,
+            share: ChunkShare::All,
+            json: true,
+            command_line: format!("python: dicephys.{call}"),
+        },
+    })
+}
+
+/// A study's JSON result, or Python's exception if it was stopped.
+fn finished(done: Done) -> PyResult<String> {
+    match done.interrupted {
+        Some(m) => Err(PyKeyboardInterrupt::new_err(arguments_in(&m))),
+        None => Ok(done.stdout.trim_end().to_string()),
+    }
+}
+
+/// A study the command line runs (`paper`, `tradeoff`, `converge`, `stability`,
+/// `crosscheck`, `fit`, `paper --calibrated`), from its configuration as a Slurm plan stores
+/// it (JSON, tagged by `study`), writing into `out`. Returns its JSON result.
+#[pyfunction]
+#[pyo3(signature = (config, out, *, threads=0, progress=None, log=None))]
+fn study(
+    py: Python<'_>,
+    config: &str,
+    out: PathBuf,
+    threads: usize,
+    progress: Option<&Bound<'_, PyAny>>,
+    log: Option<&Bound<'_, PyAny>>,
+) -> PyResult<String> {
+    let cfg: StudyConfig = serde_json::from_str(config)
+        .map_err(|e| bad("config", "…", format!("not a study's configuration: {e}")))?;
+    cfg.validate().map_err(py_err)?;
+    let cells = match &cfg {
+        StudyConfig::Fit(_) => "cells",
+        StudyConfig::Calibrated(_) => "calibration",
+        _ => "checkpoint",
+    };
+    let place = place(Some(out), cells, threads, cfg.name())?;
+    let done = detached(py, progress, log, |s| {
+        s.hooked(|h| outputs::run(&cfg, &place, h))
+    })?;
+    finished(done)
+}
+
+/// The default configuration of the study `name` (`paper`, `fit`'s parts are built by
+/// `fit_config`), as JSON, for Python to change and pass to `study`.
+#[pyfunction]
+#[pyo3(signature = (rolls, seed, engines, dt, max_steps, faithful))]
+fn paper_config(
+    rolls: u64,
+    seed: u64,
+    engines: Vec<String>,
+    dt: f64,
+    max_steps: u64,
+    faithful: bool,
+) -> PyResult<String> {
+    let mut kinds = Vec::new();
+    for e in &engines {
+        kinds.push(named::<EngineKind>("engines", "engine", e)?);
+    }
+    kinds.dedup();
+    let cfg = dicephys::studies::paper::PaperConfig {
+        rolls,
+        seed,
+        engines: kinds,
+        dt,
+        max_steps,
+        faithful,
+    };
+    cfg.validate().map_err(py_err)?;
+    serde_json::to_string(&StudyConfig::Paper(cfg))
+        .map_err(|e| PyRuntimeError::new_err(e.to_string()))
+}
+
+/// A fit's configuration (`dicephys fit`'s), from the counts (a CSV file, CSV text, or
+/// "paper") and the model, checked; as JSON.
+#[pyfunction]
+#[pyo3(signature = (data, free, shared, ranges, restitution, friction, kappa, spin_scale,
+    engine, dt, max_steps, points, rolls, degree, max_degree, refine, common_throws, seed))]
+#[allow(clippy::too_many_arguments)]
+fn fit_config(
+    data: &str,
+    free: Vec<String>,
+    shared: Vec<String>,
+    ranges: Vec<(String, f64, f64)>,
+    restitution: f64,
+    friction: f64,
+    kappa: Option<f64>,
+    spin_scale: f64,
+    engine: &str,
+    dt: f64,
+    max_steps: u64,
+    points: usize,
+    rolls: u64,
+    degree: usize,
+    max_degree: usize,
+    refine: bool,
+    common_throws: bool,
+    seed: u64,
+) -> PyResult<String> {
+    use calibration::params::{Fixed, FixedThrow, Kind, Method, ModelSpec};
+    let kind = |arg: &str, s: &str| named::<Kind>(arg, "parameter", s);
+    let mut free_kinds = free
+        .iter()
+        .map(|s| kind("free", s))
+        .collect::<PyResult<Vec<_>>>()?;
+    free_kinds.sort();
+    let mut model = ModelSpec::free(&free_kinds);
+    for (name, lo, hi) in ranges {
+        let k = kind("ranges", &name)?;
+        let i = free_kinds
+            .iter()
+            .position(|f| *f == k)
+            .ok_or_else(|| bad("ranges", &name, "not among the free parameters"))?;
+        model.ranges[i] = Range { lo, hi };
+    }
+    model.shared = shared
+        .iter()
+        .map(|s| kind("shared", s))
+        .collect::<PyResult<_>>()?;
+    model.fixed = Fixed {
+        e: restitution,
+        mu: friction,
+        throw: kappa.map_or(FixedThrow::Paper, FixedThrow::Hand),
+        spin: spin_scale,
+    };
+    model.validate().map_err(py_err)?;
+    let rows = if data == "paper" {
+        calibration::data::paper_rows()
+    } else if data.contains('\n') {
+        calibration::data::parse(data, "data")
+    } else {
+        calibration::data::read(std::path::Path::new(data), &Stop::new())
+    }
+    .map_err(|e| match e {
+        Error::Io { .. } => py_err(e),
+        e => PyValueError::new_err(format!("data: {}", arguments_in(&e.to_string()))),
+    })?;
+    let cfg = FitConfig {
+        rows,
+        model,
+        method: Method {
+            engine: named::<EngineKind>("engine", "engine", engine)?,
+            dt,
+            max_steps,
+        },
+        design: calibration::design::DesignSpec {
+            points,
+            rolls,
+            degree,
+            max_degree,
+            refine,
+            common: common_throws,
+        },
+        search: calibration::estimate::Search {
+            seed,
+            ..Default::default()
+        },
+        seed,
+    };
+    cfg.validate().map_err(py_err)?;
+    serde_json::to_string(&cfg).map_err(|e| PyRuntimeError::new_err(e.to_string()))
+}
+
+/// `dicephys fit`: the fit of `config` (from `fit_config`), written into `out`; its JSON.
+#[pyfunction]
+#[pyo3(signature = (config, out, *, threads=0, progress=None, log=None))]
+fn fit(
+    py: Python<'_>,
+    config: &str,
+    out: PathBuf,
+    threads: usize,
+    progress: Option<&Bound<'_, PyAny>>,
+    log: Option<&Bound<'_, PyAny>>,
+) -> PyResult<String> {
+    let config: FitConfig = serde_json::from_str(config)
+        .map_err(|e| bad("config", "…", format!("not a fit's configuration: {e}")))?;
+    let cfg = StudyConfig::Fit(dicephys::studies::fit::FitStudy {
+        config,
+        stage: dicephys::studies::fit::Stage::Whole,
+    });
+    let place = place(Some(out), "cells", threads, "fit")?;
+    finished(detached(py, progress, log, |s| {
+        s.hooked(|h| outputs::run(&cfg, &place, h))
+    })?)
+}
+
+/// `dicephys fit --recover`: counts simulated at `truth` (the free parameters' values, in
+/// the model's order), fitted back `repeats` times; the coverage's JSON.
+#[pyfunction]
+#[pyo3(signature = (config, truth, repeats, out, *, threads=0, progress=None, log=None))]
+#[allow(clippy::too_many_arguments)]
+fn recover(
+    py: Python<'_>,
+    config: &str,
+    truth: Vec<(String, f64)>,
+    repeats: usize,
+    out: PathBuf,
+    threads: usize,
+    progress: Option<&Bound<'_, PyAny>>,
+    log: Option<&Bound<'_, PyAny>>,
+) -> PyResult<String> {
+    use calibration::params::Kind;
+    let cfg: FitConfig = serde_json::from_str(config)
+        .map_err(|e| bad("config", "…", format!("not a fit's configuration: {e}")))?;
+    if repeats == 0 {
+        return Err(bad("repeats", 0, "need at least one repetition"));
+    }
+    let mut given = Vec::new();
+    for (name, v) in &truth {
+        let k = named::<Kind>("truth", "parameter", name)?;
+        if !cfg.model.free.contains(&k) {
+            return Err(bad("truth", name, "not among the free parameters"));
+        }
+        given.push((k, *v));
+    }
+    let values = cfg
+        .model
+        .free
+        .iter()
+        .map(|k| {
+            given
+                .iter()
+                .find(|(g, _)| g == k)
+                .map(|g| g.1)
+                .ok_or_else(|| bad("truth", k, "give a value for every free parameter"))
+        })
+        .collect::<PyResult<Vec<f64>>>()?;
+    let place = place(Some(out), "cells", threads, "recover")?;
+    finished(detached(py, progress, log, |s| {
+        s.hooked(|h| dicephys::studies::fit::outputs::recover(&cfg, &values, repeats, &place, h))
+    })?)
+}
+
+/// `dicephys predict`: the fit (its `fit.json`'s text) simulated at a block it did not see;
+/// the prediction's JSON.
+#[pyfunction]
+#[pyo3(signature = (fit, block, *, mode="3d", surface=None, thrower=None, draws=16, rolls=2000,
+    seed=2385, threads=0, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn predict(
+    py: Python<'_>,
+    fit: &str,
+    block: &str,
+    mode: &str,
+    surface: Option<String>,
+    thrower: Option<String>,
+    draws: usize,
+    rolls: u64,
+    seed: u64,
+    threads: usize,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<String> {
+    let fit: calibration::FitResult = dicephys::run::seal::open(fit)
+        .map_err(|e| bad("fit", "…", format!("not a fit's fit.json as written: {e}")))?;
+    fit.check()
+        .map_err(|e| bad("fit", "…", arguments_in(&e.to_string())))?;
+    let cfg = calibration::predict::PredictConfig {
+        block: self::block(block)?,
+        mode: self::mode(mode)?,
+        surface,
+        thrower,
+        draws,
+        rolls,
+        seed,
+    };
+    let place = place(None, "", threads, "predict")?;
+    finished(detached(py, progress, None, |s| {
+        s.hooked(|h| dicephys::studies::fit::outputs::predict(&fit, &cfg, &place, h))
+    })?)
+}
+
+/// The library's version, as `dicephys --version` prints it.
+#[pyfunction]
+fn version() -> &'static str {
+    env!("CARGO_PKG_VERSION")
+}
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(roll, m)?)?;
+    m.add_function(wrap_pyfunction!(theory, m)?)?;
+    m.add_function(wrap_pyfunction!(study, m)?)?;
+    m.add_function(wrap_pyfunction!(paper_config, m)?)?;
+    m.add_function(wrap_pyfunction!(fit_config, m)?)?;
+    m.add_function(wrap_pyfunction!(fit, m)?)?;
+    m.add_function(wrap_pyfunction!(recover, m)?)?;
+    m.add_function(wrap_pyfunction!(predict, m)?)?;
+    m.add_function(wrap_pyfunction!(version, m)?)?;
+    m.add("DEFAULT_MAX_STEPS", DEFAULT_MAX_STEPS)?;
+    m.add("DEFAULT_MARGIN", DEFAULT_MARGIN)?;
+    Ok(())
+}

@@ -1,0 +1,160 @@
+"""The Python package against the command line: the same seed gives the same numbers.
+
+The CLI is target/release/dicephys (or $DICEPHYS_BIN); every comparison is exact (counts,
+per-roll bytes), so each test can fail. Sizes are small: CI runs these in a minute or two.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import dicephys
+
+ROOT = Path(__file__).resolve().parents[2]
+BIN = os.environ.get("DICEPHYS_BIN", str(ROOT / "target" / "release" / "dicephys"))
+
+
+def cli(*args: str) -> dict:
+    out = subprocess.run([BIN, *args], check=True, capture_output=True, text=True).stdout
+    return json.loads(out)
+
+
+@pytest.mark.parametrize(
+    "engine,mode",
+    [("bullet", "3d"), ("bullet", "2d"), ("rapier", "3d"), ("rapier", "2d")],
+)
+def test_counts_equal_the_cli_for_the_same_seed(engine: str, mode: str) -> None:
+    rolls = 600 if engine == "bullet" else 200
+    args = ["roll", "--block", "140x24x20", "--rolls", str(rolls), "--seed", "1", "--engine", engine, "--json"]
+    if mode == "2d":
+        args.append("--2d")
+    want = cli(*args)
+    got = dicephys.roll("140x24x20", rolls=rolls, seed=1, engine=engine, mode=mode, threads=2)
+    assert got.counts == want["counts"]
+    assert got.faces == want["faces"]
+    assert got.ratio == (want["ratio"], want["ratio_err"])
+    assert got.steps_total == want["steps_total"]
+    # The same document, but for the cost of this run.
+    timing = {"wall_s", "cpu_s", "cpu_ms_per_roll", "threads", "checksum"}
+    mine = {k: v for k, v in got.data.items() if k not in timing}
+    theirs = {k: v for k, v in want.items() if k not in timing}
+    assert mine == theirs
+
+
+def test_the_issue_s_example() -> None:
+    # docs/python.md's first line, against `dicephys roll --block 140x24x20 --rolls 2000 --seed 1`.
+    want = cli("roll", "--block", "140x24x20", "--rolls", "2000", "--seed", "1", "--json")
+    assert dicephys.roll(block="140x24x20", rolls=2000, seed=1).counts == want["counts"]
+
+
+def test_per_roll_arrays_match_the_cli_s_csv(tmp_path: Path) -> None:
+    csv = tmp_path / "rolls.csv"
+    subprocess.run(
+        [BIN, "roll", "--block", "16x16x16", "--throw", "tumble", "--com", "0,0,-1", "--pips", "3,1",
+         "--rolls", "300", "--seed", "7", "--per-roll", str(csv)],
+        check=True, capture_output=True,
+    )
+    got = dicephys.roll("16x16x16", throw="tumble", com=(0, 0, -1), pips=(3, 1), rolls=300, seed=7, per_roll=True)
+    assert got.per_roll_csv == csv.read_bytes()
+    a = got.per_roll
+    assert a.dtype == dicephys.per_roll_dtype()
+    assert len(a) == 300 and list(a["index"]) == list(range(300))
+    settled = a["status"] == "settled"
+    # Every settled throw has a face, and the faces tally to the summary's.
+    assert (a["face"][settled] > 0).all()
+    for face, n in got.faces.items():
+        assert int((a["face"] == int(face)).sum()) == n
+    assert np.isclose(a["sim_time_s"], a["steps"] * 1e-3).all()
+
+
+@pytest.mark.parametrize(
+    "kwargs,name",
+    [
+        ({"block": "140x24"}, "block"),
+        ({"block": "140x24x20", "engine": "ode"}, "engine"),
+        ({"block": "140x24x20", "restitution": -0.5}, "restitution"),
+        ({"block": "140x24x20", "friction": float("nan")}, "friction"),
+        ({"block": "140x24x20", "dt": 0.0}, "dt"),
+        ({"block": "140x24x20", "throw": "hand"}, "kappa"),
+        ({"block": "140x24x20", "throw": "rest", "spin": (1, 2)}, "spin"),
+        ({"block": "140x24x20", "mode": "4d"}, "mode"),
+        ({"block": "140x24x20", "threads": 100000}, "threads"),
+        ({"block": "16x16x16", "com": (0, 0, 9)}, "com"),
+        ({"block": "16x16x16", "com": (0, 0)}, "com"),
+        ({"block": "140x24x20", "velocity": "fast"}, "velocity"),
+    ],
+)
+def test_bad_arguments_raise_value_error_naming_them(kwargs: dict, name: str) -> None:
+    with pytest.raises(ValueError, match=name):
+        dicephys.roll(rolls=10, **kwargs)
+
+
+def test_a_signal_stops_a_run_with_keyboard_interrupt() -> None:
+    # SIGINT half a second into a run far longer: Python's own handler raises
+    # KeyboardInterrupt in the caller once the run has stopped, within a second or two.
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    start = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        dicephys.roll("140x24x20", rolls=5_000_000, threads=2)
+    assert time.monotonic() - start < 30
+    # And the next run is whole.
+    assert sum(dicephys.roll("140x24x20", rolls=100).counts.values()) == 100
+
+
+def test_progress_is_called_with_done_and_total() -> None:
+    seen: list = []
+    dicephys.roll("140x24x20", rolls=3000, progress=lambda done, total: seen.append((done, total)))
+    assert seen and seen[-1] == (3000.0, 3000.0)
+    assert all(d <= t for d, t in seen)
+
+
+def test_theory_is_the_cli_s() -> None:
+    assert dicephys.theory("140x24x20").data == cli("theory", "--block", "140x24x20", "--json")
+    table = dicephys.theory()
+    assert len(table.rows) == 19
+
+
+def test_fair_reports_every_face() -> None:
+    want = cli("fair", "--block", "16x16x16", "--com", "0,0,-2", "--rolls", "400", "--json")
+    got = dicephys.fair("16x16x16", com=(0, 0, -2), rolls=400)
+    assert got.faces == want["summary"]["faces"]
+    assert got.fairness["chi2"] == want["fairness"]["chi2"]
+
+
+ROWS = [
+    {"label": "a", "surface": "mdf", "length_mm": 140, "breadth_mm": 24, "width_mm": 20, "mode": "2d",
+     "length_vertical": 0, "breadth_vertical": 0, "width_vertical": 0},
+    {"label": "b", "surface": "mdf", "length_mm": 140, "breadth_mm": 22, "width_mm": 13, "mode": "2d",
+     "length_vertical": 0, "breadth_vertical": 0, "width_vertical": 0},
+]
+
+
+def test_a_fit_recovers_known_values_at_a_tiny_size(tmp_path: Path) -> None:
+    rows = [dict(r, breadth_vertical=4000, width_vertical=6000) for r in ROWS]
+    res = dicephys.recover(rows, {"e": 0.5}, repeats=4, points=8, rolls=400, refine=False, out=tmp_path / "rec")
+    assert res.names == ["e[mdf]"] and res.truth == [0.5]
+    assert len(res.repetitions) == 4
+    # Each repetition's estimate near the truth, and the truth inside most 2σ regions (a
+    # tiny size: the coverage itself is measured at scale in docs/results/calibration.md).
+    for r in res.repetitions:
+        assert abs(r["values"][0] - 0.5) < 0.25
+    assert res.coverage >= 0.5
+
+
+def test_fit_then_predict_through_python(tmp_path: Path) -> None:
+    rows = [dict(r, breadth_vertical=4100, width_vertical=5900) for r in ROWS]
+    f = dicephys.fit(rows, free=["e"], points=8, rolls=300, refine=False, out=tmp_path / "fit")
+    assert Path(f.path).exists()
+    p = dicephys.predict(f, "140x30x10", mode="2d", draws=4, rolls=200)
+    want = cli("predict", "--fit", f.path, "--block", "140x30x10", "--2d", "--draws", "4", "--rolls", "200", "--json")
+    assert p.data == want
