@@ -207,7 +207,7 @@ def _progress(progress: Progress, what: str) -> Tuple[Optional[Callable[[float, 
     if progress is False:
         return None, lambda: None
     try:
-        from tqdm.auto import tqdm  # type: ignore[import-not-found]
+        from tqdm.auto import tqdm  # type: ignore[import-untyped,import-not-found,unused-ignore]
     except ImportError:
         return None, lambda: None
     if progress is None and not (sys.stderr.isatty() or "ipykernel" in sys.modules):
@@ -226,7 +226,7 @@ def _pair(name: str, x: RangeArg) -> Any:
     if x is None or isinstance(x, (int, float)):
         return x
     try:
-        lo, hi = x  # type: ignore[misc]
+        lo, hi = x
         return (float(lo), float(hi))
     except (TypeError, ValueError):
         raise ValueError(f"{name}={x!r}: give a number or (low, high)") from None

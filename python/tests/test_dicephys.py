@@ -158,3 +158,25 @@ def test_fit_then_predict_through_python(tmp_path: Path) -> None:
     p = dicephys.predict(f, "140x30x10", mode="2d", draws=4, rolls=200)
     want = cli("predict", "--fit", f.path, "--block", "140x30x10", "--2d", "--draws", "4", "--rolls", "200", "--json")
     assert p.data == want
+
+
+def test_paper_is_the_cli_s_and_a_stopped_one_writes_nothing(tmp_path: Path) -> None:
+    # Stopped half a second in: KeyboardInterrupt, and no results.json half-written.
+    stopped = tmp_path / "stopped"
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        dicephys.paper(stopped, rolls=200_000, engines=["bullet"])
+    assert not (stopped / "results.json").exists()
+
+    got = dicephys.paper(tmp_path / "py", rolls=200, engines=["bullet"])
+    subprocess.run(
+        [BIN, "paper", "--rolls", "200", "--engines", "bullet", "--out", str(tmp_path / "cli")],
+        check=True, capture_output=True,
+    )
+    want = json.loads((tmp_path / "cli" / "results.json").read_text())
+    assert got.data == json.loads((tmp_path / "py" / "results.json").read_text())
+    def cells(doc: dict) -> list:
+        return [(c["label"], c["mode"], c["engine"], c["run"]["counts"]) for c in doc["simulations"]]
+
+    assert len(cells(want)) == 10 and cells(got.data) == cells(want)
