@@ -252,7 +252,7 @@ def roll(
     restitution: float = 0.5,
     friction: float = 0.29,
     density: Optional[float] = None,
-    throw: str = "paper",
+    throw: Optional[str] = None,
     kappa: Optional[float] = None,
     source: str = "keyed",
     velocity: RangeArg = None,
@@ -288,7 +288,8 @@ def roll(
     engine: "bullet", "rapier" or "rapier-locked".
     dt: the fixed time step, s.  restitution, friction: the die's e and μ (the floor's are 1).
     density: kg/m³ (default 800, or the ``die`` file's).
-    throw: "paper", "tumble", "hand" (needs ``kappa``) or "rest".
+    throw: "paper" (the default), "tumble", "hand" (with ``kappa``) or "rest".
+    kappa: a hand's throw's concentration κ (alone, it asks for ``throw="hand"``).
     source: "keyed" (each throw from (seed, index)) or "dicephys" (DicePhys's rand()).
     velocity, spin, drop_height: the throw's ranges, one number or (low, high)
         (m/s, rad/s, m; defaults the paper's).
@@ -447,7 +448,7 @@ def _fit_config(
     dt: float,
     max_steps: int,
     points: int,
-    rolls: int,
+    point_rolls: int,
     degree: int,
     max_degree: int,
     refine: bool,
@@ -460,7 +461,7 @@ def _fit_config(
     return _native.fit_config(
         _data(data), list(free), list(shared), rs, restitution, friction,
         None if kappa is None else float(kappa), spin_scale, engine, dt, max_steps, points,
-        rolls, degree, max_degree, refine, common_throws, seed,
+        point_rolls, degree, max_degree, refine, common_throws, seed,
     )
 
 
@@ -478,7 +479,7 @@ def fit(
     dt: float = 1e-3,
     max_steps: int = DEFAULT_MAX_STEPS,
     points: int = 64,
-    rolls: int = 500,
+    point_rolls: int = 500,
     degree: int = 3,
     max_degree: int = 4,
     refine: bool = True,
@@ -497,13 +498,13 @@ def fit(
     ranges: a free parameter's box, {"e": (0.05, 0.8)}.
     restitution, friction, kappa, spin_scale: the values where a parameter is not free
         (kappa "paper": the paper's throw).
-    points, rolls: the design (points per block per pass, rolls per point).
+    points, point_rolls: the design (parameter points per block per pass, rolls at each).
     out: where fit.json, report.md, the figures and the simulations' cells are written
         (default: a new temporary directory, ``Fit.out``).
     """
     config = _fit_config(
         data, free, shared, ranges, restitution, friction, kappa, spin_scale, engine, dt,
-        max_steps, points, rolls, degree, max_degree, refine, common_throws, seed,
+        max_steps, points, point_rolls, degree, max_degree, refine, common_throws, seed,
     )
     where = _out(out, "fit")
     tell, close = _progress(progress, "fit")
@@ -535,7 +536,7 @@ def recover(
     free = list(free) if free is not None else list(truth)
     fit_options: Dict[str, Any] = dict(
         shared=(), ranges=None, restitution=0.5, friction=0.29, kappa="paper", spin_scale=1.0,
-        engine="bullet", dt=1e-3, max_steps=DEFAULT_MAX_STEPS, points=64, rolls=500, degree=3,
+        engine="bullet", dt=1e-3, max_steps=DEFAULT_MAX_STEPS, points=64, point_rolls=500, degree=3,
         max_degree=4, refine=True, common_throws=False, seed=2385,
     )
     unknown = set(options) - set(fit_options)

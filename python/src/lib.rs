@@ -250,7 +250,7 @@ fn spec(
     linear_damping: f64,
     angular_damping: f64,
     sleep: bool,
-    throw: &str,
+    throw: Option<&str>,
     kappa: Option<f64>,
     source: &str,
     velocity: Option<&Bound<'_, PyAny>>,
@@ -327,7 +327,12 @@ fn spec(
             spin: range("spin", spin, paper.spin)?,
             drop_height: range("drop_height", drop_height, paper.drop_height)?,
         },
-        style: named::<ThrowStyle>("throw", "throw style", throw)?,
+        // `kappa` is a hand's concentration: given alone, it asks for a hand's throw.
+        style: match throw {
+            Some(t) => named::<ThrowStyle>("throw", "throw style", t)?,
+            None if kappa.is_some() => ThrowStyle::Hand,
+            None => ThrowStyle::Paper,
+        },
         kappa,
     };
     let settle =
@@ -413,7 +418,7 @@ fn rolled(
 #[pyfunction]
 #[pyo3(signature = (block, *, rolls=None, seed=2385, mode="3d", engine="bullet", dt=0.001,
     restitution=0.5, friction=0.29, density=None, preset="dicephys281", floor="box",
-    floor_thickness=None, linear_damping=0.0, angular_damping=0.0, sleep=true, throw="paper",
+    floor_thickness=None, linear_damping=0.0, angular_damping=0.0, sleep=true, throw=None,
     kappa=None, source="keyed", velocity=None, spin=None, drop_height=None, settle=None,
     flight="fast", faithful=false, max_steps=DEFAULT_MAX_STEPS, margin=DEFAULT_MARGIN,
     com=None, pips=None, edge_radius=None, die=None, layout="right", threads=0,
@@ -436,7 +441,7 @@ fn roll<'py>(
     linear_damping: f64,
     angular_damping: f64,
     sleep: bool,
-    throw: &str,
+    throw: Option<&str>,
     kappa: Option<f64>,
     source: &str,
     velocity: Option<&Bound<'py, PyAny>>,
@@ -637,7 +642,7 @@ fn paper_config(
 /// "paper") and the model, checked; as JSON.
 #[pyfunction]
 #[pyo3(signature = (data, free, shared, ranges, restitution, friction, kappa, spin_scale,
-    engine, dt, max_steps, points, rolls, degree, max_degree, refine, common_throws, seed))]
+    engine, dt, max_steps, points, point_rolls, degree, max_degree, refine, common_throws, seed))]
 #[allow(clippy::too_many_arguments)]
 fn fit_config(
     data: &str,
@@ -652,7 +657,7 @@ fn fit_config(
     dt: f64,
     max_steps: u64,
     points: usize,
-    rolls: u64,
+    point_rolls: u64,
     degree: usize,
     max_degree: usize,
     refine: bool,
@@ -707,7 +712,7 @@ fn fit_config(
         },
         design: calibration::design::DesignSpec {
             points,
-            rolls,
+            rolls: point_rolls,
             degree,
             max_degree,
             refine,

@@ -141,7 +141,7 @@ ROWS = [
 
 def test_a_fit_recovers_known_values_at_a_tiny_size(tmp_path: Path) -> None:
     rows = [dict(r, breadth_vertical=4000, width_vertical=6000) for r in ROWS]
-    res = dicephys.recover(rows, {"e": 0.5}, repeats=4, points=8, rolls=400, refine=False, out=tmp_path / "rec")
+    res = dicephys.recover(rows, {"e": 0.5}, repeats=4, points=8, point_rolls=400, refine=False, out=tmp_path / "rec")
     assert res.names == ["e[mdf]"] and res.truth == [0.5]
     assert len(res.repetitions) == 4
     # Each repetition's estimate near the truth, and the truth inside most 2σ regions (a
@@ -153,7 +153,7 @@ def test_a_fit_recovers_known_values_at_a_tiny_size(tmp_path: Path) -> None:
 
 def test_fit_then_predict_through_python(tmp_path: Path) -> None:
     rows = [dict(r, breadth_vertical=4100, width_vertical=5900) for r in ROWS]
-    f = dicephys.fit(rows, free=["e"], points=8, rolls=300, refine=False, out=tmp_path / "fit")
+    f = dicephys.fit(rows, free=["e"], points=8, point_rolls=300, refine=False, out=tmp_path / "fit")
     assert Path(f.path).exists()
     p = dicephys.predict(f, "140x30x10", mode="2d", draws=4, rolls=200)
     want = cli("predict", "--fit", f.path, "--block", "140x30x10", "--2d", "--draws", "4", "--rolls", "200", "--json")

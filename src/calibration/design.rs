@@ -78,13 +78,13 @@ impl DesignSpec {
             ));
         }
         if self.points > 100_000 {
-            return bad(format!("points {}: at most 100000", self.points));
+            return Err(Error::field("points", self.points, "at most 100000"));
         }
         if self.rolls == 0 || self.rolls > crate::run::spec::MAX_ROLLS {
-            return bad(format!(
-                "rolls {}: 1 to {}",
+            return Err(Error::field(
+                "point_rolls",
                 self.rolls,
-                crate::run::spec::MAX_ROLLS
+                format!("from 1 to {}", crate::run::spec::MAX_ROLLS),
             ));
         }
         if !(1..=6).contains(&self.degree) || self.max_degree < self.degree || self.max_degree > 6 {

@@ -106,9 +106,10 @@ pub struct ThrowArgs {
     /// Seed of the throws.
     #[arg(long, default_value_t = 2385)]
     pub seed: u64,
-    /// keyed (each throw from (seed, index)) or dicephys (DicePhys's glibc rand() sequence).
-    #[arg(long, default_value = "keyed", value_parser = parse_throw_kind)]
-    pub throws: ThrowKind,
+    /// Where the throws' numbers come from: keyed (each throw from (seed, index)) or dicephys
+    /// (DicePhys's glibc rand() sequence, the paper's throw only).
+    #[arg(long = "source", alias = "throws", default_value = "keyed", value_parser = parse_throw_kind)]
+    pub source: ThrowKind,
     /// Linear velocity along x, m/s: LO:HI, or one number.
     #[arg(long, default_value = "-0.2:0.2", allow_hyphen_values = true)]
     pub velocity: Range,
@@ -125,9 +126,9 @@ pub struct ThrowArgs {
     /// range is used). [default: paper; `fair`: tumble]
     #[arg(long = "throw", value_parser = parse_throw_style)]
     pub style: Option<ThrowStyle>,
-    /// A hand's throw's concentration κ >= 0: the paper's throw turned by random angles whose
-    /// mean cosine is coth κ − 1/κ (0: the tumble's spread; large: the paper's throw).
-    /// Requires --throw hand.
+    /// A hand's throw, with this concentration κ >= 0: the paper's throw turned by random
+    /// angles whose mean cosine is coth κ − 1/κ (0: the tumble's spread; large: the paper's
+    /// throw). Implies --throw hand.
     #[arg(long, value_name = "KAPPA", allow_hyphen_values = true)]
     pub kappa: Option<f64>,
 }
@@ -190,7 +191,7 @@ pub struct RunArgs {
     pub flight: FlightArg,
     /// DicePhys exactly as the paper ran it: --settle dicephys --flight stepped (with the
     /// defaults --floor box --preset dicephys281).
-    #[arg(long)]
+    #[arg(long, conflicts_with_all = ["settle", "flight"])]
     pub faithful: bool,
 }
 
@@ -206,7 +207,7 @@ pub fn parse_preset(s: &str) -> std::result::Result<Preset, dicephys::Error> {
 pub fn parse_floor(s: &str) -> std::result::Result<Floor, dicephys::Error> {
     parse_name("floor", s)
 }
-/// `--throws` as clap reads it.
+/// `--source` as clap reads it.
 pub fn parse_throw_kind(s: &str) -> std::result::Result<ThrowKind, dicephys::Error> {
     parse_name("throw source", s)
 }
@@ -285,9 +286,14 @@ impl ThrowArgs {
 
     /// The throws, checked, in the style `default` unless `--throw` gives one.
     pub fn spec_or(&self, default: ThrowStyle) -> Result<ThrowSpec> {
-        let style = self.style.unwrap_or(default);
+        // --kappa is a hand's concentration: given alone, it asks for a hand's throw.
+        let style = self.style.unwrap_or(if self.kappa.is_some() {
+            ThrowStyle::Hand
+        } else {
+            default
+        });
         let spec = ThrowSpec {
-            kind: self.throws,
+            kind: self.source,
             seed: self.seed,
             ranges: ThrowRanges {
                 velocity: self.velocity,

@@ -14,6 +14,7 @@ pub struct BenchArgs {
     /// uniform die, a 16 mm cube in a tumble, one thread; a quarter as many on Rapier (0: none).
     #[arg(long, default_value_t = 2000)]
     pub dice_rolls: u64,
+    /// Seed of the keyed throws: the same seed gives the same rolls on any thread count.
     #[arg(long, default_value_t = 2385)]
     pub seed: u64,
     /// Threads for the "all threads" measurements (0: one per core).
@@ -23,6 +24,7 @@ pub struct BenchArgs {
     /// every time); for a machine shared with other work.
     #[arg(long, default_value_t = 1)]
     pub repeat: u32,
+    /// Print one JSON document (docs/json.md, `bench --json`) instead of the table.
     #[arg(long)]
     pub json: bool,
 }

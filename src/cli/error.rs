@@ -65,7 +65,7 @@ impl From<dicephys::Error> for Error {
 fn flag(field: &str) -> String {
     match field {
         "style" => "--throw".into(),
-        "kind" => "--throws".into(),
+        "kind" => "--source".into(),
         "budget_s" => "--budget".into(),
         "reference_budget_s" => "--reference-budget".into(),
         "preroll_chunks" => "--preroll".into(),

@@ -42,9 +42,10 @@ pub struct FitArgs {
     /// μ where it is not free.
     #[arg(long, default_value_t = 0.29, allow_hyphen_values = true)]
     pub friction: f64,
-    /// The throw where kappa is not free: "paper" (the paper's throw) or a hand's κ.
-    #[arg(long, default_value = "paper", allow_hyphen_values = true)]
-    pub kappa: String,
+    /// Where kappa is not free: a hand's throw with this concentration κ, as `roll --kappa`
+    /// [default: the paper's throw].
+    #[arg(long, value_name = "KAPPA", allow_hyphen_values = true)]
+    pub kappa: Option<String>,
     /// The spin scale where spin is not free.
     #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     pub spin_scale: f64,
@@ -60,8 +61,8 @@ pub struct FitArgs {
     /// Parameter points each block is simulated at.
     #[arg(long, default_value_t = 64)]
     pub points: usize,
-    /// Rolls at each point.
-    #[arg(long, default_value_t = 500)]
+    /// Rolls at each parameter point (as `paper --calibrated --point-rolls`).
+    #[arg(long = "point-rolls", alias = "rolls", default_value_t = 500)]
     pub rolls: u64,
     /// The surrogate's polynomial degree (raised while it lacks fit, up to --max-degree).
     #[arg(long, default_value_t = 3)]
@@ -200,10 +201,14 @@ impl FitArgs {
             })?;
             model.ranges[i] = r;
         }
-        let throw = match self.kappa.as_str() {
-            "paper" => FixedThrow::Paper,
-            k => FixedThrow::Hand(k.parse().map_err(|_| {
-                Error::Usage(format!("--kappa {k}: 'paper' or a concentration >= 0"))
+        // `--kappa paper`, the paper's throw, was the spelling before --kappa meant only a
+        // hand's κ; it is still read.
+        let throw = match self.kappa.as_deref() {
+            None | Some("paper") => FixedThrow::Paper,
+            Some(k) => FixedThrow::Hand(k.parse().map_err(|_| {
+                Error::Usage(format!(
+                    "--kappa {k}: a hand's concentration, a number >= 0"
+                ))
             })?),
         };
         model.shared = self.shared.clone();

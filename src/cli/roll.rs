@@ -31,7 +31,7 @@ const DEFINING: [&str; 28] = [
     "preset",
     "floor",
     "seed",
-    "throws",
+    "source",
     "velocity",
     "spin",
     "drop_height",

@@ -26,11 +26,13 @@ pub struct ConvergeArgs {
     /// 1/60,1/120,1/240,1/500,1/1000,1/2000,1/5000,1/10000.
     #[arg(long, value_delimiter = ',', default_value = "1/60,1/250,1/1000,1/5000", value_parser = parse_dt)]
     pub dts: Vec<f64>,
+    /// Engines to simulate with (comma-separated): bullet, rapier, rapier-locked.
     #[arg(long, value_delimiter = ',', default_value = "bullet,rapier", value_parser = parse_engine)]
     pub engines: Vec<EngineKind>,
     /// Rolls per cell (block × engine × mode × dt).
     #[arg(long, default_value_t = 200)]
     pub rolls: u64,
+    /// Seed of the keyed throws: the same seed gives the same rolls on any thread count.
     #[arg(long, default_value_t = 2385)]
     pub seed: u64,
     /// Worker threads (0: one per core).
@@ -63,6 +65,7 @@ pub struct ConvergeArgs {
 
 #[derive(Args, Debug)]
 pub struct TradeoffArgs {
+    /// The block, LENGTHxBREADTHxWIDTH in mm.
     #[arg(long, default_value = "140x24x20", conflicts_with = "blocks")]
     pub block: Block,
     /// Several blocks (comma-separated), each with its own reference and methods, and a
@@ -94,10 +97,13 @@ pub struct TradeoffArgs {
     /// CPU seconds the reference (each mode's) may spend.
     #[arg(long, default_value_t = 1800.0)]
     pub reference_budget: f64,
+    /// Seed of the keyed throws: the same seed gives the same rolls on any thread count.
     #[arg(long, default_value_t = 2385)]
     pub seed: u64,
+    /// Worker threads (0: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
+    /// Steps after which a roll not at rest counts as unconverged.
     #[arg(long, default_value_t = 2_000_000)]
     pub max_steps: u64,
     /// Output directory [default: tradeoff-out].
@@ -112,6 +118,7 @@ pub struct TradeoffArgs {
     /// `dicephys slurm tradeoff` do, before its finishing job runs the study, reading them back.
     #[arg(long, value_name = "ROLLS")]
     pub preroll: Option<u64>,
+    /// Print tradeoff.json to stdout instead of the table.
     #[arg(long)]
     pub json: bool,
 }
@@ -148,6 +155,7 @@ fn parse_dt_or_none(s: &str) -> std::result::Result<Option<f64>, String> {
 
 #[derive(Args, Debug)]
 pub struct StabilityArgs {
+    /// Engines to simulate with (comma-separated): bullet, rapier, rapier-locked.
     #[arg(long, value_delimiter = ',', default_value = "bullet,rapier", value_parser = parse_engine)]
     pub engines: Vec<EngineKind>,
     /// Time steps of the dt × restitution grid.
@@ -170,8 +178,10 @@ pub struct StabilityArgs {
     /// 1 % at 95 %.
     #[arg(long, default_value_t = 300)]
     pub rolls: u64,
+    /// Seed of the keyed throws: the same seed gives the same rolls on any thread count.
     #[arg(long, default_value_t = 2385)]
     pub seed: u64,
+    /// Worker threads (0: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
     /// The step cap: a roll still moving after it is unconverged.
@@ -184,6 +194,7 @@ pub struct StabilityArgs {
     /// Output directory [default: stability-out].
     #[arg(long, value_name = "OUT")]
     pub out: Option<PathBuf>,
+    /// Print stability.json to stdout instead of the table.
     #[arg(long)]
     pub json: bool,
 }

@@ -27,6 +27,7 @@ pub struct TraceArgs {
     /// Print every Nth step (the first and the last are always printed).
     #[arg(long, default_value_t = 1)]
     pub every: u64,
+    /// Steps after which the throw, not at rest, stops being traced.
     #[arg(long, default_value_t = DEFAULT_MAX_STEPS)]
     pub max_steps: u64,
     /// Free flight: stepped (every step by the engine) or fast (integrated in closed form where

@@ -15,6 +15,7 @@ use std::path::PathBuf;
 /// `dicephys validate`'s arguments.
 #[derive(Args, Debug)]
 pub struct ValidateArgs {
+    /// Engines to simulate with (comma-separated): bullet, rapier, rapier-locked.
     #[arg(long, value_delimiter = ',', default_value = "bullet,rapier", value_parser = parse_engine)]
     pub engines: Vec<EngineKind>,
     /// Rolls per limit cell (block × engine × case).
@@ -23,6 +24,7 @@ pub struct ValidateArgs {
     /// Rolls per point of the trend.
     #[arg(long, default_value_t = v::Config::default().trend_rolls)]
     pub trend_rolls: u64,
+    /// Seed of the keyed throws: the same seed gives the same rolls on any thread count.
     #[arg(long, default_value_t = 2385)]
     pub seed: u64,
     /// Worker threads (0: one per core).
@@ -55,6 +57,7 @@ pub struct ValidateArgs {
     /// cannot says how many would.
     #[arg(long, default_value_t = v::Config::default().resolve)]
     pub resolve: f64,
+    /// Output directory: validate.json, report.md and the figures.
     #[arg(long, default_value = "validate-out")]
     pub out: PathBuf,
     /// Print validate.json to stdout instead of the table.

@@ -193,6 +193,22 @@ impl RollConfig {
         max_steps: u64,
         margin: f64,
     ) -> crate::Result<RollConfig> {
+        if settle == Some(Rule::Certificate) && (faithful || audit) {
+            let who = if audit {
+                "an audit"
+            } else {
+                "the faithful run"
+            };
+            return Err(crate::Error::field(
+                "settle",
+                "certificate",
+                format!(
+                    "{who} settles by DicePhys's rule (an audit watches the certificate without \
+                     stopping); leave out `settle` or `{}`",
+                    if audit { "audit" } else { "faithful" }
+                ),
+            ));
+        }
         let certificate = settle.map_or(early_stop_exact(dt), |r| r == Rule::Certificate);
         let cfg = RollConfig {
             max_steps,

@@ -212,7 +212,7 @@ fn bad_input_names_the_flag_that_was_typed() {
                 "--throws",
                 "dicephys",
             ],
-            "--throws keyed",
+            "--source keyed",
         ),
         (
             &["paper", "--engines", "", "--out", "/nonexistent/x"],
@@ -402,4 +402,52 @@ fn crosscheck_precision_rolls_the_engines_in_step_until_each_is_resolved() {
     assert_eq!(bad.status.code(), Some(2));
     let bad = dicephys(&["roll", "--precision", "0"]);
     assert_eq!(bad.status.code(), Some(2));
+}
+
+/// One name per concept: `--source` (was `--throws`), `fit --point-rolls` (was `--rolls`),
+/// `--kappa K` a hand's throw everywhere. The old spellings are still read, to the same run;
+/// flags that would be ignored beside another are refused, not overridden in silence.
+#[test]
+fn the_old_spellings_still_read_and_ignored_flags_are_refused() {
+    let run = |extra: &[&str]| {
+        let base = ["roll", "--block", "140x24x20", "--rolls", "100", "--json"];
+        let doc = json(&dicephys(&[&base[..], extra].concat()));
+        (doc["counts"].clone(), doc["spec"].clone())
+    };
+    assert_eq!(
+        run(&["--source", "dicephys", "--faithful"]),
+        run(&["--throws", "dicephys", "--faithful"])
+    );
+    assert_eq!(
+        run(&["--kappa", "5"]),
+        run(&["--throw", "hand", "--kappa", "5"])
+    );
+    let fit = |flag: &str| {
+        let out = dicephys(&["fit", "--data", "paper", flag, "0", "--json"]);
+        String::from_utf8_lossy(&out.stderr).to_string()
+    };
+    // Both spellings reach the same check of the value.
+    assert!(
+        fit("--point-rolls").contains("rolls"),
+        "{}",
+        fit("--point-rolls")
+    );
+    assert_eq!(fit("--point-rolls"), fit("--rolls"));
+    for (args, says) in [
+        (
+            &["--faithful", "--settle", "certificate"][..],
+            "cannot be used with",
+        ),
+        (
+            &["--faithful", "--flight", "fast"][..],
+            "cannot be used with",
+        ),
+        (&["--audit", "--settle", "certificate"][..], "--settle"),
+    ] {
+        let out =
+            dicephys(&[&["roll", "--block", "140x24x20", "--rolls", "10"][..], args].concat());
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(says), "{args:?}: {err}");
+    }
 }
