@@ -24,6 +24,11 @@ pub struct BenchArgs {
     /// every time); for a machine shared with other work.
     #[arg(long, default_value_t = 1)]
     pub repeat: u32,
+    /// DicePhys 2.81's binary (built by ../shared/tools/build-dicephys.sh): run it beside the
+    /// methods, one process per core, for the ×DicePhys columns; without it they are left
+    /// empty.
+    #[arg(long, value_name = "PATH")]
+    pub dicephys: Option<std::path::PathBuf>,
     /// Print one JSON document (docs/json.md, `bench --json`) instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -49,6 +54,14 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         )));
     }
     let threads = super::args::threads(a.threads)?;
+    if let Some(p) = &a.dicephys {
+        if !p.is_file() {
+            return Err(Error::Usage(format!(
+                "--dicephys {}: not a file (DicePhys 2.81's binary)",
+                p.display()
+            )));
+        }
+    }
     let quiet = a.json;
     if !quiet {
         outln!("{}", bench::header());
@@ -61,6 +74,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         a.seed,
         threads,
         a.repeat,
+        a.dicephys.as_deref(),
         super::stop(),
         &|line| {
             if !quiet {

@@ -16,28 +16,106 @@ use crate::theory::stats;
 use serde::Serialize;
 use std::time::Instant;
 
-/// DicePhys 2.81's CPU time per 3D roll of 140x24x20 on this kind of machine
-/// (shared/reference/dicephys-2.81.md), measured with two DicePhys runs sharing the 2-core
-/// machine: one process per core, every core busy. The yardstick for "thirty times DicePhys".
-/// DicePhys itself is not on this machine, so the bench cannot run it beside dicephys; this
-/// reference timing stands in (compare it as the noisy number it is).
-pub const DICEPHYS_MS_PER_ROLL_3D: f64 = 4.22;
-/// The same for a 2D roll, ms.
-pub const DICEPHYS_MS_PER_ROLL_2D: f64 = 2.50;
-
-/// DicePhys 2.81's rolls per second on a machine with `cores` cores busy: DicePhys is
-/// single-threaded, so the fair way to run it on all of them is one process per core, each
-/// rolling its share, at the per-core rate measured that way (`DICEPHYS_MS_PER_ROLL_3D`).
-pub fn dicephys_rolls_per_s(mode: Mode, cores: usize) -> f64 {
-    cores.max(1) as f64 * 1000.0 / dicephys_ms_per_roll(mode)
+/// DicePhys 2.81 itself, run beside the bench (`bench --dicephys PATH`): the paper's
+/// workload (140x24x20, its throw ranges, μ 0.29, e 0.5, dt 1 ms) as one process per core,
+/// every core busy, each rolling its share. DicePhys is single-threaded, so that is the fair
+/// way to run it on a machine; a timing from another day is not a measurement.
+#[derive(Clone, Debug, Serialize)]
+pub struct DicePhysRun {
+    /// "3d" or "2d".
+    pub mode: String,
+    /// The binary run.
+    pub binary: String,
+    /// Processes run at once (the machine's cores).
+    pub processes: usize,
+    /// Rolls per process.
+    pub rolls: u64,
+    /// Wall seconds until the last process ended.
+    pub wall_s: f64,
+    /// The processes' CPU ms per roll (user and system, `getrusage` of the children).
+    pub ms_per_roll: f64,
 }
 
-/// DicePhys 2.81's CPU ms per roll in this mode (`DICEPHYS_MS_PER_ROLL_3D`).
-pub fn dicephys_ms_per_roll(mode: Mode) -> f64 {
-    match mode {
-        Mode::ThreeD => DICEPHYS_MS_PER_ROLL_3D,
-        Mode::TwoD => DICEPHYS_MS_PER_ROLL_2D,
+impl DicePhysRun {
+    /// DicePhys's rolls per second on `cores` cores busy: one process per core, each at the
+    /// per-core rate measured with every core busy.
+    pub fn rolls_per_s(&self, cores: usize) -> f64 {
+        cores.max(1) as f64 * 1000.0 / self.ms_per_roll
     }
+}
+
+/// The children's CPU seconds so far (user and system).
+fn children_cpu_s() -> f64 {
+    // SAFETY: getrusage writes the struct it is given; RUSAGE_CHILDREN is always valid.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut u) };
+    let s = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    s(u.ru_utime) + s(u.ru_stime)
+}
+
+/// Runs DicePhys 2.81 (`binary`) as the paper ran it, in `mode`, as one process per core
+/// (`processes`), each `rolls` throws, and times it.
+pub fn run_dicephys(
+    binary: &std::path::Path,
+    mode: Mode,
+    processes: usize,
+    rolls: u64,
+    stop: &crate::run::stop::Stop,
+) -> crate::Result<DicePhysRun> {
+    use std::process::{Command, Stdio};
+    // DicePhys's flags (its main.cpp): velocity, spin and drop-height ranges, friction,
+    // restitution, step, breadth, width and length (0: its 2D mode), the paper's own
+    // settings (-D), rolls.
+    let length = match mode {
+        Mode::ThreeD => "0.14",
+        Mode::TwoD => "0",
+    };
+    let args = [
+        "-v", "-0.2", "0.2", "-a", "31", "160", "-y", "0.2", "0.4", "-f", "0.29", "-r", "0.5",
+        "-t", "0.001", "-w", "0.024", "-h", "0.020", "-d", length, "-D", "-n",
+    ];
+    let failed = |why: String| crate::Error::Failed(format!("{}: {why}", binary.display()));
+    let cpu = children_cpu_s();
+    let wall = Instant::now();
+    let mut children = Vec::new();
+    for _ in 0..processes.max(1) {
+        children.push(
+            Command::new(binary)
+                .args(args)
+                .arg(rolls.to_string())
+                .stdin(Stdio::null())
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .spawn()
+                .map_err(|e| failed(format!("cannot run it ({e})")))?,
+        );
+    }
+    for mut c in children {
+        loop {
+            if let Some(status) = c.try_wait().map_err(|e| failed(e.to_string()))? {
+                if !status.success() {
+                    return Err(failed(format!("ended with {status}")));
+                }
+                break;
+            }
+            if stop.requested() {
+                let _ = c.kill();
+                let _ = c.wait();
+                return Err(crate::Error::Stopped);
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+    }
+    let wall_s = wall.elapsed().as_secs_f64();
+    let cpu_s = children_cpu_s() - cpu;
+    Ok(DicePhysRun {
+        mode: mode.name().into(),
+        binary: binary.display().to_string(),
+        processes: processes.max(1),
+        rolls,
+        wall_s,
+        ms_per_roll: 1000.0 * cpu_s / (processes.max(1) as u64 * rolls) as f64,
+    })
 }
 
 /// The cores a run on `threads` threads keeps busy: no more than the machine has.
@@ -152,16 +230,16 @@ pub struct BenchRow {
     /// Cores this measurement keeps busy (threads, at most the machine's cores).
     pub cores: usize,
     /// DicePhys 2.81's rolls per second on as many cores, one process per core
-    /// (`dicephys_rolls_per_s`; reference timing, not this run).
-    pub dicephys_rolls_per_s: f64,
+    /// (`DicePhysRun::rolls_per_s`, measured in this run); `None` unless DicePhys was given.
+    pub dicephys_rolls_per_s: Option<f64>,
     /// Rolls per second over DicePhys 2.81's on the same number of cores: per machine when
     /// every core is busy on both sides.
-    pub vs_dicephys: f64,
+    pub vs_dicephys: Option<f64>,
     /// DicePhys 2.81's CPU time per roll over this method's (process CPU, all threads): the
-    /// reference timing is CPU time, so this is the like-for-like figure, and it moves less
-    /// than `vs_dicephys` when other work takes the machine's cores (wall time counts the time
-    /// the threads waited for one; CPU time does not).
-    pub vs_dicephys_cpu: f64,
+    /// like-for-like figure, which moves less than `vs_dicephys` when other work takes the
+    /// machine's cores (wall time counts the time the threads waited for one; CPU time does
+    /// not).
+    pub vs_dicephys_cpu: Option<f64>,
     /// The engine floor (`Floor`) of this method and mode, measured on one thread.
     pub floor: EngineFloor,
     /// N(breadth vertical)/N(width vertical) over the rolls.
@@ -301,13 +379,13 @@ pub struct Verdict {
     /// Over the faithful method on one thread (DicePhys is single-threaded).
     pub speedup_vs_faithful_1_thread: f64,
     /// Rolls per second over DicePhys 2.81's on the same cores, one process per core
-    /// (reference timing, not this run).
-    pub vs_dicephys: f64,
+    /// (measured in this run; `None` unless DicePhys was given).
+    pub vs_dicephys: Option<f64>,
     /// DicePhys 2.81's CPU time per roll over this method's (`BenchRow::vs_dicephys_cpu`).
-    pub vs_dicephys_cpu: f64,
+    pub vs_dicephys_cpu: Option<f64>,
     /// `vs_dicephys_cpu` if everything but the engine's steps were free (`EngineFloor`): the
     /// most this method could reach without fewer or cheaper engine steps.
-    pub vs_dicephys_at_floor: f64,
+    pub vs_dicephys_at_floor: Option<f64>,
     /// (ratio − faithful ratio) / combined error, on the same throws.
     pub z_vs_faithful: f64,
 }
@@ -333,6 +411,8 @@ pub struct Bench {
     pub repeat: u32,
     /// What each feature of a made die costs against the sharp uniform die (`dice_costs`).
     pub dice: Vec<DiceCost>,
+    /// DicePhys 2.81 run beside the methods, per mode, when its binary was given.
+    pub dicephys: Vec<DicePhysRun>,
 }
 
 /// What a made die's features cost: a 16 mm cube thrown in a tumble, rolled by default
@@ -481,12 +561,14 @@ pub fn dice_costs(
 /// costs on `dice_rolls` (0: none, `dice_costs`); `log` gets a line per measurement. With `repeat` > 1, every method of a mode and thread count is run in turn,
 /// `repeat` rounds over, and each keeps its fastest run: a spell of load from elsewhere then
 /// falls on different methods in different rounds, not on one method's every run.
+#[allow(clippy::too_many_arguments)]
 pub fn run(
     rolls: u64,
     dice_rolls: u64,
     seed: u64,
     all_threads: usize,
     repeat: u32,
+    dicephys: Option<&std::path::Path>,
     stop: &crate::run::stop::Stop,
     log: &dyn Fn(&str),
 ) -> crate::Result<Bench> {
@@ -495,7 +577,23 @@ pub fn run(
     let base = RollConfig::default();
     let methods = methods();
     let mut rows = Vec::new();
+    let mut dicephys_runs = Vec::new();
     for mode in [Mode::ThreeD, Mode::TwoD] {
+        // DicePhys itself, beside this mode's methods: one process per core, every core busy,
+        // `rolls` throws in all.
+        let dp = match dicephys {
+            Some(binary) => {
+                let cores = cores_busy(usize::MAX);
+                let run = run_dicephys(binary, mode, cores, rolls.div_ceil(cores as u64), stop)?;
+                log(&format!(
+                    "DicePhys 2.81 {}: {} processes × {} rolls in {:.2} s, {:.3} CPU ms per roll",
+                    run.mode, run.processes, run.rolls, run.wall_s, run.ms_per_roll
+                ));
+                dicephys_runs.push(run.clone());
+                Some(run)
+            }
+            None => None,
+        };
         let mut floors = Vec::new();
         for m in &methods {
             let mut scene = Scene::paper(block, mode);
@@ -553,7 +651,7 @@ pub fn run(
                     }
                 };
                 let cores = cores_busy(threads);
-                let dicephys = dicephys_rolls_per_s(mode, cores);
+                let dicephys = dp.as_ref().map(|d| d.rolls_per_s(cores));
                 let row = BenchRow {
                     method: m.name.clone(),
                     engine: m.engine.name().into(),
@@ -568,8 +666,10 @@ pub fn run(
                     speedup,
                     cores,
                     dicephys_rolls_per_s: dicephys,
-                    vs_dicephys: rolls_per_s / dicephys,
-                    vs_dicephys_cpu: dicephys_ms_per_roll(mode) * rolls as f64 / (1000.0 * cpu_s),
+                    vs_dicephys: dicephys.map(|d| rolls_per_s / d),
+                    vs_dicephys_cpu: dp
+                        .as_ref()
+                        .map(|d| d.ms_per_roll * rolls as f64 / (1000.0 * cpu_s)),
                     floor: *floor,
                     ratio: r.value,
                     ratio_err: r.err,
@@ -619,16 +719,26 @@ pub fn run(
                 vs_dicephys_cpu: best.vs_dicephys_cpu,
                 // The floor's share of the cost, measured within one pass, carries over to
                 // this run's speed better than the floor's own time on a noisy machine.
-                vs_dicephys_at_floor: best.vs_dicephys_cpu / best.floor.share,
+                vs_dicephys_at_floor: best.vs_dicephys_cpu.map(|v| v / best.floor.share),
                 z_vs_faithful: best.z_vs_faithful,
             })
         })
         .collect();
     for v in &verdicts {
+        let against = match (v.vs_dicephys, v.vs_dicephys_cpu, v.vs_dicephys_at_floor) {
+            (Some(w), Some(c), Some(f)) => format!(
+                ", {w:.1}x DicePhys on as many cores, {c:.1}x its CPU time per roll ({f:.1}x if \
+                 all but the engine's steps were free)"
+            ),
+            _ => String::new(),
+        };
         log(&format!(
-            "fastest within |z| <= {Z_BOUND} of faithful, {}: {} on {} threads, {:.0} rolls/s: {:.2}x faithful on {} threads, {:.2}x faithful on 1 thread, {:.1}x DicePhys on as many cores, {:.1}x its CPU time per roll ({:.1}x if all but the engine's steps were free)",
-            v.mode, v.method, v.threads, v.rolls_per_s, v.speedup, v.threads, v.speedup_vs_faithful_1_thread, v.vs_dicephys, v.vs_dicephys_cpu, v.vs_dicephys_at_floor
+            "fastest within |z| <= {Z_BOUND} of faithful, {}: {} on {} threads, {:.0} rolls/s: {:.2}x faithful on {} threads, {:.2}x faithful on 1 thread{against}",
+            v.mode, v.method, v.threads, v.rolls_per_s, v.speedup, v.threads, v.speedup_vs_faithful_1_thread
         ));
+    }
+    if dicephys.is_none() {
+        log("×DicePhys: not measured (give --dicephys PATH, DicePhys 2.81's binary, to run it beside)");
     }
     let dice = if dice_rolls > 0 {
         dice_costs(dice_rolls, seed, repeat, stop, log)?
@@ -643,6 +753,7 @@ pub fn run(
         seed,
         repeat: repeat.max(1),
         dice,
+        dicephys: dicephys_runs,
     })
 }
 
@@ -705,8 +816,8 @@ pub fn format_row(r: &BenchRow) -> String {
         format!("{:.0}", r.steps_per_roll),
         format!("{:.0}", r.engine_steps_per_roll),
         format!("{:.2}x", r.speedup),
-        format!("{:.1}x", r.vs_dicephys),
-        format!("{:.1}x", r.vs_dicephys_cpu),
+        r.vs_dicephys.map_or("—".into(), |v| format!("{v:.1}x")),
+        r.vs_dicephys_cpu.map_or("—".into(), |v| format!("{v:.1}x")),
         format!("{:.3}", r.cpu_ms_per_roll * r.floor.share),
         format!("{:.0}%", 100.0 * r.floor.share),
         format!("{:.4} ± {:.4}", r.ratio, r.ratio_err),

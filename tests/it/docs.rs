@@ -671,6 +671,10 @@ fn json_md_lists_the_keys_of_crosscheck_theory_and_bench() {
         "--json",
     ]);
     c.document("bench", "bench", &bench);
+    // Without DicePhys run beside it, the bench divides by nothing: no reference timing.
+    let rows = bench["rows"].as_array().unwrap();
+    assert!(rows.iter().all(|r| r["vs_dicephys"].is_null()), "{rows:?}");
+    assert_eq!(bench["dicephys"], serde_json::json!([]));
     c.finish(&["crosscheck", "theory-block", "theory-table", "bench"]);
 }
 
