@@ -1,5 +1,7 @@
-//! The red team: what a hostile user tried against dicephys (issue "Reliability, round 2"),
-//! each probe at a small size, run on every CI run. Every probe here failed once.
+//! The promises of the README's "What dicephys promises" (docs/guide.md, "What dicephys
+//! promises") about stopping, streams and bad input: Ctrl-C and SIGTERM in every kind of run,
+//! a full or closed stdout, outputs onto links, FIFOs and directories, `merge`'s inputs, and
+//! a resumed run's rows. Each probe, at a small size, failed once before its fix.
 
 use super::helpers::{bin, Scratch};
 use std::path::{Path, PathBuf};
@@ -237,7 +239,7 @@ fn paper_interrupted_leaves_the_complete_outputs_alone() {
     assert!(full.status.success(), "{}", stderr(&full));
     let before = std::fs::read(d.join("results.json")).unwrap();
     let png = std::fs::read(d.join("prob_2d.png")).unwrap();
-    // The directory is the 20-roll run's: another run is refused there (redteam3), so the
+    // The directory is the 20-roll run's: another run is refused there (promises_files), so the
     // complete outputs are copied into a directory of no run's, and the slow run stopped there.
     let e = scratch("paper-again");
     std::fs::write(e.join("results.json"), &before).unwrap();

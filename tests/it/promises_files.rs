@@ -1,5 +1,8 @@
-//! The red team, round 3 (issue 26): what a hostile user broke next, each probe at a small
-//! size. Every probe here failed on the build before its fix.
+//! The promises about files and directories (docs/guide.md, "What dicephys promises"):
+//! outputs whole, with their mode, under long names and links; temporary files cleaned up;
+//! damaged chunks named and rolled again; a Slurm directory's name quoted or refused; paths
+//! not UTF-8; a run's directory its own; a chunk's size. Each probe, at a small size, failed
+//! on the build before its fix.
 
 use super::helpers::{bin, Scratch};
 use std::os::unix::fs::PermissionsExt;
