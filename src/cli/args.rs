@@ -164,7 +164,7 @@ pub struct RunArgs {
     /// gives the same rolls on any thread count. The summary says how many rolls it took.
     /// In `fair`: every face's probability to 2σ of this many percentage points (0.5: each
     /// face known to ±0.005).
-    #[arg(long, value_name = "PERCENT", value_parser = super::sweeps::parse_percent)]
+    #[arg(long, value_name = "PERCENT", value_parser = parse_percent)]
     pub precision: Option<f64>,
     /// Worker threads (0: one per core).
     #[arg(long, default_value_t = 0)]
@@ -193,6 +193,21 @@ pub struct RunArgs {
     /// defaults --floor box --preset dicephys281).
     #[arg(long, conflicts_with_all = ["settle", "flight"])]
     pub faithful: bool,
+}
+
+/// A precision in per cent, "1" or "1%", as a fraction in (0, 100 %).
+pub fn parse_percent(s: &str) -> std::result::Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .trim_end_matches('%')
+        .trim()
+        .parse()
+        .map_err(|_| format!("bad precision '{s}': give per cent, e.g. 1 or 1%"))?;
+    if v.is_finite() && v > 0.0 && v < 100.0 {
+        Ok(v / 100.0)
+    } else {
+        Err(format!("precision '{s}': must be in (0, 100) %"))
+    }
 }
 
 /// `--dt` as clap reads it: a decimal or a fraction (the scene checks its range).

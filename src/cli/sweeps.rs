@@ -2,7 +2,7 @@
 //! configurations (`dicephys::studies::{converge, tradeoff, stability}`); each writes
 //! `<command>.json`, `report.md` and its figures into --out (`super::study`).
 
-use super::args::parse_engine;
+use super::args::{parse_engine, parse_percent};
 use super::error::{Error, Result};
 use super::study;
 use clap::Args;
@@ -129,21 +129,6 @@ pub const DEFAULT_PRECISION: &str = "2";
 
 /// `tradeoff`'s default ladder under the reference.
 pub const DEFAULT_LADDER: &str = "1/2000,1/10000";
-
-/// A precision in per cent, "1" or "1%", as a fraction in (0, 100 %).
-pub(super) fn parse_percent(s: &str) -> std::result::Result<f64, String> {
-    let v: f64 = s
-        .trim()
-        .trim_end_matches('%')
-        .trim()
-        .parse()
-        .map_err(|_| format!("bad precision '{s}': give per cent, e.g. 1 or 1%"))?;
-    if v.is_finite() && v > 0.0 && v < 100.0 {
-        Ok(v / 100.0)
-    } else {
-        Err(format!("precision '{s}': must be in (0, 100) %"))
-    }
-}
 
 fn parse_dt_or_none(s: &str) -> std::result::Result<Option<f64>, String> {
     if s.trim() == "none" {

@@ -173,6 +173,40 @@ impl Outcome {
     }
 }
 
+/// 3D: a free body. 2D: DicePhys's mode, a 1 m deep box locked to the x-y plane, spinning
+/// about z only, so the block's length plays no part.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    Hash,
+    Serialize,
+    Deserialize,
+    strum::Display,
+    strum::EnumString,
+    strum::IntoStaticStr,
+    strum::VariantNames,
+)]
+pub enum Mode {
+    /// DicePhys's 2D mode.
+    #[serde(rename = "2d")]
+    #[strum(serialize = "2d")]
+    TwoD,
+    /// A free body.
+    #[serde(rename = "3d")]
+    #[strum(serialize = "3d")]
+    ThreeD,
+}
+
+impl Mode {
+    /// "2d" or "3d".
+    pub fn name(self) -> &'static str {
+        self.into()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -3,8 +3,9 @@
 
 use crate::model::mass::{MassProps, Turn};
 use crate::model::scene::{Mode, Scene};
+pub use crate::model::state::up_in_body;
 use crate::model::state::BodyState;
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Vector3};
 
 /// The die as the roll, the energy watch and the certificate see it. Its state's position is
 /// its centre of mass; its orientation, its body axes (the faces').
@@ -182,16 +183,6 @@ impl DieShape {
         }
         (best, down(best))
     }
-}
-
-/// The world's up direction in body axes, Rᵀ ŷ: the second row of the rotation matrix.
-pub fn up_in_body(q: &UnitQuaternion<f64>) -> Vector3<f64> {
-    let (w, x, y, z) = (q.w, q.i, q.j, q.k);
-    Vector3::new(
-        2.0 * (x * y + w * z),
-        1.0 - 2.0 * (x * x + z * z),
-        2.0 * (y * z - w * x),
-    )
 }
 
 /// Height above the floor of the lowest point of a box with half sides `half`:

@@ -3,7 +3,7 @@
 //! vertical) are the faces taken in opposite pairs; a face tells which of the pair is up.
 
 use crate::model::block::Outcome;
-use crate::model::die::up_in_body;
+use crate::model::state::up_in_body;
 use nalgebra::UnitQuaternion;
 use serde::{Deserialize, Serialize};
 

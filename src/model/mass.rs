@@ -10,8 +10,8 @@
 //! the parallel-axis theorem, and its eigenvectors are the body's principal frame.
 
 use crate::error::{Error, Result};
+use crate::model::block::Mode;
 use crate::model::faces::Layout;
-use crate::model::scene::{Mode, Scene};
 use nalgebra::{Matrix3, Rotation3, SymmetricEigen, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -489,16 +489,32 @@ impl Features {
     }
 }
 
+/// What a die's mass properties depend on: its body's sides (x, y, z; in 2D the 1 m depth),
+/// its density, its plain mass as the engines multiply it, 2D or 3D, and its features
+/// (`Scene::solid`).
+#[derive(Clone, Copy, Debug)]
+pub struct Solid<'a> {
+    /// The body's sides along x, y, z, m.
+    pub sides: [f64; 3],
+    /// kg/m³.
+    pub density: f64,
+    /// The plain block's mass, as the engines compute it (`Scene::mass`).
+    pub plain_mass: f64,
+    /// 2D or 3D.
+    pub mode: Mode,
+    /// The die as made.
+    pub features: &'a Features,
+}
+
 impl MassProps {
-    /// The mass properties of the scene's die: a solid of its density, rounded with
-    /// `edge_radius`, less its pips (plus their fill), with its centre of mass where
-    /// `com` puts it if given. The plain block's are the closed forms the engines use.
-    pub fn of(scene: &Scene) -> Result<MassProps> {
-        let [a, b, c] = scene.body_sides();
-        scene
-            .features
-            .validate(&(Vector3::new(a, b, c) / 2.0), scene.mode)?;
-        let m = MassProps::compute(scene);
+    /// The mass properties of a die: a solid of its density, rounded with `edge_radius`, less
+    /// its pips (plus their fill), with its centre of mass where `com` puts it if given. The
+    /// plain block's are the closed forms the engines use. Checked.
+    pub fn of_solid(s: &Solid) -> Result<MassProps> {
+        let [a, b, c] = s.sides;
+        s.features
+            .validate(&(Vector3::new(a, b, c) / 2.0), s.mode)?;
+        let m = MassProps::compute_solid(s);
         let ok = m.moments.iter().all(|&x| x > 0.0)
             && (0..3).all(|i| m.moments[i] <= m.moments[(i + 1) % 3] + m.moments[(i + 2) % 3]);
         if !ok {
@@ -512,14 +528,14 @@ impl MassProps {
         Ok(m)
     }
 
-    /// `of` for a scene already checked (`Scene::validate` calls `of`).
-    pub fn compute(scene: &Scene) -> MassProps {
-        let f = &scene.features;
-        let [a, b, c] = scene.body_sides();
+    /// `of_solid` for a die already checked.
+    pub fn compute_solid(s: &Solid) -> MassProps {
+        let f = s.features;
+        let [a, b, c] = s.sides;
         let half = Vector3::new(a, b, c) / 2.0;
-        let rho = scene.density;
+        let rho = s.density;
         if f.plain() {
-            let m = scene.mass();
+            let m = s.plain_mass;
             let inertia = Vector3::new(b * b + c * c, a * a + c * c, a * a + b * b) * (m / 12.0);
             return MassProps {
                 mass: m,
@@ -584,6 +600,7 @@ fn principal_frame(t: &Matrix3<f64>) -> (UnitQuaternion<f64>, Vector3<f64>) {
 mod tests {
     use super::*;
     use crate::model::block::Block;
+    use crate::model::scene::Scene;
 
     fn cube_scene(side_mm: f64) -> Scene {
         let b = Block::from_mm(side_mm, side_mm, side_mm).unwrap();

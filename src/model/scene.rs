@@ -3,45 +3,12 @@
 
 use crate::error::{Error, Result};
 use crate::model::block::Block;
-use crate::model::mass::{Features, MassProps};
+pub use crate::model::block::Mode;
+use crate::model::mass::{Features, MassProps, Solid};
 use serde::{Deserialize, Serialize};
 
 /// Gravity, m/s², along −y.
 pub const GRAVITY: f64 = 9.81;
-
-/// 3D: a free body. 2D: DicePhys's mode, a 1 m deep box locked to the x-y plane, spinning
-/// about z only, so the block's length plays no part.
-#[derive(
-    Clone,
-    Copy,
-    Debug,
-    PartialEq,
-    Eq,
-    Hash,
-    Serialize,
-    Deserialize,
-    strum::Display,
-    strum::EnumString,
-    strum::IntoStaticStr,
-    strum::VariantNames,
-)]
-pub enum Mode {
-    /// DicePhys's 2D mode.
-    #[serde(rename = "2d")]
-    #[strum(serialize = "2d")]
-    TwoD,
-    /// A free body.
-    #[serde(rename = "3d")]
-    #[strum(serialize = "3d")]
-    ThreeD,
-}
-
-impl Mode {
-    /// "2d" or "3d".
-    pub fn name(self) -> &'static str {
-        self.into()
-    }
-}
 
 /// Bullet solver settings, by name.
 #[derive(
@@ -306,6 +273,17 @@ impl Scene {
         }
     }
 
+    /// What the die's mass properties depend on (`model::mass`).
+    pub fn solid(&self) -> Solid<'_> {
+        Solid {
+            sides: self.body_sides(),
+            density: self.density,
+            plain_mass: self.mass(),
+            mode: self.mode,
+            features: &self.features,
+        }
+    }
+
     /// The die's mass, multiplied in DicePhys's order so that the numbers agree to the bit.
     pub fn mass(&self) -> f64 {
         let b = &self.block;
@@ -331,6 +309,18 @@ impl Scene {
             Mode::ThreeD => b.width.max(b.breadth).max(b.length),
             Mode::TwoD => b.width.max(b.breadth),
         }
+    }
+}
+
+impl MassProps {
+    /// The mass properties of the scene's die (`MassProps::of_solid`), checked.
+    pub fn of(scene: &Scene) -> Result<MassProps> {
+        MassProps::of_solid(&scene.solid())
+    }
+
+    /// `of` for a scene already checked (`Scene::validate` calls `of`).
+    pub fn compute(scene: &Scene) -> MassProps {
+        MassProps::compute_solid(&scene.solid())
     }
 }
 

@@ -38,3 +38,13 @@ impl BodyState {
             && self.angular_velocity.iter().all(|v| v.is_finite())
     }
 }
+
+/// The world's up direction in body axes, Rᵀ ŷ: the second row of the rotation matrix.
+pub fn up_in_body(q: &UnitQuaternion<f64>) -> Vector3<f64> {
+    let (w, x, y, z) = (q.w, q.i, q.j, q.k);
+    Vector3::new(
+        2.0 * (x * y + w * z),
+        1.0 - 2.0 * (x * x + z * z),
+        2.0 * (y * z - w * x),
+    )
+}

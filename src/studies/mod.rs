@@ -13,6 +13,7 @@ pub mod fair;
 pub mod fit;
 pub mod outputs;
 pub mod paper;
+pub mod place;
 pub mod precision;
 pub mod stability;
 pub mod stream;

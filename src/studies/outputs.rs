@@ -3,7 +3,9 @@
 //! A cluster task rolls its share and writes nothing; the finishing job writes the result.
 //! What the caller should print comes back as [`Done`].
 
-use super::{Progress, Study, StudyConfig};
+use super::place::to_json;
+pub use super::place::{Done, Hooks, Place};
+use super::{Study, StudyConfig};
 use crate::error::{Error, Result};
 use crate::report;
 use crate::report::per_roll::PerRoll;
@@ -14,53 +16,12 @@ use crate::run::io::Output;
 use crate::run::runner::{Checkpoint, ChunkShare, Runner};
 use crate::run::slurm::{Layout, Plan};
 use crate::run::spec::RunSpec;
-use crate::run::stop::Stop;
+
 use crate::sim::roll::RollRecord;
 use crate::studies;
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
-
-/// Where and how a study runs: its threads, its share of the chunks, where its outputs and
-/// cells go, what it prints.
-#[derive(Clone, Debug)]
-pub struct Place {
-    /// The output directory. `crosscheck` writes none.
-    pub out: PathBuf,
-    /// Where the cells are kept (a directory per cell), if anywhere.
-    pub checkpoint: Option<PathBuf>,
-    /// Worker threads, at least 1.
-    pub threads: usize,
-    /// All the chunks; a cluster task's share; none (the finishing job, or a dry run).
-    pub share: ChunkShare,
-    /// Print the JSON result instead of the report.
-    pub json: bool,
-    /// The command line the report names as its own.
-    pub command_line: String,
-}
-
-/// What the caller hears while a study runs: its log lines, its progress (done and in all, in
-/// the unit `Hooks::unit` gives), and the stop flag it is stopped by.
-pub struct Hooks<'a> {
-    /// A line of the log (a cell, a row, the plan).
-    pub log: &'a (dyn Fn(&str) + Sync),
-    /// Progress: done and in all.
-    pub progress: Progress<'a>,
-    /// Checked before every roll.
-    pub stop: Stop,
-}
-
-/// What a study's caller prints when it is done.
-#[derive(Debug, Default)]
-pub struct Done {
-    /// For stdout: the report, or the JSON result.
-    pub stdout: String,
-    /// For stderr: what was written where (a field it names in backquotes, as in
-    /// `Error::Field`).
-    pub note: Option<String>,
-    /// Stopped before the end, and what was kept: the caller ends with its own exit code.
-    pub interrupted: Option<String>,
-}
 
 impl StudyConfig {
     /// What the study's progress counts.
@@ -103,64 +64,6 @@ pub fn planned(lay: &Layout) -> Result<(StudyConfig, Place, u64)> {
         .map_err(|e| Error::Invalid(format!("{} is damaged ({e})", lay.plan().display())))?;
     let place = Place::cluster(lay, threads, json, ChunkShare::All, &command_line);
     Ok((cfg, place, tasks))
-}
-
-impl Place {
-    /// Where a study of a cluster run writes, on every task and in the finishing job alike:
-    /// its outputs into the run's directory, its cells under its `checkpoint/`.
-    pub fn cluster(
-        lay: &Layout,
-        threads: usize,
-        json: bool,
-        share: ChunkShare,
-        command_line: &str,
-    ) -> Place {
-        Place {
-            out: lay.dir.clone(),
-            checkpoint: Some(lay.cells()),
-            threads,
-            share,
-            json,
-            command_line: command_line.to_string(),
-        }
-    }
-
-    /// A cluster task's share or a dry run: its tallies are partial, for no report.
-    pub(crate) fn partial(&self) -> bool {
-        self.share.is_partial()
-    }
-
-    /// How the study's cells run: these threads, its share, stopped by `stop`, telling
-    /// `progress` the rolls made in the current run.
-    pub(crate) fn study<'a>(&self, stop: &Stop, progress: &'a (dyn Fn(u64) + Sync)) -> Study<'a> {
-        Study {
-            runner: Runner::new(self.threads, stop.clone())
-                .with_share(self.share.clone())
-                .with_progress(progress),
-            checkpoint: self.checkpoint.clone(),
-        }
-    }
-
-    /// Creates the output directory and checks that `files` can be written in it.
-    pub(crate) fn outputs(&self, files: &[&str]) -> Result<Vec<Output>> {
-        std::fs::create_dir_all(&self.out).map_err(|e| {
-            Error::field("out", self.out.display(), format!("cannot create it ({e})"))
-        })?;
-        files
-            .iter()
-            .map(|f| Output::check(&self.out.join(f)))
-            .collect()
-    }
-
-    /// The JSON, or the report, to print; the note that says what was written.
-    pub(crate) fn done(&self, json: &str, report: &str, file: &str) -> Done {
-        Done {
-            stdout: format!("{}\n", if self.json { json } else { report }),
-            note: (!self.json)
-                .then(|| format!("wrote {}/{file}, report.md and figures", self.out.display())),
-            interrupted: None,
-        }
-    }
 }
 
 /// A precision to roll to: the fraction, what it is of, and a hook told the rolls expected in
@@ -442,10 +345,6 @@ pub fn validate(cfg: &studies::validate::Config, place: &Place, hooks: &Hooks) -
     let figures = report::validate::write_figures(&place.out, &res)?;
     let md = report::validate::markdown(&res, &figures);
     write(place, &outputs, &res, &md, "validate.json")
-}
-
-pub(crate) fn to_json<T: Serialize>(v: &T) -> Result<String> {
-    serde_json::to_string_pretty(v).map_err(|e| Error::Failed(e.to_string()))
 }
 
 /// Writes the JSON and the report into the outputs checked before the run.

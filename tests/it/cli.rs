@@ -32,6 +32,7 @@ fn bad_input_gets_one_line_and_exit_code_2() {
         &["trace", "--block", "140x24x20", "--flight", "warp"],
         &["bench", "--rolls", "0"],
         &["bench", "--repeat", "0"],
+        &["bench", "--dicephys", "/nonexistent/dicephys-2.81"],
     ];
     for args in cases {
         let out = dicephys(args);

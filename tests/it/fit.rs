@@ -234,10 +234,13 @@ fn values_outside_their_physical_ranges_are_refused() {
         assert_eq!(out.status.code(), Some(2), "{flags:?}: {err}");
         assert!(err.contains(want), "{flags:?}: {err} (wanted {want})");
     }
-    // The hand's throw needs its κ, and κ needs the hand.
+    // The hand's throw needs its κ, and κ needs the hand (alone, --kappa asks for it).
     for (flags, want) in [
         (vec!["--throw", "hand"], "--throw hand needs --kappa"),
-        (vec!["--kappa", "3"], "only --throw hand takes"),
+        (
+            vec!["--throw", "tumble", "--kappa", "3"],
+            "only --throw hand takes",
+        ),
         (vec!["--throw", "hand", "--kappa", "-1"], "kappa -1"),
     ] {
         let mut args = vec!["roll", "--block", "140x24x20", "--rolls", "10"];

@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use crate::report::fit as report;
 use crate::run::seal;
 use crate::studies::calibrated::{self, CalibratedConfig, CalibratedStudy, FIRST_PASSES};
-use crate::studies::outputs::{to_json, Done, Hooks, Place};
+use crate::studies::place::{to_json, Done, Hooks, Place};
 use serde::Serialize;
 
 /// Claims `place.out` for this run (`run::owner`), once every value has been checked: refused
