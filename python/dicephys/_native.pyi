@@ -3,55 +3,19 @@
 Use the package's functions (``dicephys.roll`` …): they wrap these with objects and arrays.
 """
 
-from typing import Any, Callable, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, List, Optional, Tuple
 
 DEFAULT_MAX_STEPS: int
 DEFAULT_MARGIN: float
 
 _Progress = Optional[Callable[[float, float], Any]]
 _Log = Optional[Callable[[str], Any]]
-_Range = Union[None, float, Tuple[float, float]]
 
 def version() -> str: ...
-def roll(
-    block: str,
-    *,
-    rolls: Optional[int] = ...,
-    seed: int = ...,
-    mode: str = ...,
-    engine: str = ...,
-    dt: float = ...,
-    restitution: float = ...,
-    friction: float = ...,
-    density: Optional[float] = ...,
-    preset: str = ...,
-    floor: str = ...,
-    floor_thickness: Optional[float] = ...,
-    linear_damping: float = ...,
-    angular_damping: float = ...,
-    sleep: bool = ...,
-    throw: Optional[str] = ...,
-    kappa: Optional[float] = ...,
-    source: str = ...,
-    velocity: _Range = ...,
-    spin: _Range = ...,
-    drop_height: _Range = ...,
-    settle: Optional[str] = ...,
-    flight: str = ...,
-    faithful: bool = ...,
-    max_steps: int = ...,
-    margin: float = ...,
-    com: Optional[Sequence[float]] = ...,
-    pips: Optional[Sequence[float]] = ...,
-    edge_radius: Optional[float] = ...,
-    die: Optional[str] = ...,
-    layout: str = ...,
-    threads: int = ...,
-    per_roll: bool = ...,
-    precision: Optional[float] = ...,
-    fair: Optional[str] = ...,
-    progress: _Progress = ...,
-) -> Tuple[str, Optional[bytes]]: ...
+def roll(block: str, **options: Any) -> Tuple[str, Optional[bytes]]:
+    """``dicephys.roll``'s options by name (``fair``: a null, for ``dicephys.fair``)."""
+    ...
+
 def theory(block: Optional[str] = ..., tolerance: float = ...) -> str: ...
 def study(config: str, out: str, *, threads: int = ..., progress: _Progress = ..., log: _Log = ...) -> str: ...
 def paper_config(rolls: int, seed: int, engines: List[str], dt: float, max_steps: int, faithful: bool) -> str: ...

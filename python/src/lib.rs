@@ -28,9 +28,10 @@ use dicephys::sim::roll::{RollConfig, RollRecord, Rule, DEFAULT_MARGIN, DEFAULT_
 use dicephys::studies::outputs::{self, Done, Hooks, Place};
 use dicephys::studies::StudyConfig;
 use dicephys::Error;
-use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError};
+use pyo3::conversion::FromPyObjectOwned;
+use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyBytes;
+use pyo3::types::{PyBytes, PyDict};
 use std::path::PathBuf;
 use std::sync::{Condvar, Mutex};
 use std::time::Duration;
@@ -232,62 +233,90 @@ fn detached<T: Send>(
     }
 }
 
-/// The scene, the throws and the roll of `roll` and `fair`, checked by the library.
-#[allow(clippy::too_many_arguments)]
-fn spec(
-    block_: &str,
-    rolls: u64,
-    seed: u64,
-    mode_: &str,
-    engine: &str,
-    dt: f64,
-    restitution: f64,
-    friction: f64,
-    density: Option<f64>,
-    preset: &str,
-    floor: &str,
-    floor_thickness: Option<f64>,
-    linear_damping: f64,
-    angular_damping: f64,
-    sleep: bool,
-    throw: Option<&str>,
-    kappa: Option<f64>,
-    source: &str,
-    velocity: Option<&Bound<'_, PyAny>>,
-    spin: Option<&Bound<'_, PyAny>>,
-    drop_height: Option<&Bound<'_, PyAny>>,
-    settle: Option<&str>,
-    flight: &str,
-    faithful: bool,
-    max_steps: u64,
-    margin: f64,
-    com: Option<[f64; 3]>,
-    pips: Option<[f64; 2]>,
-    edge_radius: Option<f64>,
-    die: Option<PathBuf>,
-    layout: Layout,
-) -> PyResult<RunSpec> {
-    let mut scene = Scene::paper(block(block_)?, mode(mode_)?);
-    scene.dt = dt;
-    scene.friction = friction;
-    scene.restitution = restitution;
-    scene.preset = named::<Preset>("preset", "preset", preset)?;
-    scene.floor = named::<Floor>("floor", "floor", floor)?;
-    scene.linear_damping = linear_damping;
-    scene.angular_damping = angular_damping;
-    scene.sleeping = sleep;
-    if let Some(path) = &die {
-        let file = DieFile::read(path).map_err(py_err)?;
+/// A call's keyword options, read by name: each taken once, with the library's default where
+/// it is left out; a name no option has is refused, as Python would.
+struct Options<'py> {
+    given: Option<Bound<'py, PyDict>>,
+}
+
+impl<'py> Options<'py> {
+    /// The option `name`, or `default`.
+    fn get<T: FromPyObjectOwned<'py>>(&self, name: &str, default: T) -> PyResult<T> {
+        Ok(self.maybe(name)?.unwrap_or(default))
+    }
+
+    /// The option `name` if given and not None.
+    fn maybe<T: FromPyObjectOwned<'py>>(&self, name: &str) -> PyResult<Option<T>> {
+        let Some(d) = &self.given else {
+            return Ok(None);
+        };
+        let Some(v) = d.get_item(name)? else {
+            return Ok(None);
+        };
+        d.del_item(name)?;
+        if v.is_none() {
+            return Ok(None);
+        }
+        v.extract::<T>().map(Some).map_err(|_| {
+            bad(
+                name,
+                v.repr().map_or("?".into(), |r| r.to_string()),
+                "not a value of its type",
+            )
+        })
+    }
+
+    /// The option `name` as Python gave it.
+    fn object(&self, name: &str) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let Some(d) = &self.given else {
+            return Ok(None);
+        };
+        let v = d.get_item(name)?;
+        if v.is_some() {
+            d.del_item(name)?;
+        }
+        Ok(v.filter(|v| !v.is_none()))
+    }
+
+    /// Refuses whatever option was not read.
+    fn finish(self) -> PyResult<()> {
+        match self.given.and_then(|d| d.keys().iter().next()) {
+            Some(k) => Err(PyTypeError::new_err(format!(
+                "roll() got an unexpected keyword argument '{k}'"
+            ))),
+            None => Ok(()),
+        }
+    }
+}
+
+/// The scene, the throws and the roll of `roll` and `fair` from their options (`dicephys
+/// roll`'s, by the library's names and units: mm for the die as made), checked by the library.
+fn spec(block_: &str, o: &Options, layout: Layout, precision: bool) -> PyResult<RunSpec> {
+    let mut scene = Scene::paper(block(block_)?, mode(&o.get("mode", "3d".to_string())?)?);
+    scene.dt = o.get("dt", scene.dt)?;
+    scene.friction = o.get("friction", scene.friction)?;
+    scene.restitution = o.get("restitution", scene.restitution)?;
+    scene.preset = named::<Preset>(
+        "preset",
+        "preset",
+        &o.get("preset", "dicephys281".to_string())?,
+    )?;
+    scene.floor = named::<Floor>("floor", "floor", &o.get("floor", "box".to_string())?)?;
+    scene.linear_damping = o.get("linear_damping", 0.0)?;
+    scene.angular_damping = o.get("angular_damping", 0.0)?;
+    scene.sleeping = o.get("sleep", true)?;
+    if let Some(path) = o.maybe::<PathBuf>("die")? {
+        let file = DieFile::read(&path).map_err(py_err)?;
         if let Some(d) = file.density {
             scene.density = d;
         }
         scene.features = file.features();
     }
     let f = &mut scene.features;
-    if let Some(c) = com {
+    if let Some(c) = o.maybe::<[f64; 3]>("com")? {
         f.com = Some(c.map(|x| x / 1000.0));
     }
-    if let Some([d, h]) = pips {
+    if let Some([d, h]) = o.maybe::<[f64; 2]>("pips")? {
         let (d, h) = (d / 1000.0, h / 1000.0);
         f.pips = Some(match f.pips.take() {
             Some(p) => Pips {
@@ -298,17 +327,17 @@ fn spec(
             None => Pips::caps(d, h),
         });
     }
-    if let Some(r) = edge_radius {
+    if let Some(r) = o.maybe::<f64>("edge_radius")? {
         f.edge_radius = r / 1000.0;
     }
     if f.pips.is_some() {
         // The pips follow the numbers: the layout places them.
         f.layout = layout;
     }
-    if let Some(d) = density {
+    if let Some(d) = o.maybe::<f64>("density")? {
         scene.density = d;
     }
-    if let Some(t) = floor_thickness {
+    if let Some(t) = o.maybe::<f64>("floor_thickness")? {
         if scene.floor == Floor::Plane {
             return Err(bad(
                 "floor_thickness",
@@ -319,24 +348,33 @@ fn spec(
         scene.floor_thickness = t;
     }
     let paper = ThrowRanges::default();
+    let kappa = o.maybe::<f64>("kappa")?;
     let throws = ThrowSpec {
-        kind: named::<ThrowKind>("source", "throw source", source)?,
-        seed,
+        kind: named::<ThrowKind>(
+            "source",
+            "throw source",
+            &o.get("source", "keyed".to_string())?,
+        )?,
+        seed: o.get("seed", 2385)?,
         ranges: ThrowRanges {
-            velocity: range("velocity", velocity, paper.velocity)?,
-            spin: range("spin", spin, paper.spin)?,
-            drop_height: range("drop_height", drop_height, paper.drop_height)?,
+            velocity: range("velocity", o.object("velocity")?.as_ref(), paper.velocity)?,
+            spin: range("spin", o.object("spin")?.as_ref(), paper.spin)?,
+            drop_height: range(
+                "drop_height",
+                o.object("drop_height")?.as_ref(),
+                paper.drop_height,
+            )?,
         },
         // `kappa` is a hand's concentration: given alone, it asks for a hand's throw.
-        style: match throw {
-            Some(t) => named::<ThrowStyle>("throw", "throw style", t)?,
+        style: match o.maybe::<String>("throw")? {
+            Some(t) => named::<ThrowStyle>("throw", "throw style", &t)?,
             None if kappa.is_some() => ThrowStyle::Hand,
             None => ThrowStyle::Paper,
         },
         kappa,
     };
     let settle =
-        match settle {
+        match o.maybe::<String>("settle")?.as_deref() {
             None => None,
             Some("certificate") => Some(Rule::Certificate),
             Some("dicephys") => Some(Rule::Dicephys),
@@ -346,19 +384,27 @@ fn spec(
                 "give 'certificate' (the exact early stop) or 'dicephys' (DicePhys's rest rule)",
             )),
         };
-    let fast = match flight {
+    let fast = match o.get("flight", "fast".to_string())?.as_str() {
         "fast" => true,
         "stepped" => false,
         s => return Err(bad("flight", format!("'{s}'"), "give 'fast' or 'stepped'")),
     };
-    let roll =
-        RollConfig::chosen(dt, settle, fast, faithful, false, max_steps, margin).map_err(py_err)?;
+    let roll = RollConfig::chosen(
+        scene.dt,
+        settle,
+        fast,
+        o.get("faithful", false)?,
+        false,
+        o.get("max_steps", DEFAULT_MAX_STEPS)?,
+        o.get("margin", DEFAULT_MARGIN)?,
+    )
+    .map_err(py_err)?;
     let spec = RunSpec {
-        engine: named::<EngineKind>("engine", "engine", engine)?,
+        engine: named::<EngineKind>("engine", "engine", &o.get("engine", "bullet".to_string())?)?,
         roll,
         scene,
         throws,
-        rolls,
+        rolls: o.get("rolls", if precision { 10_000_000 } else { 10_000 })?,
         shard: None,
     };
     spec.validate(false).map_err(py_err)?;
@@ -413,98 +459,31 @@ fn rolled(
     })
 }
 
-/// `dicephys roll`: many throws of one block on one engine. Returns the `roll --json`
-/// document and, with `per_roll`, the `--per-roll` CSV's bytes.
+/// `dicephys roll`: many throws of one block on one engine, with `roll`'s options by the
+/// library's names (the package's `roll` lists them). Returns the `roll --json` document and,
+/// with `per_roll`, the `--per-roll` CSV's bytes; with `fair` (a null), `fair --json`'s.
 #[pyfunction]
-#[pyo3(signature = (block, *, rolls=None, seed=2385, mode="3d", engine="bullet", dt=0.001,
-    restitution=0.5, friction=0.29, density=None, preset="dicephys281", floor="box",
-    floor_thickness=None, linear_damping=0.0, angular_damping=0.0, sleep=true, throw=None,
-    kappa=None, source="keyed", velocity=None, spin=None, drop_height=None, settle=None,
-    flight="fast", faithful=false, max_steps=DEFAULT_MAX_STEPS, margin=DEFAULT_MARGIN,
-    com=None, pips=None, edge_radius=None, die=None, layout="right", threads=0,
-    per_roll=false, precision=None, fair=None, progress=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (block, **options))]
 fn roll<'py>(
     py: Python<'py>,
     block: &str,
-    rolls: Option<u64>,
-    seed: u64,
-    mode: &str,
-    engine: &str,
-    dt: f64,
-    restitution: f64,
-    friction: f64,
-    density: Option<f64>,
-    preset: &str,
-    floor: &str,
-    floor_thickness: Option<f64>,
-    linear_damping: f64,
-    angular_damping: f64,
-    sleep: bool,
-    throw: Option<&str>,
-    kappa: Option<f64>,
-    source: &str,
-    velocity: Option<&Bound<'py, PyAny>>,
-    spin: Option<&Bound<'py, PyAny>>,
-    drop_height: Option<&Bound<'py, PyAny>>,
-    settle: Option<&str>,
-    flight: &str,
-    faithful: bool,
-    max_steps: u64,
-    margin: f64,
-    com: Option<[f64; 3]>,
-    pips: Option<[f64; 2]>,
-    edge_radius: Option<f64>,
-    die: Option<PathBuf>,
-    layout: &str,
-    threads: usize,
-    per_roll: bool,
-    precision: Option<f64>,
-    fair: Option<&str>,
-    progress: Option<&Bound<'py, PyAny>>,
+    options: Option<Bound<'py, PyDict>>,
 ) -> PyResult<(String, Option<Bound<'py, PyBytes>>)> {
-    let layout = named::<Layout>("layout", "layout", layout)?;
-    let null = fair
-        .map(|n| named::<dicephys::studies::fair::Null>("null", "null", n))
+    // The caller's dict is its own: read a copy.
+    let o = Options {
+        given: options.map(|d| d.copy()).transpose()?,
+    };
+    let layout = named::<Layout>("layout", "layout", &o.get("layout", "right".to_string())?)?;
+    let null = o
+        .maybe::<String>("fair")?
+        .map(|n| named::<dicephys::studies::fair::Null>("null", "null", &n))
         .transpose()?;
-    let rolls = rolls.unwrap_or(if precision.is_some() {
-        10_000_000
-    } else {
-        10_000
-    });
-    let spec = spec(
-        block,
-        rolls,
-        seed,
-        mode,
-        engine,
-        dt,
-        restitution,
-        friction,
-        density,
-        preset,
-        floor,
-        floor_thickness,
-        linear_damping,
-        angular_damping,
-        sleep,
-        throw,
-        kappa,
-        source,
-        velocity,
-        spin,
-        drop_height,
-        settle,
-        flight,
-        faithful,
-        max_steps,
-        margin,
-        com,
-        pips,
-        edge_radius,
-        die,
-        layout,
-    )?;
+    let precision = o.maybe::<f64>("precision")?;
+    let threads = o.get("threads", 0usize)?;
+    let per_roll = o.get("per_roll", false)?;
+    let progress = o.object("progress")?;
+    let spec = spec(block, &o, layout, precision.is_some())?;
+    o.finish()?;
     if null == Some(dicephys::studies::fair::Null::SolidAngle) && spec.scene.mode == Mode::TwoD {
         return Err(bad(
             "null",
@@ -518,7 +497,15 @@ fn roll<'py>(
         Target::Ratio
     };
     let precision = precision.map(|p| (p, target));
-    let (summary, csv) = rolled(py, &spec, layout, threads, per_roll, precision, progress)?;
+    let (summary, csv) = rolled(
+        py,
+        &spec,
+        layout,
+        threads,
+        per_roll,
+        precision,
+        progress.as_ref(),
+    )?;
     let json = match null {
         None => dicephys::run::seal::to_string(&summary, true),
         Some(null) => {

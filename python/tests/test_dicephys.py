@@ -180,3 +180,8 @@ def test_paper_is_the_cli_s_and_a_stopped_one_writes_nothing(tmp_path: Path) -> 
         return [(c["label"], c["mode"], c["engine"], c["run"]["counts"]) for c in doc["simulations"]]
 
     assert len(cells(want)) == 10 and cells(got.data) == cells(want)
+
+
+def test_an_unknown_option_is_a_type_error() -> None:
+    with pytest.raises(TypeError, match="colour"):
+        dicephys.fair("16x16x16", rolls=10, colour="red")
