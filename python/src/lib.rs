@@ -16,7 +16,7 @@ use dicephys::engine::EngineKind;
 use dicephys::error::parse_name;
 use dicephys::model::block::Block;
 use dicephys::model::faces::Layout;
-use dicephys::model::mass::{DieFile, Pips};
+use dicephys::model::mass::DieFile;
 use dicephys::model::scene::{Floor, Mode, Preset, Scene};
 use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
 use dicephys::report::per_roll::PerRoll;
@@ -312,24 +312,11 @@ fn spec(block_: &str, o: &Options, layout: Layout, precision: bool) -> PyResult<
         }
         scene.features = file.features();
     }
+    scene.features =
+        scene
+            .features
+            .with_mm(o.maybe("com")?, o.maybe("pips")?, o.maybe("edge_radius")?);
     let f = &mut scene.features;
-    if let Some(c) = o.maybe::<[f64; 3]>("com")? {
-        f.com = Some(c.map(|x| x / 1000.0));
-    }
-    if let Some([d, h]) = o.maybe::<[f64; 2]>("pips")? {
-        let (d, h) = (d / 1000.0, h / 1000.0);
-        f.pips = Some(match f.pips.take() {
-            Some(p) => Pips {
-                diameter: d,
-                depth: h,
-                ..p
-            },
-            None => Pips::caps(d, h),
-        });
-    }
-    if let Some(r) = o.maybe::<f64>("edge_radius")? {
-        f.edge_radius = r / 1000.0;
-    }
     if f.pips.is_some() {
         // The pips follow the numbers: the layout places them.
         f.layout = layout;
@@ -582,6 +569,19 @@ fn study(
 ) -> PyResult<String> {
     let cfg: StudyConfig = serde_json::from_str(config)
         .map_err(|e| bad("config", "…", format!("not a study's configuration: {e}")))?;
+    run_study(py, cfg, out, threads, progress, log)
+}
+
+/// Runs a study into `out` (its cells beside its files, where the command line keeps them);
+/// its JSON result.
+fn run_study(
+    py: Python<'_>,
+    cfg: StudyConfig,
+    out: PathBuf,
+    threads: usize,
+    progress: Option<&Bound<'_, PyAny>>,
+    log: Option<&Bound<'_, PyAny>>,
+) -> PyResult<String> {
     cfg.validate().map_err(py_err)?;
     let cells = match &cfg {
         StudyConfig::Fit(_) => "cells",
@@ -589,10 +589,9 @@ fn study(
         _ => "checkpoint",
     };
     let place = place(Some(out), cells, threads, cfg.name())?;
-    let done = detached(py, progress, log, |s| {
+    finished(detached(py, progress, log, |s| {
         s.hooked(|h| outputs::run(&cfg, &place, h))
-    })?;
-    finished(done)
+    })?)
 }
 
 /// The default configuration of the study `name` (`paper`, `fit`'s parts are built by
@@ -732,10 +731,7 @@ fn fit(
         config,
         stage: dicephys::studies::fit::Stage::Whole,
     });
-    let place = place(Some(out), "cells", threads, "fit")?;
-    finished(detached(py, progress, log, |s| {
-        s.hooked(|h| outputs::run(&cfg, &place, h))
-    })?)
+    run_study(py, cfg, out, threads, progress, log)
 }
 
 /// `dicephys fit --recover`: counts simulated at `truth` (the free parameters' values, in

@@ -6,7 +6,7 @@ use clap::{Args, ValueEnum};
 use dicephys::engine::EngineKind;
 use dicephys::error::parse_name;
 use dicephys::model::block::Block;
-use dicephys::model::mass::{DieFile, Pips};
+use dicephys::model::mass::DieFile;
 use dicephys::model::scene::{Floor, Mode, Preset, Scene};
 use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
 use dicephys::run::batch::MAX_THREADS;
@@ -258,25 +258,10 @@ impl SceneArgs {
             }
             scene.features = file.features();
         }
-        let f = &mut scene.features;
-        if let Some(c) = self.com {
-            f.com = Some(c.map(|x| x / 1000.0));
-        }
-        if let Some([d, h]) = self.pips {
-            // The flags' size on the file's pips (shape, paint, spacing), if it has any.
-            let (d, h) = (d / 1000.0, h / 1000.0);
-            f.pips = Some(match f.pips.take() {
-                Some(p) => Pips {
-                    diameter: d,
-                    depth: h,
-                    ..p
-                },
-                None => Pips::caps(d, h),
-            });
-        }
-        if let Some(r) = self.edge_radius {
-            f.edge_radius = r / 1000.0;
-        }
+        // The flags over the file's values (its pips keep their shape, paint and spacing).
+        scene.features = scene
+            .features
+            .with_mm(self.com, self.pips, self.edge_radius);
         if let Some(d) = self.density {
             scene.density = d;
         }

@@ -371,6 +371,36 @@ impl DieFile {
 }
 
 impl Features {
+    /// These features with the ones given in mm (the command line's and the Python
+    /// package's units) laid over them: a centre of mass, pips' diameter and depth (on the
+    /// pips already here, keeping their shape, paint and spacing, or as empty caps), an edge
+    /// radius.
+    pub fn with_mm(
+        mut self,
+        com: Option<[f64; 3]>,
+        pips: Option<[f64; 2]>,
+        edge_radius: Option<f64>,
+    ) -> Features {
+        if let Some(c) = com {
+            self.com = Some(c.map(|x| x / 1000.0));
+        }
+        if let Some([d, h]) = pips {
+            let (d, h) = (d / 1000.0, h / 1000.0);
+            self.pips = Some(match self.pips.take() {
+                Some(p) => Pips {
+                    diameter: d,
+                    depth: h,
+                    ..p
+                },
+                None => Pips::caps(d, h),
+            });
+        }
+        if let Some(r) = edge_radius {
+            self.edge_radius = r / 1000.0;
+        }
+        self
+    }
+
     /// True if the die is the paper's ideal block.
     pub fn plain(&self) -> bool {
         self.com.is_none() && self.pips.is_none() && self.edge_radius == 0.0
