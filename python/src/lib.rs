@@ -675,6 +675,7 @@ fn fit_config(
         mu: friction,
         throw: kappa.map_or(FixedThrow::Paper, FixedThrow::Hand),
         spin: spin_scale,
+        ..Fixed::default()
     };
     model.validate().map_err(py_err)?;
     let rows = if data == "paper" {
@@ -695,6 +696,8 @@ fn fit_config(
             engine: named::<EngineKind>("engine", "engine", engine)?,
             dt,
             max_steps,
+            die: Default::default(),
+            density: None,
         },
         design: calibration::design::DesignSpec {
             points,

@@ -6,6 +6,15 @@
 //! cube-ish,felt,50,20,20,3d,12,700,-
 //! ```
 //!
+//! Or, for a die whose faces were told apart, the six faces' counts in place of the three
+//! sides' (`face_1`…`face_6`: how often each number came up; 3D rows only, breadth ≥ width as
+//! given, since the numbers sit on the body's axes by the die's layout):
+//!
+//! ```text
+//! label,surface,length_mm,breadth_mm,width_mm,mode,face_1,face_2,face_3,face_4,face_5,face_6
+//! suspect,felt,16,16,16,3d,1702,1650,1671,1648,1660,1569
+//! ```
+//!
 //! - `mode`: how the row is simulated, `3d` (a free body) or `2d` (DicePhys's plane-locked
 //!   block). A 2D block cannot land on its end: a `2d` row is fitted on its two side outcomes,
 //!   and its length-vertical count is kept but set aside.
@@ -25,6 +34,27 @@ use serde::{Deserialize, Serialize};
 
 /// The outcomes in the order rows and simulations keep them.
 pub const OUTCOMES: [&str; 3] = ["length", "breadth", "width"];
+
+/// The face counts' columns, which may stand in place of the three `*_vertical` columns.
+pub const FACE_COLUMNS: [&str; 6] = ["face_1", "face_2", "face_3", "face_4", "face_5", "face_6"];
+
+/// What a row counts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcomes {
+    /// Which side stood vertical: length, breadth, width ([`OUTCOMES`]).
+    #[default]
+    Sides,
+    /// Which number came up: 1 to 6, by the die's layout.
+    Faces,
+}
+
+impl Outcomes {
+    /// True for side counts (the default, left out of a row's JSON).
+    pub fn is_sides(&self) -> bool {
+        *self == Outcomes::Sides
+    }
+}
 
 /// The CSV's columns, in order (`thrower` may be left out).
 pub const COLUMNS: [&str; 10] = [
@@ -53,10 +83,13 @@ pub struct DataRow {
     pub block: Block,
     /// How it is simulated.
     pub mode: Mode,
-    /// Counts of length, breadth and width vertical; a merged outcome's count is in its
-    /// group's first member and 0 in the others.
-    pub counts: [u64; 3],
-    /// The outcomes counted apart, as groups of [`OUTCOMES`] indices (a 2D row: breadth and
+    /// What it counts: sides (the default) or faces.
+    #[serde(default, skip_serializing_if = "Outcomes::is_sides")]
+    pub outcomes: Outcomes,
+    /// Counts of length, breadth and width vertical, or of faces 1 to 6; a merged outcome's
+    /// count is in its group's first member and 0 in the others.
+    pub counts: Vec<u64>,
+    /// The outcomes counted apart, as groups of indices into `counts` (a 2D row: breadth and
     /// width only).
     pub groups: Vec<Vec<usize>>,
 }
@@ -75,12 +108,29 @@ impl DataRow {
         self.grouped().iter().sum()
     }
 
-    /// The groups' names: "breadth", "width", "length", or "breadth+width" when merged.
+    /// The groups' names: "breadth", "width", "length", or "breadth+width" when merged; "face
+    /// 1" … "face 6" for a row of faces.
     pub fn group_names(&self) -> Vec<String> {
+        let name = |k: usize| match self.outcomes {
+            Outcomes::Sides => OUTCOMES[k].to_string(),
+            Outcomes::Faces => format!("face {}", k + 1),
+        };
         self.groups
             .iter()
-            .map(|g| g.iter().map(|&k| OUTCOMES[k]).collect::<Vec<_>>().join("+"))
+            .map(|g| g.iter().map(|&k| name(k)).collect::<Vec<_>>().join("+"))
             .collect()
+    }
+
+    /// The same row with `counts` in its groups (a merged group's in its first member).
+    pub fn with_grouped(&self, grouped: &[u64]) -> DataRow {
+        let mut counts = vec![0; self.counts.len()];
+        for (g, c) in self.groups.iter().zip(grouped) {
+            counts[g[0]] = *c;
+        }
+        DataRow {
+            counts,
+            ..self.clone()
+        }
     }
 }
 
@@ -173,8 +223,10 @@ pub fn shown(v: &str) -> String {
 
 /// Reads a counts CSV; `name` is the file's name for messages. Linear in the file's size.
 pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
+    // The header's names, once it is read (an error before it names no column).
+    let names: std::cell::RefCell<Vec<String>> = Default::default();
     let bad = |line: usize, col: usize, msg: String| {
-        let column = COLUMNS.get(col).copied().unwrap_or("?");
+        let column = names.borrow().get(col).cloned().unwrap_or("?".into());
         Error::Invalid(format!(
             "{name}: line {line}, column {} ({column}): {msg}",
             col + 1
@@ -222,14 +274,26 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
         .from_reader(text.as_bytes());
     let header = reader.headers().map_err(csv_error)?.clone();
     let have: Vec<&str> = header.iter().collect();
-    let with_thrower = have.len() == COLUMNS.len();
-    if !(9..=10).contains(&have.len()) || have != COLUMNS[..have.len()] {
+    let faces: Vec<&str> = COLUMNS[..6].iter().chain(&FACE_COLUMNS).copied().collect();
+    let (outcomes, counted) = if have.get(6) == Some(&FACE_COLUMNS[0]) {
+        (Outcomes::Faces, 6)
+    } else {
+        (Outcomes::Sides, 3)
+    };
+    let want: Vec<&str> = match outcomes {
+        Outcomes::Sides => COLUMNS[..9].to_vec(),
+        Outcomes::Faces => faces.clone(),
+    };
+    let with_thrower = have.len() == want.len() + 1 && have.last() == Some(&"thrower");
+    if !(have == want || with_thrower && have[..want.len()] == want[..]) {
         return Err(Error::Invalid(format!(
-            "{name}: line 1: the header must be {}[,thrower], got {}",
+            "{name}: line 1: the header must be {}[,thrower] (or face_1,…,face_6 in place of \
+             the three *_vertical), got {}",
             COLUMNS[..9].join(","),
             shown(&have.join(","))
         )));
     }
+    *names.borrow_mut() = have.iter().map(|s| s.to_string()).collect();
     let mut rows: Vec<DataRow> = Vec::new();
     let mut labels = std::collections::HashSet::new();
     for rec in reader.records() {
@@ -283,12 +347,19 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
         let mode: Mode = rec[5]
             .parse()
             .map_err(|_| bad(line, 5, format!("'{}' is not 2d or 3d", shown(&rec[5]))))?;
-        let mut counts = [0u64; 3];
-        let mut dashed = [false; 3];
-        for k in 0..3 {
+        if outcomes == Outcomes::Faces && mode == Mode::TwoD {
+            return Err(bad(
+                line,
+                5,
+                "face counts are thrown in 3D (a 2D block shows a side, not a number)".into(),
+            ));
+        }
+        let mut counts = vec![0u64; counted];
+        let mut dashed = vec![false; counted];
+        for k in 0..counted {
             let c = 6 + k;
             match &rec[c] {
-                "-" => dashed[k] = true,
+                "-" if outcomes == Outcomes::Sides => dashed[k] = true,
                 v => {
                     counts[k] = v.parse().map_err(|_| {
                         bad(
@@ -302,19 +373,37 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
         }
         // Breadth is the larger side: swap a row given the other way, with its counts.
         if sides[1] < sides[2] {
+            if outcomes == Outcomes::Faces {
+                return Err(bad(
+                    line,
+                    3,
+                    "give breadth_mm >= width_mm for face counts: the numbers sit on the \
+                     body's axes (x breadth, y width, z length) by the die's layout"
+                        .into(),
+                ));
+            }
             sides.swap(1, 2);
             counts.swap(1, 2);
             dashed.swap(1, 2);
         }
         let block = Block::from_mm(sides[0], sides[1], sides[2])
             .map_err(|e| bad(line, 2, e.to_string()))?;
-        let groups = groups(mode, sides, dashed).map_err(|m| bad(line, 6, m))?;
+        let groups = match outcomes {
+            Outcomes::Sides => groups(mode, sides, [dashed[0], dashed[1], dashed[2]])
+                .map_err(|m| bad(line, 6, m))?,
+            Outcomes::Faces => (0..6).map(|k| vec![k]).collect(),
+        };
         let row = DataRow {
             label,
             surface,
-            thrower: if with_thrower { text(9)? } else { "all".into() },
+            thrower: if with_thrower {
+                text(want.len())?
+            } else {
+                "all".into()
+            },
             block,
             mode,
+            outcomes,
             counts,
             groups,
         };
@@ -426,6 +515,45 @@ mod tests {
                 "{e} (wanted {want})"
             );
             assert!(!e.contains('\n'), "{e}");
+        }
+    }
+
+    #[test]
+    fn face_counts_are_six_outcomes_and_refused_where_they_cannot_be_read() {
+        let head = "label,surface,length_mm,breadth_mm,width_mm,mode,face_1,face_2,face_3,face_4,face_5,face_6";
+        let rows = parse(
+            &format!("{head},thrower\nd,felt,16,16,16,3d,10,11,12,13,14,15,me\n"),
+            "f.csv",
+        )
+        .unwrap();
+        assert_eq!(rows[0].outcomes, Outcomes::Faces);
+        assert_eq!(rows[0].counts, vec![10, 11, 12, 13, 14, 15]);
+        assert_eq!(rows[0].groups.len(), 6);
+        assert_eq!(rows[0].n(), 75);
+        assert_eq!(rows[0].thrower, "me");
+        assert_eq!(rows[0].group_names()[5], "face 6");
+        let cases = [
+            (
+                format!("{head}\nd,felt,16,16,16,2d,1,1,1,1,1,1\n"),
+                "column 6 (mode)",
+            ),
+            (
+                format!("{head}\nd,felt,16,15,16,3d,1,1,1,1,1,1\n"),
+                "column 4 (breadth_mm): give breadth_mm >= width_mm",
+            ),
+            (
+                format!("{head}\nd,felt,16,16,16,3d,1,-,1,1,1,1\n"),
+                "column 8 (face_2)",
+            ),
+            (format!("{head}\nd,felt,16,16,16,3d,1,1,1,1,1\n"), "line 2"),
+            (
+                "label,surface,length_mm,breadth_mm,width_mm,mode,face_1,face_2\n".into(),
+                "line 1: the header",
+            ),
+        ];
+        for (text, want) in cases {
+            let e = parse(&text, "f.csv").unwrap_err().to_string();
+            assert!(e.contains(want), "{e} (wanted {want})");
         }
     }
 

@@ -153,7 +153,10 @@ pub struct Design {
     pub mode: Mode,
     /// Its coordinates: each free kind and its range.
     pub axes: Axes,
-    /// Each point and its counts of length, breadth and width vertical.
+    /// True if its outcomes are the die's six faces (numbers 1 to 6), not the three sides.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub faces: bool,
+    /// Each point and its counts of length, breadth and width vertical (or of faces 1 to 6).
     pub points: Vec<DesignPoint>,
     /// Rolls that did not settle on a face (unknown, unconverged or failed), over all points.
     pub unsettled: u64,
@@ -179,6 +182,8 @@ pub struct Key {
     pub mode: Mode,
     /// The free kinds and their ranges.
     pub axes: Axes,
+    /// True if it counts faces, not sides.
+    pub faces: bool,
 }
 
 impl Key {
@@ -188,6 +193,7 @@ impl Key {
             block: row.block,
             mode: row.mode,
             axes: model.axes(params, &model.row_dims(params, row)),
+            faces: row.outcomes == crate::calibration::data::Outcomes::Faces,
         }
     }
 
@@ -195,7 +201,8 @@ impl Key {
     pub fn tag(&self) -> String {
         let axes: Vec<String> = self.axes.iter().map(|(k, r)| format!("{k}={r}")).collect();
         let h = fnv(&axes.join(","));
-        format!("{}-{}-{:08x}", self.block, self.mode.name(), h >> 32)
+        let faces = if self.faces { "-faces" } else { "" };
+        format!("{}-{}{faces}-{:08x}", self.block, self.mode.name(), h >> 32)
     }
 
     /// The seed of point `point`'s throws.
@@ -205,12 +212,12 @@ impl Key {
 
     /// True if `d` is this key's design.
     pub fn is(&self, d: &Design) -> bool {
-        d.block == self.block && d.mode == self.mode && d.axes == self.axes
+        d.block == self.block && d.mode == self.mode && d.axes == self.axes && d.faces == self.faces
     }
 }
 
-/// The distinct keys of `rows`, in first-seen order: rows with the same block, mode and
-/// parameter ranges share one design.
+/// The distinct keys of `rows`, in first-seen order: rows with the same block, mode,
+/// parameter ranges and outcomes share one design.
 pub fn keys(rows: &[DataRow], model: &ModelSpec) -> Vec<Key> {
     let params = model.params(rows);
     let mut out: Vec<Key> = Vec::new();

@@ -111,8 +111,9 @@ impl<'a> Likelihood<'a> {
     pub fn predict(&self, r: usize, x: &[f64]) -> RowPrediction {
         let design = &self.designs[self.row_design[r]];
         let pr = design.surrogate.predict(&self.local(r, x));
-        // Groups index [length, breadth, width]; a 2D surrogate has only breadth and width.
-        let shift = usize::from(design.mode == Mode::TwoD);
+        // Groups index [length, breadth, width]; a 2D surrogate has only breadth and width (a
+        // design of faces: the six, as the row's).
+        let shift = usize::from(design.mode == Mode::TwoD && !design.faces);
         let groups: Vec<Vec<usize>> = self.rows[r]
             .groups
             .iter()
@@ -646,15 +647,7 @@ fn bootstrap_rows(lik: &Likelihood, x: &[f64], rng: &mut ChaCha8Rng) -> Vec<Data
             let s: f64 = g.iter().sum();
             g.iter().map(|v| v / s).collect()
         };
-        let grouped = multinomial(n, &p, rng);
-        let mut counts = [0u64; 3];
-        for (g, c) in row.groups.iter().zip(&grouped) {
-            counts[g[0]] = *c;
-        }
-        out.push(DataRow {
-            counts,
-            ..row.clone()
-        });
+        out.push(row.with_grouped(&multinomial(n, &p, rng)));
     }
     out
 }
@@ -893,7 +886,8 @@ mod tests {
             thrower: "all".into(),
             block,
             mode: crate::model::scene::Mode::ThreeD,
-            counts: [c[0], c[1], c[2]],
+            outcomes: Default::default(),
+            counts: vec![c[0], c[1], c[2]],
             groups: vec![vec![0], vec![1], vec![2]],
         }];
         let pts: Vec<DesignPoint> = points(1, 24)
@@ -906,6 +900,7 @@ mod tests {
         let designs = vec![Design {
             block,
             mode: crate::model::scene::Mode::ThreeD,
+            faces: false,
             axes: vec![(Kind::E, Kind::E.default_range())],
             surrogate: Surrogate::fit_best(&pts, 1, 3, 4, 6),
             points: pts,
@@ -961,7 +956,8 @@ mod tests {
                 thrower: "all".into(),
                 block,
                 mode: crate::model::scene::Mode::ThreeD,
-                counts: [c[0], c[1], c[2]],
+                outcomes: Default::default(),
+                counts: vec![c[0], c[1], c[2]],
                 groups: vec![vec![0], vec![1], vec![2]],
             });
             let pts: Vec<DesignPoint> = points(3, 64)
@@ -974,6 +970,7 @@ mod tests {
             designs.push(Design {
                 block,
                 mode: crate::model::scene::Mode::ThreeD,
+                faces: false,
                 axes: [Kind::E, Kind::Mu, Kind::Kappa]
                     .iter()
                     .map(|k| (*k, k.default_range()))

@@ -41,10 +41,10 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<BlockRow>> {
         .find(|l| !l.starts_with('#'))
         .is_some_and(|h| h.contains("length_mm"))
     {
-        return Ok(data::parse(text, name)?
+        return data::parse(text, name)?
             .into_iter()
-            .map(from_counts)
-            .collect());
+            .map(|r| from_counts(r, name))
+            .collect();
     }
     let mut reader = csv::ReaderBuilder::new()
         .comment(Some(b'#'))
@@ -125,15 +125,24 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<BlockRow>> {
 }
 
 /// A counts file's row as a block to predict and test.
-fn from_counts(r: DataRow) -> BlockRow {
-    BlockRow {
+fn from_counts(r: DataRow, name: &str) -> Result<BlockRow> {
+    let counts = match r.outcomes {
+        data::Outcomes::Sides => [r.counts[0], r.counts[1], r.counts[2]],
+        data::Outcomes::Faces => {
+            return Err(Error::Invalid(format!(
+                "{name}: face counts: the blocks a prediction tests are counted by side \
+                 (length_vertical, breadth_vertical, width_vertical)"
+            )))
+        }
+    };
+    Ok(BlockRow {
         label: r.label,
         block: r.block,
         mode: r.mode,
         surface: Some(r.surface),
         thrower: (r.thrower != "all").then_some(r.thrower),
-        counts: Some(r.counts),
-    }
+        counts: Some(counts),
+    })
 }
 
 /// A value and its standard error.
@@ -325,6 +334,7 @@ mod tests {
                 err_params: 0.0,
                 err_sim: 0.0,
             },
+            faces: None,
             theory_ratio: 0.5,
             draws: 2,
             rolls: 10,

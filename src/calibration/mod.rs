@@ -80,16 +80,55 @@ impl FitConfig {
                 params.len()
             )));
         }
-        // One cell checks the method (engine, step, roll) for every row's block.
+        if self.model.is_free(params::Kind::PipDepth) && self.method.die.pips.is_none() {
+            return Err(Error::field(
+                "free",
+                "pip_depth",
+                "the die has no pips to vary: give them (--pips D,H or a die file's [pips])",
+            ));
+        }
+        let com_free = [params::Kind::ComX, params::Kind::ComY, params::Kind::ComZ]
+            .into_iter()
+            .filter(|&k| self.model.is_free(k));
+        if self.model.is_free(params::Kind::PipDepth) && com_free.clone().count() > 0 {
+            return Err(Error::field(
+                "free",
+                "pip_depth",
+                "and a free centre of mass cannot be told apart: pips bias a die through the \
+                 centre of mass they move, and a free centre is given outright; free one or \
+                 the other",
+            ));
+        }
+        for kind in com_free {
+            let r = self.model.range(kind);
+            let axis = kind as usize - params::Kind::ComX as usize;
+            for row in &self.rows {
+                let half = 500.0 * [row.block.breadth, row.block.width, row.block.length][axis];
+                if r.lo <= -half || r.hi >= half {
+                    return Err(Error::field(
+                        "range",
+                        format!("{kind}={r}"),
+                        format!(
+                            "the centre of mass must stay inside the die: within ±{half} mm on \
+                             {} (row '{}')",
+                            row.block,
+                            data::shown(&row.label)
+                        ),
+                    ));
+                }
+            }
+        }
+        // The method (engine, step, roll) and the die for every row's block, at the box's
+        // centre and its lowest and highest corners (a centre of mass or a pip depth at the
+        // box's ends must still fit inside the die).
+        let dims = self.model.free.len();
         for r in &self.rows {
-            let v = params::values(
-                &self.model.fixed,
-                &self.model.whole_axes(),
-                &vec![0.5; self.model.free.len()],
-            );
-            self.method
-                .spec(r.block, r.mode, &v, self.seed, self.design.rolls)
-                .validate(false)?;
+            for u in [0.5, 0.0, 1.0] {
+                let v = params::values(&self.model.fixed, &self.model.whole_axes(), &vec![u; dims]);
+                self.method
+                    .spec(r.block, r.mode, &v, self.seed, self.design.rolls)
+                    .validate(false)?;
+            }
         }
         Ok(())
     }

@@ -14,6 +14,7 @@ use crate::calibration::data::DataRow;
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
+use crate::model::mass::Features;
 use crate::model::scene::{Mode, Scene};
 use crate::model::throws::{Range, ThrowRanges};
 use crate::run::spec::{RunSpec, ThrowSpec, MAX_KAPPA};
@@ -48,13 +49,31 @@ pub enum Kind {
     Kappa,
     /// A factor on the paper's spin range, 31 to 160 rad/s (per thrower).
     Spin,
+    /// The die's centre of mass along its x (breadth) axis, mm from the geometric centre (one
+    /// die for every row).
+    ComX,
+    /// … along y (width), mm.
+    ComY,
+    /// … along z (length), mm.
+    ComZ,
+    /// The depth of the die's pips, mm (its pips' diameter, shape and paint stay the die's).
+    PipDepth,
 }
 
 impl Kind {
     /// Every kind, in the order a row's coordinates take them.
-    pub const ALL: [Kind; 4] = [Kind::E, Kind::Mu, Kind::Kappa, Kind::Spin];
+    pub const ALL: [Kind; 8] = [
+        Kind::E,
+        Kind::Mu,
+        Kind::Kappa,
+        Kind::Spin,
+        Kind::ComX,
+        Kind::ComY,
+        Kind::ComZ,
+        Kind::PipDepth,
+    ];
 
-    /// "e", "mu", "kappa" or "spin".
+    /// "e", "mu", "kappa", "spin", "com_x", "com_y", "com_z" or "pip_depth".
     pub fn name(self) -> &'static str {
         self.into()
     }
@@ -64,14 +83,23 @@ impl Kind {
         matches!(self, Kind::E | Kind::Mu)
     }
 
+    /// True for the die's parameters (its centre of mass, its pips' depth): one die, shared by
+    /// every row.
+    pub fn of_die(self) -> bool {
+        matches!(self, Kind::ComX | Kind::ComY | Kind::ComZ | Kind::PipDepth)
+    }
+
     /// The widest range accepted: e in [0, 1], μ in [0, 5], κ in [0, 10⁶], spin scale in
-    /// [0.05, 20].
+    /// [0.05, 20], a centre of mass within ±1000 mm (the die's own sides bound it further:
+    /// checked with the die), a pip depth in [0.001, 100] mm.
     pub fn limits(self) -> (f64, f64) {
         match self {
             Kind::E => (0.0, 1.0),
             Kind::Mu => (0.0, 5.0),
             Kind::Kappa => (0.0, MAX_KAPPA),
             Kind::Spin => (0.05, 20.0),
+            Kind::ComX | Kind::ComY | Kind::ComZ => (-1000.0, 1000.0),
+            Kind::PipDepth => (0.001, 100.0),
         }
     }
 
@@ -84,12 +112,16 @@ impl Kind {
             Kind::Mu => Range::new(0.1, 1.0),
             Kind::Kappa => Range::new(0.0, 1e4),
             Kind::Spin => Range::new(0.5, 2.0),
+            // A hidden weight of a few percent of a 16 mm die's mass moves its centre by about a
+            // millimetre (docs/results/dice.md: 0.25 mm is seen in ~5,000 throws).
+            Kind::ComX | Kind::ComY | Kind::ComZ => Range::new(-2.0, 2.0),
+            Kind::PipDepth => Range::new(0.2, 1.5),
         }
     }
 
     fn warp(self, v: f64) -> f64 {
         match self {
-            Kind::E | Kind::Mu => v,
+            Kind::E | Kind::Mu | Kind::ComX | Kind::ComY | Kind::ComZ | Kind::PipDepth => v,
             Kind::Kappa => (1.0 + v).log10(),
             Kind::Spin => v.ln(),
         }
@@ -97,7 +129,7 @@ impl Kind {
 
     fn unwarp(self, w: f64) -> f64 {
         match self {
-            Kind::E | Kind::Mu => w,
+            Kind::E | Kind::Mu | Kind::ComX | Kind::ComY | Kind::ComZ | Kind::PipDepth => w,
             Kind::Kappa => 10f64.powf(w) - 1.0,
             Kind::Spin => w.exp(),
         }
@@ -141,6 +173,17 @@ pub struct Fixed {
     pub throw: FixedThrow,
     /// The spin scale.
     pub spin: f64,
+    /// The die's centre of mass where a fit frees it, mm, per body axis (`None`: the die's
+    /// own, as its description gives it).
+    #[serde(default, skip_serializing_if = "is_none3")]
+    pub com: [Option<f64>; 3],
+    /// The die's pips' depth where a fit frees it, mm (`None`: the die's own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pip_depth: Option<f64>,
+}
+
+fn is_none3(c: &[Option<f64>; 3]) -> bool {
+    c.iter().all(Option::is_none)
 }
 
 impl Default for Fixed {
@@ -151,6 +194,8 @@ impl Default for Fixed {
             mu: 0.29,
             throw: FixedThrow::Paper,
             spin: 1.0,
+            com: [None; 3],
+            pip_depth: None,
         }
     }
 }
@@ -193,6 +238,10 @@ pub fn values(fixed: &Fixed, axes: &[(Kind, Range)], x: &[f64]) -> Fixed {
             Kind::Mu => v.mu = value,
             Kind::Kappa => v.throw = FixedThrow::Hand(value),
             Kind::Spin => v.spin = value,
+            Kind::ComX => v.com[0] = Some(value),
+            Kind::ComY => v.com[1] = Some(value),
+            Kind::ComZ => v.com[2] = Some(value),
+            Kind::PipDepth => v.pip_depth = Some(value),
         }
     }
     v
@@ -203,7 +252,8 @@ pub fn values(fixed: &Fixed, axes: &[(Kind, Range)], x: &[f64]) -> Fixed {
 pub struct Param {
     /// Its kind.
     pub kind: Kind,
-    /// The surface (e, μ) or thrower (κ, spin) it belongs to, or "all" when shared.
+    /// The surface (e, μ) or thrower (κ, spin) it belongs to, or "all" when shared; "die"
+    /// for the die's own (its centre of mass, its pips).
     pub group: String,
     /// The range it is searched in (its kind's, or narrower after a first pass).
     pub range: Range,
@@ -305,7 +355,9 @@ impl ModelSpec {
     }
 
     fn group_of(&self, kind: Kind, row: &DataRow) -> String {
-        if kind.of_surface() {
+        if kind.of_die() {
+            "die".into()
+        } else if kind.of_surface() {
             if self.shared.contains(&kind) {
                 "all".into()
             } else {
@@ -383,6 +435,13 @@ pub struct Method {
     pub dt: f64,
     /// The step cap per roll.
     pub max_steps: u64,
+    /// The die thrown, where it is not the paper's ideal block (a centre of mass off centre,
+    /// pips, rounded edges, its faces' numbers): every row's, 3D only.
+    #[serde(default, skip_serializing_if = "Features::is_default")]
+    pub die: Features,
+    /// The die's density, kg/m³, where it is not the paper's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<f64>,
 }
 
 impl Method {
@@ -400,6 +459,22 @@ impl Method {
         }
     }
 
+    /// The die at the values `v`: a free centre of mass given outright (its components not
+    /// free from the die's description, else 0), a free pip depth on the die's pips.
+    pub fn die_at(&self, v: &Fixed) -> Features {
+        let mut die = self.die;
+        if v.com.iter().any(Option::is_some) {
+            let own = self.die.com.unwrap_or([0.0; 3]);
+            die.com = Some(std::array::from_fn(|i| {
+                v.com[i].map_or(own[i], |mm| mm / 1000.0)
+            }));
+        }
+        if let (Some(h), Some(p)) = (v.pip_depth, die.pips.as_mut()) {
+            p.depth = h / 1000.0;
+        }
+        die
+    }
+
     /// The run that simulates `block` in `mode` at the values `v`, `rolls` throws keyed by
     /// `seed`.
     pub fn spec(&self, block: Block, mode: Mode, v: &Fixed, seed: u64, rolls: u64) -> RunSpec {
@@ -407,6 +482,10 @@ impl Method {
         scene.dt = self.dt;
         scene.restitution = v.e;
         scene.friction = v.mu;
+        scene.features = self.die_at(v);
+        if let Some(d) = self.density {
+            scene.density = d;
+        }
         let mut throws = match v.throw {
             FixedThrow::Paper => ThrowSpec::keyed(seed),
             FixedThrow::Hand(k) => ThrowSpec::hand(seed, k),

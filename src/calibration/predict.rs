@@ -108,6 +108,10 @@ pub struct BlockPrediction {
     pub p: Vec<Predicted>,
     /// N(breadth vertical)/N(width vertical).
     pub ratio: Predicted,
+    /// P(face 1) … P(face 6) up, for a fit of a made die or of face counts (3D); `null`
+    /// otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub faces: Option<Vec<Predicted>>,
     /// The paper's 2D theory ratio (eq. MasterEqu) for the block.
     pub theory_ratio: f64,
     /// Posterior draws simulated.
@@ -151,7 +155,7 @@ pub fn group(
     let known: Vec<String> = fit
         .params
         .iter()
-        .filter(|p| p.kind.of_surface() == of_surface)
+        .filter(|p| !p.kind.of_die() && p.kind.of_surface() == of_surface)
         .map(|p| p.group.clone())
         .fold(Vec::new(), |mut v, g| {
             if !v.contains(&g) {

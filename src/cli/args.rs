@@ -6,7 +6,7 @@ use clap::{Args, ValueEnum};
 use dicephys::engine::EngineKind;
 use dicephys::error::parse_name;
 use dicephys::model::block::Block;
-use dicephys::model::mass::DieFile;
+use dicephys::model::mass::{DieFile, Features};
 use dicephys::model::scene::{Floor, Mode, Preset, Scene};
 use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
 use dicephys::run::batch::MAX_THREADS;
@@ -34,9 +34,6 @@ pub struct SceneArgs {
     /// Allow a restitution above 1 (an engine-stability study, not physics).
     #[arg(long)]
     pub allow_restitution_above_one: bool,
-    /// The die's density, kg/m³ [default: 800, or the --die file's].
-    #[arg(long)]
-    pub density: Option<f64>,
     /// Bullet solver settings: dicephys281 (Bullet 2.81 as the paper ran it) or bullet3.
     #[arg(long, default_value = "dicephys281", value_parser = parse_preset)]
     pub preset: Preset,
@@ -57,6 +54,17 @@ pub struct SceneArgs {
     /// freeze mid-fall).
     #[arg(long)]
     pub no_sleep: bool,
+    /// The die as it is made: its centre of mass, pips, rounded edges, density.
+    #[command(flatten)]
+    pub made: DieArgs,
+}
+
+/// The die as it is made (3D only): what departs from the paper's uniform, sharp block.
+#[derive(Args, Debug, Clone, Default)]
+pub struct DieArgs {
+    /// The die's density, kg/m³ [default: 800, or the --die file's].
+    #[arg(long)]
+    pub density: Option<f64>,
     /// The die's centre of mass, X,Y,Z in mm from its geometric centre along the body axes
     /// (x breadth, y width, z length): 0,0,-2 is a weight toward the −z face (6 on a western
     /// die). The inertia about the centre stays the solid's. 3D only.
@@ -75,6 +83,31 @@ pub struct SceneArgs {
     /// override its values.
     #[arg(long, value_name = "FILE.toml")]
     pub die: Option<std::path::PathBuf>,
+}
+
+impl DieArgs {
+    /// Lays the die's description over `scene`: the die file first, the flags over it (its
+    /// pips keep their shape, paint and spacing).
+    pub fn apply(&self, scene: &mut Scene) -> Result<()> {
+        let (features, density) = self.features()?;
+        scene.features = features;
+        if let Some(d) = density {
+            scene.density = d;
+        }
+        Ok(())
+    }
+
+    /// The die's features and its density where one is given (the flags over the file's).
+    pub fn features(&self) -> Result<(Features, Option<f64>)> {
+        let file = match &self.die {
+            Some(path) => DieFile::read(path)?,
+            None => DieFile::default(),
+        };
+        let features = file
+            .features()
+            .with_mm(self.com, self.pips, self.edge_radius);
+        Ok((features, self.density.or(file.density)))
+    }
 }
 
 /// Two or three numbers separated by commas.
@@ -251,20 +284,7 @@ impl SceneArgs {
         scene.linear_damping = self.linear_damping;
         scene.angular_damping = self.angular_damping;
         scene.sleeping = !self.no_sleep;
-        if let Some(path) = &self.die {
-            let file = DieFile::read(path)?;
-            if let Some(d) = file.density {
-                scene.density = d;
-            }
-            scene.features = file.features();
-        }
-        // The flags over the file's values (its pips keep their shape, paint and spacing).
-        scene.features = scene
-            .features
-            .with_mm(self.com, self.pips, self.edge_radius);
-        if let Some(d) = self.density {
-            scene.density = d;
-        }
+        self.made.apply(&mut scene)?;
         if let Some(t) = self.floor_thickness {
             if self.floor == Floor::Plane {
                 return Err(Error::Usage(

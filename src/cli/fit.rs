@@ -26,14 +26,15 @@ pub struct FitArgs {
     #[arg(long, value_name = "COUNTS.csv")]
     pub data: PathBuf,
     /// The free parameters (comma-separated): e (restitution), mu (friction), kappa (the
-    /// throw's concentration, --throw hand), spin (a factor on the spin range).
+    /// throw's concentration, --throw hand), spin (a factor on the spin range); for a die,
+    /// com_x, com_y, com_z (its centre of mass, mm) and pip_depth (mm).
     #[arg(long, value_delimiter = ',', default_value = "e,mu", value_parser = parse_kind)]
     pub free: Vec<Kind>,
     /// Surface parameters shared by every surface instead of one per surface (e, mu).
     #[arg(long, value_delimiter = ',', value_parser = parse_kind)]
     pub shared: Vec<Kind>,
     /// A free parameter's range, NAME=LO:HI (repeat for several). Defaults: e=0.05:0.8,
-    /// mu=0.1:1, kappa=0:10000, spin=0.5:2.
+    /// mu=0.1:1, kappa=0:10000, spin=0.5:2, com_x|y|z=-2:2, pip_depth=0.2:1.5.
     #[arg(long = "range", value_name = "NAME=LO:HI")]
     pub ranges: Vec<String>,
     /// e where it is not free.
@@ -49,6 +50,13 @@ pub struct FitArgs {
     /// The spin scale where spin is not free.
     #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     pub spin_scale: f64,
+    /// The die thrown, as `roll` takes it (a centre of mass that is not free, pips, rounded
+    /// edges, a die file); one die for every row, 3D only.
+    #[command(flatten)]
+    pub made: super::args::DieArgs,
+    /// Which number is on which face, for counts of faces: right (western dice) or left.
+    #[arg(long, default_value = "right")]
+    pub layout: dicephys::model::faces::Layout,
     /// The engine.
     #[arg(long, default_value = "bullet", value_parser = parse_engine)]
     pub engine: EngineKind,
@@ -217,6 +225,7 @@ impl FitArgs {
             mu: self.friction,
             throw,
             spin: self.spin_scale,
+            ..Fixed::default()
         };
         model.validate()?;
         Ok(model)
@@ -234,10 +243,18 @@ impl FitArgs {
         let cfg = FitConfig {
             rows,
             model: self.model()?,
-            method: Method {
-                engine: self.engine,
-                dt: self.dt,
-                max_steps: self.max_steps,
+            method: {
+                let (mut die, density) = self.made.features()?;
+                if die.layout == Default::default() {
+                    die.layout = self.layout;
+                }
+                Method {
+                    engine: self.engine,
+                    dt: self.dt,
+                    max_steps: self.max_steps,
+                    die,
+                    density,
+                }
             },
             design: DesignSpec {
                 points: self.points,

@@ -94,6 +94,8 @@ impl PaperArgs {
                 engine: EngineKind::Bullet,
                 dt: a.dt,
                 max_steps: a.max_steps,
+                die: Default::default(),
+                density: None,
             },
             design: DesignSpec {
                 points: a.points,

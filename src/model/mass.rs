@@ -18,7 +18,7 @@ use std::f64::consts::PI;
 
 /// How the die departs from the paper's ideal block: uniform, sharp, plain. Each is off by
 /// default, and a die with none of them is rolled on exactly the paper's path.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Features {
     /// The centre of mass, given outright: its offset from the geometric centre, m, in body
@@ -59,7 +59,7 @@ pub enum PipShape {
 
 /// Drilled pips. They change the mass, not the collision surface: a pip is narrower than
 /// anything the floor could reach into.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Pips {
     /// The pip's diameter on the face, m.
@@ -399,6 +399,11 @@ impl Features {
             self.edge_radius = r / 1000.0;
         }
         self
+    }
+
+    /// True if nothing is set, not even the layout.
+    pub fn is_default(&self) -> bool {
+        *self == Features::default()
     }
 
     /// True if the die is the paper's ideal block.

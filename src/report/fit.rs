@@ -44,6 +44,39 @@ pub fn fixed_text(res: &FitResult) -> String {
     if !m.is_free(Kind::Spin) {
         parts.push(format!("spin scale {}", f.spin));
     }
+    let die = &res.config.method.die;
+    if let Some(c) = die.com {
+        let free = [Kind::ComX, Kind::ComY, Kind::ComZ].map(|k| m.is_free(k));
+        if free.iter().any(|x| !x) {
+            let mm = |i: usize| {
+                if free[i] {
+                    "free".into()
+                } else {
+                    format!("{}", c[i] * 1000.0)
+                }
+            };
+            parts.push(format!(
+                "the die's centre of mass ({}, {}, {}) mm",
+                mm(0),
+                mm(1),
+                mm(2)
+            ));
+        }
+    }
+    if let Some(p) = die.pips {
+        let depth = if m.is_free(Kind::PipDepth) {
+            "free".into()
+        } else {
+            format!("{}", p.depth * 1000.0)
+        };
+        parts.push(format!(
+            "pips {} mm across, {depth} mm deep",
+            p.diameter * 1000.0
+        ));
+    }
+    if die.edge_radius > 0.0 {
+        parts.push(format!("edges rounded to {} mm", die.edge_radius * 1000.0));
+    }
     if parts.is_empty() {
         "none".into()
     } else {
@@ -441,6 +474,15 @@ pub fn prediction_text(p: &BlockPrediction) -> String {
         predicted(&p.ratio),
         p.theory_ratio
     );
+    for (k, v) in p.faces.iter().flatten().enumerate() {
+        let _ = writeln!(
+            s,
+            "  P(face {} up)  {}   {:+.1}σ from 1/6",
+            k + 1,
+            predicted(v),
+            (v.value - 1.0 / 6.0) / v.err.max(1e-12)
+        );
+    }
     if p.unsettled > 0 {
         let _ = writeln!(
             s,

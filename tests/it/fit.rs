@@ -339,7 +339,8 @@ fn counted_at_e_03(runner: &Runner) -> FitConfig {
         thrower: "all".into(),
         block: block.parse().unwrap(),
         mode: Mode::TwoD,
-        counts: [0, 0, n],
+        outcomes: Default::default(),
+        counts: vec![0, 0, n],
         groups: vec![vec![1], vec![2]],
     };
     let shape = vec![
@@ -354,6 +355,8 @@ fn counted_at_e_03(runner: &Runner) -> FitConfig {
             engine: EngineKind::Bullet,
             dt: 1.0 / 250.0,
             max_steps: dicephys::sim::roll::DEFAULT_MAX_STEPS,
+            die: Default::default(),
+            density: None,
         },
         design: DesignSpec {
             points: POINTS,

@@ -90,7 +90,8 @@ pub fn predict_block(
         thrower: thrower.clone(),
         block: cfg.block,
         mode: cfg.mode,
-        counts: [0, 1, 1],
+        outcomes: Default::default(),
+        counts: vec![0, 1, 1],
         groups: vec![vec![1], vec![2]],
     };
     let model = &fit.config.model;
@@ -98,6 +99,15 @@ pub fn predict_block(
     let axes = model.axes(&fit.params, &dims);
     let step = fit.estimate.draws.len() / cfg.draws;
     let mut freq: [Vec<f64>; 3] = Default::default();
+    let die = &fit.config.method.die;
+    let with_faces = cfg.mode == crate::model::scene::Mode::ThreeD
+        && (!die.is_default()
+            || fit
+                .config
+                .rows
+                .iter()
+                .any(|r| r.outcomes == crate::calibration::data::Outcomes::Faces));
+    let mut face_freq: [Vec<f64>; 6] = Default::default();
     let mut ratios = Vec::new();
     let mut unsettled = 0;
     for m in 0..cfg.draws {
@@ -137,6 +147,12 @@ pub fn predict_block(
             freq[k].push(*v as f64 / settled as f64);
         }
         ratios.push(c.breadth as f64 / c.width.max(1) as f64);
+        if with_faces {
+            let faces = super::simulate::outcome_counts(&done.tally, true, die)?;
+            for (k, v) in faces.iter().enumerate() {
+                face_freq[k].push(*v as f64 / settled as f64);
+            }
+        }
     }
     let all = cfg.draws as u64 * cfg.rolls;
     if unsettled as f64 > super::MAX_UNSETTLED_SHARE * all as f64 {
@@ -164,6 +180,12 @@ pub fn predict_block(
         .iter()
         .map(|v| combine(v, &|q: f64| q * (1.0 - q) / n))
         .collect();
+    let faces = with_faces.then(|| {
+        face_freq
+            .iter()
+            .map(|v| combine(v, &|q: f64| q * (1.0 - q) / n))
+            .collect()
+    });
     let ratio = combine(&ratios, &|r: f64| {
         // The paper's binomial error of a ratio r = q/(1 − q) of counts (q the breadth's share
         // of the side outcomes): Var r = q(1 − q)/(n (1 − q)⁴).
@@ -177,6 +199,7 @@ pub fn predict_block(
         thrower,
         p,
         ratio,
+        faces,
         theory_ratio: crate::theory::ratio_from_r(cfg.block.r()),
         draws: cfg.draws,
         rolls: cfg.rolls,

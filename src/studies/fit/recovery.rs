@@ -4,7 +4,7 @@
 //! Each repetition simulates its own data and its own designs (fresh keyed throws), so the
 //! surrogates' noise is part of what is checked.
 
-use crate::calibration::data::DataRow;
+use crate::calibration::data::{DataRow, Outcomes};
 use crate::calibration::design::point_seed;
 use crate::calibration::estimate::Likelihood;
 use crate::calibration::params::Fixed;
@@ -12,6 +12,7 @@ use crate::calibration::recovery::{Recovery, Repetition};
 use crate::calibration::FitConfig;
 use crate::error::{Error, Result};
 use crate::run::runner::Runner;
+use crate::studies::fit::simulate::outcome_counts;
 
 /// Counts of `rows`' blocks simulated at `truth` with as many throws as each row counts.
 pub fn simulate_data(
@@ -34,20 +35,15 @@ pub fn simulate_data(
         if !done.complete {
             return Ok(None);
         }
-        let c = &done.tally.counts;
-        let mut counts = [c.length, c.breadth, c.width];
+        let faces = row.outcomes == Outcomes::Faces;
+        let counts = outcome_counts(&done.tally, faces, &cfg.method.die)?;
         // Merged groups keep their count in the first member, as the data file does.
-        for g in &row.groups {
-            let sum: u64 = g.iter().map(|&k| counts[k]).sum();
-            for &k in g {
-                counts[k] = 0;
-            }
-            counts[g[0]] = sum;
-        }
-        out.push(DataRow {
-            counts,
-            ..row.clone()
-        });
+        let grouped: Vec<u64> = row
+            .groups
+            .iter()
+            .map(|g| g.iter().map(|&k| counts[k]).sum())
+            .collect();
+        out.push(row.with_grouped(&grouped));
     }
     Ok(Some(out))
 }

@@ -2,10 +2,12 @@
 
 use crate::calibration::design::{points, Design, DesignSpec, Key};
 use crate::calibration::params::{self, Method, ModelSpec};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::inference::surrogate::{DesignPoint, Surrogate};
+use crate::model::mass::Features;
 use crate::model::scene::Mode;
 use crate::run::runner::Runner;
+use crate::run::tally::Tally;
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
@@ -33,6 +35,7 @@ impl Session {
                 block: d.block,
                 mode: d.mode,
                 axes: d.axes.clone(),
+                faces: d.faces,
             };
             cache.push((key, seed, d.clone()));
         }
@@ -134,7 +137,7 @@ pub fn simulate(
             rolls += t.rolls;
             design_points.push(DesignPoint {
                 x: x.clone(),
-                counts: vec![t.counts.length, t.counts.breadth, t.counts.width],
+                counts: outcome_counts(t, key.faces, &plan.method.die)?,
             });
         }
         if runner.share.is_partial() {
@@ -142,6 +145,7 @@ pub fn simulate(
         }
         // A 2D block has no length outcome: its surrogate is over breadth and width.
         let (outcomes, pts): (usize, Vec<DesignPoint>) = match mode {
+            _ if key.faces => (6, design_points.clone()),
             Mode::ThreeD => (3, design_points.clone()),
             Mode::TwoD => (
                 2,
@@ -165,6 +169,7 @@ pub fn simulate(
             block,
             mode,
             axes: key.axes.clone(),
+            faces: key.faces,
             points: design_points,
             unsettled,
             rolls,
@@ -178,4 +183,25 @@ pub fn simulate(
         out.push(design);
     }
     Ok((!runner.share.is_partial()).then_some(out))
+}
+
+/// A tally's outcomes as a fit counts them: length, breadth and width vertical, or (`faces`)
+/// how often each number 1 to 6 came up on `die`'s layout.
+pub fn outcome_counts(t: &Tally, faces: bool, die: &Features) -> Result<Vec<u64>> {
+    if !faces {
+        return Ok(vec![t.counts.length, t.counts.breadth, t.counts.width]);
+    }
+    if !t.faces_complete() {
+        return Err(Error::Invalid(
+            "the checkpoint holds rolls written before faces were kept: roll it afresh \
+             (another --dir)"
+                .into(),
+        ));
+    }
+    let numbers = die.layout.numbers();
+    let mut out = vec![0; 6];
+    for (d, &n) in numbers.iter().enumerate() {
+        out[usize::from(n) - 1] = t.up[d];
+    }
+    Ok(out)
 }
