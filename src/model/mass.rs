@@ -362,7 +362,7 @@ impl DieFile {
             pips: self.pips.as_ref().map(|p| Pips {
                 diameter: p.diameter / 1000.0,
                 depth: p.depth / 1000.0,
-                ..p.clone()
+                ..*p
             }),
             edge_radius: self.edge_radius.unwrap_or(0.0) / 1000.0,
             layout: Layout::Right,
@@ -782,7 +782,7 @@ mod tests {
             fill_density: 0.0,
             spacing: 0.25,
         };
-        s.features.pips = Some(p.clone());
+        s.features.pips = Some(p);
         let m = MassProps::of(&s).unwrap();
         let v = cavity(&p)[0];
         let solid = s.mass();

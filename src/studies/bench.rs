@@ -454,7 +454,7 @@ pub fn made_dice() -> Vec<(&'static str, crate::model::mass::Features)> {
         (
             "--pips 3,1",
             Features {
-                pips: pips.clone(),
+                pips,
                 ..Default::default()
             },
         ),
@@ -513,7 +513,7 @@ pub fn dice_costs(
         for _ in 0..repeat.max(1) {
             for ((_, features), best) in dice.iter().zip(best.iter_mut()) {
                 let mut scene = Scene::paper(block, Mode::ThreeD);
-                scene.features = features.clone();
+                scene.features = *features;
                 let job = batch::Job {
                     engine,
                     scene: &scene,
