@@ -273,7 +273,7 @@ def roll(
     pips: Optional[Sequence[float]] = None,
     edge_radius: Optional[float] = None,
     die: Optional[PathLike] = None,
-    layout: str = "right",
+    layout: Optional[str] = None,
     threads: int = 0,
     per_roll: bool = False,
     precision: Optional[float] = None,
@@ -299,7 +299,8 @@ def roll(
         "dicephys".  flight: "fast" or "stepped".  faithful: DicePhys as the paper ran it.
     com: the centre of mass (x, y, z) in mm from the geometric centre; pips: (diameter,
         depth) in mm; edge_radius: mm; die: a die file (TOML) — a die as it is made.
-    layout: "right" or "left": how the numbers sit on the faces.
+    layout: "right" or "left": how the numbers sit on the faces (default: the ``die``
+        file's layout or face map, else "right").
     threads: worker threads (0: one per core).
     per_roll: also return every throw as a NumPy structured array (``Roll.per_roll``).
     precision: roll until the ratio's relative 2σ error is at most this fraction

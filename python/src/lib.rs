@@ -16,7 +16,7 @@ use dicephys::engine::EngineKind;
 use dicephys::error::parse_name;
 use dicephys::model::block::Block;
 use dicephys::model::faces::Layout;
-use dicephys::model::mass::DieFile;
+use dicephys::model::mass::Features;
 use dicephys::model::scene::{Floor, Mode, Preset, Scene};
 use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
 use dicephys::report::per_roll::PerRoll;
@@ -291,7 +291,7 @@ impl<'py> Options<'py> {
 
 /// The scene, the throws and the roll of `roll` and `fair` from their options (`dicephys
 /// roll`'s, by the library's names and units: mm for the die as made), checked by the library.
-fn spec(block_: &str, o: &Options, layout: Layout, precision: bool) -> PyResult<RunSpec> {
+fn spec(block_: &str, o: &Options, layout: Option<Layout>, precision: bool) -> PyResult<RunSpec> {
     let mut scene = Scene::paper(block(block_)?, mode(&o.get("mode", "3d".to_string())?)?);
     scene.dt = o.get("dt", scene.dt)?;
     scene.friction = o.get("friction", scene.friction)?;
@@ -305,23 +305,17 @@ fn spec(block_: &str, o: &Options, layout: Layout, precision: bool) -> PyResult<
     scene.linear_damping = o.get("linear_damping", 0.0)?;
     scene.angular_damping = o.get("angular_damping", 0.0)?;
     scene.sleeping = o.get("sleep", true)?;
-    if let Some(path) = o.maybe::<PathBuf>("die")? {
-        let file = DieFile::read(&path).map_err(py_err)?;
-        if let Some(d) = file.density {
-            scene.density = d;
-        }
-        scene.features = file.features();
-    }
-    scene.features =
-        scene
-            .features
-            .with_mm(o.maybe("com")?, o.maybe("pips")?, o.maybe("edge_radius")?);
-    let f = &mut scene.features;
-    if f.pips.is_some() {
-        // The pips follow the numbers: the layout places them.
-        f.layout = layout;
-    }
-    if let Some(d) = o.maybe::<f64>("density")? {
+    let (features, density) = Features::described(
+        o.maybe::<PathBuf>("die")?.as_deref(),
+        o.maybe("com")?,
+        o.maybe("pips")?,
+        o.maybe("edge_radius")?,
+        layout,
+        o.maybe::<f64>("density")?,
+    )
+    .map_err(py_err)?;
+    scene.features = features;
+    if let Some(d) = density {
         scene.density = d;
     }
     if let Some(t) = o.maybe::<f64>("floor_thickness")? {
@@ -460,7 +454,10 @@ fn roll<'py>(
     let o = Options {
         given: options.map(|d| d.copy()).transpose()?,
     };
-    let layout = named::<Layout>("layout", "layout", &o.get("layout", "right".to_string())?)?;
+    let layout = o
+        .maybe::<String>("layout")?
+        .map(|l| named::<Layout>("layout", "layout", &l))
+        .transpose()?;
     let null = o
         .maybe::<String>("fair")?
         .map(|n| named::<dicephys::studies::fair::Null>("null", "null", &n))
@@ -470,6 +467,8 @@ fn roll<'py>(
     let per_roll = o.get("per_roll", false)?;
     let progress = o.object("progress")?;
     let spec = spec(block, &o, layout, precision.is_some())?;
+    // The numbers: the layout given, else the die's own (a die file's map), else right.
+    let layout = layout.unwrap_or(spec.scene.features.layout);
     o.finish()?;
     if null == Some(dicephys::studies::fair::Null::SolidAngle) && spec.scene.mode == Mode::TwoD {
         return Err(bad(

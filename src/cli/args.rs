@@ -6,7 +6,7 @@ use clap::{Args, ValueEnum};
 use dicephys::engine::EngineKind;
 use dicephys::error::parse_name;
 use dicephys::model::block::Block;
-use dicephys::model::mass::{DieFile, Features};
+use dicephys::model::mass::Features;
 use dicephys::model::scene::{Floor, Mode, Preset, Scene};
 use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
 use dicephys::run::batch::MAX_THREADS;
@@ -99,14 +99,14 @@ impl DieArgs {
 
     /// The die's features and its density where one is given (the flags over the file's).
     pub fn features(&self) -> Result<(Features, Option<f64>)> {
-        let file = match &self.die {
-            Some(path) => DieFile::read(path)?,
-            None => DieFile::default(),
-        };
-        let features = file
-            .features()
-            .with_mm(self.com, self.pips, self.edge_radius);
-        Ok((features, self.density.or(file.density)))
+        Ok(Features::described(
+            self.die.as_deref(),
+            self.com,
+            self.pips,
+            self.edge_radius,
+            None,
+            self.density,
+        )?)
     }
 }
 

@@ -39,7 +39,8 @@ pub fn run(a: &FairArgs) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(|e| {
             Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
         })?;
-        let identity = serde_json::json!({ "spec": spec, "null": a.null, "layout": a.roll.layout });
+        let identity =
+            serde_json::json!({ "spec": spec, "null": a.null, "layout": a.roll.layout(&spec) });
         dicephys::studies::fair::claim(dir, &identity)?;
     }
     // --precision here is every face's probability's.

@@ -66,9 +66,10 @@ pub struct RollArgs {
     pub per_roll: Option<PathBuf>,
     /// How the numbers sit on the faces, for `faces` and the per-roll `face` column: right
     /// (western dice: 1 on +z, 6 on −z, 2 on +x, 3 on +y; 1, 2, 3 counter-clockwise about
-    /// their corner) or left (its mirror image).
-    #[arg(long, default_value = "right")]
-    pub layout: dicephys::model::faces::Layout,
+    /// their corner) or left (its mirror image) [default: right, or the --die file's layout
+    /// or face map].
+    #[arg(long)]
+    pub layout: Option<dicephys::model::faces::Layout>,
     /// Keep a checkpoint here as the run goes (chunks of 1,000 rolls, written atomically);
     /// `dicephys roll --resume DIR` continues it, bit for bit.
     #[arg(long, value_name = "DIR", conflicts_with = "resume")]
@@ -96,9 +97,9 @@ impl RollArgs {
                 .map_err(|e| Error::Usage(format!("--resume {}: {e}", dir.display())));
         }
         let mut scene = self.scene.scene()?;
-        if scene.features.pips.is_some() {
+        if let (Some(layout), Some(_)) = (self.layout, scene.features.pips) {
             // The pips follow the numbers: the layout places them.
-            scene.features.layout = self.layout;
+            scene.features.layout = layout;
         }
         let spec = RunSpec {
             engine: self.engine,
@@ -110,6 +111,12 @@ impl RollArgs {
         };
         spec.validate(self.scene.allow_restitution_above_one)?;
         Ok(spec)
+    }
+
+    /// The numbers on the faces of `spec`'s die: `--layout`, else the die's own (a die
+    /// file's layout or face map), else right.
+    pub fn layout(&self, spec: &RunSpec) -> dicephys::model::faces::Layout {
+        self.layout.unwrap_or(spec.scene.features.layout)
     }
 }
 
@@ -144,7 +151,7 @@ pub fn rolled(
     let per_roll = a
         .per_roll
         .as_deref()
-        .map(|p| super::output(p).map(|o| (o, a.layout)))
+        .map(|p| super::output(p).map(|o| (o, a.layout(spec))))
         .transpose()?;
     let dir = a.resume.as_ref().or(a.checkpoint.as_ref());
     let total = spec.indices().len();
@@ -165,7 +172,7 @@ pub fn rolled(
             .map(|p| (p, target, &expect as &dyn Fn(u64))),
         &runner,
     )?
-    .with_layout(a.layout);
+    .with_layout(a.layout(spec));
     let rolled = summary.rolls;
     if summary.partial {
         let why = Error::Interrupted(match dir {

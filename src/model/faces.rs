@@ -21,7 +21,6 @@ pub const DIRECTIONS: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
     Eq,
     Serialize,
     Deserialize,
-    strum::Display,
     strum::EnumString,
     strum::VariantNames,
 )]
@@ -36,6 +35,28 @@ pub enum Layout {
     Right,
     /// Its mirror image (2 and 3 swapped, so 5 and 4): 1, 2, 3 clockwise, as on some dice.
     Left,
+    /// Any other map (a die file's `faces`): the number on each direction's face, in
+    /// [`DIRECTIONS`]' order, a permutation of 1 to 6.
+    #[strum(disabled)]
+    Map([u8; 6]),
+}
+
+impl std::fmt::Display for Layout {
+    /// "right", "left", or the map as "+x=2 -x=5 +y=3 -y=4 +z=1 -z=6".
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Layout::Right => f.write_str("right"),
+            Layout::Left => f.write_str("left"),
+            Layout::Map(n) => {
+                let parts: Vec<String> = DIRECTIONS
+                    .iter()
+                    .zip(n)
+                    .map(|(d, k)| format!("{d}={k}"))
+                    .collect();
+                f.write_str(&parts.join(" "))
+            }
+        }
+    }
 }
 
 impl Layout {
@@ -44,7 +65,36 @@ impl Layout {
         match self {
             Layout::Right => [2, 5, 3, 4, 1, 6],
             Layout::Left => [3, 4, 2, 5, 1, 6],
+            Layout::Map(n) => n,
         }
+    }
+
+    /// The layout a face map gives: each of the six directions ("+x" … "-z") a number, the
+    /// numbers a permutation of 1 to 6; the named layout when it is one.
+    pub fn from_map(map: &std::collections::BTreeMap<String, u8>) -> crate::Result<Layout> {
+        let bad = |why: String| Err(crate::Error::field("faces", "", why));
+        let mut numbers = [0u8; 6];
+        for (d, n) in map {
+            let Some(i) = DIRECTIONS.iter().position(|x| x == d) else {
+                return bad(format!(
+                    "'{d}' is not a face: name each of +x, -x, +y, -y, +z, -z"
+                ));
+            };
+            numbers[i] = *n;
+        }
+        let mut sorted = numbers;
+        sorted.sort_unstable();
+        if map.len() != 6 || sorted != [1, 2, 3, 4, 5, 6] {
+            return bad(format!(
+                "{}: must give each of +x, -x, +y, -y, +z, -z one of the numbers 1 to 6, each \
+                 number once",
+                Layout::Map(numbers)
+            ));
+        }
+        Ok([Layout::Right, Layout::Left]
+            .into_iter()
+            .find(|l| l.numbers() == numbers)
+            .unwrap_or(Layout::Map(numbers)))
     }
 
     /// The direction (index into [`DIRECTIONS`]) whose face carries `number`.
@@ -102,6 +152,52 @@ mod tests {
             let turn = normal(1).dot(&normal(2).cross(&normal(3)));
             assert_eq!(turn > 0.0, layout == Layout::Right, "{layout}: {turn}");
         }
+    }
+
+    #[test]
+    fn a_face_map_is_a_permutation_of_one_to_six() {
+        let map = |pairs: &[(&str, u8)]| {
+            pairs
+                .iter()
+                .map(|(d, n)| (d.to_string(), *n))
+                .collect::<std::collections::BTreeMap<_, _>>()
+        };
+        let right = [
+            ("+x", 2),
+            ("-x", 5),
+            ("+y", 3),
+            ("-y", 4),
+            ("+z", 1),
+            ("-z", 6),
+        ];
+        assert_eq!(Layout::from_map(&map(&right)).unwrap(), Layout::Right);
+        // 1 and 2 swapped: no longer opposite faces summing to seven, but a die all the same.
+        let odd = [
+            ("+x", 1),
+            ("-x", 5),
+            ("+y", 3),
+            ("-y", 4),
+            ("+z", 2),
+            ("-z", 6),
+        ];
+        let l = Layout::from_map(&map(&odd)).unwrap();
+        assert_eq!(l.numbers(), [1, 5, 3, 4, 2, 6]);
+        assert_eq!(l.direction_of(2), Some(4));
+        assert_eq!(l.to_string(), "+x=1 -x=5 +y=3 -y=4 +z=2 -z=6");
+        let twice = [
+            ("+x", 1),
+            ("-x", 1),
+            ("+y", 3),
+            ("-y", 4),
+            ("+z", 2),
+            ("-z", 6),
+        ];
+        let e = Layout::from_map(&map(&twice)).unwrap_err().to_string();
+        assert!(e.contains("each number once"), "{e}");
+        let e = Layout::from_map(&map(&[("up", 1)]))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("'up' is not a face"), "{e}");
     }
 
     #[test]

@@ -36,6 +36,40 @@ pub struct Features {
     /// Which number is on which face (it decides where the pips are): `roll --layout`.
     #[serde(default, skip_serializing_if = "is_right")]
     pub layout: Layout,
+    /// A block of a second material inside the die (a weight hidden on purpose).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub insert: Option<Insert>,
+    /// The inertia tensor about the centre of mass, given outright (kg m², body axes: xx, yy,
+    /// zz, xy, xz, yz), in place of the solid's; its principal frame is found from it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inertia: Option<[f64; 6]>,
+}
+
+/// A cuboid of another density inside the die, its edges along the die's axes.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Insert {
+    /// Its sides along x, y, z, m.
+    pub size: [f64; 3],
+    /// Its centre, m from the die's geometric centre, body axes.
+    pub centre: [f64; 3],
+    /// Its density, kg/m³ (0: a hollow).
+    pub density: f64,
+}
+
+impl Insert {
+    /// Its moments at unit density about the die's geometric centre: a box of volume V at c
+    /// has Σ m r = V c and Σ m r rᵀ = V (diag(sᵢ²)/12 + c cᵀ).
+    fn moments(&self) -> Moments {
+        let s = Vector3::from(self.size);
+        let c = Vector3::from(self.centre);
+        let v = s.x * s.y * s.z;
+        Moments {
+            mass: v,
+            first: v * c,
+            second: v * (Matrix3::from_diagonal(&(s.component_mul(&s) / 12.0)) + c * c.transpose()),
+        }
+    }
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -332,6 +366,14 @@ pub struct DieFile {
     pub density: Option<f64>,
     /// Pips, in mm.
     pub pips: Option<Pips>,
+    /// "right" or "left".
+    pub layout: Option<Layout>,
+    /// The number on each face: `{ "+x" = 2, "-x" = 5, … }`.
+    pub faces: Option<std::collections::BTreeMap<String, u8>>,
+    /// An insert, in mm and kg/m³.
+    pub insert: Option<Insert>,
+    /// The inertia about the centre of mass, g mm²: xx, yy, zz, xy, xz, yz.
+    pub inertia: Option<[f64; 6]>,
 }
 
 impl DieFile {
@@ -355,22 +397,66 @@ impl DieFile {
         })
     }
 
-    /// The features it describes, lengths in metres.
-    pub fn features(&self) -> Features {
-        Features {
-            com: self.com.map(|c| c.map(|x| x / 1000.0)),
+    /// The features it describes, lengths in metres; a face map that is not a permutation of
+    /// 1 to 6, or given beside `layout`, is refused.
+    pub fn features(&self) -> Result<Features> {
+        let layout = match (&self.faces, self.layout) {
+            (Some(_), Some(_)) => {
+                return Err(Error::field(
+                    "faces",
+                    "",
+                    "give either a layout or a face map, not both",
+                ))
+            }
+            (Some(map), None) => Layout::from_map(map)?,
+            (None, l) => l.unwrap_or_default(),
+        };
+        let mm = |c: [f64; 3]| c.map(|x| x / 1000.0);
+        Ok(Features {
+            com: self.com.map(mm),
             pips: self.pips.as_ref().map(|p| Pips {
                 diameter: p.diameter / 1000.0,
                 depth: p.depth / 1000.0,
                 ..*p
             }),
             edge_radius: self.edge_radius.unwrap_or(0.0) / 1000.0,
-            layout: Layout::Right,
-        }
+            layout,
+            insert: self.insert.map(|i| Insert {
+                size: mm(i.size),
+                centre: mm(i.centre),
+                density: i.density,
+            }),
+            // g mm² = 10⁻³ kg × 10⁻⁶ m².
+            inertia: self.inertia.map(|t| t.map(|x| x * 1e-9)),
+        })
     }
 }
 
 impl Features {
+    /// A die as the command line and the Python package describe it: a die file's, if one is
+    /// named, with a centre of mass, pips' diameter and depth and an edge radius given in mm
+    /// laid over it ([`Features::with_mm`]), and a layout over the file's where the die has
+    /// pips for it to place (a plain die's numbers are the summary's business, not its
+    /// mass's). Returns the features and the density given (`density`, else the file's).
+    pub fn described(
+        file: Option<&std::path::Path>,
+        com: Option<[f64; 3]>,
+        pips: Option<[f64; 2]>,
+        edge_radius: Option<f64>,
+        layout: Option<Layout>,
+        density: Option<f64>,
+    ) -> Result<(Features, Option<f64>)> {
+        let file = match file {
+            Some(path) => DieFile::read(path)?,
+            None => DieFile::default(),
+        };
+        let mut f = file.features()?.with_mm(com, pips, edge_radius);
+        if let (Some(l), Some(_)) = (layout, f.pips) {
+            f.layout = l;
+        }
+        Ok((f, density.or(file.density)))
+    }
+
     /// These features with the ones given in mm (the command line's and the Python
     /// package's units) laid over them: a centre of mass, pips' diameter and depth (on the
     /// pips already here, keeping their shape, paint and spacing, or as empty caps), an edge
@@ -408,7 +494,11 @@ impl Features {
 
     /// True if the die is the paper's ideal block.
     pub fn plain(&self) -> bool {
-        self.com.is_none() && self.pips.is_none() && self.edge_radius == 0.0
+        self.com.is_none()
+            && self.pips.is_none()
+            && self.edge_radius == 0.0
+            && self.insert.is_none()
+            && self.inertia.is_none()
     }
 
     /// Checks the features against the die's half sides: one line naming the field.
@@ -520,6 +610,56 @@ impl Features {
                 }
             }
         }
+        if let Some(i) = &self.insert {
+            // Clear of the rounding and of the pips' cavities: inside the box whose faces
+            // lie the larger of the two inside the die's.
+            let skin = r.max(self.pips.map_or(0.0, |p| p.depth));
+            let triple = |v: [f64; 3]| format!("{},{},{}", mm(v[0]), mm(v[1]), mm(v[2]));
+            if !(i.size.iter().all(|s| s.is_finite() && *s > 0.0)) {
+                return Err(Error::field(
+                    "insert.size",
+                    triple(i.size),
+                    "must be three positive lengths, mm",
+                ));
+            }
+            let inside = (0..3).all(|k| {
+                i.centre[k].is_finite() && i.centre[k].abs() + 0.5 * i.size[k] <= half[k] - skin
+            });
+            if !inside {
+                return Err(Error::field(
+                    "insert.centre",
+                    triple(i.centre),
+                    format!(
+                        "the insert must lie inside the die, clear of its rounding and pips \
+                         (within {} mm of each face)",
+                        mm(skin)
+                    ),
+                ));
+            }
+            if !(i.density.is_finite() && (0.0..=1e5).contains(&i.density)) {
+                return Err(Error::field(
+                    "insert.density",
+                    i.density,
+                    "must be in [0, 100000] kg/m³",
+                ));
+            }
+        }
+        if let Some(t) = self.inertia {
+            let [xx, yy, zz, xy, xz, yz] = t;
+            let m = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
+            let e = SymmetricEigen::new(m).eigenvalues;
+            let physical = t.iter().all(|x| x.is_finite())
+                && e.iter().all(|&x| x > 0.0)
+                && (0..3).all(|k| e[k] <= e[(k + 1) % 3] + e[(k + 2) % 3]);
+            if !physical {
+                return Err(Error::field(
+                    "inertia",
+                    t.map(|x| format!("{}", x * 1e9)).join(","),
+                    "no solid has this inertia: its principal moments must be positive and \
+                     each at most the sum of the other two (g mm²: xx, yy, zz, xy, xz, yz)",
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -592,6 +732,9 @@ impl MassProps {
                 total.add(p.fill_density - rho, &pip_moments(&half, &cav, place));
             }
         }
+        if let Some(i) = &f.insert {
+            total.add(i.density - rho, &i.moments());
+        }
         let m = total.mass;
         let com = match f.com {
             Some(c) => Vector3::from(c),
@@ -601,8 +744,13 @@ impl MassProps {
         // I − m (|c|² 1 − c cᵀ).
         let s = total.second;
         let about_centre = Matrix3::identity() * s.trace() - s;
-        let inertia =
-            about_centre - m * (Matrix3::identity() * com.norm_squared() - com * com.transpose());
+        let inertia = match f.inertia {
+            Some([xx, yy, zz, xy, xz, yz]) => Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz),
+            None => {
+                about_centre
+                    - m * (Matrix3::identity() * com.norm_squared() - com * com.transpose())
+            }
+        };
         let (principal, moments) = principal_frame(&inertia);
         MassProps {
             mass: m,
@@ -813,6 +961,72 @@ mod tests {
         });
         let full = MassProps::of(&s).unwrap();
         assert!(rel(full.mass, solid) < 1e-15 && full.com.norm() < 1e-18);
+    }
+
+    #[test]
+    fn an_insert_moves_the_centre_and_the_moments_as_two_boxes_do() {
+        // A 16 mm cube (a = 8 mm half side) of density ρ with a cube of side b = 4 mm and
+        // density ρ' at c = (0, 0, −4 mm): in closed form, with Δ = (ρ' − ρ) b³,
+        // m = ρ (2a)³ + Δ, z̄ = Δ c / m, and about the geometric centre
+        // I_xx = ρ (2a)⁵/6 + Δ (b²/6 + c²), I_zz = ρ (2a)⁵/6 + Δ b²/6; about the centre of mass
+        // I_xx − m z̄², I_zz unchanged.
+        let mut s = cube_scene(16.0);
+        let (rho, rho2, side, b, c) = (s.density, 19300.0, 0.016, 0.004, -0.004);
+        s.features.insert = Some(Insert {
+            size: [b; 3],
+            centre: [0.0, 0.0, c],
+            density: rho2,
+        });
+        let m = MassProps::of(&s).unwrap();
+        let delta = (rho2 - rho) * b * b * b;
+        let mass = rho * side * side * side + delta;
+        let zbar = delta * c / mass;
+        let ixx = rho * side.powi(5) / 6.0 + delta * (b * b / 6.0 + c * c) - mass * zbar * zbar;
+        let izz = rho * side.powi(5) / 6.0 + delta * b * b / 6.0;
+        assert!(rel(m.mass, mass) < 1e-14, "{} {mass}", m.mass);
+        assert!(rel(m.com.z, zbar) < 1e-13 && m.com.x == 0.0 && m.com.y == 0.0);
+        assert!(m.aligned());
+        assert!(rel(m.moments.x, ixx) < 1e-13 && rel(m.moments.y, ixx) < 1e-13);
+        assert!(rel(m.moments.z, izz) < 1e-13);
+        // Of the die's own density: the plain cube.
+        s.features.insert = Some(Insert {
+            density: rho,
+            ..s.features.insert.unwrap()
+        });
+        let same = MassProps::of(&s).unwrap();
+        assert!(rel(same.mass, rho * side.powi(3)) < 1e-15 && same.com.norm() < 1e-18);
+        // Off every axis: the principal frame turns off the body's.
+        s.features.insert = Some(Insert {
+            size: [b; 3],
+            centre: [0.001, 0.001, c],
+            density: rho2,
+        });
+        assert!(!MassProps::of(&s).unwrap().aligned());
+    }
+
+    #[test]
+    fn an_inertia_given_outright_is_the_bodys() {
+        let mut s = cube_scene(16.0);
+        // A tensor with a product of inertia: its principal moments are its eigenvalues.
+        let t = [2.2e-7, 2.0e-7, 1.8e-7, 0.1e-7, 0.0, 0.0];
+        s.features.inertia = Some(t);
+        let m = MassProps::of(&s).unwrap();
+        assert_eq!(m.inertia[(0, 1)], 0.1e-7);
+        assert_eq!(m.inertia[(2, 2)], 1.8e-7);
+        let mut moments: Vec<f64> = m.moments.iter().copied().collect();
+        moments.sort_by(f64::total_cmp);
+        // The xy block's eigenvalues 2.1e-7 ± √(0.1² + 0.1²)e-7, and 1.8e-7.
+        let r = 0.02f64.sqrt() * 1e-7;
+        for (got, want) in moments.iter().zip([1.8e-7, 2.1e-7 - r, 2.1e-7 + r]) {
+            assert!(rel(*got, want) < 1e-12, "{got} {want}");
+        }
+        assert!(!m.aligned());
+        // No solid has moments that break the triangle inequality.
+        s.features.inertia = Some([1e-7, 1e-7, 3e-7, 0.0, 0.0, 0.0]);
+        assert!(MassProps::of(&s)
+            .unwrap_err()
+            .to_string()
+            .contains("no solid has this inertia"));
     }
 
     #[test]

@@ -437,9 +437,10 @@ pub struct DiceCost {
 }
 
 /// The made dice `dice_costs` times, each as flags would give it: a weight 2 mm toward
-/// face 6, 3 mm pips 1 mm deep, edges rounded 1 mm, and all three.
+/// face 6, 3 mm pips 1 mm deep, edges rounded 1 mm, all three; and a die file's insert (a
+/// 4 mm tungsten cube off every axis, so that the body is turned off the die's axes).
 pub fn made_dice() -> Vec<(&'static str, crate::model::mass::Features)> {
-    use crate::model::mass::{Features, Pips};
+    use crate::model::mass::{Features, Insert, Pips};
     let com = Some([0.0, 0.0, -0.002]);
     let pips = Some(Pips::caps(0.003, 0.001));
     vec![
@@ -471,6 +472,17 @@ pub fn made_dice() -> Vec<(&'static str, crate::model::mass::Features)> {
                 com,
                 pips,
                 edge_radius: 0.001,
+                ..Default::default()
+            },
+        ),
+        (
+            "[insert] 4 mm at 1,1,-4, 19300 kg/m³",
+            Features {
+                insert: Some(Insert {
+                    size: [0.004; 3],
+                    centre: [0.001, 0.001, -0.004],
+                    density: 19300.0,
+                }),
                 ..Default::default()
             },
         ),
