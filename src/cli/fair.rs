@@ -24,11 +24,20 @@ pub struct FairArgs {
     /// the six faces as a net, each with its probability and departure) into this directory.
     #[arg(long, value_name = "DIR")]
     pub out: Option<std::path::PathBuf>,
+    /// How a feature of the die biases it: the die rolled at N values of NAME from LO to HI
+    /// (mm; NAME com_x, com_y, com_z, pip_depth or edge_radius), the same throws at each,
+    /// each judged; with --out, the figure bias.svg, .png (each face's probability against
+    /// the value, the null beside it) and bias.json.
+    #[arg(long, value_name = "NAME=LO:HI:N", conflicts_with_all = ["checkpoint", "resume", "precision", "per_roll", "shard"])]
+    pub vary: Option<String>,
 }
 
 /// Runs `dicephys fair`.
 pub fn run(a: &FairArgs) -> Result<()> {
     let spec = a.roll.spec_or(ThrowStyle::Tumble)?;
+    if let Some(v) = &a.vary {
+        return vary(a, &spec, v);
+    }
     // The null is checked before anything rolls.
     if a.null == Null::SolidAngle && spec.scene.mode == dicephys::model::scene::Mode::TwoD {
         return Err(Error::Usage(
@@ -68,4 +77,76 @@ pub fn run(a: &FairArgs) -> Result<()> {
         out!("{}", fair.text(&summary));
     }
     done
+}
+
+/// `fair --vary`: the die at each value of one feature, judged, as a table (or JSON) and,
+/// with `--out`, the bias figure.
+fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str) -> Result<()> {
+    use dicephys::studies::fair::{parse_vary, vary, write_bias};
+    let (what, values) = parse_vary(v)?;
+    if let Some(dir) = &a.out {
+        std::fs::create_dir_all(dir).map_err(|e| {
+            Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
+        })?;
+        let identity = serde_json::json!({ "spec": spec, "null": a.null, "vary": v });
+        dicephys::studies::fair::claim(dir, &identity)?;
+    }
+    let threads = a.roll.run.threads()?;
+    let total = spec.rolls * values.len() as u64;
+    let bar = dicephys::report::progress::Progress::new(
+        "fair",
+        dicephys::report::progress::Unit::Rolls { per_cell: 0 },
+        false,
+        a.roll.json,
+        super::study::every(),
+    );
+    let progress = |n: u64| bar.set(n as f64, total as f64);
+    let runner = dicephys::run::runner::Runner::new(threads, super::stop().clone());
+    let runner = runner.with_progress(&progress);
+    let layout = a.roll.layout(spec);
+    let Some(points) = vary(spec, layout, what, &values, a.null, &runner)? else {
+        return Err(Error::Interrupted(
+            "interrupted; nothing written (a --vary run does not resume)".into(),
+        ));
+    };
+    let doc = serde_json::json!({ "vary": what, "null": a.null, "spec": spec, "points": points });
+    let json = dicephys::run::seal::to_string(&doc, true)?;
+    if let Some(dir) = &a.out {
+        let title = format!(
+            "{} mm, {}, throw {}: {} rolls at each {what}; lines: the {} null",
+            spec.scene.block,
+            spec.engine.name(),
+            spec.throws.style,
+            spec.rolls,
+            a.null
+        );
+        write_bias(dir, what, &title, &points)?;
+        dicephys::run::io::write_atomic(&dir.join("bias.json"), json.as_bytes())?;
+        if !a.roll.json {
+            eprintln!("wrote {}/bias.json and bias.svg, .png", dir.display());
+        }
+    }
+    if a.roll.json {
+        outln!("{}", json);
+        return Ok(());
+    }
+    let mut t =
+        format!("{what} (mm) | P(1) … P(6), each ± its error | χ² p | throws to see it at 2σ\n");
+    for b in &points {
+        let f = &b.fairness;
+        let ps: Vec<String> = f
+            .faces
+            .iter()
+            .map(|x| format!("{:.4}±{:.4}", x.p, x.err))
+            .collect();
+        t += &format!(
+            "{:>8.3} | {} | {:.2e} | {}\n",
+            b.value,
+            ps.join(" "),
+            f.p_value,
+            f.throws_2sigma.map_or("-".into(), |n| format!("{n:.0}"))
+        );
+    }
+    out!("{}", t);
+    Ok(())
 }

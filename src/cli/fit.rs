@@ -54,9 +54,10 @@ pub struct FitArgs {
     /// edges, a die file); one die for every row, 3D only.
     #[command(flatten)]
     pub made: super::args::DieArgs,
-    /// Which number is on which face, for counts of faces: right (western dice) or left.
-    #[arg(long, default_value = "right")]
-    pub layout: dicephys::model::faces::Layout,
+    /// Which number is on which face, for counts of faces: right (western dice) or left
+    /// [default: the --die file's layout or face map, else right].
+    #[arg(long)]
+    pub layout: Option<dicephys::model::faces::Layout>,
     /// The engine.
     #[arg(long, default_value = "bullet", value_parser = parse_engine)]
     pub engine: EngineKind,
@@ -245,8 +246,8 @@ impl FitArgs {
             model: self.model()?,
             method: {
                 let (mut die, density) = self.made.features()?;
-                if die.layout == Default::default() {
-                    die.layout = self.layout;
+                if let Some(layout) = self.layout {
+                    die.layout = layout;
                 }
                 Method {
                     engine: self.engine,

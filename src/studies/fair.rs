@@ -6,10 +6,13 @@
 //! unresolved, with the rolls that would resolve it.
 
 use crate::error::{Error, Result};
-use crate::model::faces::{side_of, DIRECTIONS};
+use crate::model::faces::{side_of, Layout, DIRECTIONS};
+use crate::model::mass::Features;
 use crate::model::scene::Mode;
 pub use crate::report::fair::{FaceVerdict, Fairness, Null};
 use crate::report::summary::RunSummary;
+use crate::run::runner::Runner;
+use crate::run::spec::RunSpec;
 use crate::theory::{self, stats};
 
 /// Two-sided tail of the normal beyond `z` σ: the p-value a "zσ" result stands for.
@@ -187,6 +190,175 @@ pub fn write(dir: &std::path::Path, json: &str, fair: &Fairness, s: &RunSummary)
     crate::run::io::write_atomic(&dir.join("fairness.json"), json.as_bytes())
 }
 
+/// A feature of the die that `fair --vary` steps through.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    serde::Serialize,
+    serde::Deserialize,
+    strum::Display,
+    strum::EnumString,
+    strum::VariantNames,
+)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum Varied {
+    /// The centre of mass along x (breadth), mm: given outright, its other components the
+    /// die's (`--com`) or 0.
+    ComX,
+    /// … along y (width), mm.
+    ComY,
+    /// … along z (length), mm.
+    ComZ,
+    /// The pips' depth, mm (the die must have pips).
+    PipDepth,
+    /// The edges' and corners' radius, mm.
+    EdgeRadius,
+}
+
+impl Varied {
+    /// `features` with this feature at `mm`.
+    pub fn set(self, features: &Features, mm: f64) -> Result<Features> {
+        let mut f = *features;
+        let m = mm / 1000.0;
+        match self {
+            Varied::ComX | Varied::ComY | Varied::ComZ => {
+                let mut c = f.com.unwrap_or([0.0; 3]);
+                c[self as usize] = m;
+                f.com = Some(c);
+            }
+            Varied::PipDepth => match f.pips.as_mut() {
+                Some(p) => p.depth = m,
+                None => {
+                    return Err(Error::field(
+                        "vary",
+                        "pip_depth",
+                        "the die has no pips to vary: give them (--pips D,H or a die file)",
+                    ))
+                }
+            },
+            Varied::EdgeRadius => f.edge_radius = m,
+        }
+        Ok(f)
+    }
+}
+
+/// `fair --vary`'s values: `N` evenly spaced from `LO` to `HI`, from "NAME=LO:HI:N".
+pub fn parse_vary(s: &str) -> Result<(Varied, Vec<f64>)> {
+    let bad = |why: &str| Error::field("vary", s, why.to_string());
+    let (name, range) = s
+        .split_once('=')
+        .ok_or_else(|| bad("write NAME=LO:HI:N, e.g. com_z=0:2:9"))?;
+    let what: Varied = crate::error::parse_name("feature", name.trim())?;
+    let parts: Vec<&str> = range.split(':').map(str::trim).collect();
+    let [lo, hi, n] = parts[..] else {
+        return Err(bad("write NAME=LO:HI:N, e.g. com_z=0:2:9"));
+    };
+    let (lo, hi): (f64, f64) = match (lo.parse(), hi.parse()) {
+        (Ok(a), Ok(b)) if f64::is_finite(a) && f64::is_finite(b) && a <= b => (a, b),
+        _ => return Err(bad("LO and HI must be numbers of mm, LO <= HI")),
+    };
+    let n: usize = n
+        .parse()
+        .ok()
+        .filter(|n| (1..=1000).contains(n))
+        .ok_or_else(|| bad("N must be a whole number from 1 to 1000"))?;
+    let values = (0..n)
+        .map(|i| {
+            if n == 1 {
+                lo
+            } else {
+                lo + (hi - lo) * i as f64 / (n - 1) as f64
+            }
+        })
+        .collect();
+    Ok((what, values))
+}
+
+/// One value of a varied feature: the die there, judged.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct BiasPoint {
+    /// The feature's value, mm.
+    pub value: f64,
+    /// The die's faces against the null.
+    pub fairness: Fairness,
+}
+
+/// The die of `spec` at each of `values` of `what`, the same keyed throws at every value (so
+/// that the curve's steps are the feature's, not the throws'), each judged against `null`.
+/// `None` if a stop request ended it.
+pub fn vary(
+    spec: &RunSpec,
+    layout: Layout,
+    what: Varied,
+    values: &[f64],
+    null: Null,
+    runner: &Runner,
+) -> Result<Option<Vec<BiasPoint>>> {
+    let specs = values
+        .iter()
+        .map(|&v| {
+            let mut s = spec.clone();
+            s.scene.features = what.set(&spec.scene.features, v)?;
+            if !s.scene.features.plain() && s.scene.features.pips.is_some() {
+                s.scene.features.layout = layout;
+            }
+            s.validate(false)?;
+            Ok(s)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let mut out = Vec::new();
+    for (i, (s, &value)) in specs.iter().zip(values).enumerate() {
+        let base = i as u64 * spec.rolls;
+        let progress = |n| (runner.progress)(base + n);
+        let summary =
+            crate::studies::outputs::roll(s, None, None, None, &runner.with_progress(&progress))?
+                .with_layout(layout);
+        if summary.partial {
+            return Ok(None);
+        }
+        out.push(BiasPoint {
+            value,
+            fairness: assess(&summary, null)?,
+        });
+    }
+    Ok(Some(out))
+}
+
+/// Writes the bias figure (`bias.svg`, `.png`: each face's probability against the varied
+/// feature, with its error and the null) into `dir`.
+pub fn write_bias(
+    dir: &std::path::Path,
+    what: Varied,
+    title: &str,
+    points: &[BiasPoint],
+) -> Result<()> {
+    use crate::report::figures::Point;
+    let series: Vec<(u8, Vec<Point>, Vec<(f64, f64)>)> = (0..6)
+        .map(|k| {
+            let pts = points
+                .iter()
+                .filter_map(|b| {
+                    b.fairness.faces.get(k).map(|f| Point {
+                        x: b.value,
+                        y: f.p,
+                        y_err: f.err,
+                    })
+                })
+                .collect();
+            let null = points
+                .iter()
+                .filter_map(|b| b.fairness.faces.get(k).map(|f| (b.value, f.null)))
+                .collect();
+            (k as u8 + 1, pts, null)
+        })
+        .collect();
+    crate::report::figures::die::bias(dir, "bias", title, &format!("{what}, mm"), &series)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -197,5 +369,25 @@ mod tests {
         assert!((two_sided(5.0) - 5.733e-7).abs() < 1e-9);
         // χ²₅ at p = 0.05: 11.07.
         assert!((critical(0.05, 5) - 11.0705).abs() < 1e-3);
+    }
+
+    #[test]
+    fn a_varied_feature_reads_its_values_and_refuses_bad_ones() {
+        let (what, v) = parse_vary("com_z=0:2:5").unwrap();
+        assert_eq!(what, Varied::ComZ);
+        assert_eq!(v, vec![0.0, 0.5, 1.0, 1.5, 2.0]);
+        assert_eq!(parse_vary("edge_radius=1:1:1").unwrap().1, vec![1.0]);
+        for bad in [
+            "com_z",
+            "weight=0:1:3",
+            "com_z=1:0:3",
+            "com_z=0:1",
+            "com_z=0:1:0",
+        ] {
+            assert!(parse_vary(bad).is_err(), "{bad}");
+        }
+        let f = Varied::ComY.set(&Features::default(), 1.5).unwrap();
+        assert_eq!(f.com, Some([0.0, 0.0015, 0.0]));
+        assert!(Varied::PipDepth.set(&Features::default(), 1.0).is_err());
     }
 }

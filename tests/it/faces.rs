@@ -266,3 +266,46 @@ fn fair_rolls_every_face_to_a_precision() {
     assert!(worst <= 0.01, "{worst}");
     assert_eq!(run("1")["summary"]["faces"], v["summary"]["faces"]);
 }
+
+/// `fair --vary`: the die at each value of one feature, the same throws at each. Its point at
+/// com_z = 1 is `fair --com 0,0,1` throw for throw (the same faces); the weight toward face 1
+/// brings 6 up more at 2 mm than at 0; `--out` writes bias.json and the figure; a bad
+/// feature or a feature the die lacks is one line, exit 2.
+#[test]
+fn fair_varies_a_feature_and_draws_its_bias() {
+    let dir = crate::helpers::Scratch::absent("vary");
+    let base = [
+        "fair", "--block", "16x16x16", "--rolls", "1500", "--seed", "8", "--json",
+    ];
+    let v = json(&dicephys(
+        &[
+            &base[..],
+            &["--vary", "com_z=0:2:3", "--out", dir.to_str().unwrap()],
+        ]
+        .concat(),
+    ));
+    let points = v["points"].as_array().unwrap();
+    assert_eq!(points.len(), 3);
+    let one = json(&dicephys(&[&base[..], &["--com", "0,0,1"]].concat()));
+    assert_eq!(points[1]["fairness"]["faces"], one["fairness"]["faces"]);
+    let p6 = |i: usize| points[i]["fairness"]["faces"][5]["p"].as_f64().unwrap();
+    assert!(p6(2) > p6(0) + 0.05, "{} {}", p6(0), p6(2));
+    for f in ["bias.json", "bias.svg", "bias.png"] {
+        assert!(dir.join(f).is_file(), "{f}");
+    }
+    for (extra, says) in [
+        (&["--vary", "weight=0:1:3"][..], "weight"),
+        (&["--vary", "pip_depth=0.5:1:2"], "no pips"),
+        (&["--vary", "com_z=0:9:2"], "--com"),
+        (
+            &["--vary", "com_z=0:1:2", "--precision", "1"],
+            "--precision",
+        ),
+    ] {
+        let out = dicephys(&[&base[..], extra].concat());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{extra:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{extra:?}: {err}");
+        assert!(err.contains(says), "{extra:?}: {err}");
+    }
+}

@@ -93,6 +93,86 @@ pub fn die_map(dir: &Path, stem: &str, title: &str, faces: &[MapFace]) -> crate:
     write_both(dir, stem, &DieMap { title, faces })
 }
 
+struct Bias<'a> {
+    title: &'a str,
+    x_desc: &'a str,
+    series: &'a [(u8, Vec<Point>, Vec<(f64, f64)>)],
+}
+
+/// A colour for each number, 1 to 6.
+const FACE_COLORS: [RGBColor; 6] = [
+    RGBColor(200, 30, 30),
+    RGBColor(230, 130, 0),
+    RGBColor(40, 150, 40),
+    RGBColor(0, 150, 170),
+    RGBColor(40, 70, 200),
+    RGBColor(140, 40, 160),
+];
+
+impl Figure for Bias<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let mut xs = Span::new(f64::INFINITY, f64::NEG_INFINITY);
+        let mut ys = Span::new(1.0 / 6.0, 1.0 / 6.0);
+        for (_, pts, null) in self.series {
+            pts.iter().for_each(|p| {
+                xs.add(p.x);
+                ys.add_point(p)
+            });
+            null.iter().for_each(|(_, y)| ys.add(*y));
+        }
+        if !xs.lo.is_finite() {
+            xs = Span::new(0.0, 1.0);
+        }
+        let mut chart = chart(
+            root,
+            self.title,
+            xs.padded(0.04, 0.04),
+            ys.padded(0.08, 0.3),
+            self.x_desc,
+            "P(face up)",
+        )?;
+        for (n, pts, null) in self.series {
+            let color = FACE_COLORS[(*n as usize).clamp(1, 6) - 1];
+            points(
+                &mut chart,
+                pts,
+                color,
+                Marker::Circle,
+                false,
+                &format!("face {n}"),
+            )?;
+            chart
+                .draw_series(LineSeries::new(
+                    null.clone(),
+                    color.mix(0.6).stroke_width(1),
+                ))
+                .map_err(plot_err)?;
+        }
+        legend(&mut chart, SeriesLabelPosition::UpperLeft)
+    }
+}
+
+/// Writes the bias figure as `dir/<stem>.svg` and `.png`: for each number (1 to 6), its
+/// probability at each value of a feature with its error (points) and the null's (a thin line
+/// in the same colour).
+pub fn bias(
+    dir: &Path,
+    stem: &str,
+    title: &str,
+    x_desc: &str,
+    series: &[(u8, Vec<Point>, Vec<(f64, f64)>)],
+) -> crate::Result<()> {
+    write_both(
+        dir,
+        stem,
+        &Bias {
+            title,
+            x_desc,
+            series,
+        },
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
