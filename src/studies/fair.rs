@@ -336,8 +336,8 @@ pub fn write_bias(
     title: &str,
     points: &[BiasPoint],
 ) -> Result<()> {
-    use crate::report::figures::Point;
-    let series: Vec<(u8, Vec<Point>, Vec<(f64, f64)>)> = (0..6)
+    use crate::report::figures::{die::FaceCurve, Point};
+    let series: Vec<FaceCurve> = (0..6)
         .map(|k| {
             let pts = points
                 .iter()
@@ -353,7 +353,11 @@ pub fn write_bias(
                 .iter()
                 .filter_map(|b| b.fairness.faces.get(k).map(|f| (b.value, f.null)))
                 .collect();
-            (k as u8 + 1, pts, null)
+            FaceCurve {
+                number: k as u8 + 1,
+                points: pts,
+                null,
+            }
         })
         .collect();
     crate::report::figures::die::bias(dir, "bias", title, &format!("{what}, mm"), &series)

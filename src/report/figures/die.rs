@@ -93,10 +93,21 @@ pub fn die_map(dir: &Path, stem: &str, title: &str, faces: &[MapFace]) -> crate:
     write_both(dir, stem, &DieMap { title, faces })
 }
 
+/// One number's curve on the bias figure.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FaceCurve {
+    /// The number, 1 to 6.
+    pub number: u8,
+    /// Its probability at each value, with its error.
+    pub points: Vec<Point>,
+    /// The null's probability at each value.
+    pub null: Vec<(f64, f64)>,
+}
+
 struct Bias<'a> {
     title: &'a str,
     x_desc: &'a str,
-    series: &'a [(u8, Vec<Point>, Vec<(f64, f64)>)],
+    series: &'a [FaceCurve],
 }
 
 /// A colour for each number, 1 to 6.
@@ -113,12 +124,12 @@ impl Figure for Bias<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let mut xs = Span::new(f64::INFINITY, f64::NEG_INFINITY);
         let mut ys = Span::new(1.0 / 6.0, 1.0 / 6.0);
-        for (_, pts, null) in self.series {
-            pts.iter().for_each(|p| {
+        for c in self.series {
+            c.points.iter().for_each(|p| {
                 xs.add(p.x);
                 ys.add_point(p)
             });
-            null.iter().for_each(|(_, y)| ys.add(*y));
+            c.null.iter().for_each(|(_, y)| ys.add(*y));
         }
         if !xs.lo.is_finite() {
             xs = Span::new(0.0, 1.0);
@@ -131,19 +142,19 @@ impl Figure for Bias<'_> {
             self.x_desc,
             "P(face up)",
         )?;
-        for (n, pts, null) in self.series {
-            let color = FACE_COLORS[(*n as usize).clamp(1, 6) - 1];
+        for c in self.series {
+            let color = FACE_COLORS[(c.number as usize).clamp(1, 6) - 1];
             points(
                 &mut chart,
-                pts,
+                &c.points,
                 color,
                 Marker::Circle,
                 false,
-                &format!("face {n}"),
+                &format!("face {}", c.number),
             )?;
             chart
                 .draw_series(LineSeries::new(
-                    null.clone(),
+                    c.null.clone(),
                     color.mix(0.6).stroke_width(1),
                 ))
                 .map_err(plot_err)?;
@@ -160,7 +171,7 @@ pub fn bias(
     stem: &str,
     title: &str,
     x_desc: &str,
-    series: &[(u8, Vec<Point>, Vec<(f64, f64)>)],
+    series: &[FaceCurve],
 ) -> crate::Result<()> {
     write_both(
         dir,
