@@ -456,14 +456,24 @@ def _fit_config(
     refine: bool,
     common_throws: bool,
     seed: int,
+    com: Optional[Sequence[float]] = None,
+    pips: Optional[Sequence[float]] = None,
+    edge_radius: Optional[float] = None,
+    die: Optional[PathLike] = None,
+    layout: Optional[str] = None,
+    density: Optional[float] = None,
 ) -> str:
     if kappa == "paper":
         kappa = None
     rs = [(k, float(lo), float(hi)) for k, (lo, hi) in (ranges or {}).items()]
+    made = dict(
+        com=_triple("com", com, 3), pips=_triple("pips", pips, 2), edge_radius=edge_radius,
+        die=None if die is None else os.fspath(die), layout=layout, density=density,
+    )
     return _native.fit_config(
         _data(data), list(free), list(shared), rs, restitution, friction,
         None if kappa is None else float(kappa), spin_scale, engine, dt, max_steps, points,
-        point_rolls, degree, max_degree, refine, common_throws, seed,
+        point_rolls, degree, max_degree, refine, common_throws, seed, made,
     )
 
 
@@ -487,6 +497,12 @@ def fit(
     refine: bool = True,
     common_throws: bool = False,
     seed: int = 2385,
+    com: Optional[Sequence[float]] = None,
+    pips: Optional[Sequence[float]] = None,
+    edge_radius: Optional[float] = None,
+    die: Optional[PathLike] = None,
+    layout: Optional[str] = None,
+    density: Optional[float] = None,
     out: Optional[PathLike] = None,
     threads: int = 0,
     progress: Progress = None,
@@ -495,18 +511,22 @@ def fit(
 
     data: the counts — a CSV path (docs/guide.md, "Calibrating"), "paper" (the paper's 19
         rows), a pandas DataFrame or a list of dicts with the CSV's columns.
-    free: the free parameters, among "e", "mu", "kappa", "spin".
+    free: the free parameters, among "e", "mu", "kappa", "spin"; for a die, "com_x",
+        "com_y", "com_z" (its centre of mass, mm) and "pip_depth" (mm).
     shared: surface parameters shared by every surface instead of one per surface.
     ranges: a free parameter's box, {"e": (0.05, 0.8)}.
     restitution, friction, kappa, spin_scale: the values where a parameter is not free
         (kappa "paper": the paper's throw).
     points, point_rolls: the design (parameter points per block per pass, rolls at each).
+    com, pips, edge_radius, die, layout, density: the die thrown, as ``roll`` takes it (one
+        die for every row; a counts file with face_1 … face_6 counts its faces).
     out: where fit.json, report.md, the figures and the simulations' cells are written
         (default: a new temporary directory, ``Fit.out``).
     """
     config = _fit_config(
         data, free, shared, ranges, restitution, friction, kappa, spin_scale, engine, dt,
         max_steps, points, point_rolls, degree, max_degree, refine, common_throws, seed,
+        com=com, pips=pips, edge_radius=edge_radius, die=die, layout=layout, density=density,
     )
     where = _out(out, "fit")
     tell, close = _progress(progress, "fit")
@@ -539,7 +559,8 @@ def recover(
     fit_options: Dict[str, Any] = dict(
         shared=(), ranges=None, restitution=0.5, friction=0.29, kappa="paper", spin_scale=1.0,
         engine="bullet", dt=1e-3, max_steps=DEFAULT_MAX_STEPS, points=64, point_rolls=500, degree=3,
-        max_degree=4, refine=True, common_throws=False, seed=2385,
+        max_degree=4, refine=True, common_throws=False, seed=2385, com=None, pips=None,
+        edge_radius=None, die=None, layout=None, density=None,
     )
     unknown = set(options) - set(fit_options)
     if unknown:

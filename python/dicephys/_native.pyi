@@ -3,7 +3,7 @@
 Use the package's functions (``dicephys.roll`` …): they wrap these with objects and arrays.
 """
 
-from typing import Any, Callable, List, Optional, Tuple
+from typing import Any, Callable, Dict, List, Optional, Tuple
 
 DEFAULT_MAX_STEPS: int
 DEFAULT_MARGIN: float
@@ -38,6 +38,7 @@ def fit_config(
     refine: bool,
     common_throws: bool,
     seed: int,
+    die: Optional[Dict[str, Any]] = ...,
 ) -> str: ...
 def fit(config: str, out: str, *, threads: int = ..., progress: _Progress = ..., log: _Log = ...) -> str: ...
 def recover(

@@ -627,9 +627,10 @@ fn paper_config(
 /// "paper") and the model, checked; as JSON.
 #[pyfunction]
 #[pyo3(signature = (data, free, shared, ranges, restitution, friction, kappa, spin_scale,
-    engine, dt, max_steps, points, point_rolls, degree, max_degree, refine, common_throws, seed))]
+    engine, dt, max_steps, points, point_rolls, degree, max_degree, refine, common_throws, seed,
+    die=None))]
 #[allow(clippy::too_many_arguments)]
-fn fit_config(
+fn fit_config<'py>(
     data: &str,
     free: Vec<String>,
     shared: Vec<String>,
@@ -648,8 +649,30 @@ fn fit_config(
     refine: bool,
     common_throws: bool,
     seed: u64,
+    die: Option<Bound<'py, PyDict>>,
 ) -> PyResult<String> {
     use calibration::params::{Fixed, FixedThrow, Kind, Method, ModelSpec};
+    // The die, by roll's names: com, pips, edge_radius, die (a file), layout, density.
+    let o = Options {
+        given: die.map(|d| d.copy()).transpose()?,
+    };
+    let layout = o
+        .maybe::<String>("layout")?
+        .map(|l| named::<Layout>("layout", "layout", &l))
+        .transpose()?;
+    let (mut features, density) = Features::described(
+        o.maybe::<PathBuf>("die")?.as_deref(),
+        o.maybe("com")?,
+        o.maybe("pips")?,
+        o.maybe("edge_radius")?,
+        None,
+        o.maybe::<f64>("density")?,
+    )
+    .map_err(py_err)?;
+    if let Some(l) = layout {
+        features.layout = l;
+    }
+    o.finish()?;
     let kind = |arg: &str, s: &str| named::<Kind>(arg, "parameter", s);
     let mut free_kinds = free
         .iter()
@@ -695,8 +718,8 @@ fn fit_config(
             engine: named::<EngineKind>("engine", "engine", engine)?,
             dt,
             max_steps,
-            die: Default::default(),
-            density: None,
+            die: features,
+            density,
         },
         design: calibration::design::DesignSpec {
             points,

@@ -160,6 +160,21 @@ def test_fit_then_predict_through_python(tmp_path: Path) -> None:
     assert p.data == want
 
 
+def test_a_die_s_weight_fitted_through_python_is_the_cli_s(tmp_path: Path) -> None:
+    faces = dicephys.roll("16x16x16", rolls=1500, seed=5, throw="tumble", com=(0, 0, -1)).data["faces"]
+    row = dict(label="suspect", surface="MDF", length_mm=16, breadth_mm=16, width_mm=16, mode="3d")
+    row.update({f"face_{k}": faces[str(k)] for k in range(1, 7)})
+    f = dicephys.fit([row], free=["com_z"], kappa=0, points=8, point_rolls=300, refine=False,
+                     out=tmp_path / "py")
+    csv_path = tmp_path / "suspect.csv"
+    csv_path.write_text(",".join(row) + "\n" + ",".join(str(v) for v in row.values()) + "\n")
+    want = cli("fit", "--data", str(csv_path), "--free", "com_z", "--kappa", "0", "--points", "8",
+               "--point-rolls", "300", "--no-refine", "--out", str(tmp_path / "cli"), "--json")
+    got, wanted = f.data["estimate"]["params"][0], want["estimate"]["params"][0]
+    assert got["value"] == wanted["value"] and got["two_sigma"] == wanted["two_sigma"]
+    assert got["two_sigma"][0] <= -1.0 <= got["two_sigma"][1]
+
+
 def test_paper_is_the_cli_s_and_a_stopped_one_writes_nothing(tmp_path: Path) -> None:
     # Stopped half a second in: KeyboardInterrupt, and no results.json half-written.
     stopped = tmp_path / "stopped"
