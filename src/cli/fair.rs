@@ -113,7 +113,7 @@ fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str) -> Result<()
     let json = dicephys::run::seal::to_string(&doc, true)?;
     if let Some(dir) = &a.out {
         let title = format!(
-            "{} mm, {}, throw {}: {} rolls at each {what}; lines: the {} null",
+            "{} mm, {}, {}: {} rolls a value; lines: {}",
             spec.scene.block,
             spec.engine.name(),
             spec.throws.style,
