@@ -507,7 +507,20 @@ fn json_md_lists_the_keys_of_fair() {
         "--json",
     ]);
     c.document("fair", "fair", &v);
-    c.finish(&["fair"]);
+    let vary = run(&[
+        "fair",
+        "--block",
+        "16x16x16",
+        "--vary",
+        "com_z=0:1:2",
+        "--rolls",
+        "100",
+        "--threads",
+        "1",
+        "--json",
+    ]);
+    c.document("fair-vary", "fair --vary", &vary);
+    c.finish(&["fair", "fair-vary"]);
 }
 
 #[test]
@@ -921,6 +934,58 @@ fn json_md_lists_the_keys_of_fit_recover_and_predict() {
     ]);
     assert!(widened["passes"][1].get("cut").is_some(), "{widened}");
     c.document("fit", "fit (a box widened)", &widened);
+    // A made die's face counts, its centre of mass free, and a prediction of its faces.
+    let faces_csv = dir.join("faces.csv");
+    std::fs::write(
+        &faces_csv,
+        "label,surface,length_mm,breadth_mm,width_mm,mode,face_1,face_2,face_3,face_4,face_5,\
+         face_6\nd,MDF,16,16,16,3d,30,25,25,25,25,20\n",
+    )
+    .unwrap();
+    let die_fit = format!("{d}/die");
+    let die = run(&[
+        "fit",
+        "--data",
+        faces_csv.to_str().unwrap(),
+        "--free",
+        "com_z",
+        "--kappa",
+        "0",
+        "--com",
+        "0,0,0",
+        "--density",
+        "1180",
+        "--points",
+        "8",
+        "--point-rolls",
+        "100",
+        "--degree",
+        "1",
+        "--no-refine",
+        "--dt",
+        "1/250",
+        "--threads",
+        "1",
+        "--out",
+        &die_fit,
+        "--json",
+    ]);
+    c.document("fit", "fit of a die's face counts", &die);
+    let p = run(&[
+        "predict",
+        "--fit",
+        &format!("{die_fit}/fit.json"),
+        "--block",
+        "16x16x16",
+        "--draws",
+        "3",
+        "--rolls",
+        "50",
+        "--threads",
+        "1",
+        "--json",
+    ]);
+    c.document("predict", "predict a die's faces", &p);
     let file: Value = serde_json::from_str(&read(&dir.join("fit/fit.json"))).unwrap();
     c.document("fit", "fit.json", &file);
     let one = run_owned(fit_args(&["--no-refine", "--out", &format!("{d}/one")]));
