@@ -591,12 +591,14 @@ def predict(
     seed: int = 2385,
     threads: int = 0,
     progress: Progress = None,
+    contact: Optional[Tuple[float, float]] = None,
 ) -> Document:
     """A block the fit did not see, simulated at the fit's posterior draws:
     ``dicephys predict --json`` (docs/json.md, "predict").
 
     fit: a ``Fit``, or the path of a fit's fit.json.
     surface, thrower: whose fitted values to use, when the fit has several.
+    contact: another surface's (e, μ), where the fit held them fixed.
     """
     path = fit.path if isinstance(fit, Fit) else os.fspath(fit)
     with open(path, encoding="utf-8") as f:
@@ -606,6 +608,7 @@ def predict(
         out = _native.predict(
             text, block, mode=mode, surface=surface, thrower=thrower, draws=draws,
             rolls=rolls, seed=seed, threads=threads, progress=tell,
+            contact=None if contact is None else (float(contact[0]), float(contact[1])),
         )
     finally:
         close()

@@ -63,4 +63,5 @@ def predict(
     seed: int = ...,
     threads: int = ...,
     progress: _Progress = ...,
+    contact: Optional[Tuple[float, float]] = ...,
 ) -> str: ...

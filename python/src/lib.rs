@@ -810,7 +810,7 @@ fn recover(
 /// the prediction's JSON.
 #[pyfunction]
 #[pyo3(signature = (fit, block, *, mode="3d", surface=None, thrower=None, draws=16, rolls=2000,
-    seed=2385, threads=0, progress=None))]
+    seed=2385, threads=0, progress=None, contact=None))]
 #[allow(clippy::too_many_arguments)]
 fn predict(
     py: Python<'_>,
@@ -824,6 +824,7 @@ fn predict(
     seed: u64,
     threads: usize,
     progress: Option<&Bound<'_, PyAny>>,
+    contact: Option<[f64; 2]>,
 ) -> PyResult<String> {
     let fit: calibration::FitResult = dicephys::run::seal::open(fit)
         .map_err(|e| bad("fit", "…", format!("not a fit's fit.json as written: {e}")))?;
@@ -834,6 +835,7 @@ fn predict(
         mode: self::mode(mode)?,
         surface,
         thrower,
+        contact,
         draws,
         rolls,
         seed,

@@ -100,7 +100,7 @@ pub struct BlockPrediction {
     pub block: Block,
     /// 2D or 3D.
     pub mode: Mode,
-    /// The surface whose e and μ were used ("all" when shared).
+    /// The surface whose e and μ were used ("all" when shared; "e E, μ M" when given).
     pub surface: String,
     /// The thrower whose throw was used.
     pub thrower: String,
@@ -137,6 +137,10 @@ pub struct PredictConfig {
     pub surface: Option<String>,
     /// The thrower whose throw to use (needed when the fit has several).
     pub thrower: Option<String>,
+    /// Another surface's restitution e and friction μ, where the fit held them fixed (a die
+    /// whose weight was fitted on one surface, predicted on another).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact: Option<[f64; 2]>,
     /// Posterior draws to simulate.
     pub draws: usize,
     /// Rolls per draw.

@@ -136,6 +136,10 @@ pub struct PredictArgs {
     /// The thrower whose fitted throw to use (when the fit has several).
     #[arg(long)]
     pub thrower: Option<String>,
+    /// Another surface, by its restitution e and friction μ (E,MU), where the fit held e and
+    /// μ fixed: a die whose weight a fit found on one surface, predicted on another.
+    #[arg(long, value_name = "E,MU", conflicts_with_all = ["surface", "blocks"], value_parser = parse_contact)]
+    pub contact: Option<[f64; 2]>,
     /// Posterior draws to simulate the block at.
     #[arg(long, default_value_t = 16)]
     pub draws: usize,
@@ -151,6 +155,18 @@ pub struct PredictArgs {
     /// Print the prediction's JSON.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `E,MU`: two numbers.
+fn parse_contact(s: &str) -> std::result::Result<[f64; 2], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    match parts[..] {
+        [e, mu] => match (e.parse::<f64>(), mu.parse::<f64>()) {
+            (Ok(e), Ok(mu)) => Ok([e, mu]),
+            _ => Err(format!("'{s}': E and MU must be numbers")),
+        },
+        _ => Err(format!("'{s}' is not E,MU (e.g. 0.2,0.6)")),
+    }
 }
 
 /// A parameter's name as clap reads it.
@@ -344,6 +360,7 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
         mode: if a.two_d { Mode::TwoD } else { Mode::ThreeD },
         surface: a.surface.clone(),
         thrower: a.thrower.clone(),
+        contact: a.contact,
         draws: a.draws,
         rolls: a.rolls,
         seed: a.seed,

@@ -350,6 +350,7 @@ fn bad_dice_are_refused_in_one_line() {
 /// (the weight is found). Then a small recovery check on z alone, three repetitions of fresh
 /// counts and designs at fixed seeds: each fitted z within 0.3 mm of the truth (about 4σ:
 /// their spread is about 0.07 mm), each truth inside its joint 2σ region.
+/// The die found is predicted on another surface (`predict --contact`).
 /// The coverage itself is measured at scale in docs/results/dice.md.
 #[test]
 fn a_fit_of_face_counts_finds_where_the_weight_sits() {
@@ -393,6 +394,24 @@ fn a_fit_of_face_counts_finds_where_the_weight_sits() {
         "{}",
         params[2]
     );
+    // The die found on MDF, predicted on felt (e 0.2, μ 0.6): each face, 1 still up more.
+    let felt = json(&dicephys(&[
+        "predict",
+        "--fit",
+        out.join("fit.json").to_str().unwrap(),
+        "--block",
+        "16x16x16",
+        "--contact",
+        "0.2,0.6",
+        "--draws",
+        "3",
+        "--rolls",
+        "1000",
+        "--json",
+    ]));
+    assert_eq!(felt["surface"], "e 0.2, μ 0.6");
+    let p = |k: usize| felt["faces"][k]["value"].as_f64().unwrap();
+    assert!(p(0) > p(5), "{}", felt["faces"]);
     let rec = json(&dicephys(&[
         "fit",
         "--data",

@@ -2,6 +2,7 @@
 
 use crate::calibration::data::DataRow;
 use crate::calibration::design::point_seed;
+use crate::calibration::params::Kind;
 use crate::calibration::predict::{group, BlockPrediction, PredictConfig, Predicted};
 use crate::calibration::FitResult;
 use crate::error::{Error, Result};
@@ -31,6 +32,26 @@ pub fn check(fit: &FitResult, cfg: &PredictConfig) -> Result<()> {
     }
     group(fit, true, &cfg.surface, "surface")?;
     group(fit, false, &cfg.thrower, "thrower")?;
+    let model = &fit.config.model;
+    if let Some([e, mu]) = cfg.contact {
+        if !((0.0..=1.0).contains(&e) && (0.0..=5.0).contains(&mu)) {
+            return Err(Error::field(
+                "contact",
+                format!("{e},{mu}"),
+                "e must be in [0, 1] and μ in [0, 5]",
+            ));
+        }
+    }
+    if let (Some([e, mu]), true) = (
+        cfg.contact,
+        model.is_free(Kind::E) || model.is_free(Kind::Mu),
+    ) {
+        return Err(Error::field(
+            "contact",
+            format!("{e},{mu}"),
+            "the fit has e or μ free, fitted per surface: name one of its surfaces instead",
+        ));
+    }
     Ok(())
 }
 
@@ -113,7 +134,10 @@ pub fn predict_block(
     for m in 0..cfg.draws {
         let x = &fit.estimate.draws[m * step];
         let local: Vec<f64> = dims.iter().map(|&d| x[d]).collect();
-        let values = crate::calibration::params::values(&model.fixed, &axes, &local);
+        let mut values = crate::calibration::params::values(&model.fixed, &axes, &local);
+        if let Some([e, mu]) = cfg.contact {
+            (values.e, values.mu) = (e, mu);
+        }
         let seed = point_seed(cfg.seed, cfg.block, cfg.mode, m);
         let spec = fit
             .config
@@ -195,7 +219,11 @@ pub fn predict_block(
     Ok(Some(BlockPrediction {
         block: cfg.block,
         mode: cfg.mode,
-        surface,
+        // A surface given by its e and μ is named by them.
+        surface: match cfg.contact {
+            Some([e, mu]) => format!("e {e}, μ {mu}"),
+            None => surface,
+        },
         thrower,
         p,
         ratio,
@@ -220,6 +248,7 @@ fn block_config(
         mode: r.mode,
         surface: r.surface.clone(),
         thrower: r.thrower.clone(),
+        contact: None,
         draws,
         rolls,
         seed,
