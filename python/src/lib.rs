@@ -582,11 +582,7 @@ fn run_study(
     log: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<String> {
     cfg.validate().map_err(py_err)?;
-    let cells = match &cfg {
-        StudyConfig::Fit(_) => "cells",
-        StudyConfig::Calibrated(_) => "calibration",
-        _ => "checkpoint",
-    };
+    let cells = cfg.study().cells();
     let place = place(Some(out), cells, threads, cfg.name())?;
     finished(detached(py, progress, log, |s| {
         s.hooked(|h| outputs::run(&cfg, &place, h))

@@ -30,13 +30,7 @@ pub fn local(out: &Path, threads: usize, json: bool) -> Result<Place> {
 /// Runs a study a cluster can split, with a bar (or progress lines) and its log on stderr.
 pub fn run(cfg: &StudyConfig, place: &Place) -> Result<()> {
     // Bars as before: paper's rolls, and the CPU of a study rolled to a precision.
-    let bar = matches!(
-        cfg,
-        StudyConfig::Paper(_)
-            | StudyConfig::Tradeoff(_)
-            | StudyConfig::Converge(_)
-            | StudyConfig::Fit(_)
-    ) && cfg.unit() != outputs::Unit::Cells;
+    let bar = cfg.study().bar() && cfg.unit() != outputs::Unit::Cells;
     with_hooks(cfg.name(), cfg.unit(), bar, place.json, |hooks| {
         outputs::run(cfg, place, hooks)
     })

@@ -3,8 +3,7 @@
 //! an array task's study with its share, and the finishing step. The command line only turns
 //! flags into a [`Job`] and a study's configuration, and runs the studies with its hooks.
 
-use super::calibrated::{CalibratedStudy, FIRST_PASSES};
-use super::fit::{FitStudy, Stage, FIRST_PASS};
+use super::fit::Stage;
 use super::outputs::{self, Hooks, Place};
 use super::StudyConfig;
 use crate::error::{Error, Result};
@@ -77,37 +76,15 @@ fn stage(s: &Submitted, job: &Job, dry: bool) -> Result<Staged> {
     Ok((plan, lay))
 }
 
-/// A study of two chained stages, at `stage`: a refined `fit` (its first pass, then its
-/// second) and a refined `paper --calibrated` (every model's first pass, then every model's
-/// second and the rest); `None` for a study of one run. Also the file the first stage writes.
-fn at_stage(cfg: &StudyConfig, stage: Stage) -> Option<(StudyConfig, &'static str)> {
-    match cfg {
-        StudyConfig::Fit(f) if f.config.design.refine => Some((
-            StudyConfig::Fit(FitStudy {
-                config: f.config.clone(),
-                stage,
-            }),
-            FIRST_PASS,
-        )),
-        StudyConfig::Calibrated(c) if c.config.design.refine => Some((
-            StudyConfig::Calibrated(CalibratedStudy {
-                config: c.config.clone(),
-                stage,
-            }),
-            FIRST_PASSES,
-        )),
-        _ => None,
-    }
-}
-
 /// A study as the runs a cluster makes of it, each checked, run dry (it stops at its first
 /// cell, so that bad input is refused here rather than in a failed array), its plan stored,
 /// its scripts written. One run; but a refined `fit` or `paper --calibrated` is two: the first
-/// passes into `DIR/first-pass` (their estimates, [`FIRST_PASS`] or [`FIRST_PASSES`]), the
+/// passes into `DIR/first-pass` (their estimates, [`FIRST_PASS`](super::fit::FIRST_PASS) or
+/// [`FIRST_PASSES`](super::calibrated::FIRST_PASSES)), the
 /// second into `DIR`, its boxes narrowed from the first's results, so that it can only start
 /// when the first has finished ([`submit`] chains them).
 pub fn stages(s: &Submitted, job: &Job) -> Result<Vec<Staged>> {
-    let Some((first_cfg, file)) = at_stage(&s.config, Stage::First) else {
+    let Some((first_cfg, file)) = s.config.study().at_stage(Stage::First) else {
         return stage(s, job, true).map(|one| vec![one]);
     };
     let pass = |config| Submitted {
@@ -122,8 +99,11 @@ pub fn stages(s: &Submitted, job: &Job) -> Result<Vec<Staged>> {
     };
     let staged = stage(&pass(first_cfg), &first_job, true).and_then(|first| {
         let from = first.1.dir.join(file);
-        let (second_cfg, _) =
-            at_stage(&s.config, Stage::Second { first: from }).expect("a study of two stages");
+        let (second_cfg, _) = s
+            .config
+            .study()
+            .at_stage(Stage::Second { first: from })
+            .expect("a study of two stages");
         let second = stage(&pass(second_cfg), job, false)?;
         Ok(vec![first, second])
     });

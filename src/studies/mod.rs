@@ -21,7 +21,7 @@ pub mod sweep;
 pub mod tradeoff;
 pub mod validate;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::run::runner::{ChunkShare, Runner};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -62,99 +62,113 @@ pub enum StudyConfig {
     Calibrated(calibrated::CalibratedStudy),
 }
 
-impl StudyConfig {
-    /// What makes two runs of the study one run, for the directory it owns
-    /// (`run::owner`): its configuration, less what only adds rounds to a study rolled to a
-    /// precision (the precision, the budgets, `plan_only`, `preroll_chunks`, and `rolls`
-    /// where a precision sets them).
-    pub fn identity(&self) -> serde_json::Value {
-        let c = match self {
-            StudyConfig::Tradeoff(t) => StudyConfig::Tradeoff(tradeoff::Config {
-                precision: 0.0,
-                budget_s: 0.0,
-                reference_budget_s: 0.0,
-                plan_only: false,
-                preroll_chunks: None,
-                ..t.clone()
-            }),
-            StudyConfig::Converge(c) if c.precision.is_some() => {
-                StudyConfig::Converge(converge::Config {
-                    precision: Some(0.0),
-                    budget_s: 0.0,
-                    reference_budget_s: 0.0,
-                    rolls: 0,
-                    ..c.clone()
-                })
-            }
-            other => other.clone(),
-        };
-        serde_json::to_value(&c).unwrap_or_default()
-    }
-
-    /// The study's name: its command.
-    pub fn name(&self) -> &'static str {
-        match self {
-            StudyConfig::Paper(_) => "paper",
-            StudyConfig::Crosscheck(_) => "crosscheck",
-            StudyConfig::Converge(_) => "converge",
-            StudyConfig::Tradeoff(_) => "tradeoff",
-            StudyConfig::Stability(_) => "stability",
-            StudyConfig::Fit(_) => "fit",
-            StudyConfig::Calibrated(_) => "paper --calibrated",
-        }
-    }
+/// What every study is, said once: its name, its checks, what it counts, how a cluster splits
+/// it, and its run, which writes its named outputs (`outputs`). A study is one type that
+/// implements this (its configuration) and one variant of [`StudyConfig`], which carries it
+/// through a cluster's plan; everything else — the directory it owns, resume, interruption,
+/// Slurm's tasks and finishing job, the command line's bar, the Python package — is written
+/// against this trait. The implementations sit beside the outputs they write
+/// ([`outputs`], [`fit::outputs`]).
+pub trait Kind: Sync {
+    /// Its name: its command.
+    fn name(&self) -> &'static str;
 
     /// Checks every value before anything runs.
+    fn validate(&self) -> Result<()>;
+
+    /// The study as the configuration a plan stores.
+    fn config(&self) -> StudyConfig;
+
+    /// What makes two runs of it one run, for the directory it owns (`run::owner`): its
+    /// configuration, less what only adds rounds to a study rolled to a precision.
+    fn identity(&self) -> StudyConfig {
+        self.config()
+    }
+
+    /// What its progress counts.
+    fn unit(&self) -> crate::report::progress::Unit {
+        crate::report::progress::Unit::Cells
+    }
+
+    /// True if the command line draws a bar for it (else it prints progress lines).
+    fn bar(&self) -> bool {
+        false
+    }
+
+    /// The directory the study writes into and owns: its `out` (crosscheck: its checkpoint,
+    /// if any).
+    fn owns<'a>(&self, place: &'a place::Place) -> Option<&'a std::path::Path> {
+        Some(place.out.as_path())
+    }
+
+    /// The name of its cells' directory under its `out` (the Python package's layout).
+    fn cells(&self) -> &'static str {
+        "checkpoint"
+    }
+
+    /// Refuses a study whose tasks could not agree on their shares: one that decides how far
+    /// to roll from every roll so far, which no task sees.
+    fn check_splittable(&self) -> Result<()> {
+        Ok(())
+    }
+
+    /// What the finishing job of a cluster run of `tasks` tasks runs, and with which share of
+    /// the chunks: the study itself, reading every chunk back and rolling none.
+    fn finishing(&self, tasks: u64) -> (StudyConfig, ChunkShare) {
+        (self.config(), ChunkShare::assemble(tasks))
+    }
+
+    /// A study of two chained stages, at `stage`, and the file its first stage writes; `None`
+    /// for a study of one run.
+    fn at_stage(&self, _stage: fit::Stage) -> Option<(StudyConfig, &'static str)> {
+        None
+    }
+
+    /// Runs it in `place`, writing its outputs whole or not at all.
+    fn run(&self, place: &place::Place, hooks: &place::Hooks) -> Result<place::Done>;
+}
+
+impl StudyConfig {
+    /// The study it configures: the one place (beside serde's tag) its variants are matched.
+    pub fn study(&self) -> &dyn Kind {
+        match self {
+            StudyConfig::Paper(c) => c,
+            StudyConfig::Crosscheck(c) => c,
+            StudyConfig::Converge(c) => c,
+            StudyConfig::Tradeoff(c) => c,
+            StudyConfig::Stability(c) => c,
+            StudyConfig::Fit(c) => c,
+            StudyConfig::Calibrated(c) => c,
+        }
+    }
+
+    /// [`Kind::identity`], as JSON.
+    pub fn identity(&self) -> serde_json::Value {
+        serde_json::to_value(self.study().identity()).unwrap_or_default()
+    }
+
+    /// [`Kind::name`].
+    pub fn name(&self) -> &'static str {
+        self.study().name()
+    }
+
+    /// [`Kind::validate`].
     pub fn validate(&self) -> Result<()> {
-        match self {
-            StudyConfig::Paper(c) => c.validate(),
-            StudyConfig::Crosscheck(c) => c.validate(),
-            StudyConfig::Converge(c) => c.validate(),
-            StudyConfig::Tradeoff(c) => c.validate(),
-            StudyConfig::Stability(c) => c.validate(),
-            StudyConfig::Fit(c) => c.validate(),
-            StudyConfig::Calibrated(c) => c.validate(),
-        }
+        self.study().validate()
     }
 
-    /// Refuses a study whose tasks could not agree on their shares: one that decides how far to
-    /// roll from every roll so far, which no task sees. `tradeoff` runs only rolled ahead
-    /// (`preroll_chunks`); `converge` only without a precision.
+    /// [`Kind::check_splittable`].
     pub fn check_splittable(&self) -> Result<()> {
-        match self {
-            StudyConfig::Tradeoff(t) if t.preroll_chunks.is_none() => Err(Error::field(
-                "preroll_chunks",
-                "",
-                "needed: the rounds are decided from every roll so far, which no task sees, \
-                 so the tasks roll the first throws of every stream ahead and the finishing job \
-                 runs the study, reading them back and rolling on itself where a method needs \
-                 more (a plan, `plan_only`, prints the rolls each needs)",
-            )),
-            StudyConfig::Converge(c) if c.precision.is_some() => Err(Error::field(
-                "precision",
-                "",
-                "decides each cell's rounds from all its rolls, which no task sees; give \
-                 `rolls` instead (a run to a precision prints the rolls each cell needs)",
-            )),
-            _ => Ok(()),
-        }
+        self.study().check_splittable()
     }
 
-    /// What the finishing job of a cluster run runs, and with which share of the chunks: the
-    /// study itself, reading every chunk back and rolling none; but `tradeoff`, whose tasks
-    /// only rolled ahead, runs whole (no `preroll_chunks`), reading their chunks back and
-    /// rolling on where a method needs more.
-    /// The run was split among `tasks` tasks (named when a chunk is missing).
+    /// [`Kind::finishing`].
     pub fn finishing(&self, tasks: u64) -> (StudyConfig, ChunkShare) {
-        match self {
-            StudyConfig::Tradeoff(t) => (
-                StudyConfig::Tradeoff(tradeoff::Config {
-                    preroll_chunks: None,
-                    ..t.clone()
-                }),
-                ChunkShare::All,
-            ),
-            other => (other.clone(), ChunkShare::assemble(tasks)),
-        }
+        self.study().finishing(tasks)
+    }
+
+    /// [`Kind::unit`].
+    pub fn unit(&self) -> crate::report::progress::Unit {
+        self.study().unit()
     }
 }

@@ -3,9 +3,9 @@
 //! A cluster task rolls its share and writes nothing; the finishing job writes the result.
 //! What the caller should print comes back as [`Done`].
 
-use super::place::to_json;
+use super::place::{to_json, Outputs};
 pub use super::place::{Done, Hooks, Place};
-use super::{Study, StudyConfig};
+use super::{Kind, Study, StudyConfig};
 use crate::error::{Error, Result};
 use crate::report;
 use crate::report::per_roll::PerRoll;
@@ -23,24 +23,169 @@ use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
 
-impl StudyConfig {
-    /// What the study's progress counts.
-    pub fn unit(&self) -> Unit {
-        match self {
-            StudyConfig::Paper(c) => Unit::Rolls { per_cell: c.rolls },
-            StudyConfig::Crosscheck(c) => Unit::Rolls {
-                per_cell: c.spec.indices().len(),
-            },
-            StudyConfig::Converge(c) if c.precision.is_some() => Unit::Cpu,
-            StudyConfig::Tradeoff(_) => Unit::Cpu,
-            StudyConfig::Fit(c) => Unit::Rolls {
-                per_cell: c.config.design.rolls,
-            },
-            StudyConfig::Calibrated(c) => Unit::Rolls {
-                per_cell: c.config.design.rolls,
-            },
-            _ => Unit::Cells,
+impl Kind for studies::paper::PaperConfig {
+    fn name(&self) -> &'static str {
+        "paper"
+    }
+    fn validate(&self) -> Result<()> {
+        studies::paper::PaperConfig::validate(self)
+    }
+    fn config(&self) -> StudyConfig {
+        StudyConfig::Paper(self.clone())
+    }
+    fn unit(&self) -> Unit {
+        Unit::Rolls {
+            per_cell: self.rolls,
         }
+    }
+    fn bar(&self) -> bool {
+        true
+    }
+    fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
+        paper(self, place, hooks)
+    }
+}
+
+impl Kind for studies::crosscheck::Config {
+    fn name(&self) -> &'static str {
+        "crosscheck"
+    }
+    fn validate(&self) -> Result<()> {
+        studies::crosscheck::Config::validate(self)
+    }
+    fn config(&self) -> StudyConfig {
+        StudyConfig::Crosscheck(self.clone())
+    }
+    fn unit(&self) -> Unit {
+        Unit::Rolls {
+            per_cell: self.spec.indices().len(),
+        }
+    }
+    fn owns<'a>(&self, place: &'a Place) -> Option<&'a Path> {
+        place.checkpoint.as_deref()
+    }
+    fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
+        crosscheck(self, place, hooks)
+    }
+}
+
+impl Kind for studies::converge::Config {
+    fn name(&self) -> &'static str {
+        "converge"
+    }
+    fn validate(&self) -> Result<()> {
+        studies::converge::Config::validate(self)
+    }
+    fn config(&self) -> StudyConfig {
+        StudyConfig::Converge(self.clone())
+    }
+    /// Rolled to a precision: less the precision, the budgets and the rolls it sets.
+    fn identity(&self) -> StudyConfig {
+        if self.precision.is_none() {
+            return self.config();
+        }
+        StudyConfig::Converge(studies::converge::Config {
+            precision: Some(0.0),
+            budget_s: 0.0,
+            reference_budget_s: 0.0,
+            rolls: 0,
+            ..self.clone()
+        })
+    }
+    fn unit(&self) -> Unit {
+        if self.precision.is_some() {
+            Unit::Cpu
+        } else {
+            Unit::Cells
+        }
+    }
+    fn bar(&self) -> bool {
+        self.precision.is_some()
+    }
+    fn check_splittable(&self) -> Result<()> {
+        if self.precision.is_some() {
+            return Err(Error::field(
+                "precision",
+                "",
+                "decides each cell's rounds from all its rolls, which no task sees; give \
+                 `rolls` instead (a run to a precision prints the rolls each cell needs)",
+            ));
+        }
+        Ok(())
+    }
+    fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
+        converge(self, place, hooks)
+    }
+}
+
+impl Kind for studies::tradeoff::Config {
+    fn name(&self) -> &'static str {
+        "tradeoff"
+    }
+    fn validate(&self) -> Result<()> {
+        studies::tradeoff::Config::validate(self)
+    }
+    fn config(&self) -> StudyConfig {
+        StudyConfig::Tradeoff(self.clone())
+    }
+    /// Less the precision, the budgets, `plan_only` and `preroll_chunks`.
+    fn identity(&self) -> StudyConfig {
+        StudyConfig::Tradeoff(studies::tradeoff::Config {
+            precision: 0.0,
+            budget_s: 0.0,
+            reference_budget_s: 0.0,
+            plan_only: false,
+            preroll_chunks: None,
+            ..self.clone()
+        })
+    }
+    fn unit(&self) -> Unit {
+        Unit::Cpu
+    }
+    fn bar(&self) -> bool {
+        true
+    }
+    fn check_splittable(&self) -> Result<()> {
+        if self.preroll_chunks.is_none() {
+            return Err(Error::field(
+                "preroll_chunks",
+                "",
+                "needed: the rounds are decided from every roll so far, which no task sees, \
+                 so the tasks roll the first throws of every stream ahead and the finishing job \
+                 runs the study, reading them back and rolling on itself where a method needs \
+                 more (a plan, `plan_only`, prints the rolls each needs)",
+            ));
+        }
+        Ok(())
+    }
+    /// Its tasks only rolled ahead: the finishing job runs it whole (no `preroll_chunks`),
+    /// reading their chunks back and rolling on where a method needs more.
+    fn finishing(&self, _tasks: u64) -> (StudyConfig, ChunkShare) {
+        (
+            StudyConfig::Tradeoff(studies::tradeoff::Config {
+                preroll_chunks: None,
+                ..self.clone()
+            }),
+            ChunkShare::All,
+        )
+    }
+    fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
+        tradeoff(self, place, hooks)
+    }
+}
+
+impl Kind for studies::stability::Config {
+    fn name(&self) -> &'static str {
+        "stability"
+    }
+    fn validate(&self) -> Result<()> {
+        studies::stability::Config::validate(self)
+    }
+    fn config(&self) -> StudyConfig {
+        StudyConfig::Stability(self.clone())
+    }
+    fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
+        stability(self, place, hooks)
     }
 }
 
@@ -141,24 +286,13 @@ pub fn roll_into(
 
 /// Runs a study that a cluster can split.
 pub fn run(config: &StudyConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
-    // The directory it writes into (crosscheck: its checkpoint) is this run's, or refused.
-    let owned = match config {
-        StudyConfig::Crosscheck(_) => place.checkpoint.as_deref(),
-        _ => Some(place.out.as_path()),
-    };
-    if let Some(dir) = owned {
-        config.validate()?;
-        crate::run::owner::claim(dir, config.name(), &config.identity())?;
+    let study = config.study();
+    // The directory it writes into is this run's, or refused.
+    if let Some(dir) = study.owns(place) {
+        study.validate()?;
+        crate::run::owner::claim(dir, study.name(), &config.identity())?;
     }
-    match config {
-        StudyConfig::Paper(c) => paper(c, place, hooks),
-        StudyConfig::Crosscheck(c) => crosscheck(c, place, hooks),
-        StudyConfig::Converge(c) => converge(c, place, hooks),
-        StudyConfig::Tradeoff(c) => tradeoff(c, place, hooks),
-        StudyConfig::Stability(c) => stability(c, place, hooks),
-        StudyConfig::Fit(c) => studies::fit::outputs::fit(c, place, hooks),
-        StudyConfig::Calibrated(c) => studies::fit::outputs::calibrated_study(c, place, hooks),
-    }
+    study.run(place, hooks)
 }
 
 /// `paper`: results.json, results.csv, report.md and the figures, in `place.out`; its cells
@@ -182,18 +316,15 @@ pub fn paper(cfg: &studies::paper::PaperConfig, place: &Place, hooks: &Hooks) ->
         return Ok(Done {
             stdout: format!("{}\n", report::paper::markdown(&res, &figures)),
             note: None,
-            interrupted: Some(format!(
-                "interrupted; {} kept what was rolled: run the same command to continue",
-                place.out.join("checkpoint").display()
-            )),
+            interrupted: place.interrupted().interrupted,
         });
     }
     let figures = report::paper::write_figures(&place.out, &res)?;
     let md = report::paper::markdown(&res, &figures);
     let json = to_json(&res)?;
-    outputs[0].write(json.as_bytes())?;
-    outputs[1].write(report::paper::results_csv(&res)?.as_bytes())?;
-    outputs[2].write(md.as_bytes())?;
+    outputs.write("results.json", json.as_bytes())?;
+    outputs.write("results.csv", report::paper::results_csv(&res)?.as_bytes())?;
+    outputs.write("report.md", md.as_bytes())?;
     let mut done = place.done(&json, &md, "report.md");
     done.note = done.note.map(|_| {
         format!(
@@ -219,19 +350,7 @@ pub fn crosscheck(cfg: &studies::crosscheck::Config, place: &Place, hooks: &Hook
         (hooks.progress)((before + n) as f64, total);
     };
     let res = match studies::crosscheck::run(cfg, &place.study(&hooks.stop, &progress)) {
-        Err(Error::Stopped) => {
-            return Ok(Done {
-                interrupted: Some(match &place.checkpoint {
-                    Some(d) => format!(
-                        "interrupted; nothing compared; the rolls made are kept in {}: run the \
-                         same command to continue",
-                        d.display()
-                    ),
-                    None => "interrupted; nothing compared".into(),
-                }),
-                ..Done::default()
-            })
-        }
+        Err(Error::Stopped) => return Ok(place.interrupted()),
         r => r?,
     };
     if place.partial() {
@@ -350,14 +469,14 @@ pub fn validate(cfg: &studies::validate::Config, place: &Place, hooks: &Hooks) -
 /// Writes the JSON and the report into the outputs checked before the run.
 fn write<T: Serialize>(
     place: &Place,
-    outputs: &[Output],
+    outputs: &Outputs,
     res: &T,
     report: &str,
     file: &str,
 ) -> Result<Done> {
     let json = to_json(res)?;
-    outputs[0].write(json.as_bytes())?;
-    outputs[1].write(report.as_bytes())?;
+    outputs.write(file, json.as_bytes())?;
+    outputs.write("report.md", report.as_bytes())?;
     Ok(place.done(&json, report, file))
 }
 

@@ -90,14 +90,21 @@ impl Place {
     }
 
     /// Creates the output directory and checks that `files` can be written in it.
-    pub(crate) fn outputs(&self, files: &[&str]) -> Result<Vec<Output>> {
+    pub(crate) fn outputs(&self, files: &[&'static str]) -> Result<Outputs> {
         std::fs::create_dir_all(&self.out).map_err(|e| {
             Error::field("out", self.out.display(), format!("cannot create it ({e})"))
         })?;
         files
             .iter()
-            .map(|f| Output::check(&self.out.join(f)))
-            .collect()
+            .map(|f| Ok((*f, Output::check(&self.out.join(f))?)))
+            .collect::<Result<_>>()
+            .map(Outputs)
+    }
+
+    /// What a study stopped before its end says (every study alike, [`interrupted`]): its
+    /// cells are kept in its checkpoint.
+    pub(crate) fn interrupted(&self) -> Done {
+        interrupted(self.checkpoint.as_deref())
     }
 
     /// The JSON, or the report, to print; the note that says what was written.
@@ -108,6 +115,36 @@ impl Place {
                 .then(|| format!("wrote {}/{file}, report.md and figures", self.out.display())),
             interrupted: None,
         }
+    }
+}
+
+/// What a study stopped before its end says, every study alike: where what was rolled is kept
+/// (`kept`), to be continued by the same command, or that nothing was written.
+pub(crate) fn interrupted(kept: Option<&std::path::Path>) -> Done {
+    Done {
+        interrupted: Some(match kept {
+            Some(d) => format!(
+                "interrupted; {} kept what was rolled: run the same command to continue",
+                d.display()
+            ),
+            None => "interrupted; nothing written".into(),
+        }),
+        ..Done::default()
+    }
+}
+
+/// A study's output files, checked writable before it rolls, each written by its name.
+pub(crate) struct Outputs(Vec<(&'static str, Output)>);
+
+impl Outputs {
+    /// Writes `bytes` as the file `name` (one the study declared), whole or not at all.
+    pub(crate) fn write(&self, name: &str, bytes: &[u8]) -> Result<()> {
+        self.0
+            .iter()
+            .find(|(n, _)| *n == name)
+            .ok_or_else(|| Error::Failed(format!("{name}: not among the study's outputs")))?
+            .1
+            .write(bytes)
     }
 }
 

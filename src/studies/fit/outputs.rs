@@ -7,10 +7,85 @@ use crate::calibration::predict::PredictConfig;
 use crate::calibration::{FitConfig, FitResult};
 use crate::error::{Error, Result};
 use crate::report::fit as report;
+use crate::report::progress::Unit;
 use crate::run::seal;
 use crate::studies::calibrated::{self, CalibratedConfig, CalibratedStudy, FIRST_PASSES};
-use crate::studies::place::{to_json, Done, Hooks, Place};
+use crate::studies::place::{interrupted, to_json, Done, Hooks, Place};
+use crate::studies::{Kind, StudyConfig};
 use serde::Serialize;
+
+impl Kind for FitStudy {
+    fn name(&self) -> &'static str {
+        "fit"
+    }
+    fn validate(&self) -> Result<()> {
+        FitStudy::validate(self)
+    }
+    fn config(&self) -> StudyConfig {
+        StudyConfig::Fit(self.clone())
+    }
+    fn unit(&self) -> Unit {
+        Unit::Rolls {
+            per_cell: self.config.design.rolls,
+        }
+    }
+    fn bar(&self) -> bool {
+        true
+    }
+    fn cells(&self) -> &'static str {
+        "cells"
+    }
+    /// A refined fit is two stages on a cluster: its first pass, then its second.
+    fn at_stage(&self, stage: Stage) -> Option<(StudyConfig, &'static str)> {
+        self.config.design.refine.then(|| {
+            (
+                StudyConfig::Fit(FitStudy {
+                    config: self.config.clone(),
+                    stage,
+                }),
+                FIRST_PASS,
+            )
+        })
+    }
+    fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
+        fit(self, place, hooks)
+    }
+}
+
+impl Kind for CalibratedStudy {
+    fn name(&self) -> &'static str {
+        "paper --calibrated"
+    }
+    fn validate(&self) -> Result<()> {
+        CalibratedStudy::validate(self)
+    }
+    fn config(&self) -> StudyConfig {
+        StudyConfig::Calibrated(self.clone())
+    }
+    fn unit(&self) -> Unit {
+        Unit::Rolls {
+            per_cell: self.config.design.rolls,
+        }
+    }
+    fn cells(&self) -> &'static str {
+        "calibration"
+    }
+    /// Refined, two stages: every model's first pass, then every model's second and the rest.
+    fn at_stage(&self, stage: Stage) -> Option<(StudyConfig, &'static str)> {
+        self.config.design.refine.then(|| {
+            (
+                StudyConfig::Calibrated(CalibratedStudy {
+                    config: self.config.clone(),
+                    stage,
+                }),
+                FIRST_PASSES,
+            )
+        })
+    }
+    fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
+        calibrated_study(self, place, hooks)
+    }
+}
 
 /// Claims `place.out` for this run (`run::owner`), once every value has been checked: refused
 /// if another command or another run owns it, or if a Slurm run does (neither `fit --recover`
@@ -30,26 +105,13 @@ fn unless_stopped<T>(r: Result<Option<T>>) -> Result<Option<T>> {
     }
 }
 
-fn interrupted(place: &Place) -> Done {
-    Done {
-        interrupted: Some(match &place.checkpoint {
-            Some(d) => format!(
-                "interrupted; {} kept what was rolled: run the same command to continue",
-                d.display()
-            ),
-            None => "interrupted before the end".into(),
-        }),
-        ..Done::default()
-    }
-}
-
 /// `fit`: fit.json, report.md and its figures in `place.out`; the simulations' cells under
 /// `place.checkpoint`. A first pass of two writes only `first-pass.json`; a cluster task's
 /// share writes nothing.
 pub fn fit(study: &FitStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
     study.validate()?;
     let first = study.stage == Stage::First;
-    let files: &[&str] = if first {
+    let files: &[&'static str] = if first {
         &[FIRST_PASS]
     } else {
         &["fit.json", "report.md"]
@@ -75,14 +137,14 @@ pub fn fit(study: &FitStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
         return Ok(Done::default());
     }
     let Some(res) = res else {
-        return Ok(interrupted(place));
+        return Ok(place.interrupted());
     };
     (hooks.progress)(total, total);
     // Sealed: `predict`, a Slurm fit's second pass and anything else that reads it refuses
     // a damaged or edited file.
     let json = seal::to_string(&res, true)?;
     if first {
-        outputs[0].write(json.as_bytes())?;
+        outputs.write(FIRST_PASS, json.as_bytes())?;
         let mut done = place.done(&json, &report::first_pass_text(&res), FIRST_PASS);
         done.note = done.note.map(|_| {
             format!(
@@ -94,8 +156,8 @@ pub fn fit(study: &FitStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
     }
     let figures = report::write_figures(&place.out, &res)?;
     let md = report::markdown(&res, &figures);
-    outputs[0].write(json.as_bytes())?;
-    outputs[1].write(md.as_bytes())?;
+    outputs.write("fit.json", json.as_bytes())?;
+    outputs.write("report.md", md.as_bytes())?;
     Ok(place.done(&json, &md, "fit.json"))
 }
 
@@ -120,15 +182,13 @@ pub fn recover(
     let runner = &study.runner;
     let res =
         unless_stopped(runner.install(|| super::recovery::run(cfg, truth, repeats, runner))?)?;
+    // Its repetitions keep no cells.
     let Some(res) = res else {
-        return Ok(Done {
-            interrupted: Some("interrupted before the repetitions were done".into()),
-            ..Done::default()
-        });
+        return Ok(interrupted(None));
     };
     (hooks.progress)(total, total);
     let json = to_json(&res)?;
-    outputs[0].write(json.as_bytes())?;
+    outputs.write("recovery.json", json.as_bytes())?;
     let text = report::recovery_text(&res);
     let mut done = place.done(&json, &text, "recovery.json");
     done.note = done
@@ -147,10 +207,7 @@ pub fn predict(fit: &FitResult, cfg: &PredictConfig, place: &Place, hooks: &Hook
     let p =
         unless_stopped(runner.install(|| super::predict::predict_block(fit, cfg, runner, None))?)?;
     let Some(p) = p else {
-        return Ok(Done {
-            interrupted: Some("interrupted before the draws were rolled".into()),
-            ..Done::default()
-        });
+        return Ok(interrupted(None));
     };
     Ok(Done {
         stdout: if place.json {
@@ -202,19 +259,16 @@ pub fn predict_blocks(
         super::predict::predict_blocks(fit, &cfg.rows, cfg.draws, cfg.rolls, cfg.seed, runner)
     })?)?;
     let Some(rows) = rows else {
-        return Ok(Done {
-            interrupted: Some("interrupted before every block was rolled; nothing written".into()),
-            ..Done::default()
-        });
+        return Ok(interrupted(None));
     };
     let res =
         crate::calibration::heldout::collect(rows, cfg.fit.clone(), place.command_line.clone());
     report::predictions_figure(&place.out, stem, &res)?;
     let md = report::predictions_markdown(&res, stem);
     let json = to_json(&res)?;
-    outputs[0].write(json.as_bytes())?;
-    outputs[1].write(report::predictions_csv(&res).as_bytes())?;
-    outputs[2].write(md.as_bytes())?;
+    outputs.write("predictions.json", json.as_bytes())?;
+    outputs.write("predictions.csv", report::predictions_csv(&res).as_bytes())?;
+    outputs.write("report.md", md.as_bytes())?;
     let mut done = place.done(&json, &md, "predictions.json");
     done.note = done.note.map(|_| {
         format!(
@@ -244,7 +298,7 @@ pub fn calibrated_study(study: &CalibratedStudy, place: &Place, hooks: &Hooks) -
     study.validate()?;
     let cfg = &study.config;
     let first = study.stage == Stage::First;
-    let files: &[&str] = if first {
+    let files: &[&'static str] = if first {
         &[FIRST_PASSES]
     } else {
         &["calibrated.json", "calibrated.md"]
@@ -269,11 +323,11 @@ pub fn calibrated_study(study: &CalibratedStudy, place: &Place, hooks: &Hooks) -
             return Ok(Done::default());
         }
         let Some(res) = res else {
-            return Ok(interrupted(place));
+            return Ok(place.interrupted());
         };
         (hooks.progress)(total, total);
         let json = seal::to_string(&res, true)?;
-        outputs[0].write(json.as_bytes())?;
+        outputs.write(FIRST_PASSES, json.as_bytes())?;
         let text: String = res
             .passes
             .iter()
@@ -294,14 +348,14 @@ pub fn calibrated_study(study: &CalibratedStudy, place: &Place, hooks: &Hooks) -
         return Ok(Done::default());
     }
     let Some(res) = res else {
-        return Ok(interrupted(place));
+        return Ok(place.interrupted());
     };
     (hooks.progress)(total, total);
     let figures = report::write_calibrated_figures(&place.out, &res)?;
     let md = report::calibrated_markdown(&res, &figures);
     let json = to_json(&res)?;
-    outputs[0].write(json.as_bytes())?;
-    outputs[1].write(md.as_bytes())?;
+    outputs.write("calibrated.json", json.as_bytes())?;
+    outputs.write("calibrated.md", md.as_bytes())?;
     let mut done = place.done(&json, &md, "calibrated.md");
     done.note = done.note.map(|_| {
         format!(
