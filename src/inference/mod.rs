@@ -1,6 +1,7 @@
-//! Inference from counts: what parameters make the simulator match measured counts, how sure
-//! that is, and what it then predicts. Pure statistics, no simulation (the study that rolls the
-//! dice is [`crate::studies::fit`]).
+//! The mathematics a fit stands on, with no dice in it: a smooth surrogate of a simulator's
+//! outcome probabilities, the likelihood of counts under it, the optimiser and the posterior
+//! sampler. What is fitted to what (the counts, the parameters, the designs) is
+//! [`crate::calibration`]'s; the rolling, [`crate::studies::fit`]'s.
 //!
 //! * [`surrogate`]: the simulator's outcome probabilities as a smooth function of the
 //!   parameters, fitted to simulated counts at many points (a multinomial logit in Legendre
