@@ -221,22 +221,12 @@ pub fn shown(v: &str) -> String {
     out
 }
 
-/// Reads a counts CSV; `name` is the file's name for messages. Linear in the file's size.
-pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
-    // The header's names, once it is read (an error before it names no column).
-    let names: std::cell::RefCell<Vec<String>> = Default::default();
-    let bad = |line: usize, col: usize, msg: String| {
-        let column = names.borrow().get(col).cloned().unwrap_or("?".into());
-        Error::Invalid(format!(
-            "{name}: line {line}, column {} ({column}): {msg}",
-            col + 1
-        ))
-    };
-    // The line of a byte offset, counted forward as the records come (CRLF, blank lines and
-    // quoted newlines all count as the file's own lines).
+/// A counter of lines: the line of each record's byte offset, counted forward as the records
+/// come (CRLF, blank lines and quoted newlines all count as the file's own lines).
+fn line_counter(text: &str) -> impl FnMut(usize) -> usize + '_ {
     let mut counted = (0usize, 1usize);
     let bytes = text.as_bytes();
-    let mut line_of = |mut byte: usize| {
+    move |mut byte: usize| {
         // A record's position may sit before the line ends, blank lines and comments that
         // precede it: step over them to its first character.
         loop {
@@ -252,14 +242,67 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
         }
         let byte = byte.max(counted.0);
         let (from, line) = counted;
-        let line = line
-            + text.as_bytes()[from..byte]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count();
+        let line = line + bytes[from..byte].iter().filter(|&&b| b == b'\n').count();
         counted = (byte, line);
         line
+    }
+}
+
+/// What a header says: sides or faces counted, how many count columns, and whether a
+/// `thrower` column ends it; a header that is neither form is refused.
+fn columns(have: &[&str], name: &str) -> Result<(Outcomes, usize, bool)> {
+    let (outcomes, counted) = if have.get(6) == Some(&FACE_COLUMNS[0]) {
+        (Outcomes::Faces, 6)
+    } else {
+        (Outcomes::Sides, 3)
     };
+    let want: Vec<&str> = match outcomes {
+        Outcomes::Sides => COLUMNS[..9].to_vec(),
+        Outcomes::Faces => COLUMNS[..6].iter().chain(&FACE_COLUMNS).copied().collect(),
+    };
+    let with_thrower = have.len() == want.len() + 1 && have.last() == Some(&"thrower");
+    if !(have == want || with_thrower && have[..want.len()] == want[..]) {
+        return Err(Error::Invalid(format!(
+            "{name}: line 1: the header must be {}[,thrower] (or face_1,…,face_6 in place of \
+             the three *_vertical), got {}",
+            COLUMNS[..9].join(","),
+            shown(&have.join(","))
+        )));
+    }
+    Ok((outcomes, counted, with_thrower))
+}
+
+/// A record's counts and which of them are `-` (sides only); a field that is not a count is
+/// the error `(column, its text)`.
+fn counts_of(
+    rec: &csv::StringRecord,
+    outcomes: Outcomes,
+    counted: usize,
+) -> std::result::Result<(Vec<u64>, Vec<bool>), (usize, String)> {
+    let mut counts = vec![0u64; counted];
+    let mut dashed = vec![false; counted];
+    for k in 0..counted {
+        let c = 6 + k;
+        match &rec[c] {
+            "-" if outcomes == Outcomes::Sides => dashed[k] = true,
+            v => counts[k] = v.parse().map_err(|_| (c, v.to_string()))?,
+        }
+    }
+    Ok((counts, dashed))
+}
+
+/// Reads a counts CSV; `name` is the file's name for messages. Linear in the file's size.
+pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
+    // The header's names, once it is read (an error before it names no column).
+    let names: std::cell::RefCell<Vec<String>> = Default::default();
+    let bad = |line: usize, col: usize, msg: String| {
+        let column = names.borrow().get(col).cloned().unwrap_or("?".into());
+        Error::Invalid(format!(
+            "{name}: line {line}, column {} ({column}): {msg}",
+            col + 1
+        ))
+    };
+    let mut line_of = line_counter(text);
     let csv_error = |e: csv::Error| {
         let line = e
             .position()
@@ -274,149 +317,21 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
         .from_reader(text.as_bytes());
     let header = reader.headers().map_err(csv_error)?.clone();
     let have: Vec<&str> = header.iter().collect();
-    let faces: Vec<&str> = COLUMNS[..6].iter().chain(&FACE_COLUMNS).copied().collect();
-    let (outcomes, counted) = if have.get(6) == Some(&FACE_COLUMNS[0]) {
-        (Outcomes::Faces, 6)
-    } else {
-        (Outcomes::Sides, 3)
-    };
-    let want: Vec<&str> = match outcomes {
-        Outcomes::Sides => COLUMNS[..9].to_vec(),
-        Outcomes::Faces => faces.clone(),
-    };
-    let with_thrower = have.len() == want.len() + 1 && have.last() == Some(&"thrower");
-    if !(have == want || with_thrower && have[..want.len()] == want[..]) {
-        return Err(Error::Invalid(format!(
-            "{name}: line 1: the header must be {}[,thrower] (or face_1,…,face_6 in place of \
-             the three *_vertical), got {}",
-            COLUMNS[..9].join(","),
-            shown(&have.join(","))
-        )));
-    }
+    let (outcomes, counted, with_thrower) = columns(&have, name)?;
     *names.borrow_mut() = have.iter().map(|s| s.to_string()).collect();
     let mut rows: Vec<DataRow> = Vec::new();
     let mut labels = std::collections::HashSet::new();
     for rec in reader.records() {
         let rec = rec.map_err(csv_error)?;
         let line = line_of(rec.position().map_or(0, |p| p.byte() as usize));
-        if rec.len() != have.len() {
-            return Err(bad(
-                line,
-                rec.len().min(have.len()),
-                format!("{} fields where the header has {}", rec.len(), have.len()),
-            ));
-        }
-        let text = |c: usize| -> Result<String> {
-            let v = rec[c].to_string();
-            if v.is_empty() {
-                return Err(bad(line, c, "empty".into()));
-            }
-            if v.chars().any(char::is_control) {
-                return Err(bad(
-                    line,
-                    c,
-                    format!("'{}' holds a control character", shown(&v)),
-                ));
-            }
-            Ok(v)
-        };
-        let label = text(0)?;
-        if !labels.insert(label.clone()) {
+        let row = row_of(&rec, have.len(), outcomes, counted, with_thrower)
+            .map_err(|(c, m)| bad(line, c, m))?;
+        if !labels.insert(row.label.clone()) {
             return Err(bad(
                 line,
                 0,
-                format!("label '{}' is used twice", shown(&label)),
+                format!("label '{}' is used twice", shown(&row.label)),
             ));
-        }
-        let surface = text(1)?;
-        let mut sides = [0.0; 3];
-        for (i, s) in sides.iter_mut().enumerate() {
-            let c = 2 + i;
-            *s = rec[c]
-                .parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite() && *v > 0.0)
-                .ok_or_else(|| {
-                    bad(
-                        line,
-                        c,
-                        format!("'{}' is not a positive number of mm", shown(&rec[c])),
-                    )
-                })?;
-        }
-        let mode: Mode = rec[5]
-            .parse()
-            .map_err(|_| bad(line, 5, format!("'{}' is not 2d or 3d", shown(&rec[5]))))?;
-        if outcomes == Outcomes::Faces && mode == Mode::TwoD {
-            return Err(bad(
-                line,
-                5,
-                "face counts are thrown in 3D (a 2D block shows a side, not a number)".into(),
-            ));
-        }
-        let mut counts = vec![0u64; counted];
-        let mut dashed = vec![false; counted];
-        for k in 0..counted {
-            let c = 6 + k;
-            match &rec[c] {
-                "-" if outcomes == Outcomes::Sides => dashed[k] = true,
-                v => {
-                    counts[k] = v.parse().map_err(|_| {
-                        bad(
-                            line,
-                            c,
-                            format!("'{}' is not a count (a whole number, or '-')", shown(v)),
-                        )
-                    })?
-                }
-            }
-        }
-        // Breadth is the larger side: swap a row given the other way, with its counts.
-        if sides[1] < sides[2] {
-            if outcomes == Outcomes::Faces {
-                return Err(bad(
-                    line,
-                    3,
-                    "give breadth_mm >= width_mm for face counts: the numbers sit on the \
-                     body's axes (x breadth, y width, z length) by the die's layout"
-                        .into(),
-                ));
-            }
-            sides.swap(1, 2);
-            counts.swap(1, 2);
-            dashed.swap(1, 2);
-        }
-        let block = Block::from_mm(sides[0], sides[1], sides[2])
-            .map_err(|e| bad(line, 2, e.to_string()))?;
-        let groups = match outcomes {
-            Outcomes::Sides => groups(mode, sides, [dashed[0], dashed[1], dashed[2]])
-                .map_err(|m| bad(line, 6, m))?,
-            Outcomes::Faces => (0..6).map(|k| vec![k]).collect(),
-        };
-        let row = DataRow {
-            label,
-            surface,
-            thrower: if with_thrower {
-                text(want.len())?
-            } else {
-                "all".into()
-            },
-            block,
-            mode,
-            outcomes,
-            counts,
-            groups,
-        };
-        let total = row.counts.iter().try_fold(0u64, |a, &c| a.checked_add(c));
-        if total.is_none_or(|t| t > MAX_ROW_THROWS) {
-            return Err(bad(
-                line,
-                6,
-                format!("counts too large: at most {MAX_ROW_THROWS} throws a row"),
-            ));
-        }
-        if row.n() == 0 {
-            return Err(bad(line, 6, "no throws counted".into()));
         }
         rows.push(row);
     }
@@ -424,6 +339,116 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
         return Err(Error::Invalid(format!("{name}: no rows of counts")));
     }
     Ok(rows)
+}
+
+/// A record's length, breadth and width, mm, each positive.
+fn sides_of(rec: &csv::StringRecord) -> std::result::Result<[f64; 3], (usize, String)> {
+    let mut sides = [0.0; 3];
+    for (i, s) in sides.iter_mut().enumerate() {
+        let c = 2 + i;
+        *s = rec[c]
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite() && *v > 0.0)
+            .ok_or_else(|| {
+                (
+                    c,
+                    format!("'{}' is not a positive number of mm", shown(&rec[c])),
+                )
+            })?;
+    }
+    Ok(sides)
+}
+
+/// One record as a row, with the header's `fields`, what it counts and whether a thrower
+/// ends it; an error is `(its column, what is wrong)`.
+fn row_of(
+    rec: &csv::StringRecord,
+    fields: usize,
+    outcomes: Outcomes,
+    counted: usize,
+    with_thrower: bool,
+) -> std::result::Result<DataRow, (usize, String)> {
+    if rec.len() != fields {
+        return Err((
+            rec.len().min(fields),
+            format!("{} fields where the header has {}", rec.len(), fields),
+        ));
+    }
+    let text = |c: usize| -> std::result::Result<String, (usize, String)> {
+        let v = rec[c].to_string();
+        if v.is_empty() {
+            return Err((c, "empty".into()));
+        }
+        if v.chars().any(char::is_control) {
+            return Err((c, format!("'{}' holds a control character", shown(&v))));
+        }
+        Ok(v)
+    };
+    let label = text(0)?;
+    let surface = text(1)?;
+    let mut sides = sides_of(rec)?;
+    let mode: Mode = rec[5]
+        .parse()
+        .map_err(|_| (5, format!("'{}' is not 2d or 3d", shown(&rec[5]))))?;
+    if outcomes == Outcomes::Faces && mode == Mode::TwoD {
+        return Err((
+            5,
+            "face counts are thrown in 3D (a 2D block shows a side, not a number)".into(),
+        ));
+    }
+    let (mut counts, mut dashed) = counts_of(rec, outcomes, counted).map_err(|(c, v)| {
+        (
+            c,
+            format!("'{}' is not a count (a whole number, or '-')", shown(&v)),
+        )
+    })?;
+    // Breadth is the larger side: swap a row given the other way, with its counts.
+    if sides[1] < sides[2] {
+        if outcomes == Outcomes::Faces {
+            return Err((
+                3,
+                "give breadth_mm >= width_mm for face counts: the numbers sit on the \
+                 body's axes (x breadth, y width, z length) by the die's layout"
+                    .into(),
+            ));
+        }
+        sides.swap(1, 2);
+        counts.swap(1, 2);
+        dashed.swap(1, 2);
+    }
+    let block = Block::from_mm(sides[0], sides[1], sides[2]).map_err(|e| (2, e.to_string()))?;
+    let groups = match outcomes {
+        Outcomes::Sides => {
+            groups(mode, sides, [dashed[0], dashed[1], dashed[2]]).map_err(|m| (6, m))?
+        }
+        Outcomes::Faces => (0..6).map(|k| vec![k]).collect(),
+    };
+    let row = DataRow {
+        label,
+        surface,
+        thrower: if with_thrower {
+            text(6 + counted)?
+        } else {
+            "all".into()
+        },
+        block,
+        mode,
+        outcomes,
+        counts,
+        groups,
+    };
+    let total = row.counts.iter().try_fold(0u64, |a, &c| a.checked_add(c));
+    if total.is_none_or(|t| t > MAX_ROW_THROWS) {
+        return Err((
+            6,
+            format!("counts too large: at most {MAX_ROW_THROWS} throws a row"),
+        ));
+    }
+    if row.n() == 0 {
+        return Err((6, "no throws counted".into()));
+    }
+    Ok(row)
 }
 
 /// The paper's 19 rows (its table "sidewaystable"), as a counts file would give them: every

@@ -544,124 +544,149 @@ impl Features {
             }
         }
         if let Some(p) = &self.pips {
-            let bad =
-                |field: &'static str, v: f64, why: String| Err(Error::field(field, mm(v), why));
-            if !(p.diameter.is_finite() && p.diameter > 0.0) {
+            self.validate_pips(p, half)?;
+        }
+        if let Some(i) = &self.insert {
+            self.validate_insert(i, half)?;
+        }
+        if let Some(t) = self.inertia {
+            validate_inertia(t)?;
+        }
+        Ok(())
+    }
+
+    /// The pips: a positive diameter, a depth a cap or cylinder can have, paint and spacing in
+    /// range, every pip inside its face (clear of the rounding) and apart from the others.
+    fn validate_pips(&self, p: &Pips, half: &Vector3<f64>) -> Result<()> {
+        let mm = |v: f64| format!("{}", (v * 1e9).round() / 1e6);
+        let min_half = half.min();
+        let r = self.edge_radius;
+        let bad = |field: &'static str, v: f64, why: String| Err(Error::field(field, mm(v), why));
+        if !(p.diameter.is_finite() && p.diameter > 0.0) {
+            return bad(
+                "pips.diameter",
+                p.diameter,
+                "must be a positive number of mm".into(),
+            );
+        }
+        let deepest = match p.shape {
+            PipShape::Cap => 0.5 * p.diameter,
+            PipShape::Cylinder => min_half,
+        };
+        if !(p.depth.is_finite() && p.depth > 0.0 && p.depth <= deepest && p.depth < min_half) {
+            return bad(
+                "pips.depth",
+                p.depth,
+                format!(
+                    "must be positive, at most {} mm ({})",
+                    mm(deepest.min(min_half)),
+                    match p.shape {
+                        PipShape::Cap => "a cap is at most a hemisphere",
+                        PipShape::Cylinder => "under half the shortest side",
+                    }
+                ),
+            );
+        }
+        if !(p.fill_density.is_finite() && (0.0..=1e5).contains(&p.fill_density)) {
+            return Err(Error::field(
+                "pips.fill_density",
+                p.fill_density,
+                "must be in [0, 100000] kg/m³",
+            ));
+        }
+        if !(p.spacing.is_finite() && p.spacing > 0.0 && p.spacing < 0.5) {
+            return Err(Error::field(
+                "pips.spacing",
+                p.spacing,
+                "must be in (0, 0.5): a fraction of the face's side",
+            ));
+        }
+        let places = pip_places(half, p, self.layout);
+        let rad = 0.5 * p.diameter;
+        for &(i, _, pj, pk) in &places {
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            if pj.abs() + rad > half[j] - r || pk.abs() + rad > half[k] - r {
                 return bad(
                     "pips.diameter",
                     p.diameter,
-                    "must be a positive number of mm".into(),
+                    "pips cross an edge of their face (or its rounding): smaller pips or a smaller spacing".into(),
                 );
             }
-            let deepest = match p.shape {
-                PipShape::Cap => 0.5 * p.diameter,
-                PipShape::Cylinder => min_half,
-            };
-            if !(p.depth.is_finite() && p.depth > 0.0 && p.depth <= deepest && p.depth < min_half) {
-                return bad(
-                    "pips.depth",
-                    p.depth,
-                    format!(
-                        "must be positive, at most {} mm ({})",
-                        mm(deepest.min(min_half)),
-                        match p.shape {
-                            PipShape::Cap => "a cap is at most a hemisphere",
-                            PipShape::Cylinder => "under half the shortest side",
-                        }
-                    ),
-                );
-            }
-            if !(p.fill_density.is_finite() && (0.0..=1e5).contains(&p.fill_density)) {
-                return Err(Error::field(
-                    "pips.fill_density",
-                    p.fill_density,
-                    "must be in [0, 100000] kg/m³",
-                ));
-            }
-            if !(p.spacing.is_finite() && p.spacing > 0.0 && p.spacing < 0.5) {
-                return Err(Error::field(
-                    "pips.spacing",
-                    p.spacing,
-                    "must be in (0, 0.5): a fraction of the face's side",
-                ));
-            }
-            let places = pip_places(half, p, self.layout);
-            let rad = 0.5 * p.diameter;
-            for &(i, _, pj, pk) in &places {
-                let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-                if pj.abs() + rad > half[j] - r || pk.abs() + rad > half[k] - r {
+        }
+        for (n, a) in places.iter().enumerate() {
+            for b in &places[n + 1..] {
+                if a.0 == b.0 && a.1 == b.1 && (a.2 - b.2).hypot(a.3 - b.3) <= p.diameter {
                     return bad(
                         "pips.diameter",
                         p.diameter,
-                        "pips cross an edge of their face (or its rounding): smaller pips or a smaller spacing".into(),
+                        "pips on a face overlap each other: smaller pips or a larger spacing"
+                            .into(),
                     );
                 }
-            }
-            for (n, a) in places.iter().enumerate() {
-                for b in &places[n + 1..] {
-                    if a.0 == b.0 && a.1 == b.1 && (a.2 - b.2).hypot(a.3 - b.3) <= p.diameter {
-                        return bad(
-                            "pips.diameter",
-                            p.diameter,
-                            "pips on a face overlap each other: smaller pips or a larger spacing"
-                                .into(),
-                        );
-                    }
-                }
-            }
-        }
-        if let Some(i) = &self.insert {
-            // Clear of the rounding and of the pips' cavities: inside the box whose faces
-            // lie the larger of the two inside the die's.
-            let skin = r.max(self.pips.map_or(0.0, |p| p.depth));
-            let triple = |v: [f64; 3]| format!("{},{},{}", mm(v[0]), mm(v[1]), mm(v[2]));
-            if !(i.size.iter().all(|s| s.is_finite() && *s > 0.0)) {
-                return Err(Error::field(
-                    "insert.size",
-                    triple(i.size),
-                    "must be three positive lengths, mm",
-                ));
-            }
-            let inside = (0..3).all(|k| {
-                i.centre[k].is_finite() && i.centre[k].abs() + 0.5 * i.size[k] <= half[k] - skin
-            });
-            if !inside {
-                return Err(Error::field(
-                    "insert.centre",
-                    triple(i.centre),
-                    format!(
-                        "the insert must lie inside the die, clear of its rounding and pips \
-                         (within {} mm of each face)",
-                        mm(skin)
-                    ),
-                ));
-            }
-            if !(i.density.is_finite() && (0.0..=1e5).contains(&i.density)) {
-                return Err(Error::field(
-                    "insert.density",
-                    i.density,
-                    "must be in [0, 100000] kg/m³",
-                ));
-            }
-        }
-        if let Some(t) = self.inertia {
-            let [xx, yy, zz, xy, xz, yz] = t;
-            let m = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
-            let e = SymmetricEigen::new(m).eigenvalues;
-            let physical = t.iter().all(|x| x.is_finite())
-                && e.iter().all(|&x| x > 0.0)
-                && (0..3).all(|k| e[k] <= e[(k + 1) % 3] + e[(k + 2) % 3]);
-            if !physical {
-                return Err(Error::field(
-                    "inertia",
-                    t.map(|x| format!("{}", x * 1e9)).join(","),
-                    "no solid has this inertia: its principal moments must be positive and \
-                     each at most the sum of the other two (g mm²: xx, yy, zz, xy, xz, yz)",
-                ));
             }
         }
         Ok(())
     }
+
+    /// The insert: positive sizes, inside the die clear of its rounding and pips, a density in
+    /// range.
+    fn validate_insert(&self, i: &Insert, half: &Vector3<f64>) -> Result<()> {
+        let mm = |v: f64| format!("{}", (v * 1e9).round() / 1e6);
+        let r = self.edge_radius;
+        // Clear of the rounding and of the pips' cavities: inside the box whose faces
+        // lie the larger of the two inside the die's.
+        let skin = r.max(self.pips.map_or(0.0, |p| p.depth));
+        let triple = |v: [f64; 3]| format!("{},{},{}", mm(v[0]), mm(v[1]), mm(v[2]));
+        if !(i.size.iter().all(|s| s.is_finite() && *s > 0.0)) {
+            return Err(Error::field(
+                "insert.size",
+                triple(i.size),
+                "must be three positive lengths, mm",
+            ));
+        }
+        let inside = (0..3).all(|k| {
+            i.centre[k].is_finite() && i.centre[k].abs() + 0.5 * i.size[k] <= half[k] - skin
+        });
+        if !inside {
+            return Err(Error::field(
+                "insert.centre",
+                triple(i.centre),
+                format!(
+                    "the insert must lie inside the die, clear of its rounding and pips \
+                     (within {} mm of each face)",
+                    mm(skin)
+                ),
+            ));
+        }
+        if !(i.density.is_finite() && (0.0..=1e5).contains(&i.density)) {
+            return Err(Error::field(
+                "insert.density",
+                i.density,
+                "must be in [0, 100000] kg/m³",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// An inertia given outright: finite, positive definite, and each principal moment at most
+/// the sum of the other two (as every solid's).
+fn validate_inertia(t: [f64; 6]) -> Result<()> {
+    let [xx, yy, zz, xy, xz, yz] = t;
+    let m = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
+    let e = SymmetricEigen::new(m).eigenvalues;
+    let physical = t.iter().all(|x| x.is_finite())
+        && e.iter().all(|&x| x > 0.0)
+        && (0..3).all(|k| e[k] <= e[(k + 1) % 3] + e[(k + 2) % 3]);
+    if !physical {
+        return Err(Error::field(
+            "inertia",
+            t.map(|x| format!("{}", x * 1e9)).join(","),
+            "no solid has this inertia: its principal moments must be positive and \
+             each at most the sum of the other two (g mm²: xx, yy, zz, xy, xz, yz)",
+        ));
+    }
+    Ok(())
 }
 
 /// What a die's mass properties depend on: its body's sides (x, y, z; in 2D the 1 m depth),
