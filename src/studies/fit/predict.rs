@@ -92,35 +92,11 @@ pub fn predict_block(
     dir: Option<&Path>,
 ) -> Result<Option<BlockPrediction>> {
     check(fit, cfg)?;
-    if cfg.draws < 2 || cfg.draws > fit.estimate.draws.len() {
-        return Err(Error::Invalid(format!(
-            "draws {}: from 2 to the fit's {} posterior draws",
-            cfg.draws,
-            fit.estimate.draws.len()
-        )));
-    }
-    if cfg.rolls == 0 || cfg.rolls > crate::run::spec::MAX_ROLLS {
-        return Err(Error::Invalid(format!("rolls {}: at least 1", cfg.rolls)));
-    }
     let surface = group(fit, true, &cfg.surface, "surface")?;
     let thrower = group(fit, false, &cfg.thrower, "thrower")?;
-    // The new row's coordinates: the fit's parameters of its surface and thrower.
-    let row = DataRow {
-        label: "predicted".into(),
-        surface: surface.clone(),
-        thrower: thrower.clone(),
-        block: cfg.block,
-        mode: cfg.mode,
-        outcomes: Default::default(),
-        counts: vec![0, 1, 1],
-        groups: vec![vec![1], vec![2]],
-    };
-    let model = &fit.config.model;
-    let dims = model.row_dims(&fit.params, &row);
-    let axes = model.axes(&fit.params, &dims);
-    let step = fit.estimate.draws.len() / cfg.draws;
     let mut freq: [Vec<f64>; 3] = Default::default();
     let die = &fit.config.method.die;
+    // A made die, or a fit of faces: its faces too.
     let with_faces = cfg.mode == crate::model::scene::Mode::ThreeD
         && (!die.is_default()
             || fit
@@ -131,28 +107,16 @@ pub fn predict_block(
     let mut face_freq: [Vec<f64>; 6] = Default::default();
     let mut ratios = Vec::new();
     let mut unsettled = 0;
-    for m in 0..cfg.draws {
-        let x = &fit.estimate.draws[m * step];
-        let local: Vec<f64> = dims.iter().map(|&d| x[d]).collect();
-        let mut values = crate::calibration::params::values(&model.fixed, &axes, &local);
-        if let Some([e, mu]) = cfg.contact {
-            (values.e, values.mu) = (e, mu);
-        }
-        let seed = point_seed(cfg.seed, cfg.block, cfg.mode, m);
-        let spec = fit
-            .config
-            .method
-            .spec(cfg.block, cfg.mode, &values, seed, cfg.rolls);
-        spec.validate(false)?;
+    for (m, spec) in draw_specs(fit, cfg, &surface, &thrower)?.iter().enumerate() {
         let ck = match dir {
-            Some(d) => Some(runner.open_cell(&d.join(format!("draw-{m:04}")), &spec)?),
+            Some(d) => Some(runner.open_cell(&d.join(format!("draw-{m:04}")), spec)?),
             None => None,
         };
         let base = m as u64 * cfg.rolls;
         let progress = |n| (runner.progress)(base + n);
         let done = runner
             .with_progress(&progress)
-            .run(&spec, ck.as_ref(), &mut |_| Ok(()))?;
+            .run(spec, ck.as_ref(), &mut |_| Ok(()))?;
         if !done.complete {
             return Ok(None);
         }
@@ -186,20 +150,6 @@ pub fn predict_block(
         )));
     }
     let n = cfg.rolls as f64;
-    let m = cfg.draws as f64;
-    let combine = |v: &[f64], noise: &dyn Fn(f64) -> f64| -> Predicted {
-        // The draws' spread less the rolls' noise is the parameters' part.
-        let raw = Predicted::of(v, 0.0);
-        let rolls_var = v.iter().map(|&x| noise(x)).sum::<f64>() / m;
-        let params_var = (raw.err_params.powi(2) - rolls_var).max(0.0);
-        let sim_var = (params_var + noise(raw.value)) / m;
-        Predicted {
-            value: raw.value,
-            err: (params_var + sim_var).sqrt(),
-            err_params: params_var.sqrt(),
-            err_sim: sim_var.sqrt(),
-        }
-    };
     let p: Vec<Predicted> = freq
         .iter()
         .map(|v| combine(v, &|q: f64| q * (1.0 - q) / n))
@@ -234,6 +184,66 @@ pub fn predict_block(
         unsettled,
         extrapolation: extrapolation(fit, &cfg.block),
     }))
+}
+
+/// The runs of a prediction: `cfg.block` at `cfg.draws` of the fit's posterior draws, evenly
+/// spaced, at the parameters of `surface` and `thrower` (or the surface `cfg.contact` gives),
+/// each on its own keyed throws; checked.
+fn draw_specs(
+    fit: &FitResult,
+    cfg: &PredictConfig,
+    surface: &str,
+    thrower: &str,
+) -> Result<Vec<crate::run::spec::RunSpec>> {
+    // The new row's coordinates: the fit's parameters of its surface and thrower.
+    let row = DataRow {
+        label: "predicted".into(),
+        surface: surface.into(),
+        thrower: thrower.into(),
+        block: cfg.block,
+        mode: cfg.mode,
+        outcomes: Default::default(),
+        counts: vec![0, 1, 1],
+        groups: vec![vec![1], vec![2]],
+    };
+    let model = &fit.config.model;
+    let dims = model.row_dims(&fit.params, &row);
+    let axes = model.axes(&fit.params, &dims);
+    let step = fit.estimate.draws.len() / cfg.draws;
+    (0..cfg.draws)
+        .map(|m| {
+            let x = &fit.estimate.draws[m * step];
+            let local: Vec<f64> = dims.iter().map(|&d| x[d]).collect();
+            let mut values = crate::calibration::params::values(&model.fixed, &axes, &local);
+            if let Some([e, mu]) = cfg.contact {
+                (values.e, values.mu) = (e, mu);
+            }
+            let seed = point_seed(cfg.seed, cfg.block, cfg.mode, m);
+            let spec = fit
+                .config
+                .method
+                .spec(cfg.block, cfg.mode, &values, seed, cfg.rolls);
+            spec.validate(false)?;
+            Ok(spec)
+        })
+        .collect()
+}
+
+/// The mean over the draws of `v`, one value a draw, with its error: the draws' spread less
+/// the rolls' noise (`noise(value)`, a value's variance from its rolls alone) is the
+/// parameters' part; the mean's own simulation error adds (parameters + noise)/draws.
+fn combine(v: &[f64], noise: &dyn Fn(f64) -> f64) -> Predicted {
+    let m = v.len() as f64;
+    let raw = Predicted::of(v, 0.0);
+    let rolls_var = v.iter().map(|&x| noise(x)).sum::<f64>() / m;
+    let params_var = (raw.err_params.powi(2) - rolls_var).max(0.0);
+    let sim_var = (params_var + noise(raw.value)) / m;
+    Predicted {
+        value: raw.value,
+        err: (params_var + sim_var).sqrt(),
+        err_params: params_var.sqrt(),
+        err_sim: sim_var.sqrt(),
+    }
 }
 
 /// What to predict for `row` of a blocks file.
