@@ -463,6 +463,39 @@ impl CalibratedStudy {
     }
 }
 
+/// The three model decisions, each the richer model's held-out gain over the simpler one's
+/// (with the likelihood ratio where they are nested).
+fn decisions(fits: &[(&str, &str, Fitted, Vec<LooRow>)], models: &[ModelScore]) -> Vec<Decision> {
+    let by = |name: &str| fits.iter().position(|f| f.0 == name).expect("model");
+    let (hand, paper_throw, shared, long_2d) =
+        (by("hand"), by("paper-throw"), by("shared"), by("long-2d"));
+    vec![
+        verdict(
+            "κ: does a hand's throw, spread by κ, predict better than the paper's throw?",
+            "paper-throw",
+            "hand",
+            gain(&fits[paper_throw].3, &fits[hand].3, false),
+            // Nested at the boundary κ → ∞: the χ²₁ p-value is conservative (twice the
+            // boundary's ½χ²₀ + ½χ²₁ mixture).
+            Some(likelihood_ratio(&models[paper_throw], &models[hand])),
+        ),
+        verdict(
+            "e and μ: one pair per surface, or one pair for all?",
+            "shared",
+            "hand",
+            gain(&fits[shared].3, &fits[hand].3, false),
+            Some(likelihood_ratio(&models[shared], &models[hand])),
+        ),
+        verdict(
+            "The long blocks: 3D, or the paper's 2D model (scored on the side outcomes)?",
+            "long-2d",
+            "hand",
+            gain(&fits[long_2d].3, &fits[hand].3, true),
+            None,
+        ),
+    ]
+}
+
 /// Everything after the fits: each model's leave-one-out scores, the decisions, the method
 /// check at the main fit's values (rolled here, on all of this process's cores, even in a
 /// cluster's finishing job: it is drawn from the fit's result, which no task saw), the theory
@@ -501,34 +534,8 @@ fn conclude(
             )
         })
         .collect();
-    let by = |name: &str| fits.iter().position(|f| f.0 == name).expect("model");
-    let (hand, paper_throw, shared, long_2d) =
-        (by("hand"), by("paper-throw"), by("shared"), by("long-2d"));
-    let decisions = vec![
-        verdict(
-            "κ: does a hand's throw, spread by κ, predict better than the paper's throw?",
-            "paper-throw",
-            "hand",
-            gain(&fits[paper_throw].3, &fits[hand].3, false),
-            // Nested at the boundary κ → ∞: the χ²₁ p-value is conservative (twice the
-            // boundary's ½χ²₀ + ½χ²₁ mixture).
-            Some(likelihood_ratio(&models[paper_throw], &models[hand])),
-        ),
-        verdict(
-            "e and μ: one pair per surface, or one pair for all?",
-            "shared",
-            "hand",
-            gain(&fits[shared].3, &fits[hand].3, false),
-            Some(likelihood_ratio(&models[shared], &models[hand])),
-        ),
-        verdict(
-            "The long blocks: 3D, or the paper's 2D model (scored on the side outcomes)?",
-            "long-2d",
-            "hand",
-            gain(&fits[long_2d].3, &fits[hand].3, true),
-            None,
-        ),
-    ];
+    let decisions = decisions(&fits, &models);
+    let hand = fits.iter().position(|f| f.0 == "hand").expect("model");
     // The method at the main fit's values, each block's row at its own surface's e and μ.
     let main = &fits[hand].2;
     let at = |row: &DataRow| {

@@ -37,6 +37,21 @@ pub struct Study<'a> {
     pub checkpoint: Option<PathBuf>,
 }
 
+impl Study<'_> {
+    /// The checkpoint of the cell `name` under this study's checkpoint directory, opened for
+    /// `spec`, if the study keeps its cells.
+    pub fn cell(
+        &self,
+        name: &str,
+        spec: &crate::run::spec::RunSpec,
+    ) -> Result<Option<crate::run::runner::Checkpoint>> {
+        self.checkpoint
+            .as_ref()
+            .map(|d| self.runner.open_cell(&d.join(name), spec))
+            .transpose()
+    }
+}
+
 /// How far a study has come: done and in all, in the study's unit (CPU seconds for a study
 /// that rolls to a precision, else cells).
 pub type Progress<'a> = &'a (dyn Fn(f64, f64) + Sync);

@@ -128,14 +128,7 @@ pub fn run(cfg: &PaperConfig, command_line: String, study: &Study) -> Result<Pap
                     rolls: cfg.rolls,
                     shard: None,
                 };
-                let ck =
-                    match &study.checkpoint {
-                        Some(d) => Some(runner.open_cell(
-                            &d.join(format!("row{row}-{engine}-{}", mode.name())),
-                            &spec,
-                        )?),
-                        None => None,
-                    };
+                let ck = study.cell(&format!("row{row}-{engine}-{}", mode.name()), &spec)?;
                 let progress = |n| (runner.progress)(base + n);
                 let done = runner
                     .with_progress(&progress)
