@@ -256,6 +256,30 @@ impl RunSummary {
         self
     }
 
+    /// What of the run is not DicePhys's (the throw style, damping, no sleeping), as a line;
+    /// empty when all is.
+    fn not_dicephys(&self) -> String {
+        let (scene, style) = (&self.spec.scene, self.spec.throws.style);
+        let mut extra = Vec::new();
+        if !style.is_paper() {
+            extra.push(format!("throw {style}"));
+        }
+        if scene.damped() {
+            extra.push(format!(
+                "damping {} (linear), {} (angular) 1/s",
+                scene.linear_damping, scene.angular_damping
+            ));
+        }
+        if !scene.sleeping {
+            extra.push("never asleep".into());
+        }
+        if extra.is_empty() {
+            String::new()
+        } else {
+            format!("  {}\n", extra.join(", "))
+        }
+    }
+
     /// The human summary: counts, the ratio with its error, theory and σ, failures, cost.
     pub fn human(&self) -> String {
         let c = &self.counts;
@@ -283,24 +307,7 @@ impl RunSummary {
             self.preset,
             self.floor
         );
-        // What is not DicePhys's: the throw style, damping, no sleeping.
-        let (scene, style) = (&self.spec.scene, self.spec.throws.style);
-        let mut extra = Vec::new();
-        if !style.is_paper() {
-            extra.push(format!("throw {style}"));
-        }
-        if scene.damped() {
-            extra.push(format!(
-                "damping {} (linear), {} (angular) 1/s",
-                scene.linear_damping, scene.angular_damping
-            ));
-        }
-        if !scene.sleeping {
-            extra.push("never asleep".into());
-        }
-        if !extra.is_empty() {
-            s += &format!("  {}\n", extra.join(", "));
-        }
+        s += &self.not_dicephys();
         s += &format!(
             "  breadth vertical {:>8}   width vertical {:>8}   length vertical {:>6}   unknown {:>6}\n",
             c.breadth, c.width, c.length, c.unknown
