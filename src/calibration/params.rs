@@ -463,14 +463,13 @@ impl Method {
     /// free from the die's description, else 0), a free pip depth on the die's pips.
     pub fn die_at(&self, v: &Fixed) -> Features {
         let mut die = self.die;
-        if v.com.iter().any(Option::is_some) {
-            let own = self.die.com.unwrap_or([0.0; 3]);
-            die.com = Some(std::array::from_fn(|i| {
-                v.com[i].map_or(own[i], |mm| mm / 1000.0)
-            }));
+        for (axis, mm) in v.com.iter().enumerate() {
+            if let Some(mm) = mm {
+                die = die.with_com_on(axis, mm / 1000.0);
+            }
         }
-        if let (Some(h), Some(p)) = (v.pip_depth, die.pips.as_mut()) {
-            p.depth = h / 1000.0;
+        if let Some(h) = v.pip_depth {
+            die = die.with_pip_depth(h / 1000.0).unwrap_or(die);
         }
         die
     }

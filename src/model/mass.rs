@@ -487,6 +487,21 @@ impl Features {
         self
     }
 
+    /// These features with the centre of mass on `axis` (0 x, 1 y, 2 z) given outright at `m`
+    /// metres from the geometric centre, its other components the ones given, else 0.
+    pub fn with_com_on(mut self, axis: usize, m: f64) -> Features {
+        let mut c = self.com.unwrap_or([0.0; 3]);
+        c[axis] = m;
+        self.com = Some(c);
+        self
+    }
+
+    /// These features with the pips `m` metres deep; `None` if the die has no pips.
+    pub fn with_pip_depth(mut self, m: f64) -> Option<Features> {
+        self.pips.as_mut()?.depth = m;
+        Some(self)
+    }
+
     /// True if nothing is set, not even the layout.
     pub fn is_default(&self) -> bool {
         *self == Features::default()

@@ -222,27 +222,23 @@ pub enum Varied {
 impl Varied {
     /// `features` with this feature at `mm`.
     pub fn set(self, features: &Features, mm: f64) -> Result<Features> {
-        let mut f = *features;
         let m = mm / 1000.0;
         match self {
             Varied::ComX | Varied::ComY | Varied::ComZ => {
-                let mut c = f.com.unwrap_or([0.0; 3]);
-                c[self as usize] = m;
-                f.com = Some(c);
+                Ok(features.with_com_on(self as usize, m))
             }
-            Varied::PipDepth => match f.pips.as_mut() {
-                Some(p) => p.depth = m,
-                None => {
-                    return Err(Error::field(
-                        "vary",
-                        "pip_depth",
-                        "the die has no pips to vary: give them (--pips D,H or a die file)",
-                    ))
-                }
-            },
-            Varied::EdgeRadius => f.edge_radius = m,
+            Varied::PipDepth => features.with_pip_depth(m).ok_or_else(|| {
+                Error::field(
+                    "vary",
+                    "pip_depth",
+                    "the die has no pips to vary: give them (--pips D,H or a die file)",
+                )
+            }),
+            Varied::EdgeRadius => Ok(Features {
+                edge_radius: m,
+                ..*features
+            }),
         }
-        Ok(f)
     }
 }
 
@@ -301,11 +297,9 @@ pub fn vary(
     let specs = values
         .iter()
         .map(|&v| {
+            // The pips already sit by the run's layout (`roll --layout` placed them).
             let mut s = spec.clone();
             s.scene.features = what.set(&spec.scene.features, v)?;
-            if !s.scene.features.plain() && s.scene.features.pips.is_some() {
-                s.scene.features.layout = layout;
-            }
             s.validate(false)?;
             Ok(s)
         })
