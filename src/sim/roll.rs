@@ -517,8 +517,221 @@ pub fn run_from(
     run(engine, scene, start, cfg, observe, false)
 }
 
+/// The checks every step's state goes through, and what they keep between steps.
+struct Watch {
+    die: DieShape,
+    certificate: Certificate,
+    /// The certificate ends the roll (`Rule::Certificate`).
+    stop_early: bool,
+    /// The certificate is checked at all (to stop, or for an audit).
+    watch: bool,
+    floor_bottom: f64,
+    /// What a jumped state must be above for the certificate to be out of reach (when it is
+    /// checked at all).
+    ceiling: f64,
+    energy: EnergyWatch,
+    rest: RestDetector,
+}
+
+impl Watch {
+    fn new(scene: &Scene, start: &BodyState, cfg: &RollConfig) -> Watch {
+        let die = DieShape::of(scene);
+        let certificate = Certificate { margin: cfg.margin };
+        let stop_early = cfg.rule == Rule::Certificate;
+        let watch = stop_early || cfg.audit;
+        let ceiling = if watch {
+            certificate.energy_ceiling(&die)
+        } else {
+            f64::NEG_INFINITY
+        };
+        Watch {
+            energy: EnergyWatch::new(&die, start),
+            die,
+            certificate,
+            stop_early,
+            watch,
+            floor_bottom: scene.floor_bottom(),
+            ceiling,
+            rest: RestDetector::default(),
+        }
+    }
+
+    /// Judges a step's state (`end.steps` already counts it): true when the roll has ended,
+    /// with `end.fate` said. `energy` is false for a ballistic flown step, which has no
+    /// contact to gain energy at.
+    fn judge(&mut self, end: &mut End, state: &BodyState, energy: bool) -> bool {
+        let die = &self.die;
+        end.dip.push(die, state);
+        if let Some(f) = check(state, die, &end.dip, self.floor_bottom) {
+            end.fate = Fate::Failed(f);
+            return true;
+        }
+        if energy {
+            self.energy.push(die, state);
+            end.energy_gain = self.energy.gained;
+        }
+        // A die whose centre is under the floor's top face is mid-dip (or through): no
+        // outcome is certain until the engine has pushed it back out, and at rest there it
+        // has failed.
+        let under = state.position.y < 0.0;
+        if self.watch && end.certified.is_none() && !under {
+            if let Some(o) = self.certificate.certain(die, state) {
+                end.certified = Some((end.steps, o));
+                if self.stop_early {
+                    // Certain of its side, and so of its face: the die cannot leave the
+                    // face region it is in (the barrier it cannot climb is the edge between).
+                    end.fate = Fate::Settled(o);
+                    end.up = up_direction(&state.rotation, o);
+                    return true;
+                }
+            }
+        }
+        if self.rest.push(state) {
+            end.fate = if under {
+                Fate::Failed(Failure::Tunnelled)
+            } else {
+                let o = classify(state);
+                end.up = up_direction(&state.rotation, o);
+                Fate::Settled(o)
+            };
+            return true;
+        }
+        false
+    }
+}
+
+/// A roll's free flight: in flight the roll steps the die itself (`Flying`), and the engine
+/// is behind until the state is handed back.
+struct Flier {
+    /// Bullet's ballistic flight, where the engine's flight is ballistic and flight is fast.
+    flight: Option<Flight>,
+    /// An engine that flies the die itself (Rapier) does so bit for bit as its own steps, so
+    /// every check is walked over its flown steps as over its own, the energy watch too.
+    own: bool,
+    flying: Flying,
+    /// The engine has not stepped the last flown states.
+    behind: bool,
+    /// The body state a ballistic flight flies: the engine's own (`Engine::body_state`), the
+    /// die's state turned back from it at each step (`Flight::to_die`).
+    body: BodyState,
+    /// Flown steps in a row so far.
+    in_a_row: u64,
+}
+
+impl Flier {
+    fn new(
+        engine: &dyn Engine,
+        scene: &Scene,
+        die: DieShape,
+        start: &BodyState,
+        cfg: &RollConfig,
+    ) -> Flier {
+        let flight =
+            (cfg.fast_flight && engine.ballistic_flight()).then(|| Flight::of_die(scene, die));
+        Flier {
+            own: cfg.fast_flight && flight.is_none() && engine.own_flight(),
+            flight,
+            flying: Flying::No,
+            behind: false,
+            body: *start,
+            in_a_row: 0,
+        }
+    }
+
+    /// Starts a flight if the die, in `state`, may fly.
+    fn start(&mut self, engine: &mut dyn Engine, state: &BodyState) {
+        self.flying = if self.own {
+            if engine.own_flight_start(state) {
+                Flying::Own
+            } else {
+                Flying::No
+            }
+        } else {
+            match &self.flight {
+                Some(f) if f.may_start(state, || engine.contact_free()) => {
+                    self.body = engine.body_state();
+                    Flying::Ballistic(f.step_rotation(&state.angular_velocity))
+                }
+                _ => Flying::No,
+            }
+        };
+    }
+
+    /// Jumps the flown steps on which no check can fire, at most `left`, leaving `state` at
+    /// the last; returns how many. Once the rest rule's window holds flown steps only it
+    /// cannot fire in flight (every flown step keeps the die awake: its ω is the same every
+    /// step, or its speed is above 0.8 m/s with the vertical velocity of one sign, so neither
+    /// sum of ten is near 0). The certificate cannot fire while the energy is above its
+    /// ceiling, and a state clear of the floor fails no check. So those steps are jumped,
+    /// the rest rule's window kept filled, and the walk takes over where a check could fire
+    /// or the die reaches the floor.
+    fn jump(
+        &mut self,
+        engine: &mut dyn Engine,
+        w: &mut Watch,
+        state: &mut BodyState,
+        left: u64,
+        scene: &Scene,
+    ) -> u64 {
+        let n = match (&self.flying, &self.flight) {
+            (Flying::Ballistic(dq), Some(f)) => {
+                let max = quiet_steps(&w.die, state, w.ceiling, f).min(left);
+                let n = f.jump(&mut self.body, dq, max, &mut w.rest);
+                *state = f.to_die(&self.body);
+                n
+            }
+            _ => {
+                let max = quiet_steps_own(state, w.ceiling, scene).min(left);
+                let (die, energy) = (&w.die, &mut w.energy);
+                jump_own(state, max, &mut w.rest, |s| {
+                    let next = engine.own_flight_step(s)?;
+                    energy.push(die, &next);
+                    Some(next)
+                })
+            }
+        };
+        if n > 0 {
+            self.in_a_row += n;
+            self.behind = true;
+        }
+        n
+    }
+
+    /// The next flown state from `state`, or `None` where the flight ends, the engine then
+    /// given the state back (an `Err` if it refused it).
+    fn next(
+        &mut self,
+        engine: &mut dyn Engine,
+        state: &BodyState,
+    ) -> Result<Option<BodyState>, ()> {
+        let next = match (&self.flying, &self.flight) {
+            (Flying::Ballistic(dq), Some(f)) => f.next(&self.body, dq).map(|b| {
+                self.body = b;
+                f.to_die(&b)
+            }),
+            _ => engine.own_flight_step(state),
+        };
+        if next.is_none() {
+            if self.behind {
+                let handed = match self.flying {
+                    Flying::Ballistic(_) => engine.set_body_state(&self.body),
+                    _ => engine.set_state(state),
+                };
+                if handed.is_err() {
+                    return Err(());
+                }
+            }
+            self.flying = Flying::No;
+            self.behind = false;
+        } else {
+            self.behind = true;
+        }
+        Ok(next)
+    }
+}
+
 /// `run_from`; with `jump`, stretches of free flight on which no check can fire are jumped
-/// (`Flight::jump`) and `observe` does not see their states.
+/// (`Flier::jump`) and `observe` does not see their states.
 fn run(
     engine: &mut dyn Engine,
     scene: &Scene,
@@ -527,12 +740,6 @@ fn run(
     mut observe: impl FnMut(u64, &BodyState),
     jump: bool,
 ) -> End {
-    let die = DieShape::of(scene);
-    let certificate = Certificate { margin: cfg.margin };
-    let stop_early = cfg.rule == Rule::Certificate;
-    let watch = stop_early || cfg.audit;
-    let flight = (cfg.fast_flight && engine.ballistic_flight()).then(|| Flight::of_die(scene, die));
-    let floor_bottom = scene.floor_bottom();
     let mut end = End {
         fate: Fate::Failed(Failure::Engine),
         steps: 0,
@@ -545,111 +752,36 @@ fn run(
     if engine.reset(start).is_err() {
         return end;
     }
-    // An engine that flies the die itself (Rapier) does so bit for bit as its own steps, so
-    // every check is walked over its flown steps as over its own, the energy watch too.
-    let own = cfg.fast_flight && flight.is_none() && engine.own_flight();
-    let mut energy = EnergyWatch::new(&die, start);
+    let mut w = Watch::new(scene, start, cfg);
+    let mut fly = Flier::new(engine, scene, w.die, start, cfg);
     observe(0, &engine.state());
-    let mut rest = RestDetector::default();
     let mut state = *start;
-    // In free flight the roll steps the die itself (`Flying`), and the engine is behind until
-    // the state is handed back.
-    let mut flying = Flying::No;
-    let mut behind = false;
-    // The body state a ballistic flight flies: the engine's own (`Engine::body_state`), the
-    // die's `state` turned back from it at each step (`Flight::to_die`).
-    let mut body = state;
-    // Flown steps in a row so far, and what a jumped state must be above for the certificate
-    // to be out of reach (when it is checked at all).
-    let mut flown_in_a_row = 0u64;
-    let ceiling = if watch {
-        certificate.energy_ceiling(&die)
-    } else {
-        f64::NEG_INFINITY
-    };
     while end.steps < cfg.max_steps {
         let mut next = None;
-        if matches!(flying, Flying::No) {
-            flying = if own {
-                if engine.own_flight_start(&state) {
-                    Flying::Own
-                } else {
-                    Flying::No
-                }
-            } else {
-                match &flight {
-                    Some(f) if f.may_start(&state, || engine.contact_free()) => {
-                        body = engine.body_state();
-                        Flying::Ballistic(f.step_rotation(&state.angular_velocity))
-                    }
-                    _ => Flying::No,
-                }
-            };
+        if matches!(fly.flying, Flying::No) {
+            fly.start(engine, &state);
         }
-        if !matches!(flying, Flying::No) {
-            // Once the rest rule's window holds flown steps only it cannot fire in flight
-            // (every flown step keeps the die awake: its ω is the same every step, or its
-            // speed is above 0.8 m/s with the vertical velocity of one sign, so neither
-            // sum of ten is near 0). The certificate cannot fire while the energy is
-            // above its ceiling, and a state clear of the floor fails no check. So
-            // those steps are jumped, the rest rule's window kept filled, and the walk
-            // takes over where a check could fire or the die reaches the floor.
-            if jump && flown_in_a_row >= REST_WINDOW as u64 {
-                let left = cfg.max_steps - end.steps;
-                let n = match (&flying, &flight) {
-                    (Flying::Ballistic(dq), Some(f)) => {
-                        let max = quiet_steps(&die, &state, ceiling, f).min(left);
-                        let n = f.jump(&mut body, dq, max, &mut rest);
-                        state = f.to_die(&body);
-                        n
-                    }
-                    _ => {
-                        let max = quiet_steps_own(&state, ceiling, scene).min(left);
-                        jump_own(&mut state, max, &mut rest, |s| {
-                            let next = engine.own_flight_step(s)?;
-                            energy.push(&die, &next);
-                            Some(next)
-                        })
-                    }
-                };
+        if !matches!(fly.flying, Flying::No) {
+            if jump && fly.in_a_row >= REST_WINDOW as u64 {
+                let n = fly.jump(engine, &mut w, &mut state, cfg.max_steps - end.steps, scene);
                 if n > 0 {
                     end.steps += n;
-                    flown_in_a_row += n;
-                    end.energy_gain = energy.gained;
+                    end.energy_gain = w.energy.gained;
                     // What the jumped states did to the dip record: the centre above the
                     // floor ends any run of dips (their depths, negative, change nothing).
-                    end.dip.push(&die, &state);
-                    behind = true;
+                    end.dip.push(&w.die, &state);
                     if end.steps >= cfg.max_steps {
                         break;
                     }
                 }
             }
-            next = match (&flying, &flight) {
-                (Flying::Ballistic(dq), Some(f)) => f.next(&body, dq).map(|b| {
-                    body = b;
-                    f.to_die(&b)
-                }),
-                _ => engine.own_flight_step(&state),
-            };
-            if next.is_none() {
-                if behind {
-                    let handed = match flying {
-                        Flying::Ballistic(_) => engine.set_body_state(&body),
-                        _ => engine.set_state(&state),
-                    };
-                    if handed.is_err() {
-                        return end;
-                    }
-                }
-                flying = Flying::No;
-                behind = false;
-            } else {
-                behind = true;
+            match fly.next(engine, &state) {
+                Ok(n) => next = n,
+                Err(()) => return end,
             }
         }
         let flown = next.is_some();
-        flown_in_a_row = if flown { flown_in_a_row + 1 } else { 0 };
+        fly.in_a_row = if flown { fly.in_a_row + 1 } else { 0 };
         state = match next {
             Some(s) => s,
             None => {
@@ -661,42 +793,9 @@ fn run(
             }
         };
         end.steps += 1;
-        // Every step's state, flown or stepped, goes through the same checks, but for the
-        // energy watch: a flown step has no contact to gain energy at.
+        // Every step's state, flown or stepped, goes through the same checks.
         observe(end.steps, &state);
-        end.dip.push(&die, &state);
-        if let Some(f) = check(&state, &die, &end.dip, floor_bottom) {
-            end.fate = Fate::Failed(f);
-            return end;
-        }
-        if !flown || own {
-            energy.push(&die, &state);
-            end.energy_gain = energy.gained;
-        }
-        // A die whose centre is under the floor's top face is mid-dip (or through): no
-        // outcome is certain until the engine has pushed it back out, and at rest there it
-        // has failed.
-        let under = state.position.y < 0.0;
-        if watch && end.certified.is_none() && !under {
-            if let Some(o) = certificate.certain(&die, &state) {
-                end.certified = Some((end.steps, o));
-                if stop_early {
-                    // Certain of its side, and so of its face: the die cannot leave the
-                    // face region it is in (the barrier it cannot climb is the edge between).
-                    end.fate = Fate::Settled(o);
-                    end.up = up_direction(&state.rotation, o);
-                    return end;
-                }
-            }
-        }
-        if rest.push(&state) {
-            end.fate = if under {
-                Fate::Failed(Failure::Tunnelled)
-            } else {
-                let o = classify(&state);
-                end.up = up_direction(&state.rotation, o);
-                Fate::Settled(o)
-            };
+        if w.judge(&mut end, &state, !flown || fly.own) {
             return end;
         }
     }
