@@ -240,6 +240,9 @@ impl super::Figure for Figure {
     }
 }
 
+/// A panel's chart: log10 CPU against log10 |departure|.
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
 impl Figure {
     fn panel<DB: DrawingBackend>(
         &self,
@@ -277,21 +280,7 @@ impl Figure {
                 y.start
             }
         };
-        for b in &p.bands {
-            let color = match b.two_d {
-                Some(t) => MODE_COLORS[t as usize].1,
-                None => GREY,
-            };
-            let (lo, hi) = (ly(b.lo), ly(b.hi));
-            if hi > lo {
-                chart
-                    .draw_series(std::iter::once(Rectangle::new(
-                        [(x.start, lo), (x.end, hi)],
-                        color.mix(0.13).filled(),
-                    )))
-                    .map_err(plot_err)?;
-            }
-        }
+        draw_bands(&mut chart, &p.bands, &x, &ly)?;
         let prec = ly(self.precision);
         chart
             .draw_series(DashedLineSeries::new(
@@ -302,126 +291,9 @@ impl Figure {
             ))
             .map_err(plot_err)?;
         let pts: Vec<&MethodPoint> = p.methods.iter().filter(|m| drawn(m)).collect();
-        for (two_d, color, _) in MODE_COLORS {
-            let mut front: Vec<(f64, f64)> = pts
-                .iter()
-                .filter(|m| m.two_d == two_d && m.on_front)
-                .map(|m| (m.cost.log10(), ly(m.error)))
-                .collect();
-            front.sort_by(|a, b| a.0.total_cmp(&b.0));
-            chart
-                .draw_series(LineSeries::new(front, color.mix(0.7).stroke_width(2)))
-                .map_err(plot_err)?;
-        }
-        for m in &pts {
-            let color = MODE_COLORS[m.two_d as usize].1;
-            let c = if m.resolved { color } else { GREY };
-            let (cx, e) = (m.cost.log10(), 2.0 * bar(m.error_err));
-            chart
-                .draw_series(std::iter::once(ErrorBar::new_vertical(
-                    cx,
-                    ly(m.error - e),
-                    ly(m.error),
-                    ly(m.error + e),
-                    c.mix(0.6).stroke_width(1),
-                    6,
-                )))
-                .map_err(plot_err)?;
-        }
-        for m in &pts {
-            let color = MODE_COLORS[m.two_d as usize].1;
-            let at = (m.cost.log10(), ly(m.error));
-            let style = if m.resolved {
-                color.filled()
-            } else {
-                GREY.stroke_width(1)
-            };
-            if m.two_d {
-                chart
-                    .draw_series(std::iter::once(Circle::new(at, 5, style)))
-                    .map_err(plot_err)?;
-            } else if m.resolved {
-                chart
-                    .draw_series(std::iter::once(TriangleMarker::new(at, 6, style)))
-                    .map_err(plot_err)?;
-            } else {
-                chart
-                    .draw_series(std::iter::once(EmptyElement::at(at) + hollow_triangle(6)))
-                    .map_err(plot_err)?;
-            }
-            if m.cheapest {
-                chart
-                    .draw_series(std::iter::once(Circle::new(at, 10, color.stroke_width(2))))
-                    .map_err(plot_err)?;
-            }
-        }
-        // The numbers: placed in pixels, drawn as offsets from their points.
-        let font = (FONT, LABEL_FONT).into_font();
-        let anchors: Vec<(i32, i32)> = pts
-            .iter()
-            .map(|m| chart.backend_coord(&(m.cost.log10(), ly(m.error))))
-            .collect();
-        let mut sizes = Vec::new();
-        for m in &pts {
-            let (w, h) = area
-                .estimate_text_size(&m.key, &font.clone().into_text_style(area))
-                .map_err(plot_err)?;
-            sizes.push((w + 2, h));
-        }
-        let (xr, yr) = chart.plotting_area().get_pixel_range();
-        let bounds = PxBox {
-            x0: xr.start,
-            y0: yr.start,
-            x1: xr.end,
-            y1: yr.end,
-        };
-        // The rings around the cheapest are in the way too.
-        let rings: Vec<PxBox> = pts
-            .iter()
-            .zip(&anchors)
-            .filter(|(m, _)| m.cheapest)
-            .map(|(_, &a)| PxBox::around(a, 12))
-            .collect();
-        let boxes = place_labels(&anchors, &sizes, bounds, MARKER, &rings);
-        for ((m, &a), b) in pts.iter().zip(&anchors).zip(&boxes) {
-            let Some(b) = b else { continue };
-            let color = if m.resolved {
-                MODE_COLORS[m.two_d as usize].1
-            } else {
-                GREY
-            };
-            let at = (m.cost.log10(), ly(m.error));
-            let (dx, dy) = (b.x0 - a.0 + 1, b.y0 - a.1);
-            let far = (b.x0 + b.x1) / 2 - a.0;
-            let far = far.abs().max(((b.y0 + b.y1) / 2 - a.1).abs()) > 2 * MARKER + 8;
-            let text = Text::new(m.key.clone(), (dx, dy), font.clone().color(&color));
-            if far {
-                // A leader from the marker's edge to the label's nearest side.
-                let tx = (b.x0 + b.x1) / 2 - a.0;
-                let ty = (b.y0 + b.y1) / 2 - a.1;
-                let len = ((tx * tx + ty * ty) as f64).sqrt().max(1.0);
-                let s = (
-                    (tx as f64 * MARKER as f64 / len) as i32,
-                    (ty as f64 * MARKER as f64 / len) as i32,
-                );
-                let end = (
-                    tx.clamp(dx, dx + b.x1 - b.x0),
-                    ty.clamp(dy, dy + b.y1 - b.y0),
-                );
-                chart
-                    .draw_series(std::iter::once(
-                        EmptyElement::at(at)
-                            + PathElement::new(vec![s, end], GREY.mix(0.8).stroke_width(1))
-                            + text,
-                    ))
-                    .map_err(plot_err)?;
-            } else {
-                chart
-                    .draw_series(std::iter::once(EmptyElement::at(at) + text))
-                    .map_err(plot_err)?;
-            }
-        }
-        Ok(())
+        draw_points(&mut chart, &pts, &ly)?;
+        let (anchors, boxes) = place_numbers(&chart, area, &pts, &ly)?;
+        draw_numbers(&mut chart, &pts, &anchors, &boxes, &ly)
     }
 
     /// The key: what the marks mean, then each number's method.
@@ -432,29 +304,8 @@ impl Figure {
         let text = |s: String, x: i32, y: i32, style: TextStyle| {
             area.draw(&Text::new(s, (x, y), style)).map_err(plot_err)
         };
-        let mark = |y: i32, what: &str, two_d: bool, resolved: bool| -> Result<(), String> {
-            let c = MODE_COLORS[two_d as usize].1;
-            let at = (16, y + 7);
-            let style = if resolved {
-                c.filled()
-            } else {
-                GREY.stroke_width(1)
-            };
-            if two_d {
-                area.draw(&Circle::new(at, 5, style)).map_err(plot_err)?;
-            } else if resolved {
-                area.draw(&TriangleMarker::new(at, 6, style))
-                    .map_err(plot_err)?;
-            } else {
-                area.draw(&(EmptyElement::at(at) + hollow_triangle(6)))
-                    .map_err(plot_err)?;
-            }
-            area.draw(&Text::new(
-                what.to_string(),
-                (32, y),
-                f(13).into_text_style(area),
-            ))
-            .map_err(plot_err)
+        let mark = |y: i32, what: &str, two_d: bool, resolved: bool| {
+            key_mark(area, y, what, two_d, resolved)
         };
         // Only the modes the figure draws.
         let has = |two_d: bool| {
@@ -535,6 +386,214 @@ impl Figure {
         }
         Ok(())
     }
+}
+
+/// The yardsticks, as bands across the panel.
+fn draw_bands<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    bands: &[Band],
+    x: &std::ops::Range<f64>,
+    ly: &impl Fn(f64) -> f64,
+) -> Result<(), String> {
+    for b in bands {
+        let color = match b.two_d {
+            Some(t) => MODE_COLORS[t as usize].1,
+            None => GREY,
+        };
+        let (lo, hi) = (ly(b.lo), ly(b.hi));
+        if hi > lo {
+            chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(x.start, lo), (x.end, hi)],
+                    color.mix(0.13).filled(),
+                )))
+                .map_err(plot_err)?;
+        }
+    }
+    Ok(())
+}
+
+/// The methods: each mode's Pareto front, the 2σ bars, the markers (filled where resolved,
+/// hollow and grey where not) and the rings around the cheapest.
+fn draw_points<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    pts: &[&MethodPoint],
+    ly: &impl Fn(f64) -> f64,
+) -> Result<(), String> {
+    for (two_d, color, _) in MODE_COLORS {
+        let mut front: Vec<(f64, f64)> = pts
+            .iter()
+            .filter(|m| m.two_d == two_d && m.on_front)
+            .map(|m| (m.cost.log10(), ly(m.error)))
+            .collect();
+        front.sort_by(|a, b| a.0.total_cmp(&b.0));
+        chart
+            .draw_series(LineSeries::new(front, color.mix(0.7).stroke_width(2)))
+            .map_err(plot_err)?;
+    }
+    for m in pts {
+        let color = MODE_COLORS[m.two_d as usize].1;
+        let c = if m.resolved { color } else { GREY };
+        let (cx, e) = (m.cost.log10(), 2.0 * bar(m.error_err));
+        chart
+            .draw_series(std::iter::once(ErrorBar::new_vertical(
+                cx,
+                ly(m.error - e),
+                ly(m.error),
+                ly(m.error + e),
+                c.mix(0.6).stroke_width(1),
+                6,
+            )))
+            .map_err(plot_err)?;
+    }
+    for m in pts {
+        let color = MODE_COLORS[m.two_d as usize].1;
+        let at = (m.cost.log10(), ly(m.error));
+        let style = if m.resolved {
+            color.filled()
+        } else {
+            GREY.stroke_width(1)
+        };
+        if m.two_d {
+            chart
+                .draw_series(std::iter::once(Circle::new(at, 5, style)))
+                .map_err(plot_err)?;
+        } else if m.resolved {
+            chart
+                .draw_series(std::iter::once(TriangleMarker::new(at, 6, style)))
+                .map_err(plot_err)?;
+        } else {
+            chart
+                .draw_series(std::iter::once(EmptyElement::at(at) + hollow_triangle(6)))
+                .map_err(plot_err)?;
+        }
+        if m.cheapest {
+            chart
+                .draw_series(std::iter::once(Circle::new(at, 10, color.stroke_width(2))))
+                .map_err(plot_err)?;
+        }
+    }
+    Ok(())
+}
+
+/// Where each method's number goes, in pixels: its marker's centre, and its label's box
+/// (`place_labels`, the rings around the cheapest in the way too; `None`: left out).
+fn place_numbers<DB: DrawingBackend>(
+    chart: &Chart<'_, DB>,
+    area: &DrawingArea<DB, Shift>,
+    pts: &[&MethodPoint],
+    ly: &impl Fn(f64) -> f64,
+) -> Result<(Vec<(i32, i32)>, Vec<Option<PxBox>>), String> {
+    let font = (FONT, LABEL_FONT).into_font();
+    let anchors: Vec<(i32, i32)> = pts
+        .iter()
+        .map(|m| chart.backend_coord(&(m.cost.log10(), ly(m.error))))
+        .collect();
+    let mut sizes = Vec::new();
+    for m in pts {
+        let (w, h) = area
+            .estimate_text_size(&m.key, &font.clone().into_text_style(area))
+            .map_err(plot_err)?;
+        sizes.push((w + 2, h));
+    }
+    let (xr, yr) = chart.plotting_area().get_pixel_range();
+    let bounds = PxBox {
+        x0: xr.start,
+        y0: yr.start,
+        x1: xr.end,
+        y1: yr.end,
+    };
+    let rings: Vec<PxBox> = pts
+        .iter()
+        .zip(&anchors)
+        .filter(|(m, _)| m.cheapest)
+        .map(|(_, &a)| PxBox::around(a, 12))
+        .collect();
+    let boxes = place_labels(&anchors, &sizes, bounds, MARKER, &rings);
+    Ok((anchors, boxes))
+}
+
+/// Draws each placed number as an offset from its point, with a leader from the marker's
+/// edge where it sits far from it.
+fn draw_numbers<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    pts: &[&MethodPoint],
+    anchors: &[(i32, i32)],
+    boxes: &[Option<PxBox>],
+    ly: &impl Fn(f64) -> f64,
+) -> Result<(), String> {
+    let font = (FONT, LABEL_FONT).into_font();
+    for ((m, &a), b) in pts.iter().zip(anchors).zip(boxes) {
+        let Some(b) = b else { continue };
+        let color = if m.resolved {
+            MODE_COLORS[m.two_d as usize].1
+        } else {
+            GREY
+        };
+        let at = (m.cost.log10(), ly(m.error));
+        let (dx, dy) = (b.x0 - a.0 + 1, b.y0 - a.1);
+        let far = (b.x0 + b.x1) / 2 - a.0;
+        let far = far.abs().max(((b.y0 + b.y1) / 2 - a.1).abs()) > 2 * MARKER + 8;
+        let text = Text::new(m.key.clone(), (dx, dy), font.clone().color(&color));
+        if far {
+            // A leader from the marker's edge to the label's nearest side.
+            let tx = (b.x0 + b.x1) / 2 - a.0;
+            let ty = (b.y0 + b.y1) / 2 - a.1;
+            let len = ((tx * tx + ty * ty) as f64).sqrt().max(1.0);
+            let s = (
+                (tx as f64 * MARKER as f64 / len) as i32,
+                (ty as f64 * MARKER as f64 / len) as i32,
+            );
+            let end = (
+                tx.clamp(dx, dx + b.x1 - b.x0),
+                ty.clamp(dy, dy + b.y1 - b.y0),
+            );
+            chart
+                .draw_series(std::iter::once(
+                    EmptyElement::at(at)
+                        + PathElement::new(vec![s, end], GREY.mix(0.8).stroke_width(1))
+                        + text,
+                ))
+                .map_err(plot_err)?;
+        } else {
+            chart
+                .draw_series(std::iter::once(EmptyElement::at(at) + text))
+                .map_err(plot_err)?;
+        }
+    }
+    Ok(())
+}
+
+/// One line of the key: a method's marker at `y`, and what it means.
+fn key_mark<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    y: i32,
+    what: &str,
+    two_d: bool,
+    resolved: bool,
+) -> Result<(), String> {
+    let c = MODE_COLORS[two_d as usize].1;
+    let at = (16, y + 7);
+    let style = if resolved {
+        c.filled()
+    } else {
+        GREY.stroke_width(1)
+    };
+    if two_d {
+        area.draw(&Circle::new(at, 5, style)).map_err(plot_err)?;
+    } else if resolved {
+        area.draw(&TriangleMarker::new(at, 6, style))
+            .map_err(plot_err)?;
+    } else {
+        area.draw(&(EmptyElement::at(at) + hollow_triangle(6)))
+            .map_err(plot_err)?;
+    }
+    area.draw(&Text::new(
+        what.to_string(),
+        (32, y),
+        (FONT, 13).into_font().into_text_style(area),
+    ))
+    .map_err(plot_err)
 }
 
 /// An unresolved 3D method's marker: plotters' `TriangleMarker` is always filled, so the hollow
