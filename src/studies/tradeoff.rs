@@ -273,20 +273,11 @@ fn plan(cfg: &Config, groups: &[&Group], threads: usize) -> Plan {
     }
 }
 
-/// Measures every method against its reference, block by block and mode by mode, to the
-/// precision asked, logging the plan and each method as it is resolved, reporting progress in
-/// estimated CPU seconds.
-pub fn run(
-    cfg: &Config,
-    study: &Study,
-    log: &dyn Fn(&str),
-    progress: Progress,
-) -> Result<TradeoffBlocks> {
-    cfg.validate()?;
-    let modes = cfg.modes_in_order();
-    let mut groups: Vec<Group> = Vec::new();
+/// One stream per method of every block and mode, in the order they are resolved.
+fn groups(cfg: &Config, modes: &[Mode]) -> Vec<Group> {
+    let mut groups = Vec::new();
     for &block in &cfg.blocks {
-        for &mode in &modes {
+        for &mode in modes {
             let streams = methods(cfg, mode)
                 .into_iter()
                 .map(|m| (m, m.stream(cfg, block, mode)))
@@ -298,32 +289,45 @@ pub fn run(
             });
         }
     }
-    let threads = study.runner.threads;
-    let one_block = |block: Block, p: Plan, modes: Vec<ModeResult>| {
-        let cpu_s = modes
-            .iter()
-            .flat_map(|m| {
-                m.rows
-                    .iter()
-                    .chain(&m.checks)
-                    .chain(std::iter::once(&m.reference))
-            })
-            .map(|r| r.cpu_s_per_1000 * r.rolls as f64 / 1000.0)
-            .sum();
-        Tradeoff {
-            block: block.to_string(),
-            precision: cfg.precision,
-            budget_s: cfg.budget_s,
-            seed: cfg.seed,
-            reference_dt: cfg.reference_dt,
-            planned_cpu_s: p.planned,
-            planned_cpu_s_at_one_percent: p.at_one,
-            precision_in_an_hour: p.in_an_hour,
-            cpu_s,
-            modes,
-        }
-    };
-    let result = |p: Plan, cpu_s: f64, per_block: Vec<Tradeoff>| TradeoffBlocks {
+    groups
+}
+
+/// A block's result: its plan, and its modes' results (none when only planned), its CPU the
+/// rolls they hold.
+fn one_block(cfg: &Config, block: Block, p: Plan, modes: Vec<ModeResult>) -> Tradeoff {
+    let cpu_s = modes
+        .iter()
+        .flat_map(|m| {
+            m.rows
+                .iter()
+                .chain(&m.checks)
+                .chain(std::iter::once(&m.reference))
+        })
+        .map(|r| r.cpu_s_per_1000 * r.rolls as f64 / 1000.0)
+        .sum();
+    Tradeoff {
+        block: block.to_string(),
+        precision: cfg.precision,
+        budget_s: cfg.budget_s,
+        seed: cfg.seed,
+        reference_dt: cfg.reference_dt,
+        planned_cpu_s: p.planned,
+        planned_cpu_s_at_one_percent: p.at_one,
+        precision_in_an_hour: p.in_an_hour,
+        cpu_s,
+        modes,
+    }
+}
+
+/// The whole study's result from its blocks' and its plan.
+fn result(
+    cfg: &Config,
+    modes: &[Mode],
+    p: Plan,
+    cpu_s: f64,
+    per_block: Vec<Tradeoff>,
+) -> TradeoffBlocks {
+    TradeoffBlocks {
         blocks: cfg.blocks.iter().map(|b| b.to_string()).collect(),
         precision: cfg.precision,
         budget_s: cfg.budget_s,
@@ -339,44 +343,20 @@ pub fn run(
             .map(|&mode| across(cfg, &per_block, mode))
             .collect(),
         per_block,
-    };
-    let nothing = Plan {
-        planned: 0.0,
-        at_one: 0.0,
-        in_an_hour: f64::NAN,
-    };
-    // Rolling ahead: the same chunks whatever the results, so a cluster's tasks, each seeing
-    // only its share, agree on which chunk is whose.
-    if let Some(k) = cfg.preroll_chunks {
-        for g in groups.iter_mut() {
-            for (_, s) in g.streams.iter_mut() {
-                s.extend(k, study, &|_| {})?;
-            }
-        }
-        let cpu = groups.iter().map(Group::cpu_s).sum();
-        let per_block = cfg
-            .blocks
-            .iter()
-            .map(|&b| one_block(b, nothing, Vec::new()))
-            .collect();
-        return Ok(result(nothing, cpu, per_block));
     }
-    // The pilot: a chunk of every stream, its cost and its variance.
-    for g in groups.iter_mut() {
-        for (_, s) in g.streams.iter_mut() {
-            s.extend(PILOT_CHUNKS, study, &|_| {})?;
-        }
-    }
-    let pilot: f64 = groups.iter().map(Group::cpu_s).sum();
-    let of_block = |b: Block| -> Vec<&Group> { groups.iter().filter(|g| g.block == b).collect() };
-    let block_plans: Vec<Plan> = cfg
-        .blocks
-        .iter()
-        .map(|&b| plan(cfg, &of_block(b), threads))
-        .collect();
-    let whole = plan(cfg, &groups.iter().collect::<Vec<_>>(), threads);
+}
+
+/// Logs what the pilot says the rest costs, block by block where there are several.
+fn log_plan(
+    cfg: &Config,
+    log: &dyn Fn(&str),
+    pilot: f64,
+    whole: Plan,
+    blocks: &[Plan],
+    threads: usize,
+) {
     if cfg.blocks.len() > 1 {
-        for (b, p) in cfg.blocks.iter().zip(&block_plans) {
+        for (b, p) in cfg.blocks.iter().zip(blocks) {
             log(&format!(
                 "plan for {b}: at ±{:.2} % the rest takes about {:.0} CPU s; ±1 % would take \
                  {:.0} CPU s",
@@ -400,6 +380,117 @@ pub fn run(
         threads,
         hour_buys(whole.in_an_hour)
     ));
+}
+
+/// Resolves one block and mode: the reference to 2σ ≤ precision/2, in rounds, then every
+/// method against it; `progress` is given the CPU spent so far (`done_cpu`, kept up to date).
+fn resolve_group(
+    cfg: &Config,
+    g: Group,
+    study: &Study,
+    log: &dyn Fn(&str),
+    done_cpu: &mut f64,
+    progress: &(dyn Fn(f64) + Sync),
+) -> Result<ModeResult> {
+    let mode = g.mode;
+    if cfg.blocks.len() > 1 {
+        log(&format!("{} {}:", g.block, mode.name()));
+    }
+    let mut streams = g.streams;
+    let (rm, rest) = streams.split_first_mut().expect("the reference is first");
+    let reference = &mut rm.1;
+    let (base, before) = (*done_cpu, reference.cpu_s);
+    resolve_reference(
+        reference,
+        cfg.precision,
+        cfg.reference_budget_s,
+        study,
+        &|c| progress(base + c),
+    )?;
+    *done_cpu += reference.cpu_s - before;
+    let mut rows = Vec::new();
+    let mut checks = Vec::new();
+    for (m, s) in rest.iter_mut() {
+        let (base, before) = (*done_cpu, s.cpu_s);
+        resolve_departure(s, reference, cfg.precision, cfg.budget_s, study, &|c| {
+            progress(base + c)
+        })?;
+        *done_cpu += s.cpu_s - before;
+        let row = row(cfg, mode, m, s, Some(reference));
+        log(&format_row(&row));
+        if m.role == Role::Method {
+            rows.push(row);
+        } else {
+            checks.push(row);
+        }
+    }
+    let reference_row = row(cfg, mode, &rm.0, reference, None);
+    log(&format!("{}  (reference)", format_row(&reference_row)));
+    let pareto_front = pareto(&rows);
+    let best = cheapest(cfg, rows.iter());
+    let note = note(cfg, &reference_row, &rows, best);
+    let cheapest_within = best.map(|r| r.method.clone());
+    Ok(ModeResult {
+        mode,
+        reference: reference_row,
+        checks,
+        rows,
+        pareto_front,
+        cheapest_within,
+        note,
+    })
+}
+
+/// Measures every method against its reference, block by block and mode by mode, to the
+/// precision asked, logging the plan and each method as it is resolved, reporting progress in
+/// estimated CPU seconds. Two other modes end early: rolling ahead (`preroll_chunks`) and
+/// the plan alone (`plan_only`).
+pub fn run(
+    cfg: &Config,
+    study: &Study,
+    log: &dyn Fn(&str),
+    progress: Progress,
+) -> Result<TradeoffBlocks> {
+    cfg.validate()?;
+    let modes = cfg.modes_in_order();
+    let mut groups = groups(cfg, &modes);
+    let threads = study.runner.threads;
+    // Rolling ahead: the same chunks whatever the results, so a cluster's tasks, each seeing
+    // only its share, agree on which chunk is whose.
+    if let Some(k) = cfg.preroll_chunks {
+        for g in groups.iter_mut() {
+            for (_, s) in g.streams.iter_mut() {
+                s.extend(k, study, &|_| {})?;
+            }
+        }
+        let nothing = Plan {
+            planned: 0.0,
+            at_one: 0.0,
+            in_an_hour: f64::NAN,
+        };
+        let cpu = groups.iter().map(Group::cpu_s).sum();
+        let per_block = cfg
+            .blocks
+            .iter()
+            .map(|&b| one_block(cfg, b, nothing, Vec::new()))
+            .collect();
+        return Ok(result(cfg, &modes, nothing, cpu, per_block));
+    }
+    // The pilot: a chunk of every stream, its cost and its variance.
+    for g in groups.iter_mut() {
+        for (_, s) in g.streams.iter_mut() {
+            s.extend(PILOT_CHUNKS, study, &|_| {})?;
+        }
+    }
+    let pilot: f64 = groups.iter().map(Group::cpu_s).sum();
+    let of_block = |b: Block| -> Vec<&Group> { groups.iter().filter(|g| g.block == b).collect() };
+    let block_plans: Vec<Plan> = cfg
+        .blocks
+        .iter()
+        .map(|&b| plan(cfg, &of_block(b), threads))
+        .collect();
+    let whole = plan(cfg, &groups.iter().collect::<Vec<_>>(), threads);
+    log_plan(cfg, log, pilot, whole, &block_plans, threads);
     if cfg.plan_only {
         let per_block = cfg
             .blocks
@@ -407,10 +498,10 @@ pub fn run(
             .zip(&block_plans)
             .map(|(&b, &p)| Tradeoff {
                 cpu_s: of_block(b).iter().map(|g| g.cpu_s()).sum(),
-                ..one_block(b, p, Vec::new())
+                ..one_block(cfg, b, p, Vec::new())
             })
             .collect();
-        return Ok(result(whole, pilot, per_block));
+        return Ok(result(cfg, &modes, whole, pilot, per_block));
     }
     // Progress counts the planned rolls only (the pilot is done), so that the bar's rate, and
     // its ETA, are this run's.
@@ -419,57 +510,11 @@ pub fn run(
     progress(0.0, total);
     let mut results: Vec<(Block, ModeResult)> = Vec::new();
     for g in groups {
-        let mode = g.mode;
-        if cfg.blocks.len() > 1 {
-            log(&format!("{} {}:", g.block, mode.name()));
-        }
-        let mut streams = g.streams;
-        // The reference, to 2σ ≤ precision/2, in rounds; then every method.
-        let (rm, rest) = streams.split_first_mut().expect("the reference is first");
-        let reference = &mut rm.1;
-        let (base, before) = (done_cpu, reference.cpu_s);
-        resolve_reference(
-            reference,
-            cfg.precision,
-            cfg.reference_budget_s,
-            study,
-            &|c| progress(base + c - pilot, total),
-        )?;
-        done_cpu += reference.cpu_s - before;
-        let mut rows = Vec::new();
-        let mut checks = Vec::new();
-        for (m, s) in rest.iter_mut() {
-            let (base, before) = (done_cpu, s.cpu_s);
-            resolve_departure(s, reference, cfg.precision, cfg.budget_s, study, &|c| {
-                progress(base + c - pilot, total)
-            })?;
-            done_cpu += s.cpu_s - before;
-            let row = row(cfg, mode, m, s, Some(reference));
-            log(&format_row(&row));
-            if m.role == Role::Method {
-                rows.push(row);
-            } else {
-                checks.push(row);
-            }
-        }
-        let reference_row = row(cfg, mode, &rm.0, reference, None);
-        log(&format!("{}  (reference)", format_row(&reference_row)));
-        let pareto_front = pareto(&rows);
-        let best = cheapest(cfg, rows.iter());
-        let note = note(cfg, &reference_row, &rows, best);
-        let cheapest_within = best.map(|r| r.method.clone());
-        results.push((
-            g.block,
-            ModeResult {
-                mode,
-                reference: reference_row,
-                checks,
-                rows,
-                pareto_front,
-                cheapest_within,
-                note,
-            },
-        ));
+        let block = g.block;
+        let m = resolve_group(cfg, g, study, log, &mut done_cpu, &|c| {
+            progress(c - pilot, total)
+        })?;
+        results.push((block, m));
     }
     progress(total, total);
     let per_block: Vec<Tradeoff> = cfg
@@ -482,11 +527,11 @@ pub fn run(
                 .filter(|(x, _)| *x == b)
                 .map(|(_, m)| m.clone())
                 .collect();
-            one_block(b, p, modes)
+            one_block(cfg, b, p, modes)
         })
         .collect();
     let cpu_s = per_block.iter().map(|t| t.cpu_s).sum();
-    Ok(result(whole, cpu_s, per_block))
+    Ok(result(cfg, &modes, whole, cpu_s, per_block))
 }
 
 /// The cheapest eligible (resolved) method whose |departure| is within the precision.
