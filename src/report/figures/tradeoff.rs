@@ -476,6 +476,9 @@ fn draw_points<DB: DrawingBackend>(
     Ok(())
 }
 
+/// Each number's anchor (its marker's centre) and its label's box, in pixels.
+type Placed = (Vec<(i32, i32)>, Vec<Option<PxBox>>);
+
 /// Where each method's number goes, in pixels: its marker's centre, and its label's box
 /// (`place_labels`, the rings around the cheapest in the way too; `None`: left out).
 fn place_numbers<DB: DrawingBackend>(
@@ -483,7 +486,7 @@ fn place_numbers<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     pts: &[&MethodPoint],
     ly: &impl Fn(f64) -> f64,
-) -> Result<(Vec<(i32, i32)>, Vec<Option<PxBox>>), String> {
+) -> Result<Placed, String> {
     let font = (FONT, LABEL_FONT).into_font();
     let anchors: Vec<(i32, i32)> = pts
         .iter()
