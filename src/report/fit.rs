@@ -562,6 +562,22 @@ pub fn calibrated_markdown(c: &CalibratedPaper, figures: &[&str]) -> String {
             ""
         }
     );
+    loo_section(&mut s, c);
+    models_section(&mut s, c);
+    main_fit_section(&mut s, c);
+    check_section(&mut s, c);
+    if !figures.is_empty() {
+        let _ = writeln!(s, "\n## Figures\n");
+        for f in figures {
+            let _ = writeln!(s, "![{f}]({f}.png)");
+        }
+    }
+    s
+}
+
+/// `calibrated.md`'s rows each predicted without itself, beside the theory.
+fn loo_section(s: &mut String, c: &CalibratedPaper) {
+    let f = &c.fit;
     let zs = |v: Vec<f64>| -> (usize, usize, usize) {
         let v: Vec<f64> = v.into_iter().filter(|z| z.is_finite()).collect();
         (
@@ -650,6 +666,10 @@ pub fn calibrated_markdown(c: &CalibratedPaper, figures: &[&str]) -> String {
             cell(r.end.map(|e| format!("{:+.2}", e.z))),
         );
     }
+}
+
+/// `calibrated.md`'s models compared, and the decisions they make.
+fn models_section(s: &mut String, c: &CalibratedPaper) {
     let _ = writeln!(s, "\n## Which model the data need\n");
     let _ = writeln!(
         s,
@@ -688,6 +708,11 @@ pub fn calibrated_markdown(c: &CalibratedPaper, figures: &[&str]) -> String {
         });
         let _ = writeln!(s, "- **{}** {}.{}", d.question, d.verdict, lr);
     }
+}
+
+/// `calibrated.md`'s main model fitted to all rows (the fit's own report, less its title).
+fn main_fit_section(s: &mut String, c: &CalibratedPaper) {
+    let f = &c.fit;
     let _ = writeln!(s, "\n## The main model's fit (all rows)\n");
     let inner = markdown(f, &[]);
     // The fit's own report, less its title and provenance (said above).
@@ -705,6 +730,10 @@ pub fn calibrated_markdown(c: &CalibratedPaper, figures: &[&str]) -> String {
             num(mu.two_sigma[1])
         );
     }
+}
+
+/// `calibrated.md`'s method checked at the fitted values against a finer step.
+fn check_section(s: &mut String, c: &CalibratedPaper) {
     let ck = &c.check;
     let _ = writeln!(s, "\n## The method at the fitted values\n");
     let _ = writeln!(
@@ -755,13 +784,6 @@ pub fn calibrated_markdown(c: &CalibratedPaper, figures: &[&str]) -> String {
             }
         );
     }
-    if !figures.is_empty() {
-        let _ = writeln!(s, "\n## Figures\n");
-        for f in figures {
-            let _ = writeln!(s, "![{f}]({f}.png)");
-        }
-    }
-    s
 }
 
 /// Writes `paper --calibrated`'s figures into `dir`; returns their stems.

@@ -102,18 +102,39 @@ pub fn cell(res: &PaperResults, row: usize, engine: EngineKind, mode: Mode) -> O
 
 /// report.md: the table formatted like the paper's, the simulation columns, and a reading.
 pub fn markdown(res: &PaperResults, figures: &[&str]) -> String {
-    let p = &res.provenance;
-    let engines: Vec<EngineKind> = {
-        let mut v: Vec<EngineKind> = res.simulations.iter().map(|c| c.engine).collect();
-        v.dedup();
-        let mut seen = Vec::new();
-        for e in v {
-            if !seen.contains(&e) {
-                seen.push(e);
-            }
+    let engines = engines_of(res);
+    let mut s = heading(res);
+    s += &table_markdown(res, &engines);
+    s += &outcomes_markdown(res);
+    s += &reading(res, &engines);
+    s +=
+        "\nThe paper: all its 3D simulations agree with experiment within error; its 2D line lies \
+          outside two of the five experimental error bars.\n\n";
+    if !figures.is_empty() {
+        s += "## Figures\n\n";
+        for f in figures {
+            s += &format!("![{f}]({f}.svg)\n\n");
         }
-        seen
-    };
+    }
+    s
+}
+
+/// The engines simulated, in the order first met.
+fn engines_of(res: &PaperResults) -> Vec<EngineKind> {
+    let mut v: Vec<EngineKind> = res.simulations.iter().map(|c| c.engine).collect();
+    v.dedup();
+    let mut seen = Vec::new();
+    for e in v {
+        if !seen.contains(&e) {
+            seen.push(e);
+        }
+    }
+    seen
+}
+
+/// report.md's title, provenance and statistical resolution.
+fn heading(res: &PaperResults) -> String {
+    let p = &res.provenance;
     let mut s = String::new();
     s += "# Pender & Uhrin (2014) reproduced by dicephys\n\n";
     if res.partial {
@@ -145,6 +166,12 @@ pub fn markdown(res: &PaperResults, figures: &[&str]) -> String {
             p.rolls_per_cell
         );
     }
+    s
+}
+
+/// The paper's table with a column of each engine and mode simulated.
+fn table_markdown(res: &PaperResults, engines: &[EngineKind]) -> String {
+    let mut s = String::new();
     s += "## The paper's table, with our simulations\n\n";
     s += "Ratio = N(breadth vertical)/N(width vertical). Theory: eq. (MasterEqu), ± from the \
           printed side errors. Measured: the paper's counts, ± binomial. No bounce: eq. (InElasK). \
@@ -153,7 +180,7 @@ pub fn markdown(res: &PaperResults, figures: &[&str]) -> String {
         "| row | L × B × W (mm) | R | theory | surface | throws | L | B | W | measured | z | no bounce |",
     );
     let mut rule = String::from("|---|---|---|---|---|---|---|---|---|---|---|---|");
-    for e in &engines {
+    for e in engines {
         for m in ["3D", "2D"] {
             head += &format!(" {e} {m} (z exp / z th) |");
             rule += "---|";
@@ -185,7 +212,7 @@ pub fn markdown(res: &PaperResults, figures: &[&str]) -> String {
             fmt_z(r.z),
             r.no_bounce_ratio
         );
-        for e in &engines {
+        for e in engines {
             for m in [Mode::ThreeD, Mode::TwoD] {
                 match cell(res, r.row, *e, m) {
                     Some(c) => {
@@ -216,9 +243,14 @@ pub fn markdown(res: &PaperResults, figures: &[&str]) -> String {
         s += &d.join("; ");
         s += ".\n\n";
     }
-    s += &outcomes_markdown(res);
+    s
+}
+
+/// How many blocks each engine and mode puts within 1σ and 2σ of experiment.
+fn reading(res: &PaperResults, engines: &[EngineKind]) -> String {
+    let mut s = String::new();
     s += "## Reading\n\n";
-    for e in &engines {
+    for e in engines {
         for (m, name) in [("3d", "3D"), ("2d", "2D")] {
             let cells: Vec<&SimCell> = res
                 .simulations
@@ -246,15 +278,6 @@ pub fn markdown(res: &PaperResults, figures: &[&str]) -> String {
                     format!("; outside 1σ: {}", outside.join(", "))
                 }
             );
-        }
-    }
-    s +=
-        "\nThe paper: all its 3D simulations agree with experiment within error; its 2D line lies \
-          outside two of the five experimental error bars.\n\n";
-    if !figures.is_empty() {
-        s += "## Figures\n\n";
-        for f in figures {
-            s += &format!("![{f}]({f}.svg)\n\n");
         }
     }
     s
