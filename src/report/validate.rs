@@ -490,8 +490,16 @@ fn rows(res: &Validation, case: Case) -> impl Iterator<Item = &Row> {
 
 /// Draws the figures into `out`; returns their stems (for `markdown`).
 pub fn write_figures(out: &Path, res: &Validation) -> Result<Vec<&'static str>> {
-    let cfg = &res.config;
     let mut stems = Vec::new();
+    for figure in [figure_2d, figure_3d, figure_flight, figure_trend] {
+        stems.extend(figure(out, res)?);
+    }
+    Ok(stems)
+}
+
+/// The 2D figure: each engine's ratio released at rest, over-damped and with damping lifted, against R.
+fn figure_2d(out: &Path, res: &Validation) -> Result<Option<&'static str>> {
+    let cfg = &res.config;
     let mut s2 = Vec::new();
     for e in &cfg.engines {
         for (case, what, triangles) in [
@@ -528,8 +536,14 @@ pub fn write_figures(out: &Path, res: &Validation) -> Result<Vec<&'static str>> 
             ),
             &s2,
         )?;
-        stems.push("validate_2d");
+        return Ok(Some("validate_2d"));
     }
+    Ok(None)
+}
+
+/// The 3D figure: each engine's probabilities released at rest against the solid angles.
+fn figure_3d(out: &Path, res: &Validation) -> Result<Option<&'static str>> {
+    let cfg = &res.config;
     let s3: Vec<fig::Series> = cfg
         .engines
         .iter()
@@ -558,8 +572,14 @@ pub fn write_figures(out: &Path, res: &Validation) -> Result<Vec<&'static str>> 
             ),
             &s3,
         )?;
-        stems.push("validate_3d");
+        return Ok(Some("validate_3d"));
     }
+    Ok(None)
+}
+
+/// The free flight's drift of angular momentum and rotational energy against dt.
+fn figure_flight(out: &Path, res: &Validation) -> Result<Option<&'static str>> {
+    let cfg = &res.config;
     let mut sf = Vec::new();
     let mut integrators: Vec<_> = res.flights.iter().map(|f| f.integrator).collect();
     integrators.dedup();
@@ -600,8 +620,14 @@ pub fn write_figures(out: &Path, res: &Validation) -> Result<Vec<&'static str>> 
             ),
             &sf,
         )?;
-        stems.push("validate_flight");
+        return Ok(Some("validate_flight"));
     }
+    Ok(None)
+}
+
+/// The 2D trend: P(breadth) against restitution (and friction with it).
+fn figure_trend(out: &Path, res: &Validation) -> Result<Option<&'static str>> {
+    let cfg = &res.config;
     let st: Vec<fig::Series> = cfg
         .engines
         .iter()
@@ -636,7 +662,7 @@ pub fn write_figures(out: &Path, res: &Validation) -> Result<Vec<&'static str>> 
             crate::theory::no_bounce_2d(cfg.trend_block.r()).breadth_vertical,
             &st,
         )?;
-        stems.push("validate_trend");
+        return Ok(Some("validate_trend"));
     }
-    Ok(stems)
+    Ok(None)
 }

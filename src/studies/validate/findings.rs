@@ -3,6 +3,7 @@
 
 use super::flight::at_one_ms;
 use super::Config;
+use crate::engine::EngineKind;
 use crate::model::scene::Mode;
 use crate::report::text::dt_label;
 use crate::report::validate::{
@@ -21,79 +22,95 @@ pub(super) fn findings(
 ) -> Vec<String> {
     let mut out = Vec::new();
     for &engine in &cfg.engines {
-        let mine: Vec<&Row> = rows
-            .iter()
-            .filter(|r| {
-                r.engine == engine.name()
-                    && matches!(
-                        r.case,
-                        Case::NoBounce2d | Case::Momentum2d | Case::QuasiStatic3d
-                    )
-            })
-            .collect();
-        let fails: Vec<String> = mine
-            .iter()
-            .filter(|r| r.verdict == Verdict::Fail)
-            .map(|r| format!("{} {} {} (z {:+.1})", r.case, r.subject, r.quantity, r.z))
-            .collect();
-        out.push(format!(
-            "{engine}: {} of {} limit rows pass at |z| ≤ {Z_PASS}{}.",
-            mine.len() - fails.len(),
-            mine.len(),
-            if fails.is_empty() {
-                String::new()
-            } else {
-                format!("; fail: {}", fails.join(", "))
-            }
-        ));
-        let mut where_started = Vec::new();
-        for mode in [Mode::TwoD, Mode::ThreeD] {
-            let (mut k, mut n) = (0, 0);
-            for c in cells
-                .iter()
-                .filter(|c| c.engine == engine && c.mode == mode)
-            {
-                k += c.ended_where_started;
-                n += c.ended_on_a_face;
-            }
-            if n > 0 {
-                where_started.push(format!("{k} of {n} in {mode}"));
-            }
-        }
-        if !where_started.is_empty() {
-            out.push(format!(
-                "{engine}: dice released at rest that ended on the face whose solid angle they \
-                 started in (the quasi-static flow's exact answer, throw by throw): {}.",
-                where_started.join(", ")
-            ));
-        }
-        let moving: Vec<String> = cells
-            .iter()
-            .filter(|c| c.engine == engine && c.moving_at_cap.total() > 0)
-            .map(|c| {
-                format!(
-                    "{} {} {}: {} of {}",
-                    c.mode,
-                    c.block,
-                    if c.damping > 0.0 {
-                        "damped"
-                    } else {
-                        "undamped"
-                    },
-                    c.moving_at_cap.total(),
-                    c.tally.rolls
+        out.extend(of_engine(cfg, engine, rows, cells));
+    }
+    out.extend(of_flights(rows, flights));
+    out.extend(of_trend(cfg, trend));
+    out
+}
+
+/// An engine's limit rows passed and failed, where its dice released at rest ended, and those
+/// still moving at the cap.
+fn of_engine(cfg: &Config, engine: EngineKind, rows: &[Row], cells: &[LimitCell]) -> Vec<String> {
+    let mut out = Vec::new();
+    let mine: Vec<&Row> = rows
+        .iter()
+        .filter(|r| {
+            r.engine == engine.name()
+                && matches!(
+                    r.case,
+                    Case::NoBounce2d | Case::Momentum2d | Case::QuasiStatic3d
                 )
-            })
-            .collect();
-        if !moving.is_empty() {
-            out.push(format!(
-                "{engine}: dice never at rest by DicePhys's rule within {} s with sleeping off \
-                 (creeping or rocking on a face; counted on it): {}.",
-                cfg.max_steps as f64 * 0.001,
-                moving.join("; ")
-            ));
+        })
+        .collect();
+    let fails: Vec<String> = mine
+        .iter()
+        .filter(|r| r.verdict == Verdict::Fail)
+        .map(|r| format!("{} {} {} (z {:+.1})", r.case, r.subject, r.quantity, r.z))
+        .collect();
+    out.push(format!(
+        "{engine}: {} of {} limit rows pass at |z| ≤ {Z_PASS}{}.",
+        mine.len() - fails.len(),
+        mine.len(),
+        if fails.is_empty() {
+            String::new()
+        } else {
+            format!("; fail: {}", fails.join(", "))
+        }
+    ));
+    let mut where_started = Vec::new();
+    for mode in [Mode::TwoD, Mode::ThreeD] {
+        let (mut k, mut n) = (0, 0);
+        for c in cells
+            .iter()
+            .filter(|c| c.engine == engine && c.mode == mode)
+        {
+            k += c.ended_where_started;
+            n += c.ended_on_a_face;
+        }
+        if n > 0 {
+            where_started.push(format!("{k} of {n} in {mode}"));
         }
     }
+    if !where_started.is_empty() {
+        out.push(format!(
+            "{engine}: dice released at rest that ended on the face whose solid angle they \
+             started in (the quasi-static flow's exact answer, throw by throw): {}.",
+            where_started.join(", ")
+        ));
+    }
+    let moving: Vec<String> = cells
+        .iter()
+        .filter(|c| c.engine == engine && c.moving_at_cap.total() > 0)
+        .map(|c| {
+            format!(
+                "{} {} {}: {} of {}",
+                c.mode,
+                c.block,
+                if c.damping > 0.0 {
+                    "damped"
+                } else {
+                    "undamped"
+                },
+                c.moving_at_cap.total(),
+                c.tally.rolls
+            )
+        })
+        .collect();
+    if !moving.is_empty() {
+        out.push(format!(
+            "{engine}: dice never at rest by DicePhys's rule within {} s with sleeping off \
+             (creeping or rocking on a face; counted on it): {}.",
+            cfg.max_steps as f64 * 0.001,
+            moving.join("; ")
+        ));
+    }
+    out
+}
+
+/// Each integrator's free flight at 1 ms: its energy lost and its drifts.
+fn of_flights(rows: &[Row], flights: &[FlightRun]) -> Vec<String> {
+    let mut out = Vec::new();
     let mut integrators: Vec<Integrator> = flights.iter().map(|f| f.integrator).collect();
     integrators.dedup();
     for i in integrators {
@@ -120,6 +137,12 @@ pub(super) fn findings(
             verdicts.join(", ")
         ));
     }
+    out
+}
+
+/// Each engine's trend from theory toward no bounce.
+fn of_trend(cfg: &Config, trend: &[TrendPoint]) -> Vec<String> {
+    let mut out = Vec::new();
     for &engine in &cfg.engines {
         let pts: Vec<String> = trend
             .iter()
