@@ -68,20 +68,19 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     }
     // A progress line that cannot be written (a closed pipe) is dropped; the result is
     // written, or its failure reported, at the end.
-    let b = bench::run(
-        a.rolls,
-        a.dice_rolls,
-        a.seed,
+    let cfg = bench::Config {
+        rolls: a.rolls,
+        dice_rolls: a.dice_rolls,
+        seed: a.seed,
         threads,
-        a.repeat,
-        a.dicephys.as_deref(),
-        super::stop(),
-        &|line| {
-            if !quiet {
-                let _ = super::stdout(&format!("{line}\n"));
-            }
-        },
-    )?;
+        repeat: a.repeat,
+        dicephys: a.dicephys.clone(),
+    };
+    let b = bench::run(&cfg, super::stop(), &|line| {
+        if !quiet {
+            let _ = super::stdout(&format!("{line}\n"));
+        }
+    })?;
     if a.json {
         outln!(
             "{}",

@@ -569,128 +569,80 @@ pub fn dice_costs(
     Ok(out)
 }
 
+/// What the benchmark measures.
+#[derive(Clone, Debug)]
+pub struct Config {
+    /// Throws per method, mode and thread count.
+    pub rolls: u64,
+    /// Throws per made die (0: none, `dice_costs`).
+    pub dice_rolls: u64,
+    /// The keyed throws' seed.
+    pub seed: u64,
+    /// Threads for the "all threads" measurements.
+    pub threads: usize,
+    /// Rounds over every method of a mode and thread count, each keeping its fastest run.
+    pub repeat: u32,
+    /// DicePhys 2.81's binary, to run beside (`None`: no ratio to DicePhys).
+    pub dicephys: Option<std::path::PathBuf>,
+}
+
+/// A method's records (the same every run: runs are reproducible) and its fastest run's wall
+/// and CPU seconds.
+type Fastest = (Vec<RollRecord>, f64, f64);
+
 /// Runs the benchmark: `rolls` throws per method, mode and thread count, then the made dice's
-/// costs on `dice_rolls` (0: none, `dice_costs`); `log` gets a line per measurement. With `repeat` > 1, every method of a mode and thread count is run in turn,
-/// `repeat` rounds over, and each keeps its fastest run: a spell of load from elsewhere then
-/// falls on different methods in different rounds, not on one method's every run.
-#[allow(clippy::too_many_arguments)]
+/// costs on `dice_rolls` (0: none, `dice_costs`); `log` gets a line per measurement. With
+/// `repeat` > 1, every method of a mode and thread count is run in turn, `repeat` rounds
+/// over, and each keeps its fastest run: a spell of load from elsewhere then falls on
+/// different methods in different rounds, not on one method's every run.
 pub fn run(
-    rolls: u64,
-    dice_rolls: u64,
-    seed: u64,
-    all_threads: usize,
-    repeat: u32,
-    dicephys: Option<&std::path::Path>,
+    cfg: &Config,
     stop: &crate::run::stop::Stop,
     log: &dyn Fn(&str),
 ) -> crate::Result<Bench> {
     let block: crate::model::block::Block = "140x24x20".parse()?;
-    let throws = Throws::new(ThrowKind::Keyed, seed, ThrowRanges::default(), 0);
+    let throws = Throws::new(ThrowKind::Keyed, cfg.seed, ThrowRanges::default(), 0);
     let base = RollConfig::default();
     let methods = methods();
     let mut rows = Vec::new();
     let mut dicephys_runs = Vec::new();
     for mode in [Mode::ThreeD, Mode::TwoD] {
-        // DicePhys itself, beside this mode's methods: one process per core, every core busy,
-        // `rolls` throws in all.
-        let dp = match dicephys {
-            Some(binary) => {
-                let cores = cores_busy(usize::MAX);
-                let run = run_dicephys(binary, mode, cores, rolls.div_ceil(cores as u64), stop)?;
-                log(&format!(
-                    "DicePhys 2.81 {}: {} processes × {} rolls in {:.2} s, {:.3} CPU ms per roll",
-                    run.mode, run.processes, run.rolls, run.wall_s, run.ms_per_roll
-                ));
-                dicephys_runs.push(run.clone());
-                Some(run)
-            }
-            None => None,
-        };
+        let dp = dicephys_beside(cfg, mode, stop, log)?;
+        dicephys_runs.extend(dp.clone());
         let mut floors = Vec::new();
         for m in &methods {
             let mut scene = Scene::paper(block, mode);
             scene.floor = m.floor;
-            floors.push(engine_floor(m, &scene, &throws, &base, rolls, stop)?);
+            floors.push(engine_floor(m, &scene, &throws, &base, cfg.rolls, stop)?);
         }
         let mut thread_counts = vec![1];
-        if all_threads > 1 {
-            thread_counts.push(all_threads);
+        if cfg.threads > 1 {
+            thread_counts.push(cfg.threads);
         }
         for &threads in &thread_counts {
-            // Per method: its records (the same every run: runs are reproducible) and its
-            // fastest run's wall and CPU seconds.
-            let mut best: Vec<(Vec<RollRecord>, f64, f64)> =
-                vec![(Vec::new(), f64::INFINITY, 0.0); methods.len()];
-            for _ in 0..repeat.max(1) {
+            let mut best: Vec<Fastest> = vec![(Vec::new(), f64::INFINITY, 0.0); methods.len()];
+            for _ in 0..cfg.repeat.max(1) {
                 for (m, best) in methods.iter().zip(best.iter_mut()) {
                     let mut scene = Scene::paper(block, mode);
                     scene.floor = m.floor;
-                    let wall = Instant::now();
-                    let cpu = process_cpu_seconds();
                     let job = batch::Job {
                         engine: m.engine,
                         scene: &scene,
                         throws: &throws,
                         cfg: &m.settle(&base),
                     };
-                    let list: Vec<u64> = (0..rolls).collect();
-                    let recs = batch::run_indices(&job, &list, threads, stop, &|_| {})?;
-                    if (recs.len() as u64) < rolls {
-                        return Err(crate::Error::Stopped);
-                    }
-                    let (c, w) = (process_cpu_seconds() - cpu, wall.elapsed().as_secs_f64());
-                    if w < best.1 {
-                        *best = (recs, w, c);
+                    let run = timed_run(&job, cfg.rolls, threads, stop)?;
+                    if run.1 < best.1 {
+                        *best = run;
                     }
                 }
             }
             let mut faithful: Option<(&[RollRecord], f64)> = None;
-            for ((m, (recs, wall_s, cpu_s)), floor) in methods.iter().zip(&best).zip(&floors) {
-                let (wall_s, cpu_s) = (*wall_s, *cpu_s);
-                let t = Tally::of(recs)?;
-                let r = stats::ratio(t.counts.breadth, t.counts.width);
-                let rolls_per_s = rolls as f64 / wall_s;
-                let (speedup, z, same) = match &faithful {
-                    None => (1.0, 0.0, 1.0),
-                    Some((f, f_rps)) => {
-                        let ft = Tally::of(f)?;
-                        let fr = stats::ratio(ft.counts.breadth, ft.counts.width);
-                        (
-                            rolls_per_s / f_rps,
-                            stats::z_score(r.value, r.err, fr.value, fr.err),
-                            Agreement::of(f, recs).of_rolls(),
-                        )
-                    }
-                };
-                let cores = cores_busy(threads);
-                let dicephys = dp.as_ref().map(|d| d.rolls_per_s(cores));
-                let row = BenchRow {
-                    method: m.name.clone(),
-                    engine: m.engine.name().into(),
-                    mode: mode.name().into(),
-                    threads,
-                    rolls,
-                    rolls_per_s,
-                    cpu_ms_per_roll: 1000.0 * cpu_s / rolls as f64,
-                    us_per_engine_step: 1e6 * cpu_s / t.engine_steps.max(1) as f64,
-                    steps_per_roll: t.steps as f64 / rolls as f64,
-                    engine_steps_per_roll: t.engine_steps as f64 / rolls as f64,
-                    speedup,
-                    cores,
-                    dicephys_rolls_per_s: dicephys,
-                    vs_dicephys: dicephys.map(|d| rolls_per_s / d),
-                    vs_dicephys_cpu: dp
-                        .as_ref()
-                        .map(|d| d.ms_per_roll * rolls as f64 / (1000.0 * cpu_s)),
-                    floor: *floor,
-                    ratio: r.value,
-                    ratio_err: r.err,
-                    z_vs_faithful: z,
-                    same_outcome: same,
-                };
+            for ((m, fastest), floor) in methods.iter().zip(&best).zip(&floors) {
+                let row = bench_row(m, mode, threads, fastest, *floor, faithful, dp.as_ref())?;
                 log(&format_row(&row));
                 if faithful.is_none() {
-                    faithful = Some((recs, rolls_per_s));
+                    faithful = Some((&fastest.0, row.rolls_per_s));
                 }
                 rows.push(row);
             }
@@ -704,7 +656,124 @@ pub fn run(
         ffi.cpp_loop_s,
         100.0 * ffi.overhead
     ));
-    let verdicts: Vec<Verdict> = [Mode::ThreeD, Mode::TwoD]
+    let verdicts = verdicts(&rows, &methods, cfg.threads);
+    log_verdicts(&verdicts, log);
+    if cfg.dicephys.is_none() {
+        log("×DicePhys: not measured (give --dicephys PATH, DicePhys 2.81's binary, to run it beside)");
+    }
+    let dice = if cfg.dice_rolls > 0 {
+        dice_costs(cfg.dice_rolls, cfg.seed, cfg.repeat, stop, log)?
+    } else {
+        Vec::new()
+    };
+    Ok(Bench {
+        rows,
+        verdicts,
+        ffi,
+        peak_rss_mb: peak_rss_bytes() as f64 / 1e6,
+        seed: cfg.seed,
+        repeat: cfg.repeat.max(1),
+        dice,
+        dicephys: dicephys_runs,
+    })
+}
+
+/// DicePhys itself, beside a mode's methods: one process per core, every core busy, `rolls`
+/// throws in all (`None` without its binary).
+fn dicephys_beside(
+    cfg: &Config,
+    mode: Mode,
+    stop: &crate::run::stop::Stop,
+    log: &dyn Fn(&str),
+) -> crate::Result<Option<DicePhysRun>> {
+    let Some(binary) = &cfg.dicephys else {
+        return Ok(None);
+    };
+    let cores = cores_busy(usize::MAX);
+    let run = run_dicephys(binary, mode, cores, cfg.rolls.div_ceil(cores as u64), stop)?;
+    log(&format!(
+        "DicePhys 2.81 {}: {} processes × {} rolls in {:.2} s, {:.3} CPU ms per roll",
+        run.mode, run.processes, run.rolls, run.wall_s, run.ms_per_roll
+    ));
+    Ok(Some(run))
+}
+
+/// One method's `rolls` throws on `threads`, timed: its records, wall and CPU seconds.
+fn timed_run(
+    job: &batch::Job,
+    rolls: u64,
+    threads: usize,
+    stop: &crate::run::stop::Stop,
+) -> crate::Result<Fastest> {
+    let wall = Instant::now();
+    let cpu = process_cpu_seconds();
+    let list: Vec<u64> = (0..rolls).collect();
+    let recs = batch::run_indices(job, &list, threads, stop, &|_| {})?;
+    if (recs.len() as u64) < rolls {
+        return Err(crate::Error::Stopped);
+    }
+    let (c, w) = (process_cpu_seconds() - cpu, wall.elapsed().as_secs_f64());
+    Ok((recs, w, c))
+}
+
+/// A method's row from its fastest run, against the mode's faithful method (the first, with
+/// its records and rolls per second) and DicePhys where it ran.
+fn bench_row(
+    m: &Method,
+    mode: Mode,
+    threads: usize,
+    (recs, wall_s, cpu_s): &Fastest,
+    floor: EngineFloor,
+    faithful: Option<(&[RollRecord], f64)>,
+    dp: Option<&DicePhysRun>,
+) -> crate::Result<BenchRow> {
+    let (wall_s, cpu_s) = (*wall_s, *cpu_s);
+    let rolls = recs.len() as u64;
+    let t = Tally::of(recs)?;
+    let r = stats::ratio(t.counts.breadth, t.counts.width);
+    let rolls_per_s = rolls as f64 / wall_s;
+    let (speedup, z, same) = match &faithful {
+        None => (1.0, 0.0, 1.0),
+        Some((f, f_rps)) => {
+            let ft = Tally::of(f)?;
+            let fr = stats::ratio(ft.counts.breadth, ft.counts.width);
+            (
+                rolls_per_s / f_rps,
+                stats::z_score(r.value, r.err, fr.value, fr.err),
+                Agreement::of(f, recs).of_rolls(),
+            )
+        }
+    };
+    let cores = cores_busy(threads);
+    let dicephys = dp.map(|d| d.rolls_per_s(cores));
+    Ok(BenchRow {
+        method: m.name.clone(),
+        engine: m.engine.name().into(),
+        mode: mode.name().into(),
+        threads,
+        rolls,
+        rolls_per_s,
+        cpu_ms_per_roll: 1000.0 * cpu_s / rolls as f64,
+        us_per_engine_step: 1e6 * cpu_s / t.engine_steps.max(1) as f64,
+        steps_per_roll: t.steps as f64 / rolls as f64,
+        engine_steps_per_roll: t.engine_steps as f64 / rolls as f64,
+        speedup,
+        cores,
+        dicephys_rolls_per_s: dicephys,
+        vs_dicephys: dicephys.map(|d| rolls_per_s / d),
+        vs_dicephys_cpu: dp.map(|d| d.ms_per_roll * rolls as f64 / (1000.0 * cpu_s)),
+        floor,
+        ratio: r.value,
+        ratio_err: r.err,
+        z_vs_faithful: z,
+        same_outcome: same,
+    })
+}
+
+/// Each mode's verdict: its fastest proven Bullet method on every thread within `Z_BOUND` of
+/// faithful.
+fn verdicts(rows: &[BenchRow], methods: &[Method], all_threads: usize) -> Vec<Verdict> {
+    [Mode::ThreeD, Mode::TwoD]
         .iter()
         .filter_map(|mode| {
             let of_mode = |t: usize| {
@@ -735,8 +804,11 @@ pub fn run(
                 z_vs_faithful: best.z_vs_faithful,
             })
         })
-        .collect();
-    for v in &verdicts {
+        .collect()
+}
+
+fn log_verdicts(verdicts: &[Verdict], log: &dyn Fn(&str)) {
+    for v in verdicts {
         let against = match (v.vs_dicephys, v.vs_dicephys_cpu, v.vs_dicephys_at_floor) {
             (Some(w), Some(c), Some(f)) => format!(
                 ", {w:.1}x DicePhys on as many cores, {c:.1}x its CPU time per roll ({f:.1}x if \
@@ -749,24 +821,6 @@ pub fn run(
             v.mode, v.method, v.threads, v.rolls_per_s, v.speedup, v.threads, v.speedup_vs_faithful_1_thread
         ));
     }
-    if dicephys.is_none() {
-        log("×DicePhys: not measured (give --dicephys PATH, DicePhys 2.81's binary, to run it beside)");
-    }
-    let dice = if dice_rolls > 0 {
-        dice_costs(dice_rolls, seed, repeat, stop, log)?
-    } else {
-        Vec::new()
-    };
-    Ok(Bench {
-        rows,
-        verdicts,
-        ffi,
-        peak_rss_mb: peak_rss_bytes() as f64 / 1e6,
-        seed,
-        repeat: repeat.max(1),
-        dice,
-        dicephys: dicephys_runs,
-    })
 }
 
 /// What one cxx call per step costs: the same 1,000-step stretch of the same throws, stepped
