@@ -227,6 +227,118 @@ fn settle_words(cfg: &Config) -> String {
     }
 }
 
+/// A block, engine and mode, and its streams, one per dt, the finest first (the group's
+/// reference).
+struct DtGroup {
+    block: Block,
+    engine: EngineKind,
+    mode: Mode,
+    streams: Vec<(f64, Stream)>,
+}
+
+/// One group per block, engine and mode.
+fn dt_groups(cfg: &Config, dts: &[f64]) -> Vec<DtGroup> {
+    let mut groups = Vec::new();
+    for &block in &cfg.blocks {
+        for &engine in &cfg.engines {
+            for mode in [Mode::ThreeD, Mode::TwoD] {
+                let streams: Vec<(f64, Stream)> = dts
+                    .iter()
+                    .rev()
+                    .map(|&dt| {
+                        let mut scene = Scene::paper(block, mode);
+                        scene.dt = dt;
+                        (dt, Stream::new(engine, scene, settle(cfg, dt), cfg.seed))
+                    })
+                    .collect();
+                groups.push(DtGroup {
+                    block,
+                    engine,
+                    mode,
+                    streams,
+                });
+            }
+        }
+    }
+    groups
+}
+
+/// Logs what the pilot says the rest costs; returns the CPU seconds it plans within the
+/// budgets.
+fn plan_rest(
+    cfg: &Config,
+    precision: f64,
+    groups: &[DtGroup],
+    spent: f64,
+    log: &dyn Fn(&str),
+) -> f64 {
+    let plan: Vec<Vec<&Stream>> = groups
+        .iter()
+        .map(|g| g.streams.iter().map(|(_, s)| s).collect())
+        .collect();
+    let total = plan_cpu(
+        &plan,
+        precision,
+        Some((cfg.reference_budget_s, cfg.budget_s)),
+    );
+    log(&format!(
+        "plan: the pilot took {spent:.0} CPU s; ±{:.2} % (2σ) takes about {total:.0} CPU s \
+         more within the budgets, {:.0} without; ±1 % {:.0} CPU s",
+        100.0 * precision,
+        plan_cpu(&plan, precision, None),
+        plan_cpu(&plan, ONE_PERCENT, None),
+    ));
+    total
+}
+
+/// A resolved group's cells, coarse to fine as without --precision, each logged; and its
+/// claim, where it has `CLAIM_DT` and a finer dt.
+fn cells_of(
+    g: &DtGroup,
+    precision: f64,
+    finest: f64,
+    log: &dyn Fn(&str),
+) -> (Vec<Cell>, Option<Claim>) {
+    let streams = &g.streams;
+    let mut cells = Vec::new();
+    let mut claim = None;
+    for (dt, s) in streams.iter().rev() {
+        let is_ref = *dt == finest;
+        let d = if is_ref {
+            Departure::zero()
+        } else {
+            paired_departure(s, &streams[0].1)
+        };
+        let m = s.measured();
+        let resolved = if is_ref {
+            rolls_for_ratio(s, 0.5 * precision).is_some_and(|n| n <= s.rolls())
+        } else {
+            2.0 * d.err <= precision
+        };
+        let cell = Cell::of(
+            &g.block,
+            g.engine,
+            g.mode,
+            *dt,
+            &m,
+            (d.value, d.err),
+            Some(resolved),
+        );
+        log(&format_cell(&cell));
+        if (dt - CLAIM_DT).abs() < 1e-12 && *dt > finest {
+            claim = Some(Claim::of(
+                &cell,
+                finest,
+                (d.value, d.err),
+                d.rolls_both(ONE_PERCENT),
+                (s.rolls(), streams[0].1.rolls()),
+            ));
+        }
+        cells.push(cell);
+    }
+    (cells, claim)
+}
+
 /// The convergence test with precision as the input: per block × engine × mode, the finest
 /// dt's stream to 2σ ≤ precision/2 of its own ratio, then every other dt's departure from it
 /// to 2σ ≤ precision, in rounds of one keyed stream each, within the budgets.
@@ -241,56 +353,21 @@ fn run_resolved(
     let finest = *dts
         .last()
         .ok_or_else(|| Error::Invalid("no dt given".into()))?;
-    let mut groups = Vec::new();
-    for block in &cfg.blocks {
-        for &engine in &cfg.engines {
-            for mode in [Mode::ThreeD, Mode::TwoD] {
-                // The finest dt first: the group's reference.
-                let streams: Vec<(f64, Stream)> = dts
-                    .iter()
-                    .rev()
-                    .map(|&dt| {
-                        let mut scene = Scene::paper(*block, mode);
-                        scene.dt = dt;
-                        (dt, Stream::new(engine, scene, settle(cfg, dt), cfg.seed))
-                    })
-                    .collect();
-                groups.push((*block, engine, mode, streams));
-            }
-        }
-    }
+    let mut groups = dt_groups(cfg, dts);
     let mut spent = 0.0;
     for g in groups.iter_mut() {
-        for (_, s) in g.3.iter_mut() {
+        for (_, s) in g.streams.iter_mut() {
             s.extend(1, study, &|_| {})?;
             spent += s.cpu_s;
         }
     }
-    let total = {
-        let plan: Vec<Vec<&Stream>> = groups
-            .iter()
-            .map(|g| g.3.iter().map(|(_, s)| s).collect())
-            .collect();
-        let total = plan_cpu(
-            &plan,
-            precision,
-            Some((cfg.reference_budget_s, cfg.budget_s)),
-        );
-        log(&format!(
-            "plan: the pilot took {spent:.0} CPU s; ±{:.2} % (2σ) takes about {total:.0} CPU s \
-             more within the budgets, {:.0} without; ±1 % {:.0} CPU s",
-            100.0 * precision,
-            plan_cpu(&plan, precision, None),
-            plan_cpu(&plan, ONE_PERCENT, None),
-        ));
-        total
-    };
+    let total = plan_rest(cfg, precision, &groups, spent, log);
     let mut done = 0.0;
     progress(0.0, total);
     let mut cells = Vec::new();
     let mut claims = Vec::new();
-    for (block, engine, mode, mut streams) in groups {
-        let (reference, rest) = streams.split_first_mut().expect("a dt is given");
+    for mut g in groups {
+        let (reference, rest) = g.streams.split_first_mut().expect("a dt is given");
         let before = reference.1.cpu_s;
         let base = done;
         resolve_reference(
@@ -308,41 +385,9 @@ fn run_resolved(
             })?;
             done += s.cpu_s - before;
         }
-        // Coarse to fine, as without --precision.
-        for (dt, s) in streams.iter().rev() {
-            let is_ref = *dt == finest;
-            let d = if is_ref {
-                Departure::zero()
-            } else {
-                paired_departure(s, &streams[0].1)
-            };
-            let m = s.measured();
-            let resolved = if is_ref {
-                rolls_for_ratio(s, 0.5 * precision).is_some_and(|n| n <= s.rolls())
-            } else {
-                2.0 * d.err <= precision
-            };
-            let cell = Cell::of(
-                &block,
-                engine,
-                mode,
-                *dt,
-                &m,
-                (d.value, d.err),
-                Some(resolved),
-            );
-            log(&format_cell(&cell));
-            if (dt - CLAIM_DT).abs() < 1e-12 && *dt > finest {
-                claims.push(Claim::of(
-                    &cell,
-                    finest,
-                    (d.value, d.err),
-                    d.rolls_both(ONE_PERCENT),
-                    (s.rolls(), streams[0].1.rolls()),
-                ));
-            }
-            cells.push(cell);
-        }
+        let (c, claim) = cells_of(&g, precision, finest, log);
+        cells.extend(c);
+        claims.extend(claim);
     }
     let resolved = !claims.is_empty() && claims.iter().all(|c| c.resolved);
     let verdict = verdict(
