@@ -510,6 +510,12 @@ pub fn write_table(out: &mut impl Write, t: &TableReport) -> std::io::Result<()>
             r.no_bounce_ratio,
         )?;
     }
+    write_data_check(out, t)?;
+    write_chi_square(out, t)
+}
+
+/// The data check: the discrepancies, and the printed errors rounded up.
+fn write_data_check(out: &mut impl Write, t: &TableReport) -> std::io::Result<()> {
     writeln!(out)?;
     if t.discrepancies.is_empty() {
         writeln!(
@@ -548,6 +554,11 @@ pub fn write_table(out: &mut impl Write, t: &TableReport) -> std::io::Result<()>
             }
         }
     }
+    Ok(())
+}
+
+/// χ² of measured against theory, per set.
+fn write_chi_square(out: &mut impl Write, t: &TableReport) -> std::io::Result<()> {
     writeln!(out)?;
     writeln!(
         out,
