@@ -185,10 +185,8 @@ fn sbatch_value(script: &str, name: &str) -> Option<String> {
     Some(arg.split_once('=').unwrap().1.to_string())
 }
 
-#[test]
-fn a_slurm_dir_name_is_quoted_for_the_shell_and_sbatch_or_refused() {
-    let d = scratch("slurm-names");
-    // A binary that records what it was given and prints a result.
+/// A binary that records what it was given (in `$FAKE_ARGS`) and prints a result.
+fn fake_dicephys(d: &Path) -> std::path::PathBuf {
     let fake = d.join("fake-dicephys");
     std::fs::write(
         &fake,
@@ -196,26 +194,36 @@ fn a_slurm_dir_name_is_quoted_for_the_shell_and_sbatch_or_refused() {
     )
     .unwrap();
     std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
-    let run = |dir: &Path, extra: &[&str]| {
-        bin()
-            .args([
-                "slurm",
-                "roll",
-                "--block",
-                "140x22x13",
-                "--2d",
-                "--rolls",
-                "20",
-            ])
-            .args(["--tasks", "2", "--bin"])
-            .arg(&fake)
-            .arg("--dir")
-            .arg(dir)
-            .args(extra)
-            .current_dir(&*d)
-            .output()
-            .unwrap()
-    };
+    fake
+}
+
+/// `slurm roll` of a small 2D run into `dir`, its tasks run by `fake`.
+fn slurm_roll(d: &Path, fake: &Path, dir: &Path, extra: &[&str]) -> Output {
+    bin()
+        .args([
+            "slurm",
+            "roll",
+            "--block",
+            "140x22x13",
+            "--2d",
+            "--rolls",
+            "20",
+        ])
+        .args(["--tasks", "2", "--bin"])
+        .arg(fake)
+        .arg("--dir")
+        .arg(dir)
+        .args(extra)
+        .current_dir(d)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn a_slurm_dir_name_is_quoted_for_the_shell_and_sbatch() {
+    let d = scratch("slurm-names");
+    let fake = fake_dicephys(&d);
+    let run = |dir: &Path, extra: &[&str]| slurm_roll(&d, &fake, dir, extra);
     // A name with everything the shell or sbatch would read: it is written safely.
     let nasty = d.join("run x#y %j \"q' $(touch pwned) `touch pwned2`");
     let out = run(&nasty, &["--time", "1:00:00"]);
@@ -257,6 +265,13 @@ fn a_slurm_dir_name_is_quoted_for_the_shell_and_sbatch_or_refused() {
     let ckpt = format!("{}/shard-1", real.to_str().unwrap());
     assert!(given.lines().any(|l| l == ckpt), "{given}");
     assert!(nasty.join("shard-1.json").exists());
+}
+
+#[test]
+fn a_slurm_dir_name_or_flag_that_cannot_be_written_safely_is_refused() {
+    let d = scratch("slurm-names-refused");
+    let fake = fake_dicephys(&d);
+    let run = |dir: &Path, extra: &[&str]| slurm_roll(&d, &fake, dir, extra);
     // What cannot be written safely is refused, with one line, before anything is stored.
     for (dir, extra) in [
         (d.join("a\nb"), &[][..]),
