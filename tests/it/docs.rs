@@ -523,6 +523,47 @@ fn json_md_lists_the_keys_of_fair() {
     c.finish(&["fair", "fair-vary"]);
 }
 
+/// A made die, every feature (its spec carries them), rolled; and fair's precision of the
+/// faces.
+fn made_die_and_faces() -> (Value, Value) {
+    let roll = |extra: &[&str]| {
+        let mut a = vec!["roll", "--rolls", "20", "--seed", "1", "--threads", "1"];
+        a.extend(extra);
+        a.push("--json");
+        run(&a)
+    };
+    let dir2 = Scratch::new("docs-die");
+    let die = dir2.join("die.toml");
+    std::fs::write(
+        &die,
+        "com = [0.0, 0.0, -1.0]\nedge_radius = 1.0\n[pips]\ndiameter = 3.0\ndepth = 1.0\nfill_density = 1200.0\n",
+    )
+    .unwrap();
+    let made = roll(&[
+        "--block",
+        "16x16x16",
+        "--throw",
+        "tumble",
+        "--die",
+        die.to_str().unwrap(),
+        "--layout",
+        "left",
+    ]);
+    let faces = run(&[
+        "fair",
+        "--block",
+        "16x16x16",
+        "--precision",
+        "10",
+        "--rolls",
+        "2000",
+        "--threads",
+        "1",
+        "--json",
+    ]);
+    (made, faces)
+}
+
 #[test]
 fn json_md_lists_the_keys_of_roll_and_merge() {
     let mut c = checker();
@@ -596,36 +637,7 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
             .unwrap(),
     );
     assert!(merged["spec"]["shard"].is_null());
-    // A made die, every feature (its spec carries them), and fair's precision of the faces.
-    let dir2 = Scratch::new("docs-die");
-    let die = dir2.join("die.toml");
-    std::fs::write(
-        &die,
-        "com = [0.0, 0.0, -1.0]\nedge_radius = 1.0\n[pips]\ndiameter = 3.0\ndepth = 1.0\nfill_density = 1200.0\n",
-    )
-    .unwrap();
-    let made = roll(&[
-        "--block",
-        "16x16x16",
-        "--throw",
-        "tumble",
-        "--die",
-        die.to_str().unwrap(),
-        "--layout",
-        "left",
-    ]);
-    let faces = run(&[
-        "fair",
-        "--block",
-        "16x16x16",
-        "--precision",
-        "10",
-        "--rolls",
-        "2000",
-        "--threads",
-        "1",
-        "--json",
-    ]);
+    let (made, faces) = made_die_and_faces();
     for (what, v) in [
         ("roll --die (every feature)", &made),
         ("fair --precision 10 (its summary)", &faces["summary"]),
@@ -848,41 +860,9 @@ fn the_key_check_finds_an_extra_a_missing_and_a_phantom_key() {
     );
 }
 
-#[test]
-fn json_md_lists_the_keys_of_fit_recover_and_predict() {
-    let mut c = checker();
-    let dir = Scratch::new("docs-fit");
-    let csv = dir.join("counts.csv");
-    std::fs::write(
-        &csv,
-        "label,surface,length_mm,breadth_mm,width_mm,mode,length_vertical,breadth_vertical,\
-         width_vertical\na,felt,140,24,20,3d,0,200,400\nb,felt,100,43.9,43.2,3d,10,300,290\n",
-    )
-    .unwrap();
-    let (csv, d) = (csv.to_str().unwrap(), dir.to_str().unwrap());
-    let small = [
-        "--points",
-        "12",
-        "--rolls",
-        "60",
-        "--degree",
-        "1",
-        "--dt",
-        "1/250",
-        "--threads",
-        "1",
-    ];
-    let fit_args = |extra: &[&str]| -> Vec<String> {
-        let mut a: Vec<&str> = vec!["fit", "--data", csv, "--free", "e,mu,kappa"];
-        a.extend(small);
-        a.extend(extra);
-        a.extend(["--json"]);
-        a.into_iter().map(String::from).collect()
-    };
-    let run_owned = |a: Vec<String>| run(&a.iter().map(String::as_str).collect::<Vec<_>>());
-    let out = format!("{d}/fit");
-    let fit = run_owned(fit_args(&["--out", &out]));
-    c.document("fit", "fit (nothing to narrow)", &fit);
+/// `fit`'s passes: a second over a narrowed box (the paper's rows), and a box widened.
+fn document_fit_passes(c: &mut Checker, dir: &Scratch) {
+    let d = dir.to_str().unwrap();
     // The paper's rows pin κ well enough for a second pass over a narrowed box.
     let two = run(&[
         "fit",
@@ -934,7 +914,11 @@ fn json_md_lists_the_keys_of_fit_recover_and_predict() {
     ]);
     assert!(widened["passes"][1].get("cut").is_some(), "{widened}");
     c.document("fit", "fit (a box widened)", &widened);
-    // A made die's face counts, its centre of mass free, and a prediction of its faces.
+}
+
+/// A made die's face counts fitted, its centre of mass free, and a prediction of its faces.
+fn document_a_die_fit(c: &mut Checker, dir: &Scratch) {
+    let d = dir.to_str().unwrap();
     let faces_csv = dir.join("faces.csv");
     std::fs::write(
         &faces_csv,
@@ -986,6 +970,45 @@ fn json_md_lists_the_keys_of_fit_recover_and_predict() {
         "--json",
     ]);
     c.document("predict", "predict a die's faces", &p);
+}
+
+#[test]
+fn json_md_lists_the_keys_of_fit_recover_and_predict() {
+    let mut c = checker();
+    let dir = Scratch::new("docs-fit");
+    let csv = dir.join("counts.csv");
+    std::fs::write(
+        &csv,
+        "label,surface,length_mm,breadth_mm,width_mm,mode,length_vertical,breadth_vertical,\
+         width_vertical\na,felt,140,24,20,3d,0,200,400\nb,felt,100,43.9,43.2,3d,10,300,290\n",
+    )
+    .unwrap();
+    let (csv, d) = (csv.to_str().unwrap(), dir.to_str().unwrap());
+    let small = [
+        "--points",
+        "12",
+        "--rolls",
+        "60",
+        "--degree",
+        "1",
+        "--dt",
+        "1/250",
+        "--threads",
+        "1",
+    ];
+    let fit_args = |extra: &[&str]| -> Vec<String> {
+        let mut a: Vec<&str> = vec!["fit", "--data", csv, "--free", "e,mu,kappa"];
+        a.extend(small);
+        a.extend(extra);
+        a.extend(["--json"]);
+        a.into_iter().map(String::from).collect()
+    };
+    let run_owned = |a: Vec<String>| run(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let out = format!("{d}/fit");
+    let fit = run_owned(fit_args(&["--out", &out]));
+    c.document("fit", "fit (nothing to narrow)", &fit);
+    document_fit_passes(&mut c, &dir);
+    document_a_die_fit(&mut c, &dir);
     let file: Value = serde_json::from_str(&read(&dir.join("fit/fit.json"))).unwrap();
     c.document("fit", "fit.json", &file);
     let one = run_owned(fit_args(&["--no-refine", "--out", &format!("{d}/one")]));
