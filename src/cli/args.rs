@@ -13,6 +13,103 @@ use dicephys::run::batch::MAX_THREADS;
 use dicephys::run::spec::ThrowSpec;
 use dicephys::sim::roll::{RollConfig, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
 
+/// The seed of the keyed throws (`*seed` reads it).
+#[derive(Args, Debug, Clone, Copy)]
+pub struct Seed {
+    /// Seed of the keyed throws: the same seed gives the same rolls on any thread count.
+    #[arg(long, default_value_t = 2385)]
+    pub seed: u64,
+}
+
+/// Worker threads (`*threads` reads them as given; `Threads::checked` resolves 0).
+#[derive(Args, Debug, Clone, Copy)]
+pub struct Threads {
+    /// Worker threads (0: one per core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+}
+
+/// One JSON document on stdout in place of the text (`*json` reads it).
+#[derive(Args, Debug, Clone, Copy)]
+pub struct Json {
+    /// Print the result as one JSON document on stdout (its keys: docs/json.md), in place of
+    /// the text and the progress bar.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The step cap, `D` steps unless given (`*max_steps` reads it).
+#[derive(Args, Debug, Clone, Copy)]
+pub struct MaxSteps<const D: u64> {
+    /// Steps after which a roll not at rest counts as unconverged.
+    #[arg(long, default_value_t = D)]
+    pub max_steps: u64,
+}
+
+/// Where a study runs and how it reports: its threads, its directory, JSON or text.
+#[derive(Args, Debug, Clone)]
+pub struct StudyPlace {
+    /// Worker threads.
+    #[command(flatten)]
+    pub threads: Threads,
+    /// Output directory: the report, its JSON, the figures, and the kept cells the same
+    /// command continues from [default: the command's name and -out, e.g. paper-out].
+    #[arg(long, value_name = "OUT")]
+    pub out: Option<std::path::PathBuf>,
+    /// JSON or text.
+    #[command(flatten)]
+    pub json: Json,
+}
+
+impl std::ops::Deref for Seed {
+    type Target = u64;
+    fn deref(&self) -> &u64 {
+        &self.seed
+    }
+}
+
+impl std::ops::Deref for Threads {
+    type Target = usize;
+    fn deref(&self) -> &usize {
+        &self.threads
+    }
+}
+
+impl std::ops::Deref for Json {
+    type Target = bool;
+    fn deref(&self) -> &bool {
+        &self.json
+    }
+}
+
+impl<const D: u64> std::ops::Deref for MaxSteps<D> {
+    type Target = u64;
+    fn deref(&self) -> &u64 {
+        &self.max_steps
+    }
+}
+
+impl Threads {
+    /// The worker threads, checked (0: one per core).
+    pub fn checked(&self) -> Result<usize> {
+        threads(self.threads)
+    }
+}
+
+impl StudyPlace {
+    /// The directory: `--out`, or `<command>-out`.
+    pub fn out(&self, command: &str) -> std::path::PathBuf {
+        self.out
+            .clone()
+            .unwrap_or_else(|| format!("{command}-out").into())
+    }
+
+    /// The study run here, on all its chunks, writing into `--out` or `<command>-out`.
+    pub fn local(&self, command: &str) -> Result<dicephys::studies::outputs::Place> {
+        super::study::local(&self.out(command), *self.threads, *self.json)
+    }
+}
+
 /// The scene: the block, the surface, the time step.
 #[derive(Args, Debug, Clone)]
 pub struct SceneArgs {
@@ -136,9 +233,9 @@ fn parse_pips(s: &str) -> std::result::Result<[f64; 2], String> {
 /// Where the throws come from.
 #[derive(Args, Debug, Clone)]
 pub struct ThrowArgs {
-    /// Seed of the throws.
-    #[arg(long, default_value_t = 2385)]
-    pub seed: u64,
+    /// The keyed throws' seed.
+    #[command(flatten)]
+    pub seed: Seed,
     /// Where the throws' numbers come from: keyed (each throw from (seed, index)) or dicephys
     /// (DicePhys's glibc rand() sequence, the paper's throw only).
     #[arg(long = "source", alias = "throws", default_value = "keyed", value_parser = parse_throw_kind)]
@@ -199,12 +296,12 @@ pub struct RunArgs {
     /// face known to ±0.005).
     #[arg(long, value_name = "PERCENT", value_parser = parse_percent)]
     pub precision: Option<f64>,
-    /// Worker threads (0: one per core).
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
-    /// Steps after which a roll not at rest counts as unconverged.
-    #[arg(long, default_value_t = DEFAULT_MAX_STEPS)]
-    pub max_steps: u64,
+    /// Worker threads.
+    #[command(flatten)]
+    pub threads: Threads,
+    /// The step cap.
+    #[command(flatten)]
+    pub max_steps: MaxSteps<DEFAULT_MAX_STEPS>,
     /// What ends a roll: certificate (the exact early stop: energy below the barrier out of
     /// the current face) or dicephys (at rest by DicePhys's rule). Default: certificate at
     /// dt <= 1/250 s, where it is audited exact; dicephys at coarser steps.
@@ -314,7 +411,7 @@ impl ThrowArgs {
         });
         let spec = ThrowSpec {
             kind: self.source,
-            seed: self.seed,
+            seed: *self.seed,
             ranges: ThrowRanges {
                 velocity: self.velocity,
                 spin: self.spin,
@@ -362,14 +459,14 @@ impl RunArgs {
             self.flight == FlightArg::Fast,
             self.faithful,
             self.audit,
-            self.max_steps,
+            *self.max_steps,
             self.margin,
         )?)
     }
 
     /// The worker threads, checked (0: one per core).
     pub fn threads(&self) -> Result<usize> {
-        threads(self.threads)
+        self.threads.checked()
     }
 }
 

@@ -1,5 +1,6 @@
 //! `dicephys bench`: speed of every engine and lever against the faithful configuration.
 
+use super::args::{Json, Seed, Threads};
 use super::error::{Error, Result};
 use super::outln;
 use clap::Args;
@@ -14,12 +15,12 @@ pub struct BenchArgs {
     /// uniform die, a 16 mm cube in a tumble, one thread; a quarter as many on Rapier (0: none).
     #[arg(long, default_value_t = 2000)]
     pub dice_rolls: u64,
-    /// Seed of the keyed throws: the same seed gives the same rolls on any thread count.
-    #[arg(long, default_value_t = 2385)]
-    pub seed: u64,
-    /// Threads for the "all threads" measurements (0: one per core).
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
+    /// The keyed throws' seed.
+    #[command(flatten)]
+    pub seed: Seed,
+    /// Worker threads.
+    #[command(flatten)]
+    pub threads: Threads,
     /// Run each measurement this many times and keep the fastest (the outcomes are the same
     /// every time); for a machine shared with other work.
     #[arg(long, default_value_t = 1)]
@@ -29,9 +30,9 @@ pub struct BenchArgs {
     /// empty.
     #[arg(long, value_name = "PATH")]
     pub dicephys: Option<std::path::PathBuf>,
-    /// Print one JSON document (docs/json.md, `bench --json`) instead of the table.
-    #[arg(long)]
-    pub json: bool,
+    /// JSON or text.
+    #[command(flatten)]
+    pub json: Json,
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
@@ -53,7 +54,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             a.rolls
         )));
     }
-    let threads = super::args::threads(a.threads)?;
+    let threads = super::args::threads(*a.threads)?;
     if let Some(p) = &a.dicephys {
         if !p.is_file() {
             return Err(Error::Usage(format!(
@@ -62,7 +63,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             )));
         }
     }
-    let quiet = a.json;
+    let quiet = *a.json;
     if !quiet {
         outln!("{}", bench::header());
     }
@@ -71,7 +72,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let cfg = bench::Config {
         rolls: a.rolls,
         dice_rolls: a.dice_rolls,
-        seed: a.seed,
+        seed: *a.seed,
         threads,
         repeat: a.repeat,
         dicephys: a.dicephys.clone(),
@@ -81,7 +82,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             let _ = super::stdout(&format!("{line}\n"));
         }
     })?;
-    if a.json {
+    if *a.json {
         outln!(
             "{}",
             serde_json::to_string_pretty(&b).map_err(|e| Error::Run(e.to_string()))?

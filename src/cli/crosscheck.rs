@@ -1,6 +1,7 @@
 //! `dicephys crosscheck`: the very same throws on several engines, side by side
 //! (`dicephys::studies::crosscheck`).
 
+use super::args::Json;
 use super::args::{parse_engine, RunArgs, SceneArgs, ThrowArgs};
 use super::error::{Error, Result};
 use super::study;
@@ -27,9 +28,9 @@ pub struct CrosscheckArgs {
     /// 1,000 rolls): the same command run again continues where it stopped.
     #[arg(long, value_name = "DIR")]
     pub checkpoint: Option<PathBuf>,
-    /// Print one JSON document instead of the human summary.
-    #[arg(long)]
-    pub json: bool,
+    /// JSON or text.
+    #[command(flatten)]
+    pub json: Json,
 }
 
 impl CrosscheckArgs {
@@ -64,7 +65,7 @@ pub fn run(a: &CrosscheckArgs) -> Result<()> {
     let cfg = a.config()?;
     let place = Place {
         checkpoint: a.checkpoint.clone(),
-        ..study::local(Path::new(""), a.run.threads, a.json)?
+        ..study::local(Path::new(""), *a.run.threads, *a.json)?
     };
     study::run(&StudyConfig::Crosscheck(cfg), &place)
 }

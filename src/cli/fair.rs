@@ -64,14 +64,14 @@ pub fn run(a: &FairArgs) -> Result<()> {
     let json = dicephys::run::seal::to_string(&doc, true)?;
     if let (Some(dir), false) = (&a.out, summary.partial) {
         dicephys::studies::fair::write(dir, &json, &fair, &summary)?;
-        if !a.roll.json {
+        if !*a.roll.json {
             eprintln!(
                 "wrote {}/fairness.json and die_map.svg, .png",
                 dir.display()
             );
         }
     }
-    if a.roll.json {
+    if *a.roll.json {
         outln!("{}", json);
     } else {
         out!("{}", fair.text(&summary));
@@ -97,7 +97,7 @@ fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str) -> Result<()
         "fair",
         dicephys::report::progress::Unit::Rolls { per_cell: 0 },
         false,
-        a.roll.json,
+        *a.roll.json,
         super::study::every(),
     );
     let progress = |n: u64| bar.set(n as f64, total as f64);
@@ -122,11 +122,11 @@ fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str) -> Result<()
         );
         write_bias(dir, what, &title, &points)?;
         dicephys::run::io::write_atomic(&dir.join("bias.json"), json.as_bytes())?;
-        if !a.roll.json {
+        if !*a.roll.json {
             eprintln!("wrote {}/bias.json and bias.svg, .png", dir.display());
         }
     }
-    if a.roll.json {
+    if *a.roll.json {
         outln!("{}", json);
         return Ok(());
     }

@@ -2,6 +2,7 @@
 //! recovers known values) and `dicephys predict` (a block the fit did not see).
 
 use super::args::{parse_engine, parse_step};
+use super::args::{Json, MaxSteps, Seed, StudyPlace, Threads};
 use super::error::{Error, Result};
 use clap::Args;
 use dicephys::calibration::data;
@@ -64,9 +65,9 @@ pub struct FitArgs {
     /// The time step, s or 1/N.
     #[arg(long, default_value = "1/1000", value_parser = parse_step)]
     pub dt: f64,
-    /// Steps after which a roll not at rest counts as unconverged.
-    #[arg(long, default_value_t = DEFAULT_MAX_STEPS)]
-    pub max_steps: u64,
+    /// The step cap.
+    #[command(flatten)]
+    pub max_steps: MaxSteps<DEFAULT_MAX_STEPS>,
     /// Parameter points each block is simulated at.
     #[arg(long, default_value_t = 64)]
     pub points: usize,
@@ -86,16 +87,12 @@ pub struct FitArgs {
     /// ones, to compare the two (docs/results/calibration.md).
     #[arg(long)]
     pub common_throws: bool,
-    /// Seed of the keyed throws.
-    #[arg(long, default_value_t = 2385)]
-    pub seed: u64,
-    /// Worker threads (0: one per core).
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
-    /// Output directory: fit.json, report.md, figures, and the simulations' cells
-    /// [default: fit-out].
-    #[arg(long, value_name = "OUT")]
-    pub out: Option<PathBuf>,
+    /// The keyed throws' seed.
+    #[command(flatten)]
+    pub seed: Seed,
+    /// Threads, --out, --json.
+    #[command(flatten)]
+    pub place: StudyPlace,
     /// Instead of fitting the file's counts: simulate counts of its rows (same blocks and
     /// numbers of throws) at these values, NAME=V,… for every free parameter, fit them back,
     /// --repeats times, and report how often the 2σ region holds the truth.
@@ -104,9 +101,6 @@ pub struct FitArgs {
     /// With --recover: repetitions (each its own data and simulations).
     #[arg(long, default_value_t = 20)]
     pub repeats: usize,
-    /// Print the result's JSON to stdout instead of the report.
-    #[arg(long)]
-    pub json: bool,
 }
 
 /// `dicephys predict`'s arguments.
@@ -146,15 +140,15 @@ pub struct PredictArgs {
     /// Rolls at each draw.
     #[arg(long, default_value_t = 2000)]
     pub rolls: u64,
-    /// Seed of the keyed throws.
-    #[arg(long, default_value_t = 2385)]
-    pub seed: u64,
-    /// Worker threads (0: one per core).
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
-    /// Print the prediction's JSON.
-    #[arg(long)]
-    pub json: bool,
+    /// The keyed throws' seed.
+    #[command(flatten)]
+    pub seed: Seed,
+    /// Worker threads.
+    #[command(flatten)]
+    pub threads: Threads,
+    /// JSON or text.
+    #[command(flatten)]
+    pub json: Json,
 }
 
 /// `E,MU`: two numbers.
@@ -268,7 +262,7 @@ impl FitArgs {
                 Method {
                     engine: self.engine,
                     dt: self.dt,
-                    max_steps: self.max_steps,
+                    max_steps: *self.max_steps,
                     die,
                     density,
                 }
@@ -282,10 +276,10 @@ impl FitArgs {
                 common: self.common_throws,
             },
             search: Search {
-                seed: self.seed,
+                seed: *self.seed,
                 ..Search::default()
             },
-            seed: self.seed,
+            seed: *self.seed,
         };
         cfg.validate()?;
         Ok(cfg)
@@ -300,10 +294,9 @@ pub fn run(a: &FitArgs) -> Result<()> {
             "--repeats 0: need at least one repetition".into(),
         ));
     }
-    let out = a.out.clone().unwrap_or_else(|| "fit-out".into());
-    let mut place = super::study::local(&out, a.threads, a.json)?;
+    let mut place = a.place.local("fit")?;
     // The simulations' cells under --out/cells.
-    place.checkpoint = Some(out.join("cells"));
+    place.checkpoint = Some(place.out.join("cells"));
     match &a.recover {
         Some(truth) => {
             let truth = truth_values(&cfg, truth)?;
@@ -363,15 +356,15 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
         contact: a.contact,
         draws: a.draws,
         rolls: a.rolls,
-        seed: a.seed,
+        seed: *a.seed,
     };
     // It writes nothing: no directory of its own.
     let place = dicephys::studies::outputs::Place {
         out: ".".into(),
         checkpoint: None,
-        threads: super::args::threads(a.threads)?,
+        threads: super::args::threads(*a.threads)?,
         share: dicephys::run::runner::ChunkShare::All,
-        json: a.json,
+        json: *a.json,
         command_line: super::command_line(),
     };
     super::study::predict(&fit, &cfg, &place)
@@ -395,11 +388,11 @@ fn predict_blocks(a: &PredictArgs, fit: &FitResult, file: &std::path::Path) -> R
         rows,
         draws: a.draws,
         rolls: a.rolls,
-        seed: a.seed,
+        seed: *a.seed,
         fit: a.fit.display().to_string(),
     };
     let out = a.out.clone().unwrap_or_else(|| "predict-out".into());
-    let mut place = super::study::local(&out, a.threads, a.json)?;
+    let mut place = super::study::local(&out, *a.threads, *a.json)?;
     place.checkpoint = None;
     super::study::predict_blocks(fit, &cfg, &place)
 }

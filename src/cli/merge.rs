@@ -1,6 +1,7 @@
 //! `dicephys merge`: shards of one run (`roll --shard K/N --json`) combined into the result of
 //! the unsharded run: the same exact counts, because every throw depends only on its index.
 
+use super::args::Json;
 use super::error::{Error, Result};
 use super::{out, outln};
 use clap::Args;
@@ -13,9 +14,9 @@ pub struct MergeArgs {
     /// The shards' `roll --json` outputs.
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
-    /// Print one JSON document instead of the human summary.
-    #[arg(long)]
-    pub json: bool,
+    /// JSON or text.
+    #[command(flatten)]
+    pub json: Json,
 }
 
 /// Runs `dicephys merge`.
@@ -32,7 +33,7 @@ pub fn run(a: &MergeArgs) -> Result<()> {
         parts.push(s);
     }
     let out = RunSummary::merge(&parts)?;
-    if a.json {
+    if *a.json {
         outln!("{}", dicephys::run::seal::to_string(&out, true)?);
     } else {
         out!("{}", out.human());

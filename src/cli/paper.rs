@@ -1,13 +1,13 @@
 //! `dicephys paper`: the main job. Reproduces the paper end to end and writes a report.
 
 use super::args::parse_engine;
+use super::args::{MaxSteps, Seed, StudyPlace};
 use super::error::Result;
 use super::study;
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::sim::roll::DEFAULT_MAX_STEPS;
 use dicephys::studies::paper::PaperConfig;
-use std::path::PathBuf;
 
 /// `dicephys paper`'s arguments.
 #[derive(Args, Debug)]
@@ -15,31 +15,25 @@ pub struct PaperArgs {
     /// Rolls per simulated cell (block × engine × 2D/3D); 100000 is the paper's own scale.
     #[arg(long, default_value_t = 10000)]
     pub rolls: u64,
-    /// Seed of the keyed throws.
-    #[arg(long, default_value_t = 2385)]
-    pub seed: u64,
+    /// The keyed throws' seed.
+    #[command(flatten)]
+    pub seed: Seed,
     /// Engines to simulate with (comma-separated).
     #[arg(long, value_delimiter = ',', default_value = "bullet,rapier", value_parser = parse_engine)]
     pub engines: Vec<EngineKind>,
     /// Fixed time step, s or 1/N.
     #[arg(long, default_value = "0.001", value_parser = super::args::parse_step)]
     pub dt: f64,
-    /// Worker threads (0: one per core).
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
-    /// Steps after which a roll not at rest counts as unconverged.
-    #[arg(long, default_value_t = DEFAULT_MAX_STEPS)]
-    pub max_steps: u64,
-    /// Output directory [default: paper-out].
-    #[arg(long, value_name = "OUT")]
-    pub out: Option<PathBuf>,
+    /// Threads, --out, --json.
+    #[command(flatten)]
+    pub place: StudyPlace,
+    /// The step cap.
+    #[command(flatten)]
+    pub max_steps: MaxSteps<DEFAULT_MAX_STEPS>,
     /// DicePhys exactly as the paper ran it (its rest rule, every flight step stepped) instead
     /// of the exact early stop and closed-form flight.
     #[arg(long)]
     pub faithful: bool,
-    /// Print results.json to stdout too (and no progress bar).
-    #[arg(long)]
-    pub json: bool,
     /// All 19 rows simulated with e, μ (per surface) and the throw's κ fitted to the counts;
     /// every row predicted by a fit without it, beside the theory; the models compared; the
     /// method checked (calibrated.md, calibrated.json and figures in --out). --dt is the fit's
@@ -75,10 +69,9 @@ pub struct PaperArgs {
 /// Runs `dicephys paper --calibrated`.
 fn calibrated(a: &PaperArgs) -> Result<()> {
     let cfg = a.calibrated_config();
-    let out = a.out.clone().unwrap_or_else(|| "paper-out".into());
-    let mut place = study::local(&out, a.threads, a.json)?;
+    let mut place = a.place.local("paper")?;
     // Its cells beside paper's own, apart.
-    place.checkpoint = Some(out.join("calibration"));
+    place.checkpoint = Some(place.out.join("calibration"));
     study::calibrated(&cfg, &place)
 }
 
@@ -93,7 +86,7 @@ impl PaperArgs {
             method: Method {
                 engine: EngineKind::Bullet,
                 dt: a.dt,
-                max_steps: a.max_steps,
+                max_steps: *a.max_steps,
                 die: Default::default(),
                 density: None,
             },
@@ -103,11 +96,11 @@ impl PaperArgs {
                 ..DesignSpec::default()
             },
             search: Search {
-                seed: a.seed,
+                seed: *a.seed,
                 bootstrap: a.bootstrap,
                 ..Search::default()
             },
-            seed: a.seed,
+            seed: *a.seed,
             check_rolls: a.check_rolls,
             reference_dt: a.reference_dt,
         }
@@ -119,10 +112,10 @@ impl PaperArgs {
         engines.dedup();
         PaperConfig {
             rolls: self.rolls,
-            seed: self.seed,
+            seed: *self.seed,
             engines,
             dt: self.dt,
-            max_steps: self.max_steps,
+            max_steps: *self.max_steps,
             faithful: self.faithful,
         }
     }
@@ -135,6 +128,5 @@ pub fn run(a: &PaperArgs) -> Result<()> {
     }
     let cfg = a.config();
     cfg.validate()?;
-    let out = a.out.clone().unwrap_or_else(|| "paper-out".into());
-    study::paper(&cfg, &study::local(&out, a.threads, a.json)?)
+    study::paper(&cfg, &a.place.local("paper")?)
 }

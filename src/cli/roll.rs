@@ -1,5 +1,6 @@
 //! `dicephys roll`: many throws of one block on one engine.
 
+use super::args::Json;
 use super::args::{parse_engine, RunArgs, SceneArgs, ThrowArgs};
 use super::error::{Error, Result};
 use super::{out, outln};
@@ -58,9 +59,9 @@ pub struct RollArgs {
     pub throw: ThrowArgs,
     #[command(flatten)]
     pub run: RunArgs,
-    /// Print one JSON document instead of the human summary.
-    #[arg(long)]
-    pub json: bool,
+    /// JSON or text.
+    #[command(flatten)]
+    pub json: Json,
     /// Write one CSV row per throw to this file.
     #[arg(long, value_name = "FILE.csv")]
     pub per_roll: Option<PathBuf>,
@@ -124,7 +125,7 @@ impl RollArgs {
 pub fn run(a: &RollArgs) -> Result<()> {
     let spec = a.spec()?;
     let (summary, done) = rolled(a, &spec, "roll", Target::Ratio)?;
-    if a.json {
+    if *a.json {
         outln!("{}", dicephys::run::seal::to_string(&summary, true)?);
     } else {
         out!("{}", summary.human());
@@ -156,7 +157,7 @@ pub fn rolled(
     let dir = a.resume.as_ref().or(a.checkpoint.as_ref());
     let total = spec.indices().len();
     let unit = Unit::Rolls { per_cell: 0 };
-    let bar = Progress::new(command, unit, false, a.json, super::study::every());
+    let bar = Progress::new(command, unit, false, *a.json, super::study::every());
     // Under --precision the total is the rolls expected so far, not the cap.
     let expected = std::sync::atomic::AtomicU64::new(total);
     let progress = |n: u64| bar.set(n as f64, expected.load(Relaxed) as f64);

@@ -194,7 +194,13 @@ fn study_of(c: &SlurmCommand) -> Result<Flags<'_>> {
             } else {
                 StudyConfig::Paper(s.config())
             };
-            (cfg, s.threads, s.json, out(s.out.is_some()), &a.job)
+            (
+                cfg,
+                *s.place.threads,
+                *s.place.json,
+                out(s.place.out.is_some()),
+                &a.job,
+            )
         }
         SlurmCommand::Crosscheck(a) => {
             let s = &a.study;
@@ -207,22 +213,40 @@ fn study_of(c: &SlurmCommand) -> Result<Flags<'_>> {
             }
             let cfg = StudyConfig::Crosscheck(s.config()?);
             let given = s.checkpoint.is_some().then_some("--checkpoint");
-            (cfg, s.run.threads, s.json, given, &a.job)
+            (cfg, *s.run.threads, *s.json, given, &a.job)
         }
         SlurmCommand::Converge(a) => {
             let s = &a.study;
             let cfg = StudyConfig::Converge(s.config());
-            (cfg, s.threads, s.json, out(s.out.is_some()), &a.job)
+            (
+                cfg,
+                *s.place.threads,
+                *s.place.json,
+                out(s.place.out.is_some()),
+                &a.job,
+            )
         }
         SlurmCommand::Tradeoff(a) => {
             let s = &a.study;
             let cfg = StudyConfig::Tradeoff(s.config()?);
-            (cfg, s.threads, s.json, out(s.out.is_some()), &a.job)
+            (
+                cfg,
+                *s.place.threads,
+                *s.place.json,
+                out(s.place.out.is_some()),
+                &a.job,
+            )
         }
         SlurmCommand::Stability(a) => {
             let s = &a.study;
             let cfg = StudyConfig::Stability(s.config());
-            (cfg, s.threads, s.json, out(s.out.is_some()), &a.job)
+            (
+                cfg,
+                *s.place.threads,
+                *s.place.json,
+                out(s.place.out.is_some()),
+                &a.job,
+            )
         }
         SlurmCommand::Fit(a) => {
             let s = &a.study;
@@ -236,7 +260,13 @@ fn study_of(c: &SlurmCommand) -> Result<Flags<'_>> {
                 config: s.config()?,
                 stage: Stage::Whole,
             });
-            (cfg, s.threads, s.json, out(s.out.is_some()), &a.job)
+            (
+                cfg,
+                *s.place.threads,
+                *s.place.json,
+                out(s.place.out.is_some()),
+                &a.job,
+            )
         }
         _ => unreachable!("not a study"),
     })
@@ -264,7 +294,7 @@ fn roll(a: &SlurmRollArgs) -> Result<Staged> {
     if r.per_roll.is_some() {
         return own("--per-roll", "not available through Slurm");
     }
-    if r.json {
+    if *r.json {
         return own(
             "--json",
             "the finishing job writes both DIR/result.json and DIR/result.txt",

@@ -3,6 +3,7 @@
 //! `<command>.json`, `report.md` and its figures into --out (`super::study`).
 
 use super::args::{parse_engine, parse_percent};
+use super::args::{MaxSteps, Seed, StudyPlace};
 use super::error::{Error, Result};
 use super::study;
 use clap::Args;
@@ -11,7 +12,6 @@ use dicephys::model::block::Block;
 use dicephys::model::scene::Mode;
 use dicephys::studies::sweep::parse_dt;
 use dicephys::studies::{converge, stability, tradeoff, StudyConfig};
-use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct ConvergeArgs {
@@ -32,15 +32,15 @@ pub struct ConvergeArgs {
     /// Rolls per cell (block × engine × mode × dt).
     #[arg(long, default_value_t = 200)]
     pub rolls: u64,
-    /// Seed of the keyed throws: the same seed gives the same rolls on any thread count.
-    #[arg(long, default_value_t = 2385)]
-    pub seed: u64,
-    /// Worker threads (0: one per core).
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
-    /// Steps after which a roll not at rest counts as unconverged.
-    #[arg(long, default_value_t = 2_000_000)]
-    pub max_steps: u64,
+    /// The keyed throws' seed.
+    #[command(flatten)]
+    pub seed: Seed,
+    /// Threads, --out, --json.
+    #[command(flatten)]
+    pub place: StudyPlace,
+    /// The step cap.
+    #[command(flatten)]
+    pub max_steps: MaxSteps<2_000_000>,
     /// Precision as the input, per cent at 2σ ("1" or "1%"): every cell rolled in rounds of one
     /// keyed stream until its departure from the finest dt is resolved to it (--rolls ignored).
     #[arg(long, value_parser = parse_percent)]
@@ -55,12 +55,6 @@ pub struct ConvergeArgs {
     /// exact at fine steps by `tradeoff`'s levers row, instead of every step stepped.
     #[arg(long)]
     pub fast: bool,
-    /// Output directory [default: converge-out].
-    #[arg(long, value_name = "OUT")]
-    pub out: Option<PathBuf>,
-    /// Print converge.json to stdout instead of the table.
-    #[arg(long)]
-    pub json: bool,
 }
 
 #[derive(Args, Debug)]
@@ -97,18 +91,15 @@ pub struct TradeoffArgs {
     /// CPU seconds the reference (each mode's) may spend.
     #[arg(long, default_value_t = 1800.0)]
     pub reference_budget: f64,
-    /// Seed of the keyed throws: the same seed gives the same rolls on any thread count.
-    #[arg(long, default_value_t = 2385)]
-    pub seed: u64,
-    /// Worker threads (0: one per core).
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
-    /// Steps after which a roll not at rest counts as unconverged.
-    #[arg(long, default_value_t = 2_000_000)]
-    pub max_steps: u64,
-    /// Output directory [default: tradeoff-out].
-    #[arg(long, value_name = "OUT")]
-    pub out: Option<PathBuf>,
+    /// The keyed throws' seed.
+    #[command(flatten)]
+    pub seed: Seed,
+    /// Threads, --out, --json.
+    #[command(flatten)]
+    pub place: StudyPlace,
+    /// The step cap.
+    #[command(flatten)]
+    pub max_steps: MaxSteps<2_000_000>,
     /// Roll the pilot (a chunk of every method, kept), print the plan (the CPU the precision
     /// asked costs, and the precision an hour buys) and stop.
     #[arg(long)]
@@ -118,9 +109,6 @@ pub struct TradeoffArgs {
     /// `dicephys slurm tradeoff` do, before its finishing job runs the study, reading them back.
     #[arg(long, value_name = "ROLLS")]
     pub preroll: Option<u64>,
-    /// Print tradeoff.json to stdout instead of the table.
-    #[arg(long)]
-    pub json: bool,
 }
 
 /// `tradeoff`'s default precision, per cent at 2σ: what about 60 minutes on 2 cores buys at
@@ -163,25 +151,19 @@ pub struct StabilityArgs {
     /// 1 % at 95 %.
     #[arg(long, default_value_t = 300)]
     pub rolls: u64,
-    /// Seed of the keyed throws: the same seed gives the same rolls on any thread count.
-    #[arg(long, default_value_t = 2385)]
-    pub seed: u64,
-    /// Worker threads (0: one per core).
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
-    /// The step cap: a roll still moving after it is unconverged.
-    #[arg(long, default_value_t = 20_000)]
-    pub max_steps: u64,
+    /// The keyed throws' seed.
+    #[command(flatten)]
+    pub seed: Seed,
+    /// Threads, --out, --json.
+    #[command(flatten)]
+    pub place: StudyPlace,
+    /// The step cap.
+    #[command(flatten)]
+    pub max_steps: MaxSteps<20_000>,
     /// The box floor's thickness, m (DicePhys's 100); 0.02, a table top, lets a die at a
     /// coarse step really pass through it.
     #[arg(long, default_value_t = dicephys::model::scene::DICEPHYS_FLOOR_THICKNESS)]
     pub floor_thickness: f64,
-    /// Output directory [default: stability-out].
-    #[arg(long, value_name = "OUT")]
-    pub out: Option<PathBuf>,
-    /// Print stability.json to stdout instead of the table.
-    #[arg(long)]
-    pub json: bool,
 }
 
 impl ConvergeArgs {
@@ -192,8 +174,8 @@ impl ConvergeArgs {
             dts: self.dts.clone(),
             engines: self.engines.clone(),
             rolls: self.rolls,
-            seed: self.seed,
-            max_steps: self.max_steps,
+            seed: *self.seed,
+            max_steps: *self.max_steps,
             precision: self.precision,
             budget_s: self.budget,
             reference_budget_s: self.reference_budget,
@@ -228,8 +210,8 @@ impl TradeoffArgs {
             precision: self.precision,
             budget_s: self.budget,
             reference_budget_s: self.reference_budget,
-            seed: self.seed,
-            max_steps: self.max_steps,
+            seed: *self.seed,
+            max_steps: *self.max_steps,
             plan_only: self.plan,
             preroll_chunks: self
                 .preroll
@@ -248,8 +230,8 @@ impl StabilityArgs {
             frictions: self.frictions.clone(),
             blocks: self.blocks.clone(),
             rolls: self.rolls,
-            seed: self.seed,
-            max_steps: self.max_steps,
+            seed: *self.seed,
+            max_steps: *self.max_steps,
             floor_thickness: self.floor_thickness,
         }
     }
@@ -257,27 +239,24 @@ impl StabilityArgs {
 
 /// Runs `dicephys converge`.
 pub fn converge(a: &ConvergeArgs) -> Result<()> {
-    let out = a.out.clone().unwrap_or_else(|| "converge-out".into());
     study::run(
         &StudyConfig::Converge(a.config()),
-        &study::local(&out, a.threads, a.json)?,
+        &a.place.local("converge")?,
     )
 }
 
 /// Runs `dicephys tradeoff`.
 pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
-    let out = a.out.clone().unwrap_or_else(|| "tradeoff-out".into());
     study::run(
         &StudyConfig::Tradeoff(a.config()?),
-        &study::local(&out, a.threads, a.json)?,
+        &a.place.local("tradeoff")?,
     )
 }
 
 /// Runs `dicephys stability`.
 pub fn stability(a: &StabilityArgs) -> Result<()> {
-    let out = a.out.clone().unwrap_or_else(|| "stability-out".into());
     study::run(
         &StudyConfig::Stability(a.config()),
-        &study::local(&out, a.threads, a.json)?,
+        &a.place.local("stability")?,
     )
 }

@@ -2,6 +2,7 @@
 //! whole experimental table set against the theory (`--table`). Text, or one JSON document with
 //! `--json` (fields documented in docs/json.md).
 
+use super::args::Json;
 use clap::{ArgGroup, Args};
 use serde::Serialize;
 use std::io::Write;
@@ -36,9 +37,9 @@ pub struct TheoryArgs {
     #[arg(long)]
     pub table: bool,
 
-    /// Print one JSON document instead of text.
-    #[arg(long)]
-    pub json: bool,
+    /// JSON or text.
+    #[command(flatten)]
+    pub json: Json,
 }
 
 fn parse_tolerance(s: &str) -> std::result::Result<f64, String> {
@@ -66,7 +67,7 @@ pub fn run(args: &TheoryArgs) -> Result<()> {
         )),
         (Some(block), false) => {
             let report = block_report(block, args.tolerance);
-            if args.json {
+            if *args.json {
                 write_json(&mut out, &report)
             } else {
                 Ok(write_block(&mut out, &report)?)
@@ -74,7 +75,7 @@ pub fn run(args: &TheoryArgs) -> Result<()> {
         }
         (None, true) => {
             let report = table_report()?;
-            if args.json {
+            if *args.json {
                 write_json(&mut out, &report)
             } else {
                 Ok(write_table(&mut out, &report)?)

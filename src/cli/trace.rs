@@ -1,5 +1,6 @@
 //! `dicephys trace`: one throw's trajectory as CSV, for looking at a single roll.
 
+use super::args::MaxSteps;
 use super::args::{parse_engine, FlightArg, SceneArgs, ThrowArgs};
 use super::error::{Error, Result};
 use clap::Args;
@@ -27,9 +28,9 @@ pub struct TraceArgs {
     /// Print every Nth step (the first and the last are always printed).
     #[arg(long, default_value_t = 1)]
     pub every: u64,
-    /// Steps after which the throw, not at rest, stops being traced.
-    #[arg(long, default_value_t = DEFAULT_MAX_STEPS)]
-    pub max_steps: u64,
+    /// The step cap.
+    #[command(flatten)]
+    pub max_steps: MaxSteps<DEFAULT_MAX_STEPS>,
     /// Free flight: stepped (every step by the engine) or fast (integrated in closed form where
     /// the engine's flight is ballistic, as `roll` does by default; the flown steps are printed
     /// too).
@@ -41,7 +42,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     let scene = a.scene.scene()?;
     let die = DieShape::of(&scene);
     let throw_spec = a.throw.spec()?;
-    if a.every == 0 || a.max_steps == 0 {
+    if a.every == 0 || *a.max_steps == 0 {
         return Err(Error::Usage(
             "--every and --max-steps must be at least 1".into(),
         ));
@@ -62,7 +63,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     let mut last = None;
     let line = |step: u64, s: &BodyState| trace::row(&die, scene.dt, step, s);
     let settle = RollConfig {
-        max_steps: a.max_steps,
+        max_steps: *a.max_steps,
         fast_flight: a.flight == FlightArg::Fast,
         ..RollConfig::default()
     };

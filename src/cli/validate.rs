@@ -3,6 +3,7 @@
 //! figures into --out.
 
 use super::args::parse_engine;
+use super::args::{Seed, StudyPlace};
 use super::error::Result;
 use super::study;
 use clap::Args;
@@ -10,7 +11,6 @@ use dicephys::engine::EngineKind;
 use dicephys::model::block::Block;
 use dicephys::studies::sweep::parse_dt;
 use dicephys::studies::validate as v;
-use std::path::PathBuf;
 
 /// `dicephys validate`'s arguments.
 #[derive(Args, Debug)]
@@ -24,12 +24,12 @@ pub struct ValidateArgs {
     /// Rolls per point of the trend.
     #[arg(long, default_value_t = v::Config::default().trend_rolls)]
     pub trend_rolls: u64,
-    /// Seed of the keyed throws: the same seed gives the same rolls on any thread count.
-    #[arg(long, default_value_t = 2385)]
-    pub seed: u64,
-    /// Worker threads (0: one per core).
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
+    /// The keyed throws' seed.
+    #[command(flatten)]
+    pub seed: Seed,
+    /// Threads, --out, --json.
+    #[command(flatten)]
+    pub place: StudyPlace,
     /// The 2D no-bounce case's blocks (several R).
     #[arg(
         long = "blocks-2d",
@@ -57,12 +57,6 @@ pub struct ValidateArgs {
     /// cannot says how many would.
     #[arg(long, default_value_t = v::Config::default().resolve)]
     pub resolve: f64,
-    /// Output directory: validate.json, report.md and the figures.
-    #[arg(long, default_value = "validate-out")]
-    pub out: PathBuf,
-    /// Print validate.json to stdout instead of the table.
-    #[arg(long)]
-    pub json: bool,
 }
 
 /// `E:MU` (or `none`) as clap reads it.
@@ -85,7 +79,7 @@ impl ValidateArgs {
             engines: self.engines.clone(),
             rolls: self.rolls,
             trend_rolls: self.trend_rolls,
-            seed: self.seed,
+            seed: *self.seed,
             blocks_2d: self.blocks_2d.clone(),
             blocks_3d: self.blocks_3d.clone(),
             trend_block: self.trend_block,
@@ -101,5 +95,5 @@ impl ValidateArgs {
 pub fn run(a: &ValidateArgs) -> Result<()> {
     let cfg = a.config();
     cfg.validate()?;
-    study::validate(&cfg, &study::local(&a.out, a.threads, a.json)?)
+    study::validate(&cfg, &a.place.local("validate")?)
 }
