@@ -12,10 +12,10 @@ pub enum Error {
     /// library spells it (`max_steps`, `rolls`): "max_steps 0: need at least one step". A
     /// field named in `why` is written in backquotes, `like_this`, so that a caller can name
     /// each as its user knows it (the command line maps them to its flags).
-    #[error("{}", field_line(field, value, why))]
+    #[error("{}", field_line(field.name(), value, why))]
     Field {
         /// The field, e.g. `max_steps`.
-        field: &'static str,
+        field: Field,
         /// Its value as given (empty if the field as a whole is wrong, e.g. an empty list).
         value: String,
         /// What is wrong with it, and what would do.
@@ -43,6 +43,179 @@ pub enum Error {
     Failed(String),
 }
 
+/// A value of a configuration that a check can refuse, as the library spells it
+/// (`max_steps`, `pips.spacing`): a caller names each as its user knows it (the command line
+/// by its flag, Python by its argument), in one table each.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    Hash,
+    strum::IntoStaticStr,
+    strum::EnumString,
+    strum::EnumIter,
+    strum::VariantNames,
+)]
+#[strum(serialize_all = "snake_case")]
+pub enum Field {
+    /// `allow_restitution_above_one`.
+    AllowRestitutionAboveOne,
+    /// `rapier_dts`.
+    RapierDts,
+    /// `refine`.
+    Refine,
+    /// `plan_only`.
+    PlanOnly,
+    /// `kind`.
+    Kind,
+    /// `trend_rolls`.
+    TrendRolls,
+    /// `time`.
+    Time,
+    /// `account`.
+    Account,
+    /// `partition`.
+    Partition,
+    /// `velocity`.
+    Velocity,
+    /// `angular_damping`.
+    AngularDamping,
+    /// `linear_damping`.
+    LinearDamping,
+    /// `bin`.
+    Bin,
+    /// `blocks`.
+    Blocks,
+    /// `bootstrap`.
+    Bootstrap,
+    /// `budget_s`.
+    BudgetS,
+    /// `check_rolls`.
+    CheckRolls,
+    /// `com`.
+    Com,
+    /// `contact`.
+    Contact,
+    /// `density`.
+    Density,
+    /// `dir`.
+    Dir,
+    /// `draws`.
+    Draws,
+    /// `drop_height`.
+    DropHeight,
+    /// `dt`.
+    Dt,
+    /// `dts`.
+    Dts,
+    /// `edge_radius`.
+    EdgeRadius,
+    /// `engines`.
+    Engines,
+    /// `faces`.
+    Faces,
+    /// `flight_dts`.
+    FlightDts,
+    /// `flight_time`.
+    FlightTime,
+    /// `floor_thickness`.
+    FloorThickness,
+    /// `free`.
+    Free,
+    /// `friction`.
+    Friction,
+    /// `frictions`.
+    Frictions,
+    /// `inertia`.
+    Inertia,
+    #[strum(serialize = "insert.centre")]
+    /// `insert.centre`.
+    InsertCentre,
+    #[strum(serialize = "insert.density")]
+    /// `insert.density`.
+    InsertDensity,
+    #[strum(serialize = "insert.size")]
+    /// `insert.size`.
+    InsertSize,
+    /// `ladder`.
+    Ladder,
+    /// `margin`.
+    Margin,
+    /// `max_steps`.
+    MaxSteps,
+    /// `modes`.
+    Modes,
+    /// `null`.
+    Null,
+    /// `out`.
+    Out,
+    #[strum(serialize = "pips.depth")]
+    /// `pips.depth`.
+    PipsDepth,
+    #[strum(serialize = "pips.diameter")]
+    /// `pips.diameter`.
+    PipsDiameter,
+    #[strum(serialize = "pips.fill_density")]
+    /// `pips.fill_density`.
+    PipsFillDensity,
+    #[strum(serialize = "pips.spacing")]
+    /// `pips.spacing`.
+    PipsSpacing,
+    /// `point_rolls`.
+    PointRolls,
+    /// `points`.
+    Points,
+    /// `precision`.
+    Precision,
+    /// `preroll_chunks`.
+    PrerollChunks,
+    /// `profile_points`.
+    ProfilePoints,
+    /// `range`.
+    Range,
+    /// `recover`.
+    Recover,
+    /// `reference_budget_s`.
+    ReferenceBudgetS,
+    /// `reference_dt`.
+    ReferenceDt,
+    /// `repeats`.
+    Repeats,
+    /// `resolve`.
+    Resolve,
+    /// `restitution`.
+    Restitution,
+    /// `restitutions`.
+    Restitutions,
+    /// `rolls`.
+    Rolls,
+    /// `seed`.
+    Seed,
+    /// `settle`.
+    Settle,
+    /// `spin`.
+    Spin,
+    /// `starts`.
+    Starts,
+    /// `style`.
+    Style,
+    /// `tasks`.
+    Tasks,
+    /// `trend`.
+    Trend,
+    /// `vary`.
+    Vary,
+}
+
+impl Field {
+    /// The field's name as the library spells it.
+    pub fn name(self) -> &'static str {
+        self.into()
+    }
+}
+
 /// A value as a message shows it: a number of many digits (1e300 prints as 301 of them) in
 /// scientific notation, anything else as it is.
 fn shown_value(v: String) -> String {
@@ -63,7 +236,7 @@ fn field_line(field: &str, value: &str, why: &str) -> String {
 
 impl Error {
     /// A value of `field` refused: see [`Error::Field`].
-    pub fn field(field: &'static str, value: impl ToString, why: impl Into<String>) -> Error {
+    pub fn field(field: Field, value: impl ToString, why: impl Into<String>) -> Error {
         Error::Field {
             field,
             value: shown_value(value.to_string()),

@@ -27,6 +27,7 @@ use dicephys::run::stop::Stop;
 use dicephys::sim::roll::{RollConfig, RollRecord, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
 use dicephys::studies::outputs::{self, Done, Hooks, Place};
 use dicephys::studies::StudyConfig;
+use dicephys::error::Field;
 use dicephys::Error;
 use pyo3::conversion::FromPyObjectOwned;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyTypeError, PyValueError};
@@ -37,20 +38,25 @@ use std::sync::{Condvar, Mutex};
 use std::time::Duration;
 
 /// The Python argument that sets a field of the library's configurations: most are the
-/// field's own name; these are spelt otherwise.
-fn argument(field: &str) -> &str {
+/// field's own name (a die's `pips.depth` is `pips`); these are spelt otherwise.
+fn argument(field: Field) -> &'static str {
     match field {
-        "style" => "throw",
-        "kind" => "source",
-        f => f.split('.').next().unwrap_or(f),
+        Field::Style => "throw",
+        Field::Kind => "source",
+        f => f.name().split('.').next().unwrap_or_default(),
     }
 }
 
-/// A library message with each field it names in backquotes named by its argument.
+/// A library message with each field it names in backquotes named by its argument (any
+/// other word in backquotes kept as written).
 fn arguments_in(why: &str) -> String {
     why.split('`')
         .enumerate()
-        .map(|(i, part)| if i % 2 == 1 { argument(part) } else { part })
+        .map(|(i, part)| match part.parse::<Field>() {
+            Ok(f) if i % 2 == 1 => argument(f).to_string(),
+            _ if i % 2 == 1 => format!("`{part}`"),
+            _ => part.to_string(),
+        })
         .collect()
 }
 
@@ -62,9 +68,9 @@ fn py_err(e: Error) -> PyErr {
         Error::Field { field, value, why } => {
             let why = arguments_in(why);
             PyValueError::new_err(if value.is_empty() {
-                format!("{}: {why}", argument(field))
+                format!("{}: {why}", argument(*field))
             } else {
-                format!("{}={value}: {why}", argument(field))
+                format!("{}={value}: {why}", argument(*field))
             })
         }
         Error::Io { .. } => PyOSError::new_err(e.to_string()),

@@ -16,6 +16,7 @@
 
 use crate::calibration::data::DataRow;
 use crate::calibration::params::{Axes, ModelSpec, Param};
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::inference::surrogate::{DesignPoint, Surrogate};
 use crate::model::block::Block;
@@ -78,11 +79,11 @@ impl DesignSpec {
             ));
         }
         if self.points > 100_000 {
-            return Err(Error::field("points", self.points, "at most 100000"));
+            return Err(Error::field(Field::Points, self.points, "at most 100000"));
         }
         if self.rolls == 0 || self.rolls > crate::run::spec::MAX_ROLLS {
             return Err(Error::field(
-                "point_rolls",
+                Field::PointRolls,
                 self.rolls,
                 format!("from 1 to {}", crate::run::spec::MAX_ROLLS),
             ));

@@ -32,6 +32,7 @@ pub mod params;
 pub mod predict;
 pub mod recovery;
 
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::model::throws::Range;
 use data::DataRow;
@@ -82,7 +83,7 @@ impl FitConfig {
         }
         if self.model.is_free(params::Kind::PipDepth) && self.method.die.pips.is_none() {
             return Err(Error::field(
-                "free",
+                Field::Free,
                 "pip_depth",
                 "the die has no pips to vary: give them (--pips D,H or a die file's [pips])",
             ));
@@ -92,7 +93,7 @@ impl FitConfig {
             .filter(|&k| self.model.is_free(k));
         if self.model.is_free(params::Kind::PipDepth) && com_free.clone().count() > 0 {
             return Err(Error::field(
-                "free",
+                Field::Free,
                 "pip_depth",
                 "and a free centre of mass cannot be told apart: pips bias a die through the \
                  centre of mass they move, and a free centre is given outright; free one or \
@@ -106,7 +107,7 @@ impl FitConfig {
                 let half = 500.0 * [row.block.breadth, row.block.width, row.block.length][axis];
                 if r.lo <= -half || r.hi >= half {
                     return Err(Error::field(
-                        "range",
+                        Field::Range,
                         format!("{kind}={r}"),
                         format!(
                             "the centre of mass must stay inside the die: within ±{half} mm on \

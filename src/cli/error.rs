@@ -1,5 +1,6 @@
 //! How a command ends: its exit code and its one line on stderr.
 
+use dicephys::error::Field;
 use std::fmt;
 
 /// The ways a command can end badly.
@@ -44,9 +45,9 @@ impl From<dicephys::Error> for Error {
             )
         } else if let dicephys::Error::Field { field, value, why } = &e {
             let line = if value.is_empty() {
-                format!("{}: {}", flag(field), flags_in(why))
+                format!("{}: {}", flag(*field), flags_in(why))
             } else {
-                format!("{} {value}: {}", flag(field), flags_in(why))
+                format!("{} {value}: {}", flag(*field), flags_in(why))
             };
             Error::Usage(line)
         } else if e.is_input() {
@@ -60,17 +61,82 @@ impl From<dicephys::Error> for Error {
     }
 }
 
-/// The flag that sets a field of the library's configurations: most are the field's name,
-/// `--` and kebab case; these few are spelt otherwise.
-fn flag(field: &str) -> String {
+/// The flag that sets each field of the library's configurations: the one table from the
+/// library's names to the command line's (a field only a die file sets is named as the file's
+/// key). Every arm is checked against the commands' flags (`every_field_names_a_real_flag`).
+pub fn flag(field: Field) -> &'static str {
     match field {
-        "style" => "--throw".into(),
-        "kind" => "--source".into(),
-        "budget_s" => "--budget".into(),
-        "reference_budget_s" => "--reference-budget".into(),
-        "preroll_chunks" => "--preroll".into(),
-        "plan_only" => "--plan".into(),
-        f => format!("--{}", f.replace('_', "-")),
+        Field::Account => "--account",
+        Field::AllowRestitutionAboveOne => "--allow-restitution-above-one",
+        Field::AngularDamping => "--angular-damping",
+        Field::Bin => "--bin",
+        Field::Blocks => "--blocks",
+        Field::Bootstrap => "--bootstrap",
+        Field::BudgetS => "--budget",
+        Field::CheckRolls => "--check-rolls",
+        Field::Com => "--com",
+        Field::Contact => "--contact",
+        Field::Density => "--density",
+        Field::Dir => "--dir",
+        Field::Draws => "--draws",
+        Field::DropHeight => "--drop-height",
+        Field::Dt => "--dt",
+        Field::Dts => "--dts",
+        Field::EdgeRadius => "--edge-radius",
+        Field::Engines => "--engines",
+        Field::Faces => "--die's [faces]",
+        Field::FlightDts => "--flight-dts",
+        // Set by no command (validate's free flight lasts its default).
+        Field::FlightTime => "flight_time",
+        Field::FloorThickness => "--floor-thickness",
+        Field::Free => "--free",
+        Field::Friction => "--friction",
+        Field::Frictions => "--frictions",
+        Field::Inertia => "--die's inertia",
+        Field::InsertCentre => "--die's insert.centre",
+        Field::InsertDensity => "--die's insert.density",
+        Field::InsertSize => "--die's insert.size",
+        Field::Kind => "--source",
+        Field::Ladder => "--ladder",
+        Field::LinearDamping => "--linear-damping",
+        Field::Margin => "--margin",
+        Field::MaxSteps => "--max-steps",
+        Field::Modes => "--modes",
+        Field::Null => "--null",
+        Field::Out => "--out",
+        Field::Partition => "--partition",
+        Field::PipsDepth => "--pips",
+        Field::PipsDiameter => "--pips",
+        Field::PipsFillDensity => "--die's pips.fill_density",
+        Field::PipsSpacing => "--die's pips.spacing",
+        Field::PlanOnly => "--plan",
+        Field::PointRolls => "--point-rolls",
+        Field::Points => "--points",
+        Field::Precision => "--precision",
+        Field::PrerollChunks => "--preroll",
+        Field::ProfilePoints => "--profile-points",
+        Field::Range => "--range",
+        Field::RapierDts => "--rapier-dts",
+        Field::Recover => "--recover",
+        Field::ReferenceBudgetS => "--reference-budget",
+        Field::ReferenceDt => "--reference-dt",
+        Field::Refine => "--no-refine",
+        Field::Repeats => "--repeats",
+        Field::Resolve => "--resolve",
+        Field::Restitution => "--restitution",
+        Field::Restitutions => "--restitutions",
+        Field::Rolls => "--rolls",
+        Field::Seed => "--seed",
+        Field::Settle => "--settle",
+        Field::Spin => "--spin",
+        Field::Starts => "--starts",
+        Field::Style => "--throw",
+        Field::Tasks => "--tasks",
+        Field::Time => "--time",
+        Field::Trend => "--trend",
+        Field::TrendRolls => "--trend-rolls",
+        Field::Vary => "--vary",
+        Field::Velocity => "--velocity",
     }
 }
 
@@ -78,10 +144,11 @@ fn flag(field: &str) -> String {
 pub fn flags_in(why: &str) -> String {
     let mut out = String::new();
     for (i, part) in why.split('`').enumerate() {
-        if i % 2 == 1 {
-            out += &flag(part);
-        } else {
-            out += part;
+        match part.parse::<Field>() {
+            Ok(f) if i % 2 == 1 => out += flag(f),
+            // Not a field (a command's name, say): kept as written.
+            _ if i % 2 == 1 => out += &format!("`{part}`"),
+            _ => out += part,
         }
     }
     out
@@ -99,3 +166,46 @@ impl From<std::io::Error> for Error {
 
 /// A command's result.
 pub type Result<T> = std::result::Result<T, Error>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+    use std::collections::HashSet;
+    use strum::IntoEnumIterator;
+
+    fn longs(c: &clap::Command, out: &mut HashSet<String>) {
+        for a in c.get_arguments() {
+            out.extend(a.get_long().map(String::from));
+        }
+        for s in c.get_subcommands() {
+            longs(s, out);
+        }
+    }
+
+    #[test]
+    fn every_field_names_a_real_flag() {
+        let mut all = HashSet::new();
+        longs(&crate::cli::Cli::command(), &mut all);
+        let missing: Vec<String> = Field::iter()
+            .filter(|&f| f != Field::FlightTime)
+            .filter(|&f| {
+                let long = flag(f).trim_start_matches("--").split(['\'', ' ']).next();
+                !all.contains(long.unwrap_or_default())
+            })
+            .map(|f| format!("{} ({})", f.name(), flag(f)))
+            .collect();
+        assert!(
+            missing.is_empty(),
+            "no command has these flags: {missing:?}"
+        );
+    }
+
+    #[test]
+    fn a_message_names_fields_by_flag_and_leaves_other_words_alone() {
+        assert_eq!(
+            flags_in("give `max_steps` or `style`, not a `roll` checkpoint"),
+            "give --max-steps or --throw, not a `roll` checkpoint"
+        );
+    }
+}

@@ -2,6 +2,7 @@
 //! and the numbers the faces carry. The three outcomes of the paper (which side stands
 //! vertical) are the faces taken in opposite pairs; a face tells which of the pair is up.
 
+use crate::error::Field;
 use crate::model::block::Outcome;
 use crate::model::state::up_in_body;
 use nalgebra::UnitQuaternion;
@@ -72,7 +73,7 @@ impl Layout {
     /// The layout a face map gives: each of the six directions ("+x" … "-z") a number, the
     /// numbers a permutation of 1 to 6; the named layout when it is one.
     pub fn from_map(map: &std::collections::BTreeMap<String, u8>) -> crate::Result<Layout> {
-        let bad = |why: String| Err(crate::Error::field("faces", "", why));
+        let bad = |why: String| Err(crate::Error::field(Field::Faces, "", why));
         let mut numbers = [0u8; 6];
         for (d, n) in map {
             let Some(i) = DIRECTIONS.iter().position(|x| x == d) else {

@@ -9,6 +9,7 @@
 //! as moments about the geometric centre; the tensor about the centre of mass follows from
 //! the parallel-axis theorem, and its eigenvectors are the body's principal frame.
 
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::model::block::Mode;
 use crate::model::faces::Layout;
@@ -403,7 +404,7 @@ impl DieFile {
         let layout = match (&self.faces, self.layout) {
             (Some(_), Some(_)) => {
                 return Err(Error::field(
-                    "faces",
+                    Field::Faces,
                     "",
                     "give either a layout or a face map, not both",
                 ))
@@ -533,7 +534,7 @@ impl Features {
         let r = self.edge_radius;
         if !(r.is_finite() && r >= 0.0 && r < min_half) {
             return Err(Error::field(
-                "edge_radius",
+                Field::EdgeRadius,
                 mm(r),
                 format!(
                     "must be at least 0 and under half the shortest side ({} mm)",
@@ -552,7 +553,7 @@ impl Features {
             };
             if !(c.iter().all(|x| x.is_finite()) && inside) {
                 return Err(Error::field(
-                    "com",
+                    Field::Com,
                     format!("{},{},{}", mm(c.x), mm(c.y), mm(c.z)),
                     "must lie inside the die (mm from its centre, body axes)",
                 ));
@@ -576,10 +577,10 @@ impl Features {
         let mm = |v: f64| format!("{}", (v * 1e9).round() / 1e6);
         let min_half = half.min();
         let r = self.edge_radius;
-        let bad = |field: &'static str, v: f64, why: String| Err(Error::field(field, mm(v), why));
+        let bad = |field: Field, v: f64, why: String| Err(Error::field(field, mm(v), why));
         if !(p.diameter.is_finite() && p.diameter > 0.0) {
             return bad(
-                "pips.diameter",
+                Field::PipsDiameter,
                 p.diameter,
                 "must be a positive number of mm".into(),
             );
@@ -590,7 +591,7 @@ impl Features {
         };
         if !(p.depth.is_finite() && p.depth > 0.0 && p.depth <= deepest && p.depth < min_half) {
             return bad(
-                "pips.depth",
+                Field::PipsDepth,
                 p.depth,
                 format!(
                     "must be positive, at most {} mm ({})",
@@ -604,14 +605,14 @@ impl Features {
         }
         if !(p.fill_density.is_finite() && (0.0..=1e5).contains(&p.fill_density)) {
             return Err(Error::field(
-                "pips.fill_density",
+                Field::PipsFillDensity,
                 p.fill_density,
                 "must be in [0, 100000] kg/m³",
             ));
         }
         if !(p.spacing.is_finite() && p.spacing > 0.0 && p.spacing < 0.5) {
             return Err(Error::field(
-                "pips.spacing",
+                Field::PipsSpacing,
                 p.spacing,
                 "must be in (0, 0.5): a fraction of the face's side",
             ));
@@ -622,7 +623,7 @@ impl Features {
             let (j, k) = ((i + 1) % 3, (i + 2) % 3);
             if pj.abs() + rad > half[j] - r || pk.abs() + rad > half[k] - r {
                 return bad(
-                    "pips.diameter",
+                    Field::PipsDiameter,
                     p.diameter,
                     "pips cross an edge of their face (or its rounding): smaller pips or a smaller spacing".into(),
                 );
@@ -632,7 +633,7 @@ impl Features {
             for b in &places[n + 1..] {
                 if a.0 == b.0 && a.1 == b.1 && (a.2 - b.2).hypot(a.3 - b.3) <= p.diameter {
                     return bad(
-                        "pips.diameter",
+                        Field::PipsDiameter,
                         p.diameter,
                         "pips on a face overlap each other: smaller pips or a larger spacing"
                             .into(),
@@ -654,7 +655,7 @@ impl Features {
         let triple = |v: [f64; 3]| format!("{},{},{}", mm(v[0]), mm(v[1]), mm(v[2]));
         if !(i.size.iter().all(|s| s.is_finite() && *s > 0.0)) {
             return Err(Error::field(
-                "insert.size",
+                Field::InsertSize,
                 triple(i.size),
                 "must be three positive lengths, mm",
             ));
@@ -664,7 +665,7 @@ impl Features {
         });
         if !inside {
             return Err(Error::field(
-                "insert.centre",
+                Field::InsertCentre,
                 triple(i.centre),
                 format!(
                     "the insert must lie inside the die, clear of its rounding and pips \
@@ -675,7 +676,7 @@ impl Features {
         }
         if !(i.density.is_finite() && (0.0..=1e5).contains(&i.density)) {
             return Err(Error::field(
-                "insert.density",
+                Field::InsertDensity,
                 i.density,
                 "must be in [0, 100000] kg/m³",
             ));
@@ -695,7 +696,7 @@ fn validate_inertia(t: [f64; 6]) -> Result<()> {
         && (0..3).all(|k| e[k] <= e[(k + 1) % 3] + e[(k + 2) % 3]);
     if !physical {
         return Err(Error::field(
-            "inertia",
+            Field::Inertia,
             t.map(|x| format!("{}", x * 1e9)).join(","),
             "no solid has this inertia: its principal moments must be positive and \
              each at most the sum of the other two (g mm²: xx, yy, zz, xy, xz, yz)",
@@ -735,7 +736,7 @@ impl MassProps {
         if !ok {
             let c = m.com * 1e3;
             return Err(Error::field(
-                "com",
+                Field::Com,
                 format!("{},{},{}", c.x, c.y, c.z),
                 "is too far from the centre for this die's inertia (no solid has these moments)",
             ));
@@ -1073,7 +1074,7 @@ mod tests {
     fn bad_dice_are_refused_by_field() {
         let half = Vector3::repeat(0.008);
         let field = |f: Features| match f.validate(&half, Mode::ThreeD) {
-            Err(Error::Field { field, .. }) => field,
+            Err(Error::Field { field, .. }) => field.name(),
             other => panic!("{other:?}"),
         };
         let pips = |d: f64, h: f64| {

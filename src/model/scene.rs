@@ -1,6 +1,7 @@
 //! The scene a throw happens in: the block, the surface, the time step, 2D or 3D, and the
 //! engine settings. Defaults are DicePhys's, as the paper ran it (DESIGN.md).
 
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
 pub use crate::model::block::Mode;
@@ -152,7 +153,7 @@ pub const MAX_DT: f64 = 0.1;
 pub const MIN_DENSITY: f64 = 1.0;
 
 /// Checks a time step `dt` given as `field`: in [`MIN_DT`], [`MAX_DT`] s.
-pub fn check_dt(field: &'static str, dt: f64) -> Result<()> {
+pub fn check_dt(field: Field, dt: f64) -> Result<()> {
     if dt.is_finite() && (MIN_DT..=MAX_DT).contains(&dt) {
         Ok(())
     } else {
@@ -172,9 +173,13 @@ impl Scene {
     /// accepted (up to 10) only for engine-stability studies that ask for it.
     pub fn validate(&self, allow_restitution_above_one: bool) -> Result<()> {
         let bad = |field, v: f64, why: String| Err(Error::field(field, v, why));
-        check_dt("dt", self.dt)?;
+        check_dt(Field::Dt, self.dt)?;
         if !(self.friction.is_finite() && self.friction >= 0.0) {
-            return bad("friction", self.friction, "must be finite and >= 0".into());
+            return bad(
+                Field::Friction,
+                self.friction,
+                "must be finite and >= 0".into(),
+            );
         }
         let e_max = if allow_restitution_above_one {
             10.0
@@ -183,7 +188,7 @@ impl Scene {
         };
         if !(self.restitution.is_finite() && self.restitution >= 0.0 && self.restitution <= e_max) {
             return bad(
-                "restitution",
+                Field::Restitution,
                 self.restitution,
                 "must be in [0, 1] (above 1 only with `allow_restitution_above_one`)".into(),
             );
@@ -192,21 +197,21 @@ impl Scene {
             && (0.001..=DICEPHYS_FLOOR_THICKNESS).contains(&self.floor_thickness))
         {
             return bad(
-                "floor_thickness",
+                Field::FloorThickness,
                 self.floor_thickness,
                 "must be in [0.001, 100] m".into(),
             );
         }
         if !(self.density.is_finite() && (MIN_DENSITY..=1e5).contains(&self.density)) {
             return bad(
-                "density",
+                Field::Density,
                 self.density,
                 format!("must be in [{MIN_DENSITY}, 100000] kg/m³"),
             );
         }
         for (name, v) in [
-            ("linear_damping", self.linear_damping),
-            ("angular_damping", self.angular_damping),
+            (Field::LinearDamping, self.linear_damping),
+            (Field::AngularDamping, self.angular_damping),
         ] {
             if !(v.is_finite() && (0.0..=MAX_DAMPING).contains(&v)) {
                 return bad(
@@ -353,7 +358,7 @@ mod tests {
                 matches!(
                     s.validate(false),
                     Err(Error::Field {
-                        field: "linear_damping",
+                        field: Field::LinearDamping,
                         ..
                     })
                 ),

@@ -14,6 +14,7 @@
 //! release at rest touching the floor (the quasi-static limit). Every style draws its
 //! directions from the same keyed stream, so each is a pure function of (seed, index).
 
+use crate::error::Field;
 use crate::model::glibc::GlibcRand;
 use crate::model::scene::{Mode, Scene};
 use crate::model::state::BodyState;
@@ -104,15 +105,15 @@ impl ThrowRanges {
     pub fn validate(&self) -> crate::Result<()> {
         let bad = |field, r: Range, why: String| Err(crate::Error::field(field, r, why));
         if self.spin.lo < 0.0 {
-            return bad("spin", self.spin, "must be >= 0 rad/s".into());
+            return bad(Field::Spin, self.spin, "must be >= 0 rad/s".into());
         }
         if self.drop_height.lo < 0.0 {
-            return bad("drop_height", self.drop_height, "must be >= 0 m".into());
+            return bad(Field::DropHeight, self.drop_height, "must be >= 0 m".into());
         }
         for (name, r, max) in [
-            ("velocity", self.velocity, 100.0),
-            ("spin", self.spin, 10_000.0),
-            ("drop_height", self.drop_height, 100.0),
+            (Field::Velocity, self.velocity, 100.0),
+            (Field::Spin, self.spin, 10_000.0),
+            (Field::DropHeight, self.drop_height, 100.0),
         ] {
             if r.lo.abs() > max || r.hi.abs() > max {
                 return bad(name, r, format!("magnitudes above {max} are not accepted"));

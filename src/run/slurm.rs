@@ -17,6 +17,7 @@
 //!
 //! This module writes the scripts; it never calls the scheduler.
 
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::run::io::Output;
 use crate::run::spec::{RunSpec, Shard};
@@ -107,14 +108,14 @@ impl Plan {
         let n = self.tasks();
         if n == 0 || n > MAX_TASKS {
             return Err(Error::field(
-                "tasks",
+                Field::Tasks,
                 n,
                 format!("need 1 to {MAX_TASKS} tasks"),
             ));
         }
         match self {
             Plan::Roll { spec, .. } if n > spec.rolls => Err(Error::field(
-                "tasks",
+                Field::Tasks,
                 n,
                 format!("more tasks than the run's {} rolls", spec.rolls),
             )),
@@ -137,12 +138,12 @@ impl Layout {
     /// ([`script_path`]) is refused before it is made (and, if only its real path is unsafe,
     /// removed again if this call made it).
     pub fn create(dir: &Path) -> Result<Layout> {
-        let bad = |e: std::io::Error| Error::field("dir", format!("{dir:?}"), e.to_string());
-        script_path("dir", &std::path::absolute(dir).map_err(bad)?)?;
+        let bad = |e: std::io::Error| Error::field(Field::Dir, format!("{dir:?}"), e.to_string());
+        script_path(Field::Dir, &std::path::absolute(dir).map_err(bad)?)?;
         let made = !dir.exists();
         std::fs::create_dir_all(dir).map_err(bad)?;
         let real = dir.canonicalize().map_err(bad)?;
-        if let Err(e) = script_path("dir", &real) {
+        if let Err(e) = script_path(Field::Dir, &real) {
             if made {
                 let _ = std::fs::remove_dir(&real);
             }
@@ -339,21 +340,21 @@ impl Options {
                 || ["unlimited", "infinite"].contains(&v.to_ascii_lowercase().as_str())
         }
         type Check = fn(&str) -> bool;
-        let rules: [(&'static str, &Option<String>, Check, &str); 3] = [
+        let rules: [(Field, &Option<String>, Check, &str); 3] = [
             (
-                "partition",
+                Field::Partition,
                 &self.partition,
                 word,
                 "letters, digits and _ . , - only",
             ),
             (
-                "account",
+                Field::Account,
                 &self.account,
                 word,
                 "letters, digits and _ . , - only",
             ),
             (
-                "time",
+                Field::Time,
                 &self.time,
                 time,
                 "minutes or [D-]HH:MM:SS as sbatch takes it (90, 1:00:00, 2-12), or UNLIMITED",
@@ -405,7 +406,7 @@ pub fn quote(s: &str) -> String {
 /// shell) and no backslash (sbatch's escape, which in a log name also turns off `%a`).
 /// Anything else is quoted where it is written: for the shell ([`quote`]) and for sbatch's
 /// own parser ([`sbatch_path`]).
-pub fn script_path<'p>(field: &'static str, p: &'p Path) -> Result<&'p str> {
+pub fn script_path(field: Field, p: &Path) -> Result<&str> {
     let refuse = |why: &str| Err(Error::field(field, format!("{p:?}"), why));
     match p.to_str() {
         None => refuse("not UTF-8; a Slurm run's path goes into its scripts as text"),
@@ -420,7 +421,7 @@ pub fn script_path<'p>(field: &'static str, p: &'p Path) -> Result<&'p str> {
 }
 
 fn path_str(p: &Path) -> Result<&str> {
-    script_path("dir", p)
+    script_path(Field::Dir, p)
 }
 
 /// A file name for an `#SBATCH` line, as sbatch's own parser reads it: `%` doubled (sbatch
@@ -447,7 +448,7 @@ pub fn sbatch_path(dir: &str, pattern: &str) -> String {
 /// scheduler requeue a task on a lost node; `--open-mode=append` keeps each attempt's log.
 pub fn array_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Result<String> {
     let dir = path_str(&lay.dir)?;
-    let bin = script_path("bin", bin)?;
+    let bin = script_path(Field::Bin, bin)?;
     let n = plan.tasks();
     let logs = lay.logs();
     let logs = path_str(&logs)?;
@@ -498,7 +499,7 @@ pub fn array_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Res
 /// naming the missing tasks, and otherwise writes the merged result (again, if rerun).
 pub fn finish_script(plan: &Plan, lay: &Layout, opt: &Options, bin: &Path) -> Result<String> {
     let d = quote(path_str(&lay.dir)?);
-    let b = quote(script_path("bin", bin)?);
+    let b = quote(script_path(Field::Bin, bin)?);
     let logs = lay.logs();
     let logs = path_str(&logs)?;
     Ok(format!(

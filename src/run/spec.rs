@@ -4,6 +4,7 @@
 //! the run that wrote them.
 
 use crate::engine::EngineKind;
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::model::scene::Scene;
 use crate::model::throws::{ThrowKind, ThrowRanges, ThrowStyle, Throws};
@@ -92,9 +93,9 @@ impl ThrowSpec {
             // A die released at rest has no velocity, spin or drop: a range given is a mistake.
             let (given, paper) = (self.ranges, ThrowRanges::default());
             for (field, g, p) in [
-                ("velocity", given.velocity, paper.velocity),
-                ("spin", given.spin, paper.spin),
-                ("drop_height", given.drop_height, paper.drop_height),
+                (Field::Velocity, given.velocity, paper.velocity),
+                (Field::Spin, given.spin, paper.spin),
+                (Field::DropHeight, given.drop_height, paper.drop_height),
             ] {
                 if g != p {
                     return Err(Error::field(
@@ -102,7 +103,8 @@ impl ThrowSpec {
                         g,
                         format!(
                             "`style` rest releases the die at rest and uses no range; leave \
-                             `{field}` out"
+                             `{}` out",
+                            field.name()
                         ),
                     ));
                 }
@@ -110,7 +112,7 @@ impl ThrowSpec {
         }
         if self.kind == ThrowKind::Dicephys && !self.style.is_paper() {
             return Err(Error::field(
-                "style",
+                Field::Style,
                 self.style,
                 "the dicephys throw source draws the paper's throw only; use the keyed throws \
                  (`kind` keyed)",
@@ -118,7 +120,7 @@ impl ThrowSpec {
         }
         if self.kind == ThrowKind::Dicephys && self.seed > u32::MAX as u64 {
             return Err(Error::field(
-                "seed",
+                Field::Seed,
                 self.seed,
                 "the dicephys throw source takes a 32-bit seed (srand)",
             ));
@@ -194,11 +196,11 @@ impl RunSpec {
         self.throws.validate()?;
         self.roll.validate()?;
         if self.rolls == 0 {
-            return Err(Error::field("rolls", 0, "need at least one roll"));
+            return Err(Error::field(Field::Rolls, 0, "need at least one roll"));
         }
         if self.rolls > MAX_ROLLS {
             return Err(Error::field(
-                "rolls",
+                Field::Rolls,
                 self.rolls,
                 format!("at most {MAX_ROLLS}"),
             ));

@@ -2,6 +2,7 @@
 //! failure), and say how it came out. Shared by every engine.
 
 use crate::engine::Engine;
+use crate::error::Field;
 use crate::model::block::Outcome;
 use crate::model::die::DieShape;
 use crate::model::faces::up_direction;
@@ -200,7 +201,7 @@ impl RollConfig {
                 "the faithful run"
             };
             return Err(crate::Error::field(
-                "settle",
+                Field::Settle,
                 "certificate",
                 format!(
                     "{who} settles by DicePhys's rule (an audit watches the certificate without \
@@ -229,10 +230,14 @@ impl RollConfig {
     pub fn validate(&self) -> crate::Result<()> {
         use crate::Error;
         if self.max_steps == 0 {
-            return Err(Error::field("max_steps", 0, "need at least one step"));
+            return Err(Error::field(Field::MaxSteps, 0, "need at least one step"));
         }
         if !(self.margin.is_finite() && (0.0..1.0).contains(&self.margin)) {
-            return Err(Error::field("margin", self.margin, "must be in [0, 1)"));
+            return Err(Error::field(
+                Field::Margin,
+                self.margin,
+                "must be in [0, 1)",
+            ));
         }
         if self.audit && self.rule == Rule::Certificate {
             return Err(Error::Invalid(

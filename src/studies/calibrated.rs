@@ -17,6 +17,7 @@ use crate::calibration::estimate::Search;
 use crate::calibration::paper::{CalibratedPaper, Decision, TheoryRow};
 use crate::calibration::params::{self, Kind, Method, ModelSpec};
 use crate::calibration::{FitConfig, FitResult};
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::model::scene::Mode;
 use crate::run::cputime::process_cpu_seconds;
@@ -50,50 +51,50 @@ impl CalibratedConfig {
         let max = crate::run::spec::MAX_ROLLS;
         if self.design.rolls == 0 || self.design.rolls > max {
             return Err(Error::field(
-                "point_rolls",
+                Field::PointRolls,
                 self.design.rolls,
                 format!("from 1 to {max}"),
             ));
         }
         if self.check_rolls == 0 || self.check_rolls > max {
             return Err(Error::field(
-                "check_rolls",
+                Field::CheckRolls,
                 self.check_rolls,
                 format!("from 1 to {max}"),
             ));
         }
         if self.search.bootstrap > MAX_BOOTSTRAP {
             return Err(Error::field(
-                "bootstrap",
+                Field::Bootstrap,
                 self.search.bootstrap,
                 format!("from 0 to {MAX_BOOTSTRAP}"),
             ));
         }
         if !(1..=MAX_STARTS).contains(&self.search.starts) {
             return Err(Error::field(
-                "starts",
+                Field::Starts,
                 self.search.starts,
                 format!("from 1 to {MAX_STARTS}"),
             ));
         }
         if !(5..=MAX_PROFILE_POINTS).contains(&self.search.profile_points) {
             return Err(Error::field(
-                "profile_points",
+                Field::ProfilePoints,
                 self.search.profile_points,
                 format!("from 5 to {MAX_PROFILE_POINTS}"),
             ));
         }
-        crate::model::scene::check_dt("reference_dt", self.reference_dt)?;
-        crate::model::scene::check_dt("dt", self.method.dt)?;
+        crate::model::scene::check_dt(Field::ReferenceDt, self.reference_dt)?;
+        crate::model::scene::check_dt(Field::Dt, self.method.dt)?;
         if self.method.max_steps == 0 {
-            return Err(Error::field("max_steps", 0, "need at least one step"));
+            return Err(Error::field(Field::MaxSteps, 0, "need at least one step"));
         }
         let rows = paper_rows()?;
         for (_, _, model, rows) in models(&rows) {
             let dims = model.free.len();
             self.design.validate(dims).map_err(|e| match e {
                 Error::Invalid(m) if m.starts_with("points ") => Error::field(
-                    "points",
+                    Field::Points,
                     self.design.points,
                     m.split_once(": ").map_or(m.clone(), |p| p.1.to_string()),
                 ),

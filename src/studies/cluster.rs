@@ -6,6 +6,7 @@
 use super::fit::Stage;
 use super::outputs::{self, Hooks, Place};
 use super::StudyConfig;
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::run::runner::{Checkpoint, ChunkShare};
 use crate::run::slurm::{script_path, Layout, Options, Plan};
@@ -144,7 +145,7 @@ fn prepare(
         Some(b) if b.is_absolute() => b.clone(),
         Some(b) => {
             return Err(Error::field(
-                "bin",
+                Field::Bin,
                 b.display(),
                 "give the absolute path the nodes see",
             ))
@@ -153,7 +154,7 @@ fn prepare(
             .and_then(|p| p.canonicalize())
             .map_err(|e| Error::Failed(format!("cannot find this binary's path ({e})")))?,
     };
-    script_path("bin", &bin)?;
+    script_path(Field::Bin, &bin)?;
     // A run refused by its dry run leaves no directory behind that this call made.
     let made = !job.dir.exists();
     let lay = Layout::create(&job.dir)?;

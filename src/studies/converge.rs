@@ -16,6 +16,7 @@ use super::sweep::{
 };
 use super::{Progress, Study};
 use crate::engine::EngineKind;
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::scene::{Mode, Scene};
@@ -113,12 +114,12 @@ impl Claim {
 impl Config {
     /// Checks every value before anything runs.
     pub fn validate(&self) -> Result<()> {
-        nonempty(&self.blocks, "blocks")?;
-        nonempty(&self.dts, "dts")?;
-        nonempty(&self.engines, "engines")?;
+        nonempty(&self.blocks, Field::Blocks)?;
+        nonempty(&self.dts, Field::Dts)?;
+        nonempty(&self.engines, Field::Engines)?;
         check_rolls_and_steps(self.rolls, self.max_steps)?;
-        check_budget(self.budget_s, "budget_s")?;
-        check_budget(self.reference_budget_s, "reference_budget_s")
+        check_budget(self.budget_s, Field::BudgetS)?;
+        check_budget(self.reference_budget_s, Field::ReferenceBudgetS)
     }
 }
 

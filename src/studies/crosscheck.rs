@@ -3,6 +3,7 @@
 
 use super::Study;
 use crate::engine::EngineKind;
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::report::crosscheck::{Crosscheck, Versus};
 use crate::report::summary::Reached;
@@ -36,7 +37,7 @@ impl Config {
     pub fn validate(&self) -> Result<()> {
         if self.engines.len() < 2 {
             return Err(Error::field(
-                "engines",
+                Field::Engines,
                 "",
                 "name at least two engines to compare",
             ));
@@ -44,7 +45,7 @@ impl Config {
         for (i, e) in self.engines.iter().enumerate() {
             if self.engines[..i].contains(e) {
                 return Err(Error::field(
-                    "engines",
+                    Field::Engines,
                     e,
                     "named twice: name each engine once, at least two different ones",
                 ));

@@ -5,6 +5,7 @@
 //! 5σ. The simulation is itself such a tester: a bias it cannot resolve at 2σ is reported as
 //! unresolved, with the rolls that would resolve it.
 
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::model::faces::{side_of, Layout, DIRECTIONS};
 use crate::model::mass::Features;
@@ -49,7 +50,7 @@ fn null_probabilities(s: &RunSummary, null: Null) -> Result<Vec<f64>> {
                 .collect())
         }
         (Null::SolidAngle, Mode::TwoD) => Err(Error::field(
-            "null",
+            Field::Null,
             "solid-angle",
             "the solid angle is the 3D theory; in 2D give uniform",
         )),
@@ -229,7 +230,7 @@ impl Varied {
             }
             Varied::PipDepth => features.with_pip_depth(m).ok_or_else(|| {
                 Error::field(
-                    "vary",
+                    Field::Vary,
                     "pip_depth",
                     "the die has no pips to vary: give them (--pips D,H or a die file)",
                 )
@@ -244,7 +245,7 @@ impl Varied {
 
 /// `fair --vary`'s values: `N` evenly spaced from `LO` to `HI`, from "NAME=LO:HI:N".
 pub fn parse_vary(s: &str) -> Result<(Varied, Vec<f64>)> {
-    let bad = |why: &str| Error::field("vary", s, why.to_string());
+    let bad = |why: &str| Error::field(Field::Vary, s, why.to_string());
     let (name, range) = s
         .split_once('=')
         .ok_or_else(|| bad("write NAME=LO:HI:N, e.g. com_z=0:2:9"))?;

@@ -6,6 +6,7 @@
 use super::place::{to_json, Outputs};
 pub use super::place::{Done, Hooks, Place};
 use super::{Kind, Study, StudyConfig};
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::report;
 use crate::report::per_roll::PerRoll;
@@ -105,7 +106,7 @@ impl Kind for studies::converge::Config {
     fn check_splittable(&self) -> Result<()> {
         if self.precision.is_some() {
             return Err(Error::field(
-                "precision",
+                Field::Precision,
                 "",
                 "decides each cell's rounds from all its rolls, which no task sees; give \
                  `rolls` instead (a run to a precision prints the rolls each cell needs)",
@@ -148,7 +149,7 @@ impl Kind for studies::tradeoff::Config {
     fn check_splittable(&self) -> Result<()> {
         if self.preroll_chunks.is_none() {
             return Err(Error::field(
-                "preroll_chunks",
+                Field::PrerollChunks,
                 "",
                 "needed: the rounds are decided from every roll so far, which no task sees, \
                  so the tasks roll the first throws of every stream ahead and the finishing job \

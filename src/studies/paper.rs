@@ -4,6 +4,7 @@
 //! theory.
 
 use crate::engine::EngineKind;
+use crate::error::Field;
 use crate::error::Result;
 use crate::model::block::Block;
 use crate::model::scene::{Mode, Preset, Scene};
@@ -54,7 +55,7 @@ impl PaperConfig {
     pub fn validate(&self) -> Result<()> {
         use crate::error::Error;
         if self.engines.is_empty() {
-            return Err(Error::field("engines", "", "name at least one engine"));
+            return Err(Error::field(Field::Engines, "", "name at least one engine"));
         }
         let mut scene = Scene::paper(Block::from_mm(140.0, 24.0, 20.0)?, Mode::ThreeD);
         scene.dt = self.dt;

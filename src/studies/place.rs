@@ -4,6 +4,7 @@
 //! `studies::fit::outputs`) are written against these, which import neither.
 
 use super::{Progress, Study};
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::run::io::Output;
 use crate::run::runner::{ChunkShare, Runner};
@@ -92,7 +93,11 @@ impl Place {
     /// Creates the output directory and checks that `files` can be written in it.
     pub(crate) fn outputs(&self, files: &[&'static str]) -> Result<Outputs> {
         std::fs::create_dir_all(&self.out).map_err(|e| {
-            Error::field("out", self.out.display(), format!("cannot create it ({e})"))
+            Error::field(
+                Field::Out,
+                self.out.display(),
+                format!("cannot create it ({e})"),
+            )
         })?;
         files
             .iter()

@@ -11,6 +11,7 @@
 use super::sweep::{cell_spec, check_rolls_and_steps, measure, nonempty};
 use super::{Progress, Study};
 use crate::engine::EngineKind;
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::scene::{Mode, Scene, DICEPHYS_FLOOR_THICKNESS};
@@ -45,16 +46,16 @@ pub struct Config {
 impl Config {
     /// Checks every value before anything runs.
     pub fn validate(&self) -> Result<()> {
-        nonempty(&self.engines, "engines")?;
-        nonempty(&self.dts, "dts")?;
-        nonempty(&self.restitutions, "restitutions")?;
+        nonempty(&self.engines, Field::Engines)?;
+        nonempty(&self.dts, Field::Dts)?;
+        nonempty(&self.restitutions, Field::Restitutions)?;
         if let Some(e) = self
             .restitutions
             .iter()
             .find(|e| !(e.is_finite() && (0.0..1.0).contains(*e)))
         {
             return Err(Error::field(
-                "restitutions",
+                Field::Restitutions,
                 e,
                 "must be in [0, 1): at e = 1 nothing is lost at a bounce and no roll ever rests",
             ));
@@ -64,11 +65,11 @@ impl Config {
             .iter()
             .find(|m| !(m.is_finite() && **m >= 0.0))
         {
-            return Err(Error::field("frictions", m, "must be finite and >= 0"));
+            return Err(Error::field(Field::Frictions, m, "must be finite and >= 0"));
         }
         if !(0.001..=DICEPHYS_FLOOR_THICKNESS).contains(&self.floor_thickness) {
             return Err(Error::field(
-                "floor_thickness",
+                Field::FloorThickness,
                 self.floor_thickness,
                 "must be in [0.001, 100] m",
             ));

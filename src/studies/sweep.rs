@@ -15,6 +15,7 @@
 //! ([`precision`](super::precision)).
 
 use crate::engine::EngineKind;
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::model::scene::Scene;
 use crate::run::cputime::process_cpu_seconds;
@@ -147,16 +148,16 @@ pub fn parse_dt(s: &str) -> Result<f64> {
 /// Checks what every sweep takes: its rolls per cell and its step cap.
 pub fn check_rolls_and_steps(rolls: u64, max_steps: u64) -> Result<()> {
     if rolls == 0 || rolls > crate::run::spec::MAX_ROLLS {
-        return Err(Error::field("rolls", rolls, "must be in 1..=1e9"));
+        return Err(Error::field(Field::Rolls, rolls, "must be in 1..=1e9"));
     }
     if max_steps == 0 {
-        return Err(Error::field("max_steps", 0, "need at least one step"));
+        return Err(Error::field(Field::MaxSteps, 0, "need at least one step"));
     }
     Ok(())
 }
 
 /// Refuses an empty list: "blocks: give at least one value".
-pub fn nonempty<T>(v: &[T], field: &'static str) -> Result<()> {
+pub fn nonempty<T>(v: &[T], field: Field) -> Result<()> {
     if v.is_empty() {
         Err(Error::field(field, "", "give at least one value"))
     } else {
@@ -165,7 +166,7 @@ pub fn nonempty<T>(v: &[T], field: &'static str) -> Result<()> {
 }
 
 /// Refuses a CPU budget that is not a positive number of seconds.
-pub fn check_budget(v: f64, field: &'static str) -> Result<()> {
+pub fn check_budget(v: f64, field: Field) -> Result<()> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {

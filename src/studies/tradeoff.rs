@@ -22,6 +22,7 @@ use super::stream::Stream;
 use super::sweep::{check_budget, check_rolls_and_steps, nonempty};
 use super::{Progress, Study};
 use crate::engine::EngineKind;
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::scene::{Floor, Mode, Scene};
@@ -69,17 +70,17 @@ pub struct Config {
 impl Config {
     /// Checks every value before anything runs.
     pub fn validate(&self) -> Result<()> {
-        nonempty(&self.blocks, "blocks")?;
+        nonempty(&self.blocks, Field::Blocks)?;
         if let Some(b) = self
             .blocks
             .iter()
             .enumerate()
             .find_map(|(i, b)| self.blocks[..i].contains(b).then_some(b))
         {
-            return Err(Error::field("blocks", b, "named twice"));
+            return Err(Error::field(Field::Blocks, b, "named twice"));
         }
-        nonempty(&self.modes, "modes")?;
-        nonempty(&self.dts, "dts")?;
+        nonempty(&self.modes, Field::Modes)?;
+        nonempty(&self.dts, Field::Dts)?;
         if self
             .dts
             .iter()
@@ -87,14 +88,14 @@ impl Config {
             .any(|&d| d <= self.reference_dt)
         {
             return Err(Error::field(
-                "reference_dt",
+                Field::ReferenceDt,
                 dt_label(self.reference_dt),
                 "must be finer than every `dts` and `rapier_dts`",
             ));
         }
         if self.ladder.contains(&self.reference_dt) {
             return Err(Error::field(
-                "ladder",
+                Field::Ladder,
                 "",
                 "the reference's dt is not a rung",
             ));
@@ -103,14 +104,14 @@ impl Config {
             let max = crate::run::spec::MAX_ROLLS / crate::run::runner::CHUNK_ROLLS;
             if k == 0 || k > max {
                 return Err(Error::field(
-                    "preroll_chunks",
+                    Field::PrerollChunks,
                     k.saturating_mul(crate::run::runner::CHUNK_ROLLS),
                     format!("must be in 1..={} rolls", crate::run::spec::MAX_ROLLS),
                 ));
             }
         }
-        check_budget(self.budget_s, "budget_s")?;
-        check_budget(self.reference_budget_s, "reference_budget_s")?;
+        check_budget(self.budget_s, Field::BudgetS)?;
+        check_budget(self.reference_budget_s, Field::ReferenceBudgetS)?;
         check_rolls_and_steps(1, self.max_steps)
     }
 

@@ -12,6 +12,7 @@ use crate::calibration::design::{self, Design};
 use crate::calibration::params::Narrowed;
 use crate::calibration::{cuts, estimate_with, widen, FitConfig, FitCost, FitResult, Pass};
 use crate::calibration::{narrow, MAX_WIDENINGS};
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::runner::{ChunkShare, Runner};
@@ -351,9 +352,9 @@ impl Stage {
     pub fn check(&self, refine: bool) -> Result<()> {
         if *self != Stage::Whole && !refine {
             return Err(Error::field(
-                "stage",
+                Field::Refine,
                 "",
-                "a study of one pass (no `refine`) has no passes to split",
+                "a study of one pass has no passes to split",
             ));
         }
         Ok(())

@@ -5,6 +5,7 @@ use crate::calibration::design::point_seed;
 use crate::calibration::params::Kind;
 use crate::calibration::predict::{group, BlockPrediction, PredictConfig, Predicted};
 use crate::calibration::FitResult;
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::run::runner::Runner;
 use std::path::Path;
@@ -15,7 +16,7 @@ pub fn check(fit: &FitResult, cfg: &PredictConfig) -> Result<()> {
     fit.check()?;
     if cfg.draws < 2 || cfg.draws > fit.estimate.draws.len() {
         return Err(Error::field(
-            "draws",
+            Field::Draws,
             cfg.draws,
             format!(
                 "from 2 to the fit's {} posterior draws",
@@ -25,7 +26,7 @@ pub fn check(fit: &FitResult, cfg: &PredictConfig) -> Result<()> {
     }
     if cfg.rolls == 0 || cfg.rolls > crate::run::spec::MAX_ROLLS {
         return Err(Error::field(
-            "rolls",
+            Field::Rolls,
             cfg.rolls,
             format!("from 1 to {}", crate::run::spec::MAX_ROLLS),
         ));
@@ -36,7 +37,7 @@ pub fn check(fit: &FitResult, cfg: &PredictConfig) -> Result<()> {
     if let Some([e, mu]) = cfg.contact {
         if !((0.0..=1.0).contains(&e) && (0.0..=5.0).contains(&mu)) {
             return Err(Error::field(
-                "contact",
+                Field::Contact,
                 format!("{e},{mu}"),
                 "e must be in [0, 1] and μ in [0, 5]",
             ));
@@ -47,7 +48,7 @@ pub fn check(fit: &FitResult, cfg: &PredictConfig) -> Result<()> {
         model.is_free(Kind::E) || model.is_free(Kind::Mu),
     ) {
         return Err(Error::field(
-            "contact",
+            Field::Contact,
             format!("{e},{mu}"),
             "the fit has e or μ free, fitted per surface: name one of its surfaces instead",
         ));

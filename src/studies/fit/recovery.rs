@@ -10,6 +10,7 @@ use crate::calibration::estimate::Likelihood;
 use crate::calibration::params::Fixed;
 use crate::calibration::recovery::{Recovery, Repetition};
 use crate::calibration::FitConfig;
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::run::runner::Runner;
 use crate::studies::fit::simulate::outcome_counts;
@@ -53,7 +54,11 @@ pub fn simulate_data(
 pub fn check_truth(cfg: &FitConfig, truth: &[f64], repeats: usize) -> Result<()> {
     let model = &cfg.model;
     if repeats == 0 {
-        return Err(Error::field("repeats", 0, "need at least one repetition"));
+        return Err(Error::field(
+            Field::Repeats,
+            0,
+            "need at least one repetition",
+        ));
     }
     if truth.len() != model.free.len() {
         return Err(Error::Invalid(format!(
@@ -65,7 +70,7 @@ pub fn check_truth(cfg: &FitConfig, truth: &[f64], repeats: usize) -> Result<()>
     for ((kind, range), v) in model.free.iter().zip(&model.ranges).zip(truth) {
         if !(range.lo..=range.hi).contains(v) {
             return Err(Error::field(
-                "recover",
+                Field::Recover,
                 format!("{kind}={v}"),
                 format!("outside its range {range} (`range` sets it)"),
             ));

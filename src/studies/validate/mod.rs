@@ -36,6 +36,7 @@ pub mod limits;
 mod trend;
 
 use crate::engine::EngineKind;
+use crate::error::Field;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::scene::{Mode, MAX_DAMPING};
@@ -103,19 +104,26 @@ impl Config {
     pub fn validate(&self) -> Result<()> {
         let bad = |field, v: String, why: &str| Err(Error::field(field, v, why));
         if self.engines.is_empty() {
-            return bad("engines", String::new(), "name at least one engine");
+            return bad(Field::Engines, String::new(), "name at least one engine");
         }
-        for (name, r) in [("rolls", self.rolls), ("trend_rolls", self.trend_rolls)] {
+        for (name, r) in [
+            (Field::Rolls, self.rolls),
+            (Field::TrendRolls, self.trend_rolls),
+        ] {
             if r == 0 || r > crate::run::spec::MAX_ROLLS {
                 return bad(name, r.to_string(), "must be in 1..=1e9");
             }
         }
         if !(self.resolve.is_finite() && self.resolve > 0.0 && self.resolve < 1.0) {
-            return bad("resolve", self.resolve.to_string(), "must be in (0, 1)");
+            return bad(
+                Field::Resolve,
+                self.resolve.to_string(),
+                "must be in (0, 1)",
+            );
         }
         if !(self.flight_time.is_finite() && self.flight_time > 0.0 && self.flight_time <= 100.0) {
             let t = self.flight_time.to_string();
-            return bad("flight_time", t, "must be in (0, 100] s");
+            return bad(Field::FlightTime, t, "must be in (0, 100] s");
         }
         if self.trend.is_empty() && self.blocks_2d.is_empty() && self.blocks_3d.is_empty() {
             return Err(Error::Invalid(
@@ -125,14 +133,14 @@ impl Config {
         for &(e, mu) in &self.trend {
             if !(e.is_finite() && (0.0..=1.0).contains(&e) && mu.is_finite() && mu >= 0.0) {
                 return bad(
-                    "trend",
+                    Field::Trend,
                     format!("{e}:{mu}"),
                     "each point is E:MU with e in [0, 1] and μ >= 0",
                 );
             }
         }
         for &dt in &self.flight_dts {
-            crate::model::scene::check_dt("flight_dts", dt)?;
+            crate::model::scene::check_dt(Field::FlightDts, dt)?;
         }
         let scene = limit_scene(self, self.trend_block, Mode::ThreeD, true);
         scene.validate(false)?;
