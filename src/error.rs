@@ -60,6 +60,8 @@ pub enum Error {
 )]
 #[strum(serialize_all = "snake_case")]
 pub enum Field {
+    /// `kappa`.
+    Kappa,
     /// `allow_restitution_above_one`.
     AllowRestitutionAboveOne,
     /// `rapier_dts`.

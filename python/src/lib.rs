@@ -14,6 +14,7 @@
 use dicephys::calibration::{self, FitConfig};
 use dicephys::engine::EngineKind;
 use dicephys::error::parse_name;
+use dicephys::error::Field;
 use dicephys::model::block::Block;
 use dicephys::model::faces::Layout;
 use dicephys::model::mass::Features;
@@ -27,7 +28,6 @@ use dicephys::run::stop::Stop;
 use dicephys::sim::roll::{RollConfig, RollRecord, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
 use dicephys::studies::outputs::{self, Done, Hooks, Place};
 use dicephys::studies::StudyConfig;
-use dicephys::error::Field;
 use dicephys::Error;
 use pyo3::conversion::FromPyObjectOwned;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyTypeError, PyValueError};

@@ -16,8 +16,7 @@
 
 use crate::calibration::data::DataRow;
 use crate::calibration::params::{Axes, ModelSpec, Param};
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::inference::surrogate::{DesignPoint, Surrogate};
 use crate::model::block::Block;
 use crate::model::scene::Mode;

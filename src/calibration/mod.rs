@@ -32,8 +32,7 @@ pub mod params;
 pub mod predict;
 pub mod recovery;
 
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::model::throws::Range;
 use data::DataRow;
 use design::{Design, DesignSpec};

@@ -420,17 +420,6 @@ impl ThrowArgs {
             style,
             kappa: self.kappa,
         };
-        if self.kappa.is_some() && style != ThrowStyle::Hand {
-            return Err(Error::Usage(format!(
-                "--kappa: only --throw hand takes a concentration, not --throw {style}"
-            )));
-        }
-        if self.kappa.is_none() && style == ThrowStyle::Hand {
-            return Err(Error::Usage(
-                "--throw hand needs --kappa K (0: the tumble's spread; large: the paper's throw)"
-                    .into(),
-            ));
-        }
         spec.validate()?;
         Ok(spec)
     }

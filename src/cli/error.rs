@@ -96,6 +96,7 @@ pub fn flag(field: Field) -> &'static str {
         Field::InsertCentre => "--die's insert.centre",
         Field::InsertDensity => "--die's insert.density",
         Field::InsertSize => "--die's insert.size",
+        Field::Kappa => "--kappa",
         Field::Kind => "--source",
         Field::Ladder => "--ladder",
         Field::LinearDamping => "--linear-damping",

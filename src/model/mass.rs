@@ -9,8 +9,7 @@
 //! as moments about the geometric centre; the tensor about the centre of mass follows from
 //! the parallel-axis theorem, and its eigenvectors are the body's principal frame.
 
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::model::block::Mode;
 use crate::model::faces::Layout;
 use nalgebra::{Matrix3, Rotation3, SymmetricEigen, UnitQuaternion, Vector3};

@@ -1,8 +1,7 @@
 //! The scene a throw happens in: the block, the surface, the time step, 2D or 3D, and the
 //! engine settings. Defaults are DicePhys's, as the paper ran it (DESIGN.md).
 
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::model::block::Block;
 pub use crate::model::block::Mode;
 use crate::model::mass::{Features, MassProps, Solid};

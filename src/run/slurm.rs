@@ -17,8 +17,7 @@
 //!
 //! This module writes the scripts; it never calls the scheduler.
 
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::run::io::Output;
 use crate::run::spec::{RunSpec, Shard};
 use serde::{Deserialize, Serialize};

@@ -4,8 +4,7 @@
 //! the run that wrote them.
 
 use crate::engine::EngineKind;
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::model::scene::Scene;
 use crate::model::throws::{ThrowKind, ThrowRanges, ThrowStyle, Throws};
 use crate::sim::roll::RollConfig;
@@ -71,22 +70,29 @@ impl ThrowSpec {
         self.ranges.validate()?;
         match (self.style, self.kappa) {
             (ThrowStyle::Hand, None) => {
-                return Err(Error::Invalid(
-                    "throw hand: give its concentration kappa (0 tumbles, large is the paper's)"
-                        .into(),
+                return Err(Error::field(
+                    Field::Style,
+                    "hand",
+                    "needs `kappa` K (0: the tumble's spread; large: the paper's throw)",
                 ))
             }
             (ThrowStyle::Hand, Some(k)) if !(0.0..=MAX_KAPPA).contains(&k) => {
-                return Err(Error::Invalid(format!(
-                    "kappa {k}: a hand's concentration is 0 to {MAX_KAPPA:e} (--throw paper is \
-                     the limit of large kappa)"
-                )))
+                return Err(Error::field(
+                    Field::Kappa,
+                    k,
+                    format!(
+                        "a hand's concentration is 0 to {MAX_KAPPA:e} (`style` paper is the \
+                         limit of large kappa)"
+                    ),
+                ))
             }
             (ThrowStyle::Hand, Some(_)) | (_, None) => {}
             (s, Some(_)) => {
-                return Err(Error::Invalid(format!(
-                    "kappa: only a hand's throw takes a concentration, not the {s} throw"
-                )))
+                return Err(Error::field(
+                    Field::Kappa,
+                    "",
+                    format!("only `style` hand takes a concentration, not `style` {s}"),
+                ))
             }
         }
         if self.style == ThrowStyle::Rest {

@@ -6,8 +6,7 @@
 use super::fit::Stage;
 use super::outputs::{self, Hooks, Place};
 use super::StudyConfig;
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::run::runner::{Checkpoint, ChunkShare};
 use crate::run::slurm::{script_path, Layout, Options, Plan};
 use crate::run::spec::RunSpec;

@@ -16,8 +16,7 @@ use super::sweep::{
 };
 use super::{Progress, Study};
 use crate::engine::EngineKind;
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::model::block::Block;
 use crate::model::scene::{Mode, Scene};
 use crate::report::converge::{format_cell, Cell, Claim, Converge};

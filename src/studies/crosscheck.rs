@@ -3,8 +3,7 @@
 
 use super::Study;
 use crate::engine::EngineKind;
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::report::crosscheck::{Crosscheck, Versus};
 use crate::report::summary::Reached;
 use crate::report::summary::{Cost, RunSummary};

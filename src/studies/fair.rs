@@ -5,8 +5,7 @@
 //! 5σ. The simulation is itself such a tester: a bias it cannot resolve at 2σ is reported as
 //! unresolved, with the rolls that would resolve it.
 
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::model::faces::{side_of, Layout, DIRECTIONS};
 use crate::model::mass::Features;
 use crate::model::scene::Mode;

@@ -6,8 +6,7 @@
 use super::place::{to_json, Outputs};
 pub use super::place::{Done, Hooks, Place};
 use super::{Kind, Study, StudyConfig};
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::report;
 use crate::report::per_roll::PerRoll;
 pub use crate::report::progress::Unit;

@@ -4,8 +4,7 @@
 //! theory.
 
 use crate::engine::EngineKind;
-use crate::error::Field;
-use crate::error::Result;
+use crate::error::{Field, Result};
 use crate::model::block::Block;
 use crate::model::scene::{Mode, Preset, Scene};
 use crate::report::paper::{PaperResults, Provenance, SimCell};

@@ -4,8 +4,7 @@
 //! `studies::fit::outputs`) are written against these, which import neither.
 
 use super::{Progress, Study};
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::run::io::Output;
 use crate::run::runner::{ChunkShare, Runner};
 use crate::run::slurm::Layout;

@@ -11,8 +11,7 @@
 use super::sweep::{cell_spec, check_rolls_and_steps, measure, nonempty};
 use super::{Progress, Study};
 use crate::engine::EngineKind;
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::model::block::Block;
 use crate::model::scene::{Mode, Scene, DICEPHYS_FLOOR_THICKNESS};
 use crate::report::stability::{format_cell, Cell, Stability, Sweep, KINDS};

@@ -15,8 +15,7 @@
 //! ([`precision`](super::precision)).
 
 use crate::engine::EngineKind;
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::model::scene::Scene;
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::io::write_atomic;

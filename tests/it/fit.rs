@@ -236,12 +236,12 @@ fn values_outside_their_physical_ranges_are_refused() {
     }
     // The hand's throw needs its κ, and κ needs the hand (alone, --kappa asks for it).
     for (flags, want) in [
-        (vec!["--throw", "hand"], "--throw hand needs --kappa"),
+        (vec!["--throw", "hand"], "--throw hand: needs --kappa"),
         (
             vec!["--throw", "tumble", "--kappa", "3"],
             "only --throw hand takes",
         ),
-        (vec!["--throw", "hand", "--kappa", "-1"], "kappa -1"),
+        (vec!["--throw", "hand", "--kappa", "-1"], "--kappa -1"),
     ] {
         let mut args = vec!["roll", "--block", "140x24x20", "--rolls", "10"];
         args.extend(flags.iter());

@@ -5,8 +5,7 @@ use crate::calibration::design::point_seed;
 use crate::calibration::params::Kind;
 use crate::calibration::predict::{group, BlockPrediction, PredictConfig, Predicted};
 use crate::calibration::FitResult;
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::run::runner::Runner;
 use std::path::Path;
 

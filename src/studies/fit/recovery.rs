@@ -10,8 +10,7 @@ use crate::calibration::estimate::Likelihood;
 use crate::calibration::params::Fixed;
 use crate::calibration::recovery::{Recovery, Repetition};
 use crate::calibration::FitConfig;
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::run::runner::Runner;
 use crate::studies::fit::simulate::outcome_counts;
 

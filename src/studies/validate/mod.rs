@@ -36,8 +36,7 @@ pub mod limits;
 mod trend;
 
 use crate::engine::EngineKind;
-use crate::error::Field;
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use crate::model::block::Block;
 use crate::model::scene::{Mode, MAX_DAMPING};
 use crate::model::throws::ThrowStyle;
