@@ -277,7 +277,7 @@ fn paper_through_slurm_writes_the_one_machine_results() {
         return;
     };
     let dir = tmp("paper");
-    let run = ["--rolls", "2000", "--threads", "1"];
+    let run = ["--rolls", "1000", "--threads", "1"];
     let (array, fin) = submit("paper", &run, 4, &dir);
     let one = tmp("paper-one");
     let status = bin()
