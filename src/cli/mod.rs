@@ -60,7 +60,8 @@ pub enum Command {
     /// The engines against the limits known in closed form: no bounce (2D), solid angles (3D),
     /// free flight, and the trend towards the paper's theory.
     Validate(validate::ValidateArgs),
-    /// Speed of each engine and lever against the faithful configuration, side by side.
+    /// Speed of each engine and method (early stop, closed-form flight, floor) against DicePhys's
+    /// own way of rolling, side by side.
     Bench(bench::BenchArgs),
     /// One throw's trajectory as CSV (step, time, position, orientation, velocities, energy).
     Trace(trace::TraceArgs),

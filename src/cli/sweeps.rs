@@ -51,8 +51,8 @@ pub struct ConvergeArgs {
     /// With --precision: CPU seconds the finest dt's cell may spend.
     #[arg(long, default_value_t = 1800.0)]
     pub reference_budget: f64,
-    /// Roll with the exact levers (closed-form flight; the early stop at dt <= 1/250 s), shown
-    /// exact at fine steps by `tradeoff`'s levers row, instead of every step stepped.
+    /// Roll the fast way (closed-form flight; the exact early stop at dt <= 1/250 s), which
+    /// `tradeoff` shows gives the same outcomes at fine steps, instead of every step stepped.
     #[arg(long)]
     pub fast: bool,
 }
@@ -75,7 +75,7 @@ pub struct TradeoffArgs {
     /// Rapier's time steps (comma-separated).
     #[arg(long, value_delimiter = ',', default_value = "1/250,1/1000", value_parser = parse_dt)]
     pub rapier_dts: Vec<f64>,
-    /// The reference's time step (Bullet, box floor, the exact levers).
+    /// The reference's time step (Bullet, box floor, rolled the fast way).
     #[arg(long, default_value = "1/5000", value_parser = parse_dt)]
     pub reference_dt: f64,
     /// The reference's ladder: other fine steps rolled like the reference, each a departure
