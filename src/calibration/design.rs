@@ -58,21 +58,19 @@ impl Default for DesignSpec {
 impl DesignSpec {
     /// Checks the sizes.
     pub fn validate(&self, dims: usize) -> Result<()> {
-        let bad = |m: String| Err(Error::Invalid(m));
+        let bad = |m: String| Err(Error::field(Field::Points, self.points, m));
         let corners = 1usize << dims.min(20);
         if self.points < corners + 1 {
             return bad(format!(
-                "points {}: a design over {dims} parameters needs at least {} (its corners and centre)",
-                self.points,
+                "a design over {dims} parameters needs at least {} (its corners and centre)",
                 corners + 1
             ));
         }
         let features = crate::inference::surrogate::exponents(dims, self.degree).len();
         if self.points < 2 * features {
             return bad(format!(
-                "points {}: a degree-{} surrogate over {dims} parameters has {features} coefficients \
-                 an outcome, and needs at least twice as many points ({})",
-                self.points,
+                "a degree-{} surrogate over {dims} parameters has {features} coefficients an \
+                 outcome, and needs at least twice as many points ({})",
                 self.degree,
                 2 * features
             ));

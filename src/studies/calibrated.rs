@@ -91,14 +91,7 @@ impl CalibratedConfig {
         let rows = paper_rows()?;
         for (_, _, model, rows) in models(&rows) {
             let dims = model.free.len();
-            self.design.validate(dims).map_err(|e| match e {
-                Error::Invalid(m) if m.starts_with("points ") => Error::field(
-                    Field::Points,
-                    self.design.points,
-                    m.split_once(": ").map_or(m.clone(), |p| p.1.to_string()),
-                ),
-                e => e,
-            })?;
+            self.design.validate(dims)?;
             FitConfig {
                 rows,
                 model,

@@ -220,7 +220,7 @@ fn values_outside_their_physical_ranges_are_refused() {
         (vec!["--friction", "-0.1"], "mu -0.1"),
         (vec!["--kappa", "-3"], "kappa -3"),
         (vec!["--free", "e,size"], "unknown parameter 'size'"),
-        (vec!["--points", "5"], "points 5"),
+        (vec!["--points", "5"], "--points 5"),
         (
             vec!["--recover", "e=0.5"],
             "give a value for the free parameter mu",
