@@ -486,15 +486,17 @@ fn lower_point(profiles: &[Vec<(f64, f64)>], best: &Minimum) -> Option<Vec<f64>>
     })
 }
 
-/// Fits `rows`: the maximum, the profiles, the goodness of fit and posterior draws. Each
-/// stage says its line to `watch` and ends at once on a stop request (`Error::Stopped`).
-pub fn estimate(
+/// Profiles in the search's coordinates: each parameter's (u, −2 ln L) points.
+type Profiles = Vec<Vec<(f64, f64)>>;
+
+/// The maximum and each parameter's profile about it, searched again from any profile point
+/// below it; with every distinct maximum met (the best first).
+fn maximum_and_profiles(
     lik: &Likelihood,
-    params: &[Param],
+    dims: usize,
     search: &Search,
     watch: &Watch,
-) -> Result<Estimate> {
-    let dims = params.len();
+) -> Result<(Minimum, Profiles, Vec<Maximum>)> {
     let f = |x: &[f64]| lik.minus_two_ln_l(x);
     (watch.say)(&format!(
         "fit: the maximum over {dims} parameters, from {} starts",
@@ -526,6 +528,43 @@ pub fn estimate(
             _ => break (best, profiles),
         }
     };
+    Ok((best, profiles, maxima))
+}
+
+/// Each parameter's fit from its profile: the value at the maximum, its 1σ and 2σ intervals
+/// at the scale `b`, whether they are identified, and its profile in physical units.
+fn param_fits(params: &[Param], profiles: Profiles, best: &Minimum, b: f64) -> Vec<ParamFit> {
+    let mut fits = Vec::new();
+    for ((j, param), prof) in params.iter().enumerate().zip(profiles) {
+        // A profile point below the maximum means the search missed it: take the lower.
+        let fmin = prof.iter().map(|p| p.1).fold(best.f, f64::min);
+        let one = interval(&prof, fmin, b);
+        let two = interval(&prof, fmin, 4.0 * b);
+        let phys = |u: f64| param.kind.value(param.range, u);
+        fits.push(ParamFit {
+            param: param.clone(),
+            name: param.name(),
+            value: phys(best.x[j]),
+            one_sigma: [phys(one.lo), phys(one.hi)],
+            two_sigma: [phys(two.lo), phys(two.hi)],
+            identified: Identified::of(&two, param),
+            profile: prof.iter().map(|(u, v)| [phys(*u), v - fmin]).collect(),
+        });
+    }
+    fits
+}
+
+/// Fits `rows`: the maximum, the profiles, the goodness of fit and posterior draws. Each
+/// stage says its line to `watch` and ends at once on a stop request (`Error::Stopped`).
+pub fn estimate(
+    lik: &Likelihood,
+    params: &[Param],
+    search: &Search,
+    watch: &Watch,
+) -> Result<Estimate> {
+    let dims = params.len();
+    let f = |x: &[f64]| lik.minus_two_ln_l(x);
+    let (best, profiles, maxima) = maximum_and_profiles(lik, dims, search, watch)?;
     if search.bootstrap > 0 && dims > 0 {
         (watch.say)(&format!(
             "fit: the likelihood ratio's scale from {} simulated data sets",
@@ -577,23 +616,7 @@ pub fn estimate(
         }
         watch.check()?;
     }
-    let mut fits = Vec::new();
-    for ((j, param), prof) in params.iter().enumerate().zip(profiles) {
-        // A profile point below the maximum means the search missed it: take the lower.
-        let fmin = prof.iter().map(|p| p.1).fold(best.f, f64::min);
-        let one = interval(&prof, fmin, b);
-        let two = interval(&prof, fmin, 4.0 * b);
-        let phys = |u: f64| param.kind.value(param.range, u);
-        fits.push(ParamFit {
-            param: param.clone(),
-            name: param.name(),
-            value: phys(best.x[j]),
-            one_sigma: [phys(one.lo), phys(one.hi)],
-            two_sigma: [phys(two.lo), phys(two.hi)],
-            identified: Identified::of(&two, param),
-            profile: prof.iter().map(|(u, v)| [phys(*u), v - fmin]).collect(),
-        });
-    }
+    let fits = param_fits(params, profiles, &best, b);
     let rows = row_fits(lik, &best.x);
     let chi2: f64 = rows.iter().map(|r| r.chi2).sum();
     let bootstrap = verdict(&sets, chi2, b * region_delta(dims, TWO_SIGMA));

@@ -131,6 +131,108 @@ impl Surrogate {
         self.exps.len()
     }
 
+    /// The penalised log-likelihood's gradient at `beta` (the score), and its information
+    /// (minus its Hessian) into `info`, over the design's counts; `(k1, m)` the outcomes but
+    /// the last and the features an outcome.
+    fn score_and_information(
+        beta: &DVector<f64>,
+        counts: &[Vec<f64>],
+        phis: &[DVector<f64>],
+        ridge: &[f64],
+        (k1, m): (usize, usize),
+        info: &mut DMatrix<f64>,
+    ) -> DVector<f64> {
+        let size = k1 * m;
+        let mut grad = DVector::from_iterator(size, (0..size).map(|i| -2.0 * ridge[i] * beta[i]));
+        info.fill(0.0);
+        for i in 0..size {
+            info[(i, i)] = 2.0 * ridge[i];
+        }
+        for (c, phi) in counts.iter().zip(phis) {
+            let nf: f64 = c.iter().sum();
+            if nf == 0.0 {
+                continue;
+            }
+            let p = Self::probs(beta, phi, k1, m);
+            for a in 0..k1 {
+                let r = c[a] - nf * p[a];
+                for i in 0..m {
+                    grad[a * m + i] += r * phi[i];
+                }
+                for b in 0..k1 {
+                    let w = nf * (if a == b { p[a] } else { 0.0 } - p[a] * p[b]);
+                    if w == 0.0 {
+                        continue;
+                    }
+                    for i in 0..m {
+                        let wi = w * phi[i];
+                        for j in 0..m {
+                            info[(a * m + i, b * m + j)] += wi * phi[j];
+                        }
+                    }
+                }
+            }
+        }
+        grad
+    }
+
+    /// Each outcome's degree (all but the last): the highest at most `degree` whose
+    /// coefficients its events over the design carry (`EVENTS_PER_COEFFICIENT` each).
+    fn outcome_degrees(
+        design: &[DesignPoint],
+        dims: usize,
+        degree: usize,
+        k1: usize,
+    ) -> Vec<usize> {
+        (0..k1)
+            .map(|a| {
+                let events: u64 = design.iter().map(|d| d.counts[a]).sum();
+                (0..=degree)
+                    .rev()
+                    .find(|&d| {
+                        exponents(dims, d).len() as f64 * EVENTS_PER_COEFFICIENT <= events as f64
+                    })
+                    .unwrap_or(0)
+            })
+            .collect()
+    }
+
+    /// The deviance against the saturated model over the outcomes seen anywhere, and its
+    /// degrees of freedom (the cells less the coefficients of the outcomes seen).
+    fn deviance(
+        design: &[DesignPoint],
+        phis: &[DVector<f64>],
+        beta: &DVector<f64>,
+        degrees: &[usize],
+        (dims, k1, m): (usize, usize, usize),
+    ) -> (f64, usize) {
+        let outcomes = k1 + 1;
+        let seen: Vec<bool> = (0..outcomes)
+            .map(|k| design.iter().any(|d| d.counts[k] > 0))
+            .collect();
+        let mut deviance = 0.0;
+        let mut cells = 0usize;
+        for (d, phi) in design.iter().zip(phis) {
+            let n: u64 = d.counts.iter().sum();
+            if n == 0 {
+                continue;
+            }
+            cells += seen.iter().filter(|s| **s).count().saturating_sub(1);
+            let p = Self::probs(beta, phi, k1, m);
+            for (k, &c) in d.counts.iter().enumerate() {
+                if c > 0 {
+                    deviance += 2.0 * c as f64 * (c as f64 / (n as f64 * p[k])).ln();
+                }
+            }
+        }
+        let coefficients: usize = (0..k1)
+            .filter(|&a| seen[a])
+            .map(|a| exponents(dims, degrees[a]).len())
+            .sum();
+        let dof = cells.saturating_sub(coefficients);
+        (deviance, dof)
+    }
+
     /// Fits the surrogate of total degree `degree` to `design` (every point's counts over the
     /// same `outcomes` outcomes; a point with no counts adds nothing). Newton's method on the
     /// penalised log-likelihood, from β = 0, to a relative change below 1e-10.
@@ -167,17 +269,7 @@ impl Surrogate {
             })
             .collect();
         // Each outcome's degree, from its events over the design.
-        let degrees: Vec<usize> = (0..k1)
-            .map(|a| {
-                let events: u64 = design.iter().map(|d| d.counts[a]).sum();
-                (0..=degree)
-                    .rev()
-                    .find(|&d| {
-                        exponents(dims, d).len() as f64 * EVENTS_PER_COEFFICIENT <= events as f64
-                    })
-                    .unwrap_or(0)
-            })
-            .collect();
+        let degrees = Self::outcome_degrees(design, dims, degree, k1);
         // A coefficient above its outcome's degree is held at 0 by a stiff penalty.
         let ridge: Vec<f64> = (0..size)
             .map(|i| {
@@ -204,37 +296,8 @@ impl Surrogate {
             ll
         };
         for _ in 0..100 {
-            let mut grad =
-                DVector::from_iterator(size, (0..size).map(|i| -2.0 * ridge[i] * beta[i]));
-            info.fill(0.0);
-            for i in 0..size {
-                info[(i, i)] = 2.0 * ridge[i];
-            }
-            for (c, phi) in counts.iter().zip(&phis) {
-                let nf: f64 = c.iter().sum();
-                if nf == 0.0 {
-                    continue;
-                }
-                let p = Self::probs(&beta, phi, k1, m);
-                for a in 0..k1 {
-                    let r = c[a] - nf * p[a];
-                    for i in 0..m {
-                        grad[a * m + i] += r * phi[i];
-                    }
-                    for b in 0..k1 {
-                        let w = nf * (if a == b { p[a] } else { 0.0 } - p[a] * p[b]);
-                        if w == 0.0 {
-                            continue;
-                        }
-                        for i in 0..m {
-                            let wi = w * phi[i];
-                            for j in 0..m {
-                                info[(a * m + i, b * m + j)] += wi * phi[j];
-                            }
-                        }
-                    }
-                }
-            }
+            let grad =
+                Self::score_and_information(&beta, &counts, &phis, &ridge, (k1, m), &mut info);
             let Some(chol) = info.clone().cholesky() else {
                 break;
             };
@@ -261,29 +324,7 @@ impl Surrogate {
             .map(|c| c.inverse())
             .unwrap_or_else(|| DMatrix::from_diagonal_element(size, size, f64::INFINITY));
         // The deviance against the saturated model, over the outcomes seen anywhere.
-        let seen: Vec<bool> = (0..outcomes)
-            .map(|k| design.iter().any(|d| d.counts[k] > 0))
-            .collect();
-        let mut deviance = 0.0;
-        let mut cells = 0usize;
-        for (d, phi) in design.iter().zip(&phis) {
-            let n: u64 = d.counts.iter().sum();
-            if n == 0 {
-                continue;
-            }
-            cells += seen.iter().filter(|s| **s).count().saturating_sub(1);
-            let p = Self::probs(&beta, phi, k1, m);
-            for (k, &c) in d.counts.iter().enumerate() {
-                if c > 0 {
-                    deviance += 2.0 * c as f64 * (c as f64 / (n as f64 * p[k])).ln();
-                }
-            }
-        }
-        let coefficients: usize = (0..k1)
-            .filter(|&a| seen[a])
-            .map(|a| exponents(dims, degrees[a]).len())
-            .sum();
-        let dof = cells.saturating_sub(coefficients);
+        let (deviance, dof) = Self::deviance(design, &phis, &beta, &degrees, (dims, k1, m));
         let dispersion = if dof > 0 {
             (deviance / dof as f64).max(1.0)
         } else {
