@@ -564,6 +564,9 @@ impl Watch {
     /// Judges a step's state (`end.steps` already counts it): true when the roll has ended,
     /// with `end.fate` said. `energy` is false for a ballistic flown step, which has no
     /// contact to gain energy at.
+    // Every step of every roll passes here: kept inline in the loop as it was written before
+    // the split (callgrind, 1,000 paper rolls: 1.9 % more instructions without; 0.8 % with).
+    #[inline(always)]
     fn judge(&mut self, end: &mut End, state: &BodyState, energy: bool) -> bool {
         let die = &self.die;
         end.dip.push(die, state);
@@ -644,6 +647,7 @@ impl Flier {
     }
 
     /// Starts a flight if the die, in `state`, may fly.
+    #[inline(always)]
     fn start(&mut self, engine: &mut dyn Engine, state: &BodyState) {
         self.flying = if self.own {
             if engine.own_flight_start(state) {
@@ -704,6 +708,7 @@ impl Flier {
 
     /// The next flown state from `state`, or `None` where the flight ends, the engine then
     /// given the state back (an `Err` if it refused it).
+    #[inline(always)]
     fn next(
         &mut self,
         engine: &mut dyn Engine,
