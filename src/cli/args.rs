@@ -46,21 +46,6 @@ pub struct MaxSteps<const D: u64> {
     pub max_steps: u64,
 }
 
-/// Where a study runs and how it reports: its threads, its directory, JSON or text.
-#[derive(Args, Debug, Clone)]
-pub struct StudyPlace {
-    /// Worker threads.
-    #[command(flatten)]
-    pub threads: Threads,
-    /// Output directory: the report, its JSON, the figures, and the kept cells the same
-    /// command continues from [default: the command's name and -out, e.g. paper-out].
-    #[arg(long, value_name = "OUT")]
-    pub out: Option<std::path::PathBuf>,
-    /// JSON or text.
-    #[command(flatten)]
-    pub json: Json,
-}
-
 impl std::ops::Deref for Seed {
     type Target = u64;
     fn deref(&self) -> &u64 {
@@ -93,20 +78,6 @@ impl Threads {
     /// The worker threads, checked (0: one per core).
     pub fn checked(&self) -> Result<usize> {
         threads(self.threads)
-    }
-}
-
-impl StudyPlace {
-    /// The directory: `--out`, or `<command>-out`.
-    pub fn out(&self, command: &str) -> std::path::PathBuf {
-        self.out
-            .clone()
-            .unwrap_or_else(|| format!("{command}-out").into())
-    }
-
-    /// The study run here, on all its chunks, writing into `--out` or `<command>-out`.
-    pub fn local(&self, command: &str) -> Result<dicephys::studies::outputs::Place> {
-        super::study::local(&self.out(command), *self.threads, *self.json)
     }
 }
 

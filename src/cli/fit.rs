@@ -2,8 +2,9 @@
 //! recovers known values) and `dicephys predict` (a block the fit did not see).
 
 use super::args::{parse_engine, parse_step};
-use super::args::{Json, MaxSteps, Seed, StudyPlace, Threads};
+use super::args::{Json, MaxSteps, Seed, Threads};
 use super::error::{Error, Result};
+use super::study::StudyPlace;
 use clap::Args;
 use dicephys::calibration::data;
 use dicephys::calibration::design::DesignSpec;

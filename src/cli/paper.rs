@@ -1,9 +1,10 @@
 //! `dicephys paper`: the main job. Reproduces the paper end to end and writes a report.
 
 use super::args::parse_engine;
-use super::args::{MaxSteps, Seed, StudyPlace};
+use super::args::{MaxSteps, Seed};
 use super::error::Result;
 use super::study;
+use super::study::StudyPlace;
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::sim::roll::DEFAULT_MAX_STEPS;

@@ -4,12 +4,42 @@
 
 use super::error::{Error, Result};
 use super::out;
+use clap::Args;
 use dicephys::report::progress::Progress;
 use dicephys::run::runner::ChunkShare;
 use dicephys::studies::outputs::{self, Done, Hooks, Place};
 use dicephys::studies::{paper::PaperConfig, validate, StudyConfig};
 use std::path::Path;
 use std::time::Duration;
+
+/// Where a study runs and how it reports: its threads, its directory, JSON or text.
+#[derive(Args, Debug, Clone)]
+pub struct StudyPlace {
+    /// Worker threads.
+    #[command(flatten)]
+    pub threads: super::args::Threads,
+    /// Output directory: the report, its JSON, the figures, and the kept cells the same
+    /// command continues from [default: the command's name and -out, e.g. paper-out].
+    #[arg(long, value_name = "OUT")]
+    pub out: Option<std::path::PathBuf>,
+    /// JSON or text.
+    #[command(flatten)]
+    pub json: super::args::Json,
+}
+
+impl StudyPlace {
+    /// The directory: `--out`, or `<command>-out`.
+    pub fn out(&self, command: &str) -> std::path::PathBuf {
+        self.out
+            .clone()
+            .unwrap_or_else(|| format!("{command}-out").into())
+    }
+
+    /// The study run here, on all its chunks, writing into `--out` or `<command>-out`.
+    pub fn local(&self, command: &str) -> Result<Place> {
+        local(&self.out(command), *self.threads, *self.json)
+    }
+}
 
 /// A study run here, on all its chunks, writing into `out` (its cells under `out/checkpoint`).
 /// A Slurm run's directory is refused: its tasks and finishing job write there.

@@ -3,9 +3,10 @@
 //! `<command>.json`, `report.md` and its figures into --out (`super::study`).
 
 use super::args::{parse_engine, parse_percent};
-use super::args::{MaxSteps, Seed, StudyPlace};
+use super::args::{MaxSteps, Seed};
 use super::error::{Error, Result};
 use super::study;
+use super::study::StudyPlace;
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::model::block::Block;

@@ -3,9 +3,10 @@
 //! figures into --out.
 
 use super::args::parse_engine;
-use super::args::{Seed, StudyPlace};
+use super::args::Seed;
 use super::error::Result;
 use super::study;
+use super::study::StudyPlace;
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::model::block::Block;
