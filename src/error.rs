@@ -60,32 +60,12 @@ pub enum Error {
 )]
 #[strum(serialize_all = "snake_case")]
 pub enum Field {
-    /// `kappa`.
-    Kappa,
-    /// `allow_restitution_above_one`.
-    AllowRestitutionAboveOne,
-    /// `rapier_dts`.
-    RapierDts,
-    /// `refine`.
-    Refine,
-    /// `plan_only`.
-    PlanOnly,
-    /// `kind`.
-    Kind,
-    /// `trend_rolls`.
-    TrendRolls,
-    /// `time`.
-    Time,
     /// `account`.
     Account,
-    /// `partition`.
-    Partition,
-    /// `velocity`.
-    Velocity,
+    /// `allow_restitution_above_one`.
+    AllowRestitutionAboveOne,
     /// `angular_damping`.
     AngularDamping,
-    /// `linear_damping`.
-    LinearDamping,
     /// `bin`.
     Bin,
     /// `blocks`.
@@ -141,8 +121,14 @@ pub enum Field {
     #[strum(serialize = "insert.size")]
     /// `insert.size`.
     InsertSize,
+    /// `kappa`.
+    Kappa,
+    /// `kind`.
+    Kind,
     /// `ladder`.
     Ladder,
+    /// `linear_damping`.
+    LinearDamping,
     /// `margin`.
     Margin,
     /// `max_steps`.
@@ -153,6 +139,8 @@ pub enum Field {
     Null,
     /// `out`.
     Out,
+    /// `partition`.
+    Partition,
     #[strum(serialize = "pips.depth")]
     /// `pips.depth`.
     PipsDepth,
@@ -165,6 +153,8 @@ pub enum Field {
     #[strum(serialize = "pips.spacing")]
     /// `pips.spacing`.
     PipsSpacing,
+    /// `plan_only`.
+    PlanOnly,
     /// `point_rolls`.
     PointRolls,
     /// `points`.
@@ -177,12 +167,16 @@ pub enum Field {
     ProfilePoints,
     /// `range`.
     Range,
+    /// `rapier_dts`.
+    RapierDts,
     /// `recover`.
     Recover,
     /// `reference_budget_s`.
     ReferenceBudgetS,
     /// `reference_dt`.
     ReferenceDt,
+    /// `refine`.
+    Refine,
     /// `repeats`.
     Repeats,
     /// `resolve`.
@@ -205,10 +199,16 @@ pub enum Field {
     Style,
     /// `tasks`.
     Tasks,
+    /// `time`.
+    Time,
     /// `trend`.
     Trend,
+    /// `trend_rolls`.
+    TrendRolls,
     /// `vary`.
     Vary,
+    /// `velocity`.
+    Velocity,
 }
 
 impl Field {

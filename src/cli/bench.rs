@@ -54,7 +54,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             a.rolls
         )));
     }
-    let threads = super::args::threads(*a.threads)?;
+    let threads = a.threads.checked()?;
     if let Some(p) = &a.dicephys {
         if !p.is_file() {
             return Err(Error::Usage(format!(

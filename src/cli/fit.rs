@@ -363,7 +363,7 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
     let place = dicephys::studies::outputs::Place {
         out: ".".into(),
         checkpoint: None,
-        threads: super::args::threads(*a.threads)?,
+        threads: a.threads.checked()?,
         share: dicephys::run::runner::ChunkShare::All,
         json: *a.json,
         command_line: super::command_line(),

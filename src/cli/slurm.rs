@@ -12,6 +12,7 @@ use super::out;
 use super::paper::PaperArgs;
 use super::roll::RollArgs;
 use super::study;
+use super::study::StudyPlace;
 use super::sweeps::{ConvergeArgs, StabilityArgs, TradeoffArgs};
 use clap::{Args, Subcommand};
 use dicephys::run::slurm::Options;
@@ -181,7 +182,16 @@ impl JobArgs {
 type Flags<'a> = (StudyConfig, usize, bool, Option<&'static str>, &'a JobArgs);
 
 fn study_of(c: &SlurmCommand) -> Result<Flags<'_>> {
-    let out = |given: bool| given.then_some("--out");
+    // A study that runs in a place: its threads, --json, and --out where it was given.
+    let placed = |cfg, p: &StudyPlace, job| {
+        (
+            cfg,
+            *p.threads,
+            *p.json,
+            p.out.is_some().then_some("--out"),
+            job,
+        )
+    };
     let refuse = |flag: &str, why: &str| Err(Error::Usage(format!("slurm {flag}: {why}")));
     Ok(match c {
         SlurmCommand::Paper(a) => {
@@ -194,13 +204,7 @@ fn study_of(c: &SlurmCommand) -> Result<Flags<'_>> {
             } else {
                 StudyConfig::Paper(s.config())
             };
-            (
-                cfg,
-                *s.place.threads,
-                *s.place.json,
-                out(s.place.out.is_some()),
-                &a.job,
-            )
+            placed(cfg, &s.place, &a.job)
         }
         SlurmCommand::Crosscheck(a) => {
             let s = &a.study;
@@ -218,35 +222,17 @@ fn study_of(c: &SlurmCommand) -> Result<Flags<'_>> {
         SlurmCommand::Converge(a) => {
             let s = &a.study;
             let cfg = StudyConfig::Converge(s.config());
-            (
-                cfg,
-                *s.place.threads,
-                *s.place.json,
-                out(s.place.out.is_some()),
-                &a.job,
-            )
+            placed(cfg, &s.place, &a.job)
         }
         SlurmCommand::Tradeoff(a) => {
             let s = &a.study;
             let cfg = StudyConfig::Tradeoff(s.config()?);
-            (
-                cfg,
-                *s.place.threads,
-                *s.place.json,
-                out(s.place.out.is_some()),
-                &a.job,
-            )
+            placed(cfg, &s.place, &a.job)
         }
         SlurmCommand::Stability(a) => {
             let s = &a.study;
             let cfg = StudyConfig::Stability(s.config());
-            (
-                cfg,
-                *s.place.threads,
-                *s.place.json,
-                out(s.place.out.is_some()),
-                &a.job,
-            )
+            placed(cfg, &s.place, &a.job)
         }
         SlurmCommand::Fit(a) => {
             let s = &a.study;
@@ -260,13 +246,7 @@ fn study_of(c: &SlurmCommand) -> Result<Flags<'_>> {
                 config: s.config()?,
                 stage: Stage::Whole,
             });
-            (
-                cfg,
-                *s.place.threads,
-                *s.place.json,
-                out(s.place.out.is_some()),
-                &a.job,
-            )
+            placed(cfg, &s.place, &a.job)
         }
         _ => unreachable!("not a study"),
     })

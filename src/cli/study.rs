@@ -28,16 +28,11 @@ pub struct StudyPlace {
 }
 
 impl StudyPlace {
-    /// The directory: `--out`, or `<command>-out`.
-    pub fn out(&self, command: &str) -> std::path::PathBuf {
-        self.out
-            .clone()
-            .unwrap_or_else(|| format!("{command}-out").into())
-    }
-
     /// The study run here, on all its chunks, writing into `--out` or `<command>-out`.
     pub fn local(&self, command: &str) -> Result<Place> {
-        local(&self.out(command), *self.threads, *self.json)
+        let out = self.out.clone();
+        let out = out.unwrap_or_else(|| format!("{command}-out").into());
+        local(&out, *self.threads, *self.json)
     }
 }
 
