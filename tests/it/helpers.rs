@@ -84,3 +84,18 @@ impl Drop for Scratch {
         }
     }
 }
+
+/// Rolls enough that no machine finishes them before a stop test's signal: a stop test's run
+/// is long by construction, never by how slow this machine is (the cap, `run::spec::MAX_ROLLS`;
+/// at a microsecond a roll it is still a quarter of an hour on one thread).
+pub const ENDLESS_ROLLS: &str = "1000000000";
+
+/// Sends `signal` to `child` after `ms`, first checking that it is still running: a run that
+/// ended before its signal would test nothing, and says so instead of failing on its exit code.
+pub fn signal_running(child: &mut std::process::Child, signal: i32, ms: u64) {
+    std::thread::sleep(std::time::Duration::from_millis(ms));
+    if let Some(s) = child.try_wait().expect("the child's status") {
+        panic!("the run ended ({s}) before its signal: it must be long by construction");
+    }
+    unsafe { libc::kill(child.id() as i32, signal) };
+}

@@ -3,7 +3,7 @@
 //! a full or closed stdout, outputs onto links, FIFOs and directories, `merge`'s inputs, and
 //! a resumed run's rows. Each probe, at a small size, failed once before its fix.
 
-use super::helpers::{bin, Scratch};
+use super::helpers::{bin, signal_running, Scratch, ENDLESS_ROLLS};
 use std::path::{Path, PathBuf};
 use std::process::{Output, Stdio};
 use std::time::Duration;
@@ -156,15 +156,17 @@ fn merge_refuses_a_bad_shard_number_and_a_tally_that_does_not_add_up() {
 
 // 4. Every command stops the same way.
 
+/// `args` run and sent `signal` after `after_ms`; the run must be long by construction
+/// (`ENDLESS_ROLLS`), or it is refused as a test of nothing.
 fn interrupted(args: &[&str], signal: i32, after_ms: u64) -> Output {
-    let child = bin()
+    let mut child = bin()
         .args(args)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    std::thread::sleep(Duration::from_millis(after_ms));
-    unsafe { libc::kill(child.id() as i32, signal) };
+    // Its output is small until the end (a partial report), so an unread pipe cannot block it.
+    signal_running(&mut child, signal, after_ms);
     child.wait_with_output().unwrap()
 }
 
@@ -178,7 +180,7 @@ fn sigterm_stops_a_roll_like_ctrl_c() {
             "--block",
             "140x24x20",
             "--rolls",
-            "300000",
+            ENDLESS_ROLLS,
             "--json",
             "--checkpoint",
         ]
@@ -221,7 +223,13 @@ fn a_slow_run_stops_within_a_roll_not_a_chunk() {
 #[test]
 fn crosscheck_stops_when_asked() {
     let out = interrupted(
-        &["crosscheck", "--block", "140x24x20", "--rolls", "200000"],
+        &[
+            "crosscheck",
+            "--block",
+            "140x24x20",
+            "--rolls",
+            ENDLESS_ROLLS,
+        ],
         libc::SIGINT,
         1500,
     );
@@ -248,7 +256,7 @@ fn paper_interrupted_leaves_the_complete_outputs_alone() {
         &[
             "paper",
             "--rolls",
-            "300000",
+            ENDLESS_ROLLS,
             "--engines",
             "bullet",
             "--out",
@@ -277,7 +285,7 @@ fn a_sweep_stops_with_exit_130() {
             "--engines",
             "bullet",
             "--rolls",
-            "300000",
+            ENDLESS_ROLLS,
             "--out",
             d.to_str().unwrap(),
         ],
@@ -382,11 +390,17 @@ fn a_resumed_run_writes_the_same_per_roll_rows_and_counts_its_whole_cost() {
         .unwrap();
     assert!(whole.status.success());
     let ck = d.join("ck");
-    // Killed with SIGKILL once its first chunk is on disk: well before its end, whatever the
-    // machine's speed.
+    // Killed with SIGKILL once its first chunk is on disk: on one thread the chunks come one
+    // at a time, so seven of eight are still to roll, however many cores the machine has.
     let mut child = bin()
         .args(args)
-        .args(["--json", "--checkpoint", ck.to_str().unwrap()])
+        .args([
+            "--threads",
+            "1",
+            "--json",
+            "--checkpoint",
+            ck.to_str().unwrap(),
+        ])
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()

@@ -692,8 +692,11 @@ fn help_and_version_into_a_full_stdout_fail() {
 
 #[test]
 fn bench_and_trace_stop_on_ctrl_c() {
+    // Each run is long by construction: bench at its cap of rolls on one thread; trace at
+    // 1 µs a step, every step a line (over a million lines) into a pipe this test does not
+    // read until it has signalled, so the run cannot end before the signal on any machine.
     for args in [
-        &["bench", "--rolls", "100000", "--threads", "1"][..],
+        &["bench", "--rolls", "10000000", "--threads", "1"][..],
         &[
             "trace",
             "--block",
@@ -708,15 +711,27 @@ fn bench_and_trace_stop_on_ctrl_c() {
     }
 }
 
+/// Starts `args`, waits for its first line on stdout (its handler is installed by then and its
+/// run begun), sends SIGINT, then drains stdout and expects exit 130 within a bound a slow
+/// machine also meets.
 fn stops_on_ctrl_c(args: &[&str]) {
+    use std::io::BufRead;
     let mut child = bin()
         .args(args)
-        .stdout(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::null())
         .spawn()
         .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let mut out = std::io::BufReader::new(child.stdout.take().unwrap());
+    let mut first = String::new();
+    out.read_line(&mut first).unwrap();
+    assert!(!first.is_empty(), "{args:?} wrote nothing");
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "{args:?} ended before its signal"
+    );
     unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let drain = std::thread::spawn(move || std::io::copy(&mut out, &mut std::io::sink()));
     let t = std::time::Instant::now();
     let status = loop {
         if let Some(s) = child.try_wait().unwrap() {
@@ -728,6 +743,7 @@ fn stops_on_ctrl_c(args: &[&str]) {
         }
         std::thread::sleep(std::time::Duration::from_millis(20));
     };
+    let _ = drain.join();
     assert_eq!(status.code(), Some(130), "{args:?}");
 }
 

@@ -10,7 +10,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 use std::process::Stdio;
 use std::time::Duration;
 
-use super::helpers::{bin, Scratch};
+use super::helpers::{bin, signal_running, Scratch, ENDLESS_ROLLS};
 
 fn tmp(name: &str) -> Scratch {
     Scratch::absent(name)
@@ -127,13 +127,13 @@ fn shards_merged_equal_the_whole() {
 #[test]
 fn ctrl_c_stops_cleanly_with_a_resumable_checkpoint_and_a_partial_report() {
     let dir = tmp("sigint");
-    let child = bin()
+    let mut child = bin()
         .args([
             "roll",
             "--block",
             "140x24x20",
             "--rolls",
-            "200000",
+            ENDLESS_ROLLS,
             "--seed",
             "3",
         ])
@@ -142,8 +142,7 @@ fn ctrl_c_stops_cleanly_with_a_resumable_checkpoint_and_a_partial_report() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    std::thread::sleep(Duration::from_millis(1500));
-    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    signal_running(&mut child, libc::SIGINT, 1500);
     let out = child.wait_with_output().unwrap();
     assert_eq!(
         out.status.code(),
@@ -153,7 +152,7 @@ fn ctrl_c_stops_cleanly_with_a_resumable_checkpoint_and_a_partial_report() {
     );
     let partial: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(partial["partial"], true);
-    assert!(partial["rolls"].as_u64().unwrap() < 200000);
+    assert!(partial["rolls"].as_u64().unwrap() < ENDLESS_ROLLS.parse::<u64>().unwrap());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--resume"));
     assert!(dir.join("spec.json").exists());
     let _ = std::fs::remove_dir_all(&dir);
