@@ -569,7 +569,11 @@ BulletWorld::BulletWorld(const BulletScene& s)
   // A rounded die meets the floor through the convex-convex test (GJK), one point per step:
   // resting on a face it would rock and slide until its manifold held enough. Perturbed
   // tests give it the whole face's points at once, as the box-box test does the sharp die.
-  if (s.made && s.edge_radius > 0) config_->setConvexConvexMultipointIterations();
+  // A die of any shape (a hull, a cylinder) meets the floor the same way, through GJK, and
+  // the same perturbed tests give it a face's points at once, on a box floor or a plane.
+  const bool shaped = !s.hull.empty() || s.cylinder;
+  if (s.made && (s.edge_radius > 0 || shaped)) config_->setConvexConvexMultipointIterations();
+  if (shaped) config_->setPlaneConvexMultipointIterations();
   dispatcher_ = std::make_unique<btCollisionDispatcher>(config_.get());
   // Two bodies: the simplest broadphase does (the pair is the same; measured identical).
   broadphase_ = std::make_unique<btSimpleBroadphase>(4);
@@ -631,6 +635,20 @@ BulletWorld::BulletWorld(const BulletScene& s)
   const double r = s.edge_radius;
   const btQuaternion p(s.principal[0], s.principal[1], s.principal[2], s.principal[3]);
   const btVector3 c = vec(s.com);
+  if (!s.hull.empty()) {
+    // A die of any shape: its hull's vertices put straight into the body's frame, Pᵀ(x − c),
+    // as the rounded box's balls below. Bullet keeps a convex hull's surface its margin out
+    // from the vertices (hull_margin, a hundredth of the die's size at most: Shape::margin).
+    auto hull = std::make_unique<btConvexHullShape>();
+    for (std::size_t k = 0; k + 2 < s.hull.size(); k += 3) {
+      const btVector3 x(s.hull[k], s.hull[k + 1], s.hull[k + 2]);
+      hull->addPoint(quatRotate(p.inverse(), x - c), false);
+    }
+    hull->recalcLocalAabb();
+    hull->setMargin(s.hull_margin);
+    die_shape_ = std::move(hull);
+    return;
+  }
   if (r > 0) {
     // The box swept by a ball of radius r is the convex hull of eight balls of radius r at
     // the inner box's corners: exactly btMultiSphereShape's shape, whose balls may sit
@@ -652,12 +670,20 @@ BulletWorld::BulletWorld(const BulletScene& s)
     return;
   }
   if (!s.offset) {
-    // Centred and aligned: the body's frame is the box's own.
-    die_shape_ = std::make_unique<btBoxShape>(half);
+    // Centred and aligned: the body's frame is the box's (the cylinder's) own.
+    if (s.cylinder) {
+      die_shape_ = std::make_unique<btCylinderShapeZ>(half);
+    } else {
+      die_shape_ = std::make_unique<btBoxShape>(half);
+    }
     return;
   }
-  // The box as a compound's child, at Pᵀ(−c), turned by Pᵀ.
-  die_solid_ = std::make_unique<btBoxShape>(half);
+  // The box (a coin: the cylinder along z) as a compound's child, at Pᵀ(−c), turned by Pᵀ.
+  if (s.cylinder) {
+    die_solid_ = std::make_unique<btCylinderShapeZ>(half);
+  } else {
+    die_solid_ = std::make_unique<btBoxShape>(half);
+  }
   btTransform solid_at;
   solid_at.setRotation(p.inverse());
   solid_at.setOrigin(quatRotate(p.inverse(), -c));

@@ -82,6 +82,8 @@ pub enum Field {
     Contact,
     /// `density`.
     Density,
+    /// `die`.
+    Die,
     /// `dir`.
     Dir,
     /// `draws`.
@@ -187,10 +189,16 @@ pub enum Field {
     Restitutions,
     /// `rolls`.
     Rolls,
+    /// `scale`.
+    Scale,
     /// `seed`.
     Seed,
     /// `settle`.
     Settle,
+    /// `shape`.
+    Shape,
+    /// `size`.
+    Size,
     /// `spin`.
     Spin,
     /// `starts`.

@@ -146,11 +146,26 @@ pub struct DieArgs {
     /// Round the die's edges and corners with this radius, mm (0, the default: sharp). 3D only.
     #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     pub edge_radius: Option<f64>,
-    /// A die file (TOML, lengths in mm): com, edge_radius, density, and [pips]
-    /// diameter, depth, shape (cap or cylinder), fill_density, spacing. Flags given beside it
-    /// override its values.
-    #[arg(long, value_name = "FILE.toml")]
+    /// A die file: a mesh (FILE.obj or FILE.stl, in mm: a die of any shape, rolled on its
+    /// convex hull, its mass from the mesh as given), or TOML (lengths in mm): com,
+    /// edge_radius, density, [pips] diameter, depth, shape (cap or cylinder), fill_density,
+    /// spacing; or mesh, scale, reads (up or down) and labels for a mesh. Flags given beside
+    /// it override its values.
+    #[arg(long, value_name = "FILE")]
     pub die: Option<std::path::PathBuf>,
+    /// A die of a named shape in place of --block: d4, d6, d8, d10 (pentagonal
+    /// trapezohedron), d12, d20, coin:D,H (a cylinder D mm across, H thick: heads, tails or
+    /// edge), prism:N,D,L (an N-sided prism D mm across its corners, L long). Thrown in a
+    /// tumble. Without --block, --shape or --die: a 16 mm d6.
+    #[arg(long, value_name = "NAME")]
+    pub shape: Option<String>,
+    /// A named shape's size, mm, instead of its standard one (see the guide: a d4's edge,
+    /// the others' distance between opposite faces).
+    #[arg(long, value_name = "MM")]
+    pub size: Option<f64>,
+    /// A mesh's lengths times this (e.g. 25.4 for a mesh in inches; default 1: mm).
+    #[arg(long, value_name = "FACTOR")]
+    pub scale: Option<f64>,
 }
 
 impl DieArgs {
@@ -339,11 +354,33 @@ pub fn parse_engine(s: &str) -> std::result::Result<EngineKind, dicephys::Error>
 impl SceneArgs {
     /// The scene, with every value checked before anything runs.
     pub fn scene(&self) -> Result<Scene> {
-        let block = self
-            .block
-            .ok_or_else(|| Error::Usage("--block is required".into()))?;
+        let m = &self.made;
+        let mut shape = dicephys::model::shape::described(
+            m.die.as_deref(),
+            m.shape.as_deref(),
+            m.size,
+            m.scale,
+        )?;
+        let block = match (self.block, &shape) {
+            (Some(_), Some(_)) => {
+                return Err(Error::Usage(
+                    "--block is the cuboid; --shape or a mesh --die replaces it: give one".into(),
+                ))
+            }
+            (Some(b), None) => b,
+            // The shape's bounding box replaces it (`Scene::with_shape`).
+            (None, Some(_)) => "1x1x1".parse()?,
+            // No die given: a 16 mm d6.
+            (None, None) => {
+                shape = dicephys::model::shape::described(None, Some("d6"), None, None)?;
+                "1x1x1".parse()?
+            }
+        };
         let mode = if self.two_d { Mode::TwoD } else { Mode::ThreeD };
         let mut scene = Scene::paper(block, mode);
+        if let Some(s) = shape {
+            scene = scene.with_shape(s);
+        }
         scene.dt = self.dt;
         scene.friction = self.friction;
         scene.restitution = self.restitution;

@@ -81,8 +81,7 @@ pub enum Command {
 
 /// The process's stop flag, raised by Ctrl-C or SIGTERM.
 pub fn stop() -> &'static Stop {
-    static STOP: std::sync::OnceLock<Stop> = std::sync::OnceLock::new();
-    STOP.get_or_init(Stop::new)
+    Stop::global()
 }
 
 /// Runs the command line; returns the process exit code (0 ok, 2 bad input, 1 failure, 130

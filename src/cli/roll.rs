@@ -15,7 +15,10 @@ use std::path::PathBuf;
 use std::sync::atomic::Ordering::Relaxed;
 
 /// The options that define a run: `--resume` takes them from the checkpoint instead.
-const DEFINING: [&str; 28] = [
+const DEFINING: [&str; 31] = [
+    "shape",
+    "size",
+    "scale",
     "com",
     "pips",
     "edge_radius",
@@ -102,6 +105,12 @@ impl RollArgs {
             // The pips follow the numbers: the layout places them.
             scene.features.layout = layout;
         }
+        // A die of any shape has no long axis to spin about: a tumble by default.
+        let default = if scene.shape.is_some() {
+            dicephys::model::throws::ThrowStyle::Tumble
+        } else {
+            default
+        };
         let spec = RunSpec {
             engine: self.engine,
             roll: self.run.roll(scene.dt)?,

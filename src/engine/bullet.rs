@@ -25,6 +25,14 @@ mod ffi {
         moments: [f64; 3],
         /// Its edges' rounding radius, m.
         edge_radius: f64,
+        /// A die of any shape (`model::shape`): its hull's vertices in body axes from its
+        /// centroid, m, x y z after each other (empty: not a hull).
+        hull: Vec<f64>,
+        /// A die of any shape that is a cylinder along body z (a coin), `sides` its
+        /// diameter, diameter and height.
+        cylinder: bool,
+        /// The hull's collision margin, m (Bullet's convex tests keep the shape this far out).
+        hull_margin: f64,
         /// Its centre of mass is off the centre or its principal frame off the body axes:
         /// the solid is a compound's child (else the body's shape itself).
         offset: bool,
@@ -148,9 +156,17 @@ impl Bullet {
     fn build(scene: &Scene, stock_world: bool) -> crate::Result<Bullet> {
         let s = solver(scene.preset);
         let (linear_damping, angular_damping) = scene.bullet_damping();
-        let made = !scene.features.plain();
+        let made = !scene.features.plain() || scene.shape.is_some();
         let mp = MassProps::of(scene)?;
         let p = mp.principal.quaternion();
+        let shape = scene.shape.as_deref();
+        let hull: Vec<f64> = shape.map_or_else(Vec::new, |s| {
+            s.points().iter().flat_map(|v| [v.x, v.y, v.z]).collect()
+        });
+        let cylinder = matches!(
+            shape.map(|s| &s.solid),
+            Some(crate::model::shape::Solid::Cylinder { .. })
+        );
         let desc = ffi::BulletScene {
             sides: scene.body_sides(),
             mass: mp.mass,
@@ -159,6 +175,9 @@ impl Bullet {
             principal: [p.i, p.j, p.k, p.w],
             moments: mp.moments.into(),
             edge_radius: scene.features.edge_radius,
+            hull,
+            cylinder,
+            hull_margin: shape.map_or(0.0, |s| s.margin()),
             offset: mp.com != Vector3::zeros() || !mp.aligned(),
             planar: scene.mode == Mode::TwoD,
             die_friction: scene.friction,

@@ -220,7 +220,7 @@ impl Rapier3d {
         );
 
         let [bx, by, bz] = scene.body_sides();
-        let made = !scene.features.plain();
+        let made = !scene.features.plain() || scene.shape.is_some();
         let mp = MassProps::of(scene)?;
         let die_collider = if made {
             // The solid in body axes, centred; the body in its principal frame P at the centre
@@ -228,15 +228,26 @@ impl Rapier3d {
             // body carries the exact mass properties).
             let r = scene.features.edge_radius;
             let (hx, hy, hz) = (0.5 * bx, 0.5 * by, 0.5 * bz);
-            let solid = if r > 0.0 {
-                ColliderBuilder::round_cuboid(hx - r, hy - r, hz - r, r)
-            } else {
-                ColliderBuilder::cuboid(hx, hy, hz)
+            // A parry cylinder's axis is its y: turned onto the die's z.
+            let mut own = Rotation::IDENTITY;
+            let solid = match scene.shape.as_deref().map(|s| (s, &s.solid)) {
+                Some((shape, crate::model::shape::Solid::Hull { .. })) => {
+                    let points: Vec<Vector> = shape.points().iter().map(from_na).collect();
+                    ColliderBuilder::convex_hull(&points).ok_or_else(|| {
+                        crate::Error::Engine("rapier: the die's hull could not be built".into())
+                    })?
+                }
+                Some((_, crate::model::shape::Solid::Cylinder { diameter, height })) => {
+                    own = Rotation::from_rotation_x(std::f64::consts::FRAC_PI_2);
+                    ColliderBuilder::cylinder(0.5 * height, 0.5 * diameter)
+                }
+                None if r > 0.0 => ColliderBuilder::round_cuboid(hx - r, hy - r, hz - r, r),
+                None => ColliderBuilder::cuboid(hx, hy, hz),
             };
             let p = mp.principal.quaternion();
             let turn = Rotation::from_xyzw(p.i, p.j, p.k, p.w).inverse();
             solid
-                .position(Pose::from_parts(turn * -from_na(&mp.com), turn))
+                .position(Pose::from_parts(turn * -from_na(&mp.com), turn * own))
                 .density(0.0)
         } else {
             ColliderBuilder::cuboid(0.5 * bx, 0.5 * by, 0.5 * bz)

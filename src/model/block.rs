@@ -156,6 +156,9 @@ pub enum Outcome {
     Length,
     /// No body axis is vertical within the tolerance (resting on an edge, or leaning).
     Unknown,
+    /// A die of any shape (`model::shape`) at rest on one of its faces, which the roll's
+    /// record names (`RollRecord::up`).
+    Face,
 }
 
 impl Outcome {

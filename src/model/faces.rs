@@ -112,7 +112,7 @@ pub fn up_direction(rotation: &UnitQuaternion<f64>, side: Outcome) -> Option<u8>
         Outcome::Breadth => 0,
         Outcome::Width => 1,
         Outcome::Length => 2,
-        Outcome::Unknown => return None,
+        Outcome::Unknown | Outcome::Face => return None,
     };
     let up = up_in_body(rotation);
     Some(2 * axis + u8::from(up[axis as usize] < 0.0))

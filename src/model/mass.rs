@@ -374,15 +374,54 @@ pub struct DieFile {
     pub insert: Option<Insert>,
     /// The inertia about the centre of mass, g mm²: xx, yy, zz, xy, xz, yz.
     pub inertia: Option<[f64; 6]>,
+    /// A die of any shape: its mesh (OBJ or STL, in mm; a path from the die file's folder).
+    pub mesh: Option<std::path::PathBuf>,
+    /// The mesh's lengths times this (e.g. 25.4 for a mesh in inches).
+    pub scale: Option<f64>,
+    /// Which face's label the die shows: "up" (most dice) or "down" (a d4).
+    pub reads: Option<crate::model::shape::Reads>,
+    /// The mesh's facets' labels: `{ normal = [0, 0, 1], label = "6" }`, one per resting
+    /// facet (matched by its outward normal); none: numbered 1…N.
+    pub labels: Option<Vec<LabelDef>>,
+}
+
+/// One facet's label in a die file.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LabelDef {
+    /// The facet's outward normal, body axes (any length).
+    pub normal: [f64; 3],
+    /// What it carries.
+    pub label: String,
+}
+
+/// The largest die file read (TOML): 1 MiB.
+pub const MAX_DIE_FILE: u64 = 1 << 20;
+
+/// True if `path` names a mesh by its extension (.obj, .stl).
+pub fn is_mesh(path: &std::path::Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj") || e.eq_ignore_ascii_case("stl"))
 }
 
 impl DieFile {
-    /// Reads and parses a die file: a key it does not know, a value of the wrong kind, or a
-    /// file that is not TOML is one line naming it.
+    /// Reads and parses a die file, through the capped reader (`run::io::read_capped`: a
+    /// missing file, a directory, a pipe or a file over 1 MiB is refused naming `--die`, and a
+    /// stop request is honoured while it blocks): a key it does not know, a value of the
+    /// wrong kind, or a file that is not TOML is one line naming it. A mesh (.obj, .stl)
+    /// describes no features: its die file is empty.
     pub fn read(path: &std::path::Path) -> Result<DieFile> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-            path: path.into(),
-            source: e,
+        if is_mesh(path) {
+            return Ok(DieFile::default());
+        }
+        let bytes = read_die_bytes(path, MAX_DIE_FILE)?;
+        let text = String::from_utf8(bytes).map_err(|_| {
+            Error::field(
+                Field::Die,
+                path.display(),
+                "is not a text file (a die file is TOML; a mesh is .obj or .stl)",
+            )
         })?;
         toml::from_str(&text).map_err(|e| {
             let line = e
@@ -430,6 +469,24 @@ impl DieFile {
             inertia: self.inertia.map(|t| t.map(|x| x * 1e-9)),
         })
     }
+}
+
+/// A die file's bytes, at most `max`, through the capped reader; any failure names `--die`.
+pub fn read_die_bytes(path: &std::path::Path, max: u64) -> Result<Vec<u8>> {
+    if path.is_dir() {
+        return Err(Error::field(Field::Die, path.display(), "is a directory"));
+    }
+    crate::run::io::read_capped(path, max, crate::run::stop::Stop::global()).map_err(|e| match e {
+        Error::Stopped => Error::Stopped,
+        Error::Invalid(m) => Error::field(
+            Field::Die,
+            path.display(),
+            m.strip_prefix(&format!("{}: ", path.display()))
+                .unwrap_or(&m)
+                .to_string(),
+        ),
+        e => e,
+    })
 }
 
 impl Features {
@@ -563,6 +620,71 @@ impl Features {
         }
         if let Some(i) = &self.insert {
             self.validate_insert(i, half)?;
+        }
+        if let Some(t) = self.inertia {
+            validate_inertia(t)?;
+        }
+        Ok(())
+    }
+
+    /// Checks the features on a die of any shape: pips and rounded edges are the cuboid's
+    /// (refused, with the reason); a centre of mass and an insert inside its hull.
+    pub fn validate_on(&self, shape: &crate::model::shape::Shape, mode: Mode) -> Result<()> {
+        let mm = |v: f64| format!("{}", (v * 1e9).round() / 1e6);
+        let triple = |v: [f64; 3]| format!("{},{},{}", mm(v[0]), mm(v[1]), mm(v[2]));
+        if mode == Mode::TwoD {
+            return Err(Error::field(
+                Field::Shape,
+                &shape.name,
+                "a die of any shape is rolled in 3D only (2D is the paper's block)",
+            ));
+        }
+        if self.pips.is_some() {
+            return Err(Error::field(
+                Field::PipsDiameter,
+                "",
+                "pips are drilled in a cuboid's faces (the standard pattern); a die of another \
+                 shape carries its mass as its mesh gives it",
+            ));
+        }
+        if self.edge_radius != 0.0 {
+            return Err(Error::field(
+                Field::EdgeRadius,
+                mm(self.edge_radius),
+                "rounded edges are the cuboid's; round a mesh's edges in the mesh itself",
+            ));
+        }
+        if let Some(c) = self.com {
+            if !(c.iter().all(|x| x.is_finite()) && shape.contains(&Vector3::from(c))) {
+                return Err(Error::field(
+                    Field::Com,
+                    triple(c),
+                    "must lie inside the die (mm from its centroid, body axes)",
+                ));
+            }
+        }
+        if let Some(i) = &self.insert {
+            let corners_inside = (0..8).all(|n| {
+                let corner = Vector3::from_fn(|k, _| {
+                    let sign = if n >> k & 1 == 1 { 0.5 } else { -0.5 };
+                    i.centre[k] + sign * i.size[k]
+                });
+                shape.contains(&corner)
+            });
+            if !(i.size.iter().all(|s| s.is_finite() && *s > 0.0) && corners_inside) {
+                return Err(Error::field(
+                    Field::InsertCentre,
+                    triple(i.centre),
+                    "the insert must lie inside the die (mm from its centroid)",
+                ));
+            }
+            if !(i.density.is_finite() && (0.0..=1e5).contains(&i.density)) {
+                return Err(Error::field(
+                    Field::InsertDensity,
+                    i.density,
+                    "must be in [0, 100000] kg/m³",
+                ));
+            }
         }
         if let Some(t) = self.inertia {
             validate_inertia(t)?;
@@ -719,6 +841,8 @@ pub struct Solid<'a> {
     pub mode: Mode,
     /// The die as made.
     pub features: &'a Features,
+    /// A die of any shape (`model::shape`), in place of the block of `sides`.
+    pub shape: Option<&'a crate::model::shape::Shape>,
 }
 
 impl MassProps {
@@ -727,8 +851,12 @@ impl MassProps {
     /// plain block's are the closed forms the engines use. Checked.
     pub fn of_solid(s: &Solid) -> Result<MassProps> {
         let [a, b, c] = s.sides;
-        s.features
-            .validate(&(Vector3::new(a, b, c) / 2.0), s.mode)?;
+        match s.shape {
+            Some(shape) => s.features.validate_on(shape, s.mode)?,
+            None => s
+                .features
+                .validate(&(Vector3::new(a, b, c) / 2.0), s.mode)?,
+        }
         let m = MassProps::compute_solid(s);
         let ok = m.moments.iter().all(|&x| x > 0.0)
             && (0..3).all(|i| m.moments[i] <= m.moments[(i + 1) % 3] + m.moments[(i + 2) % 3]);
@@ -749,7 +877,7 @@ impl MassProps {
         let [a, b, c] = s.sides;
         let half = Vector3::new(a, b, c) / 2.0;
         let rho = s.density;
-        if f.plain() {
+        if f.plain() && s.shape.is_none() {
             let m = s.plain_mass;
             let inertia = Vector3::new(b * b + c * c, a * a + c * c, a * a + b * b) * (m / 12.0);
             return MassProps {
@@ -760,11 +888,21 @@ impl MassProps {
                 moments: inertia,
             };
         }
-        let (volume, second) = rounded_box(&half, f.edge_radius);
-        let mut total = Moments {
-            mass: rho * volume,
-            first: Vector3::zeros(),
-            second: Matrix3::from_diagonal(&(second * rho)),
+        let mut total = match s.shape {
+            // A die of any shape: its solid's moments about its centroid.
+            Some(shape) => Moments {
+                mass: rho * shape.volume,
+                first: Vector3::zeros(),
+                second: shape.second_matrix() * rho,
+            },
+            None => {
+                let (volume, second) = rounded_box(&half, f.edge_radius);
+                Moments {
+                    mass: rho * volume,
+                    first: Vector3::zeros(),
+                    second: Matrix3::from_diagonal(&(second * rho)),
+                }
+            }
         };
         if let Some(p) = &f.pips {
             let cav = cavity(p);

@@ -5,6 +5,7 @@ use crate::error::{Error, Field, Result};
 use crate::model::block::Block;
 pub use crate::model::block::Mode;
 use crate::model::mass::{Features, MassProps, Solid};
+use crate::model::shape::Shape;
 use serde::{Deserialize, Serialize};
 
 /// Gravity, m/s², along −y.
@@ -119,6 +120,11 @@ pub struct Scene {
     /// (`model::mass`). Written into a specification only when it does.
     #[serde(default, skip_serializing_if = "Features::plain")]
     pub features: Features,
+    /// A die of any shape (`model::shape`: d4 … d20, a coin, a mesh) in place of the cuboid
+    /// `block`; `block` then holds its bounding box. Written into a specification only when
+    /// set, so a cuboid's specification is unchanged.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<std::sync::Arc<Shape>>,
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -243,6 +249,7 @@ impl Scene {
             angular_damping: 0.0,
             sleeping: true,
             features: Features::default(),
+            shape: None,
         }
     }
 
@@ -285,11 +292,28 @@ impl Scene {
             plain_mass: self.mass(),
             mode: self.mode,
             features: &self.features,
+            shape: self.shape.as_deref(),
         }
+    }
+
+    /// This scene with a die of any shape in place of its block (the block becomes the
+    /// shape's bounding box, for what reads the die's size: the drop, the reports).
+    pub fn with_shape(mut self, shape: Shape) -> Scene {
+        let [x, y, z] = shape.bounding_box();
+        self.block = Block {
+            breadth: x,
+            width: y,
+            length: z,
+        };
+        self.shape = Some(std::sync::Arc::new(shape));
+        self
     }
 
     /// The die's mass, multiplied in DicePhys's order so that the numbers agree to the bit.
     pub fn mass(&self) -> f64 {
+        if let Some(s) = &self.shape {
+            return s.volume * self.density;
+        }
         let b = &self.block;
         match self.mode {
             Mode::ThreeD => b.breadth * b.width * b.length * self.density,
@@ -309,6 +333,19 @@ impl Scene {
     /// The drop height is added to this: the longest side (in 2D, of breadth and width).
     pub fn drop_base(&self) -> f64 {
         let b = &self.block;
+        if let Some(s) = &self.shape {
+            // Its bounding box's longest side, or its reach from the centroid if that is more
+            // (with a centre of mass moved inside it), so it starts clear however it is turned.
+            let com = self
+                .features
+                .com
+                .map_or(0.0, |c| nalgebra::Vector3::from(c).norm());
+            return b
+                .width
+                .max(b.breadth)
+                .max(b.length)
+                .max(s.circumradius() + com);
+        }
         match self.mode {
             Mode::ThreeD => b.width.max(b.breadth).max(b.length),
             Mode::TwoD => b.width.max(b.breadth),

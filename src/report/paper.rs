@@ -320,6 +320,7 @@ fn outcomes_markdown(res: &PaperResults) -> String {
                 width: t.width_vertical,
                 length: t.length_vertical,
                 unknown: 0,
+                face: 0,
             };
             if let Some(o) = Block::from_mm(t.length_mm, t.breadth_mm, t.width_mm)
                 .ok()

@@ -66,6 +66,8 @@ pub struct PerRoll<W: Write> {
     csv: csv::Writer<W>,
     dt: f64,
     numbers: [u8; 6],
+    /// A die of any shape's labels, by its outcome.
+    labels: Option<Vec<String>>,
 }
 
 fn failed(e: csv::Error) -> Error {
@@ -84,7 +86,22 @@ impl<W: Write> PerRoll<W> {
             csv,
             dt,
             numbers: layout.numbers(),
+            labels: None,
         })
+    }
+
+    /// The same CSV for a die of any shape: its `face` column the label each roll shows.
+    pub fn for_scene(
+        out: W,
+        scene: &crate::model::scene::Scene,
+        layout: Layout,
+    ) -> Result<PerRoll<W>> {
+        let mut p = PerRoll::new(out, scene.dt, layout)?;
+        p.labels = scene
+            .shape
+            .as_ref()
+            .map(|s| s.labels().iter().map(|l| l.to_string()).collect());
+        Ok(p)
     }
 
     /// Writes one row per record, in order.
@@ -110,8 +127,9 @@ impl<W: Write> PerRoll<W> {
                     dip_steps: r.dip.steps,
                     longest_dip_steps: r.dip.longest,
                     penetration_m: r.dip.penetration,
-                    face: r.up.map_or(String::new(), |d| {
-                        self.numbers[usize::from(d).min(5)].to_string()
+                    face: r.up.map_or(String::new(), |d| match &self.labels {
+                        Some(l) => l.get(usize::from(d)).cloned().unwrap_or_default(),
+                        None => self.numbers[usize::from(d).min(5)].to_string(),
                     }),
                 })
                 .map_err(failed)?;

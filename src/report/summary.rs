@@ -104,9 +104,13 @@ pub struct RunSummary {
     pub layout: faces::Layout,
     /// Settled rolls by the number on the face up, `"1"`…`"6"` (in 2D the four sides'
     /// numbers), under `layout`: each pair of opposite faces adds up to its side's count.
-    /// Absent when some rolls came from chunks written before faces were kept.
+    /// Absent when some rolls came from chunks written before faces were kept. For a die of
+    /// any shape, by the label it shows.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub faces: Option<BTreeMap<String, u64>>,
+    /// A die of any shape: each outcome's probability against a fair die's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<ShapeOutcomes>,
     /// Steps simulated over all rolls.
     pub steps_total: u64,
     /// Steps simulated per roll.
@@ -160,6 +164,9 @@ pub struct Audit {
 /// Settled rolls by the number on the face up, under `layout` (the faces a 2D die can show
 /// only); `None` if some were read from chunks written before faces were kept.
 pub fn faces_up(tally: &Tally, mode: Mode, layout: faces::Layout) -> Option<BTreeMap<String, u64>> {
+    if tally.counts.face > 0 || !tally.faces.is_empty() {
+        return None;
+    }
     if !tally.faces_complete() {
         return None;
     }
@@ -173,6 +180,118 @@ pub fn faces_up(tally: &Tally, mode: Mode, layout: faces::Layout) -> Option<BTre
             .map(|d| (numbers[d].to_string(), tally.up[d]))
             .collect(),
     )
+}
+
+/// A die of any shape's settled rolls by the label it shows (faces that show the same label
+/// counted together), in the order of its faces; `None` for the cuboid.
+pub fn shape_faces(
+    tally: &Tally,
+    scene: &crate::model::scene::Scene,
+) -> Option<Vec<(String, u64)>> {
+    let shape = scene.shape.as_ref()?;
+    let mut out: Vec<(String, u64)> = Vec::new();
+    for (k, f) in shape.faces.iter().enumerate() {
+        let n = tally.faces.get(k).copied().unwrap_or(0);
+        match out.iter_mut().find(|(l, _)| *l == f.label) {
+            Some((_, m)) => *m += n,
+            None => out.push((f.label.clone(), n)),
+        }
+    }
+    Some(out)
+}
+
+/// One outcome of a die of any shape: its label, count, probability ± its binomial error, and
+/// its departure from 1/N in σ (N its distinct outcomes).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ShapeFace {
+    /// What the die shows.
+    pub label: String,
+    /// Settled rolls showing it.
+    pub count: u64,
+    /// Its probability among the settled rolls.
+    pub p: f64,
+    /// The binomial error of `p`.
+    pub p_err: f64,
+    /// (p − 1/N) / p_err.
+    pub z_fair: f64,
+}
+
+/// A die of any shape's outcomes against a fair die's 1/N.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ShapeOutcomes {
+    /// The die (`Shape::name`).
+    pub shape: String,
+    /// Each outcome, in the die's order.
+    pub faces: Vec<ShapeFace>,
+    /// Pearson's χ² against 1/N each.
+    pub chi2: f64,
+    /// Its degrees of freedom, N − 1.
+    pub dof: usize,
+    /// Its p-value.
+    pub p_value: f64,
+}
+
+impl ShapeOutcomes {
+    /// The outcomes of a die of any shape from its tally; `None` for the cuboid.
+    pub fn of(tally: &Tally, scene: &crate::model::scene::Scene) -> Option<ShapeOutcomes> {
+        let counts = shape_faces(tally, scene)?;
+        let n: u64 = counts.iter().map(|(_, c)| c).sum();
+        let k = counts.len();
+        let fair = 1.0 / k as f64;
+        let expected = n as f64 * fair;
+        let chi2 = counts
+            .iter()
+            .map(|(_, c)| (*c as f64 - expected).powi(2) / expected)
+            .sum();
+        let faces = counts
+            .into_iter()
+            .map(|(label, count)| {
+                let p = count as f64 / n.max(1) as f64;
+                // The error of a fair die's p at this n, so that a face never seen has one.
+                let p_err = crate::theory::stats::binomial_err(fair, n.max(1));
+                ShapeFace {
+                    label,
+                    count,
+                    p,
+                    p_err,
+                    z_fair: (p - fair) / p_err,
+                }
+            })
+            .collect();
+        Some(ShapeOutcomes {
+            shape: scene.shape.as_ref()?.name.clone(),
+            faces,
+            chi2,
+            dof: k.saturating_sub(1),
+            p_value: crate::theory::stats::chi_square_p_value(chi2, k.saturating_sub(1)),
+        })
+    }
+
+    /// Its lines in `roll`'s summary.
+    pub fn lines(&self) -> String {
+        let mut s = String::new();
+        let per_line = 5;
+        for chunk in self.faces.chunks(per_line) {
+            let each: Vec<String> = chunk
+                .iter()
+                .map(|f| {
+                    format!(
+                        "{:>5} {:>7} {:.4}±{:.4} ({:+.1}σ)",
+                        f.label, f.count, f.p, f.p_err, f.z_fair
+                    )
+                })
+                .collect();
+            s += &format!("  {}\n", each.join("  "));
+        }
+        s += &format!(
+            "  against a fair die (1/{} each): χ² {:.1} on {} degrees of freedom, p {:.3}\n",
+            self.faces.len(),
+            self.chi2,
+            self.dof,
+            self.p_value
+        );
+        s
+    }
 }
 
 impl RunSummary {
@@ -224,7 +343,11 @@ impl RunSummary {
             },
             z_theory: (ratio - theory_ratio) / ratio_err,
             layout: faces::Layout::default(),
-            faces: faces_up(tally, scene.mode, faces::Layout::default()),
+            faces: match shape_faces(tally, scene) {
+                Some(f) => Some(f.into_iter().collect()),
+                None => faces_up(tally, scene.mode, faces::Layout::default()),
+            },
+            shape: ShapeOutcomes::of(tally, scene),
             steps_total: tally.steps,
             steps_mean: tally.steps as f64 / tally.rolls.max(1) as f64,
             engine_steps_mean: tally.engine_steps as f64 / tally.rolls.max(1) as f64,
@@ -251,6 +374,9 @@ impl RunSummary {
 
     /// The same summary with its faces numbered by `layout`.
     pub fn with_layout(mut self, layout: faces::Layout) -> RunSummary {
+        if self.spec.scene.shape.is_some() {
+            return self;
+        }
         self.layout = layout;
         self.faces = faces_up(&self.tally, self.mode, layout);
         self
@@ -287,17 +413,24 @@ impl RunSummary {
         if self.partial {
             s += "PARTIAL: stopped before all rolls were made; the counts cover these rolls only\n";
         }
+        let die = match &self.spec.scene.shape {
+            Some(shape) => shape.name.clone(),
+            None => format!(
+                "{} mm",
+                crate::model::block::Block::from_mm(
+                    self.block_mm[0],
+                    self.block_mm[1],
+                    self.block_mm[2]
+                )
+                .map(|b| b.to_string())
+                .unwrap_or_default()
+            ),
+        };
         s += &format!(
-            "{} {} {} mm, {} rolls, {} throws seed {}, dt {} s, μ {}, e {}, preset {}, floor {}\n",
+            "{} {} {}, {} rolls, {} throws seed {}, dt {} s, μ {}, e {}, preset {}, floor {}\n",
             self.engine,
             self.mode,
-            crate::model::block::Block::from_mm(
-                self.block_mm[0],
-                self.block_mm[1],
-                self.block_mm[2]
-            )
-            .map(|b| b.to_string())
-            .unwrap_or_default(),
+            die,
             self.rolls,
             self.throws.name(),
             self.seed,
@@ -308,18 +441,26 @@ impl RunSummary {
             self.floor
         );
         s += &self.not_dicephys();
-        s += &format!(
-            "  breadth vertical {:>8}   width vertical {:>8}   length vertical {:>6}   unknown {:>6}\n",
-            c.breadth, c.width, c.length, c.unknown
-        );
-        s += &format!(
-            "  ratio breadth/width  {:.4} ± {:.4}   theory {:.4}   ({:+.1} σ)\n",
-            self.ratio, self.ratio_err, self.theory_ratio, self.z_theory
-        );
+        if let Some(o) = &self.shape {
+            s += &format!(
+                "  {}: on a face {:>8}   unknown (leaning) {:>6}\n",
+                o.shape, c.face, c.unknown
+            );
+            s += &o.lines();
+        } else {
+            s += &format!(
+                "  breadth vertical {:>8}   width vertical {:>8}   length vertical {:>6}   unknown {:>6}\n",
+                c.breadth, c.width, c.length, c.unknown
+            );
+            s += &format!(
+                "  ratio breadth/width  {:.4} ± {:.4}   theory {:.4}   ({:+.1} σ)\n",
+                self.ratio, self.ratio_err, self.theory_ratio, self.z_theory
+            );
+        }
         if let Some(o) = &self.outcomes {
             s += &format!("  {}\n", o.line());
         }
-        if let Some(f) = &self.faces {
+        if let (Some(f), None) = (&self.faces, &self.shape) {
             let each: Vec<String> = f.iter().map(|(k, v)| format!("{k}: {v}")).collect();
             s += &format!("  face up ({} layout)  {}\n", self.layout, each.join("   "));
         }

@@ -137,7 +137,7 @@ impl Faces {
             Outcome::Breadth => self.breadth += 1,
             Outcome::Width => self.width += 1,
             Outcome::Length => self.length += 1,
-            Outcome::Unknown => {}
+            Outcome::Unknown | Outcome::Face => {}
         }
     }
 
@@ -152,7 +152,7 @@ impl Faces {
             Outcome::Breadth => self.breadth,
             Outcome::Width => self.width,
             Outcome::Length => self.length,
-            Outcome::Unknown => 0,
+            Outcome::Unknown | Outcome::Face => 0,
         }
     }
 }

@@ -9,7 +9,9 @@
 //!   non-zero dip depth; bits 7-8 the certified outcome; bit 9 a face kept (a settled roll
 //!   from this version on), bit 10 its end of the axis (0 positive, 1 negative), so that
 //!   the face up is direction 2 × outcome + bit 10 of `faces::DIRECTIONS` (chunks written
-//!   before faces were kept have neither bit, and their rolls no face);
+//!   before faces were kept have neither bit, and their rolls no face); bit 11 a die of any
+//!   shape's face (`Outcome::Face`, bits 2-3 then 0), its index a varint right after the
+//!   tag when bit 9 is set (a cuboid's rolls never set it, so their bytes are as before);
 //! - `steps`, `engine_steps`, varints; if certified, its step, a varint;
 //! - the dip's `steps` and `longest`, varints; if bit 6, its depth `penetration`, the 8
 //!   bytes of the f64, little-endian (exact).
@@ -31,6 +33,7 @@ fn outcome_bits(o: Outcome) -> u64 {
         Outcome::Width => 1,
         Outcome::Length => 2,
         Outcome::Unknown => 3,
+        Outcome::Face => 0,
     }
 }
 
@@ -71,10 +74,22 @@ pub fn pack(records: &[RollRecord]) -> Vec<u8> {
         if let Some((_, o)) = r.certified {
             tag |= 1 << 4 | outcome_bits(o) << 7;
         }
-        if let Some(d) = r.up {
-            tag |= 1 << 9 | u64::from(d & 1) << 10;
+        let shaped = matches!(
+            r.fate,
+            Fate::Settled(Outcome::Face) | Fate::Unconverged(Outcome::Face)
+        );
+        if shaped {
+            tag |= 1 << 11;
+        }
+        match r.up {
+            Some(_) if shaped => tag |= 1 << 9,
+            Some(d) => tag |= 1 << 9 | u64::from(d & 1) << 10,
+            None => {}
         }
         varint(&mut out, tag);
+        if let (true, Some(d)) = (shaped, r.up) {
+            varint(&mut out, u64::from(d));
+        }
         varint(&mut out, r.steps);
         varint(&mut out, r.engine_steps);
         if let Some((step, _)) = r.certified {
@@ -126,13 +141,15 @@ pub fn unpack(bytes: &[u8], indices: &[u64], throws: &Throws) -> Result<Vec<Roll
     let mut out = Vec::with_capacity(indices.len());
     for &i in indices {
         let tag = r.varint()?;
-        if tag >> 11 != 0 {
+        if tag >> 12 != 0 {
             return Err(format!("roll {i}: unknown tag bits"));
         }
         let what = tag >> 2 & 3;
+        let shaped = tag >> 11 & 1 == 1;
+        let side = |b| if shaped { Outcome::Face } else { outcome_of(b) };
         let fate = match tag & 3 {
-            0 => Fate::Settled(outcome_of(what)),
-            1 => Fate::Unconverged(outcome_of(what)),
+            0 => Fate::Settled(side(what)),
+            1 => Fate::Unconverged(side(what)),
             2 => Fate::Failed(match what {
                 0 => Failure::NonFinite,
                 1 => Failure::Tunnelled,
@@ -140,6 +157,12 @@ pub fn unpack(bytes: &[u8], indices: &[u64], throws: &Throws) -> Result<Vec<Roll
                 _ => return Err(format!("roll {i}: unknown failure")),
             }),
             _ => return Err(format!("roll {i}: unknown fate")),
+        };
+        let face = if shaped && tag >> 9 & 1 == 1 {
+            let d = r.varint()?;
+            Some(u8::try_from(d).map_err(|_| format!("roll {i}: face {d} past 255"))?)
+        } else {
+            None
         };
         let steps = r.varint()?;
         let engine_steps = r.varint()?;
@@ -151,6 +174,7 @@ pub fn unpack(bytes: &[u8], indices: &[u64], throws: &Throws) -> Result<Vec<Roll
         let (dip_steps, longest) = (r.varint()?, r.varint()?);
         let penetration = if tag >> 6 & 1 == 1 { r.f64()? } else { 0.0 };
         let up = match (tag >> 9 & 1, fate) {
+            (1, Fate::Settled(Outcome::Face)) => face,
             (1, Fate::Settled(o)) if o != crate::model::block::Outcome::Unknown => {
                 Some(2 * outcome_bits(o) as u8 + (tag >> 10 & 1) as u8)
             }

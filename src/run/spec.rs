@@ -201,6 +201,20 @@ impl RunSpec {
         self.scene.validate(allow_restitution_above_one)?;
         self.throws.validate()?;
         self.roll.validate()?;
+        if let Some(shape) = &self.scene.shape {
+            use crate::model::throws::ThrowStyle;
+            if matches!(self.throws.style, ThrowStyle::Paper | ThrowStyle::Hand) {
+                return Err(Error::field(
+                    Field::Style,
+                    self.throws.style.name(),
+                    format!(
+                        "the paper's throw and a hand's spin a die about its long axis, which \
+                         {} has not: use tumble or rest",
+                        shape.name
+                    ),
+                ));
+            }
+        }
         if self.rolls == 0 {
             return Err(Error::field(Field::Rolls, 0, "need at least one roll"));
         }

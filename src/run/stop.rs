@@ -10,6 +10,13 @@ use std::sync::Arc;
 pub struct Stop(Arc<AtomicBool>);
 
 impl Stop {
+    /// The process's own flag, raised by its signal handler (the command line's Ctrl-C and
+    /// SIGTERM): what a read deep in the library (a die file on a named pipe) honours.
+    pub fn global() -> &'static Stop {
+        static STOP: std::sync::OnceLock<Stop> = std::sync::OnceLock::new();
+        STOP.get_or_init(Stop::new)
+    }
+
     /// A flag not yet raised.
     pub fn new() -> Stop {
         Stop::default()

@@ -48,6 +48,10 @@ pub struct Tally {
     /// rolls from chunks written before faces were kept ([`Tally::faces_complete`]).
     #[serde(default)]
     pub up: [u64; 6],
+    /// A die of any shape (`model::shape`): settled rolls by its outcome, in the order of its
+    /// faces (`Shape::faces`); they add up to `counts.face`. Empty for the cuboid.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub faces: Vec<u64>,
 }
 
 /// Settled rolls by the side standing vertical.
@@ -61,6 +65,13 @@ pub struct Counts {
     pub length: u64,
     /// No side vertical (at rest on an edge, or leaning).
     pub unknown: u64,
+    /// A die of any shape at rest on one of its faces (which: `Tally::faces`).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub face: u64,
+}
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
 }
 
 impl Counts {
@@ -71,6 +82,7 @@ impl Counts {
             Outcome::Width => &mut self.width,
             Outcome::Length => &mut self.length,
             Outcome::Unknown => &mut self.unknown,
+            Outcome::Face => &mut self.face,
         };
         plus(n, 1)
     }
@@ -108,8 +120,16 @@ impl Tally {
                 Fate::Failed(_) => {}
             }
         }
-        if let (Fate::Settled(_), Some(d)) = (r.fate, r.up) {
-            plus(&mut self.up[usize::from(d).min(5)], 1)?;
+        match (r.fate, r.up) {
+            (Fate::Settled(Outcome::Face), Some(d)) => {
+                let d = usize::from(d);
+                if self.faces.len() <= d {
+                    self.faces.resize(d + 1, 0);
+                }
+                plus(&mut self.faces[d], 1)?;
+            }
+            (Fate::Settled(_), Some(d)) => plus(&mut self.up[usize::from(d).min(5)], 1)?,
+            _ => {}
         }
         match r.fate {
             Fate::Settled(o) => self.counts.add(o),
@@ -122,10 +142,17 @@ impl Tally {
     /// audit's counts within the rolls. A tally read from a file must pass this.
     pub fn check(&self) -> crate::Result<()> {
         let c = &self.counts;
-        let ended = [c.breadth, c.width, c.length, c.unknown, self.unconverged]
-            .into_iter()
-            .chain(self.failed.values().copied())
-            .try_fold(0u64, u64::checked_add);
+        let ended = [
+            c.breadth,
+            c.width,
+            c.length,
+            c.unknown,
+            c.face,
+            self.unconverged,
+        ]
+        .into_iter()
+        .chain(self.failed.values().copied())
+        .try_fold(0u64, u64::checked_add);
         let fine = ended == Some(self.rolls)
             && self.certified <= self.rolls
             && self
@@ -142,7 +169,12 @@ impl Tally {
             && (0..3).all(|k| {
                 let side = [c.breadth, c.width, c.length][k];
                 self.up[2 * k].saturating_add(self.up[2 * k + 1]) <= side
-            });
+            })
+            && self
+                .faces
+                .iter()
+                .try_fold(0u64, |a, &b| a.checked_add(b))
+                .is_some_and(|n| n == c.face);
         if fine {
             Ok(())
         } else {
@@ -170,6 +202,13 @@ impl Tally {
         plus(&mut self.counts.width, o.counts.width)?;
         plus(&mut self.counts.length, o.counts.length)?;
         plus(&mut self.counts.unknown, o.counts.unknown)?;
+        plus(&mut self.counts.face, o.counts.face)?;
+        if self.faces.len() < o.faces.len() {
+            self.faces.resize(o.faces.len(), 0);
+        }
+        for (a, b) in self.faces.iter_mut().zip(&o.faces) {
+            plus(a, *b)?;
+        }
         plus(&mut self.unconverged, o.unconverged)?;
         for (k, v) in &o.failed {
             plus(self.failed.entry(*k).or_insert(0), *v)?;
@@ -242,7 +281,8 @@ impl Agreement {
             g.rolls += 1;
             if let (Fate::Settled(p), Fate::Settled(q)) = (x.fate, y.fate) {
                 g.both_settled += 1;
-                g.same += (p == q) as u64;
+                // A die of any shape: the same face, not only both on a face.
+                g.same += (p == q && (p != Outcome::Face || x.up == y.up)) as u64;
             }
         }
         g

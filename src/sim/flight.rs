@@ -47,7 +47,7 @@ const LINEAR_SLEEPING_THRESHOLD: f64 = 0.8 * 1.01;
 const ANGULAR_SLEEPING_THRESHOLD: f64 = 1.0 * 1.01;
 
 /// Free flight as Bullet integrates it out of contact: what a flown step needs of the scene.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct Flight {
     /// The time step, s.
     pub dt: f64,
@@ -71,16 +71,17 @@ impl Flight {
 
     /// `of`, given the scene's die (`DieShape::of`) already made.
     pub fn of_die(scene: &Scene, die: DieShape) -> Flight {
+        // A rounded die, or one of any shape, meets the floor through Bullet's convex test
+        // (GJK), which, as the plane's, reports points up to the breaking threshold away.
+        let clear = match scene.floor {
+            Floor::Box if die.radius == 0.0 && die.convex.is_none() => CLEAR,
+            _ => CLEAR_OF_PLANE,
+        };
         Flight {
             dt: scene.dt,
             gravity: scene.gravity,
             die,
-            // A rounded die meets the floor through Bullet's convex test (GJK), which, as
-            // the plane's, reports points up to the breaking threshold away.
-            clear: match scene.floor {
-                Floor::Box if die.radius == 0.0 => CLEAR,
-                _ => CLEAR_OF_PLANE,
-            },
+            clear,
         }
     }
 
@@ -184,14 +185,7 @@ impl Flight {
         // half diagonal. With room for rounding.
         let (q, d) = (s.rotation.quaternion(), dq.quaternion());
         let planar = q.i == 0.0 && q.j == 0.0 && d.i == 0.0 && d.j == 0.0;
-        let d = &self.die;
-        let reach = (if planar {
-            d.core.x.hypot(d.core.y)
-        } else {
-            d.core.norm()
-        } + d.radius
-            + d.com.norm())
-            * (1.0 + 1e-9);
+        let reach = self.die.reach(planar) * (1.0 + 1e-9);
         // Flight changes only the vertical velocity (x, z and ω are copied), so the last
         // states' velocities are kept as that one number.
         let mut vy = [0.0; REST_WINDOW];

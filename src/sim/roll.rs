@@ -11,7 +11,7 @@ use crate::model::state::BodyState;
 use crate::model::throws::Throw;
 use crate::sim::certificate::Certificate;
 use crate::sim::flight::Flight;
-use crate::sim::rest::{classify, RestDetector, REST_WINDOW};
+use crate::sim::rest::{RestDetector, REST_WINDOW};
 use nalgebra::UnitQuaternion;
 use serde::{Deserialize, Serialize};
 
@@ -598,8 +598,8 @@ impl Watch {
             end.fate = if under {
                 Fate::Failed(Failure::Tunnelled)
             } else {
-                let o = classify(state);
-                end.up = up_direction(&state.rotation, o);
+                let (o, up) = self.die.outcome(state);
+                end.up = up;
                 Fate::Settled(o)
             };
             return true;
@@ -763,7 +763,7 @@ fn run(
         return end;
     }
     let mut w = Watch::new(scene, start, cfg);
-    let mut fly = Flier::new(engine, scene, w.die, start, cfg);
+    let mut fly = Flier::new(engine, scene, w.die.clone(), start, cfg);
     observe(0, &engine.state());
     let mut state = *start;
     while end.steps < cfg.max_steps {
@@ -809,7 +809,7 @@ fn run(
             return end;
         }
     }
-    end.fate = Fate::Unconverged(classify(&state));
+    end.fate = Fate::Unconverged(w.die.outcome(&state).0);
     end
 }
 

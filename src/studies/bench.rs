@@ -432,8 +432,31 @@ pub struct DiceCost {
     pub vs_sharp: f64,
     /// Engine steps per roll.
     pub engine_steps_per_roll: f64,
-    /// Face counts, 1 to 6.
-    pub faces: [u64; 6],
+    /// Face counts: a cube's 1 to 6; a die of any shape's in the order of its faces.
+    pub faces: Vec<u64>,
+}
+
+/// Every die `dice_costs` times, as a scene: the made cubes of [`made_dice`], then dice of
+/// other shapes (`--shape`: a d6 on the general hull path beside the cuboid's, a d20, a d4, a
+/// coin).
+pub fn bench_dice() -> crate::Result<Vec<(String, Scene)>> {
+    let block: crate::model::block::Block = "16x16x16".parse()?;
+    let mut out: Vec<(String, Scene)> = made_dice()
+        .into_iter()
+        .map(|(name, features)| {
+            let mut scene = Scene::paper(block, Mode::ThreeD);
+            scene.features = features;
+            (name.to_string(), scene)
+        })
+        .collect();
+    for name in ["d6", "d20", "d4", "coin:24,2"] {
+        let shape = crate::model::shape::named(name, None)?;
+        out.push((
+            format!("--shape {name}"),
+            Scene::paper(block, Mode::ThreeD).with_shape(shape),
+        ));
+    }
+    Ok(out)
 }
 
 /// The made dice `dice_costs` times, each as flags would give it: a weight 2 mm toward
@@ -500,7 +523,6 @@ pub fn dice_costs(
     log: &dyn Fn(&str),
 ) -> crate::Result<Vec<DiceCost>> {
     use crate::model::throws::ThrowStyle;
-    let block: crate::model::block::Block = "16x16x16".parse()?;
     let throws = Throws::styled(
         ThrowKind::Keyed,
         ThrowStyle::Tumble,
@@ -515,7 +537,7 @@ pub fn dice_costs(
         fast_flight: true,
         ..RollConfig::default()
     };
-    let dice = made_dice();
+    let dice = bench_dice()?;
     let mut out = Vec::new();
     for (engine, n) in [
         (EngineKind::Bullet, rolls),
@@ -523,12 +545,10 @@ pub fn dice_costs(
     ] {
         let mut best = vec![(f64::INFINITY, Vec::new()); dice.len()];
         for _ in 0..repeat.max(1) {
-            for ((_, features), best) in dice.iter().zip(best.iter_mut()) {
-                let mut scene = Scene::paper(block, Mode::ThreeD);
-                scene.features = *features;
+            for ((_, scene), best) in dice.iter().zip(best.iter_mut()) {
                 let job = batch::Job {
                     engine,
-                    scene: &scene,
+                    scene,
                     throws: &throws,
                     cfg: &cfg,
                 };
@@ -555,9 +575,14 @@ pub fn dice_costs(
                 cpu_ms_per_roll: ms,
                 vs_sharp: ms / sharp_ms,
                 engine_steps_per_roll: t.engine_steps as f64 / n as f64,
-                faces: Layout::Right
-                    .numbers()
-                    .map(|k| t.up[Layout::Right.direction_of(k).unwrap_or(0)]),
+                faces: if t.faces.is_empty() {
+                    Layout::Right
+                        .numbers()
+                        .map(|k| t.up[Layout::Right.direction_of(k).unwrap_or(0)])
+                        .to_vec()
+                } else {
+                    t.faces.clone()
+                },
             };
             log(&format!(
                 "made die, {:<6} {:<16} {:>6} rolls  {:.3} ms/roll  {:.2}x the sharp uniform die  {:.0} engine steps/roll",

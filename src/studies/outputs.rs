@@ -230,7 +230,7 @@ pub fn roll(
     runner: &Runner,
 ) -> Result<RunSummary> {
     let mut csv = match &per_roll {
-        Some((out, layout)) => Some(PerRoll::new(out.writer()?, spec.scene.dt, *layout)?),
+        Some((out, layout)) => Some(PerRoll::for_scene(out.writer()?, &spec.scene, *layout)?),
         None => None,
     };
     let mut sink = |recs: &[RollRecord]| -> Result<()> {

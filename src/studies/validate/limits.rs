@@ -67,7 +67,7 @@ impl LimitCell {
             Outcome::Breadth => 'b',
             Outcome::Width => 'w',
             Outcome::Length => 'l',
-            Outcome::Unknown => '?',
+            Outcome::Unknown | Outcome::Face => '?',
         });
         Ok(())
     }

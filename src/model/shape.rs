@@ -1,0 +1,460 @@
+//! A die of any shape: a convex body with labelled resting faces. The paper's cuboid is not
+//! one of these (it keeps its own fast path, `model::die`); a `Shape` is what `--shape`
+//! (d4 … d20, a coin, a prism) and a mesh (`--die FILE.obj|.stl`) describe.
+//!
+//! What a shape holds is what decides a roll's outcome, so it is part of the run's
+//! specification (and its checksum): the hull the engines collide (or the cylinder), the
+//! solid's volume and second moments (the mesh as given, non-convex allowed: the floor only
+//! ever touches the hull), and its outcomes, the stable facets of the hull, each with the
+//! label the die shows when it rests on that facet.
+
+use crate::error::{Error, Field, Result};
+use crate::model::polytope::{self, Mesh, Reads as PolyReads};
+use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// A facet is a resting face only if its centre of mass's foot lies inside it by more than
+/// this fraction of the die's size: a die balanced on a facet's edge is no outcome.
+pub const STABLE_MARGIN: f64 = 1e-6;
+
+/// The most outcomes a die may have (a roll records its face in a byte).
+pub const MAX_FACES: usize = 255;
+
+/// Which face's label a die shows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Reads {
+    /// The face facing up (most dice).
+    #[default]
+    Up,
+    /// The face on the floor (a d4's point up).
+    Down,
+}
+
+/// The body that collides.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Solid {
+    /// A convex polyhedron: its hull's vertices, m, body axes, from the solid's centroid.
+    Hull {
+        /// The vertices.
+        points: Vec<[f64; 3]>,
+    },
+    /// A cylinder along body z, centred (a coin: its two faces and its edge).
+    Cylinder {
+        /// m.
+        diameter: f64,
+        /// m.
+        height: f64,
+    },
+}
+
+/// One outcome: a resting face.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Face {
+    /// The face's outward normal in body axes (the face on the floor when the die rests on
+    /// it); a cylinder's curved side has none (`[0, 0, 0]`: any direction normal to z).
+    pub normal: [f64; 3],
+    /// What the die shows resting on this face.
+    pub label: String,
+}
+
+/// A die of any shape.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Shape {
+    /// What it is: `d20`, `coin:24,2`, `prism:6,16,40`, or a mesh's file name and checksum.
+    pub name: String,
+    /// What collides.
+    pub solid: Solid,
+    /// The solid's volume, m³.
+    pub volume: f64,
+    /// Its second moments at unit density about its centroid, ∫ x xᵀ dV (m⁵, body axes):
+    /// xx, yy, zz, xy, xz, yz.
+    pub second: [f64; 6],
+    /// The outcomes, in the order every count of them keeps.
+    pub faces: Vec<Face>,
+}
+
+/// Parses `NAME` or `NAME:ARGS`: a named die and its size, mm (`None`: its standard size).
+pub fn named(spec: &str, size_mm: Option<f64>) -> Result<Shape> {
+    let bad = |why: String| Error::field(Field::Shape, spec, why);
+    let spec_t = spec.trim();
+    if let Some(args) = spec_t.strip_prefix("coin:") {
+        let v = numbers(args).map_err(bad)?;
+        let [d, h] = v[..] else {
+            return Err(bad("a coin is coin:DIAMETER,THICKNESS in mm".into()));
+        };
+        if size_mm.is_some() {
+            return Err(bad(
+                "a coin's size is in its name (coin:D,H); leave out the size".into(),
+            ));
+        }
+        return coin(d, h).map_err(bad);
+    }
+    let named = polytope::named(spec_t, size_mm).map_err(bad)?;
+    let reads = match named.reads {
+        PolyReads::Up => Reads::Up,
+        PolyReads::Down => Reads::Down,
+    };
+    let name = match size_mm {
+        Some(s) if !spec_t.contains(':') => format!("{spec_t}@{s}"),
+        _ => spec_t.to_string(),
+    };
+    from_mesh(&named.mesh, name, Some(&named.labels), reads).map_err(bad)
+}
+
+/// The list of numbers in `a,b,…` (mm).
+fn numbers(args: &str) -> std::result::Result<Vec<f64>, String> {
+    args.split(',')
+        .map(|p| {
+            p.trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite() && *x > 0.0)
+                .ok_or_else(|| format!("'{}' is not a positive number of mm", p.trim()))
+        })
+        .collect()
+}
+
+/// A coin `d` mm across and `h` mm thick: a cylinder, its outcomes heads (the +z face up),
+/// tails and edge.
+pub fn coin(d: f64, h: f64) -> std::result::Result<Shape, String> {
+    let (dm, hm) = (d / 1000.0, h / 1000.0);
+    for v in [dm, hm] {
+        if !(crate::model::block::MIN_SIDE_M..=crate::model::block::MAX_SIDE_M).contains(&v) {
+            return Err(format!(
+                "a coin's sizes must be in [{}, {}] mm",
+                crate::model::block::MIN_SIDE_M * 1e3,
+                crate::model::block::MAX_SIDE_M * 1e3
+            ));
+        }
+    }
+    let mp = polytope::Cylinder {
+        diameter: dm,
+        height: hm,
+    }
+    .mass_properties();
+    let label = |s: &str| s.to_string();
+    Ok(Shape {
+        name: format!("coin:{d},{h}"),
+        solid: Solid::Cylinder {
+            diameter: dm,
+            height: hm,
+        },
+        volume: mp.volume,
+        second: second_moments(&mp.inertia, mp.volume),
+        faces: vec![
+            Face {
+                normal: [0.0, 0.0, -1.0],
+                label: label("heads"),
+            },
+            Face {
+                normal: [0.0, 0.0, 1.0],
+                label: label("tails"),
+            },
+            Face {
+                normal: [0.0; 3],
+                label: label("edge"),
+            },
+        ],
+    })
+}
+
+/// ∫ x xᵀ dV from the inertia tensor I = tr(S)·1 − S about the same point: S = tr(I)/2·1 − I.
+fn second_moments(inertia: &Matrix3<f64>, _volume: f64) -> [f64; 6] {
+    let s = Matrix3::identity() * (0.5 * inertia.trace()) - inertia;
+    [
+        s[(0, 0)],
+        s[(1, 1)],
+        s[(2, 2)],
+        s[(0, 1)],
+        s[(0, 2)],
+        s[(1, 2)],
+    ]
+}
+
+/// A die from a mesh in mm (closed and consistently oriented; checked), named `name`, its
+/// facets labelled by `labels` (outward normal → label; `None`: numbered 1…N in a fixed
+/// order) and read as `reads` says.
+pub fn from_mesh(
+    mesh_mm: &Mesh,
+    name: String,
+    labels: Option<&[(Vector3<f64>, String)]>,
+    reads: Reads,
+) -> std::result::Result<Shape, String> {
+    mesh_mm.check()?;
+    let mesh = mesh_mm.scaled(1e-3);
+    let mp = mesh.mass_properties();
+    if !(mp.volume > 0.0) {
+        return Err("the mesh encloses no volume".into());
+    }
+    let centred: Vec<Vector3<f64>> = mesh.vertices.iter().map(|v| v - mp.centroid).collect();
+    let hull = polytope::hull(&centred)?;
+    let size = hull
+        .vertices
+        .iter()
+        .map(|v| v.norm())
+        .fold(0.0f64, f64::max);
+    for (what, v) in [("largest", 2.0 * size), ("smallest", mp.volume.cbrt())] {
+        if !(crate::model::block::MIN_SIDE_M..=crate::model::block::MAX_SIDE_M).contains(&v) {
+            return Err(format!(
+                "its {what} size, {} mm, is outside [{}, {}] mm (is the mesh in mm? --scale)",
+                v * 1e3,
+                crate::model::block::MIN_SIDE_M * 1e3,
+                crate::model::block::MAX_SIDE_M * 1e3
+            ));
+        }
+    }
+    let facets = polytope::facets(&hull, polytope::COPLANAR_TOLERANCE);
+    let com = Vector3::zeros();
+    let stable: Vec<&polytope::Facet> = facets
+        .iter()
+        .filter(|f| polytope::stable(f, &com, STABLE_MARGIN * size))
+        .collect();
+    if stable.is_empty() {
+        return Err("no facet of its hull is stable: it cannot come to rest".into());
+    }
+    if stable.len() > MAX_FACES {
+        return Err(format!(
+            "its hull has {} stable facets, more than {MAX_FACES}: simplify the mesh",
+            stable.len()
+        ));
+    }
+    // The label printed on each stable facet: the given one whose normal is nearest, or
+    // 1…N in order of the facets' normals (down first, then by angle).
+    let printed: Vec<String> = match labels {
+        Some(l) => stable
+            .iter()
+            .map(|f| {
+                l.iter()
+                    .max_by(|a, b| f.normal.dot(&a.0).total_cmp(&f.normal.dot(&b.0)))
+                    .filter(|(n, _)| f.normal.dot(n) > 1.0 - 1e-6)
+                    .map(|(_, s)| s.clone())
+                    .ok_or_else(|| {
+                        format!(
+                            "no label for the facet with normal ({:.4}, {:.4}, {:.4})",
+                            f.normal.x, f.normal.y, f.normal.z
+                        )
+                    })
+            })
+            .collect::<std::result::Result<_, _>>()?,
+        None => (1..=stable.len()).map(|k| k.to_string()).collect(),
+    };
+    let faces = stable
+        .iter()
+        .enumerate()
+        .map(|(k, f)| {
+            let label = match reads {
+                Reads::Down => printed[k].clone(),
+                // The facet facing up when this one is down: the most nearly opposite.
+                Reads::Up => {
+                    let up = (0..stable.len())
+                        .min_by(|&a, &b| {
+                            stable[a]
+                                .normal
+                                .dot(&f.normal)
+                                .total_cmp(&stable[b].normal.dot(&f.normal))
+                        })
+                        .unwrap_or(k);
+                    printed[up].clone()
+                }
+            };
+            Face {
+                normal: f.normal.into(),
+                label,
+            }
+        })
+        .collect();
+    Ok(Shape {
+        name,
+        solid: Solid::Hull {
+            points: hull.vertices.iter().map(|&v| v.into()).collect(),
+        },
+        volume: mp.volume,
+        second: second_moments(&mp.inertia, mp.volume),
+        faces,
+    })
+}
+
+impl Shape {
+    /// The hull's vertices (a cylinder: none), m, body axes, from the centroid.
+    pub fn points(&self) -> Vec<Vector3<f64>> {
+        match &self.solid {
+            Solid::Hull { points } => points.iter().map(|&p| Vector3::from(p)).collect(),
+            Solid::Cylinder { .. } => Vec::new(),
+        }
+    }
+
+    /// The largest distance from the centroid to any point of the die, m.
+    pub fn circumradius(&self) -> f64 {
+        match &self.solid {
+            Solid::Hull { points } => points
+                .iter()
+                .map(|p| Vector3::from(*p).norm())
+                .fold(0.0, f64::max),
+            Solid::Cylinder { diameter, height } => (0.5 * diameter).hypot(0.5 * height),
+        }
+    }
+
+    /// The sides of its bounding box along body x, y, z, m.
+    pub fn bounding_box(&self) -> [f64; 3] {
+        match &self.solid {
+            Solid::Hull { points } => std::array::from_fn(|i| {
+                let (lo, hi) = points.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+                    (lo.min(p[i]), hi.max(p[i]))
+                });
+                hi - lo
+            }),
+            Solid::Cylinder { diameter, height } => [*diameter, *diameter, *height],
+        }
+    }
+
+    /// The second moments as a matrix.
+    pub fn second_matrix(&self) -> Matrix3<f64> {
+        let [xx, yy, zz, xy, xz, yz] = self.second;
+        Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
+    }
+
+    /// True if `p` (m, body axes, from the centroid) lies strictly inside the die's hull.
+    pub fn contains(&self, p: &Vector3<f64>) -> bool {
+        match &self.solid {
+            Solid::Cylinder { diameter, height } => {
+                p.x.hypot(p.y) < 0.5 * diameter && p.z.abs() < 0.5 * height
+            }
+            Solid::Hull { .. } => self.planes().iter().all(|(n, d)| n.dot(p) < *d),
+        }
+    }
+
+    /// The hull's facet planes (outward normal n, offset d: n·x = d on the facet).
+    pub fn planes(&self) -> Vec<(Vector3<f64>, f64)> {
+        let pts = self.points();
+        match polytope::hull(&pts) {
+            Ok(h) => polytope::facets(&h, polytope::COPLANAR_TOLERANCE)
+                .into_iter()
+                .map(|f| (f.normal, f.offset))
+                .collect(),
+            Err(_) => Vec::new(),
+        }
+    }
+
+    /// The collision margin an engine that keeps one around a convex hull is given (Bullet):
+    /// 0.1 mm, or a hundredth of the distance from the centroid to the nearest facet if that
+    /// is less. The hull is kept this far out, its edges so rounded: a hundredth of the die's
+    /// size at most, far below what changes a face's odds.
+    pub fn margin(&self) -> f64 {
+        let inradius = match &self.solid {
+            Solid::Cylinder { diameter, height } => (0.5 * diameter).min(0.5 * height),
+            Solid::Hull { .. } => self
+                .planes()
+                .iter()
+                .map(|(_, d)| *d)
+                .fold(f64::INFINITY, f64::min),
+        };
+        (1e-4f64).min(0.01 * inradius)
+    }
+
+    /// The outcomes' labels, in order.
+    pub fn labels(&self) -> Vec<&str> {
+        self.faces.iter().map(|f| f.label.as_str()).collect()
+    }
+}
+
+/// The largest mesh file read: 256 MiB (a printed die's STL is rarely above a few MiB).
+pub const MAX_MESH_FILE: u64 = 256 << 20;
+
+/// The die of any shape the front ends describe, if any: `name` (`--shape`, sized by
+/// `size_mm`), or a die `file` that is a mesh (.obj, .stl) or a TOML die file naming one
+/// (`mesh`, with its `scale`, `reads` and `labels`), the mesh's lengths times `scale` (the
+/// file's, else 1). Both a name and a mesh, or a size or scale with nothing to size, are
+/// refused with the reason.
+pub fn described(
+    file: Option<&std::path::Path>,
+    name: Option<&str>,
+    size_mm: Option<f64>,
+    scale: Option<f64>,
+) -> Result<Option<Shape>> {
+    use crate::model::mass::{is_mesh, read_die_bytes, DieFile};
+    let mesh = match file {
+        Some(p) if is_mesh(p) => Some((p.to_path_buf(), DieFile::default())),
+        Some(p) => {
+            let f = DieFile::read(p)?;
+            let dir = p.parent().unwrap_or(std::path::Path::new("."));
+            f.mesh.clone().map(|m| (dir.join(m), f))
+        }
+        None => None,
+    };
+    if let Some(s) = size_mm {
+        if !(s.is_finite() && s > 0.0) || name.is_none() {
+            return Err(Error::field(
+                Field::Size,
+                s,
+                "must be a positive number of mm, with --shape (a mesh is sized by --scale)",
+            ));
+        }
+    }
+    if let Some(s) = scale {
+        if !(s.is_finite() && s > 0.0) || mesh.is_none() {
+            return Err(Error::field(
+                Field::Scale,
+                s,
+                "must be a positive factor, with a mesh die file (--die FILE.obj|.stl)",
+            ));
+        }
+    }
+    match (name, mesh) {
+        (Some(n), Some(_)) => Err(Error::field(
+            Field::Shape,
+            n,
+            "give a named shape or a mesh die file (--die), not both",
+        )),
+        (Some(n), None) => named(n, size_mm).map(Some),
+        (None, None) => Ok(None),
+        (None, Some((path, f))) => {
+            let bytes = read_die_bytes(&path, MAX_MESH_FILE)?;
+            let file_name = path.file_name().map_or_else(
+                || path.display().to_string(),
+                |n| n.to_string_lossy().into(),
+            );
+            let bad = |why: String| Error::field(Field::Die, path.display(), why);
+            let mesh = crate::model::mesh_file::read_mesh(&bytes, &file_name).map_err(bad)?;
+            let k = scale.or(f.scale).unwrap_or(1.0);
+            if !(k.is_finite() && k > 0.0) {
+                return Err(bad(format!("scale {k}: must be a positive factor")));
+            }
+            let labels: Option<Vec<(Vector3<f64>, String)>> = f.labels.as_ref().map(|l| {
+                l.iter()
+                    .map(|d| (Vector3::from(d.normal).normalize(), d.label.clone()))
+                    .collect()
+            });
+            let name = format!(
+                "{file_name}{} fnv1a64:{:016x}",
+                if k == 1.0 {
+                    String::new()
+                } else {
+                    format!(" ×{k}")
+                },
+                fnv64(&bytes)
+            );
+            from_mesh(
+                &mesh.scaled(k),
+                name,
+                labels.as_deref(),
+                f.reads.unwrap_or(if f.labels.is_some() {
+                    Reads::Up
+                } else {
+                    Reads::Down
+                }),
+            )
+            .map(Some)
+            .map_err(bad)
+        }
+    }
+}
+
+/// FNV-1a, 64 bits: a mesh file's fingerprint in the die's name (its geometry itself is in
+/// the run's specification, under its checksum).
+fn fnv64(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}

@@ -1,0 +1,288 @@
+//! Dice of any shape (`--shape`, a mesh `--die`): the named dice fair in a tumble on both
+//! engines, a cube given as a mesh the built-in d6, a coin's three outcomes, bad meshes and
+//! bad combinations refused in one line, and a shaped run resumed, sharded and merged bit for
+//! bit. Each statistical check states its tolerance in standard errors at a fixed seed.
+
+use super::helpers::{bin, dicephys, json, Scratch};
+
+/// `roll` of a die of any shape as JSON.
+fn roll(args: &[&str]) -> serde_json::Value {
+    json(&dicephys(
+        &[&["roll", "--json", "--seed", "1"][..], args].concat(),
+    ))
+}
+
+/// The JSON's outcomes: (label, count) in the die's order.
+fn faces(v: &serde_json::Value) -> Vec<(String, u64)> {
+    v["shape"]["faces"]
+        .as_array()
+        .expect("a shape's faces")
+        .iter()
+        .map(|f| {
+            (
+                f["label"].as_str().unwrap().to_string(),
+                f["count"].as_u64().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// Every face within `tol` standard errors of 1/N and the χ² against a fair die not rejected
+/// at 0.001; the labels those the convention gives.
+fn fair(v: &serde_json::Value, labels: &[&str], tol: f64) {
+    let f = faces(v);
+    let mut got: Vec<&str> = f.iter().map(|(l, _)| l.as_str()).collect();
+    got.sort_by_key(|l| l.parse::<u32>().unwrap_or(u32::MAX));
+    assert_eq!(got, labels, "{}", v["shape"]);
+    for face in v["shape"]["faces"].as_array().unwrap() {
+        let z = face["z_fair"].as_f64().unwrap();
+        assert!(
+            z.abs() < tol,
+            "face {face} is {z:.1}σ from 1/N: {}",
+            v["shape"]
+        );
+    }
+    let p = v["shape"]["p_value"].as_f64().unwrap();
+    assert!(p > 0.001, "χ² p {p}: {}", v["shape"]);
+    // Few rolls end leaning or unsettled.
+    let settled = v["counts"]["face"].as_u64().unwrap();
+    assert!(
+        settled * 100 >= 98 * v["rolls"].as_u64().unwrap(),
+        "{}",
+        v["counts"]
+    );
+}
+
+fn numbers(n: u32) -> Vec<String> {
+    (1..=n).map(|k| k.to_string()).collect()
+}
+
+#[test]
+fn the_named_dice_come_up_fair_in_a_tumble_on_bullet() {
+    // 1,200 rolls a die: 1/N known to about ±0.006 (a d4's ±0.0125): 4σ each (six dice,
+    // up to 20 faces each, so a 3σ bound would fail by chance about one run in four).
+    for (name, n) in [
+        ("d4", 4),
+        ("d6", 6),
+        ("d8", 8),
+        ("d10", 10),
+        ("d12", 12),
+        ("d20", 20),
+    ] {
+        let v = roll(&["--shape", name, "--rolls", "1200"]);
+        let labels = numbers(n);
+        let labels: Vec<&str> = labels.iter().map(String::as_str).collect();
+        fair(&v, &labels, 4.0);
+        assert_eq!(v["spec"]["throws"]["style"], "tumble", "{name}");
+    }
+}
+
+#[test]
+fn a_d20_comes_up_fair_on_rapier() {
+    let v = roll(&["--shape", "d20", "--rolls", "600", "--engine", "rapier"]);
+    let labels = numbers(20);
+    let labels: Vec<&str> = labels.iter().map(String::as_str).collect();
+    fair(&v, &labels, 4.0);
+}
+
+/// A cube of side `s` mm as an OBJ mesh: eight corners, six quads, counter-clockwise seen
+/// from outside.
+fn cube_obj(s: f64) -> String {
+    let h = s / 2.0;
+    let mut t = String::from("# a cube\n");
+    for k in 0..8 {
+        let c = |bit: usize| if k >> bit & 1 == 1 { h } else { -h };
+        t += &format!("v {} {} {}\n", c(0), c(1), c(2));
+    }
+    // Corners numbered from 1: bit 0 x, bit 1 y, bit 2 z.
+    for f in [
+        "1 3 4 2", // -z
+        "5 6 8 7", // +z
+        "1 2 6 5", // -y
+        "3 7 8 4", // +y
+        "1 5 7 3", // -x
+        "2 4 8 6", // +x
+    ] {
+        t += &format!("f {f}\n");
+    }
+    t
+}
+
+/// Pearson's χ² of two count vectors against their common proportions, on k − 1 degrees of
+/// freedom.
+fn two_sample_chi2(a: &[u64], b: &[u64]) -> f64 {
+    let (na, nb) = (a.iter().sum::<u64>() as f64, b.iter().sum::<u64>() as f64);
+    a.iter()
+        .zip(b)
+        .map(|(&x, &y)| {
+            let p = (x + y) as f64 / (na + nb);
+            let (ea, eb) = (p * na, p * nb);
+            if p == 0.0 {
+                0.0
+            } else {
+                (x as f64 - ea).powi(2) / ea + (y as f64 - eb).powi(2) / eb
+            }
+        })
+        .sum()
+}
+
+#[test]
+fn a_cube_given_as_a_mesh_rolls_as_the_built_in_d6_on_both_engines() {
+    let dir = Scratch::new("shape-obj");
+    let obj = dir.join("cube.obj");
+    std::fs::write(&obj, cube_obj(16.0)).unwrap();
+    for (engine, rolls) in [("bullet", "1200"), ("rapier", "400")] {
+        let mesh = roll(&[
+            "--die",
+            obj.to_str().unwrap(),
+            "--rolls",
+            rolls,
+            "--engine",
+            engine,
+        ]);
+        let d6 = roll(&["--shape", "d6", "--rolls", rolls, "--engine", engine]);
+        // The mesh ran on the general hull path, and says which die it was.
+        assert!(
+            mesh["shape"]["shape"]
+                .as_str()
+                .unwrap()
+                .starts_with("cube.obj"),
+            "{}",
+            mesh["shape"]
+        );
+        assert!(mesh["spec"]["scene"]["shape"]["solid"]["hull"].is_object());
+        let counts = |v: &serde_json::Value| {
+            let mut f: Vec<u64> = faces(v).iter().map(|(_, c)| *c).collect();
+            f.sort();
+            f
+        };
+        // The mesh's facets are numbered by its own order, the d6's by its layout: compare
+        // the sorted counts, and each a fair die within 4σ.
+        let (a, b) = (counts(&mesh), counts(&d6));
+        assert_eq!(a.len(), 6);
+        let chi2 = two_sample_chi2(&a, &b);
+        // χ²₅ exceeds 20.5 with probability 0.001.
+        assert!(
+            chi2 < 20.5,
+            "{engine}: mesh {a:?} against d6 {b:?}: χ² {chi2:.1}"
+        );
+        for (_, f) in [&mesh, &d6].iter().map(|v| ((), v)) {
+            for face in f["shape"]["faces"].as_array().unwrap() {
+                assert!(
+                    face["z_fair"].as_f64().unwrap().abs() < 4.0,
+                    "{engine}: {face}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn a_coin_lands_heads_tails_or_on_its_edge() {
+    let v = roll(&["--shape", "coin:24,2", "--rolls", "600"]);
+    let f = faces(&v);
+    let labels: Vec<&str> = f.iter().map(|(l, _)| l.as_str()).collect();
+    assert_eq!(labels, ["heads", "tails", "edge"]);
+    let (h, t) = (f[0].1 as f64, f[1].1 as f64);
+    // Heads and tails alike within 4σ of their difference; a thin coin rarely on its edge.
+    let z = (h - t) / (h + t).sqrt();
+    assert!(z.abs() < 4.0, "heads {h} tails {t}");
+    assert!(f[2].1 * 20 < 600, "edge {}", f[2].1);
+    // A coin as thick as it is wide stands on its edge often.
+    let v = roll(&["--shape", "coin:10,10", "--rolls", "300"]);
+    assert!(faces(&v)[2].1 > 30, "{}", v["shape"]);
+}
+
+/// One line on stderr, exit 2, containing every one of `says`.
+fn refused(args: &[&str], says: &[&str]) {
+    let o = dicephys(args);
+    let e = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {e}");
+    assert_eq!(e.trim_end().lines().count(), 1, "{args:?}: {e}");
+    for s in says {
+        assert!(e.contains(s), "{args:?}: wanted '{s}' in {e}");
+    }
+}
+
+#[test]
+fn bad_meshes_and_combinations_are_refused_in_one_line() {
+    let dir = Scratch::new("shape-bad");
+    let holed = dir.join("holed.obj");
+    // The cube less its +x face: open.
+    let text: String = cube_obj(16.0)
+        .lines()
+        .filter(|l| *l != "f 2 4 8 6")
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(&holed, text).unwrap();
+    let h = holed.to_str().unwrap();
+    refused(&["roll", "--die", h], &["--die", "closed"]);
+    let missing = dir.join("missing.stl");
+    refused(&["roll", "--die", missing.to_str().unwrap()], &["--die"]);
+    refused(
+        &["roll", "--die", dir.to_str().unwrap()],
+        &["--die", "directory"],
+    );
+    let garbage = dir.join("garbage.stl");
+    std::fs::write(&garbage, "not a mesh at all").unwrap();
+    refused(&["roll", "--die", garbage.to_str().unwrap()], &["--die"]);
+    refused(&["roll", "--shape", "d7"], &["--shape"]);
+    refused(&["roll", "--shape", "coin:24"], &["--shape"]);
+    refused(
+        &["roll", "--shape", "d20", "--throw", "paper"],
+        &["--throw", "tumble"],
+    );
+    refused(&["roll", "--shape", "d20", "--2d"], &["--shape", "3D"]);
+    refused(&["roll", "--shape", "d20", "--pips", "3,1"], &["pips"]);
+    refused(
+        &["roll", "--shape", "d20", "--edge-radius", "1"],
+        &["--edge-radius"],
+    );
+    refused(
+        &["roll", "--shape", "d20", "--com", "0,0,30"],
+        &["--com", "inside"],
+    );
+    refused(
+        &["roll", "--shape", "d20", "--block", "16x16x16"],
+        &["--block"],
+    );
+    refused(&["roll", "--size", "20"], &["--size"]);
+    refused(&["roll", "--shape", "d20", "--scale", "2"], &["--scale"]);
+}
+
+#[test]
+fn a_shaped_run_resumes_and_merges_bit_for_bit() {
+    let dir = Scratch::new("shape-resume");
+    let args = ["--shape", "d8", "--rolls", "2500", "--com", "0,0,-1"];
+    let whole = roll(&args);
+    let ck = dir.join("ck");
+    let first = roll(&[&args[..], &["--checkpoint", ck.to_str().unwrap()]].concat());
+    assert_eq!(first["tally"], whole["tally"]);
+    // Resumed from its complete checkpoint: every chunk read back, the same tally.
+    let again = json(&dicephys(&[
+        "roll",
+        "--json",
+        "--resume",
+        ck.to_str().unwrap(),
+    ]));
+    assert_eq!(again["tally"], whole["tally"]);
+    assert_eq!(again["shape"], whole["shape"]);
+    // Two shards merged: the unsharded result.
+    let mut files = Vec::new();
+    for k in 0..2 {
+        let v = roll(&[&args[..], &["--shard", &format!("{k}/2")]].concat());
+        let f = dir.join(format!("s{k}.json"));
+        std::fs::write(&f, v.to_string()).unwrap();
+        files.push(f);
+    }
+    let merged = json(
+        &bin()
+            .arg("merge")
+            .arg("--json")
+            .args(&files)
+            .output()
+            .unwrap(),
+    );
+    assert_eq!(merged["tally"], whole["tally"]);
+    assert_eq!(merged["faces"], whole["faces"]);
+}
