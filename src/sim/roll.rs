@@ -624,6 +624,12 @@ struct Flier {
     body: BodyState,
     /// Flown steps in a row so far.
     in_a_row: u64,
+    /// A jump may still take steps in this flight: false once one took none. In flight the
+    /// energy only falls, so a state at or below the certificate's ceiling is followed by
+    /// others at or below it, and a flight whose next step must be walked ends there: asking
+    /// again at every walked step (most of a low bounce's) would cost a call each and find
+    /// nothing. Not asking changes nothing: a walked step is the jumped step (`run`).
+    jumpable: bool,
 }
 
 impl Flier {
@@ -643,12 +649,14 @@ impl Flier {
             behind: false,
             body: *start,
             in_a_row: 0,
+            jumpable: true,
         }
     }
 
     /// Starts a flight if the die, in `state`, may fly.
     #[inline(always)]
     fn start(&mut self, engine: &mut dyn Engine, state: &BodyState) {
+        self.jumpable = true;
         self.flying = if self.own {
             if engine.own_flight_start(state) {
                 Flying::Own
@@ -686,7 +694,9 @@ impl Flier {
             (Flying::Ballistic(dq), Some(f)) => {
                 let max = quiet_steps(&w.die, state, w.ceiling, f).min(left);
                 let n = f.jump(&mut self.body, dq, max, &mut w.rest);
-                *state = f.to_die(&self.body);
+                if n > 0 {
+                    *state = f.to_die(&self.body);
+                }
                 n
             }
             _ => {
@@ -702,6 +712,8 @@ impl Flier {
         if n > 0 {
             self.in_a_row += n;
             self.behind = true;
+        } else {
+            self.jumpable = false;
         }
         n
     }
@@ -772,7 +784,7 @@ fn run(
             fly.start(engine, &state);
         }
         if !matches!(fly.flying, Flying::No) {
-            if jump && fly.in_a_row >= REST_WINDOW as u64 {
+            if jump && fly.jumpable && fly.in_a_row >= REST_WINDOW as u64 {
                 let n = fly.jump(engine, &mut w, &mut state, cfg.max_steps - end.steps, scene);
                 if n > 0 {
                     end.steps += n;
