@@ -718,22 +718,31 @@ impl Flier {
         n
     }
 
-    /// The next flown state from `state`, or `None` where the flight ends, the engine then
-    /// given the state back (an `Err` if it refused it).
+    /// Flies `state` on to the next flown state: true if it did, false where the flight
+    /// ends, the engine then given the state back (an `Err` if it refused it). The state is
+    /// advanced in place, not returned: most walked steps of a flight are flown, and an
+    /// `Option<BodyState>` handed on was copied three times over on each (callgrind: 1.2 %
+    /// of a plain roll's instructions).
     #[inline(always)]
-    fn next(
-        &mut self,
-        engine: &mut dyn Engine,
-        state: &BodyState,
-    ) -> Result<Option<BodyState>, ()> {
-        let next = match (&self.flying, &self.flight) {
-            (Flying::Ballistic(dq), Some(f)) => f.next(&self.body, dq).map(|b| {
-                self.body = b;
-                f.to_die(&b)
-            }),
-            _ => engine.own_flight_step(state),
+    fn next(&mut self, engine: &mut dyn Engine, state: &mut BodyState) -> Result<bool, ()> {
+        let flown = match (&self.flying, &self.flight) {
+            (Flying::Ballistic(dq), Some(f)) => match f.next(&self.body, dq) {
+                Some(b) => {
+                    self.body = b;
+                    *state = f.to_die(&b);
+                    true
+                }
+                None => false,
+            },
+            _ => match engine.own_flight_step(state) {
+                Some(s) => {
+                    *state = s;
+                    true
+                }
+                None => false,
+            },
         };
-        if next.is_none() {
+        if !flown {
             if self.behind {
                 let handed = match self.flying {
                     Flying::Ballistic(_) => engine.set_body_state(&self.body),
@@ -748,7 +757,7 @@ impl Flier {
         } else {
             self.behind = true;
         }
-        Ok(next)
+        Ok(flown)
     }
 }
 
@@ -779,7 +788,7 @@ fn run(
     observe(0, &engine.state());
     let mut state = *start;
     while end.steps < cfg.max_steps {
-        let mut next = None;
+        let mut flown = false;
         if matches!(fly.flying, Flying::No) {
             fly.start(engine, &state);
         }
@@ -797,23 +806,19 @@ fn run(
                     }
                 }
             }
-            match fly.next(engine, &state) {
-                Ok(n) => next = n,
+            match fly.next(engine, &mut state) {
+                Ok(f) => flown = f,
                 Err(()) => return end,
             }
         }
-        let flown = next.is_some();
         fly.in_a_row = if flown { fly.in_a_row + 1 } else { 0 };
-        state = match next {
-            Some(s) => s,
-            None => {
-                if engine.step().is_err() {
-                    return end;
-                }
-                end.engine_steps += 1;
-                engine.state()
+        if !flown {
+            if engine.step().is_err() {
+                return end;
             }
-        };
+            end.engine_steps += 1;
+            state = engine.state();
+        }
         end.steps += 1;
         // Every step's state, flown or stepped, goes through the same checks.
         observe(end.steps, &state);
