@@ -30,12 +30,16 @@ impl BodyState {
     }
 
     /// True if every component of position, rotation and velocities is finite.
+    ///
+    /// Asked of every walked step's state, so in one test rather than thirteen: x·0 is ±0
+    /// for a finite x and NaN for ±∞ or NaN, so the sum of the components times 0 is 0
+    /// exactly when every one is finite (a NaN never cancels; products first, so no sum of
+    /// finite components can overflow).
     pub fn is_finite(&self) -> bool {
-        let q = self.rotation.quaternion();
-        self.position.iter().all(|v| v.is_finite())
-            && [q.i, q.j, q.k, q.w].iter().all(|v| v.is_finite())
-            && self.linear_velocity.iter().all(|v| v.is_finite())
-            && self.angular_velocity.iter().all(|v| v.is_finite())
+        let q = &self.rotation.coords;
+        let v = self.position * 0.0 + self.linear_velocity * 0.0 + self.angular_velocity * 0.0;
+        let w = q * 0.0;
+        v.x + v.y + v.z + w.x + w.y + w.z + w.w == 0.0
     }
 }
 

@@ -103,14 +103,22 @@ impl Flight {
         }
     }
 
-    /// The lowest point of a flown body state.
-    #[inline]
+    /// The lowest point of a flown body state. Every flown step asks it: the body not turned
+    /// (every die but a made one off its principal axes) takes it inline, straight from the
+    /// body state, and only a turned body pays for the call that turns it first.
+    #[inline(always)]
     fn body_lowest(&self, body: &BodyState) -> f64 {
         if self.die.turn.turned() {
-            self.lowest_point(&self.to_die(body))
+            self.turned_lowest(body)
         } else {
             self.lowest_point(body)
         }
+    }
+
+    /// `body_lowest` of a turned body: its die's state first (`to_die`).
+    #[inline(never)]
+    fn turned_lowest(&self, body: &BodyState) -> f64 {
+        self.lowest_point(&self.to_die(body))
     }
 
     /// True if a flight may start from `s`, the state after the engine's last step: the die
@@ -189,20 +197,17 @@ impl Flight {
         // Flight changes only the vertical velocity (x, z and ω are copied), so the last
         // states' velocities are kept as that one number.
         let mut vy = [0.0; REST_WINDOW];
-        let mut n = 0u64;
-        while n < max {
-            let next = self.step(s, dq);
-            if !(spinning || next.linear_velocity.norm() >= LINEAR_SLEEPING_THRESHOLD) {
-                break;
-            }
-            // The step that lands is left to the walk, with every check a landing can fire.
-            if next.position.y - reach <= self.clear && self.body_lowest(&next) <= self.clear {
-                break;
-            }
-            *s = next;
-            vy[(n % REST_WINDOW as u64) as usize] = s.linear_velocity.y;
-            n += 1;
-        }
+        // The loop is made twice, its landing test inline for a body not turned (every die
+        // but a made one off its principal axes: the plain roll's every jumped step is here).
+        let n = if self.die.turn.turned() {
+            self.fly(s, dq, max, spinning, reach, &mut vy, |b| {
+                self.turned_lowest(b)
+            })
+        } else {
+            self.fly(s, dq, max, spinning, reach, &mut vy, |b| {
+                self.lowest_point(b)
+            })
+        };
         // The window keeps the last ten: the earlier states only move its count on.
         let first = n.saturating_sub(REST_WINDOW as u64);
         rest.skip(first);
@@ -211,6 +216,46 @@ impl Flight {
             at.linear_velocity.y = vy[(k % REST_WINDOW as u64) as usize];
             rest.record(&at);
         }
+        n
+    }
+
+    /// `jump`'s steps: from `s`, at most `max`, while each is awake (`spinning`, or fast
+    /// enough) and its state clear of the floor (`lowest`, asked only where the centre is
+    /// within `reach` of it); each state's vertical velocity kept in `vy` by step number
+    /// modulo `REST_WINDOW`. Leaves `s` at the last state reached; returns how many.
+    ///
+    /// The state stepped is a local, written back once at the end, and its slot in `vy`
+    /// counts round by itself: every jumped step passes here, and so the loop keeps the
+    /// state in registers.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn fly(
+        &self,
+        s: &mut BodyState,
+        dq: &UnitQuaternion<f64>,
+        max: u64,
+        spinning: bool,
+        reach: f64,
+        vy: &mut [f64; REST_WINDOW],
+        lowest: impl Fn(&BodyState) -> f64,
+    ) -> u64 {
+        let mut at = *s;
+        let (mut n, mut slot) = (0u64, 0);
+        while n < max {
+            let next = self.step(&at, dq);
+            if !(spinning || next.linear_velocity.norm() >= LINEAR_SLEEPING_THRESHOLD) {
+                break;
+            }
+            // The step that lands is left to the walk, with every check a landing can fire.
+            if next.position.y - reach <= self.clear && lowest(&next) <= self.clear {
+                break;
+            }
+            at = next;
+            vy[slot] = at.linear_velocity.y;
+            slot = if slot + 1 == REST_WINDOW { 0 } else { slot + 1 };
+            n += 1;
+        }
+        *s = at;
         n
     }
 
