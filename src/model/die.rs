@@ -23,6 +23,35 @@ pub struct Convex {
     normals: Vec<Vector3<f64>>,
     /// The largest distance from the centre of mass to any point of the die, m.
     pub reach: f64,
+    /// The regions of down directions by the face the downward ray from the centre of mass
+    /// leaves through (a hull's facets; a cylinder's caps, then its side).
+    regions: Vec<Region>,
+}
+
+/// The down directions g (body axes) whose ray from the centre of mass c leaves the die
+/// through one face. On the region's boundary the ray leaves through a point p of the face's
+/// rim, and a die touching the floor holds c at height h(g) ≥ (p − c)·g = |p − c|, at least
+/// the distance from c to the rim (an edge's line; a cylinder's rim circle): the region's
+/// barrier. So a die whose energy is below mg times the barrier cannot leave the region, and
+/// comes to rest on that face: `sim::certificate`'s argument for the cuboid, for any convex
+/// die.
+#[derive(Clone, Debug)]
+struct Region {
+    /// The face's outward normal (a cylinder's side: zero, any radial direction).
+    normal: Vector3<f64>,
+    /// The centre of mass's height resting on the face (its distance from the face's plane;
+    /// a cylinder's side: the radius less the centre's distance from the axis).
+    rest: f64,
+    /// The least height of the centre of mass on the region's boundary.
+    barrier: f64,
+    /// The outcome of a die at rest on the face (`None`: not a resting face).
+    outcome: Option<u8>,
+}
+
+/// The distance from the origin to the line through `a` and `b`.
+fn line_distance(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    let d = b - a;
+    a.cross(&d).norm() / d.norm()
 }
 
 impl Convex {
@@ -42,17 +71,143 @@ impl Convex {
                 .map(|p: &Vector3<f64>| p.norm())
                 .fold(0.0, f64::max),
         };
+        let normals: Vec<Vector3<f64>> = shape
+            .faces
+            .iter()
+            .map(|f| Vector3::from(f.normal))
+            .collect();
+        let outcome = |n: &Vector3<f64>| {
+            normals
+                .iter()
+                .position(|m| {
+                    if *n == Vector3::zeros() {
+                        *m == Vector3::zeros()
+                    } else {
+                        m.dot(n) > 1.0 - 1e-9
+                    }
+                })
+                .map(|k| k as u8)
+        };
+        let regions = match cylinder {
+            Some((r, h)) => {
+                // From the centre of mass: the caps' planes at the centroid's z ± h, the rims
+                // at the radius r about the axis through the centroid.
+                let off = centroid.xy().norm();
+                let caps = [1.0, -1.0].map(|sign: f64| {
+                    let rest = h + sign * centroid.z;
+                    let normal = Vector3::new(0.0, 0.0, sign);
+                    Region {
+                        normal,
+                        rest,
+                        barrier: (r - off).hypot(rest),
+                        outcome: outcome(&normal),
+                    }
+                });
+                let side = Region {
+                    normal: Vector3::zeros(),
+                    rest: r - off,
+                    // The nearer rim.
+                    barrier: (r - off).hypot(h - centroid.z.abs()),
+                    outcome: outcome(&Vector3::zeros()),
+                };
+                vec![caps[0].clone(), caps[1].clone(), side]
+            }
+            None => shape
+                .facets()
+                .iter()
+                .map(|f| {
+                    let n = f.normal;
+                    let m = f.polygon.len();
+                    let barrier = (0..m)
+                        .map(|i| {
+                            line_distance(&(f.polygon[i] - com), &(f.polygon[(i + 1) % m] - com))
+                        })
+                        .fold(f64::INFINITY, f64::min);
+                    Region {
+                        normal: n,
+                        rest: f.offset - n.dot(com),
+                        barrier,
+                        outcome: outcome(&n),
+                    }
+                })
+                .collect(),
+        };
         Convex {
             points,
             cylinder,
             centroid,
-            normals: shape
-                .faces
-                .iter()
-                .map(|f| Vector3::from(f.normal))
-                .collect(),
+            normals,
             reach,
+            regions,
         }
+    }
+
+    /// The region the down direction `down` (unit, body axes) is in: the face the ray from
+    /// the centre of mass leaves through first (a hull: the largest n·g over its distance; a
+    /// cylinder: a cap, unless the side comes first).
+    fn region(&self, down: &Vector3<f64>) -> &Region {
+        match self.cylinder {
+            Some((r, _)) => {
+                let cap = &self.regions[if down.z > 0.0 { 0 } else { 1 }];
+                let t_cap = cap.rest / down.z.abs();
+                // |c + t g| = r across the axis, c the centre of mass from the axis.
+                let (c, g) = (-self.centroid.xy(), down.xy());
+                let (a, b, e) = (g.norm_squared(), c.dot(&g), c.norm_squared() - r * r);
+                let t_side = if a > 0.0 {
+                    (-b + (b * b - a * e).max(0.0).sqrt()) / a
+                } else {
+                    f64::INFINITY
+                };
+                if t_cap <= t_side {
+                    cap
+                } else {
+                    &self.regions[2]
+                }
+            }
+            None => {
+                let mut best = &self.regions[0];
+                let mut key = f64::NEG_INFINITY;
+                for reg in &self.regions {
+                    let k = reg.normal.dot(down) / reg.rest;
+                    if k > key {
+                        (best, key) = (reg, k);
+                    }
+                }
+                best
+            }
+        }
+    }
+
+    /// The early stop (`sim::certificate`): the outcome certain for a die whose world up is
+    /// `up` (body axes) and whose energy height (E/mg, plus what it has sunk into the floor)
+    /// is `height`, keeping `margin` of each barrier in reserve.
+    /// `at_least` is a cheap lower bound of that height, tried first; `height` computes it.
+    pub fn certain(
+        &self,
+        up: &Vector3<f64>,
+        at_least: f64,
+        height: impl FnOnce() -> f64,
+        margin: f64,
+    ) -> Option<u8> {
+        let reg = self.region(&-up);
+        let allowed = (1.0 - margin) * (reg.barrier - reg.rest);
+        if allowed.is_nan() || allowed <= 0.0 || reg.outcome.is_none() {
+            return None;
+        }
+        if at_least - reg.rest >= allowed || height() - reg.rest >= allowed {
+            return None;
+        }
+        reg.outcome
+    }
+
+    /// The energy height above which nothing is certain: the largest over resting faces of
+    /// rest + (1 − margin)(barrier − rest).
+    pub fn ceiling(&self, margin: f64) -> f64 {
+        self.regions
+            .iter()
+            .filter(|r| r.outcome.is_some())
+            .map(|r| r.rest + (1.0 - margin) * (r.barrier - r.rest))
+            .fold(f64::NEG_INFINITY, f64::max)
     }
 
     /// How far the die reaches below its centre of mass along `down` (a unit vector, body

@@ -60,7 +60,7 @@ pub struct Face {
 }
 
 /// A die of any shape.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Shape {
     /// What it is: `d20`, `coin:24,2`, `prism:6,16,40`, or a mesh's file name and checksum.
     pub name: String,
@@ -73,6 +73,21 @@ pub struct Shape {
     pub second: [f64; 6],
     /// The outcomes, in the order every count of them keeps.
     pub faces: Vec<Face>,
+    /// The hull's facets, found once on first use (`Shape::facets`): every roll's die asks
+    /// for them.
+    #[serde(skip)]
+    facets: std::sync::OnceLock<std::sync::Arc<Vec<polytope::Facet>>>,
+}
+
+impl PartialEq for Shape {
+    /// The same die: everything but the facets found from it.
+    fn eq(&self, o: &Shape) -> bool {
+        self.name == o.name
+            && self.solid == o.solid
+            && self.volume == o.volume
+            && self.second == o.second
+            && self.faces == o.faces
+    }
 }
 
 /// Parses `NAME` or `NAME:ARGS`: a named die and its size, mm (`None`: its standard size).
@@ -143,6 +158,7 @@ pub fn coin(d: f64, h: f64) -> std::result::Result<Shape, String> {
         },
         volume: mp.volume,
         second: second_moments(&mp.inertia, mp.volume),
+        facets: Default::default(),
         faces: vec![
             Face {
                 normal: [0.0, 0.0, -1.0],
@@ -273,6 +289,7 @@ pub fn from_mesh(
         volume: mp.volume,
         second: second_moments(&mp.inertia, mp.volume),
         faces,
+        facets: Default::default(),
     })
 }
 
@@ -325,16 +342,24 @@ impl Shape {
         }
     }
 
+    /// The hull's facets, from the centroid (none for a cylinder), found once.
+    pub fn facets(&self) -> std::sync::Arc<Vec<polytope::Facet>> {
+        self.facets
+            .get_or_init(|| {
+                let pts = self.points();
+                std::sync::Arc::new(match (&self.solid, polytope::hull(&pts)) {
+                    (Solid::Hull { .. }, Ok(h)) => {
+                        polytope::facets(&h, polytope::COPLANAR_TOLERANCE)
+                    }
+                    _ => Vec::new(),
+                })
+            })
+            .clone()
+    }
+
     /// The hull's facet planes (outward normal n, offset d: n·x = d on the facet).
     pub fn planes(&self) -> Vec<(Vector3<f64>, f64)> {
-        let pts = self.points();
-        match polytope::hull(&pts) {
-            Ok(h) => polytope::facets(&h, polytope::COPLANAR_TOLERANCE)
-                .into_iter()
-                .map(|f| (f.normal, f.offset))
-                .collect(),
-            Err(_) => Vec::new(),
-        }
+        self.facets().iter().map(|f| (f.normal, f.offset)).collect()
     }
 
     /// The collision margin an engine that keeps one around a convex hull is given (Bullet):

@@ -150,6 +150,7 @@ fn roll_one(
         steps: 0,
         engine_steps: 0,
         certified: None,
+        certified_face: None,
         energy_gain: false,
         dip: Default::default(),
         up: None,

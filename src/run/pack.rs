@@ -11,7 +11,8 @@
 //!   the face up is direction 2 × outcome + bit 10 of `faces::DIRECTIONS` (chunks written
 //!   before faces were kept have neither bit, and their rolls no face); bit 11 a die of any
 //!   shape's face (`Outcome::Face`, bits 2-3 then 0), its index a varint right after the
-//!   tag when bit 9 is set (a cuboid's rolls never set it, so their bytes are as before);
+//!   tag when bit 9 is set; bit 12 a die of any shape's certified face, a varint after the
+//!   certified step (a cuboid's rolls set neither, so their bytes are as before);
 //! - `steps`, `engine_steps`, varints; if certified, its step, a varint;
 //! - the dip's `steps` and `longest`, varints; if bit 6, its depth `penetration`, the 8
 //!   bytes of the f64, little-endian (exact).
@@ -81,6 +82,9 @@ pub fn pack(records: &[RollRecord]) -> Vec<u8> {
         if shaped {
             tag |= 1 << 11;
         }
+        if r.certified.is_some() && r.certified_face.is_some() {
+            tag |= 1 << 12;
+        }
         match r.up {
             Some(_) if shaped => tag |= 1 << 9,
             Some(d) => tag |= 1 << 9 | u64::from(d & 1) << 10,
@@ -94,6 +98,10 @@ pub fn pack(records: &[RollRecord]) -> Vec<u8> {
         varint(&mut out, r.engine_steps);
         if let Some((step, _)) = r.certified {
             varint(&mut out, step);
+            // A die of any shape's certified face (bit 12).
+            if let Some(k) = r.certified_face {
+                varint(&mut out, u64::from(k));
+            }
         }
         varint(&mut out, r.dip.steps);
         varint(&mut out, r.dip.longest);
@@ -141,7 +149,7 @@ pub fn unpack(bytes: &[u8], indices: &[u64], throws: &Throws) -> Result<Vec<Roll
     let mut out = Vec::with_capacity(indices.len());
     for &i in indices {
         let tag = r.varint()?;
-        if tag >> 12 != 0 {
+        if tag >> 13 != 0 {
             return Err(format!("roll {i}: unknown tag bits"));
         }
         let what = tag >> 2 & 3;
@@ -166,10 +174,17 @@ pub fn unpack(bytes: &[u8], indices: &[u64], throws: &Throws) -> Result<Vec<Roll
         };
         let steps = r.varint()?;
         let engine_steps = r.varint()?;
-        let certified = if tag >> 4 & 1 == 1 {
-            Some((r.varint()?, outcome_of(tag >> 7)))
+        let (certified, certified_face) = if tag >> 4 & 1 == 1 {
+            let step = r.varint()?;
+            if tag >> 12 & 1 == 1 {
+                let k = r.varint()?;
+                let k = u8::try_from(k).map_err(|_| format!("roll {i}: face {k} past 255"))?;
+                (Some((step, Outcome::Face)), Some(k))
+            } else {
+                (Some((step, outcome_of(tag >> 7))), None)
+            }
         } else {
-            None
+            (None, None)
         };
         let (dip_steps, longest) = (r.varint()?, r.varint()?);
         let penetration = if tag >> 6 & 1 == 1 { r.f64()? } else { 0.0 };
@@ -187,6 +202,7 @@ pub fn unpack(bytes: &[u8], indices: &[u64], throws: &Throws) -> Result<Vec<Roll
             steps,
             engine_steps,
             certified,
+            certified_face,
             energy_gain: tag >> 5 & 1 == 1,
             dip: Dip::of(dip_steps, longest, penetration),
             up,

@@ -115,7 +115,9 @@ impl Tally {
                     plus(&mut self.certified_unknown, 1)?
                 }
                 Fate::Settled(s) | Fate::Unconverged(s) => {
-                    plus(&mut self.certified_wrong, (s != o) as u64)?
+                    // A die of any shape: the same face, not only a face.
+                    let wrong = s != o || (s == Outcome::Face && r.up != r.certified_face);
+                    plus(&mut self.certified_wrong, wrong as u64)?
                 }
                 Fate::Failed(_) => {}
             }

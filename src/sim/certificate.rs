@@ -37,6 +37,9 @@ impl Certificate {
     /// whose energy is above it (`DieShape::energy_height_at_least`) is never certain, so
     /// the check can be skipped there (`flight::Flight::jump`).
     pub fn energy_ceiling(&self, die: &DieShape) -> f64 {
+        if let Some(c) = &die.convex {
+            return c.ceiling(self.margin);
+        }
         let n = if die.planar { 2 } else { 3 };
         (0..n)
             .flat_map(|i| [(i, 0), (i, 1)])
@@ -71,6 +74,30 @@ impl Certificate {
         }
         let excess = die.energy(s) / (die.mass * g) + sunk - rest;
         (excess < allowed).then_some(SIDES[i])
+    }
+}
+
+impl Certificate {
+    /// `certain` for a die of any shape: its face, by `Convex::certain`'s regions. Kept out
+    /// of line: the cuboid's check passes it by.
+    #[inline(never)]
+    pub fn certain_convex(
+        &self,
+        c: &crate::model::die::Convex,
+        die: &DieShape,
+        s: &BodyState,
+    ) -> Option<u8> {
+        let up = &up_in_body(&s.rotation);
+        let sunk = (-die.lowest_point_up(s, up)).max(0.0);
+        let g = die.gravity;
+        // The cheap lower bound first, as for the cuboid.
+        let quick = s.position.y + sunk + 0.5 * s.linear_velocity.norm_squared() / g;
+        c.certain(
+            up,
+            quick,
+            || die.energy(s) / (die.mass * g) + sunk,
+            self.margin,
+        )
     }
 }
 

@@ -88,6 +88,10 @@ pub struct RollRecord {
     /// certificate held, and the outcome it certified (under the certificate rule, the step
     /// the roll ended).
     pub certified: Option<(u64, Outcome)>,
+    /// A die of any shape: the face the certificate named (`certified`'s outcome is then
+    /// `Outcome::Face`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub certified_face: Option<u8>,
     /// The engine injected energy: the die's kinetic + potential energy rose above its lowest
     /// value so far by more than `ENERGY_GAIN_TOLERANCE` of its starting energy. A flag, not a
     /// failure: the roll goes on and may still settle.
@@ -404,6 +408,7 @@ fn record_of(throw: &Throw, end: End) -> RollRecord {
         steps: end.steps,
         engine_steps: end.engine_steps,
         certified: end.certified,
+        certified_face: end.certified_face,
         energy_gain: end.energy_gain,
         dip: end.dip,
         up: end.up,
@@ -502,6 +507,8 @@ pub struct End {
     /// With an audit or the certificate rule: the first step at which the energy certificate
     /// held, and the outcome it certified.
     pub certified: Option<(u64, Outcome)>,
+    /// See `RollRecord::certified_face`.
+    pub certified_face: Option<u8>,
     /// See `RollRecord::energy_gain`.
     pub energy_gain: bool,
     /// See `RollRecord::dip`.
@@ -583,13 +590,22 @@ impl Watch {
         // has failed.
         let under = state.position.y < 0.0;
         if self.watch && end.certified.is_none() && !under {
-            if let Some(o) = self.certificate.certain(die, state) {
+            let certain = match &die.convex {
+                None => self.certificate.certain(die, state).map(|o| (o, None)),
+                // A die of any shape: the face of the region it cannot leave.
+                Some(c) => self
+                    .certificate
+                    .certain_convex(c, die, state)
+                    .map(|k| (Outcome::Face, Some(k))),
+            };
+            if let Some((o, face)) = certain {
                 end.certified = Some((end.steps, o));
+                end.certified_face = face;
                 if self.stop_early {
                     // Certain of its side, and so of its face: the die cannot leave the
                     // face region it is in (the barrier it cannot climb is the edge between).
                     end.fate = Fate::Settled(o);
-                    end.up = up_direction(&state.rotation, o);
+                    end.up = face.or_else(|| up_direction(&state.rotation, o));
                     return true;
                 }
             }
@@ -776,6 +792,7 @@ fn run(
         steps: 0,
         engine_steps: 0,
         certified: None,
+        certified_face: None,
         energy_gain: false,
         dip: Dip::default(),
         up: None,
