@@ -404,11 +404,6 @@ impl SceneArgs {
 }
 
 impl ThrowArgs {
-    /// The throws, checked (the paper's throw unless `--throw` says otherwise).
-    pub fn spec(&self) -> Result<ThrowSpec> {
-        self.spec_or(ThrowStyle::Paper)
-    }
-
     /// The throws, checked, in the style `default` unless `--throw` gives one.
     pub fn spec_or(&self, default: ThrowStyle) -> Result<ThrowSpec> {
         // --kappa is a hand's concentration: given alone, it asks for a hand's throw.
@@ -443,9 +438,20 @@ impl RunArgs {
         })
     }
 
-    /// How each roll is carried out and ended, checked, for a scene with time step `dt`: the
-    /// early stop by default only where it is exact (`roll::EARLY_STOP_MAX_DT`).
-    pub fn roll(&self, dt: f64) -> Result<RollConfig> {
+    /// How each roll is carried out and ended, checked, for `scene`: the early stop by
+    /// default only where it is exact (`roll::EARLY_STOP_MAX_DT`); the step cap DicePhys's,
+    /// or for a die of any shape left at its default, `roll::SHAPE_MAX_STEPS` (a cylinder
+    /// rolling on its side never stops: no engine here has rolling resistance).
+    pub fn roll(&self, scene: &Scene) -> Result<RollConfig> {
+        let mut cfg = self.roll_at(scene.dt)?;
+        if scene.shape.is_some() && cfg.max_steps == DEFAULT_MAX_STEPS {
+            cfg.max_steps = dicephys::sim::roll::SHAPE_MAX_STEPS;
+        }
+        Ok(cfg)
+    }
+
+    /// `roll` for a scene with time step `dt`, the step cap as given.
+    pub fn roll_at(&self, dt: f64) -> Result<RollConfig> {
         let settle = self.settle.map(|s| match s {
             SettleArg::Certificate => Rule::Certificate,
             SettleArg::Dicephys => Rule::Dicephys,

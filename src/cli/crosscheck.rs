@@ -42,13 +42,14 @@ impl CrosscheckArgs {
             ));
         }
         let scene = self.scene.scene()?;
+        let style = dicephys::model::throws::ThrowStyle::default_for(&scene);
         let cfg = crosscheck::Config {
             engines: self.engines.clone(),
             spec: RunSpec {
                 engine: self.engines[0],
-                roll: self.run.roll(scene.dt)?,
+                roll: self.run.roll(&scene)?,
                 scene,
-                throws: self.throw.spec()?,
+                throws: self.throw.spec_or(style)?,
                 rolls: self.run.rolls(),
                 shard: None,
             },

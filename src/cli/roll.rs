@@ -106,14 +106,13 @@ impl RollArgs {
             scene.features.layout = layout;
         }
         // A die of any shape has no long axis to spin about: a tumble by default.
-        let default = if scene.shape.is_some() {
-            dicephys::model::throws::ThrowStyle::Tumble
-        } else {
-            default
+        let default = match dicephys::model::throws::ThrowStyle::default_for(&scene) {
+            dicephys::model::throws::ThrowStyle::Paper => default,
+            other => other,
         };
         let spec = RunSpec {
             engine: self.engine,
-            roll: self.run.roll(scene.dt)?,
+            roll: self.run.roll(&scene)?,
             scene,
             throws: self.throw.spec_or(default)?,
             rolls: self.run.rolls(),

@@ -41,7 +41,9 @@ pub struct TraceArgs {
 pub fn run(a: &TraceArgs) -> Result<()> {
     let scene = a.scene.scene()?;
     let die = DieShape::of(&scene);
-    let throw_spec = a.throw.spec()?;
+    let throw_spec = a
+        .throw
+        .spec_or(dicephys::model::throws::ThrowStyle::default_for(&scene))?;
     if a.every == 0 || *a.max_steps == 0 {
         return Err(Error::Usage(
             "--every and --max-steps must be at least 1".into(),

@@ -483,3 +483,98 @@ fn fnv64(bytes: &[u8]) -> u64 {
         (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::mass::MassProps;
+    use crate::model::scene::{Mode, Scene};
+
+    fn scene(shape: Shape) -> Scene {
+        Scene::paper("16x16x16".parse().unwrap(), Mode::ThreeD).with_shape(shape)
+    }
+
+    fn close(a: f64, b: f64, tol: f64) -> bool {
+        (a - b).abs() <= tol * b.abs().max(1e-30)
+    }
+
+    #[test]
+    fn the_named_d6_weighs_and_turns_as_the_block_it_is() {
+        // A 16 mm cube: mass ρa³, inertia ρa⁵/6 about every axis through its centre.
+        let mp = MassProps::of(&scene(named("d6", None).unwrap())).unwrap();
+        let a: f64 = 0.016;
+        assert!(close(mp.mass, 800.0 * a.powi(3), 1e-12), "{}", mp.mass);
+        for i in 0..3 {
+            assert!(close(mp.inertia[(i, i)], 800.0 * a.powi(5) / 6.0, 1e-12));
+            assert!(mp.com[i].abs() < 1e-15);
+        }
+        assert!(mp.inertia[(0, 1)].abs() < 1e-12 * mp.inertia[(0, 0)]);
+    }
+
+    #[test]
+    fn a_coin_weighs_and_turns_as_its_cylinder() {
+        // m = ρπr²h; about its axis mr²/2, about a diameter m(3r² + h²)/12.
+        let mp = MassProps::of(&scene(named("coin:24,2", None).unwrap())).unwrap();
+        let (r, h): (f64, f64) = (0.012, 0.002);
+        let m = 800.0 * std::f64::consts::PI * r * r * h;
+        assert!(close(mp.mass, m, 1e-12));
+        assert!(close(mp.inertia[(2, 2)], m * r * r / 2.0, 1e-12));
+        assert!(close(
+            mp.inertia[(0, 0)],
+            m * (3.0 * r * r + h * h) / 12.0,
+            1e-12
+        ));
+    }
+
+    #[test]
+    fn platonic_dice_have_n_resting_faces_and_isotropic_inertia() {
+        for (name, n) in [("d4", 4), ("d6", 6), ("d8", 8), ("d12", 12), ("d20", 20)] {
+            let s = named(name, None).unwrap();
+            assert_eq!(s.faces.len(), n, "{name}");
+            let mp = MassProps::of(&scene(s)).unwrap();
+            // A Platonic solid's inertia about its centre is a multiple of the identity.
+            let i0 = mp.inertia[(0, 0)];
+            for i in 0..3 {
+                for j in 0..3 {
+                    let want = if i == j { i0 } else { 0.0 };
+                    assert!(
+                        (mp.inertia[(i, j)] - want).abs() < 1e-9 * i0,
+                        "{name} {i}{j}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_d6_shows_the_western_layout_and_opposite_faces_sum_to_seven() {
+        let s = named("d6", None).unwrap();
+        for f in &s.faces {
+            // Resting on the face with normal n, the face up is −n's: on a western die the
+            // number up and the number down sum to 7.
+            let up: u32 = f.label.parse().unwrap();
+            let down = s
+                .faces
+                .iter()
+                .find(|g| Vector3::from(g.normal).dot(&-Vector3::from(f.normal)) > 0.999)
+                .unwrap();
+            let down_shows: u32 = down.label.parse().unwrap();
+            assert_eq!(up + down_shows, 7);
+            // Resting on −z (6 down), 1 is up.
+            if f.normal[2] < -0.999 {
+                assert_eq!(f.label, "1");
+            }
+        }
+    }
+
+    #[test]
+    fn a_shapes_specification_round_trips_and_says_what_decides_it() {
+        let s = named("d10", None).unwrap();
+        let text = serde_json::to_string(&s).unwrap();
+        let back: Shape = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, s);
+        assert_eq!(back.facets().len(), 10);
+        // Another size is another die.
+        assert_ne!(named("d10", Some(20.0)).unwrap(), s);
+    }
+}

@@ -181,6 +181,16 @@ impl ThrowStyle {
     pub fn is_paper(&self) -> bool {
         *self == ThrowStyle::Paper
     }
+
+    /// The throw a scene's die gets when none is asked: the paper's for the cuboid, a tumble
+    /// for a die of any shape (it has no long axis to spin about).
+    pub fn default_for(scene: &crate::model::scene::Scene) -> ThrowStyle {
+        if scene.shape.is_some() {
+            ThrowStyle::Tumble
+        } else {
+            ThrowStyle::Paper
+        }
+    }
 }
 
 /// One throw's drawn numbers.

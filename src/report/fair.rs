@@ -37,7 +37,8 @@ pub enum Null {
 pub struct FaceVerdict {
     /// Its number, under the run's layout.
     pub number: u8,
-    /// Its outward direction in body axes (`+x` … `-z`).
+    /// Its outward direction in body axes (`+x` … `-z`); a die of any shape's: the label
+    /// it shows.
     pub direction: String,
     /// Rolls that came to rest with it up.
     pub count: u64,
@@ -91,17 +92,18 @@ pub struct Fairness {
 impl Fairness {
     /// The human report.
     pub fn text(&self, s: &RunSummary) -> String {
+        let die = match &s.spec.scene.shape {
+            Some(shape) => shape.name.clone(),
+            None => format!(
+                "{} mm, {} layout",
+                s.block_mm.map(|v| v.to_string()).join("x"),
+                s.layout
+            ),
+        };
         let mut out = format!(
-            "Is this die fair? {} mm, {} {}, throw {}, {} rolls ({} at rest on a face), {} \
-             layout, against {}\n",
-            s.block_mm.map(|v| v.to_string()).join("x"),
-            s.engine,
-            s.mode,
-            s.spec.throws.style,
-            s.rolls,
-            self.n,
-            s.layout,
-            self.null
+            "Is this die fair? {die}, {} {}, throw {}, {} rolls ({} at rest on a face), \
+             against {}\n",
+            s.engine, s.mode, s.spec.throws.style, s.rolls, self.n, self.null
         );
         out += "  face  up  count      p        ± 1σ     null     departure      z   throws to see it (2σ / 5σ)\n";
         for f in &self.faces {

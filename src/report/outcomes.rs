@@ -93,6 +93,7 @@ mod tests {
             width: 100,
             length: 100,
             unknown: 7,
+            face: 0,
         };
         let o = Outcomes3d::of(&cube, &c).unwrap();
         assert_eq!(o.n, 300);

@@ -18,6 +18,12 @@ use serde::{Deserialize, Serialize};
 /// DicePhys's cap: a roll not at rest after this many steps is unconverged.
 pub const DEFAULT_MAX_STEPS: u64 = 20_000_000;
 
+/// The cap for a die of any shape unless one is given: 200,000 steps (200 s at the paper's
+/// step). A cylinder rolling on its side (a thick coin) keeps rolling on a floor without
+/// rolling resistance, and neither engine here has any; such a roll ends unconverged, its face
+/// at the cap recorded, in a fraction of a second rather than hours.
+pub const SHAPE_MAX_STEPS: u64 = 200_000;
+
 /// Why a roll failed: the engine's state stopped making sense.
 #[derive(
     Clone,

@@ -140,6 +140,7 @@ pub fn run(cfg: &Config, study: &Study) -> Result<Crosscheck> {
                 both_settled: agree.both_settled,
                 same_outcome_fraction: agree.of_settled(),
                 cpu_ratio: runs[i].cpu_ms_per_roll / runs[0].cpu_ms_per_roll,
+                outcomes: crate::report::crosscheck::OutcomesCompared::of(&runs[i], &runs[0]),
             }
         })
         .collect();

@@ -188,9 +188,12 @@ fn a_coin_lands_heads_tails_or_on_its_edge() {
     let z = (h - t) / (h + t).sqrt();
     assert!(z.abs() < 4.0, "heads {h} tails {t}");
     assert!(f[2].1 * 20 < 600, "edge {}", f[2].1);
-    // A coin as thick as it is wide stands on its edge often.
-    let v = roll(&["--shape", "coin:10,10", "--rolls", "300"]);
-    assert!(faces(&v)[2].1 > 30, "{}", v["shape"]);
+    // A coin as thick as it is wide stands on its edge most often (and a cylinder rolling
+    // on its side may roll on to the cap: `roll::SHAPE_MAX_STEPS`, counted unconverged).
+    let v = roll(&["--shape", "coin:10,10", "--rolls", "60"]);
+    let f = faces(&v);
+    assert!(f[2].1 > f[0].1 + f[1].1, "{}", v["shape"]);
+    assert_eq!(v["spec"]["roll"]["max_steps"], 200_000);
 }
 
 /// One line on stderr, exit 2, containing every one of `says`.
