@@ -242,8 +242,11 @@ def _triple(name: str, x: Optional[Sequence[float]], n: int) -> Optional[List[fl
 
 
 def roll(
-    block: str,
+    block: Optional[str] = None,
     *,
+    shape: Optional[str] = None,
+    size: Optional[float] = None,
+    scale: Optional[float] = None,
     rolls: Optional[int] = None,
     seed: int = 2385,
     mode: str = "3d",
@@ -267,7 +270,7 @@ def roll(
     settle: Optional[str] = None,
     flight: str = "fast",
     faithful: bool = False,
-    max_steps: int = DEFAULT_MAX_STEPS,
+    max_steps: Optional[int] = None,
     margin: float = DEFAULT_MARGIN,
     com: Optional[Sequence[float]] = None,
     pips: Optional[Sequence[float]] = None,
@@ -282,6 +285,10 @@ def roll(
     """Throws one block many times on one engine: ``dicephys roll``.
 
     block: LENGTHxBREADTHxWIDTH in mm, the paper's order ("140x24x20").
+    shape: a die of any shape in place of ``block``, as ``--shape``: "d4", "d6", "d8",
+        "d10", "d12", "d20", "coin:D,H", "prism:N,D,L" (thrown in a tumble); size: its
+        size in mm instead of the standard one.  A mesh die is ``die="my.stl"`` (OBJ or
+        STL, mm, times ``scale``).  No block, shape or die: a 16 mm d6.
     rolls: throws (default 10,000; with ``precision``, the most it may take, 10,000,000).
     seed: the keyed throws' seed; the same seed gives the same counts on any thread count.
     mode: "3d" or "2d" (DicePhys's plane-locked block).
@@ -310,7 +317,8 @@ def roll(
     tell, close = _progress(progress, "roll")
     try:
         text, csv_bytes = _native.roll(
-            block, rolls=rolls, seed=seed, mode=mode, engine=engine, dt=dt,
+            block, shape=shape, size=size, scale=scale, rolls=rolls, seed=seed, mode=mode,
+            engine=engine, dt=dt,
             restitution=restitution, friction=friction, density=density, preset=preset,
             floor=floor, floor_thickness=floor_thickness, linear_damping=linear_damping,
             angular_damping=angular_damping, sleep=sleep, throw=throw, kappa=kappa,
@@ -327,7 +335,7 @@ def roll(
 
 
 def fair(
-    block: str,
+    block: Optional[str] = None,
     *,
     null: str = "uniform",
     throw: str = "tumble",

@@ -12,7 +12,7 @@ _Progress = Optional[Callable[[float, float], Any]]
 _Log = Optional[Callable[[str], Any]]
 
 def version() -> str: ...
-def roll(block: str, **options: Any) -> Tuple[str, Optional[bytes]]:
+def roll(block: Optional[str] = None, **options: Any) -> Tuple[str, Optional[bytes]]:
     """``dicephys.roll``'s options by name (``fair``: a null, for ``dicephys.fair``)."""
     ...
 

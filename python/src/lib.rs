@@ -297,8 +297,43 @@ impl<'py> Options<'py> {
 
 /// The scene, the throws and the roll of `roll` and `fair` from their options (`dicephys
 /// roll`'s, by the library's names and units: mm for the die as made), checked by the library.
-fn spec(block_: &str, o: &Options, layout: Option<Layout>, precision: bool) -> PyResult<RunSpec> {
-    let mut scene = Scene::paper(block(block_)?, mode(&o.get("mode", "3d".to_string())?)?);
+fn spec(
+    block_: Option<&str>,
+    o: &Options,
+    layout: Option<Layout>,
+    precision: bool,
+) -> PyResult<RunSpec> {
+    // A die of any shape (`shape`, or a mesh `die`) in place of the block; no die at all: a
+    // 16 mm d6, as the command line's.
+    let die = o.maybe::<PathBuf>("die")?;
+    let mut shape = dicephys::model::shape::described(
+        die.as_deref(),
+        o.maybe::<String>("shape")?.as_deref(),
+        o.maybe("size")?,
+        o.maybe("scale")?,
+    )
+    .map_err(py_err)?;
+    let the_block = match (block_, &shape) {
+        (Some(_), Some(_)) => {
+            return Err(bad(
+                "block",
+                "",
+                "the block is the cuboid; shape (or a mesh die) replaces it: give one",
+            ))
+        }
+        (Some(b), None) => block(b)?,
+        (None, s) => {
+            if s.is_none() {
+                shape = dicephys::model::shape::described(None, Some("d6"), None, None)
+                    .map_err(py_err)?;
+            }
+            block("1x1x1")?
+        }
+    };
+    let mut scene = Scene::paper(the_block, mode(&o.get("mode", "3d".to_string())?)?);
+    if let Some(s) = shape {
+        scene = scene.with_shape(s);
+    }
     scene.dt = o.get("dt", scene.dt)?;
     scene.friction = o.get("friction", scene.friction)?;
     scene.restitution = o.get("restitution", scene.restitution)?;
@@ -312,7 +347,7 @@ fn spec(block_: &str, o: &Options, layout: Option<Layout>, precision: bool) -> P
     scene.angular_damping = o.get("angular_damping", 0.0)?;
     scene.sleeping = o.get("sleep", true)?;
     let (features, density) = Features::described(
-        o.maybe::<PathBuf>("die")?.as_deref(),
+        die.as_deref(),
         o.maybe("com")?,
         o.maybe("pips")?,
         o.maybe("edge_radius")?,
@@ -356,7 +391,7 @@ fn spec(block_: &str, o: &Options, layout: Option<Layout>, precision: bool) -> P
         style: match o.maybe::<String>("throw")? {
             Some(t) => named::<ThrowStyle>("throw", "throw style", &t)?,
             None if kappa.is_some() => ThrowStyle::Hand,
-            None => ThrowStyle::Paper,
+            None => ThrowStyle::default_for(&scene),
         },
         kappa,
     };
@@ -382,7 +417,14 @@ fn spec(block_: &str, o: &Options, layout: Option<Layout>, precision: bool) -> P
         fast,
         o.get("faithful", false)?,
         false,
-        o.get("max_steps", DEFAULT_MAX_STEPS)?,
+        o.get(
+            "max_steps",
+            if scene.shape.is_some() {
+                dicephys::sim::roll::SHAPE_MAX_STEPS
+            } else {
+                DEFAULT_MAX_STEPS
+            },
+        )?,
         o.get("margin", DEFAULT_MARGIN)?,
     )
     .map_err(py_err)?;
@@ -450,10 +492,10 @@ fn rolled(
 /// library's names (the package's `roll` lists them). Returns the `roll --json` document and,
 /// with `per_roll`, the `--per-roll` CSV's bytes; with `fair` (a null), `fair --json`'s.
 #[pyfunction]
-#[pyo3(signature = (block, **options))]
+#[pyo3(signature = (block=None, **options))]
 fn roll<'py>(
     py: Python<'py>,
-    block: &str,
+    block: Option<&str>,
     options: Option<Bound<'py, PyDict>>,
 ) -> PyResult<(String, Option<Bound<'py, PyBytes>>)> {
     // The caller's dict is its own: read a copy.
