@@ -356,6 +356,10 @@ fn spec(
     )
     .map_err(py_err)?;
     scene.features = features;
+    if let Some(l) = layout {
+        // The numbering is the run's (in its specification), as the command line's.
+        scene.features.layout = l;
+    }
     if let Some(d) = density {
         scene.density = d;
     }

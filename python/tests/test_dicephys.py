@@ -50,6 +50,20 @@ def test_counts_equal_the_cli_for_the_same_seed(engine: str, mode: str) -> None:
     assert mine == theirs
 
 
+def test_a_die_of_any_shape_is_the_cli_s(tmp_path: Path) -> None:
+    want = cli("roll", "--shape", "d20", "--rolls", "300", "--seed", "1", "--json")
+    got = dicephys.roll(shape="d20", rolls=300, seed=1)
+    assert got.faces == want["faces"]
+    assert len(got.faces) == 20
+    assert got.summary["shape"] == want["shape"]
+    # No die at all: the CLI's 16 mm d6, in a tumble.
+    d6 = dicephys.roll(rolls=100, seed=2)
+    assert d6.faces == cli("roll", "--rolls", "100", "--seed", "2", "--json")["faces"]
+    assert d6.summary["spec"]["throws"]["style"] == "tumble"
+    with pytest.raises(ValueError, match="shape"):
+        dicephys.roll(shape="d7")
+
+
 def test_the_issue_s_example() -> None:
     # docs/python.md's first line, against `dicephys roll --block 140x24x20 --rolls 2000 --seed 1`.
     want = cli("roll", "--block", "140x24x20", "--rolls", "2000", "--seed", "1", "--json")

@@ -101,8 +101,10 @@ impl RollArgs {
                 .map_err(|e| Error::Usage(format!("--resume {}: {e}", dir.display())));
         }
         let mut scene = self.scene.scene()?;
-        if let (Some(layout), Some(_)) = (self.layout, scene.features.pips) {
-            // The pips follow the numbers: the layout places them.
+        if let Some(layout) = self.layout {
+            // The numbers on the faces are the run's: stored in its specification, so that a
+            // resumed, merged or Slurm run reads its faces as this one (and the pips follow
+            // the numbers: the layout places them).
             scene.features.layout = layout;
         }
         // A die of any shape has no long axis to spin about: a tumble by default.
@@ -125,7 +127,7 @@ impl RollArgs {
     /// The numbers on the faces of `spec`'s die: `--layout`, else the die's own (a die
     /// file's layout or face map), else right.
     pub fn layout(&self, spec: &RunSpec) -> dicephys::model::faces::Layout {
-        self.layout.unwrap_or(spec.scene.features.layout)
+        spec.scene.features.layout
     }
 }
 

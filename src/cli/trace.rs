@@ -94,6 +94,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
         writeln!(out, "{l}")?;
     }
     out.flush()?;
-    eprintln!("{}", trace::ending(a.index, &throw, &record));
+    let labels = scene.shape.as_ref().map(|s| s.labels()).unwrap_or_default();
+    eprintln!("{}", trace::ending(a.index, &throw, &record, &labels));
     Ok(())
 }

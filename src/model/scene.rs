@@ -117,8 +117,10 @@ pub struct Scene {
     #[serde(default = "yes", skip_serializing_if = "is_true")]
     pub sleeping: bool,
     /// How the die departs from the ideal block: its centre of mass, pips, rounded edges
-    /// (`model::mass`). Written into a specification only when it does.
-    #[serde(default, skip_serializing_if = "Features::plain")]
+    /// (`model::mass`), and how its faces are numbered (`layout`, which decides what its
+    /// faces read, so it is the run's too). Written into a specification only when any is
+    /// not the default.
+    #[serde(default, skip_serializing_if = "Features::is_default")]
     pub features: Features,
     /// A die of any shape (`model::shape`: d4 … d20, a coin, a mesh) in place of the cuboid
     /// `block`; `block` then holds its bounding box. Written into a specification only when

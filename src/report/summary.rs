@@ -342,10 +342,11 @@ impl RunSummary {
                 Mode::TwoD => None,
             },
             z_theory: (ratio - theory_ratio) / ratio_err,
-            layout: faces::Layout::default(),
+            // The run's own numbering (its specification's), whoever reads it back.
+            layout: scene.features.layout,
             faces: match shape_faces(tally, scene) {
                 Some(f) => Some(f.into_iter().collect()),
-                None => faces_up(tally, scene.mode, faces::Layout::default()),
+                None => faces_up(tally, scene.mode, scene.features.layout),
             },
             shape: ShapeOutcomes::of(tally, scene),
             steps_total: tally.steps,

@@ -38,9 +38,16 @@ pub fn row(die: &DieShape, dt: f64, step: u64, s: &BodyState) -> String {
     )
 }
 
-/// How throw `index` ended, in one line.
-pub fn ending(index: u64, throw: &Throw, record: &RollRecord) -> String {
+/// How throw `index` ended, in one line; a die of any shape's face named by `labels`.
+pub fn ending(index: u64, throw: &Throw, record: &RollRecord, labels: &[&str]) -> String {
     let fate = match record.fate {
+        Fate::Settled(crate::model::block::Outcome::Face) => format!(
+            "settled, showing {}",
+            record
+                .up
+                .and_then(|k| labels.get(usize::from(k)))
+                .unwrap_or(&"?")
+        ),
         Fate::Settled(o) => format!("settled, {} vertical", o.name()),
         Fate::Unconverged(o) => format!("unconverged ({} vertical at the cap)", o.name()),
         Fate::Failed(f) => format!("failed: {}", f.name()),

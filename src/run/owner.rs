@@ -88,8 +88,10 @@ pub fn claim(dir: &Path, command: &str, config: &Value) -> Result<()> {
             // Put in place only if still absent (a hard link fails on an existing name), so
             // that of two runs claiming one directory at the same moment one wins, and the
             // other reads the winner's claim and is refused unless it is the same run.
+            // 0666 less the umask, as every other output (tempfile's own default is 0600).
             let mut tmp = tempfile::Builder::new()
                 .prefix(".dicephys-run.")
+                .permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666))
                 .tempfile_in(dir)
                 .map_err(|e| Error::io(dir, e))?;
             std::io::Write::write_all(&mut tmp, format!("{json}\n").as_bytes())

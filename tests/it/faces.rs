@@ -309,3 +309,62 @@ fn fair_varies_a_feature_and_draws_its_bias() {
         assert!(err.contains(says), "{extra:?}: {err}");
     }
 }
+
+/// Reliability round 5, classes A and B: the numbering is the run's. `--layout left` and a
+/// die file's layout used to live only in the live run: a resumed checkpoint, a merge of
+/// shards read faces as a right-handed die's, shards of two layouts merged, and a die file
+/// holding only a layout could not be checkpointed at all.
+#[test]
+fn the_numbering_is_kept_through_resume_merge_and_a_die_file() {
+    let dir = Scratch::new("layout-kept");
+    let args = [
+        "roll", "--block", "16x16x16", "--throw", "tumble", "--rolls", "1200", "--seed", "4",
+        "--json",
+    ];
+    let whole = json(&dicephys(&[&args[..], &["--layout", "left"]].concat()));
+    assert_eq!(whole["layout"], "left");
+    // Resumed from its complete checkpoint: the same faces, numbered left.
+    let ck = dir.join("ck");
+    let ck = ck.to_str().unwrap();
+    json(&dicephys(
+        &[&args[..], &["--layout", "left", "--checkpoint", ck]].concat(),
+    ));
+    let resumed = json(&dicephys(&["roll", "--json", "--resume", ck]));
+    assert_eq!(resumed["faces"], whole["faces"]);
+    assert_eq!(resumed["layout"], "left");
+    // Merged shards: numbered left; shards of two layouts refused.
+    let shard = |k: u32, layout: &str| {
+        let v = json(&dicephys(
+            &[
+                &args[..],
+                &["--layout", layout, "--shard", &format!("{k}/2")],
+            ]
+            .concat(),
+        ));
+        let f = dir.join(format!("{layout}{k}.json"));
+        std::fs::write(&f, v.to_string()).unwrap();
+        f.to_str().unwrap().to_string()
+    };
+    let (l0, l1, r1) = (shard(0, "left"), shard(1, "left"), shard(1, "right"));
+    let merged = json(&dicephys(&["merge", "--json", &l0, &l1]));
+    assert_eq!(merged["faces"], whole["faces"]);
+    let mixed = dicephys(&["merge", "--json", &l0, &r1]);
+    assert_eq!(mixed.status.code(), Some(2), "shards of two layouts merged");
+    // A die file holding only a layout: checkpointed, and its faces its own.
+    let file = dir.join("left.toml");
+    std::fs::write(&file, "layout = \"left\"\n").unwrap();
+    let ck2 = dir.join("ck2");
+    let from_file = json(&dicephys(
+        &[
+            &args[..],
+            &[
+                "--die",
+                file.to_str().unwrap(),
+                "--checkpoint",
+                ck2.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    ));
+    assert_eq!(from_file["faces"], whole["faces"]);
+}

@@ -80,6 +80,79 @@ fn outputs_honour_the_umask_and_keep_an_existing_files_mode() {
     assert_eq!(mode(&csv), 0o640, "an existing file keeps its mode");
 }
 
+/// Reliability round 5, class L: a study's claim on its directory, `dicephys-run.json`, was
+/// always 0600; it honours the umask as every other output.
+#[test]
+fn a_directorys_claim_honours_the_umask() {
+    let d = scratch("claim-umask");
+    let out = d.join("out");
+    let mut c = bin();
+    c.args(["fair", "--rolls", "20", "--threads", "1", "--out"])
+        .arg(&out);
+    // SAFETY: umask(2) is async-signal-safe.
+    unsafe {
+        c.pre_exec(|| {
+            libc::umask(0o022);
+            Ok(())
+        })
+    };
+    let o = c.output().unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(mode(&out.join("dicephys-run.json")), 0o644);
+}
+
+/// Reliability round 5, class D: a `--die` file is read through the capped reader and named:
+/// missing, a directory, not text, endless (/dev/zero) or a pipe no one writes to.
+#[test]
+fn a_die_file_is_read_capped_and_named() {
+    let d = scratch("die-read");
+    let refused = |die: &std::path::Path, says: &str| {
+        let o = bin()
+            .args(["roll", "--rolls", "1", "--block", "16x16x16", "--die"])
+            .arg(die)
+            .output()
+            .unwrap();
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{}: {e}", die.display());
+        assert_eq!(e.trim_end().lines().count(), 1, "{e}");
+        assert!(
+            e.contains("--die") && e.contains(says),
+            "{}: {e}",
+            die.display()
+        );
+    };
+    refused(&d.join("missing.toml"), "No such file");
+    refused(&d, "directory");
+    std::fs::write(d.join("binary.toml"), [0xff, 0xfe, 0x00, 0x80]).unwrap();
+    refused(&d.join("binary.toml"), "not a text file");
+    refused(Path::new("/dev/zero"), "larger than 1 MiB");
+    // A named pipe with no writer: SIGTERM ends the wait (exit 130).
+    let fifo = d.join("die.toml");
+    let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    let mut child = bin()
+        .args(["roll", "--block", "16x16x16", "--die"])
+        .arg(&fifo)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+    let t = std::time::Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if t.elapsed().as_secs() > 5 {
+            let _ = child.kill();
+            panic!("a --die pipe held off SIGTERM");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    assert_eq!(status.code(), Some(130));
+}
+
 #[test]
 fn an_output_name_of_250_bytes_is_written() {
     let d = scratch("long-name");
