@@ -688,45 +688,7 @@ pub fn named(name: &str, size: Option<f64>) -> Result<Named, String> {
             "the size of a {key} must be a positive length, got {size}"
         ));
     }
-    let points: Vec<Vector3<f64>> = match key.as_str() {
-        // Alternate corners of the cube [−1, 1]³: edge 2√2.
-        "d4" => vec![
-            Vector3::new(1.0, 1.0, 1.0),
-            Vector3::new(1.0, -1.0, -1.0),
-            Vector3::new(-1.0, 1.0, -1.0),
-            Vector3::new(-1.0, -1.0, 1.0),
-        ],
-        "d6" => signs3()
-            .map(|[sx, sy, sz]| Vector3::new(sx, sy, sz))
-            .collect(),
-        "d8" => (0..3)
-            .flat_map(|i| [1.0, -1.0].map(|s| Vector3::ith(i, s)))
-            .collect(),
-        "d10" => d10_points(),
-        // (±1, ±1, ±1), (0, ±1/φ, ±φ), (±1/φ, ±φ, 0), (±φ, 0, ±1/φ).
-        "d12" => {
-            let mut p: Vec<Vector3<f64>> = signs3()
-                .map(|[sx, sy, sz]| Vector3::new(sx, sy, sz))
-                .collect();
-            for [s1, s2] in SIGNS2 {
-                p.push(Vector3::new(0.0, s1 / PHI, s2 * PHI));
-                p.push(Vector3::new(s1 / PHI, s2 * PHI, 0.0));
-                p.push(Vector3::new(s1 * PHI, 0.0, s2 / PHI));
-            }
-            p
-        }
-        // (0, ±1, ±φ) and its cyclic permutations.
-        "d20" => {
-            let mut p = Vec::new();
-            for [s1, s2] in SIGNS2 {
-                p.push(Vector3::new(0.0, s1, s2 * PHI));
-                p.push(Vector3::new(s1, s2 * PHI, 0.0));
-                p.push(Vector3::new(s1 * PHI, 0.0, s2));
-            }
-            p
-        }
-        _ => unreachable!("every name of DEFAULT_SIZES_MM is built above"),
-    };
+    let points = named_points(&key);
     let unit = hull(&points)?.centred();
     let scale = if key == "d4" {
         size / (2.0 * 2f64.sqrt())
@@ -743,44 +705,7 @@ pub fn named(name: &str, size: Option<f64>) -> Result<Named, String> {
         .iter()
         .map(|f| f.normal)
         .collect();
-    let labels: Vec<usize> = match key.as_str() {
-        "d4" => {
-            let mut order: Vec<usize> = (0..normals.len()).collect();
-            order.sort_by_key(|&i| order_key(&normals[i]));
-            let mut labels = vec![0; normals.len()];
-            for (rank, &i) in order.iter().enumerate() {
-                labels[i] = rank + 1;
-            }
-            labels
-        }
-        "d6" => normals
-            .iter()
-            .map(|n| {
-                // The face's axis and side: 1 +z, 6 −z, 2 +x, 5 −x, 3 +y, 4 −y.
-                let axis = n.iamax();
-                match (axis, n[axis] > 0.0) {
-                    (2, true) => 1,
-                    (2, false) => 6,
-                    (0, true) => 2,
-                    (0, false) => 5,
-                    (1, true) => 3,
-                    _ => 4,
-                }
-            })
-            .collect(),
-        "d10" => normals
-            .iter()
-            .map(|n| {
-                // Faces round the ring by azimuth (36° apart; even steps are the faces of the
-                // −z apex), labelled in the zigzag order of the usual d10 (0, 7, 4, 1, 6, 9, 2,
-                // 5, 8, 3 on a 0–9 die, plus one): the face opposite step m is step m + 5.
-                const ZIGZAG: [usize; 10] = [1, 8, 5, 2, 7, 10, 3, 6, 9, 4];
-                let step = (azimuth(n) / (PI / 5.0)).round() as usize % 10;
-                ZIGZAG[step]
-            })
-            .collect(),
-        _ => opposite_pair_labels(&normals)?,
-    };
+    let labels = named_labels(&key, &normals)?;
     let expected = match key.as_str() {
         "d4" => 4,
         "d6" => 6,
@@ -909,6 +834,94 @@ fn extrude(polygon: &[(f64, f64)], cap: &[[usize; 3]], z0: f64, z1: f64) -> Mesh
         vertices,
         triangles,
     }
+}
+
+/// A named die's vertices before sizing (the Platonic solids' standard coordinates; the d10's
+/// from [`d10_points`]).
+fn named_points(key: &str) -> Vec<Vector3<f64>> {
+    match key {
+        // Alternate corners of the cube [−1, 1]³: edge 2√2.
+        "d4" => vec![
+            Vector3::new(1.0, 1.0, 1.0),
+            Vector3::new(1.0, -1.0, -1.0),
+            Vector3::new(-1.0, 1.0, -1.0),
+            Vector3::new(-1.0, -1.0, 1.0),
+        ],
+        "d6" => signs3()
+            .map(|[sx, sy, sz]| Vector3::new(sx, sy, sz))
+            .collect(),
+        "d8" => (0..3)
+            .flat_map(|i| [1.0, -1.0].map(|s| Vector3::ith(i, s)))
+            .collect(),
+        "d10" => d10_points(),
+        // (±1, ±1, ±1), (0, ±1/φ, ±φ), (±1/φ, ±φ, 0), (±φ, 0, ±1/φ).
+        "d12" => {
+            let mut p: Vec<Vector3<f64>> = signs3()
+                .map(|[sx, sy, sz]| Vector3::new(sx, sy, sz))
+                .collect();
+            for [s1, s2] in SIGNS2 {
+                p.push(Vector3::new(0.0, s1 / PHI, s2 * PHI));
+                p.push(Vector3::new(s1 / PHI, s2 * PHI, 0.0));
+                p.push(Vector3::new(s1 * PHI, 0.0, s2 / PHI));
+            }
+            p
+        }
+        // (0, ±1, ±φ) and its cyclic permutations.
+        "d20" => {
+            let mut p = Vec::new();
+            for [s1, s2] in SIGNS2 {
+                p.push(Vector3::new(0.0, s1, s2 * PHI));
+                p.push(Vector3::new(s1, s2 * PHI, 0.0));
+                p.push(Vector3::new(s1 * PHI, 0.0, s2));
+            }
+            p
+        }
+        _ => unreachable!("every name of DEFAULT_SIZES_MM is built above"),
+    }
+}
+
+/// The labels of a named die's faces, by their outward normals: the d4's in a fixed order, the
+/// d6's the western layout, the d10's the usual zigzag, the others' opposite pairs summing to
+/// N + 1.
+fn named_labels(key: &str, normals: &[Vector3<f64>]) -> Result<Vec<usize>, String> {
+    Ok(match key {
+        "d4" => {
+            let mut order: Vec<usize> = (0..normals.len()).collect();
+            order.sort_by_key(|&i| order_key(&normals[i]));
+            let mut labels = vec![0; normals.len()];
+            for (rank, &i) in order.iter().enumerate() {
+                labels[i] = rank + 1;
+            }
+            labels
+        }
+        "d6" => normals
+            .iter()
+            .map(|n| {
+                // The face's axis and side: 1 +z, 6 −z, 2 +x, 5 −x, 3 +y, 4 −y.
+                let axis = n.iamax();
+                match (axis, n[axis] > 0.0) {
+                    (2, true) => 1,
+                    (2, false) => 6,
+                    (0, true) => 2,
+                    (0, false) => 5,
+                    (1, true) => 3,
+                    _ => 4,
+                }
+            })
+            .collect(),
+        "d10" => normals
+            .iter()
+            .map(|n| {
+                // Faces round the ring by azimuth (36° apart; even steps are the faces of the
+                // −z apex), labelled in the zigzag order of the usual d10 (0, 7, 4, 1, 6, 9, 2,
+                // 5, 8, 3 on a 0–9 die, plus one): the face opposite step m is step m + 5.
+                const ZIGZAG: [usize; 10] = [1, 8, 5, 2, 7, 10, 3, 6, 9, 4];
+                let step = (azimuth(n) / (PI / 5.0)).round() as usize % 10;
+                ZIGZAG[step]
+            })
+            .collect(),
+        _ => opposite_pair_labels(normals)?,
+    })
 }
 
 /// The regular N-gon prism of circumscribed diameter D and length L along z, centred. Corners

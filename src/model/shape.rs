@@ -201,7 +201,7 @@ pub fn from_mesh(
     mesh_mm.check()?;
     let mesh = mesh_mm.scaled(1e-3);
     let mp = mesh.mass_properties();
-    if !(mp.volume > 0.0) {
+    if mp.volume.is_nan() || mp.volume <= 0.0 {
         return Err("the mesh encloses no volume".into());
     }
     let centred: Vec<Vector3<f64>> = mesh.vertices.iter().map(|v| v - mp.centroid).collect();

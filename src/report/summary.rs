@@ -407,9 +407,35 @@ impl RunSummary {
         }
     }
 
+    /// The summary's lines of outcomes: a die of any shape's faces against 1/N, or the
+    /// block's sides, its ratio with theory, and its three outcomes (3D).
+    fn outcome_lines(&self) -> String {
+        let c = &self.counts;
+        let mut s = String::new();
+        if let Some(o) = &self.shape {
+            s += &format!(
+                "  {}: on a face {:>8}   unknown (leaning) {:>6}\n",
+                o.shape, c.face, c.unknown
+            );
+            s += &o.lines();
+        } else {
+            s += &format!(
+                "  breadth vertical {:>8}   width vertical {:>8}   length vertical {:>6}   unknown {:>6}\n",
+                c.breadth, c.width, c.length, c.unknown
+            );
+            s += &format!(
+                "  ratio breadth/width  {:.4} ± {:.4}   theory {:.4}   ({:+.1} σ)\n",
+                self.ratio, self.ratio_err, self.theory_ratio, self.z_theory
+            );
+        }
+        if let Some(o) = &self.outcomes {
+            s += &format!("  {}\n", o.line());
+        }
+        s
+    }
+
     /// The human summary: counts, the ratio with its error, theory and σ, failures, cost.
     pub fn human(&self) -> String {
-        let c = &self.counts;
         let mut s = String::new();
         if self.partial {
             s += "PARTIAL: stopped before all rolls were made; the counts cover these rolls only\n";
@@ -442,25 +468,7 @@ impl RunSummary {
             self.floor
         );
         s += &self.not_dicephys();
-        if let Some(o) = &self.shape {
-            s += &format!(
-                "  {}: on a face {:>8}   unknown (leaning) {:>6}\n",
-                o.shape, c.face, c.unknown
-            );
-            s += &o.lines();
-        } else {
-            s += &format!(
-                "  breadth vertical {:>8}   width vertical {:>8}   length vertical {:>6}   unknown {:>6}\n",
-                c.breadth, c.width, c.length, c.unknown
-            );
-            s += &format!(
-                "  ratio breadth/width  {:.4} ± {:.4}   theory {:.4}   ({:+.1} σ)\n",
-                self.ratio, self.ratio_err, self.theory_ratio, self.z_theory
-            );
-        }
-        if let Some(o) = &self.outcomes {
-            s += &format!("  {}\n", o.line());
-        }
+        s += &self.outcome_lines();
         if let (Some(f), None) = (&self.faces, &self.shape) {
             let each: Vec<String> = f.iter().map(|(k, v)| format!("{k}: {v}")).collect();
             s += &format!("  face up ({} layout)  {}\n", self.layout, each.join("   "));

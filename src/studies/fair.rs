@@ -66,20 +66,15 @@ fn null_probabilities(s: &RunSummary, null: Null) -> Result<Vec<f64>> {
     }
 }
 
-/// The faces of the run `s` set against `null`.
-pub fn assess(s: &RunSummary, null: Null) -> Result<Fairness> {
-    let q = null_probabilities(s, null)?;
-    let shape = crate::report::summary::shape_faces(&s.tally, &s.spec.scene);
-    if shape.is_none() && !s.tally.faces_complete() {
-        return Err(Error::Invalid(
-            "some of these rolls were read from chunks written before faces were kept: roll \
-             them again (a new --checkpoint)"
-                .into(),
-        ));
-    }
-    // Each face's number and name: a cube's under its layout, by direction; a die of any
-    // shape's by the label it shows (its number where the label is one, else its place).
-    let (numbers, names, counts): (Vec<u8>, Vec<String>, Vec<u64>) = match &shape {
+/// Each face's number, name and count: a cube's under its layout, by direction (the first
+/// `shown`); a die of any shape's by the label it shows (its number where the label is one,
+/// else its place).
+fn face_counts(
+    s: &RunSummary,
+    shape: Option<&[(String, u64)]>,
+    shown: usize,
+) -> (Vec<u8>, Vec<String>, Vec<u64>) {
+    match shape {
         Some(f) => (
             f.iter()
                 .enumerate()
@@ -91,9 +86,23 @@ pub fn assess(s: &RunSummary, null: Null) -> Result<Fairness> {
         None => (
             s.layout.numbers().to_vec(),
             DIRECTIONS.iter().map(|d| d.to_string()).collect(),
-            s.tally.up[..q.len()].to_vec(),
+            s.tally.up[..shown].to_vec(),
         ),
-    };
+    }
+}
+
+/// The faces of the run `s` set against `null`.
+pub fn assess(s: &RunSummary, null: Null) -> Result<Fairness> {
+    let q = null_probabilities(s, null)?;
+    let shape = crate::report::summary::shape_faces(&s.tally, &s.spec.scene);
+    if shape.is_none() && !s.tally.faces_complete() {
+        return Err(Error::Invalid(
+            "some of these rolls were read from chunks written before faces were kept: roll \
+             them again (a new --checkpoint)"
+                .into(),
+        ));
+    }
+    let (numbers, names, counts) = face_counts(s, shape.as_deref(), q.len());
     let n: u64 = counts.iter().sum();
     if n == 0 {
         return Err(Error::Failed(
