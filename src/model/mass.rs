@@ -868,6 +868,32 @@ impl MassProps {
                 "is too far from the centre for this die's inertia (no solid has these moments)",
             ));
         }
+        if let Some(t) = s.features.inertia {
+            // Reliability round 5, class E: any solid's moment about an axis through its
+            // centre of mass is at most m r², r the farthest any of its points lies from that
+            // centre; far below it (a millionth) no engine here integrates the die.
+            let reach = match s.shape {
+                Some(shape) => shape.circumradius() + m.com.norm(),
+                None => (Vector3::new(a, b, c) / 2.0).norm() + m.com.norm(),
+            };
+            let most = m.mass * reach * reach;
+            if m.moments
+                .iter()
+                .any(|&x| x > most * (1.0 + 1e-9) || x < 1e-6 * most)
+            {
+                return Err(Error::field(
+                    Field::Inertia,
+                    t.map(|x| format!("{}", x * 1e9)).join(","),
+                    format!(
+                        "no die of this mass and size turns so: its principal moments must lie \
+                         between a millionth of m·r² and m·r² = {:.4} g mm² (r = {:.3} mm, the \
+                         farthest point from its centre of mass)",
+                        most * 1e9,
+                        reach * 1e3
+                    ),
+                ));
+            }
+        }
         Ok(m)
     }
 

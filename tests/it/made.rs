@@ -311,6 +311,17 @@ fn bad_dice_are_refused_in_one_line() {
             "inertia = [100.0, 100.0, 300.0, 0.0, 0.0, 0.0]\n",
             "inertia",
         ),
+        // Reliability round 5, class E: moments no die of this mass and size can have.
+        (
+            "tiny-inertia.toml",
+            "inertia = [1e-30, 1e-30, 1e-30, 0.0, 0.0, 0.0]\n",
+            "no die of this mass and size",
+        ),
+        (
+            "huge-inertia.toml",
+            "inertia = [1e30, 1e30, 1e30, 0.0, 0.0, 0.0]\n",
+            "no die of this mass and size",
+        ),
     ];
     let paths: Vec<String> = files
         .iter()
