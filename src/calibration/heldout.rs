@@ -58,6 +58,29 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<BlockRow>> {
         .map(str::to_string)
         .collect();
     let col = |c: &str| header.iter().position(|h| h == c);
+    // Reliability round 5, class J: a column this reader does not know (face counts among
+    // them) used to be dropped, leaving the row unmeasured in silence.
+    const KNOWN: [&str; 8] = [
+        "label",
+        "block",
+        "mode",
+        "surface",
+        "thrower",
+        "length_vertical",
+        "breadth_vertical",
+        "width_vertical",
+    ];
+    if let Some(h) = header.iter().find(|h| !KNOWN.contains(&h.as_str())) {
+        return Err(bad(
+            1,
+            format!(
+                "unknown column '{}' (a blocks file has {}; face counts belong in a counts \
+                 file, `fit --data`)",
+                shown(h),
+                KNOWN.join(", ")
+            ),
+        ));
+    }
     let (Some(label), Some(block), Some(mode)) = (col("label"), col("block"), col("mode")) else {
         return Err(bad(
             1,
@@ -269,6 +292,17 @@ pub fn collect(rows: Vec<PredictedRow>, fit: String, command_line: String) -> Pr
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_column_it_does_not_know_is_refused_not_dropped() {
+        let e = parse("label,block,mode,face_1\nA,140x24x20,3d,5\n", "b.csv").unwrap_err();
+        assert!(e.to_string().contains("unknown column 'face_1'"), "{e}");
+        let e = parse(
+            "label,block,mode,lenght_vertical\nA,140x24x20,3d,5\n",
+            "b.csv",
+        );
+        assert!(e.is_err());
+    }
 
     #[test]
     fn blocks_files_and_counts_files_both_read() {
