@@ -475,13 +475,14 @@ pub fn prediction_text(p: &BlockPrediction) -> String {
         p.theory_ratio
     );
     for (k, v) in p.faces.iter().flatten().enumerate() {
-        let _ = writeln!(
-            s,
-            "  P(face {} up)  {}   {:+.1}σ from 1/6",
-            k + 1,
-            predicted(v),
-            (v.value - 1.0 / 6.0) / v.err.max(1e-12)
-        );
+        // Reliability round 5, class K: over an error of 0 (a face never or always up in
+        // every draw) a departure in σ means nothing; it is not printed.
+        let z = if v.err > 0.0 && v.err.is_finite() {
+            format!("   {:+.1}σ from 1/6", (v.value - 1.0 / 6.0) / v.err)
+        } else {
+            "   (no error: not compared with 1/6)".to_string()
+        };
+        let _ = writeln!(s, "  P(face {} up)  {}{z}", k + 1, predicted(v));
     }
     if p.unsettled > 0 {
         let _ = writeln!(
