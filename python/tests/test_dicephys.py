@@ -105,6 +105,9 @@ def test_per_roll_arrays_match_the_cli_s_csv(tmp_path: Path) -> None:
         ({"block": "16x16x16", "com": (0, 0, 9)}, "com"),
         ({"block": "16x16x16", "com": (0, 0)}, "com"),
         ({"block": "140x24x20", "velocity": "fast"}, "velocity"),
+        # Reliability round 5, class I: what the command line refuses, Python refuses.
+        ({"block": "140x24x20", "velocity": (2, 1)}, "velocity"),
+        ({"block": "140x24x20", "drop_height": (0.4, 0.2)}, "drop_height"),
     ],
 )
 def test_bad_arguments_raise_value_error_naming_them(kwargs: dict, name: str) -> None:

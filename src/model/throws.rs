@@ -104,6 +104,20 @@ impl ThrowRanges {
     /// Checks the ranges: spin and drop height not negative, no magnitude absurdly large.
     pub fn validate(&self) -> crate::Result<()> {
         let bad = |field, r: Range, why: String| Err(crate::Error::field(field, r, why));
+        // Checked here, not only where the command line parses them (reliability round 5,
+        // class I: Python's velocity=(2, 1) used to run).
+        for (name, r) in [
+            (Field::Velocity, self.velocity),
+            (Field::Spin, self.spin),
+            (Field::DropHeight, self.drop_height),
+        ] {
+            if !(r.lo.is_finite() && r.hi.is_finite()) {
+                return bad(name, r, "must be finite".into());
+            }
+            if r.lo > r.hi {
+                return bad(name, r, "runs from high to low: give LOW:HIGH".into());
+            }
+        }
         if self.spin.lo < 0.0 {
             return bad(Field::Spin, self.spin, "must be >= 0 rad/s".into());
         }
