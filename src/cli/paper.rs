@@ -96,9 +96,13 @@ impl PaperArgs {
                 rolls: a.point_rolls,
                 ..DesignSpec::default()
             },
+            // Every flag honoured (reliability round 5, class F: --starts and
+            // --profile-points used to be parsed and left at their defaults).
             search: Search {
                 seed: *a.seed,
                 bootstrap: a.bootstrap,
+                starts: a.starts,
+                profile_points: a.profile_points,
                 ..Search::default()
             },
             seed: *a.seed,

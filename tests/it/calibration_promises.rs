@@ -376,6 +376,9 @@ fn calibrated_values_are_checked_first_by_their_flags() {
         ("--point-rolls", "0"),
         ("--points", "0"),
         ("--max-steps", "0"),
+        // Reliability round 5, class F: parsed and ignored before, now honoured and checked.
+        ("--starts", "0"),
+        ("--profile-points", "2"),
     ] {
         let out = dir.join(format!("out{}", flag.len()));
         let (code, err, took) = timed(
