@@ -19,20 +19,65 @@ pub struct MergeArgs {
     pub json: Json,
 }
 
-/// Runs `dicephys merge`.
+/// A shard's `fair --shard K/N --json` document: its roll's summary and the null it was
+/// judged against (the whole document under its checksum).
+#[derive(serde::Deserialize)]
+struct FairShard {
+    fairness: NullOnly,
+    summary: ShardResult,
+}
+
+#[derive(serde::Deserialize)]
+struct NullOnly {
+    null: dicephys::studies::fair::Null,
+}
+
+/// Runs `dicephys merge`: shards of `roll --json`, or of `fair --json` (reliability round 5,
+/// class M), combined into the unsharded run's result (a fair document judged again).
 pub fn run(a: &MergeArgs) -> Result<()> {
     let mut parts = Vec::new();
+    let mut nulls = Vec::new();
     for f in &a.files {
         let text = read_small(f)?;
-        let s: ShardResult = dicephys::run::seal::open(&text).map_err(|e| {
+        let value: serde_json::Value = dicephys::run::seal::open(&text).map_err(|e| {
             Error::Usage(format!(
-                "merge: {}: not a whole `roll --json` output: {e}",
+                "merge: {}: not a whole `roll --json` or `fair --json` output: {e}",
                 f.display()
             ))
         })?;
-        parts.push(s);
+        let shape = |e: serde_json::Error| {
+            Error::Usage(format!(
+                "merge: {}: not a whole `roll --json` or `fair --json` output: {e}",
+                f.display()
+            ))
+        };
+        if value.get("fairness").is_some() {
+            let s: FairShard = serde_json::from_value(value).map_err(shape)?;
+            nulls.push(Some(s.fairness.null));
+            parts.push(s.summary);
+        } else {
+            nulls.push(None);
+            parts.push(serde_json::from_value(value).map_err(shape)?);
+        }
+    }
+    if nulls.windows(2).any(|w| w[0] != w[1]) {
+        return Err(Error::Usage(
+            "merge: the shards are of different commands (roll and fair) or nulls: give one \
+             run's shards"
+                .into(),
+        ));
     }
     let out = RunSummary::merge(&parts)?;
+    if let Some(Some(null)) = nulls.first() {
+        let fair = dicephys::studies::fair::assess(&out, *null)?;
+        let doc = serde_json::json!({ "fairness": fair, "summary": out });
+        if *a.json {
+            outln!("{}", dicephys::run::seal::to_string(&doc, true)?);
+        } else {
+            out!("{}", fair.text(&out));
+        }
+        return Ok(());
+    }
     if *a.json {
         outln!("{}", dicephys::run::seal::to_string(&out, true)?);
     } else {

@@ -368,3 +368,26 @@ fn the_numbering_is_kept_through_resume_merge_and_a_die_file() {
     ));
     assert_eq!(from_file["faces"], whole["faces"]);
 }
+
+/// Reliability round 5, class M: `fair --shard K/N` outputs merge into the unsharded `fair`.
+#[test]
+fn fair_shards_merge_into_the_whole_fair() {
+    let dir = Scratch::new("fair-shards");
+    let args = [
+        "fair", "--block", "16x16x16", "--rolls", "1200", "--seed", "6", "--json",
+    ];
+    let whole = json(&dicephys(&args));
+    let mut files = Vec::new();
+    for k in 0..2 {
+        let v = json(&dicephys(
+            &[&args[..], &["--shard", &format!("{k}/2")]].concat(),
+        ));
+        let f = dir.join(format!("f{k}.json"));
+        std::fs::write(&f, v.to_string()).unwrap();
+        files.push(f.to_str().unwrap().to_string());
+    }
+    let merged = json(&dicephys(&["merge", "--json", &files[0], &files[1]]));
+    assert_eq!(merged["fairness"]["faces"], whole["fairness"]["faces"]);
+    assert_eq!(merged["fairness"]["chi2"], whole["fairness"]["chi2"]);
+    assert_eq!(merged["summary"]["tally"], whole["summary"]["tally"]);
+}
