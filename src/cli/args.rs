@@ -141,7 +141,7 @@ pub struct DieArgs {
     /// Pips drilled in the standard pattern (one to six, as the faces' numbers), DIAMETER,DEPTH
     /// in mm, as spherical caps: they lighten the die (its mass, centre and inertia), not its
     /// surface. Paint, cylinders, spacing: in a --die file. 3D only.
-    #[arg(long, value_name = "D,H", value_parser = parse_pips)]
+    #[arg(long, value_name = "D,H", allow_hyphen_values = true, value_parser = parse_pips)]
     pub pips: Option<[f64; 2]>,
     /// Round the die's edges and corners with this radius, mm (0, the default: sharp). 3D only.
     #[arg(long, value_name = "MM", allow_hyphen_values = true)]
@@ -345,6 +345,12 @@ pub fn parse_throw_kind(s: &str) -> std::result::Result<ThrowKind, dicephys::Err
 /// `--throw` as clap reads it.
 pub fn parse_throw_style(s: &str) -> std::result::Result<ThrowStyle, dicephys::Error> {
     parse_name("throw style", s)
+}
+/// `--layout` as clap reads it: "unknown layout 'x' (known: right, left)".
+pub fn parse_layout(
+    s: &str,
+) -> std::result::Result<dicephys::model::faces::Layout, dicephys::Error> {
+    parse_name("layout", s)
 }
 /// `--engine` as clap reads it.
 pub fn parse_engine(s: &str) -> std::result::Result<EngineKind, dicephys::Error> {

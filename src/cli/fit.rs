@@ -58,7 +58,7 @@ pub struct FitArgs {
     pub made: super::args::DieArgs,
     /// Which number is on which face, for counts of faces: right (western dice) or left
     /// [default: the --die file's layout or face map, else right].
-    #[arg(long)]
+    #[arg(long, value_parser = super::args::parse_layout)]
     pub layout: Option<dicephys::model::faces::Layout>,
     /// The engine.
     #[arg(long, default_value = "bullet", value_parser = parse_engine)]

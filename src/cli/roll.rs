@@ -72,7 +72,7 @@ pub struct RollArgs {
     /// (western dice: 1 on +z, 6 on −z, 2 on +x, 3 on +y; 1, 2, 3 counter-clockwise about
     /// their corner) or left (its mirror image) [default: right, or the --die file's layout
     /// or face map].
-    #[arg(long)]
+    #[arg(long, value_parser = super::args::parse_layout)]
     pub layout: Option<dicephys::model::faces::Layout>,
     /// Keep a checkpoint here as the run goes (chunks of 1,000 rolls, written atomically);
     /// `dicephys roll --resume DIR` continues it, bit for bit.

@@ -581,7 +581,7 @@ impl Features {
         if mode == Mode::TwoD {
             return Err(Error::Invalid(
                 "a centre of mass off the centre, pips and rounded edges are modelled in 3D only \
-                 (2D is the paper's ideal block): add --mode 3d"
+                 (2D is the paper's ideal block): roll it in 3D"
                     .into(),
             ));
         }
