@@ -588,6 +588,7 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
         "--no-sleep",
     ]);
     let none = roll(&["--block", "140x24x20", "--max-steps", "1"]);
+    let shaped = roll(&["--shape", "d6"]);
     let precise = run(&[
         "roll",
         "--block",
@@ -645,6 +646,7 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
         ("roll 2D", &d2),
         ("roll --audit --throw tumble, damped", &odd),
         ("roll --max-steps 1", &none),
+        ("roll --shape d6", &shaped),
         ("roll --precision 60", &precise),
         ("roll --precision 1 --rolls 1000", &short),
         ("merge", &merged),
