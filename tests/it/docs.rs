@@ -549,6 +549,26 @@ fn made_die_and_faces() -> (Value, Value) {
         "--layout",
         "left",
     ]);
+    // A die file's insert, inertia and face map (spec.scene.features.insert, .inertia and
+    // .layout as a map).
+    let weighted = dir2.join("weighted.toml");
+    std::fs::write(
+        &weighted,
+        "inertia = [150.0, 150.0, 150.0, 0.0, 0.0, 0.0]\n\
+         [insert]\nsize = [4.0, 4.0, 4.0]\ncentre = [0.0, 0.0, -4.0]\ndensity = 19300.0\n\
+         [faces]\n\"+x\" = 2\n\"-x\" = 5\n\"+y\" = 4\n\"-y\" = 3\n\"+z\" = 1\n\"-z\" = 6\n",
+    )
+    .unwrap();
+    let weighted = roll(&[
+        "--block",
+        "16x16x16",
+        "--throw",
+        "tumble",
+        "--die",
+        weighted.to_str().unwrap(),
+    ]);
+    assert!(weighted["spec"]["scene"]["features"]["layout"]["map"].is_array());
+    let made = serde_json::json!([made, weighted]);
     let faces = run(&[
         "fair",
         "--block",
@@ -640,7 +660,8 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
     assert!(merged["spec"]["shard"].is_null());
     let (made, faces) = made_die_and_faces();
     for (what, v) in [
-        ("roll --die (every feature)", &made),
+        ("roll --die (every feature)", &made[0]),
+        ("roll --die (insert, inertia, face map)", &made[1]),
         ("fair --precision 10 (its summary)", &faces["summary"]),
         ("roll 3D", &d3),
         ("roll 2D", &d2),
