@@ -204,6 +204,12 @@ def _progress(progress: Progress, what: str) -> Tuple[Optional[Callable[[float, 
     """The callback a run reports to, and what closes it."""
     if callable(progress):
         return progress, lambda: None
+    if progress is not None and not isinstance(progress, bool):
+        # As the command line refuses what it does not know (reliability round 5, class I).
+        raise ValueError(
+            f"progress={progress!r}: give None (a bar on a terminal), True, False or a "
+            "callable(done, total)"
+        )
     if progress is False:
         return None, lambda: None
     try:
@@ -314,6 +320,8 @@ def roll(
         (0.02 is 2 %), tested every 1,000 rolls.
     progress: see the module's help.
     """
+    if isinstance(rolls, bool):
+        raise ValueError(f"rolls={rolls!r}: give a number of rolls")
     tell, close = _progress(progress, "roll")
     try:
         text, csv_bytes = _native.roll(

@@ -108,11 +108,14 @@ def test_per_roll_arrays_match_the_cli_s_csv(tmp_path: Path) -> None:
         # Reliability round 5, class I: what the command line refuses, Python refuses.
         ({"block": "140x24x20", "velocity": (2, 1)}, "velocity"),
         ({"block": "140x24x20", "drop_height": (0.4, 0.2)}, "drop_height"),
+        ({"block": "140x24x20", "progress": 5}, "progress"),
+        ({"block": "140x24x20", "progress": "yes"}, "progress"),
+        ({"block": "140x24x20", "rolls": True}, "rolls"),
     ],
 )
 def test_bad_arguments_raise_value_error_naming_them(kwargs: dict, name: str) -> None:
     with pytest.raises(ValueError, match=name):
-        dicephys.roll(rolls=10, **kwargs)
+        dicephys.roll(**{"rolls": 10, **kwargs})
 
 
 def test_a_signal_stops_a_run_with_keyboard_interrupt() -> None:
