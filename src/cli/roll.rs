@@ -134,6 +134,9 @@ impl RollArgs {
 /// Runs `dicephys roll`.
 pub fn run(a: &RollArgs) -> Result<()> {
     let spec = a.spec()?;
+    if let Some(w) = paper_throw_warning(&spec) {
+        eprintln!("{w}");
+    }
     let (summary, done) = rolled(a, &spec, "roll", Target::Ratio)?;
     if *a.json {
         outln!("{}", dicephys::run::seal::to_string(&summary, true)?);
@@ -200,4 +203,20 @@ pub fn rolled(
         return Ok((summary, Err(why)));
     }
     Ok((summary, Ok(())))
+}
+
+/// A warning when the paper's throw meets a block whose long axis is not unique (a cube): the
+/// throw spins it about body z, so the two z faces come up less often than a tester's throw
+/// would show them (issue 50: "a fair cube that looks loaded").
+fn paper_throw_warning(spec: &RunSpec) -> Option<String> {
+    let b = &spec.scene.block;
+    let paper = spec.throws.style == dicephys::model::throws::ThrowStyle::Paper;
+    (paper && spec.scene.shape.is_none() && b.length <= b.breadth * (1.0 + 1e-9)).then(|| {
+        format!(
+            "dicephys: warning: the paper's throw spins the block about its length, and {} has \
+             no longer length: faces 1 and 6 will come up less often than on a tester's throw; \
+             --throw tumble throws it without a preferred axis",
+            b
+        )
+    })
 }

@@ -391,3 +391,26 @@ fn fair_shards_merge_into_the_whole_fair() {
     assert_eq!(merged["fairness"]["chi2"], whole["fairness"]["chi2"]);
     assert_eq!(merged["summary"]["tally"], whole["summary"]["tally"]);
 }
+
+/// Issue 50, "a fair cube that looks loaded": the paper's throw on a block whose length is not
+/// its longest side warns in one line and names the tumble; a paper block and a tumble do not.
+#[test]
+fn the_papers_throw_on_a_cube_warns_and_names_the_tumble() {
+    let stderr = |args: &[&str]| {
+        let o = dicephys(args);
+        assert!(o.status.success());
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let cube = stderr(&["roll", "--block", "16x16x16", "--rolls", "20", "--json"]);
+    assert!(
+        cube.contains("warning") && cube.contains("--throw tumble"),
+        "{cube}"
+    );
+    assert_eq!(cube.trim_end().lines().count(), 1, "{cube}");
+    let paper = stderr(&["roll", "--block", "140x24x20", "--rolls", "20", "--json"]);
+    assert!(!paper.contains("warning"), "{paper}");
+    let tumble = stderr(&[
+        "roll", "--block", "16x16x16", "--throw", "tumble", "--rolls", "20", "--json",
+    ]);
+    assert!(!tumble.contains("warning"), "{tumble}");
+}
