@@ -138,6 +138,12 @@ pub fn run(a: &RollArgs) -> Result<()> {
         eprintln!("{w}");
     }
     let (summary, done) = rolled(a, &spec, "roll", Target::Ratio)?;
+    // Broken physics says so on the terminal too, whatever goes to stdout.
+    if *a.json {
+        for w in &summary.warnings {
+            eprintln!("dicephys: warning: {w}");
+        }
+    }
     if *a.json {
         outln!("{}", dicephys::run::seal::to_string(&summary, true)?);
     } else {

@@ -111,6 +111,9 @@ pub struct RunSummary {
     /// A die of any shape: each outcome's probability against a fair die's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shape: Option<ShapeOutcomes>,
+    /// Physics that broke, said in words (`physics_warnings`): absent when none did.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
     /// Steps simulated over all rolls.
     pub steps_total: u64,
     /// Steps simulated per roll.
@@ -294,6 +297,37 @@ impl ShapeOutcomes {
     }
 }
 
+/// The share of rolls above which a sign of broken physics is reported (`physics_warnings`).
+pub const BROKEN_SHARE: f64 = 0.5;
+
+/// What says the engine's physics broke at this step (issue 50: `--dt 1/30` used to pass in
+/// silence with 1,986 of 2,000 rolls sunk into the floor): more than half the rolls with the
+/// die's centre pushed below the floor's top face (sunk by more than its own half-size), or
+/// more than half gaining energy. One line each, naming the step and `stability`.
+pub fn physics_warnings(tally: &Tally, dt: f64) -> Vec<String> {
+    let n = tally.rolls as f64;
+    let mut out = Vec::new();
+    if n > 0.0 && tally.dipped as f64 > BROKEN_SHARE * n {
+        out.push(format!(
+            "at dt {dt} s {} of {} rolls sank their centre below the floor (as deep as {:.1} mm): \
+             the step is too coarse for this die; `dicephys stability` maps where each engine holds",
+            tally.dipped,
+            tally.rolls,
+            tally.deepest_dip_m() * 1e3
+        ));
+    }
+    if n > 0.0 && tally.energy_gain as f64 > BROKEN_SHARE * n {
+        out.push(format!(
+            "at dt {dt} s {} of {} rolls gained energy (more than {} % of their start): the \
+             engine injects it; `dicephys stability` maps where each engine holds",
+            tally.energy_gain,
+            tally.rolls,
+            100.0 * crate::sim::roll::ENERGY_GAIN_TOLERANCE
+        ));
+    }
+    out
+}
+
 impl RunSummary {
     /// The report of a run of `spec` that made the rolls in `tally`.
     pub fn new(spec: &RunSpec, tally: &Tally, cost: Cost) -> RunSummary {
@@ -349,6 +383,7 @@ impl RunSummary {
                 None => faces_up(tally, scene.mode, scene.features.layout),
             },
             shape: ShapeOutcomes::of(tally, scene),
+            warnings: physics_warnings(tally, scene.dt),
             steps_total: tally.steps,
             steps_mean: tally.steps as f64 / tally.rolls.max(1) as f64,
             engine_steps_mean: tally.engine_steps as f64 / tally.rolls.max(1) as f64,
@@ -439,6 +474,9 @@ impl RunSummary {
         let mut s = String::new();
         if self.partial {
             s += "PARTIAL: stopped before all rolls were made; the counts cover these rolls only\n";
+        }
+        for w in &self.warnings {
+            s += &format!("WARNING: {w}\n");
         }
         let die = match &self.spec.scene.shape {
             Some(shape) => shape.name.clone(),

@@ -609,6 +609,9 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
     ]);
     let none = roll(&["--block", "140x24x20", "--max-steps", "1"]);
     let shaped = roll(&["--shape", "d6"]);
+    let broken = roll(&["--block", "140x24x20", "--dt", "1/30"]);
+    assert!(broken["warnings"].is_array(), "{}", broken["dipped"]);
+    assert!(shaped.get("warnings").is_none());
     let precise = run(&[
         "roll",
         "--block",
@@ -668,6 +671,7 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
         ("roll --audit --throw tumble, damped", &odd),
         ("roll --max-steps 1", &none),
         ("roll --shape d6", &shaped),
+        ("roll --dt 1/30", &broken),
         ("roll --precision 60", &precise),
         ("roll --precision 1 --rolls 1000", &short),
         ("merge", &merged),

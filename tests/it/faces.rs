@@ -414,3 +414,40 @@ fn the_papers_throw_on_a_cube_warns_and_names_the_tumble() {
     ]);
     assert!(!tumble.contains("warning"), "{tumble}");
 }
+
+/// Issue 50, "physics that broke passes in silence": at dt = 1/30 s most rolls sink into the
+/// floor, and the run says so (stderr and the JSON's `warnings`); at the defaults it says
+/// nothing.
+#[test]
+fn broken_physics_says_so_and_the_defaults_do_not() {
+    let run = |extra: &[&str]| {
+        let o = dicephys(
+            &[
+                &[
+                    "roll",
+                    "--block",
+                    "140x24x20",
+                    "--rolls",
+                    "300",
+                    "--seed",
+                    "1",
+                    "--json",
+                ][..],
+                extra,
+            ]
+            .concat(),
+        );
+        let e = String::from_utf8_lossy(&o.stderr).into_owned();
+        (json(&o), e)
+    };
+    let (v, e) = run(&["--dt", "1/30"]);
+    let w = v["warnings"].as_array().expect("warnings");
+    assert!(
+        w.iter().any(|l| l.as_str().unwrap().contains("sank")),
+        "{w:?}"
+    );
+    assert!(e.contains("warning") && e.contains("stability"), "{e}");
+    let (v, e) = run(&[]);
+    assert!(v.get("warnings").is_none(), "{}", v["warnings"]);
+    assert!(!e.contains("warning"), "{e}");
+}
