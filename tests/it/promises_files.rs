@@ -139,17 +139,7 @@ fn a_die_file_is_read_capped_and_named() {
         .unwrap();
     std::thread::sleep(std::time::Duration::from_millis(500));
     unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
-    let t = std::time::Instant::now();
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if t.elapsed().as_secs() > 5 {
-            let _ = child.kill();
-            panic!("a --die pipe held off SIGTERM");
-        }
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    };
+    let status = exit_within(&mut child, 5, "a --die pipe held off SIGTERM");
     assert_eq!(status.code(), Some(130));
 }
 
@@ -676,17 +666,11 @@ fn validate_stops_on_ctrl_c_in_its_free_flight_stage() {
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
     unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
-    let t = std::time::Instant::now();
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if t.elapsed().as_secs() > 5 {
-            let _ = child.kill();
-            panic!("validate ignored Ctrl-C in its free-flight stage");
-        }
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    };
+    let status = exit_within(
+        &mut child,
+        5,
+        "validate ignored Ctrl-C in its free-flight stage",
+    );
     assert_eq!(status.code(), Some(130));
     assert!(
         !out.join("validate.json").exists(),
@@ -805,17 +789,7 @@ fn stops_on_ctrl_c(args: &[&str]) {
     );
     unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
     let drain = std::thread::spawn(move || std::io::copy(&mut out, &mut std::io::sink()));
-    let t = std::time::Instant::now();
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if t.elapsed().as_secs() > 5 {
-            let _ = child.kill();
-            panic!("{args:?} ignored Ctrl-C");
-        }
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    };
+    let status = exit_within(&mut child, 5, format!("{args:?} ignored Ctrl-C"));
     let _ = drain.join();
     assert_eq!(status.code(), Some(130), "{args:?}");
 }
@@ -928,5 +902,25 @@ fn a_chunk_takes_at_most_32_bytes_a_roll() {
         let chunk = ck.join("chunk-000000000000-1000.json");
         let bytes = std::fs::metadata(&chunk).unwrap().len();
         assert!(bytes <= 32 * 1000, "{name}: {bytes} bytes for 1000 rolls");
+    }
+}
+
+/// `child`'s exit status once it ends, at most `secs` seconds from now (a bound a slow machine
+/// also meets); past it the child is killed and the test fails with `what`.
+fn exit_within(
+    child: &mut std::process::Child,
+    secs: u64,
+    what: impl std::fmt::Display,
+) -> std::process::ExitStatus {
+    let t = std::time::Instant::now();
+    loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            return s;
+        }
+        if t.elapsed().as_secs() > secs {
+            let _ = child.kill();
+            panic!("{what}");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
     }
 }
