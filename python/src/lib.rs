@@ -510,9 +510,10 @@ fn roll<'py>(
         .maybe::<String>("layout")?
         .map(|l| named::<Layout>("layout", "layout", &l))
         .transpose()?;
-    let null = o
-        .maybe::<String>("fair")?
-        .map(|n| named::<dicephys::studies::fair::Null>("null", "null", &n))
+    let null_given = o.maybe::<String>("fair")?;
+    let null = null_given
+        .as_deref()
+        .map(|n| named::<dicephys::studies::fair::Null>("null", "null", n))
         .transpose()?;
     let precision = o.maybe::<f64>("precision")?;
     let threads = o.get("threads", 0usize)?;
@@ -522,11 +523,11 @@ fn roll<'py>(
     // The numbers: the layout given, else the die's own (a die file's map), else right.
     let layout = layout.unwrap_or(spec.scene.features.layout);
     o.finish()?;
-    if null == Some(dicephys::studies::fair::Null::SolidAngle) && spec.scene.mode == Mode::TwoD {
+    if null == Some(dicephys::studies::fair::Null::QuasiStatic) && spec.scene.mode == Mode::TwoD {
         return Err(bad(
             "null",
-            "'solid-angle'",
-            "the solid angle is the 3D theory; in 2D give 'uniform'",
+            &format!("'{}'", null_given.as_deref().unwrap_or_default()),
+            "the quasi-static theory is 3D; in 2D give 'uniform'",
         ));
     }
     let target = if null.is_some() {

@@ -51,11 +51,24 @@ def test_counts_equal_the_cli_for_the_same_seed(engine: str, mode: str) -> None:
 
 
 def test_a_die_of_any_shape_is_the_cli_s(tmp_path: Path) -> None:
-    want = cli("roll", "--shape", "d20", "--rolls", "300", "--seed", "1", "--json")
-    got = dicephys.roll(shape="d20", rolls=300, seed=1)
+    want = cli("roll", "--shape", "d20", "--rolls", "2000", "--seed", "1", "--json")
+    got = dicephys.roll(shape="d20", rolls=2000, seed=1)
     assert got.faces == want["faces"]
     assert len(got.faces) == 20
     assert got.summary["shape"] == want["shape"]
+    # Beside each face, the quasi-static theory: a d20's 1/20.
+    assert all(abs(f["quasi_static"] - 0.05) < 1e-9 for f in got.summary["shape"]["faces"])
+    # A mesh by its path: a cube's eight corners and six quads.
+    cube = tmp_path / "cube.obj"
+    corners = [(x, y, z) for x in (0, 16) for y in (0, 16) for z in (0, 16)]
+    quads = [(1, 2, 4, 3), (5, 7, 8, 6), (1, 5, 6, 2), (3, 4, 8, 7), (1, 3, 7, 5), (2, 6, 8, 4)]
+    cube.write_text(
+        "".join(f"v {x} {y} {z}\n" for x, y, z in corners)
+        + "".join("f " + " ".join(map(str, q)) + "\n" for q in quads)
+    )
+    mesh = cli("roll", "--die", str(cube), "--rolls", "200", "--seed", "3", "--json")
+    assert dicephys.roll(die=str(cube), rolls=200, seed=3).faces == mesh["faces"]
+    assert len(mesh["faces"]) == 6
     # No die at all: the CLI's 16 mm d6, in a tumble.
     d6 = dicephys.roll(rolls=100, seed=2)
     assert d6.faces == cli("roll", "--rolls", "100", "--seed", "2", "--json")["faces"]

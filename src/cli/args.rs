@@ -352,6 +352,10 @@ pub fn parse_layout(
 ) -> std::result::Result<dicephys::model::faces::Layout, dicephys::Error> {
     parse_name("layout", s)
 }
+/// `--null` as clap reads it.
+pub fn parse_null(s: &str) -> std::result::Result<dicephys::studies::fair::Null, dicephys::Error> {
+    parse_name("null", s)
+}
 /// `--engine` as clap reads it.
 pub fn parse_engine(s: &str) -> std::result::Result<EngineKind, dicephys::Error> {
     parse_name("engine", s)

@@ -14,11 +14,11 @@ use dicephys::studies::fair::{assess, Null};
 pub struct FairArgs {
     #[command(flatten)]
     pub roll: RollArgs,
-    /// What fair means: uniform (each face 1/6; in 2D each side 1/4) or solid-angle (the
-    /// quasi-static theory: each face the solid angle the face opposite subtends from the
-    /// centre of mass, what the die would show released at rest and rolling without a bounce;
-    /// 3D).
-    #[arg(long, default_value = "uniform")]
+    /// What fair means: uniform (each face 1/N; in 2D each side 1/4) or quasi-static (what
+    /// the die would show released at rest and rolling down without a bounce: for a cuboid
+    /// each face the solid angle the face opposite subtends from the centre of mass, so also
+    /// called solid-angle; for any other die the exact basins of its rolling; 3D).
+    #[arg(long, default_value = "uniform", value_parser = super::args::parse_null)]
     pub null: Null,
     /// Also write fairness.json (the --json document) and the die map (die_map.svg, .png:
     /// the six faces as a net, each with its probability and departure) into this directory.
@@ -39,9 +39,10 @@ pub fn run(a: &FairArgs) -> Result<()> {
         return vary(a, &spec, v);
     }
     // The null is checked before anything rolls.
-    if a.null == Null::SolidAngle && spec.scene.mode == dicephys::model::scene::Mode::TwoD {
+    if a.null == Null::QuasiStatic && spec.scene.mode == dicephys::model::scene::Mode::TwoD {
         return Err(Error::Usage(
-            "--null solid-angle: the solid angle is the 3D theory; in 2D give uniform".into(),
+            "--null quasi-static (solid-angle): the quasi-static theory is 3D; in 2D give uniform"
+                .into(),
         ));
     }
     if let Some(dir) = &a.out {

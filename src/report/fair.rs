@@ -24,12 +24,15 @@ pub enum Null {
     /// Every face it can show equally often: 1/6 (in 2D, 1/4 for each side).
     #[default]
     Uniform,
-    /// Each face the solid angle it subtends from the centre over 4π (Simpson's quasi-static
-    /// theory, eq. after (InElasK), split evenly between a side's two faces): what an ideal
-    /// block of these sides would show were it released at rest. For a made die, the solid
-    /// angle of the opposite face of its inner box from its centre of mass
-    /// (`theory::quasi_static`). 3D only.
-    SolidAngle,
+    /// The quasi-static theory: what the die shows released at rest in a random orientation
+    /// and rolling down without a bounce, the end of the gradient flow of its centre of mass's
+    /// height. For a cuboid that is each face's solid angle from the centre of mass over 4π
+    /// (Simpson's, eq. after (InElasK), for the paper's block; the inner box's for a made die;
+    /// `theory::quasi_static`), hence its other name, `solid-angle`; for a die of any shape,
+    /// the flow's exact basins (`theory::basins`). 3D only.
+    #[serde(rename = "quasi-static", alias = "solid-angle")]
+    #[strum(to_string = "quasi-static", serialize = "solid-angle")]
+    QuasiStatic,
 }
 
 /// One face's verdict.

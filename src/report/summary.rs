@@ -217,6 +217,10 @@ pub struct ShapeFace {
     pub p_err: f64,
     /// (p − 1/N) / p_err.
     pub z_fair: f64,
+    /// The quasi-static theory's probability (`theory::quasi_static::shape`), of the rolls
+    /// that end on an outcome; absent where it is not built (a coin loaded off its axis).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quasi_static: Option<f64>,
 }
 
 /// A die of any shape's outcomes against a fair die's 1/N.
@@ -232,6 +236,11 @@ pub struct ShapeOutcomes {
     pub dof: usize,
     /// Its p-value.
     pub p_value: f64,
+    /// Pearson's χ² against the quasi-static theory (over the outcomes it gives a share;
+    /// degrees of freedom one fewer), its degrees of freedom and p-value: how far the bounce
+    /// takes the die from rolling down at rest.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub against_quasi_static: Option<(f64, usize, f64)>,
 }
 
 impl ShapeOutcomes {
@@ -246,9 +255,32 @@ impl ShapeOutcomes {
             .iter()
             .map(|(_, c)| (*c as f64 - expected).powi(2) / expected)
             .sum();
+        let die = crate::model::die::DieShape::of(scene);
+        let theory = crate::theory::quasi_static::shape_labels(scene.shape.as_ref()?, &die.com)
+            .ok()
+            .map(|q| {
+                let listed: f64 = q.iter().map(|(_, x)| x).sum();
+                q.into_iter().map(|(_, x)| x / listed).collect::<Vec<f64>>()
+            });
+        let against_quasi_static = theory.as_ref().map(|q| {
+            let (mut chi2, mut k) = (0.0, 0usize);
+            for ((_, c), q) in counts.iter().zip(q) {
+                if *q > 0.0 {
+                    chi2 += (*c as f64 - n as f64 * q).powi(2) / (n as f64 * q);
+                    k += 1;
+                }
+            }
+            let dof = k.saturating_sub(1);
+            (
+                chi2,
+                dof,
+                crate::theory::stats::chi_square_p_value(chi2, dof),
+            )
+        });
         let faces = counts
             .into_iter()
-            .map(|(label, count)| {
+            .enumerate()
+            .map(|(i, (label, count))| {
                 let p = count as f64 / n.max(1) as f64;
                 // The error of a fair die's p at this n, so that a face never seen has one.
                 let p_err = crate::theory::stats::binomial_err(fair, n.max(1));
@@ -258,6 +290,7 @@ impl ShapeOutcomes {
                     p,
                     p_err,
                     z_fair: (p - fair) / p_err,
+                    quasi_static: theory.as_ref().map(|q| q[i]),
                 }
             })
             .collect();
@@ -267,6 +300,7 @@ impl ShapeOutcomes {
             chi2,
             dof: k.saturating_sub(1),
             p_value: crate::theory::stats::chi_square_p_value(chi2, k.saturating_sub(1)),
+            against_quasi_static,
         })
     }
 
@@ -293,7 +327,35 @@ impl ShapeOutcomes {
             self.dof,
             self.p_value
         );
+        if let Some((chi2, dof, p)) = self.against_quasi_static {
+            let worst = self
+                .faces
+                .iter()
+                .filter_map(|f| {
+                    let q = f.quasi_static?;
+                    let z =
+                        (f.p - q) / crate::theory::stats::binomial_err(q, self.rolls()).max(1e-300);
+                    Some((f, q, z))
+                })
+                .max_by(|a, b| a.2.abs().total_cmp(&b.2.abs()));
+            s += &format!(
+                "  against the quasi-static theory (released at rest, no bounce): χ² {chi2:.1} on \
+                 {dof}, p {p:.3}"
+            );
+            if let Some((f, q, z)) = worst {
+                s += &format!(
+                    "; farthest {} {:.4} against {q:.4} ({z:+.1}σ)",
+                    f.label, f.p
+                );
+            }
+            s += "\n";
+        }
         s
+    }
+
+    /// The rolls that ended on an outcome.
+    fn rolls(&self) -> u64 {
+        self.faces.iter().map(|f| f.count).sum::<u64>().max(1)
     }
 }
 

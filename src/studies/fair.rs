@@ -33,22 +33,27 @@ fn null_probabilities(s: &RunSummary, null: Null) -> Result<Vec<f64>> {
     if let Some(f) = crate::report::summary::shape_faces(&s.tally, &s.spec.scene) {
         return match null {
             Null::Uniform => Ok(vec![1.0 / f.len() as f64; f.len()]),
-            Null::SolidAngle => Err(Error::field(
-                Field::Null,
-                "solid-angle",
-                "the quasi-static theory of a die of any shape is not built yet; give uniform",
-            )),
+            Null::QuasiStatic => {
+                let shape = s.spec.scene.shape.as_deref().expect("a die of any shape");
+                let die = crate::model::die::DieShape::of(&s.spec.scene);
+                let p = theory::quasi_static::shape_labels(shape, &die.com)
+                    .map_err(|e| Error::field(Field::Null, "quasi-static", e))?;
+                // Of the rolls that end on one of its outcomes (a facet that holds the die
+                // only at this centre of mass is none).
+                let listed: f64 = p.iter().map(|(_, q)| q).sum();
+                Ok(p.iter().map(|(_, q)| q / listed).collect())
+            }
         };
     }
     let shown = if s.mode == Mode::ThreeD { 6 } else { 4 };
     match (null, s.mode) {
         (Null::Uniform, _) => Ok(vec![1.0 / shown as f64; shown]),
-        (Null::SolidAngle, Mode::ThreeD) if !s.spec.scene.features.plain() => {
+        (Null::QuasiStatic, Mode::ThreeD) if !s.spec.scene.features.plain() => {
             // A made die: each face's solid angle from the centre of mass, of the inner box.
             let die = crate::model::die::DieShape::of(&s.spec.scene);
             Ok(theory::quasi_static::faces_up(&die).to_vec())
         }
-        (Null::SolidAngle, Mode::ThreeD) => {
+        (Null::QuasiStatic, Mode::ThreeD) => {
             let (p, _) = theory::simpson_3d(&s.spec.scene.block);
             Ok((0..6)
                 .map(|d| match side_of(d) {
@@ -58,10 +63,10 @@ fn null_probabilities(s: &RunSummary, null: Null) -> Result<Vec<f64>> {
                 })
                 .collect())
         }
-        (Null::SolidAngle, Mode::TwoD) => Err(Error::field(
+        (Null::QuasiStatic, Mode::TwoD) => Err(Error::field(
             Field::Null,
-            "solid-angle",
-            "the solid angle is the 3D theory; in 2D give uniform",
+            "quasi-static",
+            "the quasi-static theory is 3D; in 2D give uniform",
         )),
     }
 }

@@ -17,6 +17,7 @@ use std::f64::consts::FRAC_2_PI;
 
 use crate::model::block::Block;
 
+pub mod basins;
 pub mod dreidel;
 pub mod markov;
 pub mod paper_data;

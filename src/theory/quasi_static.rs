@@ -17,6 +17,8 @@
 //! through its distances to the faces.
 
 use crate::model::die::DieShape;
+use crate::model::shape::{Shape, Solid};
+use nalgebra::Vector3;
 
 /// The solid angle at the origin of the rectangle [x₁, x₂] × [y₁, y₂] in the plane at distance
 /// `d`: Σ ± atan(xy / (d √(x² + y² + d²))) over its corners (the corner formula is odd in x and
@@ -43,6 +45,72 @@ pub fn faces_up(die: &DieShape) -> [f64; 6] {
             [-k[l] - c[l], k[l] - c[l]],
         ) / (4.0 * std::f64::consts::PI)
     })
+}
+
+/// The quasi-static probability of each outcome of a die of any shape, in its order
+/// (`Shape::faces`), with its centre of mass at `com` (m, body axes, from the centroid). A hull:
+/// the exact basins of the flow (`theory::basins`); a facet that is a resting face at this
+/// centre but not among the die's outcomes (it was none at the centroid) keeps its share out
+/// of the list, so the list sums to less than 1. A coin with its centre on its axis: each
+/// cap's share is the cap of the sphere inside the cone from the centre of mass to the cap's
+/// rim, (1 − d/√(r² + d²))/2 at the cap's distance d, and the edge has the rest (the flow on
+/// a rim point's directions runs in its meridian, away from the rim: the solid angle).
+pub fn shape(shape: &Shape, com: &Vector3<f64>) -> Result<Vec<f64>, String> {
+    match &shape.solid {
+        Solid::Cylinder { diameter, height } => {
+            if com.xy().norm() > 1e-9 * diameter {
+                return Err(
+                    "the quasi-static theory of a coin is built for a centre of mass on its axis"
+                        .into(),
+                );
+            }
+            let r = 0.5 * diameter;
+            let cap = |d: f64| 0.5 * (1.0 - d / r.hypot(d));
+            // Heads rests on the −z cap (its outward normal −z), tails on the +z cap.
+            let below = 0.5 * height + com.z;
+            let above = 0.5 * height - com.z;
+            Ok(shape
+                .faces
+                .iter()
+                .map(|f| match f.normal[2] {
+                    z if z < 0.0 => cap(below),
+                    z if z > 0.0 => cap(above),
+                    _ => 1.0 - cap(below) - cap(above),
+                })
+                .collect())
+        }
+        Solid::Hull { .. } => {
+            let facets = shape.facets();
+            let p = crate::theory::basins::facets(&facets, com)?;
+            Ok(shape
+                .faces
+                .iter()
+                .map(|f| {
+                    let n = Vector3::from(f.normal);
+                    facets
+                        .iter()
+                        .zip(&p)
+                        .filter(|(x, _)| x.normal.dot(&n) > 1.0 - 1e-9)
+                        .map(|(_, p)| p)
+                        .sum()
+                })
+                .collect())
+        }
+    }
+}
+
+/// [`shape`] summed over the outcomes that show the same label, in the order of their first
+/// appearance (`report::summary::shape_faces`'s).
+pub fn shape_labels(shape_: &Shape, com: &Vector3<f64>) -> Result<Vec<(String, f64)>, String> {
+    let p = shape(shape_, com)?;
+    let mut out: Vec<(String, f64)> = Vec::new();
+    for (f, p) in shape_.faces.iter().zip(p) {
+        match out.iter_mut().find(|(l, _)| *l == f.label) {
+            Some((_, q)) => *q += p,
+            None => out.push((f.label.clone(), p)),
+        }
+    }
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -77,6 +145,26 @@ mod tests {
         assert!((p[0] + p[1] - simpson.breadth_vertical).abs() < 1e-13);
         assert!((p[2] + p[3] - simpson.width_vertical).abs() < 1e-13);
         assert!((p[4] + p[5] - simpson.length_vertical).abs() < 1e-13);
+    }
+
+    #[test]
+    fn a_coin_is_the_cones_to_its_rims_and_a_named_die_is_fair() {
+        let coin = crate::model::shape::coin(24.0, 2.0).unwrap();
+        let p = shape(&coin, &Vector3::zeros()).unwrap();
+        // r = 12, d = 1 mm: the edge 1/√145 (the classic three-way coin needs r = 2√2 d).
+        assert!((p[2] - 1.0 / 145f64.sqrt()).abs() < 1e-12, "{p:?}");
+        assert!((p[0] - p[1]).abs() < 1e-15 && (p.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+        let third = crate::model::shape::coin(24.0, 24.0 / 8f64.sqrt()).unwrap();
+        let p = shape(&third, &Vector3::zeros()).unwrap();
+        assert!((p[2] - 1.0 / 3.0).abs() < 1e-12, "{p:?}");
+        // Loaded towards heads' cap (−z): heads more often.
+        let p = shape(&coin, &Vector3::new(0.0, 0.0, -0.0002)).unwrap();
+        assert!(p[0] > p[1], "{p:?}");
+        assert!(shape(&coin, &Vector3::new(0.001, 0.0, 0.0)).is_err());
+        let d20 = crate::model::shape::named("d20", None).unwrap();
+        let p = shape_labels(&d20, &Vector3::zeros()).unwrap();
+        assert_eq!(p.len(), 20);
+        assert!(p.iter().all(|(_, q)| (q - 0.05).abs() < 1e-9), "{p:?}");
     }
 
     #[test]

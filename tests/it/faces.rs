@@ -196,7 +196,7 @@ fn fair_refuses_what_it_cannot_judge() {
                 "--null",
                 "solid-angle",
             ],
-            "--null solid-angle",
+            "--null quasi-static (solid-angle)",
         ),
         (
             vec![

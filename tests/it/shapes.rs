@@ -289,3 +289,56 @@ fn a_shaped_run_resumes_and_merges_bit_for_bit() {
     assert_eq!(merged["tally"], whole["tally"]);
     assert_eq!(merged["faces"], whole["faces"]);
 }
+
+/// `fair --null quasi-static` for a die of any shape: the exact basins of its rolling beside
+/// the counts (a d20's 1/20; a loaded d10's computed, summing to 1), the same in `roll`'s
+/// JSON, and `solid-angle` its other name.
+#[test]
+fn fair_judges_any_die_against_the_quasi_static_theory() {
+    let v = json(&dicephys(&[
+        "fair",
+        "--shape",
+        "d20",
+        "--null",
+        "quasi-static",
+        "--rolls",
+        "400",
+        "--json",
+    ]));
+    assert_eq!(v["fairness"]["null"], "quasi-static");
+    let faces = v["fairness"]["faces"].as_array().unwrap();
+    assert_eq!(faces.len(), 20);
+    for f in faces {
+        assert!((f["null"].as_f64().unwrap() - 0.05).abs() < 1e-9, "{f}");
+    }
+    let args = ["--shape", "d10", "--com", "0,0,-2", "--rolls", "300"];
+    let fair = json(&dicephys(
+        &[&["fair", "--null", "solid-angle", "--json"][..], &args[..]].concat(),
+    ));
+    let roll = roll(&args);
+    let by_label = |faces: &serde_json::Value, label: &str, value: &str| {
+        let mut v: Vec<(String, f64)> = faces
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| {
+                (
+                    f[label].as_str().unwrap().to_string(),
+                    f[value].as_f64().unwrap(),
+                )
+            })
+            .collect();
+        v.sort_by(|a, b| a.0.cmp(&b.0));
+        v
+    };
+    let theory = by_label(&roll["shape"]["faces"], "label", "quasi_static");
+    let q: Vec<f64> = theory.iter().map(|x| x.1).collect();
+    assert!((q.iter().sum::<f64>() - 1.0).abs() < 1e-9, "{q:?}");
+    // Loaded 2 mm towards the −z point's kites: those five faces down more often.
+    assert!(q.iter().cloned().fold(0.0, f64::max) > 0.11, "{q:?}");
+    assert_eq!(
+        by_label(&fair["fairness"]["faces"], "direction", "null"),
+        theory
+    );
+    assert!(roll["shape"]["against_quasi_static"][0].as_f64().is_some());
+}
