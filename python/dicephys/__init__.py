@@ -354,8 +354,8 @@ def fair(
     """Is this die fair, face by face: ``dicephys fair --json``.
 
     Rolls the die as ``roll`` does (any of its options; thrown in a tumble unless ``throw``
-    says otherwise) and sets each face against ``null``: "uniform" (each face 1/6) or
-    "solid-angle" (the quasi-static theory, 3D). The result's ``fairness`` is the fair
+    says otherwise) and sets each face against ``null``: "uniform" (each face 1/N) or
+    "quasi-static" (also "solid-angle": released at rest, rolling without a bounce; 3D). The result's ``fairness`` is the fair
     report (each face's probability, its departure in σ, χ², the throws a tester needs);
     ``precision`` here is every face's probability's 2σ, a fraction (0.005: ±0.005).
     """

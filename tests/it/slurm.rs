@@ -180,6 +180,29 @@ fn a_four_task_roll_through_slurm_merges_to_the_one_machine_counts() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A die given as a mesh (`--die FILE.obj`) through Slurm: the tasks read no file (the hull
+/// travels in the plan's specification), and the merged faces are the one machine's.
+#[test]
+fn a_mesh_die_through_slurm_is_the_one_machine_roll() {
+    let Some(_cluster) = cluster("slurm roll --die mesh") else {
+        return;
+    };
+    let dir = tmp("roll-mesh");
+    let obj = Scratch::new("slurm-mesh-die");
+    let file = obj.path().join("irregular.obj");
+    std::fs::write(&file, super::shapes::IRREGULAR_OBJ).unwrap();
+    let path = file.to_str().unwrap();
+    let run = ["--die", path, "--rolls", "600", "--threads", "1"];
+    let (array, fin) = submit("roll", &run, 3, &dir);
+    let whole = json(&bin().arg("roll").args(run).arg("--json").output().unwrap());
+    wait_gone(&[&array, &fin], &dir, Duration::from_secs(90));
+    let merged = result(&dir, &[&array, &fin]);
+    assert_eq!(merged["faces"], whole["faces"]);
+    assert_eq!(merged["shape"], whole["shape"]);
+    assert_eq!(merged["spec"], whole["spec"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn a_task_cancelled_mid_run_and_requeued_resumes_and_the_counts_still_match() {
     let Some(_cluster) = cluster("slurm roll, a task cancelled") else {
