@@ -34,6 +34,9 @@ pub struct SlurmArgs {
 pub enum SlurmCommand {
     /// `roll` as a job array: task K of N rolls shard K/N; the finishing job merges them.
     Roll(Box<SlurmRollArgs>),
+    /// `fair` as a job array: task K of N rolls shard K/N; the finishing job merges them and
+    /// judges the faces (DIR/result.json is `fair --json`'s document, DIR/result.txt its text).
+    Fair(Box<SlurmFairArgs>),
     /// `paper` as a job array: the tasks share the cells' chunks; the finishing job writes
     /// the report into --dir. `paper --calibrated` as two chained arrays: every model's first
     /// pass into --dir/first-pass, then every model's second pass into --dir, whose finishing
@@ -112,6 +115,18 @@ pub struct SlurmRollArgs {
     pub job: JobArgs,
 }
 
+/// `dicephys slurm fair`'s arguments: `roll`'s, the null, and the job's.
+#[derive(Args, Debug)]
+pub struct SlurmFairArgs {
+    #[command(flatten)]
+    pub roll: RollArgs,
+    /// What fair means, as `fair --null` (uniform or quasi-static).
+    #[arg(long, default_value = "uniform", value_parser = super::args::parse_null)]
+    pub null: dicephys::studies::fair::Null,
+    #[command(flatten)]
+    pub job: JobArgs,
+}
+
 /// `dicephys slurm finish`'s arguments.
 #[derive(Args, Debug)]
 pub struct FinishArgs {
@@ -130,7 +145,8 @@ pub fn run(a: &SlurmArgs) -> Result<()> {
             eprintln!("{}", cluster::mark(&t.dir, t.k, tasks)?);
             return Ok(());
         }
-        SlurmCommand::Roll(r) => (vec![roll(r)?], &r.job),
+        SlurmCommand::Roll(r) => (vec![roll("roll", &r.roll, None, &r.job)?], &r.job),
+        SlurmCommand::Fair(f) => (vec![roll("fair", &f.roll, Some(f.null), &f.job)?], &f.job),
         c => {
             let (cfg, threads, json, given, job) = study_of(c)?;
             if let Some(flag) = given {
@@ -252,17 +268,22 @@ fn study_of(c: &SlurmCommand) -> Result<Flags<'_>> {
     })
 }
 
-/// `slurm roll`: its own flags refused, its shards made.
-fn roll(a: &SlurmRollArgs) -> Result<Staged> {
-    let r = &a.roll;
-    let own = |flag: &str, why: &str| Err(Error::Usage(format!("slurm roll: {flag}: {why}")));
+/// `slurm roll` (or `slurm fair`, judged against `fair`): its own flags refused, its shards
+/// made.
+fn roll(
+    command: &str,
+    r: &RollArgs,
+    fair: Option<dicephys::studies::fair::Null>,
+    job: &JobArgs,
+) -> Result<Staged> {
+    let own = |flag: &str, why: &str| Err(Error::Usage(format!("slurm {command}: {flag}: {why}")));
     if r.shard.is_some() {
         return own("--shard", "the tasks are the shards (--tasks N)");
     }
     if r.run.precision.is_some() {
         return own(
             "--precision",
-            "tasks split a fixed number of rolls; give --rolls (roll --precision on one machine)",
+            "tasks split a fixed number of rolls; give --rolls (--precision on one machine)",
         );
     }
     if r.checkpoint.is_some() || r.resume.is_some() {
@@ -282,7 +303,20 @@ fn roll(a: &SlurmRollArgs) -> Result<Staged> {
     }
     let threads = r.run.threads.max(1);
     super::args::threads(threads)?;
-    Ok(cluster::roll(&r.spec()?, threads, &a.job.job())?)
+    // `fair` throws in a tumble unless told otherwise, as on one machine.
+    let spec = match fair {
+        None => r.spec()?,
+        Some(_) => r.spec_or(dicephys::model::throws::ThrowStyle::Tumble)?,
+    };
+    if fair == Some(dicephys::studies::fair::Null::QuasiStatic)
+        && spec.scene.mode == dicephys::model::scene::Mode::TwoD
+    {
+        return own(
+            "--null quasi-static (solid-angle)",
+            "the quasi-static theory is 3D; in 2D give uniform",
+        );
+    }
+    Ok(cluster::roll(&spec, fair, threads, &job.job())?)
 }
 
 /// The finishing step: every task's result present and whole, then the merged result, written

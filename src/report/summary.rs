@@ -5,7 +5,6 @@ use crate::engine::EngineKind;
 use crate::model::faces;
 use crate::model::scene::{Floor, Mode, Preset};
 use crate::model::throws::{ThrowKind, ThrowRanges};
-use crate::run::io::Output;
 use crate::run::slurm::{Layout, Plan};
 use crate::run::spec::RunSpec;
 use crate::run::tally::{Counts, Tally};
@@ -645,10 +644,9 @@ pub struct ShardResult {
 }
 
 impl RunSummary {
-    /// The finishing job of a `roll` through Slurm: every task's result there, whole and of
-    /// its shard, merged and written whole into the run's directory (`result.json`,
-    /// `result.txt`; rerun, it writes the same); the text it printed.
-    pub fn merge_tasks(lay: &Layout, spec: &RunSpec, tasks: u64) -> crate::Result<String> {
+    /// The shards of a `roll` through Slurm merged: every task's result there, whole and of
+    /// its shard (a damaged one moved aside, so that its task, rerun, writes it again).
+    pub fn merge_tasks(lay: &Layout, spec: &RunSpec, tasks: u64) -> crate::Result<RunSummary> {
         let (mut parts, mut missing, mut why) = (Vec::new(), Vec::new(), Vec::new());
         for k in 0..tasks {
             let p = lay.shard_result(k);
@@ -669,16 +667,7 @@ impl RunSummary {
         if !missing.is_empty() {
             return Err(lay.not_finished(tasks, &missing, &why.join("; ")));
         }
-        let merged = RunSummary::merge(&parts)?;
-        let json = crate::run::seal::to_string(&merged, true)?;
-        let text = merged.human();
-        let (j, t) = (
-            Output::check(&lay.result_json())?,
-            Output::check(&lay.result_text())?,
-        );
-        j.write(format!("{json}\n").as_bytes())?;
-        t.write(text.as_bytes())?;
-        Ok(text)
+        RunSummary::merge(&parts)
     }
 }
 

@@ -36,6 +36,9 @@ pub enum Plan {
         spec: Box<RunSpec>,
         /// Array tasks, one shard each.
         tasks: u64,
+        /// `dicephys fair`: the merged faces judged against this null (absent: `roll`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        fair: Option<crate::theory::null::Null>,
     },
     /// A study of several cells, its chunks shared among the tasks.
     Study {
@@ -64,7 +67,8 @@ impl Plan {
     /// The command it runs, for job names and messages.
     pub fn command(&self) -> &str {
         match self {
-            Plan::Roll { .. } => "roll",
+            Plan::Roll { fair: None, .. } => "roll",
+            Plan::Roll { fair: Some(_), .. } => "fair",
             Plan::Study { config, .. } => config
                 .get("study")
                 .and_then(serde_json::Value::as_str)

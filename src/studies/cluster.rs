@@ -7,6 +7,7 @@ use super::fit::Stage;
 use super::outputs::{self, Hooks, Place};
 use super::StudyConfig;
 use crate::error::{Error, Field, Result};
+use crate::run::io::Output;
 use crate::run::runner::{Checkpoint, ChunkShare};
 use crate::run::slurm::{script_path, Layout, Options, Plan};
 use crate::run::spec::RunSpec;
@@ -114,10 +115,16 @@ pub fn stages(s: &Submitted, job: &Job) -> Result<Vec<Staged>> {
 }
 
 /// `roll` as a run of `job.tasks` shards, each with its checkpoint made.
-pub fn roll(spec: &RunSpec, threads: usize, job: &Job) -> Result<Staged> {
+pub fn roll(
+    spec: &RunSpec,
+    fair: Option<crate::theory::null::Null>,
+    threads: usize,
+    job: &Job,
+) -> Result<Staged> {
     let plan = Plan::Roll {
         spec: Box::new(spec.clone()),
         tasks: job.tasks,
+        fair,
     };
     let lay = prepare(&plan, job, threads, |_| Ok(()))?;
     for k in 0..job.tasks {
@@ -301,8 +308,23 @@ pub fn finishing(dir: &Path) -> Result<Finishing> {
                 tasks,
             ))
         }
-        Plan::Roll { spec, tasks } => {
-            let text = crate::report::summary::RunSummary::merge_tasks(&lay, &spec, tasks)?;
+        Plan::Roll { spec, tasks, fair } => {
+            let merged = crate::report::summary::RunSummary::merge_tasks(&lay, &spec, tasks)?;
+            // What the one machine's `roll --json` (or `fair --json`) prints, and its text.
+            let (json, text) = match fair {
+                None => (crate::run::seal::to_string(&merged, true)?, merged.human()),
+                Some(null) => {
+                    let f = crate::studies::fair::assess(&merged, null)?;
+                    let doc = serde_json::json!({ "fairness": f, "summary": merged });
+                    (crate::run::seal::to_string(&doc, true)?, f.text(&merged))
+                }
+            };
+            let (j, t) = (
+                Output::check(&lay.result_json())?,
+                Output::check(&lay.result_text())?,
+            );
+            j.write(format!("{json}\n").as_bytes())?;
+            t.write(text.as_bytes())?;
             Ok(Finishing::Roll(format!(
                 "{text}slurm finish: {tasks} tasks merged into {}\n",
                 lay.result_json().display()

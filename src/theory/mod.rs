@@ -20,6 +20,7 @@ use crate::model::block::Block;
 pub mod basins;
 pub mod dreidel;
 pub mod markov;
+pub mod null;
 pub mod paper_data;
 pub mod propagation;
 pub mod quasi_static;

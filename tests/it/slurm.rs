@@ -201,6 +201,26 @@ fn a_mesh_die_through_slurm_is_the_one_machine_roll() {
     assert_eq!(merged["shape"], whole["shape"]);
     assert_eq!(merged["spec"], whole["spec"]);
     let _ = std::fs::remove_dir_all(&dir);
+    // `slurm fair` judges the merged faces as `fair` does on one machine.
+    let dir = tmp("fair-mesh");
+    let judged = [&run[..], &["--null", "quasi-static"]].concat();
+    let (array, fin) = submit("fair", &judged, 3, &dir);
+    let whole = json(
+        &bin()
+            .arg("fair")
+            .args(&judged)
+            .arg("--json")
+            .output()
+            .unwrap(),
+    );
+    wait_gone(&[&array, &fin], &dir, Duration::from_secs(90));
+    let merged = result(&dir, &[&array, &fin]);
+    assert_eq!(merged["fairness"], whole["fairness"]);
+    assert_eq!(merged["summary"]["spec"], whole["summary"]["spec"]);
+    assert_eq!(merged["fairness"]["null"], "quasi-static");
+    let text = std::fs::read_to_string(dir.join("result.txt")).unwrap();
+    assert!(text.contains("quasi-static"), "{text}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
