@@ -564,7 +564,8 @@ BulletWorld::BulletWorld(const BulletScene& s)
       gyroscopic_(s.gyroscopic_implicit),
       deactivation_(s.deactivation),
       linear_damping_(s.linear_damping),
-      angular_damping_(s.angular_damping) {
+      angular_damping_(s.angular_damping),
+      rolling_friction_(s.rolling_friction) {
   config_ = std::make_unique<btDefaultCollisionConfiguration>();
   // A rounded die meets the floor through the convex-convex test (GJK), one point per step:
   // resting on a face it would rock and slide until its manifold held enough. Perturbed
@@ -733,6 +734,13 @@ void BulletWorld::reset(const BodyStateFfi& start) {
   // step, before the contacts are solved.
   if (linear_damping_ != 0 || angular_damping_ != 0) {
     die_->setDamping(linear_damping_, angular_damping_);
+  }
+  // Rolling resistance: Bullet bounds the torque against rolling (and against turning in
+  // place) by this times the floor's friction times the contact's push. Its contacts then
+  // go through Bullet's own solver, not the shim's (`DieSolver` declines them).
+  if (rolling_friction_ > 0) {
+    die_->setRollingFriction(rolling_friction_);
+    die_->setSpinningFriction(rolling_friction_);
   }
   world_->addRigidBody(die_.get());
 }

@@ -61,6 +61,7 @@ class BulletWorld {
   bool deactivation_;
   double linear_damping_;
   double angular_damping_;
+  double rolling_friction_;
 };
 
 std::unique_ptr<BulletWorld> new_world(const BulletScene& scene);

@@ -173,6 +173,8 @@ pub enum Field {
     RapierDts,
     /// `recover`.
     Recover,
+    /// `rolling_resistance`.
+    RollingResistance,
     /// `reference_budget_s`.
     ReferenceBudgetS,
     /// `reference_dt`.

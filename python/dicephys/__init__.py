@@ -272,6 +272,7 @@ def roll(
     floor_thickness: Optional[float] = None,
     linear_damping: float = 0.0,
     angular_damping: float = 0.0,
+    rolling_resistance: float = 0.0,
     sleep: bool = True,
     settle: Optional[str] = None,
     flight: str = "fast",
@@ -308,6 +309,8 @@ def roll(
         (m/s, rad/s, m; defaults the paper's).
     preset, floor, floor_thickness, linear_damping, angular_damping, sleep: the scene
         (as ``dicephys roll --help`` says).
+    rolling_resistance: mm, the lever arm of the floor's push against rolling and turning in
+        place (so that a coin rolling on its rim stops); Bullet only.
     settle: None (the exact early stop where it is audited exact), "certificate" or
         "dicephys".  flight: "fast" or "stepped".  faithful: DicePhys as the paper ran it.
     com: the centre of mass (x, y, z) in mm from the geometric centre; pips: (diameter,
@@ -329,7 +332,7 @@ def roll(
             engine=engine, dt=dt,
             restitution=restitution, friction=friction, density=density, preset=preset,
             floor=floor, floor_thickness=floor_thickness, linear_damping=linear_damping,
-            angular_damping=angular_damping, sleep=sleep, throw=throw, kappa=kappa,
+            angular_damping=angular_damping, rolling_resistance=rolling_resistance, sleep=sleep, throw=throw, kappa=kappa,
             source=source, velocity=_pair("velocity", velocity), spin=_pair("spin", spin),
             drop_height=_pair("drop_height", drop_height), settle=settle, flight=flight, faithful=faithful,
             max_steps=max_steps, margin=margin, com=_triple("com", com, 3),

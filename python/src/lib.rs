@@ -344,6 +344,7 @@ fn spec(
     )?;
     scene.floor = named::<Floor>("floor", "floor", &o.get("floor", "box".to_string())?)?;
     scene.linear_damping = o.get("linear_damping", 0.0)?;
+    scene.rolling_resistance = o.get("rolling_resistance", 0.0)? / 1000.0;
     scene.angular_damping = o.get("angular_damping", 0.0)?;
     scene.sleeping = o.get("sleep", true)?;
     let (features, density) = Features::described(

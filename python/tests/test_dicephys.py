@@ -69,6 +69,11 @@ def test_a_die_of_any_shape_is_the_cli_s(tmp_path: Path) -> None:
     mesh = cli("roll", "--die", str(cube), "--rolls", "200", "--seed", "3", "--json")
     assert dicephys.roll(die=str(cube), rolls=200, seed=3).faces == mesh["faces"]
     assert len(mesh["faces"]) == 6
+    # A thick coin with rolling resistance: the same faces, none still rolling at the cap.
+    coin = ["--shape", "coin:24,12", "--rolls", "60", "--rolling-resistance", "0.05"]
+    want = cli("roll", *coin, "--seed", "1", "--json")
+    got = dicephys.roll(shape="coin:24,12", rolls=60, seed=1, rolling_resistance=0.05)
+    assert got.faces == want["faces"] and got.summary["unconverged"] == 0
     # No die at all: the CLI's 16 mm d6, in a tumble.
     d6 = dicephys.roll(rolls=100, seed=2)
     assert d6.faces == cli("roll", "--rolls", "100", "--seed", "2", "--json")["faces"]

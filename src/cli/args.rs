@@ -118,6 +118,16 @@ pub struct SceneArgs {
     /// Angular damping, a rate in 1/s (0 to 30; DicePhys: 0).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub angular_damping: f64,
+    /// Rolling resistance, mm: the lever arm of the floor's push against a die rolling or
+    /// turning in place, so that a cylinder rolling on its side or a coin spinning on its rim
+    /// stops (0 to 1; hard surfaces about 0.01, felt more; DicePhys: 0). Bullet only.
+    #[arg(
+        long,
+        value_name = "MM",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    pub rolling_resistance: f64,
     /// Never let the engine put the die to sleep (for slow, over-damped rolls, which it would
     /// freeze mid-fall).
     #[arg(long)]
@@ -397,6 +407,7 @@ impl SceneArgs {
         scene.preset = self.preset;
         scene.floor = self.floor;
         scene.linear_damping = self.linear_damping;
+        scene.rolling_resistance = self.rolling_resistance / 1000.0;
         scene.angular_damping = self.angular_damping;
         scene.sleeping = !self.no_sleep;
         self.made.apply(&mut scene)?;

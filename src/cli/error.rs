@@ -101,6 +101,7 @@ pub fn flag(field: Field) -> &'static str {
         Field::Kind => "--source",
         Field::Ladder => "--ladder",
         Field::LinearDamping => "--linear-damping",
+        Field::RollingResistance => "--rolling-resistance",
         Field::Margin => "--margin",
         Field::MaxSteps => "--max-steps",
         Field::Modes => "--modes",

@@ -15,7 +15,7 @@ use std::path::PathBuf;
 use std::sync::atomic::Ordering::Relaxed;
 
 /// The options that define a run: `--resume` takes them from the checkpoint instead.
-const DEFINING: [&str; 31] = [
+const DEFINING: [&str; 32] = [
     "shape",
     "size",
     "scale",
@@ -45,6 +45,7 @@ const DEFINING: [&str; 31] = [
     "shard",
     "linear_damping",
     "angular_damping",
+    "rolling_resistance",
     "no_sleep",
     "style",
 ];

@@ -60,6 +60,9 @@ mod ffi {
         /// (1 − d)^dt each step (`Scene::bullet_damping`); DicePhys: 0, 0.
         linear_damping: f64,
         angular_damping: f64,
+        /// The die's rolling and spinning friction (`Scene::rolling_resistance` over the
+        /// floor's friction, which Bullet multiplies them by); 0: none, as DicePhys.
+        rolling_friction: f64,
         /// Bullet's own world and solver, every part of a step as Bullet does it, without the
         /// shim's shortcuts (`DiceWorld`, `DieSolver` in cpp/shim.cc): for the check that
         /// they change nothing.
@@ -195,6 +198,11 @@ impl Bullet {
             deactivation: scene.sleeping,
             linear_damping,
             angular_damping,
+            rolling_friction: if scene.rolling_resistance > 0.0 {
+                scene.rolling_resistance / scene.floor_friction
+            } else {
+                0.0
+            },
             stock_world,
         };
         let world =

@@ -110,6 +110,13 @@ pub struct Scene {
     /// Angular damping, a rate in 1/s, as `linear_damping` but for the angular velocity.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub angular_damping: f64,
+    /// Rolling resistance, m: the lever arm of the floor's push against a die rolling or
+    /// turning in place on it, so that a torque up to this length times the contact force
+    /// opposes both (Bullet's rolling and spinning friction). DicePhys: 0, none, as neither
+    /// engine has by default; then a cylinder rolling on its side or a coin spinning on its
+    /// rim never stops. Bullet only. Written into a specification only when not 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub rolling_resistance: f64,
     /// The engine may put a die that has slowed down to sleep (Bullet's deactivation after
     /// 2 s under 0.8 m/s and 1 rad/s, Rapier's after 0.5 s under its thresholds), as DicePhys
     /// let Bullet do. False: never, for a die that moves slowly for long (an over-damped roll,
@@ -146,6 +153,10 @@ fn yes() -> bool {
 /// rounds to 0 in double precision and Bullet would zero the velocity every step instead. At
 /// 30/s, 1 − d = 9.4e-14 is held to 6e-4 of itself: the rate to 2e-5.
 pub const MAX_DAMPING: f64 = 30.0;
+
+/// The largest rolling resistance accepted, m: 1 mm, already the lever arm of soft felt
+/// under a heavy die (hard surfaces are near 0.01 mm).
+pub const MAX_ROLLING_RESISTANCE: f64 = 1e-3;
 
 /// The finest time step accepted, s: 1 µs. A roll at rest by DicePhys's rule takes about a
 /// second of simulated time, a million steps here; finer steps only multiply the work (a
@@ -228,6 +239,15 @@ impl Scene {
                 );
             }
         }
+        if !(self.rolling_resistance.is_finite()
+            && (0.0..=MAX_ROLLING_RESISTANCE).contains(&self.rolling_resistance))
+        {
+            return bad(
+                Field::RollingResistance,
+                self.rolling_resistance * 1e3,
+                format!("must be in [0, {}] mm", MAX_ROLLING_RESISTANCE * 1e3),
+            );
+        }
         MassProps::of(self)?;
         Ok(())
     }
@@ -249,6 +269,7 @@ impl Scene {
             gravity: GRAVITY,
             linear_damping: 0.0,
             angular_damping: 0.0,
+            rolling_resistance: 0.0,
             sleeping: true,
             features: Features::default(),
             shape: None,

@@ -201,6 +201,16 @@ impl RunSpec {
         self.scene.validate(allow_restitution_above_one)?;
         self.throws.validate()?;
         self.roll.validate()?;
+        if self.scene.rolling_resistance > 0.0 && self.engine != EngineKind::Bullet {
+            return Err(Error::field(
+                Field::RollingResistance,
+                self.scene.rolling_resistance * 1e3,
+                format!(
+                    "{} has no rolling resistance; give --engine bullet",
+                    self.engine.name()
+                ),
+            ));
+        }
         if let Some(shape) = &self.scene.shape {
             use crate::model::throws::ThrowStyle;
             if matches!(self.throws.style, ThrowStyle::Paper | ThrowStyle::Hand) {

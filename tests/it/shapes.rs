@@ -194,6 +194,33 @@ fn a_coin_lands_heads_tails_or_on_its_edge() {
     let f = faces(&v);
     assert!(f[2].1 > f[0].1 + f[1].1, "{}", v["shape"]);
     assert_eq!(v["spec"]["roll"]["max_steps"], 200_000);
+    // With a little rolling resistance (0.05 mm) every thick coin stops, on Bullet; Rapier
+    // has none, and says so.
+    let v = roll(&[
+        "--shape",
+        "coin:24,12",
+        "--rolls",
+        "100",
+        "--rolling-resistance",
+        "0.05",
+    ]);
+    assert_eq!(v["unconverged"], 0, "{}", v["shape"]);
+    assert_eq!(v["spec"]["scene"]["rolling_resistance"], 5e-5);
+    refused(
+        &[
+            "roll",
+            "--shape",
+            "coin:24,12",
+            "--engine",
+            "rapier",
+            "--rolling-resistance",
+            "0.05",
+        ],
+        &[
+            "--rolling-resistance 0.05",
+            "rapier has no rolling resistance",
+        ],
+    );
 }
 
 /// One line on stderr, exit 2, containing every one of `says`.
