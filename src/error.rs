@@ -229,12 +229,23 @@ impl Field {
 }
 
 /// A value as a message shows it: a number of many digits (1e300 prints as 301 of them) in
-/// scientific notation, anything else as it is.
+/// scientific notation, one that a unit's conversion left with a tail of rounding
+/// (7.998999999999999) to 12 significant digits (7.999), each of a list's numbers alike,
+/// anything else as it is.
 fn shown_value(v: String) -> String {
-    match v.parse::<f64>() {
-        Ok(x) if v.len() > 20 => format!("{x:e}"),
-        _ => v,
-    }
+    let one = |p: &str| match p.parse::<f64>() {
+        Ok(x) if x.is_finite() && p.len() > 14 => {
+            let short: f64 = format!("{x:.11e}").parse().unwrap_or(x);
+            let plain = format!("{short}");
+            if plain.len() > 20 {
+                format!("{short:e}")
+            } else {
+                plain
+            }
+        }
+        _ => p.to_string(),
+    };
+    v.split(',').map(one).collect::<Vec<_>>().join(",")
 }
 
 /// "field value: why", or "field: why" without a value.

@@ -190,6 +190,43 @@ impl DieArgs {
         Ok(())
     }
 
+    /// A refused value a TOML die file gave (its flag not given beside it), named by the file
+    /// and its key as the user wrote them, not by a flag they did not give (reliability round
+    /// 5, class G): "--die d.toml: com 0,0,8: must lie inside the die".
+    pub fn named(&self, e: dicephys::Error) -> Error {
+        use dicephys::error::Field as F;
+        let (Some(path), dicephys::Error::Field { field, value, why }) = (&self.die, &e) else {
+            return e.into();
+        };
+        let (key, flagged) = match field {
+            F::Com => ("com", self.com.is_some()),
+            F::Density => ("density", self.density.is_some()),
+            F::EdgeRadius => ("edge_radius", self.edge_radius.is_some()),
+            F::PipsDiameter => ("pips.diameter", self.pips.is_some()),
+            F::PipsDepth => ("pips.depth", self.pips.is_some()),
+            F::PipsSpacing => ("pips.spacing", false),
+            F::PipsFillDensity => ("pips.fill_density", false),
+            F::Inertia => ("inertia", false),
+            F::InsertCentre => ("insert.centre", false),
+            F::InsertDensity => ("insert.density", false),
+            F::InsertSize => ("insert.size", false),
+            _ => return e.into(),
+        };
+        if flagged || dicephys::model::mass::is_mesh(path) {
+            return e.into();
+        }
+        let value = if value.is_empty() {
+            String::new()
+        } else {
+            format!(" {value}")
+        };
+        Error::Usage(format!(
+            "--die {}: {key}{value}: {}",
+            path.display(),
+            super::error::flags_in(why)
+        ))
+    }
+
     /// The die's features and its density where one is given (the flags over the file's).
     pub fn features(&self) -> Result<(Features, Option<f64>)> {
         Ok(Features::described(
@@ -419,7 +456,9 @@ impl SceneArgs {
             }
             scene.floor_thickness = t;
         }
-        scene.validate(self.allow_restitution_above_one)?;
+        scene
+            .validate(self.allow_restitution_above_one)
+            .map_err(|e| self.made.named(e))?;
         Ok(scene)
     }
 }

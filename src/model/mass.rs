@@ -329,6 +329,20 @@ fn in_pip(p: &Pips, half: &Vector3<f64>, (i, sign, pj, pk): Place, x: &Vector3<f
     }
 }
 
+/// A length in m shown in mm as the user would write it: to 12 significant digits (so
+/// 7.999 mm read in and stored in metres prints as 7.999, not 7.998999999999999, and
+/// 8.0000001 as itself), a length too large to write out in scientific notation (1e308, not
+/// inf or 309 digits).
+fn shown_mm(v: f64) -> String {
+    let mm: f64 = format!("{:.11e}", v * 1e3).parse().unwrap_or(v * 1e3);
+    let plain = format!("{mm}");
+    if plain.len() > 20 {
+        format!("{mm:e}")
+    } else {
+        plain
+    }
+}
+
 /// A pip's place (`pip_places`).
 type Place = (usize, f64, f64, f64);
 
@@ -675,7 +689,7 @@ impl Features {
                     .into(),
             ));
         }
-        let mm = |v: f64| format!("{}", (v * 1e9).round() / 1e6);
+        let mm = shown_mm;
         let min_half = half.min();
         let r = self.edge_radius;
         if !(r.is_finite() && r >= 0.0 && r < min_half) {
@@ -720,7 +734,7 @@ impl Features {
     /// Checks the features on a die of any shape: pips and rounded edges are the cuboid's
     /// (refused, with the reason); a centre of mass and an insert inside its hull.
     pub fn validate_on(&self, shape: &crate::model::shape::Shape, mode: Mode) -> Result<()> {
-        let mm = |v: f64| format!("{}", (v * 1e9).round() / 1e6);
+        let mm = shown_mm;
         let triple = |v: [f64; 3]| format!("{},{},{}", mm(v[0]), mm(v[1]), mm(v[2]));
         if mode == Mode::TwoD {
             return Err(Error::field(
@@ -785,7 +799,7 @@ impl Features {
     /// The pips: a positive diameter, a depth a cap or cylinder can have, paint and spacing in
     /// range, every pip inside its face (clear of the rounding) and apart from the others.
     fn validate_pips(&self, p: &Pips, half: &Vector3<f64>) -> Result<()> {
-        let mm = |v: f64| format!("{}", (v * 1e9).round() / 1e6);
+        let mm = shown_mm;
         let min_half = half.min();
         let r = self.edge_radius;
         let bad = |field: Field, v: f64, why: String| Err(Error::field(field, mm(v), why));
@@ -858,7 +872,7 @@ impl Features {
     /// The insert: positive sizes, inside the die clear of its rounding and pips, a density in
     /// range.
     fn validate_insert(&self, i: &Insert, half: &Vector3<f64>) -> Result<()> {
-        let mm = |v: f64| format!("{}", (v * 1e9).round() / 1e6);
+        let mm = shown_mm;
         let r = self.edge_radius;
         // Clear of the rounding and of the pips' cavities: inside the box whose faces
         // lie the larger of the two inside the die's.

@@ -154,6 +154,10 @@ fn yes() -> bool {
 /// 30/s, 1 − d = 9.4e-14 is held to 6e-4 of itself: the rate to 2e-5.
 pub const MAX_DAMPING: f64 = 30.0;
 
+/// The largest friction coefficient accepted: Bullet clamps a contact's combined friction
+/// to 10 (`btManifoldResult`'s `MAX_FRICTION`), so a larger μ would run silently as 10.
+pub const MAX_FRICTION: f64 = 10.0;
+
 /// The largest rolling resistance accepted, m: 1 mm, already the lever arm of soft felt
 /// under a heavy die (hard surfaces are near 0.01 mm).
 pub const MAX_ROLLING_RESISTANCE: f64 = 1e-3;
@@ -192,11 +196,14 @@ impl Scene {
     pub fn validate(&self, allow_restitution_above_one: bool) -> Result<()> {
         let bad = |field, v: f64, why: String| Err(Error::field(field, v, why));
         check_dt(Field::Dt, self.dt)?;
-        if !(self.friction.is_finite() && self.friction >= 0.0) {
+        if !(self.friction.is_finite() && (0.0..=MAX_FRICTION).contains(&self.friction)) {
             return bad(
                 Field::Friction,
                 self.friction,
-                "must be finite and >= 0".into(),
+                format!(
+                    "must be in [0, {MAX_FRICTION}] (Bullet holds a contact's friction at \
+                     {MAX_FRICTION} at most)"
+                ),
             );
         }
         let e_max = if allow_restitution_above_one {

@@ -343,7 +343,21 @@ pub fn vary(
             // The pips already sit by the run's layout (`roll --layout` placed them).
             let mut s = spec.clone();
             s.scene.features = what.set(&spec.scene.features, v)?;
-            s.validate(false)?;
+            // A value the die cannot take is named as the user wrote it, `--vary NAME=V`, not
+            // as the feature's own flag, which they did not give (reliability round 5, G).
+            s.validate(false).map_err(|e| match e {
+                Error::Field { field, why, .. }
+                    if matches!(
+                        (field, what),
+                        (Field::Com, Varied::ComX | Varied::ComY | Varied::ComZ)
+                            | (Field::PipsDepth, Varied::PipDepth)
+                            | (Field::EdgeRadius, Varied::EdgeRadius)
+                    ) =>
+                {
+                    Error::field(Field::Vary, format!("{what}={v}"), why)
+                }
+                e => e,
+            })?;
             Ok(s)
         })
         .collect::<Result<Vec<_>>>()?;

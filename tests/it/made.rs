@@ -284,6 +284,20 @@ fn bad_dice_are_refused_in_one_line() {
         (vec!["--pips", "3,2"], "depth"),
         (vec!["--pips", "3,1", "--2d"], "3D"),
         (vec!["--die", unknown.to_str().unwrap()], "weight"),
+        // Reliability round 5, class G: values printed as given, not as their rounding.
+        (
+            vec!["--edge-radius", "8.0000001"],
+            "--edge-radius 8.0000001:",
+        ),
+        (vec!["--com", "1e308,0,0"], "--com 1e308,0,0:"),
+        (
+            vec!["--friction", "1e300"],
+            "--friction 1e300: must be in [0, 10]",
+        ),
+        (
+            vec!["--vary", "com_z=0:9:3"],
+            "--vary com_z=9: must lie inside",
+        ),
     ];
     let files = [
         (
@@ -322,6 +336,22 @@ fn bad_dice_are_refused_in_one_line() {
             "inertia = [1e30, 1e30, 1e30, 0.0, 0.0, 0.0]\n",
             "no die of this mass and size",
         ),
+        // Class G: a die file's values named by the file and its key, not as flags.
+        (
+            "com.toml",
+            "com = [0.0, 0.0, 8.0]\n",
+            "com.toml: com 0,0,8: must lie inside",
+        ),
+        (
+            "density.toml",
+            "density = 0\n",
+            "density.toml: density 0: must be in",
+        ),
+        (
+            "deep.toml",
+            "[pips]\ndiameter = 3.0\ndepth = 9.0\n",
+            "deep.toml: pips.depth 9:",
+        ),
     ];
     let paths: Vec<String> = files
         .iter()
@@ -341,8 +371,10 @@ fn bad_dice_are_refused_in_one_line() {
         )
         .collect();
     for (extra, says) in cases {
+        // --vary is fair's.
+        let command = if extra[0] == "--vary" { "fair" } else { "roll" };
         let args = [
-            &["roll", "--block", "16x16x16", "--rolls", "10", "--json"][..],
+            &[command, "--block", "16x16x16", "--rolls", "10", "--json"][..],
             &extra,
         ]
         .concat();
