@@ -608,7 +608,7 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
         "--no-sleep",
     ]);
     let none = roll(&["--block", "140x24x20", "--max-steps", "1"]);
-    let shaped = roll(&["--shape", "d6"]);
+    let shaped = roll(&["--shape", "d6", "--rolling-resistance", "0.05"]);
     let broken = roll(&["--block", "140x24x20", "--dt", "1/30"]);
     assert!(broken["warnings"].is_array(), "{}", broken["dipped"]);
     assert!(shaped.get("warnings").is_none());
