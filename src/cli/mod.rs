@@ -142,6 +142,20 @@ pub fn dispatch(command: Command) -> error::Result<()> {
     }
 }
 
+/// clap's "did you mean" for a misspelt flag or command, kept in the one line: "; did you
+/// mean --rolls?" (issue 50: it used to be cut with the usage hints after it).
+fn suggestion(e: &clap::Error) -> String {
+    use clap::error::{ContextKind, ContextValue};
+    let named = [ContextKind::SuggestedArg, ContextKind::SuggestedSubcommand]
+        .into_iter()
+        .find_map(|k| match e.get(k) {
+            Some(ContextValue::String(s)) => Some(s.clone()),
+            Some(ContextValue::Strings(v)) if !v.is_empty() => Some(v.join(" or ")),
+            _ => None,
+        });
+    named.map_or_else(String::new, |s| format!("; did you mean {s}?"))
+}
+
 /// Help and version go to stdout as clap prints them; any other parse error becomes one
 /// line on stderr and exit code 2.
 fn clap_error(e: clap::Error) -> i32 {
@@ -177,7 +191,7 @@ fn clap_error(e: clap::Error) -> i32 {
             } else {
                 line
             };
-            eprintln!("dicephys: {line}");
+            eprintln!("dicephys: {line}{}", suggestion(&e));
             2
         }
     }

@@ -43,6 +43,22 @@ fn bad_input_gets_one_line_and_exit_code_2() {
     }
 }
 
+/// A misspelt flag or command keeps clap's suggestion in its one line (issue 50).
+#[test]
+fn a_misspelt_flag_or_command_is_told_what_it_may_mean() {
+    for (args, says) in [
+        (&["roll", "--rols", "10"][..], "did you mean --rolls?"),
+        (&["rol"][..], "did you mean roll?"),
+        (&["fair", "--nul", "uniform"][..], "did you mean --null?"),
+    ] {
+        let out = dicephys(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+    }
+}
+
 #[test]
 fn roll_json_has_the_documented_fields_and_ignores_thread_count() {
     let base = [
