@@ -53,6 +53,9 @@ pub fn run(a: &FairArgs) -> Result<()> {
             serde_json::json!({ "spec": spec, "null": a.null, "layout": a.roll.layout(&spec) });
         dicephys::studies::fair::claim(dir, &identity)?;
     }
+    if let Some(w) = spec.endless_roll_warning() {
+        eprintln!("dicephys: warning: {w}");
+    }
     // --precision here is every face's probability's.
     let (summary, done) = rolled(
         &a.roll,

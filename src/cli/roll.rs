@@ -138,6 +138,9 @@ pub fn run(a: &RollArgs) -> Result<()> {
     if let Some(w) = paper_throw_warning(&spec) {
         eprintln!("{w}");
     }
+    if let Some(w) = spec.endless_roll_warning() {
+        eprintln!("dicephys: warning: {w}");
+    }
     let (summary, done) = rolled(a, &spec, "roll", Target::Ratio)?;
     // Broken physics says so on the terminal too, whatever goes to stdout.
     if *a.json {

@@ -241,6 +241,44 @@ impl RunSpec {
         Ok(())
     }
 
+    /// A warning, before anything rolls, for a die that may never come to rest (reliability
+    /// round 5, class H; issue 48): a coin with no rolling resistance rolls on its rim or its
+    /// side, and a cube rounded almost to a ball rolls like one; such rolls run to the step
+    /// cap and are counted unconverged.
+    pub fn endless_roll_warning(&self) -> Option<String> {
+        let s = &self.scene;
+        if s.rolling_resistance > 0.0 {
+            return None;
+        }
+        let remedy = match self.engine {
+            EngineKind::Bullet => "--rolling-resistance 0.05 (mm) lets it stop",
+            _ => "--engine bullet --rolling-resistance 0.05 (mm) lets it stop",
+        };
+        let cap = self.roll.max_steps;
+        let coin = matches!(
+            s.shape.as_deref().map(|x| &x.solid),
+            Some(crate::model::shape::Solid::Cylinder { .. })
+        );
+        if coin {
+            return Some(format!(
+                "a coin with no rolling resistance may roll on its rim or its side until the \
+                 step cap ({cap} steps), counted unconverged: {remedy}"
+            ));
+        }
+        let half = s.block.breadth.min(s.block.width).min(s.block.length) / 2.0;
+        let flat = half - s.features.edge_radius;
+        (s.shape.is_none() && s.features.edge_radius > 0.0 && flat < 0.1 * half).then(|| {
+            format!(
+                "the die's faces are flat over only {:.3} mm of their {:.1} mm half side \
+                 (edge radius {} mm): it rolls like a ball and may reach the step cap ({cap} \
+                 steps), counted unconverged: {remedy}",
+                flat * 1e3,
+                half * 1e3,
+                s.features.edge_radius * 1e3
+            )
+        })
+    }
+
     /// The throw indices this run rolls.
     pub fn indices(&self) -> Indices {
         match self.shard {

@@ -206,6 +206,15 @@ fn a_coin_lands_heads_tails_or_on_its_edge() {
     ]);
     assert_eq!(v["unconverged"], 0, "{}", v["shape"]);
     assert_eq!(v["spec"]["scene"]["rolling_resistance"], 5e-5);
+    // Without it, `roll` and `fair` say before rolling that a coin may never stop.
+    for command in ["roll", "fair"] {
+        let out = dicephys(&[command, "--shape", "coin:24,2", "--rolls", "2", "--json"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("--rolling-resistance 0.05"),
+            "{command}: {err}"
+        );
+    }
     refused(
         &[
             "roll",
