@@ -203,9 +203,12 @@ pub fn claim(dir: &std::path::Path, identity: &serde_json::Value) -> Result<()> 
 /// Writes `fairness.json` (the document `json`, as `--json` prints it) and the die map
 /// (`die_map.svg`, `die_map.png`) into `dir`, each whole or not at all.
 pub fn write(dir: &std::path::Path, json: &str, fair: &Fairness, s: &RunSummary) -> Result<()> {
+    let die = match &s.spec.scene.shape {
+        Some(shape) => shape.name.clone(),
+        None => format!("{} mm", s.block_mm.map(|v| v.to_string()).join("x")),
+    };
     let title = format!(
-        "{} mm, {} {}, throw {}: {} rolls at rest; {}",
-        s.block_mm.map(|v| v.to_string()).join("x"),
+        "{die}, {} {}, throw {}: {} rolls at rest; {}",
         s.engine,
         s.mode,
         s.spec.throws.style,
@@ -226,10 +229,25 @@ pub fn write(dir: &std::path::Path, json: &str, fair: &Fairness, s: &RunSummary)
             z: f.z,
         })
         .collect();
-    // The die map is a cube's net: drawn for the cuboid only.
+    // The die map is a cube's net: drawn for the cuboid only; the faces figure for every die.
     if s.spec.scene.shape.is_none() {
         crate::report::figures::die::die_map(dir, "die_map", &title, &faces)?;
     }
+    let bars: Vec<crate::report::figures::die::FaceBar> = fair
+        .faces
+        .iter()
+        .map(|f| crate::report::figures::die::FaceBar {
+            label: match s.spec.scene.shape {
+                Some(_) => f.direction.clone(),
+                None => f.number.to_string(),
+            },
+            p: f.p,
+            err: f.err,
+            null: f.null,
+        })
+        .collect();
+    let null = format!("{} null", fair.null);
+    crate::report::figures::die::faces(dir, "faces", &title, &null, &bars)?;
     crate::run::io::write_atomic(&dir.join("fairness.json"), json.as_bytes())
 }
 

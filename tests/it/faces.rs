@@ -171,7 +171,7 @@ fn fair_out_writes_its_document_and_the_die_map_into_a_directory_of_its_own() {
     let file: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("fairness.json")).unwrap()).unwrap();
     assert_eq!(file, v);
-    for f in ["die_map.svg", "die_map.png"] {
+    for f in ["die_map.svg", "die_map.png", "faces.svg", "faces.png"] {
         assert!(std::fs::metadata(dir.join(f)).unwrap().len() > 1000, "{f}");
     }
     assert!(dicephys(&args).status.success(), "the same run again");
@@ -296,7 +296,8 @@ fn fair_varies_a_feature_and_draws_its_bias() {
     for (extra, says) in [
         (&["--vary", "weight=0:1:3"][..], "weight"),
         (&["--vary", "pip_depth=0.5:1:2"], "no pips"),
-        (&["--vary", "com_z=0:9:2"], "--com"),
+        // Named as given (reliability round 5, class G), not as --com.
+        (&["--vary", "com_z=0:9:2"], "--vary com_z=9:"),
         (
             &["--vary", "com_z=0:1:2", "--precision", "1"],
             "--precision",

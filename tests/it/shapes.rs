@@ -349,6 +349,17 @@ fn fair_judges_any_die_against_the_quasi_static_theory() {
         "--json",
     ]));
     assert_eq!(v["fairness"]["null"], "quasi-static");
+    // `--out`: the faces figure for any die (a cube's net is the cube's alone).
+    let out = Scratch::new("fair-d20-out");
+    let dir = out.path().join("d20");
+    let args = ["fair", "--shape", "d20", "--rolls", "200", "--out"];
+    assert!(dicephys(&[&args[..], &[dir.to_str().unwrap()]].concat())
+        .status
+        .success());
+    for f in ["faces.svg", "faces.png", "fairness.json"] {
+        assert!(std::fs::metadata(dir.join(f)).unwrap().len() > 1000, "{f}");
+    }
+    assert!(!dir.join("die_map.svg").exists());
     let faces = v["fairness"]["faces"].as_array().unwrap();
     assert_eq!(faces.len(), 20);
     for f in faces {

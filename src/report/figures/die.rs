@@ -93,6 +93,111 @@ pub fn die_map(dir: &Path, stem: &str, title: &str, faces: &[MapFace]) -> crate:
     write_both(dir, stem, &DieMap { title, faces })
 }
 
+/// One outcome's bar on the faces figure: its label, probability, binomial error and the
+/// null's probability.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FaceBar {
+    /// What the die shows (a number, `heads`, `edge`).
+    pub label: String,
+    /// Its probability.
+    pub p: f64,
+    /// Its binomial error (1σ).
+    pub err: f64,
+    /// The null's probability.
+    pub null: f64,
+}
+
+struct Faces<'a> {
+    title: &'a str,
+    null: &'a str,
+    bars: &'a [FaceBar],
+}
+
+impl Figure for Faces<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let n = self.bars.len();
+        let mut ys = Span::new(f64::INFINITY, f64::NEG_INFINITY);
+        for b in self.bars {
+            ys.add(b.p - 2.0 * bar(b.err));
+            ys.add(b.p + 2.0 * bar(b.err));
+            ys.add(b.null);
+        }
+        root.fill(&WHITE).map_err(plot_err)?;
+        let labels: Vec<String> = self.bars.iter().map(|b| b.label.clone()).collect();
+        let name = move |v: &f64| {
+            let k = v.round();
+            if (v - k).abs() < 1e-6 && k >= 1.0 && k as usize <= labels.len() {
+                labels[k as usize - 1].clone()
+            } else {
+                String::new()
+            }
+        };
+        let mut chart = ChartBuilder::on(root)
+            .caption(self.title, (FONT, 22))
+            .margin(20)
+            .x_label_area_size(55)
+            .y_label_area_size(80)
+            .build_cartesian_2d(0.4..n as f64 + 0.6, ys.padded(0.1, 0.3))
+            .map_err(plot_err)?;
+        chart
+            .configure_mesh()
+            .x_desc("face (the label it shows)")
+            .y_desc("P(face), with its 2σ interval")
+            .axis_desc_style((FONT, 20))
+            .label_style((FONT, 16))
+            .x_labels(n + 1)
+            .x_label_formatter(&name)
+            .y_label_formatter(&tick)
+            .disable_x_mesh()
+            .light_line_style(RGBColor(243, 243, 243))
+            .bold_line_style(RGBColor(210, 210, 210))
+            .draw()
+            .map_err(plot_err)?;
+        // The null: a short grey bar across each face's place.
+        let grey = RGBColor(90, 90, 90).stroke_width(3);
+        chart
+            .draw_series(self.bars.iter().enumerate().map(|(k, b)| {
+                let x = k as f64 + 1.0;
+                PathElement::new(vec![(x - 0.35, b.null), (x + 0.35, b.null)], grey)
+            }))
+            .map_err(plot_err)?
+            .label(self.null)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], grey));
+        let pts: Vec<Point> = self
+            .bars
+            .iter()
+            .enumerate()
+            .map(|(k, b)| Point {
+                x: k as f64 + 1.0,
+                y: b.p,
+                y_err: 2.0 * b.err,
+            })
+            .collect();
+        points(
+            &mut chart,
+            &pts,
+            RGBColor(200, 30, 30),
+            Marker::Circle,
+            false,
+            "measured, ± 2σ",
+        )?;
+        legend(&mut chart, SeriesLabelPosition::UpperRight)
+    }
+}
+
+/// Writes the faces figure as `dir/<stem>.svg` and `.png`: each outcome's probability with
+/// its 2σ interval beside the null's, for a die of any number of faces (issue 48: the die map
+/// is a cube's net; issue 50: a bar chart with error bars).
+pub fn faces(
+    dir: &Path,
+    stem: &str,
+    title: &str,
+    null: &str,
+    bars: &[FaceBar],
+) -> crate::Result<()> {
+    write_both(dir, stem, &Faces { title, null, bars })
+}
+
 /// One number's curve on the bias figure.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FaceCurve {
