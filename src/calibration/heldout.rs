@@ -34,6 +34,30 @@ pub struct BlockRow {
     pub counts: Option<[u64; 3]>,
 }
 
+/// Reliability round 5, class J: a column a blocks file does not know (face counts among
+/// them) used to be dropped, leaving the row unmeasured in silence; now it is refused.
+fn known_columns(header: &[String]) -> std::result::Result<(), String> {
+    const KNOWN: [&str; 8] = [
+        "label",
+        "block",
+        "mode",
+        "surface",
+        "thrower",
+        "length_vertical",
+        "breadth_vertical",
+        "width_vertical",
+    ];
+    match header.iter().find(|h| !KNOWN.contains(&h.as_str())) {
+        Some(h) => Err(format!(
+            "unknown column '{}' (a blocks file has {}; face counts belong in a counts file, \
+             `fit --data`)",
+            shown(h),
+            KNOWN.join(", ")
+        )),
+        None => Ok(()),
+    }
+}
+
 /// Reads a blocks file (or a counts file); `name` names it in messages.
 pub fn parse(text: &str, name: &str) -> Result<Vec<BlockRow>> {
     if text
@@ -58,29 +82,7 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<BlockRow>> {
         .map(str::to_string)
         .collect();
     let col = |c: &str| header.iter().position(|h| h == c);
-    // Reliability round 5, class J: a column this reader does not know (face counts among
-    // them) used to be dropped, leaving the row unmeasured in silence.
-    const KNOWN: [&str; 8] = [
-        "label",
-        "block",
-        "mode",
-        "surface",
-        "thrower",
-        "length_vertical",
-        "breadth_vertical",
-        "width_vertical",
-    ];
-    if let Some(h) = header.iter().find(|h| !KNOWN.contains(&h.as_str())) {
-        return Err(bad(
-            1,
-            format!(
-                "unknown column '{}' (a blocks file has {}; face counts belong in a counts \
-                 file, `fit --data`)",
-                shown(h),
-                KNOWN.join(", ")
-            ),
-        ));
-    }
+    known_columns(&header).map_err(|m| bad(1, m))?;
     let (Some(label), Some(block), Some(mode)) = (col("label"), col("block"), col("mode")) else {
         return Err(bad(
             1,

@@ -371,20 +371,25 @@ fn bad_dice_are_refused_in_one_line() {
         )
         .collect();
     for (extra, says) in cases {
-        // --vary is fair's.
-        let command = if extra[0] == "--vary" { "fair" } else { "roll" };
-        let args = [
-            &[command, "--block", "16x16x16", "--rolls", "10", "--json"][..],
-            &extra,
-        ]
-        .concat();
-        let out = dicephys(&args);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{extra:?}: {err}");
-        assert!(out.stdout.is_empty(), "{extra:?}");
-        assert_eq!(err.trim_end().lines().count(), 1, "{extra:?}: {err}");
-        assert!(err.contains(says), "{extra:?}: {err}");
+        refused_in_one_line(&extra, says);
     }
+}
+
+/// A 16 mm cube with `extra` refused: exit 2, nothing on stdout, one line on stderr saying
+/// `says` (`--vary` is `fair`'s, the rest `roll`'s).
+fn refused_in_one_line(extra: &[&str], says: &str) {
+    let command = if extra[0] == "--vary" { "fair" } else { "roll" };
+    let args = [
+        &[command, "--block", "16x16x16", "--rolls", "10", "--json"][..],
+        extra,
+    ]
+    .concat();
+    let out = dicephys(&args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{extra:?}: {err}");
+    assert!(out.stdout.is_empty(), "{extra:?}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{extra:?}: {err}");
+    assert!(err.contains(says), "{extra:?}: {err}");
 }
 
 /// Where is its weight? Face counts of a cube loaded 1 mm toward face 6 (6,000 throws in a
