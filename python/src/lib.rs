@@ -527,7 +527,7 @@ fn roll<'py>(
     if null == Some(dicephys::studies::fair::Null::QuasiStatic) && spec.scene.mode == Mode::TwoD {
         return Err(bad(
             "null",
-            &format!("'{}'", null_given.as_deref().unwrap_or_default()),
+            format!("'{}'", null_given.as_deref().unwrap_or_default()),
             "the quasi-static theory is 3D; in 2D give 'uniform'",
         ));
     }
