@@ -241,10 +241,37 @@ def _pair(name: str, x: RangeArg) -> Any:
 def _triple(name: str, x: Optional[Sequence[float]], n: int) -> Optional[List[float]]:
     if x is None:
         return None
-    values = [float(v) for v in x]
+    # A string is a sequence of characters: '0,0,-1' would be read one character at a time.
+    if isinstance(x, (str, bytes)):
+        raise ValueError(f"{name}={x!r}: give {n} numbers of mm as a tuple, not a string")
+    try:
+        values = [float(v) for v in x]
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}={x!r}: give {n} numbers of mm") from None
     if len(values) != n:
         raise ValueError(f"{name}={tuple(x)}: give {n} numbers of mm")
     return values
+
+
+def _names(name: str, x: Union[str, Sequence[str]]) -> List[str]:
+    """Parameter names: a sequence of them, or one string as the CLI spells it ("e,mu")."""
+    if isinstance(x, str):
+        return [p.strip() for p in x.split(",") if p.strip()]
+    if not all(isinstance(p, str) for p in x):
+        raise ValueError(f"{name}={x!r}: give parameter names, e.g. ('e', 'mu')")
+    return list(x)
+
+
+def _contact(x: Optional[Sequence[float]]) -> Optional[Tuple[float, float]]:
+    if x is None:
+        return None
+    if isinstance(x, (str, bytes)):
+        raise ValueError(f"contact={x!r}: give (e, mu) as two numbers, not a string")
+    try:
+        e, mu = x
+        return (float(e), float(mu))
+    except (TypeError, ValueError):
+        raise ValueError(f"contact={x!r}: give (e, mu) as two numbers") from None
 
 
 def roll(
@@ -490,7 +517,7 @@ def _fit_config(
         die=None if die is None else os.fspath(die), layout=layout, density=density,
     )
     return _native.fit_config(
-        _data(data), list(free), list(shared), rs, restitution, friction,
+        _data(data), _names("free", free), _names("shared", shared), rs, restitution, friction,
         None if kappa is None else float(kappa), spin_scale, engine, dt, max_steps, points,
         point_rolls, degree, max_degree, refine, common_throws, seed, made,
     )
@@ -574,7 +601,7 @@ def recover(
     ``repeats`` times; the result says how often the 2σ region held the truth. The other
     options are ``fit``'s.
     """
-    free = list(free) if free is not None else list(truth)
+    free = _names("free", free) if free is not None else list(truth)
     fit_options: Dict[str, Any] = dict(
         shared=(), ranges=None, restitution=0.5, friction=0.29, kappa="paper", spin_scale=1.0,
         engine="bullet", dt=1e-3, max_steps=DEFAULT_MAX_STEPS, points=64, point_rolls=500, degree=3,
@@ -627,7 +654,7 @@ def predict(
         out = _native.predict(
             text, block, mode=mode, surface=surface, thrower=thrower, draws=draws,
             rolls=rolls, seed=seed, threads=threads, progress=tell,
-            contact=None if contact is None else (float(contact[0]), float(contact[1])),
+            contact=_contact(contact),
         )
     finally:
         close()

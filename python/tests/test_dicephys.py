@@ -129,11 +129,27 @@ def test_per_roll_arrays_match_the_cli_s_csv(tmp_path: Path) -> None:
         ({"block": "140x24x20", "progress": 5}, "progress"),
         ({"block": "140x24x20", "progress": "yes"}, "progress"),
         ({"block": "140x24x20", "rolls": True}, "rolls"),
+        # Class G: a string where numbers belong is named, not read a character at a time.
+        ({"block": "16x16x16", "com": "0,0,-1"}, "com='0,0,-1'"),
+        ({"block": "16x16x16", "com": ("a", 0, 0)}, "com="),
+        ({"block": "140x24x20", "kappa": "bogus"}, "kappa='bogus'"),
     ],
 )
 def test_bad_arguments_raise_value_error_naming_them(kwargs: dict, name: str) -> None:
     with pytest.raises(ValueError, match=name):
         dicephys.roll(**{"rolls": 10, **kwargs})
+
+
+def test_parameter_names_and_a_contact_are_read_as_the_cli_reads_them() -> None:
+    # free='mu' is one name (it used to be read as 'm', 'u'); "e,mu" two, as --free e,mu.
+    assert dicephys._names("free", "mu") == ["mu"]
+    assert dicephys._names("free", "e, mu") == ["e", "mu"]
+    assert dicephys._names("free", ("e", "mu")) == ["e", "mu"]
+    with pytest.raises(ValueError, match="free="):
+        dicephys._names("free", [1, 2])  # type: ignore[list-item]
+    assert dicephys._contact((0.5, 0.3)) == (0.5, 0.3)
+    with pytest.raises(ValueError, match="contact='0.5,0.3'"):
+        dicephys._contact("0.5,0.3")  # type: ignore[arg-type]
 
 
 def test_a_signal_stops_a_run_with_keyboard_interrupt() -> None:
