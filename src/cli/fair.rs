@@ -116,9 +116,12 @@ fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str) -> Result<()
     let doc = serde_json::json!({ "vary": what, "null": a.null, "spec": spec, "points": points });
     let json = dicephys::run::seal::to_string(&doc, true)?;
     if let Some(dir) = &a.out {
+        let die = match &spec.scene.shape {
+            Some(shape) => shape.name.clone(),
+            None => format!("{} mm", spec.scene.block),
+        };
         let title = format!(
-            "{} mm, {}, {}: {} rolls a value; lines: {}",
-            spec.scene.block,
+            "{die}, {}, {}: {} rolls a value; lines: {}",
             spec.engine.name(),
             spec.throws.style,
             spec.rolls,
@@ -134,8 +137,21 @@ fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str) -> Result<()
         outln!("{}", json);
         return Ok(());
     }
-    let mut t =
-        format!("{what} (mm) | P(1) … P(6), each ± its error | χ² p | throws to see it at 2σ\n");
+    // Each face in the order the rows give them (a cube's 1 … 6, a shape's labels).
+    let names: Vec<String> = points.first().map_or_else(Vec::new, |b| {
+        b.fairness
+            .faces
+            .iter()
+            .map(|f| f.number.to_string())
+            .collect()
+    });
+    let mut t = format!(
+        "{what} (mm) | P({}), each ± its error | χ² p | throws to see it at 2σ\n",
+        match names.len() {
+            0..=6 => names.join(", "),
+            n => format!("{} … {}, {n} faces", names[0], names[n - 1]),
+        }
+    );
     for b in &points {
         let f = &b.fairness;
         let ps: Vec<String> = f

@@ -406,7 +406,9 @@ pub fn write_bias(
     points: &[BiasPoint],
 ) -> Result<()> {
     use crate::report::figures::{die::FaceCurve, Point};
-    let series: Vec<FaceCurve> = (0..6)
+    // Every face the die has (a cube's six, a d20's twenty), by the label it shows.
+    let faces = points.first().map_or(0, |b| b.fairness.faces.len());
+    let series: Vec<FaceCurve> = (0..faces)
         .map(|k| {
             let pts = points
                 .iter()
@@ -424,6 +426,15 @@ pub fn write_bias(
                 .collect();
             FaceCurve {
                 number: k as u8 + 1,
+                label: {
+                    let f = &points[0].fairness.faces[k];
+                    // A cube's face by its number; a shape's by its label.
+                    if DIRECTIONS.iter().any(|d| f.direction == *d) {
+                        f.number.to_string()
+                    } else {
+                        f.direction.clone()
+                    }
+                },
                 points: pts,
                 null,
             }

@@ -360,6 +360,30 @@ fn fair_judges_any_die_against_the_quasi_static_theory() {
         assert!(std::fs::metadata(dir.join(f)).unwrap().len() > 1000, "{f}");
     }
     assert!(!dir.join("die_map.svg").exists());
+    // `--vary` for any die: every face at every value, in the table, the JSON and the figure.
+    let vary = dir.with_file_name("d10-vary");
+    let args = [
+        "fair",
+        "--shape",
+        "d10",
+        "--vary",
+        "com_z=0:1:2",
+        "--rolls",
+        "100",
+    ];
+    let out = dicephys(&[&args[..], &["--out", vary.to_str().unwrap()]].concat());
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("P(1 … 10, 10 faces)"));
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(vary.join("bias.json")).unwrap()).unwrap();
+    assert_eq!(
+        doc["points"][1]["fairness"]["faces"]
+            .as_array()
+            .unwrap()
+            .len(),
+        10
+    );
+    assert!(std::fs::metadata(vary.join("bias.svg")).unwrap().len() > 1000);
     let faces = v["fairness"]["faces"].as_array().unwrap();
     assert_eq!(faces.len(), 20);
     for f in faces {

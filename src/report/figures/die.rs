@@ -201,8 +201,10 @@ pub fn faces(
 /// One number's curve on the bias figure.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FaceCurve {
-    /// The number, 1 to 6.
+    /// Its place among the die's faces, from 1.
     pub number: u8,
+    /// What it shows, named in the legend (a cube's number; a shape's label).
+    pub label: String,
     /// Its probability at each value, with its error.
     pub points: Vec<Point>,
     /// The null's probability at each value.
@@ -247,15 +249,24 @@ impl Figure for Bias<'_> {
             self.x_desc,
             "P(face up)",
         )?;
+        let n = self.series.len();
         for c in self.series {
-            let color = FACE_COLORS[(c.number as usize).clamp(1, 6) - 1];
+            // A cube's six colours; a die of more faces, hues round the wheel.
+            let color = match n {
+                0..=6 => FACE_COLORS[(c.number as usize).clamp(1, 6) - 1],
+                _ => {
+                    let hsl = HSLColor((c.number as f64 - 1.0) / n as f64, 0.75, 0.42);
+                    let (r, g, b) = hsl.rgb();
+                    RGBColor(r, g, b)
+                }
+            };
             points(
                 &mut chart,
                 &c.points,
                 color,
                 Marker::Circle,
                 false,
-                &format!("face {}", c.number),
+                &format!("face {}", c.label),
             )?;
             chart
                 .draw_series(LineSeries::new(
