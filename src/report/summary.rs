@@ -254,13 +254,7 @@ impl ShapeOutcomes {
             .iter()
             .map(|(_, c)| (*c as f64 - expected).powi(2) / expected)
             .sum();
-        let die = crate::model::die::DieShape::of(scene);
-        let theory = crate::theory::quasi_static::shape_labels(scene.shape.as_ref()?, &die.com)
-            .ok()
-            .map(|q| {
-                let listed: f64 = q.iter().map(|(_, x)| x).sum();
-                q.into_iter().map(|(_, x)| x / listed).collect::<Vec<f64>>()
-            });
+        let theory = crate::theory::quasi_static::outcome_shares(scene)?.ok();
         let against_quasi_static = theory.as_ref().map(|q| {
             let (mut chi2, mut k) = (0.0, 0usize);
             for ((_, c), q) in counts.iter().zip(q) {

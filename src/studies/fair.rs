@@ -33,16 +33,9 @@ fn null_probabilities(s: &RunSummary, null: Null) -> Result<Vec<f64>> {
     if let Some(f) = crate::report::summary::shape_faces(&s.tally, &s.spec.scene) {
         return match null {
             Null::Uniform => Ok(vec![1.0 / f.len() as f64; f.len()]),
-            Null::QuasiStatic => {
-                let shape = s.spec.scene.shape.as_deref().expect("a die of any shape");
-                let die = crate::model::die::DieShape::of(&s.spec.scene);
-                let p = theory::quasi_static::shape_labels(shape, &die.com)
-                    .map_err(|e| Error::field(Field::Null, "quasi-static", e))?;
-                // Of the rolls that end on one of its outcomes (a facet that holds the die
-                // only at this centre of mass is none).
-                let listed: f64 = p.iter().map(|(_, q)| q).sum();
-                Ok(p.iter().map(|(_, q)| q / listed).collect())
-            }
+            Null::QuasiStatic => theory::quasi_static::outcome_shares(&s.spec.scene)
+                .expect("a die of any shape")
+                .map_err(|e| Error::field(Field::Null, "quasi-static", e)),
         };
     }
     let shown = if s.mode == Mode::ThreeD { 6 } else { 4 };

@@ -99,6 +99,19 @@ pub fn shape(shape: &Shape, com: &Vector3<f64>) -> Result<Vec<f64>, String> {
     }
 }
 
+/// The quasi-static share of each outcome of a scene's die of any shape, by label
+/// ([`shape_labels`], at its centre of mass), of the rolls that end on one of them (a facet
+/// that holds the die only at this centre of mass is no outcome): what `fair --null
+/// quasi-static` and `roll`'s summary set the counts against. `None` for the cuboid.
+pub fn outcome_shares(scene: &crate::model::scene::Scene) -> Option<Result<Vec<f64>, String>> {
+    let s = scene.shape.as_deref()?;
+    let com = crate::model::mass::MassProps::compute(scene).com;
+    Some(shape_labels(s, &com).map(|p| {
+        let listed: f64 = p.iter().map(|(_, q)| q).sum();
+        p.iter().map(|(_, q)| q / listed).collect()
+    }))
+}
+
 /// [`shape`] summed over the outcomes that show the same label, in the order of their first
 /// appearance (`report::summary::shape_faces`'s).
 pub fn shape_labels(shape_: &Shape, com: &Vector3<f64>) -> Result<Vec<(String, f64)>, String> {
