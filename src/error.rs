@@ -68,6 +68,8 @@ pub enum Field {
     AngularDamping,
     /// `bin`.
     Bin,
+    /// `block`.
+    Block,
     /// `blocks`.
     Blocks,
     /// `bootstrap`.

@@ -508,6 +508,9 @@ def _fit_config(
     die: Optional[PathLike] = None,
     layout: Optional[str] = None,
     density: Optional[float] = None,
+    shape: Optional[str] = None,
+    size: Optional[float] = None,
+    scale: Optional[float] = None,
 ) -> str:
     if kappa == "paper":
         kappa = None
@@ -515,6 +518,7 @@ def _fit_config(
     made = dict(
         com=_triple("com", com, 3), pips=_triple("pips", pips, 2), edge_radius=edge_radius,
         die=None if die is None else os.fspath(die), layout=layout, density=density,
+        shape=shape, size=size, scale=scale,
     )
     return _native.fit_config(
         _data(data), _names("free", free), _names("shared", shared), rs, restitution, friction,
@@ -549,6 +553,9 @@ def fit(
     die: Optional[PathLike] = None,
     layout: Optional[str] = None,
     density: Optional[float] = None,
+    shape: Optional[str] = None,
+    size: Optional[float] = None,
+    scale: Optional[float] = None,
     out: Optional[PathLike] = None,
     threads: int = 0,
     progress: Progress = None,
@@ -562,10 +569,13 @@ def fit(
     shared: surface parameters shared by every surface instead of one per surface.
     ranges: a free parameter's box, {"e": (0.05, 0.8)}.
     restitution, friction, kappa, spin_scale: the values where a parameter is not free
-        (kappa "paper": the paper's throw).
+        (kappa "paper": the paper's throw, which a die of any shape takes as the tumble).
     points, point_rolls: the design (parameter points per block per pass, rolls at each).
     com, pips, edge_radius, die, layout, density: the die thrown, as ``roll`` takes it (one
         die for every row; a counts file with face_1 … face_6 counts its faces).
+    shape, size, scale: a die of any shape, as ``roll`` takes it ("d20", "coin:24,8"; or a
+        mesh ``die``): the counts are then label, surface and a face_<label> column for each
+        of its faces, and it is thrown in a tumble (kappa is left out: it has no long axis).
     out: where fit.json, report.md, the figures and the simulations' cells are written
         (default: a new temporary directory, ``Fit.out``).
     """
@@ -573,6 +583,7 @@ def fit(
         data, free, shared, ranges, restitution, friction, kappa, spin_scale, engine, dt,
         max_steps, points, point_rolls, degree, max_degree, refine, common_throws, seed,
         com=com, pips=pips, edge_radius=edge_radius, die=die, layout=layout, density=density,
+        shape=shape, size=size, scale=scale,
     )
     where = _out(out, "fit")
     tell, close = _progress(progress, "fit")
@@ -606,7 +617,7 @@ def recover(
         shared=(), ranges=None, restitution=0.5, friction=0.29, kappa="paper", spin_scale=1.0,
         engine="bullet", dt=1e-3, max_steps=DEFAULT_MAX_STEPS, points=64, point_rolls=500, degree=3,
         max_degree=4, refine=True, common_throws=False, seed=2385, com=None, pips=None,
-        edge_radius=None, die=None, layout=None, density=None,
+        edge_radius=None, die=None, layout=None, density=None, shape=None, size=None, scale=None,
     )
     unknown = set(options) - set(fit_options)
     if unknown:
@@ -627,7 +638,7 @@ def recover(
 
 def predict(
     fit: Union[Fit, PathLike],
-    block: str,
+    block: Optional[str] = None,
     *,
     mode: str = "3d",
     surface: Optional[str] = None,
@@ -643,6 +654,7 @@ def predict(
     ``dicephys predict --json`` (docs/json.md, "predict").
 
     fit: a ``Fit``, or the path of a fit's fit.json.
+    block: the block, "140x24x20" (a fit of a die of any shape predicts that die: None).
     surface, thrower: whose fitted values to use, when the fit has several.
     contact: another surface's (e, μ), where the fit held them fixed.
     """

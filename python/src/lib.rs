@@ -710,8 +710,9 @@ fn fit_config<'py>(
         .maybe::<String>("layout")?
         .map(|l| named::<Layout>("layout", "layout", &l))
         .transpose()?;
+    let die_file = o.maybe::<PathBuf>("die")?;
     let (mut features, density) = Features::described(
-        o.maybe::<PathBuf>("die")?.as_deref(),
+        die_file.as_deref(),
         o.maybe("com")?,
         o.maybe("pips")?,
         o.maybe("edge_radius")?,
@@ -722,6 +723,14 @@ fn fit_config<'py>(
     if let Some(l) = layout {
         features.layout = l;
     }
+    // A die of any shape (`shape`, or a mesh `die`): its rows count its faces by label.
+    let shape = dicephys::model::shape::described(
+        die_file.as_deref(),
+        o.maybe::<String>("shape")?.as_deref(),
+        o.maybe("size")?,
+        o.maybe("scale")?,
+    )
+    .map_err(py_err)?;
     o.finish()?;
     let kind = |arg: &str, s: &str| named::<Kind>(arg, "parameter", s);
     let mut free_kinds = free
@@ -745,7 +754,12 @@ fn fit_config<'py>(
     model.fixed = Fixed {
         e: restitution,
         mu: friction,
-        throw: kappa.map_or(FixedThrow::Paper, FixedThrow::Hand),
+        // No κ: the paper's throw, or the tumble for a die of any shape (it has no long axis).
+        throw: match (kappa, &shape) {
+            (Some(k), _) => FixedThrow::Hand(k),
+            (None, Some(_)) => FixedThrow::Tumble,
+            (None, None) => FixedThrow::Paper,
+        },
         spin: spin_scale,
         ..Fixed::default()
     };
@@ -761,6 +775,11 @@ fn fit_config<'py>(
         Error::Io { .. } => py_err(e),
         e => PyValueError::new_err(format!("data: {}", arguments_in(&e.to_string()))),
     })?;
+    let rows = match &shape {
+        Some(sh) => calibration::data::on_shape(&rows, sh)
+            .map_err(|e| PyValueError::new_err(format!("data: {e}")))?,
+        None => rows,
+    };
     let cfg = FitConfig {
         rows,
         model,
@@ -770,6 +789,7 @@ fn fit_config<'py>(
             max_steps,
             die: features,
             density,
+            shape: shape.map(std::sync::Arc::new),
         },
         design: calibration::design::DesignSpec {
             points,
@@ -859,13 +879,13 @@ fn recover(
 /// `dicephys predict`: the fit (its `fit.json`'s text) simulated at a block it did not see;
 /// the prediction's JSON.
 #[pyfunction]
-#[pyo3(signature = (fit, block, *, mode="3d", surface=None, thrower=None, draws=16, rolls=2000,
-    seed=2385, threads=0, progress=None, contact=None))]
+#[pyo3(signature = (fit, block=None, *, mode="3d", surface=None, thrower=None, draws=16,
+    rolls=2000, seed=2385, threads=0, progress=None, contact=None))]
 #[allow(clippy::too_many_arguments)]
 fn predict(
     py: Python<'_>,
     fit: &str,
-    block: &str,
+    block: Option<&str>,
     mode: &str,
     surface: Option<String>,
     thrower: Option<String>,
@@ -880,8 +900,14 @@ fn predict(
         .map_err(|e| bad("fit", "…", format!("not a fit's fit.json as written: {e}")))?;
     fit.check()
         .map_err(|e| bad("fit", "…", arguments_in(&e.to_string())))?;
+    // A fit of a die of any shape predicts that die; a fit of blocks needs the block.
+    let block = match (block, calibration::predict::own_block(&fit)) {
+        (Some(b), _) => self::block(b)?,
+        (None, Some(b)) => b,
+        (None, None) => return Err(bad("block", "None", "give the block to predict")),
+    };
     let cfg = calibration::predict::PredictConfig {
-        block: self::block(block)?,
+        block,
         mode: self::mode(mode)?,
         surface,
         thrower,

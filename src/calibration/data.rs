@@ -15,6 +15,15 @@
 //! suspect,felt,16,16,16,3d,1702,1650,1671,1648,1660,1569
 //! ```
 //!
+//! Or, for a die of any shape (`--shape`, a mesh `--die`: its size is the shape's, so no sides
+//! are given, and it is thrown in 3D), one `face_<label>` column for each of its faces, named by
+//! what the face shows, in any order ([`on_shape`] checks them against the die):
+//!
+//! ```text
+//! label,surface,face_heads,face_tails,face_edge
+//! thick coin,felt,412,398,190
+//! ```
+//!
 //! - `mode`: how the row is simulated, `3d` (a free body) or `2d` (DicePhys's plane-locked
 //!   block). A 2D block cannot land on its end: a `2d` row is fitted on its two side outcomes,
 //!   and its length-vertical count is kept but set aside.
@@ -92,6 +101,10 @@ pub struct DataRow {
     /// The outcomes counted apart, as groups of indices into `counts` (a 2D row: breadth and
     /// width only).
     pub groups: Vec<Vec<usize>>,
+    /// A die of any shape: what each count's face shows, in the order of `counts` (the die's
+    /// faces' order once [`on_shape`] has read the row against it). Empty for a block's rows.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub labels: Vec<String>,
 }
 
 impl DataRow {
@@ -103,17 +116,33 @@ impl DataRow {
             .collect()
     }
 
+    /// The file's column of the first count (0-based): after the sides and mode, or (a die of
+    /// any shape) after the label and surface.
+    fn first_count_column(&self) -> usize {
+        if self.labels.is_empty() {
+            6
+        } else {
+            2
+        }
+    }
+
+    /// True if the row counts the faces of a die of any shape (`face_<label>` columns).
+    pub fn of_shape(&self) -> bool {
+        !self.labels.is_empty()
+    }
+
     /// Throws counted in the fit (a 2D row: its side outcomes).
     pub fn n(&self) -> u64 {
         self.grouped().iter().sum()
     }
 
     /// The groups' names: "breadth", "width", "length", or "breadth+width" when merged; "face
-    /// 1" … "face 6" for a row of faces.
+    /// 1" … "face 6" for a row of faces, "face <label>" for a die of any shape.
     pub fn group_names(&self) -> Vec<String> {
-        let name = |k: usize| match self.outcomes {
-            Outcomes::Sides => OUTCOMES[k].to_string(),
-            Outcomes::Faces => format!("face {}", k + 1),
+        let name = |k: usize| match (self.outcomes, self.labels.get(k)) {
+            (Outcomes::Faces, Some(l)) => format!("face {l}"),
+            (Outcomes::Sides, _) => OUTCOMES[k].to_string(),
+            (Outcomes::Faces, None) => format!("face {}", k + 1),
         };
         self.groups
             .iter()
@@ -248,9 +277,33 @@ fn line_counter(text: &str) -> impl FnMut(usize) -> usize + '_ {
     }
 }
 
-/// What a header says: sides or faces counted, how many count columns, and whether a
-/// `thrower` column ends it; a header that is neither form is refused.
-fn columns(have: &[&str], name: &str) -> Result<(Outcomes, usize, bool)> {
+/// What a header says is counted.
+#[derive(Clone, Debug, PartialEq)]
+enum Form {
+    /// Sides or a cube's six faces, with this many count columns.
+    Block(Outcomes, usize),
+    /// A die of any shape, by these labels (the header's `face_<label>`, in its order).
+    Shape(Vec<String>),
+}
+
+/// What a header says (sides, a cube's faces or a shape's, and whether a `thrower` column ends
+/// it); a header that is none of the forms is refused.
+fn columns(have: &[&str], name: &str) -> Result<(Form, bool)> {
+    let with_thrower = have.last() == Some(&"thrower");
+    if have.len() > 2 && have[..2] == COLUMNS[..2] && have[2].starts_with("face_") {
+        let faces = &have[2..have.len() - usize::from(with_thrower)];
+        let labels: Vec<String> = faces
+            .iter()
+            .map(|c| c.strip_prefix("face_").unwrap_or("").to_string())
+            .collect();
+        if labels.len() < 2 || labels.iter().any(String::is_empty) {
+            return Err(Error::Invalid(format!(
+                "{name}: line 1: a die of any shape is counted as label,surface,face_<label>,…                  (a column for each face, at least two)[,thrower], got {}",
+                shown(&have.join(","))
+            )));
+        }
+        return Ok((Form::Shape(labels), with_thrower));
+    }
     let (outcomes, counted) = if have.get(6) == Some(&FACE_COLUMNS[0]) {
         (Outcomes::Faces, 6)
     } else {
@@ -260,16 +313,17 @@ fn columns(have: &[&str], name: &str) -> Result<(Outcomes, usize, bool)> {
         Outcomes::Sides => COLUMNS[..9].to_vec(),
         Outcomes::Faces => COLUMNS[..6].iter().chain(&FACE_COLUMNS).copied().collect(),
     };
-    let with_thrower = have.len() == want.len() + 1 && have.last() == Some(&"thrower");
+    let with_thrower = with_thrower && have.len() == want.len() + 1;
     if !(have == want || with_thrower && have[..want.len()] == want[..]) {
         return Err(Error::Invalid(format!(
             "{name}: line 1: the header must be {}[,thrower] (or face_1,…,face_6 in place of \
-             the three *_vertical), got {}",
+             the three *_vertical; or label,surface,face_<label>,… for a die of any shape), \
+             got {}",
             COLUMNS[..9].join(","),
             shown(&have.join(","))
         )));
     }
-    Ok((outcomes, counted, with_thrower))
+    Ok((Form::Block(outcomes, counted), with_thrower))
 }
 
 /// A record's counts and which of them are `-` (sides only); a field that is not a count is
@@ -317,14 +371,14 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
         .from_reader(text.as_bytes());
     let header = reader.headers().map_err(csv_error)?.clone();
     let have: Vec<&str> = header.iter().collect();
-    let (outcomes, counted, with_thrower) = columns(&have, name)?;
+    let (form, with_thrower) = columns(&have, name)?;
     *names.borrow_mut() = have.iter().map(|s| s.to_string()).collect();
     let mut rows: Vec<DataRow> = Vec::new();
     let mut labels = std::collections::HashSet::new();
     for rec in reader.records() {
         let rec = rec.map_err(csv_error)?;
         let line = line_of(rec.position().map_or(0, |p| p.byte() as usize));
-        let row = row_of(&rec, have.len(), outcomes, counted, with_thrower)
+        let row = row_of(&rec, have.len(), &form, with_thrower)
             .map_err(|(c, m)| bad(line, c, m))?;
         if !labels.insert(row.label.clone()) {
             return Err(bad(
@@ -360,13 +414,12 @@ fn sides_of(rec: &csv::StringRecord) -> std::result::Result<[f64; 3], (usize, St
     Ok(sides)
 }
 
-/// One record as a row, with the header's `fields`, what it counts and whether a thrower
-/// ends it; an error is `(its column, what is wrong)`.
+/// One record as a row, with the header's `fields`, what it counts (`form`) and whether a
+/// thrower ends it; an error is `(its column, what is wrong)`.
 fn row_of(
     rec: &csv::StringRecord,
     fields: usize,
-    outcomes: Outcomes,
-    counted: usize,
+    form: &Form,
     with_thrower: bool,
 ) -> std::result::Result<DataRow, (usize, String)> {
     if rec.len() != fields {
@@ -387,6 +440,70 @@ fn row_of(
     };
     let label = text(0)?;
     let surface = text(1)?;
+    let thrower = if with_thrower {
+        text(fields - 1)?
+    } else {
+        "all".into()
+    };
+    let row = match form {
+        Form::Block(outcomes, counted) => block_row(rec, *outcomes, *counted)?,
+        Form::Shape(labels) => shape_row(rec, labels)?,
+    };
+    let row = DataRow {
+        label,
+        surface,
+        thrower,
+        ..row
+    };
+    let total = row.counts.iter().try_fold(0u64, |a, &c| a.checked_add(c));
+    if total.is_none_or(|t| t > MAX_ROW_THROWS) {
+        return Err((
+            row.first_count_column(),
+            format!("counts too large: at most {MAX_ROW_THROWS} throws a row"),
+        ));
+    }
+    if row.n() == 0 {
+        return Err((row.first_count_column(), "no throws counted".into()));
+    }
+    Ok(row)
+}
+
+/// A record's counts of a die of any shape, one a label, from column 3 (its block is a
+/// placeholder until [`on_shape`] reads the row against the die).
+fn shape_row(
+    rec: &csv::StringRecord,
+    labels: &[String],
+) -> std::result::Result<DataRow, (usize, String)> {
+    let counts = (0..labels.len())
+        .map(|k| {
+            let c = 2 + k;
+            rec[c].parse::<u64>().map_err(|_| {
+                (
+                    c,
+                    format!("'{}' is not a count (a whole number)", shown(&rec[c])),
+                )
+            })
+        })
+        .collect::<std::result::Result<Vec<u64>, _>>()?;
+    Ok(DataRow {
+        label: String::new(),
+        surface: String::new(),
+        thrower: String::new(),
+        block: Block::from_mm(1.0, 1.0, 1.0).expect("a unit block"),
+        mode: Mode::ThreeD,
+        outcomes: Outcomes::Faces,
+        groups: (0..counts.len()).map(|k| vec![k]).collect(),
+        counts,
+        labels: labels.to_vec(),
+    })
+}
+
+/// A record's block and counts of its sides or of a cube's six faces.
+fn block_row(
+    rec: &csv::StringRecord,
+    outcomes: Outcomes,
+    counted: usize,
+) -> std::result::Result<DataRow, (usize, String)> {
     let mut sides = sides_of(rec)?;
     let mode: Mode = rec[5]
         .parse()
@@ -424,31 +541,91 @@ fn row_of(
         }
         Outcomes::Faces => (0..6).map(|k| vec![k]).collect(),
     };
-    let row = DataRow {
-        label,
-        surface,
-        thrower: if with_thrower {
-            text(6 + counted)?
-        } else {
-            "all".into()
-        },
+    Ok(DataRow {
+        label: String::new(),
+        surface: String::new(),
+        thrower: String::new(),
         block,
         mode,
         outcomes,
         counts,
         groups,
+        labels: Vec::new(),
+    })
+}
+
+/// `rows` read against the die of any shape they count: each row's `face_<label>` columns must
+/// be the die's faces, each once (in any order); its counts are put in the die's order and its
+/// block is the die's bounding box. Rows of a block's sides or a cube's numbers are refused, as
+/// is a die whose faces share a label (its counts could not be told apart).
+pub fn on_shape(rows: &[DataRow], shape: &crate::model::shape::Shape) -> Result<Vec<DataRow>> {
+    let want = shape.labels();
+    let bad = |m: String| Error::Invalid(m);
+    if let Some(l) = want.iter().find(|l| want.iter().filter(|m| m == l).count() > 1) {
+        return Err(bad(format!(
+            "{} has more than one face that shows '{l}': its counts cannot be told apart \
+             (give the faces distinct labels)",
+            shape.name
+        )));
+    }
+    let [x, y, z] = shape.bounding_box();
+    let block = Block {
+        breadth: x,
+        width: y,
+        length: z,
     };
-    let total = row.counts.iter().try_fold(0u64, |a, &c| a.checked_add(c));
-    if total.is_none_or(|t| t > MAX_ROW_THROWS) {
-        return Err((
-            6,
-            format!("counts too large: at most {MAX_ROW_THROWS} throws a row"),
-        ));
-    }
-    if row.n() == 0 {
-        return Err((6, "no throws counted".into()));
-    }
-    Ok(row)
+    rows.iter()
+        .map(|r| {
+            if !r.of_shape() {
+                return Err(bad(format!(
+                    "row '{}': {} is counted by its faces, one face_<label> column each \
+                     (label,surface,face_{},…), not by a block's sides or a cube's numbers",
+                    shown(&r.label),
+                    shape.name,
+                    want.join(",face_")
+                )));
+            }
+            let missing: Vec<&str> = want
+                .iter()
+                .filter(|l| !r.labels.iter().any(|m| m == *l))
+                .copied()
+                .collect();
+            let extra: Vec<&str> = r
+                .labels
+                .iter()
+                .filter(|m| !want.contains(&m.as_str()))
+                .map(String::as_str)
+                .collect();
+            if !missing.is_empty() || !extra.is_empty() || r.labels.len() != want.len() {
+                return Err(bad(format!(
+                    "row '{}': the columns must be {}'s faces, face_{} (each once){}{}",
+                    shown(&r.label),
+                    shape.name,
+                    want.join(",face_"),
+                    if missing.is_empty() {
+                        String::new()
+                    } else {
+                        format!("; missing face_{}", missing.join(", face_"))
+                    },
+                    if extra.is_empty() {
+                        String::new()
+                    } else {
+                        format!("; not its faces: face_{}", shown(&extra.join(", face_")))
+                    }
+                )));
+            }
+            let counts = want
+                .iter()
+                .map(|l| r.counts[r.labels.iter().position(|m| m == l).expect("found")])
+                .collect();
+            Ok(DataRow {
+                block,
+                counts,
+                labels: want.iter().map(|l| l.to_string()).collect(),
+                ..r.clone()
+            })
+        })
+        .collect()
 }
 
 /// The paper's 19 rows (its table "sidewaystable"), as a counts file would give them: every
@@ -580,6 +757,58 @@ mod tests {
             let e = parse(&text, "f.csv").unwrap_err().to_string();
             assert!(e.contains(want), "{e} (wanted {want})");
         }
+    }
+
+    #[test]
+    fn a_shapes_faces_are_read_by_label_into_its_order_and_refused_where_they_are_not_its() {
+        let coin = crate::model::shape::named("coin:24,8", None).unwrap();
+        assert_eq!(coin.labels(), ["heads", "tails", "edge"]);
+        let rows = parse(
+            "label,surface,face_edge,face_heads,face_tails,thrower\nthick,felt,190,412,398,me\n",
+            "f.csv",
+        )
+        .unwrap();
+        assert!(rows[0].of_shape());
+        assert_eq!(rows[0].labels, ["edge", "heads", "tails"]);
+        assert_eq!(rows[0].thrower, "me");
+        let read = on_shape(&rows, &coin).unwrap();
+        // The die's order, whatever the file's; the block its bounding box.
+        assert_eq!(read[0].counts, [412, 398, 190]);
+        assert_eq!(read[0].labels, ["heads", "tails", "edge"]);
+        assert_eq!(read[0].group_names(), ["face heads", "face tails", "face edge"]);
+        assert_eq!(read[0].n(), 1000);
+        assert!((read[0].block.breadth - 0.024).abs() < 1e-12);
+        assert!((read[0].block.length - 0.008).abs() < 1e-12);
+        let refused = |text: &str, says: &str| {
+            let rows = parse(text, "f.csv");
+            let e = match rows {
+                Ok(rows) => on_shape(&rows, &coin).unwrap_err().to_string(),
+                Err(e) => e.to_string(),
+            };
+            assert!(e.contains(says), "{e} (wanted {says})");
+            assert!(!e.contains('\n'), "{e}");
+        };
+        refused(
+            "label,surface,face_heads,face_tails\nc,felt,1,2\n",
+            "missing face_edge",
+        );
+        refused(
+            "label,surface,face_heads,face_tails,face_edge,face_rim\nc,felt,1,2,3,4\n",
+            "not its faces: face_rim",
+        );
+        refused(
+            "label,surface,face_heads,face_tails,face_edge\nc,felt,1,x,3\n",
+            "line 2, column 4 (face_tails): 'x' is not a count",
+        );
+        refused(
+            "label,surface,face_heads,face_tails,face_edge\nc,felt,0,0,0\n",
+            "column 3 (face_heads): no throws",
+        );
+        refused("label,surface,face_\nc,felt,1\n", "line 1: a die of any shape");
+        refused(
+            &format!("{HEAD}a,MDF,140,24,20,3d,0,361,639\n"),
+            "row 'a': coin:24,8 is counted by its faces",
+        );
     }
 
     #[test]

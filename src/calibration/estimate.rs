@@ -912,6 +912,7 @@ mod tests {
             outcomes: Default::default(),
             counts: vec![c[0], c[1], c[2]],
             groups: vec![vec![0], vec![1], vec![2]],
+            labels: Vec::new(),
         }];
         let pts: Vec<DesignPoint> = points(1, 24)
             .into_iter()
@@ -982,6 +983,7 @@ mod tests {
                 outcomes: Default::default(),
                 counts: vec![c[0], c[1], c[2]],
                 groups: vec![vec![0], vec![1], vec![2]],
+                labels: Vec::new(),
             });
             let pts: Vec<DesignPoint> = points(3, 64)
                 .into_iter()

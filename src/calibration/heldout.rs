@@ -239,7 +239,9 @@ pub fn test(row: &BlockRow, p: BlockPrediction) -> PredictedRow {
             err: (q * (1.0 - q) / n).sqrt() / (1.0 - q).powi(2),
         }
     });
-    let z = measured_ratio.map(|m| stats::z_score(m.value, m.err, p.ratio.value, p.ratio.err));
+    let z = measured_ratio
+        .zip(p.ratio)
+        .map(|(m, r)| stats::z_score(m.value, m.err, r.value, r.err));
     // The outcomes a row counts: a 2D block cannot stand on its end.
     let live: Vec<usize> = match row.mode {
         Mode::ThreeD => vec![0, 1, 2],
@@ -364,14 +366,16 @@ mod tests {
                     err_sim: 0.0,
                 })
                 .collect(),
-            ratio: Predicted {
+            ratio: Some(Predicted {
                 value: pb / (1.0 - pb),
                 err: 0.0,
                 err_params: 0.0,
                 err_sim: 0.0,
-            },
+            }),
             faces: None,
-            theory_ratio: 0.5,
+            labels: Vec::new(),
+            shape: None,
+            theory_ratio: Some(0.5),
             draws: 2,
             rolls: 10,
             unsettled: 0,

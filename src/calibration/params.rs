@@ -16,7 +16,7 @@ use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::mass::Features;
 use crate::model::scene::{Mode, Scene};
-use crate::model::throws::{Range, ThrowRanges};
+use crate::model::throws::{Range, ThrowRanges, ThrowStyle};
 use crate::run::spec::{RunSpec, ThrowSpec, MAX_KAPPA};
 use crate::sim::roll::{early_stop_exact, RollConfig, Rule};
 use serde::{Deserialize, Serialize};
@@ -160,6 +160,9 @@ pub enum FixedThrow {
     Paper,
     /// A hand's throw with this κ.
     Hand(f64),
+    /// The tumble: a random orientation and spin axis (the throw of a die of any shape, which
+    /// has no long axis for the paper's or a hand's throw to spin it about).
+    Tumble,
 }
 
 /// Values of the parameters that are not free.
@@ -427,7 +430,7 @@ impl ModelSpec {
 }
 
 /// How each throw is simulated: the engine, the time step, and what ends a roll.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Method {
     /// The engine.
     pub engine: EngineKind,
@@ -442,6 +445,10 @@ pub struct Method {
     /// The die's density, kg/m³, where it is not the paper's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub density: Option<f64>,
+    /// A die of any shape (`model::shape`) in place of every row's block: its rows count its
+    /// faces by label ([`crate::calibration::data::on_shape`]), thrown in a tumble.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<std::sync::Arc<crate::model::shape::Shape>>,
 }
 
 impl Method {
@@ -478,6 +485,10 @@ impl Method {
     /// `seed`.
     pub fn spec(&self, block: Block, mode: Mode, v: &Fixed, seed: u64, rolls: u64) -> RunSpec {
         let mut scene = Scene::paper(block, mode);
+        if let Some(s) = &self.shape {
+            scene.block = block;
+            scene.shape = Some(s.clone());
+        }
         scene.dt = self.dt;
         scene.restitution = v.e;
         scene.friction = v.mu;
@@ -488,6 +499,7 @@ impl Method {
         let mut throws = match v.throw {
             FixedThrow::Paper => ThrowSpec::keyed(seed),
             FixedThrow::Hand(k) => ThrowSpec::hand(seed, k),
+            FixedThrow::Tumble => ThrowSpec::keyed_style(seed, ThrowStyle::Tumble),
         };
         let paper = ThrowRanges::default().spin;
         throws.ranges.spin = Range::new(paper.lo * v.spin, paper.hi * v.spin);

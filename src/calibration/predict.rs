@@ -30,6 +30,14 @@ pub struct Predicted {
 }
 
 impl Predicted {
+    /// No prediction (NaN), where a table of blocks has a cell a die of any shape lacks.
+    pub const NONE: Predicted = Predicted {
+        value: f64::NAN,
+        err: f64::NAN,
+        err_params: f64::NAN,
+        err_sim: f64::NAN,
+    };
+
     /// The mean of `values` with their spread as the parameters' error and `sim_var` as the
     /// simulation's.
     pub fn of(values: &[f64], sim_var: f64) -> Predicted {
@@ -104,16 +112,26 @@ pub struct BlockPrediction {
     pub surface: String,
     /// The thrower whose throw was used.
     pub thrower: String,
-    /// P(length), P(breadth), P(width) vertical (a 2D block: length 0).
+    /// A die of any shape (the fit's), by name, in place of the block (its bounding box).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<String>,
+    /// P(length), P(breadth), P(width) vertical (a 2D block: length 0); empty for a die of any
+    /// shape.
     pub p: Vec<Predicted>,
-    /// N(breadth vertical)/N(width vertical).
-    pub ratio: Predicted,
-    /// P(face 1) … P(face 6) up, for a fit of a made die or of face counts (3D); `null`
-    /// otherwise.
+    /// N(breadth vertical)/N(width vertical); left out for a die of any shape.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ratio: Option<Predicted>,
+    /// P(face 1) … P(face 6) up, for a fit of a made die or of face counts (3D), or each face
+    /// of a die of any shape (in `labels`' order); `null` otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub faces: Option<Vec<Predicted>>,
-    /// The paper's 2D theory ratio (eq. MasterEqu) for the block.
-    pub theory_ratio: f64,
+    /// What each of `faces` shows: "1" … "6", or a die of any shape's labels.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub labels: Vec<String>,
+    /// The paper's 2D theory ratio (eq. MasterEqu) for the block; left out for a die of any
+    /// shape.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub theory_ratio: Option<f64>,
     /// Posterior draws simulated.
     pub draws: usize,
     /// Rolls per draw.
@@ -147,6 +165,12 @@ pub struct PredictConfig {
     pub rolls: u64,
     /// The throws' seed.
     pub seed: u64,
+}
+
+/// The block a prediction from `fit` simulates where none is given: a fit of a die of any
+/// shape predicts that die (its rows' block is its bounding box); a fit of blocks needs one.
+pub fn own_block(fit: &FitResult) -> Option<Block> {
+    fit.config.method.shape.as_ref().map(|_| fit.config.rows[0].block)
 }
 
 /// Which group a new row takes from the fit: the named one, or the only one there is.

@@ -70,6 +70,7 @@ pub fn flag(field: Field) -> &'static str {
         Field::AllowRestitutionAboveOne => "--allow-restitution-above-one",
         Field::AngularDamping => "--angular-damping",
         Field::Bin => "--bin",
+        Field::Block => "--block",
         Field::Blocks => "--blocks",
         Field::Bootstrap => "--bootstrap",
         Field::BudgetS => "--budget",

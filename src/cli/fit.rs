@@ -110,8 +110,9 @@ pub struct PredictArgs {
     /// The fit to predict from (a fit's fit.json).
     #[arg(long, value_name = "FIT.json")]
     pub fit: PathBuf,
-    /// The block, LENGTHxBREADTHxWIDTH in mm.
-    #[arg(long, required_unless_present = "blocks", conflicts_with = "blocks")]
+    /// The block, LENGTHxBREADTHxWIDTH in mm (a fit of a die of any shape predicts that die:
+    /// leave it out).
+    #[arg(long, conflicts_with = "blocks")]
     pub block: Option<Block>,
     /// Many blocks at once: a CSV with the columns label, block, mode and optionally surface,
     /// thrower and the three counts (length_vertical, breadth_vertical, width_vertical), or a
@@ -206,7 +207,9 @@ fn once(flag: &str, kinds: impl Iterator<Item = Kind>) -> Result<()> {
 }
 
 impl FitArgs {
-    fn model(&self) -> Result<ModelSpec> {
+    /// The model; `shape`: the die is of any shape, thrown in a tumble unless --kappa says
+    /// otherwise.
+    fn model(&self, shape: bool) -> Result<ModelSpec> {
         once("--free", self.free.iter().copied())?;
         once("--shared", self.shared.iter().copied())?;
         let mut free = self.free.clone();
@@ -224,7 +227,9 @@ impl FitArgs {
         // `--kappa paper`, the paper's throw, was the spelling before --kappa meant only a
         // hand's κ; it is still read.
         let throw = match self.kappa.as_deref() {
+            None if shape => FixedThrow::Tumble,
             None | Some("paper") => FixedThrow::Paper,
+            Some("tumble") => FixedThrow::Tumble,
             Some(k) => FixedThrow::Hand(k.parse().map_err(|_| {
                 Error::Usage(format!(
                     "--kappa {k}: a hand's concentration, a number >= 0"
@@ -244,6 +249,13 @@ impl FitArgs {
     }
 
     pub fn config(&self) -> Result<FitConfig> {
+        let m = &self.made;
+        let shape = dicephys::model::shape::described(
+            m.die.as_deref(),
+            m.shape.as_deref(),
+            m.size,
+            m.scale,
+        )?;
         let rows = if self.data.as_os_str() == "paper" && !self.data.exists() {
             data::paper_rows()?
         } else {
@@ -252,9 +264,13 @@ impl FitArgs {
                 e => Error::Usage(format!("--data {e}")),
             })?
         };
+        let rows = match &shape {
+            Some(s) => data::on_shape(&rows, s).map_err(|e| Error::Usage(format!("--data {e}")))?,
+            None => rows,
+        };
         let cfg = FitConfig {
             rows,
-            model: self.model()?,
+            model: self.model(shape.is_some())?,
             method: {
                 let (mut die, density) = self.made.features()?;
                 if let Some(layout) = self.layout {
@@ -266,6 +282,7 @@ impl FitArgs {
                     max_steps: *self.max_steps,
                     die,
                     density,
+                    shape: shape.map(std::sync::Arc::new),
                 }
             },
             design: DesignSpec {
@@ -348,7 +365,14 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
     if let Some(file) = &a.blocks {
         return predict_blocks(a, &fit, file);
     }
-    let block = a.block.expect("clap requires --block without --blocks");
+    let block = match (a.block, dicephys::calibration::predict::own_block(&fit)) {
+        (Some(b), _) | (None, Some(b)) => b,
+        (None, None) => {
+            return Err(Error::Usage(
+                "give --block (the block to predict) or --blocks (a file of them)".into(),
+            ))
+        }
+    };
     let cfg = PredictConfig {
         block,
         mode: if a.two_d { Mode::TwoD } else { Mode::ThreeD },

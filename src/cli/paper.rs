@@ -85,6 +85,7 @@ impl PaperArgs {
         let a = self;
         dicephys::studies::calibrated::CalibratedConfig {
             method: Method {
+                shape: None,
                 engine: EngineKind::Bullet,
                 dt: a.dt,
                 max_steps: *a.max_steps,

@@ -39,6 +39,7 @@ pub fn fixed_text(res: &FitResult) -> String {
         parts.push(match f.throw {
             FixedThrow::Paper => "the paper's throw".into(),
             FixedThrow::Hand(k) => format!("a hand's throw with κ = {k}"),
+            FixedThrow::Tumble => "a tumble".into(),
         });
     }
     if !m.is_free(Kind::Spin) {
@@ -286,13 +287,17 @@ pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
     );
     let _ = writeln!(
         s,
-        "Method: {} at dt = {} s, {} rows on {} blocks, each simulated at {} parameter points × {} \
+        "Method: {} at dt = {} s, {} rows on {} {}, each simulated at {} parameter points × {} \
          rolls (seed {}); {} rolls in all ({} did not settle on a face and are left out), {:.0} s \
          wall, {:.0} s CPU. Fixed: {}.\n",
         c.method.engine,
         c.method.dt,
         c.rows.len(),
         res.designs.len(),
+        match &c.method.shape {
+            Some(shape) => format!("designs of {}", shape.name),
+            None => "blocks".into(),
+        },
         res.designs.first().map_or(0, |d| d.points.len()),
         c.design.rolls,
         c.seed,
@@ -349,7 +354,10 @@ pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
         let _ = writeln!(
             s,
             "| {} | {} | {:.1} / {} | {:.3} | {:.2} | {} of {} |",
-            d.name(),
+            c.method
+                .shape
+                .as_ref()
+                .map_or_else(|| d.name(), |shape| shape.name.clone()),
             sg.degree,
             sg.deviance,
             sg.dof,
@@ -458,7 +466,7 @@ pub fn prediction_text(p: &BlockPrediction) -> String {
     let _ = writeln!(
         s,
         "{} {} on {} (thrower {}): {} posterior draws × {} rolls",
-        p.block,
+        p.shape.clone().unwrap_or_else(|| p.block.to_string()),
         p.mode.name(),
         p.surface,
         p.thrower,
@@ -468,21 +476,26 @@ pub fn prediction_text(p: &BlockPrediction) -> String {
     for (name, v) in ["length", "breadth", "width"].iter().zip(&p.p) {
         let _ = writeln!(s, "  P({name} vertical)  {}", predicted(v));
     }
-    let _ = writeln!(
-        s,
-        "  ratio breadth/width  {}   theory (MasterEqu) {:.4}",
-        predicted(&p.ratio),
-        p.theory_ratio
-    );
-    for (k, v) in p.faces.iter().flatten().enumerate() {
+    if let (Some(r), Some(t)) = (p.ratio, p.theory_ratio) {
+        let _ = writeln!(
+            s,
+            "  ratio breadth/width  {}   theory (MasterEqu) {t:.4}",
+            predicted(&r)
+        );
+    }
+    let faces = p.faces.as_deref().unwrap_or_default();
+    let fair = 1.0 / faces.len().max(1) as f64;
+    let n = faces.len();
+    for (k, v) in faces.iter().enumerate() {
+        let label = p.labels.get(k).cloned().unwrap_or_else(|| (k + 1).to_string());
         // Reliability round 5, class K: over an error of 0 (a face never or always up in
         // every draw) a departure in σ means nothing; it is not printed.
         let z = if v.err > 0.0 && v.err.is_finite() {
-            format!("   {:+.1}σ from 1/6", (v.value - 1.0 / 6.0) / v.err)
+            format!("   {:+.1}σ from 1/{n}", (v.value - fair) / v.err)
         } else {
-            "   (no error: not compared with 1/6)".to_string()
+            format!("   (no error: not compared with 1/{n})")
         };
-        let _ = writeln!(s, "  P(face {} up)  {}{z}", k + 1, predicted(v));
+        let _ = writeln!(s, "  P(face {label} up)  {}{z}", predicted(v));
     }
     if p.unsettled > 0 {
         let _ = writeln!(
@@ -851,8 +864,8 @@ pub fn predictions_markdown(p: &crate::calibration::heldout::Predictions, stem: 
             short(&q.p[0]),
             short(&q.p[1]),
             short(&q.p[2]),
-            short(&q.ratio),
-            q.theory_ratio,
+            short(&q.ratio.unwrap_or(Predicted::NONE)),
+            q.theory_ratio.unwrap_or(f64::NAN),
             r.measured_ratio
                 .map_or("–".into(), |m| format!("{:.3} ± {:.3}", m.value, m.err)),
             r.z.map_or("–".into(), |z| format!("{z:+.2}")),
@@ -927,9 +940,9 @@ pub fn predictions_csv(p: &crate::calibration::heldout::Predictions) -> String {
             q.p[1].err,
             q.p[2].value,
             q.p[2].err,
-            q.ratio.value,
-            q.ratio.err,
-            q.theory_ratio,
+            q.ratio.unwrap_or(Predicted::NONE).value,
+            q.ratio.unwrap_or(Predicted::NONE).err,
+            q.theory_ratio.unwrap_or(f64::NAN),
             opt(r.counts.map(|c| c[0].to_string())),
             opt(r.counts.map(|c| c[1].to_string())),
             opt(r.counts.map(|c| c[2].to_string())),
@@ -963,12 +976,12 @@ pub fn predictions_figure(
             }),
             simulated: Point {
                 x: 0.0,
-                y: r.prediction.ratio.value,
-                y_err: r.prediction.ratio.err,
+                y: r.prediction.ratio.unwrap_or(Predicted::NONE).value,
+                y_err: r.prediction.ratio.unwrap_or(Predicted::NONE).err,
             },
-            theory: Some(Point {
+            theory: r.prediction.theory_ratio.map(|y| Point {
                 x: 0.0,
-                y: r.prediction.theory_ratio,
+                y,
                 y_err: 0.0,
             }),
         })

@@ -95,7 +95,7 @@ impl CalibratedConfig {
             FitConfig {
                 rows,
                 model,
-                method: self.method,
+                method: self.method.clone(),
                 design: self.design,
                 search: self.search,
                 seed: self.seed,
@@ -184,7 +184,7 @@ pub fn first_pass_rolls(cfg: &CalibratedConfig) -> Result<u64> {
             FitConfig {
                 rows,
                 model,
-                method: cfg.method,
+                method: cfg.method.clone(),
                 design: cfg.design,
                 search: cfg.search,
                 seed: cfg.seed,
@@ -305,7 +305,7 @@ fn fit_config(
     let fc = FitConfig {
         rows,
         model,
-        method: cfg.method,
+        method: cfg.method.clone(),
         design: cfg.design,
         search,
         seed: cfg.seed,

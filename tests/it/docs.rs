@@ -946,6 +946,25 @@ fn document_fit_passes(c: &mut Checker, dir: &Scratch) {
 /// A made die's face counts fitted, its centre of mass free, and a prediction of its faces.
 fn document_a_die_fit(c: &mut Checker, dir: &Scratch) {
     let d = dir.to_str().unwrap();
+    // A die of any shape: counted by label, predicted without a block.
+    let d4_csv = dir.join("d4.csv");
+    std::fs::write(
+        &d4_csv,
+        "label,surface,face_4,face_3,face_2,face_1\nd,MDF,30,25,25,20\n",
+    )
+    .unwrap();
+    let d4_fit = format!("{d}/d4");
+    let d4 = run(&[
+        "fit", "--data", d4_csv.to_str().unwrap(), "--shape", "d4", "--free", "com_z",
+        "--points", "8", "--point-rolls", "60", "--degree", "1", "--no-refine", "--dt", "1/250",
+        "--threads", "1", "--out", &d4_fit, "--json",
+    ]);
+    c.document("fit", "fit of a d4's face counts", &d4);
+    let p = run(&[
+        "predict", "--fit", &format!("{d4_fit}/fit.json"), "--draws", "3", "--rolls", "50",
+        "--threads", "1", "--json",
+    ]);
+    c.document("predict", "predict of a d4", &p);
     let faces_csv = dir.join("faces.csv");
     std::fs::write(
         &faces_csv,

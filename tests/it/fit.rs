@@ -342,6 +342,7 @@ fn counted_at_e_03(runner: &Runner) -> FitConfig {
         outcomes: Default::default(),
         counts: vec![0, 0, n],
         groups: vec![vec![1], vec![2]],
+        labels: Vec::new(),
     };
     let shape = vec![
         row("a1", "A", "140x30x10", 4000),
@@ -357,6 +358,7 @@ fn counted_at_e_03(runner: &Runner) -> FitConfig {
             max_steps: dicephys::sim::roll::DEFAULT_MAX_STEPS,
             die: Default::default(),
             density: None,
+            shape: None,
         },
         design: DesignSpec {
             points: POINTS,

@@ -16,6 +16,7 @@ mod promises;
 mod promises_files;
 mod rapier;
 mod reliability;
+mod shape_fit;
 mod shapes;
 mod slurm;
 mod speed;

@@ -26,7 +26,7 @@ pub fn run(
 ) -> Result<Option<MethodCheck>> {
     let reference = Method {
         dt: reference_dt,
-        ..*method
+        ..method.clone()
     };
     let mut checks = Vec::new();
     for (block, mode) in blocks(rows) {

@@ -32,6 +32,19 @@ pub fn check(fit: &FitResult, cfg: &PredictConfig) -> Result<()> {
     }
     group(fit, true, &cfg.surface, "surface")?;
     group(fit, false, &cfg.thrower, "thrower")?;
+    if let Some(s) = &fit.config.method.shape {
+        let own = fit.config.rows[0].block;
+        if cfg.block != own || cfg.mode != crate::model::scene::Mode::ThreeD {
+            return Err(Error::field(
+                Field::Block,
+                format!("{} {}", cfg.block, cfg.mode.name()),
+                format!(
+                    "the fit is of {}: a prediction is of that die, in 3D (leave the block out)",
+                    s.name
+                ),
+            ));
+        }
+    }
     let model = &fit.config.model;
     if let Some([e, mu]) = cfg.contact {
         if !((0.0..=1.0).contains(&e) && (0.0..=5.0).contains(&mu)) {
@@ -84,7 +97,8 @@ pub fn extrapolation(fit: &FitResult, block: &crate::model::block::Block) -> Opt
     (!out.is_empty()).then(|| format!("outside the blocks the fit saw: {}", out.join(", ")))
 }
 
-/// Simulates `cfg.block` at posterior draws of `fit`. `None` if stopped early.
+/// Simulates `cfg.block` (or the fit's die of any shape) at posterior draws of `fit`. `None`
+/// if stopped early.
 pub fn predict_block(
     fit: &FitResult,
     cfg: &PredictConfig,
@@ -94,17 +108,19 @@ pub fn predict_block(
     check(fit, cfg)?;
     let surface = group(fit, true, &cfg.surface, "surface")?;
     let thrower = group(fit, false, &cfg.thrower, "thrower")?;
-    let mut freq: [Vec<f64>; 3] = Default::default();
-    let die = &fit.config.method.die;
-    // A made die, or a fit of faces: its faces too.
+    let method = &fit.config.method;
+    let shape = method.shape.as_deref();
+    // A made die, a fit of faces or a die of any shape: its faces too.
     let with_faces = cfg.mode == crate::model::scene::Mode::ThreeD
-        && (!die.is_default()
+        && (!method.die.is_default()
+            || shape.is_some()
             || fit
                 .config
                 .rows
                 .iter()
                 .any(|r| r.outcomes == crate::calibration::data::Outcomes::Faces));
-    let mut face_freq: [Vec<f64>; 6] = Default::default();
+    let mut freq: [Vec<f64>; 3] = Default::default();
+    let mut face_freq: Vec<Vec<f64>> = vec![Vec::new(); super::simulate::face_count(method)];
     let mut ratios = Vec::new();
     let mut unsettled = 0;
     for (m, spec) in draw_specs(fit, cfg, &surface, &thrower)?.iter().enumerate() {
@@ -121,22 +137,25 @@ pub fn predict_block(
             return Ok(None);
         }
         let c = &done.tally.counts;
-        let settled = c.length + c.breadth + c.width;
+        let settled = super::simulate::settled(&done.tally);
         unsettled += done.tally.rolls - settled;
         let sides = c.breadth + c.width;
-        if sides == 0 || settled == 0 {
+        if settled == 0 || shape.is_none() && sides == 0 {
             return Err(Error::Failed(format!(
-                "none of the {} rolls at posterior draw {m} settled on a side: no probabilities \
+                "none of the {} rolls at posterior draw {m} settled on a {}: no probabilities \
                  to give; raise `max_steps` in the fit, or use a finer `dt`",
-                done.tally.rolls
+                done.tally.rolls,
+                if shape.is_some() { "face" } else { "side" }
             )));
         }
-        for (k, v) in [c.length, c.breadth, c.width].iter().enumerate() {
-            freq[k].push(*v as f64 / settled as f64);
+        if shape.is_none() {
+            for (k, v) in [c.length, c.breadth, c.width].iter().enumerate() {
+                freq[k].push(*v as f64 / settled as f64);
+            }
+            ratios.push(c.breadth as f64 / c.width.max(1) as f64);
         }
-        ratios.push(c.breadth as f64 / c.width.max(1) as f64);
         if with_faces {
-            let faces = super::simulate::outcome_counts(&done.tally, true, die)?;
+            let faces = super::simulate::outcome_counts(&done.tally, true, method)?;
             for (k, v) in faces.iter().enumerate() {
                 face_freq[k].push(*v as f64 / settled as f64);
             }
@@ -150,39 +169,49 @@ pub fn predict_block(
         )));
     }
     let n = cfg.rolls as f64;
-    let p: Vec<Predicted> = freq
-        .iter()
-        .map(|v| combine(v, &|q: f64| q * (1.0 - q) / n))
-        .collect();
-    let faces = with_faces.then(|| {
-        face_freq
-            .iter()
-            .map(|v| combine(v, &|q: f64| q * (1.0 - q) / n))
-            .collect()
-    });
-    let ratio = combine(&ratios, &|r: f64| {
-        // The paper's binomial error of a ratio r = q/(1 − q) of counts (q the breadth's share
-        // of the side outcomes): Var r = q(1 − q)/(n (1 − q)⁴).
-        let q = r / (1.0 + r);
-        q * (1.0 - q) / n / (1.0 - q).powi(4)
+    let binomial = |q: f64| q * (1.0 - q) / n;
+    let faces = with_faces.then(|| face_freq.iter().map(|v| combine(v, &binomial)).collect());
+    let ratio = shape.is_none().then(|| {
+        combine(&ratios, &|r: f64| {
+            // The paper's binomial error of a ratio r = q/(1 − q) of counts (q the breadth's
+            // share of the side outcomes): Var r = q(1 − q)/(n (1 − q)⁴).
+            let q = r / (1.0 + r);
+            q * (1.0 - q) / n / (1.0 - q).powi(4)
+        })
     });
     Ok(Some(BlockPrediction {
         block: cfg.block,
         mode: cfg.mode,
+        shape: shape.map(|s| s.name.clone()),
         // A surface given by its e and μ is named by them.
         surface: match cfg.contact {
             Some([e, mu]) => format!("e {e}, μ {mu}"),
             None => surface,
         },
         thrower,
-        p,
+        p: freq
+            .iter()
+            .filter(|v| !v.is_empty())
+            .map(|v| combine(v, &binomial))
+            .collect(),
         ratio,
+        labels: match shape {
+            Some(s) => s.labels().iter().map(|l| l.to_string()).collect(),
+            None if with_faces => (1..=6).map(|k| k.to_string()).collect(),
+            None => Vec::new(),
+        },
         faces,
-        theory_ratio: crate::theory::ratio_from_r(cfg.block.r()),
+        theory_ratio: shape
+            .is_none()
+            .then(|| crate::theory::ratio_from_r(cfg.block.r())),
         draws: cfg.draws,
         rolls: cfg.rolls,
         unsettled,
-        extrapolation: extrapolation(fit, &cfg.block),
+        extrapolation: if shape.is_some() {
+            None
+        } else {
+            extrapolation(fit, &cfg.block)
+        },
     }))
 }
 
@@ -205,6 +234,7 @@ fn draw_specs(
         outcomes: Default::default(),
         counts: vec![0, 1, 1],
         groups: vec![vec![1], vec![2]],
+        labels: Vec::new(),
     };
     let model = &fit.config.model;
     let dims = model.row_dims(&fit.params, &row);

@@ -36,7 +36,7 @@ pub fn simulate_data(
             return Ok(None);
         }
         let faces = row.outcomes == Outcomes::Faces;
-        let counts = outcome_counts(&done.tally, faces, &cfg.method.die)?;
+        let counts = outcome_counts(&done.tally, faces, &cfg.method)?;
         // Merged groups keep their count in the first member, as the data file does.
         let grouped: Vec<u64> = row
             .groups

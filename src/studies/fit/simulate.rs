@@ -4,7 +4,6 @@ use crate::calibration::design::{points, Design, DesignSpec, Key};
 use crate::calibration::params::{self, Method, ModelSpec};
 use crate::error::{Error, Result};
 use crate::inference::surrogate::{DesignPoint, Surrogate};
-use crate::model::mass::Features;
 use crate::model::scene::Mode;
 use crate::run::runner::Runner;
 use crate::run::tally::Tally;
@@ -133,11 +132,11 @@ pub fn simulate(
                 continue;
             }
             let t = &done.tally;
-            unsettled += t.rolls - (t.counts.length + t.counts.breadth + t.counts.width);
+            unsettled += t.rolls - settled(t);
             rolls += t.rolls;
             design_points.push(DesignPoint {
                 x: x.clone(),
-                counts: outcome_counts(t, key.faces, &plan.method.die)?,
+                counts: outcome_counts(t, key.faces, plan.method)?,
             });
         }
         if runner.share.is_partial() {
@@ -145,7 +144,7 @@ pub fn simulate(
         }
         // A 2D block has no length outcome: its surrogate is over breadth and width.
         let (outcomes, pts): (usize, Vec<DesignPoint>) = match mode {
-            _ if key.faces => (6, design_points.clone()),
+            _ if key.faces => (face_count(plan.method), design_points.clone()),
             Mode::ThreeD => (3, design_points.clone()),
             Mode::TwoD => (
                 2,
@@ -185,11 +184,29 @@ pub fn simulate(
     Ok((!runner.share.is_partial()).then_some(out))
 }
 
+/// Rolls of a tally that settled on a side, a number or (a die of any shape) a face.
+pub fn settled(t: &Tally) -> u64 {
+    let c = &t.counts;
+    c.length + c.breadth + c.width + c.face
+}
+
+/// How many faces a fit of faces counts: a die of any shape's, else a cube's six.
+pub fn face_count(method: &Method) -> usize {
+    method.shape.as_ref().map_or(6, |s| s.faces.len())
+}
+
 /// A tally's outcomes as a fit counts them: length, breadth and width vertical, or (`faces`)
-/// how often each number 1 to 6 came up on `die`'s layout.
-pub fn outcome_counts(t: &Tally, faces: bool, die: &Features) -> Result<Vec<u64>> {
+/// how often each number 1 to 6 came up on the die's layout, or each face of a die of any
+/// shape in its order.
+pub fn outcome_counts(t: &Tally, faces: bool, method: &Method) -> Result<Vec<u64>> {
     if !faces {
         return Ok(vec![t.counts.length, t.counts.breadth, t.counts.width]);
+    }
+    if method.shape.is_some() {
+        // The tally keeps faces up to the last that came up: the rest are 0.
+        let mut out = t.faces.clone();
+        out.resize(face_count(method), 0);
+        return Ok(out);
     }
     if !t.faces_complete() {
         return Err(Error::Invalid(
@@ -198,7 +215,7 @@ pub fn outcome_counts(t: &Tally, faces: bool, die: &Features) -> Result<Vec<u64>
                 .into(),
         ));
     }
-    let numbers = die.layout.numbers();
+    let numbers = method.die.layout.numbers();
     let mut out = vec![0; 6];
     for (d, &n) in numbers.iter().enumerate() {
         out[usize::from(n) - 1] = t.up[d];
