@@ -53,7 +53,7 @@ def recover(
 ) -> str: ...
 def predict(
     fit: str,
-    block: str,
+    block: Optional[str] = ...,
     *,
     mode: str = ...,
     surface: Optional[str] = ...,

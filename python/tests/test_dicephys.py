@@ -13,6 +13,7 @@ import subprocess
 import threading
 import time
 from pathlib import Path
+from typing import Any, Dict
 
 import numpy as np
 import pytest
@@ -227,6 +228,25 @@ def test_a_die_s_weight_fitted_through_python_is_the_cli_s(tmp_path: Path) -> No
     got, wanted = f.data["estimate"]["params"][0], want["estimate"]["params"][0]
     assert got["value"] == wanted["value"] and got["two_sigma"] == wanted["two_sigma"]
     assert got["two_sigma"][0] <= -1.0 <= got["two_sigma"][1]
+
+
+def test_a_d4_s_weight_fitted_and_predicted_through_python_is_the_cli_s(tmp_path: Path) -> None:
+    # A die of any shape: counts by face_<label>, predicted without a block.
+    faces = dicephys.roll(shape="d4", rolls=1200, seed=5, com=(0, 0, -1)).faces
+    row: Dict[str, Any] = dict(label="suspect", surface="MDF")
+    row.update({f"face_{k}": v for k, v in faces.items()})
+    small = dict(free=["com_z"], points=8, point_rolls=200, refine=False, dt=1 / 250)
+    f = dicephys.fit([row], shape="d4", out=tmp_path / "py", **small)  # type: ignore[arg-type]
+    csv_path = tmp_path / "d4.csv"
+    csv_path.write_text(",".join(row) + "\n" + ",".join(str(v) for v in row.values()) + "\n")
+    want = cli("fit", "--data", str(csv_path), "--shape", "d4", "--free", "com_z", "--points", "8",
+               "--point-rolls", "200", "--no-refine", "--dt", "1/250", "--out", str(tmp_path / "cli"),
+               "--json")
+    assert f.data["estimate"]["params"][0]["value"] == want["estimate"]["params"][0]["value"]
+    p = dicephys.predict(f, draws=3, rolls=100)
+    assert p.data == cli("predict", "--fit", f.path, "--draws", "3", "--rolls", "100", "--json")
+    assert p.data["shape"] == "d4" and len(p.data["faces"]) == 4
+    assert sorted(p.data["labels"]) == ["1", "2", "3", "4"]
 
 
 def test_paper_is_the_cli_s_and_a_stopped_one_writes_nothing(tmp_path: Path) -> None:

@@ -378,8 +378,8 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DataRow>> {
     for rec in reader.records() {
         let rec = rec.map_err(csv_error)?;
         let line = line_of(rec.position().map_or(0, |p| p.byte() as usize));
-        let row = row_of(&rec, have.len(), &form, with_thrower)
-            .map_err(|(c, m)| bad(line, c, m))?;
+        let row =
+            row_of(&rec, have.len(), &form, with_thrower).map_err(|(c, m)| bad(line, c, m))?;
         if !labels.insert(row.label.clone()) {
             return Err(bad(
                 line,
@@ -561,7 +561,10 @@ fn block_row(
 pub fn on_shape(rows: &[DataRow], shape: &crate::model::shape::Shape) -> Result<Vec<DataRow>> {
     let want = shape.labels();
     let bad = |m: String| Error::Invalid(m);
-    if let Some(l) = want.iter().find(|l| want.iter().filter(|m| m == l).count() > 1) {
+    if let Some(l) = want
+        .iter()
+        .find(|l| want.iter().filter(|m| m == l).count() > 1)
+    {
         return Err(bad(format!(
             "{} has more than one face that shows '{l}': its counts cannot be told apart \
              (give the faces distinct labels)",
@@ -775,7 +778,10 @@ mod tests {
         // The die's order, whatever the file's; the block its bounding box.
         assert_eq!(read[0].counts, [412, 398, 190]);
         assert_eq!(read[0].labels, ["heads", "tails", "edge"]);
-        assert_eq!(read[0].group_names(), ["face heads", "face tails", "face edge"]);
+        assert_eq!(
+            read[0].group_names(),
+            ["face heads", "face tails", "face edge"]
+        );
         assert_eq!(read[0].n(), 1000);
         assert!((read[0].block.breadth - 0.024).abs() < 1e-12);
         assert!((read[0].block.length - 0.008).abs() < 1e-12);
@@ -804,7 +810,10 @@ mod tests {
             "label,surface,face_heads,face_tails,face_edge\nc,felt,0,0,0\n",
             "column 3 (face_heads): no throws",
         );
-        refused("label,surface,face_\nc,felt,1\n", "line 1: a die of any shape");
+        refused(
+            "label,surface,face_\nc,felt,1\n",
+            "line 1: a die of any shape",
+        );
         refused(
             &format!("{HEAD}a,MDF,140,24,20,3d,0,361,639\n"),
             "row 'a': coin:24,8 is counted by its faces",

@@ -170,7 +170,11 @@ pub struct PredictConfig {
 /// The block a prediction from `fit` simulates where none is given: a fit of a die of any
 /// shape predicts that die (its rows' block is its bounding box); a fit of blocks needs one.
 pub fn own_block(fit: &FitResult) -> Option<Block> {
-    fit.config.method.shape.as_ref().map(|_| fit.config.rows[0].block)
+    fit.config
+        .method
+        .shape
+        .as_ref()
+        .map(|_| fit.config.rows[0].block)
 }
 
 /// Which group a new row takes from the fit: the named one, or the only one there is.

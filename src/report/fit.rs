@@ -487,7 +487,11 @@ pub fn prediction_text(p: &BlockPrediction) -> String {
     let fair = 1.0 / faces.len().max(1) as f64;
     let n = faces.len();
     for (k, v) in faces.iter().enumerate() {
-        let label = p.labels.get(k).cloned().unwrap_or_else(|| (k + 1).to_string());
+        let label = p
+            .labels
+            .get(k)
+            .cloned()
+            .unwrap_or_else(|| (k + 1).to_string());
         // Reliability round 5, class K: over an error of 0 (a face never or always up in
         // every draw) a departure in σ means nothing; it is not printed.
         let z = if v.err > 0.0 && v.err.is_finite() {

@@ -955,14 +955,40 @@ fn document_a_die_fit(c: &mut Checker, dir: &Scratch) {
     .unwrap();
     let d4_fit = format!("{d}/d4");
     let d4 = run(&[
-        "fit", "--data", d4_csv.to_str().unwrap(), "--shape", "d4", "--free", "com_z",
-        "--points", "8", "--point-rolls", "60", "--degree", "1", "--no-refine", "--dt", "1/250",
-        "--threads", "1", "--out", &d4_fit, "--json",
+        "fit",
+        "--data",
+        d4_csv.to_str().unwrap(),
+        "--shape",
+        "d4",
+        "--free",
+        "com_z",
+        "--points",
+        "8",
+        "--point-rolls",
+        "60",
+        "--degree",
+        "1",
+        "--no-refine",
+        "--dt",
+        "1/250",
+        "--threads",
+        "1",
+        "--out",
+        &d4_fit,
+        "--json",
     ]);
     c.document("fit", "fit of a d4's face counts", &d4);
     let p = run(&[
-        "predict", "--fit", &format!("{d4_fit}/fit.json"), "--draws", "3", "--rolls", "50",
-        "--threads", "1", "--json",
+        "predict",
+        "--fit",
+        &format!("{d4_fit}/fit.json"),
+        "--draws",
+        "3",
+        "--rolls",
+        "50",
+        "--threads",
+        "1",
+        "--json",
     ]);
     c.document("predict", "predict of a d4", &p);
     let faces_csv = dir.join("faces.csv");
