@@ -222,9 +222,24 @@ pub fn write(dir: &std::path::Path, json: &str, fair: &Fairness, s: &RunSummary)
             z: f.z,
         })
         .collect();
-    // The die map is a cube's net: drawn for the cuboid only; the faces figure for every die.
-    if s.spec.scene.shape.is_none() {
-        crate::report::figures::die::die_map(dir, "die_map", &title, &faces)?;
+    // The die map: a cube's net, or a die of any shape seen from two sides.
+    match &s.spec.scene.shape {
+        None => crate::report::figures::die::die_map(dir, "die_map", &title, &faces)?,
+        Some(shape) => {
+            let by_label: Vec<crate::report::figures::die::ShapeFace> = shape
+                .faces
+                .iter()
+                .map(|o| {
+                    let v = fair.faces.iter().find(|f| f.direction == o.label);
+                    crate::report::figures::die::ShapeFace {
+                        label: o.label.clone(),
+                        p: v.map_or(0.0, |f| f.p),
+                        z: v.map_or(0.0, |f| f.z),
+                    }
+                })
+                .collect();
+            crate::report::figures::die::shape_map(dir, "die_map", &title, shape, &by_label)?;
+        }
     }
     let bars: Vec<crate::report::figures::die::FaceBar> = fair
         .faces

@@ -4,6 +4,7 @@
 //! one.
 
 use super::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 /// One face on the map.
 #[derive(Clone, Debug, PartialEq)]
@@ -322,5 +323,244 @@ mod tests {
         assert_eq!(cells.len(), 6);
         assert_eq!(shade(0.0), RGBColor(255, 255, 255));
         assert_eq!(shade(9.0), RGBColor(255, 90, 90));
+    }
+}
+
+/// One outcome of a die of any shape on its map: its label and how often the die came to
+/// rest on that face.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShapeFace {
+    /// What the die shows resting on the face.
+    pub label: String,
+    /// Its probability.
+    pub p: f64,
+    /// Its departure from the null in σ.
+    pub z: f64,
+}
+
+/// A facet of the hull as the map draws it: its outline projected on the plane normal to the
+/// view, seen from the front (`back` false) or from behind (mirrored, as one sees the far side
+/// by turning the die over), and the outcome resting on it, if any.
+#[derive(Clone, Debug, PartialEq)]
+struct Drawn {
+    outline: Vec<(f64, f64)>,
+    back: bool,
+    face: Option<usize>,
+}
+
+/// The view that sees every facet most squarely: of 64 directions spread over a hemisphere
+/// (a Fibonacci lattice, fixed, so the map is the same every run), the one whose smallest
+/// |normal · view| over the facets is largest. A facet seen edge-on (a cube's sides along an
+/// axis) would vanish; this view sees each at a slant, half from the front, half from behind.
+fn view(normals: &[nalgebra::Vector3<f64>]) -> nalgebra::Vector3<f64> {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..64)
+        .map(|i| {
+            let z = 1.0 - (i as f64 + 0.5) / 64.0;
+            let r = (1.0 - z * z).sqrt();
+            let a = golden * i as f64;
+            nalgebra::Vector3::new(r * a.cos(), r * a.sin(), z)
+        })
+        .max_by(|a, b| {
+            let worst = |v: &nalgebra::Vector3<f64>| {
+                normals
+                    .iter()
+                    .map(|n| n.dot(v).abs())
+                    .fold(f64::INFINITY, f64::min)
+            };
+            worst(a).total_cmp(&worst(b))
+        })
+        .expect("64 directions")
+}
+
+/// The hull's facets projected for the map, each matched to the outcome whose face it is (by
+/// normal, within 1e-6; a facet the die cannot rest on has none).
+fn projected(shape: &crate::model::shape::Shape) -> Vec<Drawn> {
+    let facets = shape.facets();
+    let normals: Vec<_> = facets.iter().map(|f| f.normal).collect();
+    let v = view(&normals);
+    // A basis of the view's plane: e1 horizontal (no z), e2 = v × e1 upward.
+    let e1 = nalgebra::Vector3::new(-v.y, v.x, 0.0)
+        .try_normalize(1e-9)
+        .unwrap_or(nalgebra::Vector3::x());
+    let e2 = v.cross(&e1);
+    facets
+        .iter()
+        .map(|f| {
+            let back = f.normal.dot(&v) < 0.0;
+            let sign = if back { -1.0 } else { 1.0 };
+            Drawn {
+                outline: f
+                    .polygon
+                    .iter()
+                    .map(|p| (sign * p.dot(&e1), p.dot(&e2)))
+                    .collect(),
+                back,
+                face: shape
+                    .faces
+                    .iter()
+                    .position(|o| (nalgebra::Vector3::from(o.normal) - f.normal).norm() < 1e-6),
+            }
+        })
+        .collect()
+}
+
+struct ShapeMap<'a> {
+    title: &'a str,
+    drawn: Vec<Drawn>,
+    faces: &'a [ShapeFace],
+}
+
+impl Figure for ShapeMap<'_> {
+    fn size(&self) -> (u32, u32) {
+        (1100, 640)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        root.fill(&WHITE).map_err(plot_err)?;
+        let (top, body) = root.split_vertically(70);
+        top.titled(self.title, (FONT, 18)).map_err(plot_err)?;
+        let extent = self
+            .drawn
+            .iter()
+            .flat_map(|d| &d.outline)
+            .fold(0.0f64, |m, (x, y)| m.max(x.abs()).max(y.abs()));
+        let (w, h) = body.dim_in_pixel();
+        let half = (w / 2) as f64;
+        let scale = 0.42 * half.min(h as f64 - 70.0) / extent.max(1e-12);
+        body.draw(&Text::new(
+            "Each face shaded by how much more (red) or less (blue) often the die came to rest \
+             on it than the null says (full at 5σ), labelled with what the die then shows.",
+            (20, h as i32 - 24),
+            (FONT, 15).into_font(),
+        ))
+        .map_err(plot_err)?;
+        for (panel, back) in [(0.0, false), (half, true)] {
+            let (cx, cy) = (panel + half / 2.0, (h as f64 - 20.0) / 2.0);
+            let at = |(x, y): (f64, f64)| ((cx + scale * x) as i32, (cy - scale * y) as i32);
+            let caption = if back {
+                "the far side (the die turned over, left to right)"
+            } else {
+                "seen from one side"
+            };
+            body.draw(&Text::new(
+                caption,
+                (panel as i32 + 20, 6),
+                (FONT, 17).into_font(),
+            ))
+            .map_err(plot_err)?;
+            for d in self.drawn.iter().filter(|d| d.back == back) {
+                let pts: Vec<(i32, i32)> = d.outline.iter().map(|&p| at(p)).collect();
+                let face = d.face.and_then(|k| self.faces.get(k));
+                let fill = face.map_or(RGBColor(225, 225, 225), |f| shade(f.z));
+                body.draw(&Polygon::new(pts.clone(), fill.filled()))
+                    .map_err(plot_err)?;
+                let mut ring = pts.clone();
+                ring.push(pts[0]);
+                body.draw(&PathElement::new(ring, BLACK.stroke_width(2)))
+                    .map_err(plot_err)?;
+                if let Some(f) = face {
+                    let n = d.outline.len() as f64;
+                    let c = d
+                        .outline
+                        .iter()
+                        .fold((0.0, 0.0), |a, p| (a.0 + p.0 / n, a.1 + p.1 / n));
+                    let (x, y) = at(c);
+                    let style = |size: i32| {
+                        (FONT, size)
+                            .into_font()
+                            .into_text_style(&body)
+                            .pos(Pos::new(HPos::Center, VPos::Center))
+                    };
+                    body.draw(&Text::new(f.label.clone(), (x, y - 12), style(20)))
+                        .map_err(plot_err)?;
+                    body.draw(&Text::new(format!("{:+.1}σ", f.z), (x, y + 10), style(14)))
+                        .map_err(plot_err)?;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Writes the map of a die of any shape as `dir/<stem>.svg` and `.png`: its hull seen from
+/// one side and from the other (a slanted view that sees every facet), each face shaded by how
+/// much more (red) or less (blue) often the die came to rest on it than the null says (white
+/// at 0, full at 5σ), with the label the die then shows and the departure in σ; a facet the
+/// die cannot rest on is grey. Nothing is written for a die without flat facets (a coin: its
+/// faces figure says it all).
+pub fn shape_map(
+    dir: &Path,
+    stem: &str,
+    title: &str,
+    shape: &crate::model::shape::Shape,
+    faces: &[ShapeFace],
+) -> crate::Result<()> {
+    let drawn = projected(shape);
+    if drawn.is_empty() {
+        return Ok(());
+    }
+    write_both(
+        dir,
+        stem,
+        &ShapeMap {
+            title,
+            drawn,
+            faces,
+        },
+    )
+}
+
+#[cfg(test)]
+mod map_tests {
+    use super::*;
+
+    #[test]
+    fn the_map_shows_every_facet_once_half_from_each_side_and_each_outcome_on_its_face() {
+        for name in ["d4", "d6", "d8", "d10", "d12", "d20"] {
+            let shape = crate::model::shape::named(name, None).unwrap();
+            let drawn = projected(&shape);
+            assert_eq!(drawn.len(), shape.facets().len(), "{name}");
+            // Every outcome drawn exactly once, on the facet of its normal.
+            for k in 0..shape.faces.len() {
+                assert_eq!(
+                    drawn.iter().filter(|d| d.face == Some(k)).count(),
+                    1,
+                    "{name} face {k}"
+                );
+            }
+            // The view sees no facet edge-on, and each side shows some.
+            let normals: Vec<_> = shape.facets().iter().map(|f| f.normal).collect();
+            let v = view(&normals);
+            assert!(normals.iter().all(|n| n.dot(&v).abs() > 0.05), "{name}");
+            assert!(drawn.iter().any(|d| d.back) && drawn.iter().any(|d| !d.back));
+            // A projection keeps a facet's area times |cos| of its slant: the front's facets
+            // cover the hull's outline, as the back's do, so the two sides' areas are equal.
+            let area = |back: bool| -> f64 {
+                drawn
+                    .iter()
+                    .filter(|d| d.back == back)
+                    .map(|d| {
+                        let o = &d.outline;
+                        (0..o.len())
+                            .map(|i| {
+                                let (a, b) = (o[i], o[(i + 1) % o.len()]);
+                                a.0 * b.1 - b.0 * a.1
+                            })
+                            .sum::<f64>()
+                            .abs()
+                            / 2.0
+                    })
+                    .sum()
+            };
+            assert!(
+                (area(false) - area(true)).abs() < 1e-9 * area(false),
+                "{name}: {} {}",
+                area(false),
+                area(true)
+            );
+        }
+        let coin = crate::model::shape::named("coin:24,2", None).unwrap();
+        assert!(projected(&coin).is_empty());
     }
 }
