@@ -128,10 +128,42 @@ impl FitConfig {
                 let v = params::values(&self.model.fixed, &self.model.whole_axes(), &vec![u; dims]);
                 self.method
                     .spec(r.block, r.mode, &v, self.seed, self.design.rolls)
-                    .validate(false)?;
+                    .validate(false)
+                    .map_err(|e| self.at_box_end(e))?;
             }
         }
         Ok(())
+    }
+
+    /// A die refused at the end of a free parameter's box, named by that box (`--range
+    /// com_z=-7.9:7.9`), not by the flag that gives the die outright, which the user may not
+    /// have written (reliability round 5, class G).
+    fn at_box_end(&self, e: Error) -> Error {
+        let Error::Field { field, value, why } = &e else {
+            return e;
+        };
+        let kinds: &[params::Kind] = match field {
+            Field::Com => &[params::Kind::ComX, params::Kind::ComY, params::Kind::ComZ],
+            Field::PipsDepth => &[params::Kind::PipDepth],
+            _ => return e,
+        };
+        let boxes: Vec<String> = kinds
+            .iter()
+            .filter(|k| self.model.is_free(**k))
+            .map(|k| format!("{k}={}", self.model.range(*k)))
+            .collect();
+        if boxes.is_empty() {
+            return e;
+        }
+        let what = match field {
+            Field::Com => "centre of mass",
+            _ => "pip depth",
+        };
+        Error::field(
+            Field::Range,
+            boxes.join(","),
+            format!("the die at the box's end, its {what} {value} mm, {why}; narrow the range"),
+        )
     }
 
     /// A die of any shape and its rows agree: every row counts its faces by label, in its

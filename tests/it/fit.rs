@@ -234,6 +234,45 @@ fn values_outside_their_physical_ranges_are_refused() {
         assert_eq!(out.status.code(), Some(2), "{flags:?}: {err}");
         assert!(err.contains(want), "{flags:?}: {err} (wanted {want})");
     }
+    // A die refused at the end of a free parameter's box is named by the box the user sets
+    // with --range, not by --com or --pips, which they may not have written (reliability
+    // round 5, class G).
+    let faces = dir.join("faces.csv");
+    std::fs::write(
+        &faces,
+        "label,surface,length_mm,breadth_mm,width_mm,mode,face_1,face_2,face_3,face_4,face_5,\
+         face_6\nd,MDF,16,16,16,3d,30,25,25,25,25,20\n",
+    )
+    .unwrap();
+    for (flags, want) in [
+        (
+            vec!["--free", "com_z", "--range", "com_z=-7.9:7.9"],
+            "--range com_z=-7.9:7.9: the die at the box's end, its centre of mass 0,0,-7.9 mm, \
+             is too far",
+        ),
+        (
+            vec![
+                "--free",
+                "pip_depth",
+                "--pips",
+                "3,1",
+                "--range",
+                "pip_depth=0.5:1.6",
+            ],
+            "--range pip_depth=0.5:1.6: the die at the box's end, its pip depth 1.6 mm",
+        ),
+    ] {
+        let mut args = vec!["fit", "--data", faces.to_str().unwrap(), "--kappa", "0"];
+        args.extend(flags.iter());
+        let out = dicephys(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flags:?}: {err}");
+        assert!(err.contains(want), "{flags:?}: {err} (wanted {want})");
+        assert!(
+            !err.contains("--com") && !err.contains("--pips depth"),
+            "{err}"
+        );
+    }
     // The hand's throw needs its κ, and κ needs the hand (alone, --kappa asks for it).
     for (flags, want) in [
         (vec!["--throw", "hand"], "--throw hand: needs --kappa"),
