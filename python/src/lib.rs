@@ -43,6 +43,7 @@ fn argument(field: Field) -> &'static str {
     match field {
         Field::Style => "throw",
         Field::Kind => "source",
+        Field::Range => "ranges",
         f => f.name().split('.').next().unwrap_or_default(),
     }
 }
