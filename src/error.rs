@@ -82,6 +82,8 @@ pub enum Field {
     Com,
     /// `contact`.
     Contact,
+    /// `counts`.
+    Counts,
     /// `density`.
     Density,
     /// `die`.

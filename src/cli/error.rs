@@ -77,6 +77,7 @@ pub fn flag(field: Field) -> &'static str {
         Field::CheckRolls => "--check-rolls",
         Field::Com => "--com",
         Field::Contact => "--contact",
+        Field::Counts => "--counts",
         Field::Density => "--density",
         Field::Die => "--die",
         Field::Dir => "--dir",

@@ -30,11 +30,21 @@ pub struct FairArgs {
     /// the value, the null beside it) and bias.json.
     #[arg(long, value_name = "NAME=LO:HI:N", conflicts_with_all = ["checkpoint", "resume", "precision", "per_roll", "shard"])]
     pub vary: Option<String>,
+    /// Judge counts you measured instead of rolling: LABEL=N for each face (1=170,2=160,…;
+    /// heads=48,tails=51,edge=1), against --null (uniform: 1/N over the faces given;
+    /// quasi-static: the die --block, --shape or --die describe). No simulation: each face's
+    /// p ± σ, the χ², and the throws that would see the bias; with --out, fairness.csv,
+    /// fairness.json and the faces figure.
+    #[arg(long, value_name = "LABEL=N,...", conflicts_with_all = ["vary", "checkpoint", "resume", "precision", "per_roll", "shard"])]
+    pub counts: Option<String>,
 }
 
 /// Runs `dicephys fair`.
 pub fn run(a: &FairArgs) -> Result<()> {
     let spec = a.roll.spec_or(ThrowStyle::Tumble)?;
+    if let Some(c) = &a.counts {
+        return counted(a, &spec, c);
+    }
     if let Some(v) = &a.vary {
         return vary(a, &spec, v);
     }
@@ -81,6 +91,40 @@ pub fn run(a: &FairArgs) -> Result<()> {
         out!("{}", fair.text(&summary));
     }
     done
+}
+
+/// `fair --counts`: measured counts judged without a simulation.
+fn counted(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, text: &str) -> Result<()> {
+    use dicephys::studies::fair::{assess_counts, parse_counts, write_counted};
+    let counts = parse_counts(text)?;
+    let fair = assess_counts(&counts, a.null, &spec.scene, a.roll.layout(spec))?;
+    let doc = serde_json::json!({ "fairness": fair });
+    let json = dicephys::run::seal::to_string(&doc, true)?;
+    if let Some(dir) = &a.out {
+        std::fs::create_dir_all(dir).map_err(|e| {
+            Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
+        })?;
+        let identity = serde_json::json!({ "counts": counts, "null": a.null });
+        dicephys::studies::fair::claim(dir, &identity)?;
+        write_counted(dir, &json, &fair)?;
+        if !*a.roll.json {
+            eprintln!(
+                "wrote {}/fairness.json, fairness.csv and faces.svg, .png",
+                dir.display()
+            );
+        }
+    }
+    if *a.roll.json {
+        outln!("{}", json);
+    } else {
+        out!(
+            "Is this die fair? {} throws counted, against {}\n{}",
+            fair.n,
+            fair.null,
+            fair.table()
+        );
+    }
+    Ok(())
 }
 
 /// `fair --vary`: the die at each value of one feature, judged, as a table (or JSON) and,

@@ -64,6 +64,50 @@ pub struct Fairness {
 }
 
 impl Fairness {
+    /// The faces' table and the verdict, as the terminal shows them.
+    pub fn table(&self) -> String {
+        let mut out = String::from(
+            "  face  up  count      p        ± 1σ     null     departure      z   throws to see \
+             it (2σ / 5σ)\n",
+        );
+        for f in &self.faces {
+            let see = match (f.throws_2sigma, f.throws_5sigma) {
+                (Some(a), Some(b)) => format!("{a:.0} / {b:.0}"),
+                _ => "unresolved".into(),
+            };
+            out += &format!(
+                "  {:>4}  {:<2} {:>7}  {:.5}  {:.5}  {:.5}  {:+.5}  {:+6.2}   {see}\n",
+                f.number, f.direction, f.count, f.p, f.err, f.null, f.departure, f.z
+            );
+        }
+        out += &format!("  {}\n", self.verdict);
+        out
+    }
+
+    /// The faces' table as CSV: one row a face (`face` its number, `label` its direction on a
+    /// cube or what a die of any shape shows), the throws to see it empty where unresolved.
+    pub fn csv(&self) -> String {
+        let mut out =
+            String::from("face,label,count,p,err,null,departure,z,throws_2sigma,throws_5sigma\n");
+        let opt = |v: Option<f64>| v.map_or(String::new(), |t| format!("{t:.0}"));
+        for f in &self.faces {
+            out += &format!(
+                "{},{},{},{},{},{},{},{},{},{}\n",
+                f.number,
+                f.direction,
+                f.count,
+                f.p,
+                f.err,
+                f.null,
+                f.departure,
+                f.z,
+                opt(f.throws_2sigma),
+                opt(f.throws_5sigma)
+            );
+        }
+        out
+    }
+
     /// The human report.
     pub fn text(&self, s: &RunSummary) -> String {
         let die = match &s.spec.scene.shape {
@@ -79,18 +123,7 @@ impl Fairness {
              against {}\n",
             s.engine, s.mode, s.spec.throws.style, s.rolls, self.n, self.null
         );
-        out += "  face  up  count      p        ± 1σ     null     departure      z   throws to see it (2σ / 5σ)\n";
-        for f in &self.faces {
-            let see = match (f.throws_2sigma, f.throws_5sigma) {
-                (Some(a), Some(b)) => format!("{a:.0} / {b:.0}"),
-                _ => "unresolved".into(),
-            };
-            out += &format!(
-                "  {:>4}  {:<2} {:>7}  {:.5}  {:.5}  {:.5}  {:+.5}  {:+6.2}   {see}\n",
-                f.number, f.direction, f.count, f.p, f.err, f.null, f.departure, f.z
-            );
-        }
-        out += &format!("  {}\n", self.verdict);
+        out += &self.table();
         if let Some(r) = &s.precision {
             out += &format!("  {}\n", r.line());
         }

@@ -101,6 +101,128 @@ pub fn assess(s: &RunSummary, null: Null) -> Result<Fairness> {
         ));
     }
     let (numbers, names, counts) = face_counts(s, shape.as_deref(), q.len());
+    judge(&numbers, &names, &counts, &q, null, "rolls at rest")
+}
+
+/// Counts a tester measured, `LABEL=N,LABEL=N,…` (`1=170,2=160,…`; a label as the die shows it,
+/// `heads`, `20`), each label once, at least two: (label, count) in the order given.
+pub fn parse_counts(text: &str) -> Result<Vec<(String, u64)>> {
+    let bad = |why: String| Error::field(Field::Counts, text, why);
+    let mut out: Vec<(String, u64)> = Vec::new();
+    for item in text.split(',').map(str::trim) {
+        let (label, n) = item
+            .split_once('=')
+            .ok_or_else(|| bad(format!("'{item}': write LABEL=COUNT (e.g. 1=170,2=160,…)")))?;
+        let label = label.trim();
+        let n: u64 = n
+            .trim()
+            .parse()
+            .map_err(|_| bad(format!("'{}' is not a count (a whole number)", n.trim())))?;
+        if label.is_empty() || out.iter().any(|(l, _)| l == label) {
+            return Err(bad(format!("face '{label}' is empty or given twice")));
+        }
+        out.push((label.to_string(), n));
+    }
+    if out.len() < 2 {
+        return Err(bad("give at least two faces' counts".into()));
+    }
+    if out.iter().map(|(_, n)| n).sum::<u64>() == 0 {
+        return Err(bad("no throws counted".into()));
+    }
+    Ok(out)
+}
+
+/// Measured counts (`parse_counts`) set against `null`: uniform (each of the faces given 1/N),
+/// or quasi-static for the die `scene` describes (its faces' labels, or a cube's numbers under
+/// `layout`, must be the ones counted). No simulation: the same table, χ² and throws to see
+/// the bias as a run's.
+pub fn assess_counts(
+    counted: &[(String, u64)],
+    null: Null,
+    scene: &crate::model::scene::Scene,
+    layout: Layout,
+) -> Result<Fairness> {
+    let q = match null {
+        Null::Uniform => vec![1.0 / counted.len() as f64; counted.len()],
+        Null::QuasiStatic => {
+            let shares: Vec<(String, f64)> = match &scene.shape {
+                Some(shape) => {
+                    let p = theory::quasi_static::outcome_shares(scene)
+                        .expect("a die of any shape")
+                        .map_err(|e| Error::field(Field::Null, "quasi-static", e))?;
+                    shape
+                        .labels()
+                        .iter()
+                        .map(|l| l.to_string())
+                        .zip(p)
+                        .collect()
+                }
+                None => {
+                    let die = crate::model::die::DieShape::of(scene);
+                    let up = theory::quasi_static::faces_up(&die);
+                    layout
+                        .numbers()
+                        .iter()
+                        .zip(up)
+                        .map(|(n, p)| (n.to_string(), p))
+                        .collect()
+                }
+            };
+            let mut labels: Vec<&str> = shares.iter().map(|(l, _)| l.as_str()).collect();
+            labels.sort_by_key(|l| (l.parse::<u32>().unwrap_or(u32::MAX), l.to_string()));
+            if counted.len() != shares.len() {
+                return Err(Error::field(
+                    Field::Counts,
+                    counted.len(),
+                    format!(
+                        "faces counted; the die has {} ({}): count them all against the \
+                         quasi-static null",
+                        shares.len(),
+                        labels.join(", ")
+                    ),
+                ));
+            }
+            counted
+                .iter()
+                .map(|(l, _)| {
+                    shares
+                        .iter()
+                        .find(|(m, _)| m == l)
+                        .map(|s| s.1)
+                        .ok_or_else(|| {
+                            Error::field(
+                                Field::Counts,
+                                l,
+                                format!(
+                                    "is not a face of the die (its faces: {})",
+                                    labels.join(", ")
+                                ),
+                            )
+                        })
+                })
+                .collect::<Result<Vec<f64>>>()?
+        }
+    };
+    let names: Vec<String> = counted.iter().map(|(l, _)| l.clone()).collect();
+    let numbers: Vec<u8> = names
+        .iter()
+        .enumerate()
+        .map(|(k, l)| l.parse().unwrap_or(k as u8 + 1))
+        .collect();
+    let counts: Vec<u64> = counted.iter().map(|(_, c)| *c).collect();
+    judge(&numbers, &names, &counts, &q, null, "throws counted")
+}
+
+/// Each face's count set against its null probability `q`: the verdict of [`assess`]; `what`
+/// names the counts in it ("rolls at rest", "throws counted").
+fn judge(
+    numbers: &[u8],
+    names: &[String],
+    counts: &[u64],
+    q: &[f64],
+    null: Null,
+    what: &str,
+) -> Result<Fairness> {
     let n: u64 = counts.iter().sum();
     if n == 0 {
         return Err(Error::Failed(
@@ -111,7 +233,7 @@ pub fn assess(s: &RunSummary, null: Null) -> Result<Fairness> {
     let see = |z: f64, q: f64, d: f64| z * z * q * (1.0 - q) / (d * d);
     let mut faces: Vec<FaceVerdict> = counts
         .iter()
-        .zip(&q)
+        .zip(q)
         .enumerate()
         .map(|(d, (&c, &q))| {
             let p = stats::proportion(c, n);
@@ -134,7 +256,7 @@ pub fn assess(s: &RunSummary, null: Null) -> Result<Fairness> {
     faces.sort_by_key(|f| f.number);
     let chi2: f64 = counts
         .iter()
-        .zip(&q)
+        .zip(q)
         .map(|(&c, &q)| (c as f64 - nf * q).powi(2) / (nf * q))
         .sum();
     let dof = q.len() - 1;
@@ -166,9 +288,9 @@ pub fn assess(s: &RunSummary, null: Null) -> Result<Fairness> {
             _ => String::new(),
         };
         format!(
-            "unresolved: no departure from {null} at 2σ in {n} rolls at rest (χ² = {chi2:.1} on \
-             {dof} dof, p = {p_value:.2}); these rolls would resolve a bias of λ ≥ \
-             {smallest:.2e} a throw{need}"
+            "unresolved: no departure from {null} at 2σ in {n} {what} (χ² = {chi2:.1} on {dof} \
+             dof, p = {p_value:.2}); these would resolve a bias of λ ≥ {smallest:.2e} a \
+             throw{need}"
         )
     };
     Ok(Fairness {
@@ -256,6 +378,35 @@ pub fn write(dir: &std::path::Path, json: &str, fair: &Fairness, s: &RunSummary)
         .collect();
     let null = format!("{} null", fair.null);
     crate::report::figures::die::faces(dir, "faces", &title, &null, &bars)?;
+    crate::run::io::write_atomic(&dir.join("fairness.csv"), fair.csv().as_bytes())?;
+    crate::run::io::write_atomic(&dir.join("fairness.json"), json.as_bytes())
+}
+
+/// Writes measured counts' verdict (`assess_counts`) into `dir`: `fairness.json` (the document
+/// `json`), `fairness.csv` and the faces figure (`faces.svg`, `.png`).
+pub fn write_counted(dir: &std::path::Path, json: &str, fair: &Fairness) -> Result<()> {
+    let title = format!(
+        "{} throws counted; {}",
+        fair.n,
+        if fair.resolved {
+            format!("biased (χ² p = {:.1e})", fair.p_value)
+        } else {
+            format!("no bias resolved (χ² p = {:.2})", fair.p_value)
+        }
+    );
+    let bars: Vec<crate::report::figures::die::FaceBar> = fair
+        .faces
+        .iter()
+        .map(|f| crate::report::figures::die::FaceBar {
+            label: f.direction.clone(),
+            p: f.p,
+            err: f.err,
+            null: f.null,
+        })
+        .collect();
+    let null = format!("{} null", fair.null);
+    crate::report::figures::die::faces(dir, "faces", &title, &null, &bars)?;
+    crate::run::io::write_atomic(&dir.join("fairness.csv"), fair.csv().as_bytes())?;
     crate::run::io::write_atomic(&dir.join("fairness.json"), json.as_bytes())
 }
 

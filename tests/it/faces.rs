@@ -174,6 +174,13 @@ fn fair_out_writes_its_document_and_the_die_map_into_a_directory_of_its_own() {
     for f in ["die_map.svg", "die_map.png", "faces.svg", "faces.png"] {
         assert!(std::fs::metadata(dir.join(f)).unwrap().len() > 1000, "{f}");
     }
+    // The table as CSV too: a header and a row a face, its count the JSON's.
+    let csv = std::fs::read_to_string(dir.join("fairness.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().collect();
+    assert_eq!(rows.len(), 7, "{csv}");
+    assert!(rows[0].starts_with("face,label,count,p,err,null"));
+    let count: u64 = rows[1].split(',').nth(2).unwrap().parse().unwrap();
+    assert_eq!(count, v["fairness"]["faces"][0]["count"].as_u64().unwrap());
     assert!(dicephys(&args).status.success(), "the same run again");
     let other = dicephys(&[&args[..], &["--null", "solid-angle"]].concat());
     assert_eq!(other.status.code(), Some(2));
@@ -181,6 +188,89 @@ fn fair_out_writes_its_document_and_the_die_map_into_a_directory_of_its_own() {
     let after: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("fairness.json")).unwrap()).unwrap();
     assert_eq!(after["fairness"]["null"], "uniform");
+}
+
+/// `fair --counts`: a tester's own counts judged without a simulation, as a run's are: the χ²
+/// and each face's departure by their closed forms, the quasi-static null of the die described,
+/// the table as CSV; bad counts refused in one line.
+#[test]
+fn fair_judges_measured_counts_without_rolling() {
+    let counts = [170u64, 160, 175, 168, 150, 200];
+    let text: Vec<String> = counts
+        .iter()
+        .enumerate()
+        .map(|(k, c)| format!("{}={c}", k + 1))
+        .collect();
+    let text = text.join(",");
+    let v = json(&dicephys(&["fair", "--counts", &text, "--json"]));
+    let f = &v["fairness"];
+    let n: u64 = counts.iter().sum();
+    let e = n as f64 / 6.0;
+    let chi2: f64 = counts.iter().map(|&c| (c as f64 - e).powi(2) / e).sum();
+    assert!((f["chi2"].as_f64().unwrap() - chi2).abs() < 1e-9, "{f}");
+    assert_eq!(f["n"], n);
+    assert!(v.get("summary").is_none(), "no simulation: no run summary");
+    // Face 6, 200 of 1,023: z = (p − 1/6)/√(q(1 − q)/n), and the throws to see it at 2σ,
+    // 4 q(1 − q)/(p − q)².
+    let six = &f["faces"][5];
+    let (p, q) = (200.0 / n as f64, 1.0 / 6.0);
+    let z = (p - q) / (q * (1.0 - q) / n as f64).sqrt();
+    assert!((six["z"].as_f64().unwrap() - z).abs() < 1e-9);
+    let see = 4.0 * q * (1.0 - q) / (p - q).powi(2);
+    assert!((six["throws_2sigma"].as_f64().unwrap() - see).abs() < 1e-6);
+    // Against the quasi-static theory of a thick coin: the nulls its outcome shares, by label.
+    let coin = json(&dicephys(&[
+        "fair",
+        "--counts",
+        "edge=300,heads=350,tails=350",
+        "--shape",
+        "coin:24,8",
+        "--null",
+        "quasi-static",
+        "--json",
+    ]));
+    let nulls: f64 = coin["fairness"]["faces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x["null"].as_f64().unwrap())
+        .sum();
+    assert!((nulls - 1.0).abs() < 1e-12, "{coin}");
+    // With --out: the CSV, the JSON and the faces figure.
+    let dir = Scratch::absent("fair-counts");
+    let d = dir.to_str().unwrap();
+    assert!(dicephys(&["fair", "--counts", &text, "--out", d])
+        .status
+        .success());
+    let csv = std::fs::read_to_string(dir.join("fairness.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 7, "{csv}");
+    assert!(dir.join("faces.svg").exists() && dir.join("fairness.json").exists());
+    for (args, says) in [
+        (
+            vec!["--counts", "1=17,x"],
+            "--counts 1=17,x: 'x': write LABEL=COUNT",
+        ),
+        (
+            vec!["--counts", "1=17,1=3"],
+            "face '1' is empty or given twice",
+        ),
+        (vec!["--counts", "1=-4,2=3"], "'-4' is not a count"),
+        (vec!["--counts", "1=5"], "at least two faces"),
+        (
+            vec!["--counts", "1=5,9=5", "--null", "quasi-static"],
+            "the die has 6 (1, 2, 3, 4, 5, 6)",
+        ),
+        (
+            vec!["--counts", "1=5,2=5", "--vary", "com_z=0:1:2"],
+            "cannot be used with",
+        ),
+    ] {
+        let o = dicephys(&[&["fair"][..], &args].concat());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err} (wanted {says})");
+    }
 }
 
 /// `fair`'s own bad input: one line, exit 2, before anything rolls.

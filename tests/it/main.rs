@@ -11,6 +11,7 @@ mod docs;
 mod faces;
 mod fit;
 mod fuzz;
+mod impact;
 mod made;
 mod promises;
 mod promises_files;
