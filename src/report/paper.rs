@@ -119,6 +119,96 @@ pub fn markdown(res: &PaperResults, figures: &[&str]) -> String {
     s
 }
 
+/// What `paper` prints on the terminal: the verdict first, block by block, in at most 40
+/// lines of at most 120 columns; the long report is `report.md` in `out` (issue 50).
+pub fn verdict(res: &PaperResults, out: &std::path::Path) -> String {
+    let engines = engines_of(res);
+    let p = &res.provenance;
+    let mut s = format!(
+        "Pender & Uhrin (2014) reproduced by dicephys {}: {} rolls a simulated block, seed {}\n",
+        p.dicephys_version, p.rolls_per_cell, p.seed
+    );
+    if res.partial {
+        s += "PARTIAL: stopped before every block was simulated; the same command continues it\n";
+    }
+    // The theory against the paper's rows, set by set (as `theory --table` gives it).
+    let sets: Vec<String> = res
+        .table
+        .chi_square
+        .iter()
+        .map(|c| {
+            let p = if c.p_value >= 0.001 {
+                format!("{:.3}", c.p_value)
+            } else {
+                format!("{:.1e}", c.p_value)
+            };
+            format!("{} {:.1} on {} (p {p})", c.set.name(), c.chi2, c.dof)
+        })
+        .collect();
+    s += &format!(
+        "The theory, eq. (MasterEqu), against the paper's measured rows, χ² by set:\n  {}\n",
+        sets.join("; ")
+    );
+    s += "\nThe ratio N(breadth)/N(width) on MDF, simulated, against experiment (z: combined σ):\n";
+    let mut head = format!("  {:<11} {:>15}", "block", "experiment");
+    let columns: Vec<(EngineKind, Mode)> = engines
+        .iter()
+        .flat_map(|e| [(*e, Mode::ThreeD), (*e, Mode::TwoD)])
+        .filter(|(e, m)| {
+            res.simulations
+                .iter()
+                .any(|c| c.engine == *e && c.mode == *m)
+        })
+        .collect();
+    for (e, m) in &columns {
+        head += &format!(" {:>20}", format!("{e} {}", m.name()));
+    }
+    s += &head;
+    s += "\n";
+    for r in res.table.rows.iter().filter(|r| r.simulated) {
+        let mut line = format!(
+            "  {:<11} {:>15}",
+            format!("{}x{}x{}", r.length_mm, r.breadth_mm, r.width_mm),
+            format!(
+                "{:.3} ± {:.3}",
+                r.measured_ratio.value, r.measured_ratio.err
+            )
+        );
+        for (e, m) in &columns {
+            line += &match cell(res, r.row, *e, *m) {
+                Some(c) => format!(
+                    " {:>20}",
+                    format!(
+                        "{:.3} ± {:.3} {}",
+                        c.ratio.value,
+                        c.ratio.err,
+                        fmt_z(c.z_experiment)
+                    )
+                ),
+                None => format!(" {:>20}", "–"),
+            };
+        }
+        s += &line;
+        s += "\n";
+    }
+    s += "\n";
+    for line in reading(res, &engines).lines().skip(2) {
+        let line = line
+            .trim_start_matches("- ")
+            .replace(" experimental standard error (combined)", "σ");
+        if !line.is_empty() {
+            s += &format!("  {line}\n");
+        }
+    }
+    s += "  (the paper: its 3D simulations all within error; its 2D line outside two of five)\n";
+    s += &format!(
+        "\nThe whole report (the table, the three outcomes, the figures), and the results:\n  \
+         {d}/report.md, {d}/results.json, {d}/results.csv\n",
+        d = out.display()
+    );
+    s
+}
+
 /// The engines simulated, in the order first met.
 fn engines_of(res: &PaperResults) -> Vec<EngineKind> {
     let mut v: Vec<EngineKind> = res.simulations.iter().map(|c| c.engine).collect();

@@ -325,7 +325,12 @@ pub fn paper(cfg: &studies::paper::PaperConfig, place: &Place, hooks: &Hooks) ->
     outputs.write("results.json", json.as_bytes())?;
     outputs.write("results.csv", report::paper::results_csv(&res)?.as_bytes())?;
     outputs.write("report.md", md.as_bytes())?;
-    let mut done = place.done(&json, &md, "report.md");
+    // On the terminal the verdict, not the report: the report is the file's.
+    let mut done = place.done(
+        &json,
+        &report::paper::verdict(&res, &place.out),
+        "report.md",
+    );
     done.note = done.note.map(|_| {
         format!(
             "wrote {}/report.md, results.json, results.csv and figures",

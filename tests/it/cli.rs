@@ -154,6 +154,31 @@ fn a_tiny_paper_run_is_complete_and_repeatable() {
             "{}",
             String::from_utf8_lossy(&out.stderr)
         );
+        // On the terminal the verdict, first and short (issue 50): at most 40 lines of at
+        // most 120 characters, the theory's χ² and every simulated block in it, the report
+        // named; the report itself is the file's.
+        let text = String::from_utf8_lossy(&out.stdout);
+        let lines: Vec<&str> = text.lines().collect();
+        assert!(lines.len() <= 40, "{text}");
+        assert!(lines.iter().all(|l| l.chars().count() <= 120), "{text}");
+        assert!(
+            lines[0].starts_with("Pender & Uhrin (2014) reproduced"),
+            "{text}"
+        );
+        assert!(text.contains("mdf 42.5 on 8"), "{text}");
+        for block in [
+            "140x24x20",
+            "140x22x13",
+            "140x27x13",
+            "140x29x11",
+            "140x30x10",
+        ] {
+            assert!(text.contains(block), "{block}: {text}");
+        }
+        assert!(
+            text.contains("report.md") && !text.contains("| row |"),
+            "{text}"
+        );
         let text = std::fs::read_to_string(dir.join("results.json")).unwrap();
         serde_json::from_str::<serde_json::Value>(&text).unwrap()
     };
