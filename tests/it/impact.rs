@@ -1,13 +1,33 @@
-//! exploratory
-use dicephys::engine::{new_engine, EngineKind};
+//! A loaded die's impacts against closed forms (issue 46, class N: the engines disagree about a
+//! loaded cube that bounces). Each engine is driven through the library's own `Engine` (reset
+//! to a start state, step, read the state), on scenes whose answer is known exactly:
+//!
+//! - free flight with gravity off: the centre of mass stays put;
+//! - the cube balanced on an edge: it falls to the side its centre of mass lies on;
+//! - the cube falling without rotation onto one edge (tilted about x, so the problem is 2D in
+//!   the y–z plane), frictionless, restitution e: the single-contact impulse law gives
+//!   J = (1 + e) V / (1/m + r_z²/I_x), v' = −V + J/m, ω'_x = −r_z J / I_x, with r the edge
+//!   from the centre of mass and I_x the moment about the x axis through it.
+//!
+//! The cube: 16 mm, density 800, centre of mass 4.5 mm toward its −z face, so I_x =
+//! m (2·16²/12 − 4.5²) mm² = 22.42 m mm² (42.67 m mm² about the centre) and I_z = 42.67 m mm².
+
+use dicephys::engine::{new_engine, Engine, EngineKind};
 use dicephys::model::mass::Features;
 use dicephys::model::scene::{Mode, Scene};
-use dicephys::model::state::BodyState;
+use dicephys::model::state::{up_in_body, BodyState};
 use nalgebra::{UnitQuaternion, Vector3};
 
 const SIDE: f64 = 0.016;
+const COM_Z: f64 = -0.0045;
+/// Approach speed, m/s (a die dropped 0.2 m lands at 2 m/s).
+const V: f64 = 2.0;
+const E: f64 = 0.5;
+/// Bullet's Baumgarte factor for contacts (`btContactSolverInfo::m_erp2`, 3.24's default).
+const BULLET_ERP: f64 = 0.2;
 
-fn scene(com_z: f64, mu: f64, e: f64, g: f64, dt: f64) -> Scene {
+/// The 16 mm cube with its centre of mass at (0, 0, `com_z`), as `roll --com` makes it.
+fn cube(com_z: f64, friction: f64, gravity: f64, dt: f64) -> Scene {
     let mut s = Scene::paper("16x16x16".parse().unwrap(), Mode::ThreeD);
     if com_z != 0.0 {
         s.features = Features {
@@ -15,136 +35,322 @@ fn scene(com_z: f64, mu: f64, e: f64, g: f64, dt: f64) -> Scene {
             ..Default::default()
         };
     }
-    s.friction = mu;
-    s.restitution = e;
-    s.gravity = g;
+    s.friction = friction;
+    s.restitution = E;
+    s.gravity = gravity;
     s.dt = dt;
     s.validate(false).unwrap();
     s
 }
 
+fn at_rest(position: Vector3<f64>, rotation: UnitQuaternion<f64>) -> BodyState {
+    BodyState {
+        position,
+        rotation,
+        linear_velocity: Vector3::zeros(),
+        angular_velocity: Vector3::zeros(),
+        sleeping: false,
+    }
+}
+
+/// An edge impact: the cube turned by `theta` about x falls straight down at V onto the edge
+/// parallel to x that is lowest.
+struct EdgeImpact {
+    m: f64,
+    ix: f64,
+    rotation: UnitQuaternion<f64>,
+    /// The edge's midpoint from the centre of mass, world axes.
+    r: Vector3<f64>,
+}
+
+impl EdgeImpact {
+    fn new(scene: &Scene, com_z: f64, theta_deg: f64) -> EdgeImpact {
+        let m = scene.mass();
+        let ix = m * (2.0 * SIDE * SIDE / 12.0 - com_z * com_z);
+        let rotation = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), theta_deg.to_radians());
+        let c = Vector3::new(0.0, 0.0, com_z);
+        let r = [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)]
+            .map(|(y, z)| rotation * (Vector3::new(0.0, y, z) * (SIDE / 2.0) - c))
+            .into_iter()
+            .min_by(|a, b| a.y.total_cmp(&b.y))
+            .unwrap();
+        EdgeImpact { m, ix, rotation, r }
+    }
+
+    /// The impulse law: (J/m, the velocity change; ω'_x).
+    fn law(&self) -> (f64, f64) {
+        let j = (1.0 + E) * V / (1.0 / self.m + self.r.z * self.r.z / self.ix);
+        (j / self.m, -self.r.z * j / self.ix)
+    }
+
+    /// The state one step after the die, its edge `gap` above the floor (negative: into it),
+    /// starts falling, gravity off.
+    fn after(&self, engine: &mut dyn Engine, gap: f64) -> BodyState {
+        engine
+            .reset(&BodyState {
+                linear_velocity: Vector3::new(0.0, -V, 0.0),
+                ..at_rest(Vector3::new(0.0, -self.r.y + gap, 0.0), self.rotation)
+            })
+            .unwrap();
+        engine.step().unwrap();
+        engine.state()
+    }
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b) / b
+}
+
+/// Gravity off, spinning about no principal axis: the centre of mass stays within 1e-12 m of
+/// where it started for 200 steps on both engines (an engine that turned the body about its
+/// geometric centre, or about the wrong offset, would carry it around a 4.5 mm circle).
 #[test]
-fn explore() {
-    let v0 = 2.0;
-    let e = 0.5;
-    let gap = -1e-7;
-    for dt in [1e-3, 2.5e-4] {
-        for (com_z, theta_deg) in [
-            (-0.0045, 45.0f64),
-            (-0.0045, -45.0),
-            (0.0, 45.0),
-            (0.0, 30.0),
-            (0.0, 15.0),
-            (-0.0045, 30.0),
+fn in_free_flight_the_loaded_cube_turns_about_its_centre_of_mass() {
+    let scene = cube(COM_Z, 0.29, 0.0, 0.001);
+    let start = BodyState {
+        angular_velocity: Vector3::new(30.0, -50.0, 80.0),
+        ..at_rest(
+            Vector3::new(0.0, 0.5, 0.0),
+            UnitQuaternion::from_euler_angles(0.3, -0.7, 1.1),
+        )
+    };
+    for kind in [EngineKind::Bullet, EngineKind::Rapier] {
+        let mut engine = new_engine(kind, &scene).unwrap();
+        engine.reset(&start).unwrap();
+        for _ in 0..200 {
+            engine.step().unwrap();
+        }
+        let moved = (engine.state().position - start.position).norm();
+        assert!(
+            moved < 1e-12,
+            "{kind:?}: the centre of mass moved {moved:e} m"
+        );
+    }
+}
+
+/// Balanced on the edge between its −y and −z faces, the loaded cube's centre of mass is above
+/// the edge at a tilt of atan(3.5/8) = 23.63° (45° if it were centred, 57.4° with the offset's
+/// sign flipped). Released at rest 2° either side, on both engines, it falls the way its centre
+/// of mass lies: back onto −y, or over onto −z (its up direction, after 2 s, within 0.05 rad of
+/// that face's opposite).
+#[test]
+fn balanced_on_an_edge_the_loaded_cube_falls_the_way_its_centre_of_mass_lies() {
+    let scene = cube(COM_Z, 0.29, scene_gravity(), 0.001);
+    let critical = (3.5f64 / 8.0).atan().to_degrees();
+    for kind in [EngineKind::Bullet, EngineKind::Rapier] {
+        let mut engine = new_engine(kind, &scene).unwrap();
+        for (tilt, up) in [
+            (critical - 2.0, Vector3::y()),
+            (critical + 2.0, Vector3::z()),
         ] {
-            let sc = scene(com_z, 0.0, e, 0.0, dt);
-            let m = sc.mass();
-            let ix = m * (2.0 * SIDE * SIDE / 12.0 - com_z * com_z);
-            let th = theta_deg.to_radians();
-            let q = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), th);
-            let c = Vector3::new(0.0, 0.0, com_z);
-            let mut r = Vector3::new(0.0, 1e9, 0.0);
-            for (y, z) in [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)] {
-                let p = q * (Vector3::new(0.0, y * SIDE / 2.0, z * SIDE / 2.0) - c);
-                if p.y < r.y {
-                    r = p;
-                }
-            }
-            let kn = 1.0 / m + r.z * r.z / ix;
-            let j = (1.0 + e) * v0 / kn;
-            let dv = j / m;
-            let wx = -r.z * j / ix;
-            for kind in [EngineKind::Bullet, EngineKind::Rapier] {
-                let mut eng = new_engine(kind, &sc).unwrap();
-                eng.reset(&BodyState {
-                    position: Vector3::new(0.0, -r.y + gap, 0.0),
-                    rotation: q,
-                    linear_velocity: Vector3::new(0.0, -v0, 0.0),
-                    angular_velocity: Vector3::zeros(),
-                    sleeping: false,
-                })
+            let rotation = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), -tilt.to_radians());
+            // The edge (y, z) = (−8, −8) mm, from the centre of mass, is the lowest point.
+            let edge = rotation
+                * (Vector3::new(0.0, -SIDE / 2.0, -SIDE / 2.0) - Vector3::new(0.0, 0.0, COM_Z));
+            engine
+                .reset(&at_rest(Vector3::new(0.0, -edge.y, 0.0), rotation))
                 .unwrap();
-                let mut out = String::new();
-                for k in 0..3 {
-                    eng.step().unwrap();
-                    let s = eng.state();
-                    let edv = (s.linear_velocity.y + v0) / dv - 1.0;
-                    let ewx = if wx != 0.0 {
-                        s.angular_velocity.x / wx - 1.0
-                    } else {
-                        s.angular_velocity.x
-                    };
-                    out += &format!(
-                        " | s{k}: dv {edv:+.4} wx {ewx:+.4} wy {:+.2} wz {:+.2} vz {:+.4}",
-                        s.angular_velocity.y, s.angular_velocity.z, s.linear_velocity.z
-                    );
-                }
-                println!("dt {dt} com {com_z} th {theta_deg} r=({:.2},{:.2}) dv {dv:.4} wx {wx:.2} {kind:?}{out}", r.y*1e3, r.z*1e3);
+            for _ in 0..2000 {
+                engine.step().unwrap();
             }
+            let got = up_in_body(&engine.state().rotation);
+            assert!(
+                got.angle(&up) < 0.05,
+                "{kind:?} at {tilt:.2}°: up {got:?}, should be {up:?}"
+            );
         }
     }
 }
 
+fn scene_gravity() -> f64 {
+    Scene::paper("16x16x16".parse().unwrap(), Mode::ThreeD).gravity
+}
+
+/// The off-centre lever on both engines: whatever an engine's impulse, it turns the cube by
+/// ω'_x = −(m r_z / I_x) Δv_y. That ratio is the mass, the moment about the centre of mass and
+/// the offset's sign and size together (the moment about the geometric centre would be 90 %
+/// off, the offset's sign flipped 180 % at 45°). Frictionless, so v_z stays 0 (within 1e-9
+/// m/s). Within 1e-3, at tilts ±45° (the weight away from, and toward, the edge that lands)
+/// and ±30°.
 #[test]
-fn explore_rapier_iterations() {
-    use rapier3d_f64::prelude::*;
-    let com_z = -0.0045;
-    let (v0, e) = (2.0, 0.5);
-    let m = 800.0 * SIDE * SIDE * SIDE;
-    let ix = m * (2.0 * SIDE * SIDE / 12.0 - com_z * com_z);
-    let iz = m * (2.0 * SIDE * SIDE / 12.0);
-    let th = 45f64.to_radians();
-    let q = nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::x_axis(), th);
-    let c = nalgebra::Vector3::new(0.0, 0.0, com_z);
-    let r = q * (nalgebra::Vector3::new(0.0, -SIDE / 2.0, SIDE / 2.0) - c);
-    let kn = 1.0 / m + r.z * r.z / ix;
-    let j = (1.0 + e) * v0 / kn;
-    for (iters, pgs) in [(1, 1), (2, 1), (4, 1), (8, 1), (16, 1), (4, 4), (4, 16)] {
-        let mut w = PhysicsWorld::new();
-        w.gravity = Vector::new(0.0, 0.0, 0.0);
-        w.integration_parameters.dt = 1e-3;
-        w.integration_parameters.max_ccd_substeps = 0;
-        w.integration_parameters.num_solver_iterations = iters;
-        w.integration_parameters.num_internal_pgs_iterations = pgs;
-        w.insert_collider(
-            ColliderBuilder::cuboid(5000.0, 50.0, 5000.0)
-                .translation(Vector::new(0.0, -50.0, 0.0))
-                .friction(1.0)
-                .restitution(1.0)
-                .friction_combine_rule(CoefficientCombineRule::Multiply)
-                .restitution_combine_rule(CoefficientCombineRule::Multiply),
-            None,
-        );
-        let qq = q.quaternion();
-        let body = RigidBodyBuilder::dynamic()
-            .pose(Pose::from_parts(
-                Vector::new(0.0, -r.y - 1e-7, 0.0),
-                Rotation::from_xyzw(qq.i, qq.j, qq.k, qq.w),
-            ))
-            .linvel(Vector::new(0.0, -v0, 0.0))
-            .additional_mass_properties(MassProperties::new(
-                Vector::ZERO,
-                m,
-                Vector::new(ix, ix, iz),
-            ));
-        let col = ColliderBuilder::cuboid(SIDE / 2.0, SIDE / 2.0, SIDE / 2.0)
-            .position(Pose::from_parts(
-                Vector::new(0.0, 0.0, -com_z),
-                Rotation::IDENTITY,
-            ))
-            .density(0.0)
-            .friction(0.0)
-            .restitution(e)
-            .friction_combine_rule(CoefficientCombineRule::Multiply)
-            .restitution_combine_rule(CoefficientCombineRule::Multiply);
-        let (h, _) = w.insert(body, col);
-        w.step();
-        let b = &w.bodies[h];
-        let dv = (b.linvel().y + v0) / (j / m) - 1.0;
-        let wx = b.angvel().x / (-r.z * j / ix) - 1.0;
+fn an_edge_impact_turns_the_loaded_cube_by_its_lever_on_both_engines() {
+    let scene = cube(COM_Z, 0.0, 0.0, 0.001);
+    for kind in [EngineKind::Bullet, EngineKind::Rapier] {
+        let mut engine = new_engine(kind, &scene).unwrap();
+        for theta in [45.0, -45.0, 30.0, -30.0] {
+            let hit = EdgeImpact::new(&scene, COM_Z, theta);
+            let s = hit.after(engine.as_mut(), -1e-9);
+            let dv = s.linear_velocity.y + V;
+            let lever = -hit.m * hit.r.z / hit.ix;
+            let got = s.angular_velocity.x / dv;
+            println!(
+                "{kind:?} {theta}°: r = ({:.3}, {:.3}) mm, ω'_x/Δv_y {got:.3} against {lever:.3} \
+                 ({:+.1e})",
+                hit.r.y * 1e3,
+                hit.r.z * 1e3,
+                rel(got, lever)
+            );
+            assert!(
+                rel(got, lever).abs() < 1e-3,
+                "{kind:?} {theta}°: ω'_x/Δv_y {got} against −m r_z/I_x {lever}"
+            );
+            assert!(
+                s.linear_velocity.z.abs() < 1e-9,
+                "{kind:?} {theta}°: v_z {}",
+                s.linear_velocity.z
+            );
+        }
+    }
+}
+
+/// Bullet meets the impulse law itself: touching the floor as the step starts (1e-9 m in, so
+/// its box-box test finds the edge), v' and ω'_x within 1e-5 of the law, for the loaded cube
+/// and for a centred cube tilted 30° (whose edge is off the centre too). Found deeper, d into
+/// the floor, Bullet bounces harder by exactly its Baumgarte term: it folds the position error
+/// into the velocity solve (`cpp/shim.cc`, `contact_row`: split impulse only beyond 4 cm,
+/// `m_splitImpulsePenetrationThreshold`), so the edge leaves at e V + 0.2 d/dt; a die landing
+/// at V is found up to V·dt deep, so its restitution is e + 0.2 U, U uniform in [0, 1):
+/// 0.6 on average for e = 0.5. Within 1e-4 of that, from 0.1 mm and 1 mm above the floor.
+#[test]
+fn bullet_meets_the_impulse_law_and_adds_its_baumgarte_term() {
+    for (com_z, theta) in [(COM_Z, 45.0), (COM_Z, -45.0), (COM_Z, 30.0), (0.0, 30.0)] {
+        let scene = cube(com_z, 0.0, 0.0, 0.001);
+        let mut engine = new_engine(EngineKind::Bullet, &scene).unwrap();
+        let hit = EdgeImpact::new(&scene, com_z, theta);
+        let (dv, wx) = hit.law();
+        let s = hit.after(engine.as_mut(), -1e-9);
+        let (got_dv, got_wx) = (s.linear_velocity.y + V, s.angular_velocity.x);
         println!(
-            "iters {iters} pgs {pgs}: dv {dv:+.5} wx {wx:+.5} wz {:+.3}",
-            b.angvel().z
+            "Bullet com {com_z} {theta}°: Δv {got_dv:.5} ({:+.1e}), ω'_x {got_wx:.3} ({:+.1e}) \
+             against {dv:.5}, {wx:.3}",
+            rel(got_dv, dv),
+            rel(got_wx, wx)
+        );
+        assert!(
+            rel(got_dv, dv).abs() < 1e-5,
+            "Bullet {theta}°: Δv {got_dv} against {dv}"
+        );
+        assert!(
+            rel(got_wx, wx).abs() < 1e-5,
+            "Bullet {theta}°: ω'_x {got_wx} against {wx}"
+        );
+        for gap in [1e-4, 1e-3] {
+            // Found after one step, V dt − gap deep: the edge leaves at e V + 0.2 d/dt.
+            let d = V * scene.dt - gap;
+            let boost = (E * V + BULLET_ERP * d / scene.dt + V) / ((1.0 + E) * V);
+            engine
+                .reset(&BodyState {
+                    linear_velocity: Vector3::new(0.0, -V, 0.0),
+                    ..at_rest(Vector3::new(0.0, -hit.r.y + gap, 0.0), hit.rotation)
+                })
+                .unwrap();
+            engine.step().unwrap();
+            engine.step().unwrap();
+            let got = engine.state().linear_velocity.y + V;
+            println!(
+                "Bullet com {com_z} {theta}° from {gap:e} m: Δv {got:.5} = law × {:.5}, \
+                 Baumgarte predicts × {boost:.5}",
+                got / dv
+            );
+            assert!(
+                rel(got / dv, boost).abs() < 1e-4,
+                "Bullet {theta}° from {gap} m: Δv {got} = law × {}, not × {boost}",
+                got / dv
+            );
+        }
+    }
+}
+
+/// Rapier's edge impact, predicted: its substeps bring the edge's two contact points (x = ±8 mm)
+/// to rest together, converged (the inelastic impulse V/(1/m + r_z²/I_x)); then its end-of-step
+/// restitution pass (rapier3d-f64 0.36.1, `staged_island_solver/worker.rs`, "applied ONCE
+/// after all substeps") drives each point's normal velocity to e V once, one point after the
+/// other: the first gets e V/K₁₁, the second (e V − K₂₁ Δ₁)/K₂₂, where K is the two points'
+/// coupling (K₁₁ = 1/m + r_z²/I_x + a² (I⁻¹)_zz, K₁₂ = 1/m + r_z²/I_x − a² (I⁻¹)_zz, a = 8 mm).
+/// The impulse falls short of the law (4.0 % at ±45°, 2.1 % for a centred cube at 30°) or
+/// overshoots it (3.3 % at 30°, where the two points' coupling K₁₂ is positive), and the
+/// difference of the two tips the die about the horizontal axis across the edge, world z
+/// (15 rad/s at ±45°, also for a centred cube). Measured: the model accounts for at least 90 % of the departure (all of it at
+/// ±45°, to 1e-4), and for the spin within 10 %, whatever the step (1 ms, 0.25 ms).
+#[test]
+fn rapier_bounces_an_edge_with_one_sequential_restitution_pass() {
+    for dt in [0.001, 0.00025] {
+        for (com_z, theta) in [
+            (COM_Z, 45.0),
+            (COM_Z, -45.0),
+            (COM_Z, 30.0),
+            (0.0, 45.0),
+            (0.0, 30.0),
+        ] {
+            let scene = cube(com_z, 0.0, 0.0, dt);
+            let mut engine = new_engine(EngineKind::Rapier, &scene).unwrap();
+            let hit = EdgeImpact::new(&scene, com_z, theta);
+            let (m, a) = (hit.m, SIDE / 2.0);
+            // (I⁻¹)_zz in world axes: body z turned by θ about x mixes I_y = I_x and I_z.
+            let iz = m * 2.0 * SIDE * SIDE / 12.0;
+            let th = theta.to_radians();
+            let inv_zz = th.sin().powi(2) / hit.ix + th.cos().powi(2) / iz;
+            let common = 1.0 / m + hit.r.z * hit.r.z / hit.ix;
+            let (k11, k12) = (common + a * a * inv_zz, common - a * a * inv_zz);
+            let inelastic = V / common;
+            let d1 = E * V / k11;
+            let d2 = (E * V - k12 * d1) / k11;
+            let predicted = (inelastic + d1 + d2) / m;
+            let spin = inv_zz * a * (d2 - d1);
+            let (dv, _) = hit.law();
+            let s = hit.after(engine.as_mut(), -1e-9);
+            let got = s.linear_velocity.y + V;
+            println!(
+                "Rapier dt {dt} com {com_z} {theta}°: Δv {got:.5} = law {:+.2} %, one-pass model \
+                 {:+.2} %; tip |ω_z| {:.2} rad/s, model {:.2}",
+                100.0 * rel(got, dv),
+                100.0 * rel(predicted, dv),
+                tip_across_the_edge(&s),
+                spin.abs()
+            );
+            // The model, not the law: at least 90 % of Rapier's departure from the law is the
+            // one pass's.
+            assert!(
+                (got - predicted).abs() < 0.1 * (dv - predicted).abs(),
+                "Rapier dt {dt} {theta}°: Δv {got}, one-pass model {predicted}, law {dv}"
+            );
+            assert!(
+                (tip_across_the_edge(&s) - spin.abs()).abs() < 0.1 * spin.abs(),
+                "Rapier {theta}°: spin {} against {}",
+                tip_across_the_edge(&s),
+                spin.abs()
+            );
+        }
+    }
+}
+
+/// The tip about world z (across the edge) that unequal impulses at the edge's two ends leave.
+fn tip_across_the_edge(s: &BodyState) -> f64 {
+    s.angular_velocity.z.abs()
+}
+
+/// The exact limit on Rapier: v' and ω'_x within 0.5 % of the impulse law, as Bullet meets it
+/// within 1e-5. Fails by −4.0 % (and a 15 rad/s tip across the edge) at ±45°: see
+/// `rapier_bounces_an_edge_with_one_sequential_restitution_pass`.
+#[test]
+#[ignore = "Rapier 0.36.1 applies restitution in one sequential pass over an edge's two contact \
+            points after its substeps: the impulse is 4 % short at 45° (the law needs the pass \
+            iterated or solved as a block); inside the rapier3d-f64 crate, not fixable here"]
+fn rapier_meets_the_impulse_law() {
+    let scene = cube(COM_Z, 0.0, 0.0, 0.001);
+    let mut engine = new_engine(EngineKind::Rapier, &scene).unwrap();
+    for theta in [45.0, -45.0, 30.0] {
+        let hit = EdgeImpact::new(&scene, COM_Z, theta);
+        let (dv, wx) = hit.law();
+        let s = hit.after(engine.as_mut(), -1e-9);
+        let (got_dv, got_wx) = (s.linear_velocity.y + V, s.angular_velocity.x);
+        assert!(
+            rel(got_dv, dv).abs() < 5e-3,
+            "Rapier {theta}°: Δv {got_dv} against {dv}"
+        );
+        assert!(
+            rel(got_wx, wx).abs() < 5e-3,
+            "Rapier {theta}°: ω'_x {got_wx} against {wx}"
         );
     }
 }
