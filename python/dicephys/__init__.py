@@ -497,8 +497,8 @@ def _fit_config(
     max_steps: int,
     points: int,
     point_rolls: int,
-    degree: int,
-    max_degree: int,
+    degree: Optional[int],
+    max_degree: Optional[int],
     refine: bool,
     common_throws: bool,
     seed: int,
@@ -542,8 +542,8 @@ def fit(
     max_steps: int = DEFAULT_MAX_STEPS,
     points: int = 64,
     point_rolls: int = 500,
-    degree: int = 3,
-    max_degree: int = 4,
+    degree: Optional[int] = None,
+    max_degree: Optional[int] = None,
     refine: bool = True,
     common_throws: bool = False,
     seed: int = 2385,
@@ -571,6 +571,8 @@ def fit(
     restitution, friction, kappa, spin_scale: the values where a parameter is not free
         (kappa "paper": the paper's throw, which a die of any shape takes as the tumble).
     points, point_rolls: the design (parameter points per block per pass, rolls at each).
+    degree, max_degree: the surrogate's polynomial degree, first and highest (None: 3 and 4;
+        2 and 2 for a die of more than six faces).
     com, pips, edge_radius, die, layout, density: the die thrown, as ``roll`` takes it (one
         die for every row; a counts file with face_1 … face_6 counts its faces).
     shape, size, scale: a die of any shape, as ``roll`` takes it ("d20", "coin:24,8"; or a
@@ -615,8 +617,8 @@ def recover(
     free = _names("free", free) if free is not None else list(truth)
     fit_options: Dict[str, Any] = dict(
         shared=(), ranges=None, restitution=0.5, friction=0.29, kappa="paper", spin_scale=1.0,
-        engine="bullet", dt=1e-3, max_steps=DEFAULT_MAX_STEPS, points=64, point_rolls=500, degree=3,
-        max_degree=4, refine=True, common_throws=False, seed=2385, com=None, pips=None,
+        engine="bullet", dt=1e-3, max_steps=DEFAULT_MAX_STEPS, points=64, point_rolls=500, degree=None,
+        max_degree=None, refine=True, common_throws=False, seed=2385, com=None, pips=None,
         edge_radius=None, die=None, layout=None, density=None, shape=None, size=None, scale=None,
     )
     unknown = set(options) - set(fit_options)

@@ -695,8 +695,8 @@ fn fit_config<'py>(
     max_steps: u64,
     points: usize,
     point_rolls: u64,
-    degree: usize,
-    max_degree: usize,
+    degree: Option<usize>,
+    max_degree: Option<usize>,
     refine: bool,
     common_throws: bool,
     seed: u64,
@@ -781,6 +781,11 @@ fn fit_config<'py>(
             .map_err(|e| PyValueError::new_err(format!("data: {e}")))?,
         None => rows,
     };
+    let degrees = calibration::design::DesignSpec::degrees(
+        degree,
+        max_degree,
+        shape.as_ref().map_or(6, |s| s.faces.len()),
+    );
     let cfg = FitConfig {
         rows,
         model,
@@ -795,8 +800,8 @@ fn fit_config<'py>(
         design: calibration::design::DesignSpec {
             points,
             rolls: point_rolls,
-            degree,
-            max_degree,
+            degree: degrees.0,
+            max_degree: degrees.1,
             refine,
             common: common_throws,
         },

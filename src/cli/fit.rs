@@ -75,12 +75,13 @@ pub struct FitArgs {
     /// Rolls at each parameter point (as `paper --calibrated --point-rolls`).
     #[arg(long = "point-rolls", alias = "rolls", default_value_t = 500)]
     pub rolls: u64,
-    /// The surrogate's polynomial degree (raised while it lacks fit, up to --max-degree).
-    #[arg(long, default_value_t = 3)]
-    pub degree: usize,
-    /// The highest surrogate degree tried.
-    #[arg(long, default_value_t = 4)]
-    pub max_degree: usize,
+    /// The surrogate's polynomial degree (raised while it lacks fit, up to --max-degree)
+    /// [default: 3; 2 for a die of more than six faces].
+    #[arg(long)]
+    pub degree: Option<usize>,
+    /// The highest surrogate degree tried [default: 4; 2 for a die of more than six faces].
+    #[arg(long)]
+    pub max_degree: Option<usize>,
     /// One pass only: no second pass over the box narrowed to the first pass's region.
     #[arg(long)]
     pub no_refine: bool,
@@ -268,6 +269,11 @@ impl FitArgs {
             Some(s) => data::on_shape(&rows, s).map_err(|e| Error::Usage(format!("--data {e}")))?,
             None => rows,
         };
+        let (degree, max_degree) = DesignSpec::degrees(
+            self.degree,
+            self.max_degree,
+            shape.as_ref().map_or(6, |s| s.faces.len()),
+        );
         let cfg = FitConfig {
             rows,
             model: self.model(shape.is_some())?,
@@ -288,8 +294,8 @@ impl FitArgs {
             design: DesignSpec {
                 points: self.points,
                 rolls: self.rolls,
-                degree: self.degree,
-                max_degree: self.max_degree,
+                degree,
+                max_degree,
                 refine: !self.no_refine,
                 common: self.common_throws,
             },
