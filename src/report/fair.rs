@@ -64,6 +64,15 @@ pub struct Fairness {
 }
 
 impl Fairness {
+    /// The verdict in a few words, for a figure's title: biased or not, with χ²'s p.
+    pub fn short_verdict(&self) -> String {
+        if self.resolved {
+            format!("biased (χ² p = {:.1e})", self.p_value)
+        } else {
+            format!("no bias resolved (χ² p = {:.2})", self.p_value)
+        }
+    }
+
     /// The faces' table and the verdict, as the terminal shows them.
     pub fn table(&self) -> String {
         let mut out = String::from(

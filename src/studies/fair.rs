@@ -328,11 +328,7 @@ pub fn write(dir: &std::path::Path, json: &str, fair: &Fairness, s: &RunSummary)
         s.mode,
         s.spec.throws.style,
         fair.n,
-        if fair.resolved {
-            format!("biased (χ² p = {:.1e})", fair.p_value)
-        } else {
-            format!("no bias resolved (χ² p = {:.2})", fair.p_value)
-        }
+        fair.short_verdict()
     );
     let faces: Vec<crate::report::figures::die::MapFace> = fair
         .faces
@@ -363,13 +359,28 @@ pub fn write(dir: &std::path::Path, json: &str, fair: &Fairness, s: &RunSummary)
             crate::report::figures::die::shape_map(dir, "die_map", &title, shape, &by_label)?;
         }
     }
+    // A cube's faces by number; any other die's by the label it shows.
+    let by_number = s.spec.scene.shape.is_none();
+    write_faces(dir, json, fair, &title, by_number)
+}
+
+/// The faces figure (`faces.svg`, `.png`: each face by its number, or by its label), the
+/// table as `fairness.csv` and the document `json` as `fairness.json`, into `dir`.
+fn write_faces(
+    dir: &std::path::Path,
+    json: &str,
+    fair: &Fairness,
+    title: &str,
+    by_number: bool,
+) -> Result<()> {
     let bars: Vec<crate::report::figures::die::FaceBar> = fair
         .faces
         .iter()
         .map(|f| crate::report::figures::die::FaceBar {
-            label: match s.spec.scene.shape {
-                Some(_) => f.direction.clone(),
-                None => f.number.to_string(),
+            label: if by_number {
+                f.number.to_string()
+            } else {
+                f.direction.clone()
             },
             p: f.p,
             err: f.err,
@@ -377,7 +388,7 @@ pub fn write(dir: &std::path::Path, json: &str, fair: &Fairness, s: &RunSummary)
         })
         .collect();
     let null = format!("{} null", fair.null);
-    crate::report::figures::die::faces(dir, "faces", &title, &null, &bars)?;
+    crate::report::figures::die::faces(dir, "faces", title, &null, &bars)?;
     crate::run::io::write_atomic(&dir.join("fairness.csv"), fair.csv().as_bytes())?;
     crate::run::io::write_atomic(&dir.join("fairness.json"), json.as_bytes())
 }
@@ -385,29 +396,8 @@ pub fn write(dir: &std::path::Path, json: &str, fair: &Fairness, s: &RunSummary)
 /// Writes measured counts' verdict (`assess_counts`) into `dir`: `fairness.json` (the document
 /// `json`), `fairness.csv` and the faces figure (`faces.svg`, `.png`).
 pub fn write_counted(dir: &std::path::Path, json: &str, fair: &Fairness) -> Result<()> {
-    let title = format!(
-        "{} throws counted; {}",
-        fair.n,
-        if fair.resolved {
-            format!("biased (χ² p = {:.1e})", fair.p_value)
-        } else {
-            format!("no bias resolved (χ² p = {:.2})", fair.p_value)
-        }
-    );
-    let bars: Vec<crate::report::figures::die::FaceBar> = fair
-        .faces
-        .iter()
-        .map(|f| crate::report::figures::die::FaceBar {
-            label: f.direction.clone(),
-            p: f.p,
-            err: f.err,
-            null: f.null,
-        })
-        .collect();
-    let null = format!("{} null", fair.null);
-    crate::report::figures::die::faces(dir, "faces", &title, &null, &bars)?;
-    crate::run::io::write_atomic(&dir.join("fairness.csv"), fair.csv().as_bytes())?;
-    crate::run::io::write_atomic(&dir.join("fairness.json"), json.as_bytes())
+    let title = format!("{} throws counted; {}", fair.n, fair.short_verdict());
+    write_faces(dir, json, fair, &title, false)
 }
 
 /// A feature of the die that `fair --vary` steps through.
