@@ -87,13 +87,14 @@ pub fn stop() -> &'static Stop {
 /// Runs the command line; returns the process exit code (0 ok, 2 bad input, 1 failure, 130
 /// stopped early with what was done kept).
 pub fn main() -> i32 {
-    // Ctrl-C or SIGTERM: the first asks runs to stop before their next roll (they keep their
-    // checkpoint and report what was done, as partial); a second ends the process at once.
+    // Ctrl-C or SIGTERM: the first asks runs to stop (a roll under way is abandoned within
+    // 4,096 steps; they keep their checkpoint and report what was done, as partial); a second
+    // ends the process at once.
     let _ = ctrlc::set_handler(|| {
         if stop().request() {
             std::process::exit(130);
         }
-        eprintln!("dicephys: stopping after the rolls under way (Ctrl-C again to quit now)");
+        eprintln!("dicephys: stopping (Ctrl-C again to quit now)");
     });
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,

@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 use crate::model::scene::Scene;
 use crate::model::throws::Throws;
 use crate::run::stop::Stop;
-use crate::sim::roll::{roll, Failure, Fate, RollConfig, RollRecord};
+use crate::sim::roll::{roll_or_abandon, Failure, Fate, RollConfig, RollRecord};
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -89,7 +89,8 @@ pub fn run_indices(
                     return None;
                 }
                 let throw = throws.get(i);
-                let r = WORLD.with(|w| roll_one(&mut w.borrow_mut(), engine, scene, &throw, cfg));
+                let r = WORLD
+                    .with(|w| roll_one(&mut w.borrow_mut(), engine, scene, &throw, cfg, stop))?;
                 let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                 progress(n);
                 Some(r)
@@ -129,14 +130,16 @@ thread_local! {
 }
 
 /// One roll that cannot take the batch down: an engine panic is caught, counted as an engine
-/// failure, and the thread's world is rebuilt for the next throw.
+/// failure, and the thread's world is rebuilt for the next throw. `None`: abandoned midway by a
+/// stop request (left out, as a roll not begun is).
 fn roll_one(
     world: &mut Option<World>,
     kind: EngineKind,
     scene: &Scene,
     throw: &crate::model::throws::Throw,
     cfg: &RollConfig,
-) -> RollRecord {
+    stop: &Stop,
+) -> Option<RollRecord> {
     if !matches!(world, Some(w) if w.kind == kind && w.scene == *scene) {
         *world = new_engine(kind, scene).ok().map(|engine| World {
             kind,
@@ -156,15 +159,16 @@ fn roll_one(
         up: None,
     };
     let Some(w) = world.as_mut() else {
-        return failed;
+        return Some(failed);
     };
+    let abandon = || stop.requested();
     match catch_unwind(AssertUnwindSafe(|| {
-        roll(w.engine.as_mut(), scene, throw, cfg)
+        roll_or_abandon(w.engine.as_mut(), scene, throw, cfg, &abandon)
     })) {
         Ok(r) => r,
         Err(_) => {
             *world = None;
-            failed
+            Some(failed)
         }
     }
 }

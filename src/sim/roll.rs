@@ -402,7 +402,16 @@ pub fn roll_observed(
     cfg: &RollConfig,
     observe: impl FnMut(u64, &BodyState),
 ) -> RollRecord {
-    let end = run(engine, scene, &throw.start(scene), cfg, observe, false);
+    let end = run(
+        engine,
+        scene,
+        &throw.start(scene),
+        cfg,
+        observe,
+        false,
+        &|| false,
+    )
+    .expect("never abandoned");
     record_of(throw, end)
 }
 
@@ -532,7 +541,7 @@ pub fn run_from(
     cfg: &RollConfig,
     observe: impl FnMut(u64, &BodyState),
 ) -> End {
-    run(engine, scene, start, cfg, observe, false)
+    run(engine, scene, start, cfg, observe, false, &|| false).expect("never abandoned")
 }
 
 /// The checks every step's state goes through, and what they keep between steps.
@@ -792,7 +801,8 @@ fn run(
     cfg: &RollConfig,
     mut observe: impl FnMut(u64, &BodyState),
     jump: bool,
-) -> End {
+    abandon: &dyn Fn() -> bool,
+) -> Option<End> {
     let mut end = End {
         fate: Fate::Failed(Failure::Engine),
         steps: 0,
@@ -804,7 +814,7 @@ fn run(
         up: None,
     };
     if engine.reset(start).is_err() {
-        return end;
+        return Some(end);
     }
     let mut w = Watch::new(scene, start, cfg);
     let mut fly = Flier::new(engine, scene, w.die.clone(), start, cfg);
@@ -831,31 +841,56 @@ fn run(
             }
             match fly.next(engine, &mut state) {
                 Ok(f) => flown = f,
-                Err(()) => return end,
+                Err(()) => return Some(end),
             }
         }
         fly.in_a_row = if flown { fly.in_a_row + 1 } else { 0 };
         if !flown {
             if engine.step().is_err() {
-                return end;
+                return Some(end);
             }
             end.engine_steps += 1;
             state = engine.state();
         }
         end.steps += 1;
+        // A roll that runs long (a die that never settles, to the step cap) asks every 4,096
+        // steps whether it is to be abandoned, so that a stop ends it within a second.
+        if end.steps & 0xfff == 0 && abandon() {
+            return None;
+        }
         // Every step's state, flown or stepped, goes through the same checks.
         observe(end.steps, &state);
         if w.judge(&mut end, &state, !flown || fly.own) {
-            return end;
+            return Some(end);
         }
     }
     end.fate = Fate::Unconverged(w.die.outcome(&state).0);
-    end
+    Some(end)
 }
 
 /// Rolls one throw to its end: `roll_observed` watching nothing, with free flight jumped
 /// where no check can fire (`Flight::jump`), which leaves the record bit for bit the same.
 pub fn roll(engine: &mut dyn Engine, scene: &Scene, throw: &Throw, cfg: &RollConfig) -> RollRecord {
-    let end = run(engine, scene, &throw.start(scene), cfg, |_, _| {}, true);
-    record_of(throw, end)
+    roll_or_abandon(engine, scene, throw, cfg, &|| false).expect("never abandoned")
+}
+
+/// [`roll`], abandoned (`None`) when `abandon` says so: it is asked every 4,096 steps (a stop
+/// request, which must end even a roll that runs to the step cap within a second).
+pub fn roll_or_abandon(
+    engine: &mut dyn Engine,
+    scene: &Scene,
+    throw: &Throw,
+    cfg: &RollConfig,
+    abandon: &dyn Fn() -> bool,
+) -> Option<RollRecord> {
+    let end = run(
+        engine,
+        scene,
+        &throw.start(scene),
+        cfg,
+        |_, _| {},
+        true,
+        abandon,
+    )?;
+    Some(record_of(throw, end))
 }

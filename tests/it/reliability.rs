@@ -158,6 +158,43 @@ fn ctrl_c_stops_cleanly_with_a_resumable_checkpoint_and_a_partial_report() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A stop ends even a roll that runs to its step cap within a second (reliability round 5,
+/// class H): a frictionless cube never settles, and with a cap of 10⁹ steps its first roll
+/// would take minutes (measured before the fix: SIGTERM honoured 139 s later, when both rolls
+/// had run out; now 14 ms). The bound, 3 s, is one a slow machine also meets: the roll asks
+/// every 4,096 steps, milliseconds apart.
+#[test]
+fn sigterm_ends_a_roll_that_runs_to_its_step_cap_within_a_second() {
+    let mut child = bin()
+        .args([
+            "roll",
+            "--block",
+            "16x16x16",
+            "--friction",
+            "0",
+            "--throw",
+            "tumble",
+            "--rolls",
+            "2",
+            "--threads",
+            "1",
+            "--max-steps",
+            "1000000000",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    signal_running(&mut child, libc::SIGTERM, 1500);
+    let sent = std::time::Instant::now();
+    let out = child.wait_with_output().unwrap();
+    let took = sent.elapsed().as_secs_f64();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(took < 3.0, "ended {took:.1} s after SIGTERM: {err}");
+    assert!(err.contains("interrupted after 0 of 2 rolls"), "{err}");
+}
+
 #[test]
 fn a_roll_forced_non_finite_is_counted_as_failed() {
     let scene = Scene::paper("140x24x20".parse().unwrap(), Mode::ThreeD);
