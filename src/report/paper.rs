@@ -193,9 +193,16 @@ pub fn verdict(res: &PaperResults, out: &std::path::Path) -> String {
     }
     s += "\n";
     for line in reading(res, &engines).lines().skip(2) {
+        // Shortened to fit 120 columns with every block outside 1σ named.
         let line = line
             .trim_start_matches("- ")
-            .replace(" experimental standard error (combined)", "σ");
+            .replace(
+                " blocks within 1 experimental standard error (combined)",
+                " within 1σ",
+            )
+            .replace(" within 2", " within 2σ")
+            .replace(" MDF (", " (")
+            .replace("; outside 1σ:", ";\n    outside 1σ:");
         if !line.is_empty() {
             s += &format!("  {line}\n");
         }

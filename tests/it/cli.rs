@@ -179,6 +179,12 @@ fn a_tiny_paper_run_is_complete_and_repeatable() {
             text.contains("report.md") && !text.contains("| row |"),
             "{text}"
         );
+        // The reading's blocks outside 1σ on a line of their own, so that all five fit.
+        assert!(
+            text.contains(" within 1σ, ") && !text.contains(" MDF ("),
+            "{text}"
+        );
+        assert!(!text.contains("; outside 1σ"), "{text}");
         let text = std::fs::read_to_string(dir.join("results.json")).unwrap();
         serde_json::from_str::<serde_json::Value>(&text).unwrap()
     };
