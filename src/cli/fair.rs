@@ -56,12 +56,9 @@ pub fn run(a: &FairArgs) -> Result<()> {
         ));
     }
     if let Some(dir) = &a.out {
-        std::fs::create_dir_all(dir).map_err(|e| {
-            Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
-        })?;
         let identity =
             serde_json::json!({ "spec": spec, "null": a.null, "layout": a.roll.layout(&spec) });
-        dicephys::studies::fair::claim(dir, &identity)?;
+        claim_out(dir, &identity)?;
     }
     if let Some(w) = spec.endless_roll_warning() {
         eprintln!("dicephys: warning: {w}");
@@ -93,6 +90,13 @@ pub fn run(a: &FairArgs) -> Result<()> {
     done
 }
 
+/// `--out DIR` made and claimed for this `fair` run (another run's directory is refused).
+fn claim_out(dir: &std::path::Path, identity: &serde_json::Value) -> Result<()> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| Error::Usage(format!("--out {}: cannot create it ({e})", dir.display())))?;
+    Ok(dicephys::studies::fair::claim(dir, identity)?)
+}
+
 /// `fair --counts`: measured counts judged without a simulation.
 fn counted(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, text: &str) -> Result<()> {
     use dicephys::studies::fair::{assess_counts, parse_counts, write_counted};
@@ -101,11 +105,10 @@ fn counted(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, text: &str) -> Res
     let doc = serde_json::json!({ "fairness": fair });
     let json = dicephys::run::seal::to_string(&doc, true)?;
     if let Some(dir) = &a.out {
-        std::fs::create_dir_all(dir).map_err(|e| {
-            Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
-        })?;
-        let identity = serde_json::json!({ "counts": counts, "null": a.null });
-        dicephys::studies::fair::claim(dir, &identity)?;
+        claim_out(
+            dir,
+            &serde_json::json!({ "counts": counts, "null": a.null }),
+        )?;
         write_counted(dir, &json, &fair)?;
         if !*a.roll.json {
             eprintln!(
