@@ -151,39 +151,93 @@ def _rows(csv_bytes: bytes) -> Any:
 
 
 class Roll(Document):
-    """A roll's result: ``dicephys roll --json``'s document (docs/json.md, "roll").
+    """A roll's result: ``dicephys roll --json``'s document (docs/json.md, "roll"), or
+    ``fair --json``'s (its ``fairness`` beside the run's).
 
     ``counts`` (which side ended vertical), ``faces`` (the number up), ``ratio`` with its
-    error; with ``per_roll=True``, ``per_roll`` is a NumPy structured array of every throw (the
-    ``--per-roll`` CSV's columns, ``per_roll_dtype()``) and ``per_roll_csv`` its bytes.
+    error; ``summary()`` is the text the command line prints, ``face_table()`` the faces as
+    NumPy columns (``pandas.DataFrame(r.face_table())`` for a frame); ``result`` is the run's
+    document (``roll --json``'s, or ``fair``'s ``summary``). With ``per_roll=True``,
+    ``per_roll`` is a NumPy structured array of every throw (the ``--per-roll`` CSV's columns,
+    ``per_roll_dtype()``) and ``per_roll_csv`` its bytes.
     """
 
-    def __init__(self, text: str, csv_bytes: Optional[bytes]) -> None:
+    def __init__(self, text: str, human: str, csv_bytes: Optional[bytes]) -> None:
         super().__init__(text)
-        summary = self.data.get("summary", self.data)
-        self.summary: Dict[str, Any] = summary
+        self.result: Dict[str, Any] = self.data.get("summary", self.data)
+        self._human = human
         self.per_roll_csv: Optional[bytes] = csv_bytes
         self.per_roll: Any = _rows(csv_bytes) if csv_bytes is not None else None
+
+    def summary(self) -> str:
+        """What ``dicephys roll`` (or ``fair``) prints for this run, as text."""
+        return self._human
+
+    def __repr__(self) -> str:
+        r = self.result
+        shape = r.get("spec", {}).get("scene", {}).get("shape")
+        die = shape["name"] if shape else "x".join(f"{v:g}" for v in r.get("block_mm", []))
+        engine = r.get("spec", {}).get("engine", "?")
+        head = f"{type(self).__name__}({die}, {engine}, {r.get('rolls', 0):,} rolls"
+        faces = self.faces
+        if 0 < len(faces) <= 12:
+            head += ": faces " + " ".join(f"{k}:{v}" for k, v in faces.items())
+        elif faces:
+            head += f": {len(faces)} faces"
+        if "fairness" in self.data:
+            f = self.data["fairness"]
+            word = str(f["verdict"]).split(":")[0]
+            head += f"; {word} (χ² {f['chi2']:.1f} on {f['dof']}, p {f['p_value']:.2g})"
+        elif shape is None and r.get("ratio") is not None:
+            head += f"; ratio {r['ratio']:.4f} ± {r['ratio_err']:.4f}"
+        return head + ")"
+
+    def face_table(self) -> Dict[str, Any]:
+        """The faces as NumPy columns: ``label``, ``count``, ``p`` and ``err`` (1σ), and for
+        ``fair`` ``null`` and ``z``, one row per face in the die's order."""
+        import numpy as np
+
+        if "fairness" in self.data:
+            rows = self.data["fairness"]["faces"]
+            cols: Dict[str, Any] = {
+                "label": np.array([str(f.get("label", f.get("number"))) for f in rows]),
+                "count": np.array([f["count"] for f in rows], dtype=np.int64),
+                "p": np.array([f["p"] for f in rows], dtype=np.float64),
+                "err": np.array([f["err"] for f in rows], dtype=np.float64),
+                "null": np.array([f["null"] for f in rows], dtype=np.float64),
+                "z": np.array([np.nan if f["z"] is None else f["z"] for f in rows], dtype=np.float64),
+            }
+            return cols
+        faces = self.faces
+        n = sum(faces.values())
+        count = np.array(list(faces.values()), dtype=np.int64)
+        p = count / n if n else np.full(len(count), np.nan)
+        return {
+            "label": np.array(list(faces.keys())),
+            "count": count,
+            "p": p,
+            "err": np.sqrt(p * (1 - p) / n) if n else np.full(len(count), np.nan),
+        }
 
     @property
     def counts(self) -> Dict[str, int]:
         """Rolls by the side that ended vertical (length, breadth, width, unknown)."""
-        return dict(self.summary["counts"])
+        return dict(self.result["counts"])
 
     @property
     def faces(self) -> Dict[str, int]:
         """Rolls by the number up, ``"1"``…``"6"`` (in 2D the four sides' numbers)."""
-        return dict(self.summary.get("faces", {}))
+        return dict(self.result.get("faces", {}))
 
     @property
     def ratio(self) -> Value:
         """N(breadth vertical) / N(width vertical), the paper's ratio, with its error."""
-        return Value(self.summary["ratio"], self.summary["ratio_err"])
+        return Value(self.result["ratio"], self.result["ratio_err"])
 
     @property
     def theory_ratio(self) -> float:
         """The paper's 2D theory of the ratio for this block (its eq. MasterEqu)."""
-        return float(self.summary["theory_ratio"])
+        return float(self.result["theory_ratio"])
 
 
 class Fit(Document):
@@ -198,6 +252,27 @@ class Fit(Document):
     def path(self) -> str:
         """The fit's ``fit.json``, which ``predict`` and ``dicephys predict --fit`` read."""
         return os.path.join(self.out, "fit.json")
+
+    def summary(self) -> str:
+        """The fit's report (``report.md``, what ``dicephys fit`` prints), as text."""
+        with open(os.path.join(self.out, "report.md"), encoding="utf-8") as f:
+            return f.read()
+
+    def __repr__(self) -> str:
+        e = self.data.get("estimate", {})
+        shown = []
+        for p in e.get("params", []):
+            lo, hi = (p.get("one_sigma") or [None, None])[:2]
+            value = f"{p['name']} {p['value']:.4g}"
+            if lo is not None and hi is not None:
+                value += f" (1σ {lo:.4g}–{hi:.4g})"
+            if p.get("identified") == "no":
+                value += " unidentified"
+            shown.append(value)
+        fit = ""
+        if e.get("p_value") is not None:
+            fit = f"; χ² {e['chi2']:.1f} on {e['dof']}, p {e['p_value']:.2g}"
+        return f"Fit({', '.join(shown)}{fit}; out={self.out!r})"
 
 
 def _progress(progress: Progress, what: str) -> Tuple[Optional[Callable[[float, float], Any]], Callable[[], None]]:
@@ -221,8 +296,9 @@ def _progress(progress: Progress, what: str) -> Tuple[Optional[Callable[[float, 
     bar = tqdm(total=0, desc=what, unit="roll" if what in ("roll", "fair") else "")
 
     def tell(done: float, total: float) -> None:
-        bar.total = total
-        bar.n = done
+        # Whole counts (rolls, cells): "2000/20000", not "2000.0/20000.0".
+        bar.total = int(round(total))
+        bar.n = int(round(min(done, total)))
         bar.refresh()
 
     return tell, bar.close
@@ -350,63 +426,121 @@ def roll(
         (0.02 is 2 %), tested every 1,000 rolls.
     progress: see the module's help.
     """
-    if isinstance(rolls, bool):
-        raise ValueError(f"rolls={rolls!r}: give a number of rolls")
-    tell, close = _progress(progress, "roll")
+    return _roll(
+        block, "roll", progress, None, precision,
+        shape=shape, size=size, scale=scale, rolls=rolls, seed=seed, mode=mode, engine=engine,
+        dt=dt, restitution=restitution, friction=friction, density=density, preset=preset,
+        floor=floor, floor_thickness=floor_thickness, linear_damping=linear_damping,
+        angular_damping=angular_damping, rolling_resistance=rolling_resistance, sleep=sleep,
+        throw=throw, kappa=kappa, source=source, velocity=velocity, spin=spin,
+        drop_height=drop_height, settle=settle, flight=flight, faithful=faithful,
+        max_steps=max_steps, margin=margin, com=com, pips=pips, edge_radius=edge_radius, die=die,
+        layout=layout, threads=threads, per_roll=per_roll,
+    )
+
+
+def _roll(
+    block: Optional[str],
+    what: str,
+    progress: Progress,
+    null: Optional[str],
+    precision: Optional[float],
+    **opts: Any,
+) -> Roll:
+    """``roll``'s and ``fair``'s one call into the library, the arguments converted."""
+    if isinstance(opts.get("rolls"), bool):
+        raise ValueError(f"rolls={opts['rolls']!r}: give a number of rolls")
+    for k in ("velocity", "spin", "drop_height"):
+        opts[k] = _pair(k, opts.get(k))
+    opts["com"] = _triple("com", opts.get("com"), 3)
+    opts["pips"] = _triple("pips", opts.get("pips"), 2)
+    if opts.get("die") is not None:
+        opts["die"] = os.fspath(opts["die"])
+    tell, close = _progress(progress, what)
     try:
-        text, csv_bytes = _native.roll(
-            block, shape=shape, size=size, scale=scale, rolls=rolls, seed=seed, mode=mode,
-            engine=engine, dt=dt,
-            restitution=restitution, friction=friction, density=density, preset=preset,
-            floor=floor, floor_thickness=floor_thickness, linear_damping=linear_damping,
-            angular_damping=angular_damping, rolling_resistance=rolling_resistance, sleep=sleep, throw=throw, kappa=kappa,
-            source=source, velocity=_pair("velocity", velocity), spin=_pair("spin", spin),
-            drop_height=_pair("drop_height", drop_height), settle=settle, flight=flight, faithful=faithful,
-            max_steps=max_steps, margin=margin, com=_triple("com", com, 3),
-            pips=_triple("pips", pips, 2), edge_radius=edge_radius,
-            die=None if die is None else os.fspath(die), layout=layout, threads=threads,
-            per_roll=per_roll, precision=precision, progress=tell,
+        text, human, csv_bytes = _native.roll(
+            block, precision=precision, fair=null, progress=tell, **opts
         )
     finally:
         close()
-    return Roll(text, None if csv_bytes is None else bytes(csv_bytes))
+    return Roll(text, human, None if csv_bytes is None else bytes(csv_bytes))
 
 
 def fair(
     block: Optional[str] = None,
     *,
     null: str = "uniform",
+    within: Optional[float] = None,
+    shape: Optional[str] = None,
+    size: Optional[float] = None,
+    scale: Optional[float] = None,
+    rolls: Optional[int] = None,
+    seed: int = 2385,
+    mode: str = "3d",
+    engine: str = "bullet",
+    dt: float = 1e-3,
+    restitution: float = 0.5,
+    friction: float = 0.29,
+    density: Optional[float] = None,
     throw: str = "tumble",
-    precision: Optional[float] = None,
+    kappa: Optional[float] = None,
+    source: str = "keyed",
+    velocity: RangeArg = None,
+    spin: RangeArg = None,
+    drop_height: RangeArg = None,
+    preset: str = "dicephys281",
+    floor: str = "box",
+    floor_thickness: Optional[float] = None,
+    linear_damping: float = 0.0,
+    angular_damping: float = 0.0,
+    rolling_resistance: float = 0.0,
+    sleep: bool = True,
+    settle: Optional[str] = None,
+    flight: str = "fast",
+    faithful: bool = False,
+    max_steps: Optional[int] = None,
+    margin: float = DEFAULT_MARGIN,
+    com: Optional[Sequence[float]] = None,
+    pips: Optional[Sequence[float]] = None,
+    edge_radius: Optional[float] = None,
+    die: Optional[PathLike] = None,
+    layout: Optional[str] = None,
+    threads: int = 0,
+    per_roll: bool = False,
     progress: Progress = None,
-    **options: Any,
+    precision: Optional[float] = None,
 ) -> Roll:
     """Is this die fair, face by face: ``dicephys fair --json``.
 
-    Rolls the die as ``roll`` does (any of its options; thrown in a tumble unless ``throw``
-    says otherwise) and sets each face against ``null``: "uniform" (each face 1/N) or
-    "quasi-static" (also "solid-angle": released at rest, rolling without a bounce; 3D). The result's ``fairness`` is the fair
-    report (each face's probability, its departure in σ, χ², the throws a tester needs);
-    ``precision`` here is every face's probability's 2σ, a fraction (0.005: ±0.005).
+    Rolls the die as ``roll`` does (the same arguments, with the same meanings; thrown in a
+    tumble unless ``throw`` says otherwise) and sets each face against ``null``: "uniform"
+    (each face 1/N) or "quasi-static" (also "solid-angle": released at rest, rolling without a
+    bounce; 3D). The result's ``fairness`` is the fair report (each face's probability, its
+    departure in σ, χ², the throws a tester needs); ``probabilities()`` the faces as arrays.
+
+    within: roll until every face's probability is known to this 2σ, a probability (0.005:
+        each face to ±0.005; the command line's ``--within 0.5``, in percentage points).
+    precision: the old name of ``within`` (deprecated: in ``roll`` it is the ratio's relative
+        error).
     """
-    tell, close = _progress(progress, "fair")
-    opts = dict(options)
-    for k in ("velocity", "spin", "drop_height"):
-        if k in opts:
-            opts[k] = _pair(k, opts[k])
-    if "com" in opts:
-        opts["com"] = _triple("com", opts["com"], 3)
-    if "pips" in opts:
-        opts["pips"] = _triple("pips", opts["pips"], 2)
-    if "die" in opts and opts["die"] is not None:
-        opts["die"] = os.fspath(opts["die"])
-    try:
-        text, csv_bytes = _native.roll(
-            block, throw=throw, precision=precision, fair=null, progress=tell, **opts
-        )
-    finally:
-        close()
-    return Roll(text, None if csv_bytes is None else bytes(csv_bytes))
+    if precision is not None:
+        if within is not None:
+            raise ValueError("give within= (precision= is its old name), not both")
+        import warnings
+
+        warnings.warn("fair(precision=) is now fair(within=)", DeprecationWarning, stacklevel=2)
+        within = precision
+    return _roll(
+        block, "fair", progress, null, within,
+        shape=shape, size=size, scale=scale, rolls=rolls, seed=seed, mode=mode, engine=engine,
+        dt=dt, restitution=restitution, friction=friction, density=density, preset=preset,
+        floor=floor, floor_thickness=floor_thickness, linear_damping=linear_damping,
+        angular_damping=angular_damping, rolling_resistance=rolling_resistance, sleep=sleep,
+        throw=throw, kappa=kappa, source=source, velocity=velocity, spin=spin,
+        drop_height=drop_height, settle=settle, flight=flight, faithful=faithful,
+        max_steps=max_steps, margin=margin, com=com, pips=pips, edge_radius=edge_radius, die=die,
+        layout=layout, threads=threads, per_roll=per_roll,
+    )
 
 
 def theory(block: Optional[str] = None, *, tolerance: float = 0.1) -> Document:
@@ -602,30 +736,49 @@ def recover(
     *,
     repeats: int = 20,
     free: Optional[Sequence[str]] = None,
+    shared: Sequence[str] = (),
+    ranges: Optional[Mapping[str, Tuple[float, float]]] = None,
+    restitution: float = 0.5,
+    friction: float = 0.29,
+    kappa: Union[None, str, float] = "paper",
+    spin_scale: float = 1.0,
+    engine: str = "bullet",
+    dt: float = 1e-3,
+    max_steps: int = DEFAULT_MAX_STEPS,
+    points: int = 64,
+    point_rolls: int = 500,
+    degree: Optional[int] = None,
+    max_degree: Optional[int] = None,
+    refine: bool = True,
+    common_throws: bool = False,
+    seed: int = 2385,
+    com: Optional[Sequence[float]] = None,
+    pips: Optional[Sequence[float]] = None,
+    edge_radius: Optional[float] = None,
+    die: Optional[PathLike] = None,
+    layout: Optional[str] = None,
+    density: Optional[float] = None,
+    shape: Optional[str] = None,
+    size: Optional[float] = None,
+    scale: Optional[float] = None,
     out: Optional[PathLike] = None,
     threads: int = 0,
     progress: Progress = None,
-    **options: Any,
 ) -> Document:
     """Checks that a fit recovers known values: ``dicephys fit --recover``.
 
     Counts of ``data``'s rows (the same blocks and numbers of throws) are simulated at
     ``truth`` ({"e": 0.5, "mu": 0.3}: a value for every free parameter) and fitted back,
-    ``repeats`` times; the result says how often the 2σ region held the truth. The other
-    options are ``fit``'s.
+    ``repeats`` times; the result says how often the 2σ region held the truth. ``free``
+    defaults to the parameters ``truth`` names; the other arguments are ``fit``'s.
     """
     free = _names("free", free) if free is not None else list(truth)
-    fit_options: Dict[str, Any] = dict(
-        shared=(), ranges=None, restitution=0.5, friction=0.29, kappa="paper", spin_scale=1.0,
-        engine="bullet", dt=1e-3, max_steps=DEFAULT_MAX_STEPS, points=64, point_rolls=500, degree=None,
-        max_degree=None, refine=True, common_throws=False, seed=2385, com=None, pips=None,
-        edge_radius=None, die=None, layout=None, density=None, shape=None, size=None, scale=None,
+    config = _fit_config(
+        data, free, shared, ranges, restitution, friction, kappa, spin_scale, engine, dt,
+        max_steps, points, point_rolls, degree, max_degree, refine, common_throws, seed,
+        com=com, pips=pips, edge_radius=edge_radius, die=die, layout=layout, density=density,
+        shape=shape, size=size, scale=scale,
     )
-    unknown = set(options) - set(fit_options)
-    if unknown:
-        raise TypeError(f"recover() got unexpected options {sorted(unknown)}")
-    fit_options.update(options)
-    config = _fit_config(data, free, **fit_options)
     where = _out(out, "recover")
     tell, close = _progress(progress, "recover")
     try:

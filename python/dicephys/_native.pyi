@@ -12,8 +12,9 @@ _Progress = Optional[Callable[[float, float], Any]]
 _Log = Optional[Callable[[str], Any]]
 
 def version() -> str: ...
-def roll(block: Optional[str] = None, **options: Any) -> Tuple[str, Optional[bytes]]:
-    """``dicephys.roll``'s options by name (``fair``: a null, for ``dicephys.fair``)."""
+def roll(block: Optional[str] = None, **options: Any) -> Tuple[str, str, Optional[bytes]]:
+    """``dicephys.roll``'s options by name (``fair``: a null, for ``dicephys.fair``): the
+    JSON document, the command line's text, the per-roll CSV."""
     ...
 
 def theory(block: Optional[str] = ..., tolerance: float = ...) -> str: ...

@@ -495,15 +495,16 @@ fn rolled(
 }
 
 /// `dicephys roll`: many throws of one block on one engine, with `roll`'s options by the
-/// library's names (the package's `roll` lists them). Returns the `roll --json` document and,
-/// with `per_roll`, the `--per-roll` CSV's bytes; with `fair` (a null), `fair --json`'s.
+/// library's names (the package's `roll` lists them). Returns the `roll --json` document, the
+/// text `roll` prints and, with `per_roll`, the `--per-roll` CSV's bytes; with `fair` (a
+/// null), `fair --json`'s document and `fair`'s text.
 #[pyfunction]
 #[pyo3(signature = (block=None, **options))]
 fn roll<'py>(
     py: Python<'py>,
     block: Option<&str>,
     options: Option<Bound<'py, PyDict>>,
-) -> PyResult<(String, Option<Bound<'py, PyBytes>>)> {
+) -> PyResult<(String, String, Option<Bound<'py, PyBytes>>)> {
     // The caller's dict is its own: read a copy.
     let o = Options {
         given: options.map(|d| d.copy()).transpose()?,
@@ -547,16 +548,26 @@ fn roll<'py>(
         precision,
         progress.as_ref(),
     )?;
-    let json = match null {
-        None => dicephys::run::seal::to_string(&summary, true),
+    // The document and the text the command line prints for it (`summary()` in Python).
+    let (json, text) = match null {
+        None => (
+            dicephys::run::seal::to_string(&summary, true),
+            summary.human(),
+        ),
         Some(null) => {
             let fair = dicephys::studies::fair::assess(&summary, null).map_err(py_err)?;
             let doc = serde_json::json!({ "fairness": fair, "summary": summary });
-            dicephys::run::seal::to_string(&doc, true)
+            (
+                dicephys::run::seal::to_string(&doc, true),
+                fair.text(&summary),
+            )
         }
-    }
-    .map_err(py_err)?;
-    Ok((json, csv.map(|b| PyBytes::new(py, &b))))
+    };
+    Ok((
+        json.map_err(py_err)?,
+        text,
+        csv.map(|b| PyBytes::new(py, &b)),
+    ))
 }
 
 /// `dicephys theory --block … --json` (or `--table --json` without a block).

@@ -56,9 +56,9 @@ def test_a_die_of_any_shape_is_the_cli_s(tmp_path: Path) -> None:
     got = dicephys.roll(shape="d20", rolls=2000, seed=1)
     assert got.faces == want["faces"]
     assert len(got.faces) == 20
-    assert got.summary["shape"] == want["shape"]
+    assert got.result["shape"] == want["shape"]
     # Beside each face, the quasi-static theory: a d20's 1/20.
-    assert all(abs(f["quasi_static"] - 0.05) < 1e-9 for f in got.summary["shape"]["faces"])
+    assert all(abs(f["quasi_static"] - 0.05) < 1e-9 for f in got.result["shape"]["faces"])
     # A mesh by its path: a cube's eight corners and six quads.
     cube = tmp_path / "cube.obj"
     corners = [(x, y, z) for x in (0, 16) for y in (0, 16) for z in (0, 16)]
@@ -74,11 +74,11 @@ def test_a_die_of_any_shape_is_the_cli_s(tmp_path: Path) -> None:
     coin = ["--shape", "coin:24,12", "--rolls", "60", "--rolling-resistance", "0.05"]
     want = cli("roll", *coin, "--seed", "1", "--json")
     got = dicephys.roll(shape="coin:24,12", rolls=60, seed=1, rolling_resistance=0.05)
-    assert got.faces == want["faces"] and got.summary["unconverged"] == 0
+    assert got.faces == want["faces"] and got.result["unconverged"] == 0
     # No die at all: the CLI's 16 mm d6, in a tumble.
     d6 = dicephys.roll(rolls=100, seed=2)
     assert d6.faces == cli("roll", "--rolls", "100", "--seed", "2", "--json")["faces"]
-    assert d6.summary["spec"]["throws"]["style"] == "tumble"
+    assert d6.result["spec"]["throws"]["style"] == "tumble"
     with pytest.raises(ValueError, match="shape"):
         dicephys.roll(shape="d7")
 
@@ -186,6 +186,37 @@ def test_fair_reports_every_face() -> None:
     assert got.fairness["chi2"] == want["fairness"]["chi2"]
 
 
+def test_a_result_reads_at_a_glance_and_as_arrays() -> None:
+    # summary() is the command line's text; the repr one short line; the faces as columns.
+    got = dicephys.fair("16x16x16", com=(0, 0, -2), rolls=400, seed=5)
+    text = subprocess.run(
+        [BIN, "fair", "--block", "16x16x16", "--com", "0,0,-2", "--rolls", "400", "--seed", "5"],
+        capture_output=True, text=True, check=True,
+    ).stdout
+    assert got.summary() == text
+    line = repr(got)
+    assert "\n" not in line and len(line) < 200 and "400 rolls" in line, line
+    t = got.face_table()
+    assert list(t["label"]) == ["1", "2", "3", "4", "5", "6"]
+    assert int(t["count"].sum()) == sum(got.faces.values())
+    assert abs(t["p"].sum() - 1) < 1e-12 and (t["err"] > 0).all() and t["z"].shape == (6,)
+    r = dicephys.roll("140x24x20", rolls=500, seed=1)
+    assert "ratio" in repr(r) and r.face_table()["count"].sum() == sum(r.faces.values())
+    d20 = dicephys.roll(shape="d20", rolls=300, seed=1)
+    assert repr(d20).startswith("Roll(d20, bullet, 300 rolls: 20 faces") and "ratio" not in repr(d20)
+
+
+def test_fair_within_is_every_face_s_2_sigma_as_a_probability() -> None:
+    # within=0.02 is the command line's --within 2 (percentage points); precision= its old name.
+    want = cli("fair", "--block", "16x16x16", "--within", "2", "--seed", "3", "--json")
+    got = dicephys.fair("16x16x16", within=0.02, seed=3)
+    assert got.faces == want["summary"]["faces"]
+    assert got.result["precision"]["resolved"] is True
+    with pytest.warns(DeprecationWarning):
+        old = dicephys.fair("16x16x16", precision=0.02, seed=3)
+    assert old.faces == got.faces
+
+
 ROWS = [
     {"label": "a", "surface": "mdf", "length_mm": 140, "breadth_mm": 24, "width_mm": 20, "mode": "2d",
      "length_vertical": 0, "breadth_vertical": 0, "width_vertical": 0},
@@ -210,6 +241,8 @@ def test_fit_then_predict_through_python(tmp_path: Path) -> None:
     rows = [dict(r, breadth_vertical=4100, width_vertical=5900) for r in ROWS]
     f = dicephys.fit(rows, free=["e"], points=8, point_rolls=300, refine=False, out=tmp_path / "fit")
     assert Path(f.path).exists()
+    assert repr(f).startswith("Fit(e[mdf] ") and "\n" not in repr(f)
+    assert f.summary() == (tmp_path / "fit" / "report.md").read_text(encoding="utf-8")
     p = dicephys.predict(f, "140x30x10", mode="2d", draws=4, rolls=200)
     want = cli("predict", "--fit", f.path, "--block", "140x30x10", "--2d", "--draws", "4", "--rolls", "200", "--json")
     assert p.data == want

@@ -16,7 +16,8 @@ use dicephys::sim::roll::{RollConfig, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
 /// The seed of the keyed throws (`*seed` reads it).
 #[derive(Args, Debug, Clone, Copy)]
 pub struct Seed {
-    /// Seed of the keyed throws: the same seed gives the same rolls on any thread count.
+    /// Seed of the throws (each throw drawn from the seed and its own number, "keyed"): the
+    /// same seed gives the same rolls on any thread count.
     #[arg(long, default_value_t = 2385)]
     pub seed: u64,
 }
@@ -273,10 +274,12 @@ pub struct ThrowArgs {
     /// (DicePhys's glibc rand() sequence, the paper's throw only).
     #[arg(long = "source", alias = "throws", default_value = "keyed", value_parser = parse_throw_kind)]
     pub source: ThrowKind,
-    /// Linear velocity along x, m/s: LO:HI, or one number.
+    /// Launch velocity, m/s: LO:HI, or one number (the paper's throw: along x; a tumble or a
+    /// hand's throw: its speed, in a random horizontal direction).
     #[arg(long, default_value = "-0.2:0.2", allow_hyphen_values = true)]
     pub velocity: Range,
-    /// Spin about the length axis, rad/s: LO:HI, or one number.
+    /// Spin, rad/s: LO:HI, or one number (the paper's throw: about the length axis; a tumble
+    /// or a hand's throw: its magnitude, about an axis drawn at random).
     #[arg(long, default_value = "31:160", allow_hyphen_values = true)]
     pub spin: Range,
     /// Drop height added to the longest side, m: LO:HI, or one number.
@@ -318,15 +321,13 @@ pub enum FlightArg {
 /// How many rolls, how.
 #[derive(Args, Debug, Clone)]
 pub struct RunArgs {
-    /// Number of rolls [default: 10,000]; with --precision, the most it may take [default:
+    /// Number of rolls [default: 10,000]; with --precision (fair: --within), the most it may take [default:
     /// 10,000,000].
     #[arg(long)]
     pub rolls: Option<u64>,
     /// Roll until the ratio breadth/width is known to this precision: its relative 2σ error
     /// (per cent, e.g. 2 or 2%) at most this, tested every 1,000 rolls, so that the same seed
     /// gives the same rolls on any thread count. The summary says how many rolls it took.
-    /// In `fair`: every face's probability to 2σ of this many percentage points (0.5: each
-    /// face known to ±0.005).
     #[arg(long, value_name = "PERCENT", value_parser = parse_percent)]
     pub precision: Option<f64>,
     /// Worker threads.
@@ -356,6 +357,21 @@ pub struct RunArgs {
     /// defaults --floor box --preset dicephys281).
     #[arg(long, conflicts_with_all = ["settle", "flight"])]
     pub faithful: bool,
+}
+
+/// Percentage points of a probability, "0.5" or "0.5pp", as a probability in (0, 1).
+pub fn parse_points(s: &str) -> std::result::Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .trim_end_matches("pp")
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}': give percentage points, e.g. 0.5 (each face to ±0.005)"))?;
+    if v.is_finite() && v > 0.0 && v < 100.0 {
+        Ok(v / 100.0)
+    } else {
+        Err(format!("'{s}': must be in (0, 100) percentage points"))
+    }
 }
 
 /// A precision in per cent, "1" or "1%", as a fraction in (0, 100 %).

@@ -11,9 +11,16 @@ use dicephys::studies::fair::{assess, Null};
 
 /// `dicephys fair`'s arguments.
 #[derive(Args, Debug)]
+#[command(mut_arg("precision", |a| a.hide(true)))]
 pub struct FairArgs {
     #[command(flatten)]
     pub roll: RollArgs,
+    /// Roll until every face's probability is known within ±PP percentage points at 2σ (0.5:
+    /// each face to ±0.005), tested every 1,000 rolls, so that the same seed gives the same
+    /// rolls on any thread count; --rolls is then the most it may take [default: 10,000,000].
+    /// (`--precision`, a relative error of the ratio in `roll`, meant this here before.)
+    #[arg(long, value_name = "PP", value_parser = super::args::parse_points, conflicts_with = "precision")]
+    pub within: Option<f64>,
     /// What fair means: uniform (each face 1/N; in 2D each side 1/4) or quasi-static (what
     /// the die would show released at rest and rolling down without a bounce: for a cuboid
     /// each face the solid angle the face opposite subtends from the centre of mass, so also
@@ -28,19 +35,30 @@ pub struct FairArgs {
     /// (mm; NAME com_x, com_y, com_z, pip_depth or edge_radius), the same throws at each,
     /// each judged; with --out, the figure bias.svg, .png (each face's probability against
     /// the value, the null beside it) and bias.json.
-    #[arg(long, value_name = "NAME=LO:HI:N", conflicts_with_all = ["checkpoint", "resume", "precision", "per_roll", "shard"])]
+    #[arg(long, value_name = "NAME=LO:HI:N", conflicts_with_all = ["checkpoint", "resume", "precision", "within", "per_roll", "shard"])]
     pub vary: Option<String>,
     /// Judge counts you measured instead of rolling: LABEL=N for each face (1=170,2=160,…;
     /// heads=48,tails=51,edge=1), against --null (uniform: 1/N over the faces given;
     /// quasi-static: the die --block, --shape or --die describe). No simulation: each face's
     /// p ± σ, the χ², and the throws that would see the bias; with --out, fairness.csv,
     /// fairness.json and the faces figure.
-    #[arg(long, value_name = "LABEL=N,...", conflicts_with_all = ["vary", "checkpoint", "resume", "precision", "per_roll", "shard"])]
+    #[arg(long, value_name = "LABEL=N,...", conflicts_with_all = ["vary", "checkpoint", "resume", "precision", "within", "per_roll", "shard"])]
     pub counts: Option<String>,
 }
 
 /// Runs `dicephys fair`.
-pub fn run(a: &FairArgs) -> Result<()> {
+pub fn run(mut a: FairArgs) -> Result<()> {
+    // One meaning for --precision (a relative error of the ratio): fair's own target, every
+    // face's probability in percentage points, is --within; the old spelling still works for
+    // this version, with a word.
+    if a.roll.run.precision.is_some() {
+        eprintln!(
+            "dicephys: warning: fair --precision is now --within (the same number: percentage \
+             points of every face's probability at 2σ)"
+        );
+    }
+    a.roll.run.precision = a.within.or(a.roll.run.precision);
+    let a = &a;
     let spec = a.roll.spec_or(ThrowStyle::Tumble)?;
     if let Some(c) = &a.counts {
         return counted(a, &spec, c);
@@ -63,7 +81,7 @@ pub fn run(a: &FairArgs) -> Result<()> {
     if let Some(w) = spec.endless_roll_warning() {
         eprintln!("dicephys: warning: {w}");
     }
-    // --precision here is every face's probability's.
+    // The precision (--within) here is every face's probability's.
     let (summary, done) = rolled(
         &a.roll,
         &spec,
@@ -147,7 +165,7 @@ fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str) -> Result<()
     let bar = dicephys::report::progress::Progress::new(
         "fair",
         dicephys::report::progress::Unit::Rolls { per_cell: 0 },
-        false,
+        true,
         *a.roll.json,
         super::study::every(),
     );
@@ -155,7 +173,9 @@ fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str) -> Result<()
     let runner = dicephys::run::runner::Runner::new(threads, super::stop().clone());
     let runner = runner.with_progress(&progress);
     let layout = a.roll.layout(spec);
-    let Some(points) = vary(spec, layout, what, &values, a.null, &runner)? else {
+    let points = vary(spec, layout, what, &values, a.null, &runner);
+    bar.finish();
+    let Some(points) = points? else {
         return Err(Error::Interrupted(
             "interrupted; nothing written (a --vary run does not resume)".into(),
         ));

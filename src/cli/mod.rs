@@ -120,7 +120,7 @@ pub fn dispatch(command: Command) -> error::Result<()> {
         Command::Tradeoff(a) => sweeps::tradeoff(&a),
         Command::Fit(a) => fit::run(&a),
         Command::Predict(a) => fit::predict(&a),
-        Command::Fair(a) => fair::run(&a),
+        Command::Fair(a) => fair::run(a),
         Command::Merge(a) => merge::run(&a),
         Command::Paper(a) => paper::run(&a),
         Command::Theory(a) => theory::run(&a),

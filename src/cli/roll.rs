@@ -165,11 +165,15 @@ pub fn rolled(
     command: &'static str,
     target: dicephys::report::summary::Target,
 ) -> Result<(dicephys::report::summary::RunSummary, Result<()>)> {
+    // The flag that set the precision: fair's target is its faces (--within).
+    let flag = match target {
+        Target::Ratio => "--precision",
+        Target::Faces => "--within",
+    };
     if let (Some(_), Some(_)) = (a.run.precision, spec.shard) {
-        return Err(Error::Usage(
-            "--precision with --shard: a shard rolls a fixed share of the throws; give --rolls"
-                .into(),
-        ));
+        return Err(Error::Usage(format!(
+            "{flag} with --shard: a shard rolls a fixed share of the throws; give --rolls"
+        )));
     }
     let threads = a.run.threads()?;
     let per_roll = a
@@ -180,7 +184,7 @@ pub fn rolled(
     let dir = a.resume.as_ref().or(a.checkpoint.as_ref());
     let total = spec.indices().len();
     let unit = Unit::Rolls { per_cell: 0 };
-    let bar = Progress::new(command, unit, false, *a.json, super::study::every());
+    let bar = Progress::new(command, unit, true, *a.json, super::study::every());
     // Under --precision the total is the rolls expected so far, not the cap.
     let expected = std::sync::atomic::AtomicU64::new(total);
     let progress = |n: u64| bar.set(n as f64, expected.load(Relaxed) as f64);
@@ -195,8 +199,9 @@ pub fn rolled(
             .precision
             .map(|p| (p, target, &expect as &dyn Fn(u64))),
         &runner,
-    )?
-    .with_layout(a.layout(spec));
+    );
+    bar.finish();
+    let summary = summary?.with_layout(a.layout(spec));
     let rolled = summary.rolls;
     if summary.partial {
         let why = Error::Interrupted(match dir {
@@ -206,7 +211,7 @@ pub fn rolled(
                 d.display(),
                 a.run
                     .precision
-                    .map_or(String::new(), |p| format!(" --precision {}", 100.0 * p))
+                    .map_or(String::new(), |p| format!(" {flag} {}", 100.0 * p))
             ),
             None => format!("interrupted after {rolled} of {total} rolls"),
         });

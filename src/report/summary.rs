@@ -853,23 +853,27 @@ pub struct Reached {
 impl Reached {
     /// One line for the human summary.
     pub fn line(&self) -> String {
-        let (what, unseen) = match self.target {
-            Target::Ratio => ("the ratio", "breadth or width not yet seen"),
-            Target::Faces => ("every face's probability", "no face yet"),
+        // The ratio's error is relative (per cent of it); a face's is of a probability
+        // (percentage points).
+        let (what, unseen, unit) = match self.target {
+            Target::Ratio => ("the ratio", "breadth or width not yet seen", "%"),
+            Target::Faces => ("every face's probability", "no face yet", "pp"),
         };
         let reached = self
             .reached_percent
-            .map_or(format!("undefined ({unseen})"), |p| format!("{p:.2} %"));
+            .map_or(format!("undefined ({unseen})"), |p| {
+                format!("{p:.2} {unit}")
+            });
         if self.resolved {
             format!(
-                "precision: 2σ of {what} {reached} ≤ {} % asked, after {} rolls (the first \
-                 chunk of 1,000 where it held)",
+                "precision: 2σ of {what} {reached} ≤ {} {unit} asked, after {} rolls (the \
+                 first chunk of 1,000 where it held)",
                 self.asked_percent, self.rolls
             )
         } else {
             format!(
-                "precision NOT reached: 2σ of {what} {reached} > {} % asked after {} rolls; \
-                 about {} rolls would reach it (raise --rolls, the cap)",
+                "precision NOT reached: 2σ of {what} {reached} > {} {unit} asked after {} \
+                 rolls; about {} rolls would reach it (raise --rolls, the cap)",
                 self.asked_percent,
                 self.rolls,
                 self.rolls_needed

@@ -335,6 +335,11 @@ pub fn write(dir: &std::path::Path, json: &str, fair: &Fairness, s: &RunSummary)
         .iter()
         .map(|f| crate::report::figures::die::MapFace {
             number: f.number,
+            // The face's place on the die, so that a mirror die is drawn as its mirror.
+            direction: crate::model::faces::DIRECTIONS
+                .iter()
+                .position(|d| *d == f.direction)
+                .unwrap_or(4),
             p: f.p,
             err: f.err,
             z: f.z,

@@ -573,7 +573,7 @@ fn made_die_and_faces() -> (Value, Value) {
         "fair",
         "--block",
         "16x16x16",
-        "--precision",
+        "--within",
         "10",
         "--rolls",
         "2000",
@@ -665,7 +665,7 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
     for (what, v) in [
         ("roll --die (every feature)", &made[0]),
         ("roll --die (insert, inertia, face map)", &made[1]),
-        ("fair --precision 10 (its summary)", &faces["summary"]),
+        ("fair --within 10 (its summary)", &faces["summary"]),
         ("roll 3D", &d3),
         ("roll 2D", &d2),
         ("roll --audit --throw tumble, damped", &odd),

@@ -1,7 +1,7 @@
 //! The die map (`die_map`): the six faces laid out as a net, each with its number, its
 //! probability and its departure from a fair die's in σ, shaded red where it comes up more
-//! often and blue where less, as the paper's DiceMap figure sets a fair die beside a biased
-//! one.
+//! often and blue where less (a key says how much), as the paper's DiceMap figure sets a fair
+//! die beside a biased one.
 
 use super::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -11,6 +11,9 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 pub struct MapFace {
     /// Its number.
     pub number: u8,
+    /// Where it sits on the die: its outward direction in body axes, an index into
+    /// [`crate::model::faces::DIRECTIONS`] (`+x`, `−x`, `+y`, `−y`, `+z`, `−z`).
+    pub direction: usize,
     /// Its probability and binomial error.
     pub p: f64,
     /// Its error.
@@ -24,17 +27,19 @@ struct DieMap<'a> {
     faces: &'a [MapFace],
 }
 
-/// Where each number sits on the net (column, row): 1 in the middle, 5 and 2 either side,
-/// 3 above, 4 below, 6 beyond 2, so that the net folds into the right-handed die (for the
-/// left layout, 2 and 3 swap with 5 and 4's sides, as on that die).
-fn cell(number: u8) -> (u32, u32) {
-    match number {
-        1 => (1, 1),
-        5 => (0, 1),
-        2 => (2, 1),
-        6 => (3, 1),
-        3 => (1, 0),
-        _ => (1, 2),
+/// Where each face sits on the net (column, row), by its direction in body axes: +z in the
+/// middle seen from outside, −x and +x either side, +y above, −y below, −z beyond +x, so that
+/// the net folds into the die. The numbers are the layout's: a western (right-handed) die has
+/// 1 in the middle, 5 and 2 either side, 3 above, 4 below and 6 beyond 2; its mirror shows
+/// 4 and 3 either side and 2 above, as that die does.
+fn cell(direction: usize) -> (u32, u32) {
+    match direction {
+        0 => (2, 1),
+        1 => (0, 1),
+        2 => (1, 0),
+        3 => (1, 2),
+        4 => (1, 1),
+        _ => (3, 1),
     }
 }
 
@@ -60,8 +65,9 @@ impl Figure for DieMap<'_> {
         top.titled(self.title, (FONT, 19)).map_err(plot_err)?;
         let side = 200i32;
         let (x0, y0) = (40i32, 20i32);
+        key(&body, (x0 + 2 * side + 30, y0 + 2 * side + 50))?;
         for f in self.faces {
-            let (c, r) = cell(f.number);
+            let (c, r) = cell(f.direction);
             let (x, y) = (x0 + c as i32 * side, y0 + r as i32 * side);
             body.draw(&Rectangle::new(
                 [(x, y), (x + side, y + side)],
@@ -87,6 +93,49 @@ impl Figure for DieMap<'_> {
         }
         Ok(())
     }
+}
+
+/// The colour key at `(x, y)`: the shade from 5σ less often (blue) through 0 (white) to 5σ
+/// more often (red), with its ticks.
+fn key<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (x, y): (i32, i32),
+) -> Result<(), String> {
+    let (w, h) = (300i32, 22i32);
+    for i in 0..w {
+        let z = -5.0 + 10.0 * (i as f64 + 0.5) / w as f64;
+        area.draw(&Rectangle::new(
+            [(x + i, y), (x + i + 1, y + h)],
+            shade(z).filled(),
+        ))
+        .map_err(plot_err)?;
+    }
+    area.draw(&Rectangle::new(
+        [(x, y), (x + w, y + h)],
+        BLACK.stroke_width(1),
+    ))
+    .map_err(plot_err)?;
+    let style = (FONT, 15)
+        .into_font()
+        .into_text_style(area)
+        .pos(Pos::new(HPos::Center, VPos::Top));
+    for z in [-5, -2, 0, 2, 5] {
+        let at = x + ((z + 5) as f64 / 10.0 * w as f64).round() as i32;
+        let label = if z == 0 {
+            "0".into()
+        } else {
+            format!("{z:+}σ")
+        };
+        area.draw(&Text::new(label, (at, y + h + 4), style.clone()))
+            .map_err(plot_err)?;
+    }
+    area.draw(&Text::new(
+        "departure from the null: less often … more often",
+        (x, y - 22),
+        (FONT, 15).into_font(),
+    ))
+    .map_err(plot_err)?;
+    Ok(())
 }
 
 /// Writes the die map as `dir/<stem>.svg` and `.png`.
@@ -248,10 +297,19 @@ impl Figure for Bias<'_> {
             xs.padded(0.04, 0.04),
             ys.padded(0.08, 0.3),
             self.x_desc,
-            "P(face up)",
+            "P(face up), bars ±1σ",
         )?;
         let n = self.series.len();
-        for c in self.series {
+        // Each face's points nudged sideways, a little apart, so that six error bars at one
+        // value do not hide each other (the null's lines stay where they are).
+        let step = (xs.hi - xs.lo) * if n <= 6 { 0.008 } else { 0.003 };
+        for (i, c) in self.series.iter().enumerate() {
+            let dx = (i as f64 - (n as f64 - 1.0) / 2.0) * step;
+            let nudged: Vec<Point> = c
+                .points
+                .iter()
+                .map(|p| Point { x: p.x + dx, ..*p })
+                .collect();
             // A cube's six colours; a die of more faces, hues round the wheel.
             let color = match n {
                 0..=6 => FACE_COLORS[(c.number as usize).clamp(1, 6) - 1],
@@ -263,7 +321,7 @@ impl Figure for Bias<'_> {
             };
             points(
                 &mut chart,
-                &c.points,
+                &nudged,
                 color,
                 Marker::Circle,
                 false,
@@ -309,15 +367,20 @@ mod tests {
     fn the_net_folds_into_a_die_whose_opposite_faces_never_touch() {
         // On a cross-shaped net, two faces are opposite on the folded cube when they share a
         // row or a column two cells apart (the one between them folds up between them).
-        let opposite = |a: u8, b: u8| {
+        let opposite = |a: usize, b: usize| {
             let ((ca, ra), (cb, rb)) = (cell(a), cell(b));
             (ra == rb && ca.abs_diff(cb) == 2) || (ca == cb && ra.abs_diff(rb) == 2)
         };
-        for (a, b) in [(1, 6), (2, 5), (3, 4)] {
+        // ±x, ±y, ±z (DIRECTIONS' order) are opposite on the folded cube.
+        for (a, b) in [(0, 1), (2, 3), (4, 5)] {
             assert!(opposite(a, b), "{a} and {b}");
         }
+        // Seen from outside the middle face (+z), +x is to its right and +y above: the body's
+        // axes right-handed, so the net is the die, not its mirror.
+        assert_eq!(cell(0).0, cell(4).0 + 1);
+        assert_eq!(cell(2).1 + 1, cell(4).1);
         // Every cell distinct.
-        let mut cells: Vec<(u32, u32)> = (1..=6).map(cell).collect();
+        let mut cells: Vec<(u32, u32)> = (0..6).map(cell).collect();
         cells.sort();
         cells.dedup();
         assert_eq!(cells.len(), 6);

@@ -79,7 +79,7 @@ impl Figure for MasterGraph<'_> {
         };
         let mut chart = chart(
             root,
-            "Probability ratio against R: theory, experiment and simulation",
+            "Probability ratio against R: theory, experiment and simulation (bars ±1σ)",
             x.clone(),
             y.clone(),
             R_DESC,
@@ -90,25 +90,16 @@ impl Figure for MasterGraph<'_> {
             &mut chart,
             curve(x0, x1, 400, &y, theory::ratio_from_r),
             DARK_BLUE.stroke_width(3),
-            "theory, eq. (MasterEqu)",
+            "theory with bounces (the paper's eq. 8)",
         )?;
         dashed(
             &mut chart,
             curve(x0, x1, 400, &y, theory::no_bounce_ratio),
             LIGHT_BLUE.stroke_width(2),
-            "no bounce, eq. (InElasK)",
+            "theory without a bounce (eq. 1)",
         )?;
-        for set in &sets {
-            let (label, color) = set_style(set);
-            points(
-                &mut chart,
-                &exp_points(set),
-                color,
-                Marker::Circle,
-                false,
-                &label,
-            )?;
-        }
+        // The simulations first, so that the measurements, drawn last, are never hidden
+        // under their markers (the MDF points at R = 0.833 were).
         let (mut n2, mut n3) = (0, 0);
         for s in self.sims {
             let (color, marker) = if s.two_d {
@@ -120,6 +111,17 @@ impl Figure for MasterGraph<'_> {
             };
             points(&mut chart, &s.points, color, marker, s.two_d, &s.label)?;
         }
+        for set in &sets {
+            let (label, color) = set_style(set);
+            points(
+                &mut chart,
+                &exp_points(set),
+                color,
+                Marker::Circle,
+                false,
+                &label,
+            )?;
+        }
         legend(&mut chart, SeriesLabelPosition::UpperLeft)
     }
 }
@@ -127,8 +129,9 @@ impl Figure for MasterGraph<'_> {
 /// Figure MasterGraph2: the ratio P(breadth vertical)/P(width vertical) against R over (0, 1]
 /// (wider if points lie beyond): the theory (MasterEqu) as a solid dark blue line, the no-bounce
 /// ratio (InElasK) dashed in lighter blue, the measured points with their error bars coloured by
-/// set (pine sienna, MDF red, carpet green), each 2D simulation as connected circles and each 3D
-/// simulation as separate triangles. Every series is named in the legend.
+/// set (pine sienna, MDF red, carpet green) drawn above each 2D simulation (connected circles)
+/// and each 3D simulation (separate triangles), every error bar ±1σ as the title says. Every
+/// series is named in the legend in words (the paper's equation by its number).
 pub fn master_graph(
     dir: &Path,
     stem: &str,
@@ -158,13 +161,13 @@ impl Figure for Prob2d {
             &mut chart,
             curve(x0, x1, n, &y, k(theory::two_d)),
             DARK_BLUE.stroke_width(3),
-            "P(K) = P(width vertical), theory",
+            "P(K) = P(width vertical), theory (eqs. 8, 9)",
         )?;
         solid(
             &mut chart,
             curve(x0, x1, n, &y, l(theory::two_d)),
             MDF_RED.stroke_width(3),
-            "P(L) = P(breadth vertical), theory",
+            "P(L) = P(breadth vertical), theory (eqs. 8, 9)",
         )?;
         dashed(
             &mut chart,
@@ -205,10 +208,10 @@ impl Figure for LenGraph<'_> {
         }
         let mut chart = chart(
             root,
-            "Probability ratio against block length",
+            "Measured probability ratio against block length (bars ±1σ)",
             xs.padded(0.0, 0.06),
             ys.padded(0.0, 0.25),
-            "block length m (mm)",
+            "block length (mm)",
             RATIO_DESC,
         )?;
         for (i, g) in self.groups.iter().enumerate() {

@@ -135,18 +135,23 @@ fn master_graph_writes_both_files_with_every_series() {
     has_all(
         &svg,
         &[
-            "theory",
-            "no bounce",
+            "theory with bounces (the paper&apos;s eq. 8)",
+            "theory without a bounce (eq. 1)",
             "pine blocks",
             "MDF",
             "tough carpet",
             "Bullet 2D",
             "Rapier 2D",
             "Bullet 3D",
+            "±1σ",
             R_DESC,
             "P(breadth vertical) / P(width vertical)",
         ],
     );
+    // Plain names in the legend, not the paper's LaTeX labels; the measurements drawn after
+    // (above) the simulations, the legend in drawing order.
+    assert!(!svg.contains("MasterEqu") && !svg.contains("InElasK"));
+    assert!(svg.find("Bullet 3D").unwrap() < svg.find("pine blocks").unwrap());
 }
 
 #[test]
@@ -205,7 +210,10 @@ fn master_graph_survives_bad_and_empty_input() {
         &["all NaN", "empty 3D", "beyond one", "Marble &lt;&amp;&gt;"],
     );
     master_graph(&dir.0, "empty", &[], &[]).unwrap();
-    has_all(&check_files(&dir.0, "empty"), &["theory", "no bounce"]);
+    has_all(
+        &check_files(&dir.0, "empty"),
+        &["theory", "without a bounce"],
+    );
 }
 
 #[test]
@@ -237,7 +245,7 @@ fn len_graph_draws_the_papers_groups() {
             "pine 25x18 on Carpet",
             "printed 24x20 on MDF",
             "printed 22x13 on MDF",
-            "block length m (mm)",
+            "block length (mm)",
         ],
     );
     let bad = vec![
