@@ -4,7 +4,7 @@
 
 Rolls each MDF block of the paper's table (the rows its own simulation reproduced) in 2D on
 Bullet, prints the simulated ratio N(breadth)/N(width) with its error beside the theory
-(the paper's eq. MasterEqu) and the measured ratio, and plots the three against R, the
+(the paper's eq. 8, "MasterEqu") and the measured ratio, and plots the three against R, the
 block's aspect parameter, when matplotlib is installed. docs/python.md walks through it.
 """
 
@@ -44,7 +44,7 @@ r = [p[0] for p in points]
 fig, ax = plt.subplots(figsize=(6, 4))
 ax.errorbar(r, [p[1].value for p in points], yerr=[2 * p[1].error for p in points], fmt="o",
             label=f"Bullet 2D, {rolls:,} rolls (2σ)")
-ax.plot(r, [p[2] for p in points], "s-", label="theory (eq. MasterEqu)")
+ax.plot(r, [p[2] for p in points], "s-", label="theory (the paper's eq. 8)")
 ax.errorbar(r, [p[3]["value"] for p in points], yerr=[2 * p[3]["err"] for p in points], fmt="^",
             label="measured (2σ)")
 ax.set_xlabel("R = width / breadth")

@@ -7,7 +7,7 @@ use crate::calibration::design::Design;
 use crate::calibration::params::{ModelSpec, Param};
 use crate::error::{Error, Result};
 use crate::inference::likelihood::{concentration, ln_dirichlet_multinomial, merge, pearson};
-use crate::inference::optimize::{interval, minimize, profile, Interval, Minimum};
+use crate::inference::optimize::{interval, minimize_until, profile, Interval, Minimum};
 use crate::inference::posterior;
 use crate::model::scene::Mode;
 use crate::run::stop::{Stop, Watch};
@@ -343,9 +343,10 @@ pub fn maximise(lik: &Likelihood, dims: usize, starts: usize) -> Result<(Minimum
 /// met, best first, each with the starts that ended there.
 pub fn maximise_from(lik: &Likelihood, starts: &[Vec<f64>]) -> Result<(Minimum, Vec<Maximum>)> {
     let f = |x: &[f64]| lik.minus_two_ln_l(x);
+    let stopped = || lik.stop.requested();
     let mut found: Vec<Minimum> = Vec::new();
     for s in starts {
-        found.push(minimize(&f, s, 0.15, 1e-7));
+        found.push(minimize_until(&f, s, 0.15, 1e-7, &stopped));
     }
     if lik.stop.requested() {
         return Err(Error::Stopped);
@@ -463,11 +464,13 @@ fn profiles_at(
     f: &(dyn Fn(&[f64]) -> f64 + Sync),
     best: &Minimum,
     points: usize,
+    stop: &Stop,
 ) -> Vec<Vec<(f64, f64)>> {
     use rayon::prelude::*;
+    let stopped = || stop.requested();
     (0..best.x.len())
         .into_par_iter()
-        .map(|j| profile(f, best, j, points, 1e-6))
+        .map(|j| profile(f, best, j, points, 1e-6, &stopped))
         .collect()
 }
 
@@ -508,7 +511,7 @@ fn maximum_and_profiles(
         rounds += 1;
         watch.check()?;
         (watch.say)(&format!("fit: the profiles of {dims} parameters"));
-        let profiles = profiles_at(&f, &best, search.profile_points);
+        let profiles = profiles_at(&f, &best, search.profile_points, &lik.stop);
         watch.check()?;
         // A profile point below the maximum means the search missed a higher one: search
         // again from there, so that the value printed is the maximum its intervals are
@@ -606,9 +609,10 @@ pub fn estimate(
             f: m.minus_two_ln_l,
             ..best.clone()
         };
-        for (p, q) in profiles
-            .iter_mut()
-            .zip(profiles_at(&f, &at, search.profile_points))
+        for (p, q) in
+            profiles
+                .iter_mut()
+                .zip(profiles_at(&f, &at, search.profile_points, &lik.stop))
         {
             for (a, b) in p.iter_mut().zip(q) {
                 a.1 = a.1.min(b.1);

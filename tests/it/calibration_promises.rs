@@ -233,6 +233,74 @@ fn ctrl_c_in_the_estimate_stops_a_fit_at_once_and_it_resumes() {
     assert_eq!(read("stopped")["estimate"], read("whole")["estimate"]);
 }
 
+/// Reliability round 5, class H: a stop in the profiles of many parameters ends the fit at
+/// once. Twelve surfaces with e and μ free each (24 parameters) on one thread: the profiles
+/// take about 100 s here, and before the fix a Ctrl-C in them took 56 s to end the run (each
+/// profile point's search spent its whole budget on a likelihood that had become +∞). The
+/// signal follows the stage's own line, so the run is long by construction; the bound, 3 s,
+/// is one a slow machine meets (5 ms here).
+#[test]
+fn ctrl_c_in_the_profiles_of_24_parameters_ends_the_fit_at_once() {
+    let dir = Scratch::new("promise-profiles");
+    let data = dir.join("twelve.csv");
+    let mut csv = String::from(HEAD);
+    for k in 0..12 {
+        for (block, base) in [("140,24,20", 330), ("140,22,13", 180), ("140,30,10", 40)] {
+            let b = base + 5 * k;
+            let label = block.replace(',', "x");
+            csv.push_str(&format!(
+                "r{k}-{label},s{k},{block},2d,0,{b},{}\n",
+                1000 - b
+            ));
+        }
+    }
+    std::fs::write(&data, csv).unwrap();
+    let mut child = bin()
+        .args(["fit", "--data"])
+        .arg(&data)
+        .args([
+            "--free", "e,mu", "--points", "12", "--rolls", "40", "--degree", "2",
+        ])
+        .args([
+            "--max-degree",
+            "2",
+            "--no-refine",
+            "--threads",
+            "1",
+            "--dt",
+            "1/250",
+            "--out",
+        ])
+        .arg(dir.join("out"))
+        .env("DICEPHYS_PROGRESS_SECS", "0")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut seen = String::new();
+    loop {
+        let mut line = String::new();
+        use std::io::BufRead;
+        if err.read_line(&mut line).unwrap() == 0 {
+            panic!("the fit ended before its profiles: {seen}");
+        }
+        seen.push_str(&line);
+        if line.contains("fit: the profiles of 24 parameters") {
+            break;
+        }
+    }
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let stopped = Instant::now();
+    // Drain stderr so that the child never blocks on a full pipe.
+    std::thread::spawn(move || std::io::copy(&mut err, &mut std::io::sink()));
+    let status = child.wait().unwrap();
+    let waited = stopped.elapsed();
+    assert_eq!(status.code(), Some(130), "{seen}");
+    assert!(waited < Duration::from_secs(3), "stopped after {waited:?}");
+    assert!(!dir.join("out/fit.json").exists());
+}
+
 /// Class 3: the bootstrap's cost does not grow with the counts (10¹¹ throws in a row).
 #[test]
 fn a_row_of_a_hundred_billion_throws_is_estimated_in_seconds() {
