@@ -510,6 +510,21 @@ fn the_papers_throw_on_a_cube_warns_and_names_the_tumble() {
         "roll", "--block", "16x16x16", "--throw", "tumble", "--rolls", "20", "--json",
     ]);
     assert!(!tumble.contains("warning"), "{tumble}");
+    // The summary's first line always names the throw that made the counts.
+    let header = |args: &[&str]| {
+        let o = dicephys(args);
+        String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .next()
+            .unwrap_or_default()
+            .to_string()
+    };
+    let paper = header(&["roll", "--block", "16x16x16", "--rolls", "20"]);
+    assert!(paper.contains(", the paper's throw, seed 2385,"), "{paper}");
+    let tumble = header(&[
+        "roll", "--block", "16x16x16", "--throw", "tumble", "--rolls", "20",
+    ]);
+    assert!(tumble.contains(", a tumble, seed 2385,"), "{tumble}");
 }
 
 /// Issue 50, "physics that broke passes in silence": at dt = 1/30 s most rolls sink into the
