@@ -59,6 +59,85 @@ fn a_misspelt_flag_or_command_is_told_what_it_may_mean() {
     }
 }
 
+/// Every flag a message of the program names exists (issue 50: "add --mode 3d" named a flag
+/// there is none of). Walks every string the source writes, outside comments, for `--name`,
+/// and finds each in some command's `--help` (the Python crate's too, which should name none);
+/// the only others are sbatch's options, which the Slurm scripts pass to sbatch.
+#[test]
+fn every_flag_a_message_names_exists() {
+    let help = |args: &[&str]| String::from_utf8_lossy(&dicephys(args).stdout).into_owned();
+    let commands = |text: &str| -> Vec<String> {
+        text.lines()
+            .skip_while(|l| !l.starts_with("Commands:"))
+            .skip(1)
+            .take_while(|l| !l.trim().is_empty())
+            .filter_map(|l| l.split_whitespace().next().map(str::to_string))
+            .filter(|c| c != "help")
+            .collect()
+    };
+    let mut all = help(&["--help"]);
+    for c in commands(&all.clone()) {
+        let text = help(&[&c, "--help"]);
+        for sub in commands(&text) {
+            all += &help(&[&c, &sub, "--help"]);
+        }
+        all += &text;
+    }
+    let flags = |text: &str| -> std::collections::BTreeSet<String> {
+        let b = text.as_bytes();
+        let mut out = std::collections::BTreeSet::new();
+        for i in 0..b.len().saturating_sub(2) {
+            let starts = b[i] == b'-' && b[i + 1] == b'-' && b[i + 2].is_ascii_lowercase();
+            if starts && (i == 0 || !(b[i - 1].is_ascii_alphanumeric() || b[i - 1] == b'-')) {
+                let end = (i + 2..b.len())
+                    .find(|&j| !(b[j].is_ascii_alphanumeric() || b[j] == b'-'))
+                    .unwrap_or(b.len());
+                out.insert(text[i..end].trim_end_matches('-').to_string());
+            }
+        }
+        out
+    };
+    let known = flags(&all);
+    assert!(known.contains("--rolls") && known.contains("--within") && known.len() > 80);
+    let sbatch = [
+        "--array",
+        "--cpus-per-task",
+        "--dependency",
+        "--job-name",
+        "--kill-on-invalid-dep",
+        "--open-mode",
+        "--output",
+        "--parsable",
+        "--requeue",
+    ];
+    let mut unknown = Vec::new();
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut stack = vec![root.join("src"), root.join("python/src")];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+                continue;
+            }
+            if path.extension().is_none_or(|e| e != "rs") {
+                continue;
+            }
+            let text = std::fs::read_to_string(&path).unwrap();
+            // The tests' own modules may spell anything; the program's messages may not.
+            let text = text.split("#[cfg(test)]").next().unwrap_or_default();
+            for line in text.lines().filter(|l| !l.trim_start().starts_with("//")) {
+                for f in flags(line) {
+                    if !known.contains(&f) && !sbatch.contains(&f.as_str()) {
+                        unknown.push(format!("{}: {f}", path.display()));
+                    }
+                }
+            }
+        }
+    }
+    assert!(unknown.is_empty(), "flags no command has: {unknown:#?}");
+}
+
 #[test]
 fn roll_json_has_the_documented_fields_and_ignores_thread_count() {
     let base = [
