@@ -100,16 +100,19 @@ pub fn cell(res: &PaperResults, row: usize, engine: EngineKind, mode: Mode) -> O
         .find(|c| c.row == row && c.engine == engine && c.mode == mode)
 }
 
-/// report.md: the table formatted like the paper's, the simulation columns, and a reading.
+/// report.md: the verdict first (what `paper` prints), then the tables by subject — the theory
+/// against the paper's rows, each engine's simulations against experiment, the three
+/// outcomes — and the figures.
 pub fn markdown(res: &PaperResults, figures: &[&str]) -> String {
     let engines = engines_of(res);
     let mut s = heading(res);
-    s += &table_markdown(res, &engines);
+    s += &format!(
+        "## Verdict\n\n```text\n{}```\n\n",
+        verdict_body(res, &engines)
+    );
+    s += &table_markdown(res);
+    s += &simulations_markdown(res, &engines);
     s += &outcomes_markdown(res);
-    s += &reading(res, &engines);
-    s +=
-        "\nThe paper: all its 3D simulations agree with experiment within error; its 2D line lies \
-          outside two of the five experimental error bars.\n\n";
     if !figures.is_empty() {
         s += "## Figures\n\n";
         for f in figures {
@@ -122,7 +125,17 @@ pub fn markdown(res: &PaperResults, figures: &[&str]) -> String {
 /// What `paper` prints on the terminal: the verdict first, block by block, in at most 40
 /// lines of at most 120 columns; the long report is `report.md` in `out` (issue 50).
 pub fn verdict(res: &PaperResults, out: &std::path::Path) -> String {
-    let engines = engines_of(res);
+    let mut s = verdict_body(res, &engines_of(res));
+    s += &format!(
+        "\nThe whole report (the tables, the three outcomes, the figures), and the results:\n  \
+         {d}/report.md, {d}/results.json, {d}/results.csv\n",
+        d = out.display()
+    );
+    s
+}
+
+/// The verdict, without where the files are: the terminal's and report.md's opening.
+fn verdict_body(res: &PaperResults, engines: &[EngineKind]) -> String {
     let p = &res.provenance;
     let mut s = format!(
         "Pender & Uhrin (2014) reproduced by dicephys {}: {} rolls a simulated block, seed {}\n",
@@ -146,7 +159,7 @@ pub fn verdict(res: &PaperResults, out: &std::path::Path) -> String {
         })
         .collect();
     s += &format!(
-        "The theory, eq. (MasterEqu), against the paper's measured rows, χ² by set:\n  {}\n",
+        "The theory (the paper's eq. 8) against its measured rows, χ² by set:\n  {}\n",
         sets.join("; ")
     );
     s += "\nThe ratio N(breadth)/N(width) on MDF, simulated, against experiment (z: combined σ):\n";
@@ -192,7 +205,7 @@ pub fn verdict(res: &PaperResults, out: &std::path::Path) -> String {
         s += "\n";
     }
     s += "\n";
-    for line in reading(res, &engines).lines().skip(2) {
+    for line in reading(res, engines).lines().skip(2) {
         // Shortened to fit 120 columns with every block outside 1σ named.
         let line = line
             .trim_start_matches("- ")
@@ -208,11 +221,6 @@ pub fn verdict(res: &PaperResults, out: &std::path::Path) -> String {
         }
     }
     s += "  (the paper: its 3D simulations all within error; its 2D line outside two of five)\n";
-    s += &format!(
-        "\nThe whole report (the table, the three outcomes, the figures), and the results:\n  \
-         {d}/report.md, {d}/results.json, {d}/results.csv\n",
-        d = out.display()
-    );
     s
 }
 
@@ -240,7 +248,7 @@ fn heading(res: &PaperResults) -> String {
     }
     s += &format!(
         "Command: `{}`  \nDate: {}  \ndicephys {}; engines: {}; preset {}; dt {} s; seed {}; \
-         {} rolls per simulated cell (keyed throws, the paper's ranges); wall {:.0} s, CPU {:.0} s.\n\n",
+         {} rolls per simulated cell (the paper's throw and ranges); wall {:.0} s, CPU {:.0} s.\n\n",
         p.command_line,
         p.date_utc,
         p.dicephys_version,
@@ -266,68 +274,38 @@ fn heading(res: &PaperResults) -> String {
     s
 }
 
-/// The paper's table with a column of each engine and mode simulated.
-fn table_markdown(res: &PaperResults, engines: &[EngineKind]) -> String {
+/// The paper's table: every row's measurement against the theory (no simulation columns).
+fn table_markdown(res: &PaperResults) -> String {
     let mut s = String::new();
-    s += "## The paper's table, with our simulations\n\n";
-    s += "Ratio = N(breadth vertical)/N(width vertical). Theory: eq. (MasterEqu), ± from the \
-          printed side errors. Measured: the paper's counts, ± binomial. No bounce: eq. (InElasK). \
-          Simulated cells: ratio ± binomial error, then z against experiment / against theory.\n\n";
-    let mut head = String::from(
-        "| row | L × B × W (mm) | R | theory | surface | throws | L | B | W | measured | z | no bounce |",
-    );
-    let mut rule = String::from("|---|---|---|---|---|---|---|---|---|---|---|---|");
-    for e in engines {
-        for m in ["3D", "2D"] {
-            head += &format!(" {e} {m} (z exp / z th) |");
-            rule += "---|";
-        }
-    }
-    s += &head;
-    s += "\n";
-    s += &rule;
-    s += "\n";
+    s += "## The theory against the paper's rows\n\n";
+    s += "Ratio = N(breadth vertical)/N(width vertical). Theory: the paper's eq. 8, ± from the \
+          printed side errors; no bounce: its eq. 1. Measured: the paper's counts (length, \
+          breadth, width vertical), ± binomial; z of measured against theory.\n\n";
+    s += "| row | L×B×W (mm) | surface | R | counts L / B / W | measured | theory | z | no bounce |\n";
+    s += "|---|---|---|---|---|---|---|---|---|\n";
     for r in &res.table.rows {
         s += &format!(
-            "| {}{} | {}×{}×{} | {:.3} ± {:.3} | {:.3} ± {:.3} | {} | {} | {} | {} | {} | {:.3} ± {:.3} | {} | {:.3} |",
+            "| {}{} | {}×{}×{} | {} | {:.3} ± {:.3} | {} / {} / {} | {:.3} ± {:.3} | {:.3} ± {:.3} | {} | {:.3} |\n",
             r.row,
             if r.simulated { "*" } else { "" },
             r.length_mm,
             r.breadth_mm,
             r.width_mm,
+            r.surface.name(),
             r.r.value,
             r.r.err,
-            r.theory_ratio.value,
-            r.theory_ratio.err,
-            r.surface.name(),
-            r.throws,
             r.length_vertical,
             r.breadth_vertical,
             r.width_vertical,
             r.measured_ratio.value,
             r.measured_ratio.err,
+            r.theory_ratio.value,
+            r.theory_ratio.err,
             fmt_z(r.z),
             r.no_bounce_ratio
         );
-        for e in engines {
-            for m in [Mode::ThreeD, Mode::TwoD] {
-                match cell(res, r.row, *e, m) {
-                    Some(c) => {
-                        s += &format!(
-                            " {:.4} ± {:.4} ({} / {}) |",
-                            c.ratio.value,
-                            c.ratio.err,
-                            fmt_z(c.z_experiment),
-                            fmt_z(c.z_theory)
-                        )
-                    }
-                    None => s += " |",
-                }
-            }
-        }
-        s += "\n";
     }
-    s += "\n\\* simulated (printed blocks on MDF, μ = 0.29, e = 0.5).\n\n";
+    s += "\n\\* simulated below (printed blocks on MDF, μ = 0.29, e = 0.5).\n\n";
     s += &format!("Not simulated: {}\n\n", res.not_simulated);
     if !res.table.discrepancies.is_empty() {
         s += "Data check: ";
@@ -339,6 +317,41 @@ fn table_markdown(res: &PaperResults, engines: &[EngineKind]) -> String {
             .collect();
         s += &d.join("; ");
         s += ".\n\n";
+    }
+    s
+}
+
+/// Each engine's simulated blocks against experiment and theory, a table an engine.
+fn simulations_markdown(res: &PaperResults, engines: &[EngineKind]) -> String {
+    let mut s = String::new();
+    for e in engines {
+        s += &format!(
+            "## {} against experiment\n\nEach simulated ratio ± its binomial error, and its z \
+             against the measurement and against the theory (combined σ).\n\n",
+            engine_label(*e)
+        );
+        s += "| block | measured | 3D | z exp | z theory | 2D | z exp | z theory |\n";
+        s += "|---|---|---|---|---|---|---|---|\n";
+        for r in res.table.rows.iter().filter(|r| r.simulated) {
+            s += &format!(
+                "| {}×{}×{} | {:.3} ± {:.3} |",
+                r.length_mm, r.breadth_mm, r.width_mm, r.measured_ratio.value, r.measured_ratio.err
+            );
+            for m in [Mode::ThreeD, Mode::TwoD] {
+                s += &match cell(res, r.row, *e, m) {
+                    Some(c) => format!(
+                        " {:.4} ± {:.4} | {} | {} |",
+                        c.ratio.value,
+                        c.ratio.err,
+                        fmt_z(c.z_experiment),
+                        fmt_z(c.z_theory)
+                    ),
+                    None => " – | | |".to_string(),
+                };
+            }
+            s += "\n";
+        }
+        s += "\n";
     }
     s
 }

@@ -277,13 +277,29 @@ fn a_tiny_paper_run_is_complete_and_repeatable() {
         assert_eq!(x["run"]["counts"], y["run"]["counts"]);
         assert_eq!(x["ratio"], y["ratio"]);
     }
-    assert!(dir.join("report.md").exists());
+    // report.md opens with the verdict, then its tables by subject, none of them wide (a
+    // single table of 16 columns reached 290 characters).
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    let sections: Vec<&str> = md.lines().filter(|l| l.starts_with("## ")).collect();
+    assert_eq!(sections.first(), Some(&"## Verdict"), "{md}");
+    assert!(
+        sections.contains(&"## The theory against the paper's rows")
+            && sections.contains(&"## Bullet against experiment"),
+        "{sections:?}"
+    );
+    let widest = md
+        .lines()
+        .filter(|l| l.starts_with('|'))
+        .map(|l| l.chars().count())
+        .max()
+        .unwrap();
+    assert!(widest <= 160, "a table row of {widest} characters");
     for (fig, series) in [
         (
             "master_graph",
             &[
                 "theory",
-                "no bounce",
+                "without a bounce",
                 "printed on MDF",
                 "Bullet 2D simulation",
                 "Bullet 3D simulation",
