@@ -54,9 +54,7 @@ pub fn local(out: &Path, threads: usize, json: bool) -> Result<Place> {
 
 /// Runs a study a cluster can split, with a bar (or progress lines) and its log on stderr.
 pub fn run(cfg: &StudyConfig, place: &Place) -> Result<()> {
-    // Bars as before: paper's rolls, and the CPU of a study rolled to a precision.
-    let bar = cfg.study().bar() && cfg.unit() != outputs::Unit::Cells;
-    with_hooks(cfg.name(), cfg.unit(), bar, place.json, |hooks| {
+    with_hooks(cfg.name(), cfg.unit(), true, place.json, |hooks| {
         outputs::run(cfg, place, hooks)
     })
 }
@@ -71,7 +69,7 @@ pub fn validate(cfg: &validate::Config, place: &Place) -> Result<()> {
     with_hooks(
         "validate",
         outputs::Unit::Cells,
-        false,
+        true,
         place.json,
         |hooks| outputs::validate(cfg, place, hooks),
     )

@@ -46,7 +46,10 @@ impl Progress {
             let b = ProgressBar::with_draw_target(Some(1), ProgressDrawTarget::stderr());
             let template = match unit {
                 Unit::Rolls { .. } => "{elapsed_precise} [{wide_bar}] {pos}/{len} rolls, ETA {eta}",
-                _ => "{elapsed_precise} [{wide_bar}] {percent}% of the planned CPU, ETA {eta}",
+                Unit::Cells => "{elapsed_precise} [{wide_bar}] {pos}/{len} cells, ETA {eta}",
+                Unit::Cpu => {
+                    "{elapsed_precise} [{wide_bar}] {percent}% of the planned CPU, ETA {eta}"
+                }
             };
             b.set_style(
                 ProgressStyle::with_template(template)
@@ -68,11 +71,8 @@ impl Progress {
 
     /// `done` of `total` so far.
     pub fn set(&self, done: f64, total: f64) {
-        let scale = if matches!(self.unit, Unit::Rolls { .. }) {
-            1.0
-        } else {
-            1000.0
-        };
+        // Whole rolls and cells as they are; CPU seconds in thousandths, so the bar moves.
+        let scale = if self.unit == Unit::Cpu { 1000.0 } else { 1.0 };
         self.bar.set_length((scale * total) as u64);
         self.bar.set_position((scale * done.min(total)) as u64);
         let Some((start, last)) = &self.lines else {

@@ -105,11 +105,6 @@ pub trait Kind: Sync {
         crate::report::progress::Unit::Cells
     }
 
-    /// True if the command line draws a bar for it (else it prints progress lines).
-    fn bar(&self) -> bool {
-        false
-    }
-
     /// The directory the study writes into and owns: its `out` (crosscheck: its checkpoint,
     /// if any).
     fn owns<'a>(&self, place: &'a place::Place) -> Option<&'a std::path::Path> {

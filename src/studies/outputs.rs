@@ -38,9 +38,6 @@ impl Kind for studies::paper::PaperConfig {
             per_cell: self.rolls,
         }
     }
-    fn bar(&self) -> bool {
-        true
-    }
     fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
         paper(self, place, hooks)
     }
@@ -99,9 +96,6 @@ impl Kind for studies::converge::Config {
             Unit::Cells
         }
     }
-    fn bar(&self) -> bool {
-        self.precision.is_some()
-    }
     fn check_splittable(&self) -> Result<()> {
         if self.precision.is_some() {
             return Err(Error::field(
@@ -141,9 +135,6 @@ impl Kind for studies::tradeoff::Config {
     }
     fn unit(&self) -> Unit {
         Unit::Cpu
-    }
-    fn bar(&self) -> bool {
-        true
     }
     fn check_splittable(&self) -> Result<()> {
         if self.preroll_chunks.is_none() {

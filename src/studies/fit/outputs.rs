@@ -29,9 +29,6 @@ impl Kind for FitStudy {
             per_cell: self.config.design.rolls,
         }
     }
-    fn bar(&self) -> bool {
-        true
-    }
     fn cells(&self) -> &'static str {
         "cells"
     }
