@@ -605,6 +605,7 @@ BulletWorld::BulletWorld(const BulletScene& s)
   if (!s.stock_world) world_->getDispatchInfo().m_useContinuous = false;
   btContactSolverInfo& info = world_->getSolverInfo();
   info.m_splitImpulse = s.split_impulse ? 1 : 0;
+  if (s.split_every_depth) info.m_splitImpulsePenetrationThreshold = 0;
   info.m_restitutionVelocityThreshold = s.restitution_velocity_threshold;
   info.m_numIterations = s.solver_iterations;
 

@@ -103,7 +103,9 @@ pub struct SceneArgs {
     /// Allow a restitution above 1 (an engine-stability study, not physics).
     #[arg(long)]
     pub allow_restitution_above_one: bool,
-    /// Bullet solver settings: dicephys281 (Bullet 2.81 as the paper ran it) or bullet3.
+    /// Bullet solver settings: dicephys281 (Bullet 2.81 as the paper ran it), bullet3 (Debian
+    /// 3.24's defaults) or split (dicephys281 with every penetration pushed out apart from the
+    /// bounce, so that a bounce is exactly e: dicephys281's averages e + 0.1).
     #[arg(long, default_value = "dicephys281", value_parser = parse_preset)]
     pub preset: Preset,
     /// The floor: box (DicePhys's 10 km static box) or plane.

@@ -33,6 +33,9 @@ pub enum Preset {
     Dicephys281,
     /// Debian 3.24's stock defaults.
     Bullet3,
+    /// Bullet 2.81's behaviour (dicephys281) with every penetration corrected by a split
+    /// impulse, so that a bounce leaves at exactly e times the approach speed.
+    Split,
 }
 
 impl Preset {
