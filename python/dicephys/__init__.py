@@ -54,6 +54,7 @@ RangeArg = Union[None, float, Tuple[float, float]]
 # The library's defaults, as the command line's.
 DEFAULT_MAX_STEPS: int = _native.DEFAULT_MAX_STEPS
 DEFAULT_MARGIN: float = _native.DEFAULT_MARGIN
+DEFAULT_SEED: int = _native.DEFAULT_SEED
 
 
 class Value(NamedTuple):
@@ -357,7 +358,7 @@ def roll(
     size: Optional[float] = None,
     scale: Optional[float] = None,
     rolls: Optional[int] = None,
-    seed: int = 2385,
+    seed: int = DEFAULT_SEED,
     mode: str = "3d",
     engine: str = "bullet",
     dt: float = 1e-3,
@@ -475,7 +476,7 @@ def fair(
     size: Optional[float] = None,
     scale: Optional[float] = None,
     rolls: Optional[int] = None,
-    seed: int = 2385,
+    seed: int = DEFAULT_SEED,
     mode: str = "3d",
     engine: str = "bullet",
     dt: float = 1e-3,
@@ -577,7 +578,7 @@ def paper(
     out: PathLike = "paper-out",
     *,
     rolls: int = 10_000,
-    seed: int = 2385,
+    seed: int = DEFAULT_SEED,
     engines: Sequence[str] = ("bullet", "rapier"),
     dt: float = 1e-3,
     max_steps: int = DEFAULT_MAX_STEPS,
@@ -680,7 +681,7 @@ def fit(
     max_degree: Optional[int] = None,
     refine: bool = True,
     common_throws: bool = False,
-    seed: int = 2385,
+    seed: int = DEFAULT_SEED,
     com: Optional[Sequence[float]] = None,
     pips: Optional[Sequence[float]] = None,
     edge_radius: Optional[float] = None,
@@ -751,7 +752,7 @@ def recover(
     max_degree: Optional[int] = None,
     refine: bool = True,
     common_throws: bool = False,
-    seed: int = 2385,
+    seed: int = DEFAULT_SEED,
     com: Optional[Sequence[float]] = None,
     pips: Optional[Sequence[float]] = None,
     edge_radius: Optional[float] = None,
@@ -800,7 +801,7 @@ def predict(
     thrower: Optional[str] = None,
     draws: int = 16,
     rolls: int = 2000,
-    seed: int = 2385,
+    seed: int = DEFAULT_SEED,
     threads: int = 0,
     progress: Progress = None,
     contact: Optional[Tuple[float, float]] = None,

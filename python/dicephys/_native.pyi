@@ -7,6 +7,7 @@ from typing import Any, Callable, Dict, List, Optional, Tuple
 
 DEFAULT_MAX_STEPS: int
 DEFAULT_MARGIN: float
+DEFAULT_SEED: int
 
 _Progress = Optional[Callable[[float, float], Any]]
 _Log = Optional[Callable[[str], Any]]

@@ -19,6 +19,7 @@ use dicephys::model::block::Block;
 use dicephys::model::faces::Layout;
 use dicephys::model::mass::Features;
 use dicephys::model::scene::{Floor, Mode, Preset, Scene};
+use dicephys::model::throws::DEFAULT_SEED;
 use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
 use dicephys::report::per_roll::PerRoll;
 use dicephys::report::summary::Target;
@@ -383,7 +384,7 @@ fn spec(
             "throw source",
             &o.get("source", "keyed".to_string())?,
         )?,
-        seed: o.get("seed", 2385)?,
+        seed: o.get("seed", DEFAULT_SEED)?,
         ranges: ThrowRanges {
             velocity: range("velocity", o.object("velocity")?.as_ref(), paper.velocity)?,
             spin: range("spin", o.object("spin")?.as_ref(), paper.spin)?,
@@ -897,7 +898,7 @@ fn recover(
 /// the prediction's JSON.
 #[pyfunction]
 #[pyo3(signature = (fit, block=None, *, mode="3d", surface=None, thrower=None, draws=16,
-    rolls=2000, seed=2385, threads=0, progress=None, contact=None))]
+    rolls=2000, seed=DEFAULT_SEED, threads=0, progress=None, contact=None))]
 #[allow(clippy::too_many_arguments)]
 fn predict(
     py: Python<'_>,
@@ -957,6 +958,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(predict, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     m.add("DEFAULT_MAX_STEPS", DEFAULT_MAX_STEPS)?;
+    m.add("DEFAULT_SEED", DEFAULT_SEED)?;
     m.add("DEFAULT_MARGIN", DEFAULT_MARGIN)?;
     Ok(())
 }

@@ -18,7 +18,7 @@ use dicephys::sim::roll::{RollConfig, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
 pub struct Seed {
     /// Seed of the throws (each throw drawn from the seed and its own number, "keyed"): the
     /// same seed gives the same rolls on any thread count.
-    #[arg(long, default_value_t = 2385)]
+    #[arg(long, default_value_t = dicephys::model::throws::DEFAULT_SEED)]
     pub seed: u64,
 }
 

@@ -28,6 +28,10 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
 
+/// The seed of every command that is not given one: DicePhys's own (its `srand(2385)`), so
+/// that a default run is the paper's throws. The command line and Python take it from here.
+pub const DEFAULT_SEED: u64 = 2385;
+
 /// A closed interval `lo..=hi` to draw uniformly from; `lo == hi` fixes the value.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Range {

@@ -76,7 +76,7 @@ impl Default for Config {
             engines: vec![EngineKind::Bullet, EngineKind::Rapier],
             rolls: 6000,
             trend_rolls: 1000,
-            seed: 2385,
+            seed: crate::model::throws::DEFAULT_SEED,
             blocks_2d: vec![
                 b("140x24x24"),
                 b("140x24x20"),
