@@ -1,0 +1,153 @@
+//! Reading a die file (TOML, lengths in mm) and the features it describes.
+
+use super::features::{Features, Insert, Pips};
+use crate::error::{Error, Field, Result};
+use crate::model::faces::Layout;
+use serde::Deserialize;
+
+/// A die file (TOML), every length in mm, every key optional:
+///
+/// ```toml
+/// com = [0.0, 0.0, -2.0]   # the centre of mass from the geometric centre, body axes
+/// edge_radius = 1.0        # edges and corners rounded
+/// density = 1180.0         # kg/m³ (the solid's)
+/// [pips]
+/// diameter = 3.0
+/// depth = 1.0
+/// shape = "cap"            # or "cylinder"
+/// fill_density = 1400.0    # paint, kg/m³ (0: empty)
+/// spacing = 0.25           # off-centre pips' distance from the face's centre / its side
+/// ```
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DieFile {
+    /// mm.
+    pub com: Option<[f64; 3]>,
+    /// mm.
+    pub edge_radius: Option<f64>,
+    /// kg/m³.
+    pub density: Option<f64>,
+    /// Pips, in mm.
+    pub pips: Option<Pips>,
+    /// "right" or "left".
+    pub layout: Option<Layout>,
+    /// The number on each face: `{ "+x" = 2, "-x" = 5, … }`.
+    pub faces: Option<std::collections::BTreeMap<String, u8>>,
+    /// An insert, in mm and kg/m³.
+    pub insert: Option<Insert>,
+    /// The inertia about the centre of mass, g mm²: xx, yy, zz, xy, xz, yz.
+    pub inertia: Option<[f64; 6]>,
+    /// A die of any shape: its mesh (OBJ or STL, in mm; a path from the die file's folder).
+    pub mesh: Option<std::path::PathBuf>,
+    /// The mesh's lengths times this (e.g. 25.4 for a mesh in inches).
+    pub scale: Option<f64>,
+    /// Which face's label the die shows: "up" (most dice) or "down" (a d4).
+    pub reads: Option<crate::model::shape::Reads>,
+    /// The mesh's facets' labels: `{ normal = [0, 0, 1], label = "6" }`, one per resting
+    /// facet (matched by its outward normal); none: numbered 1…N.
+    pub labels: Option<Vec<LabelDef>>,
+}
+
+/// One facet's label in a die file.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LabelDef {
+    /// The facet's outward normal, body axes (any length).
+    pub normal: [f64; 3],
+    /// What it carries.
+    pub label: String,
+}
+
+/// The largest die file read (TOML): 1 MiB.
+pub const MAX_DIE_FILE: u64 = 1 << 20;
+
+/// True if `path` names a mesh by its extension (.obj, .stl).
+pub fn is_mesh(path: &std::path::Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj") || e.eq_ignore_ascii_case("stl"))
+}
+
+impl DieFile {
+    /// Reads and parses a die file, through the capped reader (`run::io::read_capped`: a
+    /// missing file, a directory, a pipe or a file over 1 MiB is refused naming `--die`, and a
+    /// stop request is honoured while it blocks): a key it does not know, a value of the
+    /// wrong kind, or a file that is not TOML is one line naming it. A mesh (.obj, .stl)
+    /// describes no features: its die file is empty.
+    pub fn read(path: &std::path::Path) -> Result<DieFile> {
+        if is_mesh(path) {
+            return Ok(DieFile::default());
+        }
+        let bytes = read_die_bytes(path, MAX_DIE_FILE)?;
+        let text = String::from_utf8(bytes).map_err(|_| {
+            Error::field(
+                Field::Die,
+                path.display(),
+                "is not a text file (a die file is TOML; a mesh is .obj or .stl)",
+            )
+        })?;
+        toml::from_str(&text).map_err(|e| {
+            let line = e
+                .span()
+                .map(|s| format!(" (line {})", text[..s.start].matches('\n').count() + 1))
+                .unwrap_or_default();
+            Error::Invalid(format!(
+                "die file {}{line}: {}",
+                path.display(),
+                e.message().trim()
+            ))
+        })
+    }
+
+    /// The features it describes, lengths in metres; a face map that is not a permutation of
+    /// 1 to 6, or given beside `layout`, is refused.
+    pub fn features(&self) -> Result<Features> {
+        let layout = match (&self.faces, self.layout) {
+            (Some(_), Some(_)) => {
+                return Err(Error::field(
+                    Field::Faces,
+                    "",
+                    "give either a layout or a face map, not both",
+                ))
+            }
+            (Some(map), None) => Layout::from_map(map)?,
+            (None, l) => l.unwrap_or_default(),
+        };
+        let mm = |c: [f64; 3]| c.map(|x| x / 1000.0);
+        Ok(Features {
+            com: self.com.map(mm),
+            pips: self.pips.as_ref().map(|p| Pips {
+                diameter: p.diameter / 1000.0,
+                depth: p.depth / 1000.0,
+                ..*p
+            }),
+            edge_radius: self.edge_radius.unwrap_or(0.0) / 1000.0,
+            layout,
+            insert: self.insert.map(|i| Insert {
+                size: mm(i.size),
+                centre: mm(i.centre),
+                density: i.density,
+            }),
+            // g mm² = 10⁻³ kg × 10⁻⁶ m².
+            inertia: self.inertia.map(|t| t.map(|x| x * 1e-9)),
+        })
+    }
+}
+
+/// A die file's bytes, at most `max`, through the capped reader; any failure names `--die`.
+pub fn read_die_bytes(path: &std::path::Path, max: u64) -> Result<Vec<u8>> {
+    if path.is_dir() {
+        return Err(Error::field(Field::Die, path.display(), "is a directory"));
+    }
+    crate::run::io::read_capped(path, max, crate::run::stop::Stop::global()).map_err(|e| match e {
+        Error::Stopped => Error::Stopped,
+        Error::Invalid(m) => Error::field(
+            Field::Die,
+            path.display(),
+            m.strip_prefix(&format!("{}: ", path.display()))
+                .unwrap_or(&m)
+                .to_string(),
+        ),
+        e => e,
+    })
+}
