@@ -363,31 +363,38 @@ pub struct RunArgs {
 
 /// Percentage points of a probability, "0.5" or "0.5pp", as a probability in (0, 1).
 pub fn parse_points(s: &str) -> std::result::Result<f64, String> {
-    let v: f64 = s
-        .trim()
-        .trim_end_matches("pp")
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{s}': give percentage points, e.g. 0.5 (each face to ±0.005)"))?;
-    if v.is_finite() && v > 0.0 && v < 100.0 {
-        Ok(v / 100.0)
-    } else {
-        Err(format!("'{s}': must be in (0, 100) percentage points"))
-    }
+    hundredths(s, "pp").map_err(|bad| match bad {
+        Bad::Unread => format!("'{s}': give percentage points, e.g. 0.5 (each face to ±0.005)"),
+        Bad::Range => format!("'{s}': must be in (0, 100) percentage points"),
+    })
 }
 
 /// A precision in per cent, "1" or "1%", as a fraction in (0, 100 %).
 pub fn parse_percent(s: &str) -> std::result::Result<f64, String> {
+    hundredths(s, "%").map_err(|bad| match bad {
+        Bad::Unread => format!("bad precision '{s}': give per cent, e.g. 1 or 1%"),
+        Bad::Range => format!("precision '{s}': must be in (0, 100) %"),
+    })
+}
+
+/// Why a number of hundredths was refused.
+enum Bad {
+    Unread,
+    Range,
+}
+
+/// A number in (0, 100), its unit `suffix` optional, over 100.
+fn hundredths(s: &str, suffix: &str) -> std::result::Result<f64, Bad> {
     let v: f64 = s
         .trim()
-        .trim_end_matches('%')
+        .trim_end_matches(suffix)
         .trim()
         .parse()
-        .map_err(|_| format!("bad precision '{s}': give per cent, e.g. 1 or 1%"))?;
+        .map_err(|_| Bad::Unread)?;
     if v.is_finite() && v > 0.0 && v < 100.0 {
         Ok(v / 100.0)
     } else {
-        Err(format!("precision '{s}': must be in (0, 100) %"))
+        Err(Bad::Range)
     }
 }
 

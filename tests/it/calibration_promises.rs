@@ -193,7 +193,7 @@ fn ctrl_c_in_the_estimate_stops_a_fit_at_once_and_it_resumes() {
         .chain([dir.join(out).display().to_string()])
         .collect()
     };
-    let mut child = bin()
+    let child = bin()
         .args(args("stopped"))
         .env("DICEPHYS_PROGRESS_SECS", "0")
         .stdout(Stdio::null())
@@ -201,25 +201,8 @@ fn ctrl_c_in_the_estimate_stops_a_fit_at_once_and_it_resumes() {
         .spawn()
         .unwrap();
     // Wait for the estimate's first line, then interrupt.
-    let mut err = std::io::BufReader::new(child.stderr.take().unwrap());
-    let mut seen = String::new();
-    let t = Instant::now();
-    loop {
-        let mut line = String::new();
-        use std::io::BufRead;
-        if err.read_line(&mut line).unwrap() == 0 || t.elapsed() > Duration::from_secs(120) {
-            panic!("no estimate stage line: {seen}");
-        }
-        seen.push_str(&line);
-        if line.contains("fit: the maximum") {
-            break;
-        }
-    }
-    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
-    let stopped = Instant::now();
-    let status = child.wait().unwrap();
-    let waited = stopped.elapsed();
-    assert_eq!(status.code(), Some(130), "{seen}");
+    let (code, seen, waited) = interrupt_after(child, "fit: the maximum");
+    assert_eq!(code, Some(130), "{seen}");
     assert!(waited < Duration::from_secs(3), "stopped after {waited:?}");
     assert!(!dir.join("stopped/fit.json").exists());
     // Run again: it finishes, and its estimate is that of a fit never stopped.
@@ -255,7 +238,7 @@ fn ctrl_c_in_the_profiles_of_24_parameters_ends_the_fit_at_once() {
         }
     }
     std::fs::write(&data, csv).unwrap();
-    let mut child = bin()
+    let child = bin()
         .args(["fit", "--data"])
         .arg(&data)
         .args([
@@ -277,16 +260,28 @@ fn ctrl_c_in_the_profiles_of_24_parameters_ends_the_fit_at_once() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
+    let (code, seen, waited) = interrupt_after(child, "fit: the profiles of 24 parameters");
+    assert_eq!(code, Some(130), "{seen}");
+    assert!(waited < Duration::from_secs(3), "stopped after {waited:?}");
+    assert!(!dir.join("out/fit.json").exists());
+}
+
+/// Waits (at most 2 minutes) for a line of `child`'s stderr that contains `stage`, sends it
+/// SIGINT, and returns its exit code, its stderr up to that line and how long it took to end:
+/// a stop signalled after the stage has said it started, so the run is long by construction.
+fn interrupt_after(mut child: std::process::Child, stage: &str) -> (Option<i32>, String, Duration) {
+    use std::io::BufRead;
     let mut err = std::io::BufReader::new(child.stderr.take().unwrap());
     let mut seen = String::new();
+    let t = Instant::now();
     loop {
         let mut line = String::new();
-        use std::io::BufRead;
-        if err.read_line(&mut line).unwrap() == 0 {
-            panic!("the fit ended before its profiles: {seen}");
+        if err.read_line(&mut line).unwrap() == 0 || t.elapsed() > Duration::from_secs(120) {
+            let _ = child.kill();
+            panic!("no line '{stage}' before the run ended: {seen}");
         }
         seen.push_str(&line);
-        if line.contains("fit: the profiles of 24 parameters") {
+        if line.contains(stage) {
             break;
         }
     }
@@ -295,10 +290,7 @@ fn ctrl_c_in_the_profiles_of_24_parameters_ends_the_fit_at_once() {
     // Drain stderr so that the child never blocks on a full pipe.
     std::thread::spawn(move || std::io::copy(&mut err, &mut std::io::sink()));
     let status = child.wait().unwrap();
-    let waited = stopped.elapsed();
-    assert_eq!(status.code(), Some(130), "{seen}");
-    assert!(waited < Duration::from_secs(3), "stopped after {waited:?}");
-    assert!(!dir.join("out/fit.json").exists());
+    (status.code(), seen, stopped.elapsed())
 }
 
 /// Class 3: the bootstrap's cost does not grow with the counts (10¹¹ throws in a row).

@@ -86,13 +86,20 @@ impl EdgeImpact {
     /// The state one step after the die, its edge `gap` above the floor (negative: into it),
     /// starts falling, gravity off.
     fn after(&self, engine: &mut dyn Engine, gap: f64) -> BodyState {
+        self.after_steps(engine, gap, 1)
+    }
+
+    /// The same after `steps` steps.
+    fn after_steps(&self, engine: &mut dyn Engine, gap: f64, steps: usize) -> BodyState {
         engine
             .reset(&BodyState {
                 linear_velocity: Vector3::new(0.0, -V, 0.0),
                 ..at_rest(Vector3::new(0.0, -self.r.y + gap, 0.0), self.rotation)
             })
             .unwrap();
-        engine.step().unwrap();
+        for _ in 0..steps {
+            engine.step().unwrap();
+        }
         engine.state()
     }
 }
@@ -238,15 +245,7 @@ fn bullet_meets_the_impulse_law_and_adds_its_baumgarte_term() {
             // Found after one step, V dt − gap deep: the edge leaves at e V + 0.2 d/dt.
             let d = V * scene.dt - gap;
             let boost = (E * V + BULLET_ERP * d / scene.dt + V) / ((1.0 + E) * V);
-            engine
-                .reset(&BodyState {
-                    linear_velocity: Vector3::new(0.0, -V, 0.0),
-                    ..at_rest(Vector3::new(0.0, -hit.r.y + gap, 0.0), hit.rotation)
-                })
-                .unwrap();
-            engine.step().unwrap();
-            engine.step().unwrap();
-            let got = engine.state().linear_velocity.y + V;
+            let got = hit.after_steps(engine.as_mut(), gap, 2).linear_velocity.y + V;
             println!(
                 "Bullet com {com_z} {theta}° from {gap:e} m: Δv {got:.5} = law × {:.5}, \
                  Baumgarte predicts × {boost:.5}",
@@ -274,17 +273,8 @@ fn with_the_split_preset_bullet_meets_the_impulse_law_from_any_depth() {
         let hit = EdgeImpact::new(&scene, com_z, theta);
         let (dv, wx) = hit.law();
         for gap in [-1e-9, 1e-4, 1e-3] {
-            engine
-                .reset(&BodyState {
-                    linear_velocity: Vector3::new(0.0, -V, 0.0),
-                    ..at_rest(Vector3::new(0.0, -hit.r.y + gap, 0.0), hit.rotation)
-                })
-                .unwrap();
-            engine.step().unwrap();
-            if gap > 0.0 {
-                engine.step().unwrap();
-            }
-            let s = engine.state();
+            // From above the floor the impact is the second step's.
+            let s = hit.after_steps(engine.as_mut(), gap, if gap > 0.0 { 2 } else { 1 });
             let (got_dv, got_wx) = (s.linear_velocity.y + V, s.angular_velocity.x);
             println!(
                 "Bullet split com {com_z} {theta}° from {gap:e} m: Δv = law × {:.5}, ω'_x = law \
