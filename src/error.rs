@@ -108,6 +108,8 @@ pub enum Field {
     FlightDts,
     /// `flight_time`.
     FlightTime,
+    /// `floor`.
+    Floor,
     /// `floor_thickness`.
     FloorThickness,
     /// `free`.
@@ -213,6 +215,8 @@ pub enum Field {
     Style,
     /// `tasks`.
     Tasks,
+    /// `threads`.
+    Threads,
     /// `time`.
     Time,
     /// `trend`.

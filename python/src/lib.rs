@@ -108,11 +108,7 @@ fn mode(s: &str) -> PyResult<Mode> {
 }
 
 fn threads(asked: usize) -> PyResult<usize> {
-    use dicephys::run::batch::MAX_THREADS;
-    if asked > MAX_THREADS {
-        return Err(bad("threads", asked, format!("at most {MAX_THREADS}")));
-    }
-    Ok(dicephys::run::batch::threads(asked))
+    dicephys::run::batch::checked_threads(asked).map_err(py_err)
 }
 
 /// A range of the throw: one number, or (low, high).
@@ -367,14 +363,7 @@ fn spec(
         scene.density = d;
     }
     if let Some(t) = o.maybe::<f64>("floor_thickness")? {
-        if scene.floor == Floor::Plane {
-            return Err(bad(
-                "floor_thickness",
-                t,
-                "the plane floor is a half-space; use floor='box'",
-            ));
-        }
-        scene.floor_thickness = t;
+        scene.set_floor_thickness(t).map_err(py_err)?;
     }
     let paper = ThrowRanges::default();
     let kappa = o.maybe::<f64>("kappa")?;
@@ -865,9 +854,6 @@ fn recover(
     use calibration::params::Kind;
     let cfg: FitConfig = serde_json::from_str(config)
         .map_err(|e| bad("config", "…", format!("not a fit's configuration: {e}")))?;
-    if repeats == 0 {
-        return Err(bad("repeats", 0, "need at least one repetition"));
-    }
     let mut given = Vec::new();
     for (name, v) in &truth {
         let k = named::<Kind>("truth", "parameter", name)?;

@@ -134,6 +134,8 @@ def test_per_roll_arrays_match_the_cli_s_csv(tmp_path: Path) -> None:
         ({"block": "16x16x16", "com": "0,0,-1"}, "com='0,0,-1'"),
         ({"block": "16x16x16", "com": ("a", 0, 0)}, "com="),
         ({"block": "140x24x20", "kappa": "bogus"}, "kappa='bogus'"),
+        # The library's own checks, named by the argument (house round 4).
+        ({"block": "140x24x20", "floor": "plane", "floor_thickness": 0.02}, "floor_thickness=0.02: .* give floor box"),
     ],
 )
 def test_bad_arguments_raise_value_error_naming_them(kwargs: dict, name: str) -> None:

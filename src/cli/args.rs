@@ -9,7 +9,6 @@ use dicephys::model::block::Block;
 use dicephys::model::mass::Features;
 use dicephys::model::scene::{Floor, Mode, Preset, Scene};
 use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
-use dicephys::run::batch::MAX_THREADS;
 use dicephys::run::spec::ThrowSpec;
 use dicephys::sim::roll::{RollConfig, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
 
@@ -474,12 +473,7 @@ impl SceneArgs {
         scene.sleeping = !self.no_sleep;
         self.made.apply(&mut scene)?;
         if let Some(t) = self.floor_thickness {
-            if self.floor == Floor::Plane {
-                return Err(Error::Usage(
-                    "--floor-thickness: the plane floor is a half-space; use --floor box".into(),
-                ));
-            }
-            scene.floor_thickness = t;
+            scene.set_floor_thickness(t)?;
         }
         scene
             .validate(self.allow_restitution_above_one)
@@ -558,12 +552,7 @@ impl RunArgs {
     }
 }
 
-/// Checks `--threads` (0: one per core) and resolves it.
+/// Checks `--threads` (0: one per core) and resolves it (the library's check).
 pub fn threads(asked: usize) -> Result<usize> {
-    if asked > MAX_THREADS {
-        return Err(Error::Usage(format!(
-            "--threads {asked}: at most {MAX_THREADS}"
-        )));
-    }
-    Ok(dicephys::run::batch::threads(asked))
+    Ok(dicephys::run::batch::checked_threads(asked)?)
 }

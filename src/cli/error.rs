@@ -91,6 +91,7 @@ pub fn flag(field: Field) -> &'static str {
         Field::FlightDts => "--flight-dts",
         // Set by no command (validate's free flight lasts its default).
         Field::FlightTime => "flight_time",
+        Field::Floor => "--floor",
         Field::FloorThickness => "--floor-thickness",
         Field::Free => "--free",
         Field::Friction => "--friction",
@@ -140,6 +141,7 @@ pub fn flag(field: Field) -> &'static str {
         Field::Starts => "--starts",
         Field::Style => "--throw",
         Field::Tasks => "--tasks",
+        Field::Threads => "--threads",
         Field::Time => "--time",
         Field::Trend => "--trend",
         Field::TrendRolls => "--trend-rolls",

@@ -313,11 +313,6 @@ impl FitArgs {
 /// Runs `dicephys fit`.
 pub fn run(a: &FitArgs) -> Result<()> {
     let cfg = a.config()?;
-    if a.recover.is_some() && a.repeats == 0 {
-        return Err(Error::Usage(
-            "--repeats 0: need at least one repetition".into(),
-        ));
-    }
     let mut place = a.place.local("fit")?;
     // The simulations' cells under --out/cells.
     place.checkpoint = Some(place.out.join("cells"));

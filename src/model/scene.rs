@@ -194,6 +194,19 @@ pub fn check_dt(field: Field, dt: f64) -> Result<()> {
 pub const DICEPHYS_FLOOR_THICKNESS: f64 = 100.0;
 
 impl Scene {
+    /// The box floor's thickness, m, as a front end sets it: refused on the plane floor,
+    /// which is a half-space.
+    pub fn set_floor_thickness(&mut self, t: f64) -> crate::Result<()> {
+        if self.floor == Floor::Plane {
+            return Err(crate::Error::field(
+                crate::error::Field::FloorThickness,
+                t,
+                "the plane floor is a half-space; give `floor` box",
+            ));
+        }
+        self.floor_thickness = t;
+        Ok(())
+    }
     /// Checks every value before anything runs. A restitution above 1 is not physics; it is
     /// accepted (up to 10) only for engine-stability studies that ask for it.
     pub fn validate(&self, allow_restitution_above_one: bool) -> Result<()> {

@@ -38,6 +38,18 @@ pub fn threads(asked: usize) -> usize {
 /// The most worker threads a run takes.
 pub const MAX_THREADS: usize = 1024;
 
+/// Worker threads asked (0: one per core), checked and resolved: what every front end calls.
+pub fn checked_threads(asked: usize) -> crate::Result<usize> {
+    if asked > MAX_THREADS {
+        return Err(crate::Error::field(
+            crate::error::Field::Threads,
+            asked,
+            format!("at most {MAX_THREADS}"),
+        ));
+    }
+    Ok(threads(asked))
+}
+
 /// Rolls throws `indices` with `threads` threads (0: one per core), no stop; records in index
 /// order.
 pub fn run(
