@@ -301,6 +301,24 @@ fn spec(
     layout: Option<Layout>,
     precision: bool,
 ) -> PyResult<RunSpec> {
+    let scene = scene_of(block_, o, layout)?;
+    let throws = throws_of(o, &scene)?;
+    let roll = roll_of(o, &scene)?;
+    let spec = RunSpec {
+        engine: named::<EngineKind>("engine", "engine", &o.get("engine", "bullet".to_string())?)?,
+        roll,
+        scene,
+        throws,
+        rolls: o.get("rolls", if precision { 10_000_000 } else { 10_000 })?,
+        shard: None,
+    };
+    spec.validate(false).map_err(py_err)?;
+    Ok(spec)
+}
+
+/// The scene of `roll`'s options: the die (a block, a shape, a mesh or a die file) as made, on
+/// its floor.
+fn scene_of(block_: Option<&str>, o: &Options, layout: Option<Layout>) -> PyResult<Scene> {
     // A die of any shape (`shape`, or a mesh `die`) in place of the block; no die at all: a
     // 16 mm d6, as the command line's.
     let die = o.maybe::<PathBuf>("die")?;
@@ -365,9 +383,14 @@ fn spec(
     if let Some(t) = o.maybe::<f64>("floor_thickness")? {
         scene.set_floor_thickness(t).map_err(py_err)?;
     }
+    Ok(scene)
+}
+
+/// The throws of `roll`'s options: their source, seed, ranges and style.
+fn throws_of(o: &Options, scene: &Scene) -> PyResult<ThrowSpec> {
     let paper = ThrowRanges::default();
     let kappa = o.maybe::<f64>("kappa")?;
-    let throws = ThrowSpec {
+    Ok(ThrowSpec {
         kind: named::<ThrowKind>(
             "source",
             "throw source",
@@ -387,10 +410,14 @@ fn spec(
         style: match o.maybe::<String>("throw")? {
             Some(t) => named::<ThrowStyle>("throw", "throw style", &t)?,
             None if kappa.is_some() => ThrowStyle::Hand,
-            None => ThrowStyle::default_for(&scene),
+            None => ThrowStyle::default_for(scene),
         },
         kappa,
-    };
+    })
+}
+
+/// How a roll ends, from `roll`'s options: the rest rule, the flight, the step cap.
+fn roll_of(o: &Options, scene: &Scene) -> PyResult<RollConfig> {
     let settle =
         match o.maybe::<String>("settle")?.as_deref() {
             None => None,
@@ -407,7 +434,7 @@ fn spec(
         "stepped" => false,
         s => return Err(bad("flight", format!("'{s}'"), "give 'fast' or 'stepped'")),
     };
-    let roll = RollConfig::chosen(
+    RollConfig::chosen(
         scene.dt,
         settle,
         fast,
@@ -423,17 +450,7 @@ fn spec(
         )?,
         o.get("margin", DEFAULT_MARGIN)?,
     )
-    .map_err(py_err)?;
-    let spec = RunSpec {
-        engine: named::<EngineKind>("engine", "engine", &o.get("engine", "bullet".to_string())?)?,
-        roll,
-        scene,
-        throws,
-        rolls: o.get("rolls", if precision { 10_000_000 } else { 10_000 })?,
-        shard: None,
-    };
-    spec.validate(false).map_err(py_err)?;
-    Ok(spec)
+    .map_err(py_err)
 }
 
 /// Rolls `spec` as `dicephys roll` does: its summary's JSON document (numbered by `layout`)
@@ -675,35 +692,11 @@ fn paper_config(
         .map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }
 
-/// A fit's configuration (`dicephys fit`'s), from the counts (a CSV file, CSV text, or
-/// "paper") and the model, checked; as JSON.
-#[pyfunction]
-#[pyo3(signature = (data, free, shared, ranges, restitution, friction, kappa, spin_scale,
-    engine, dt, max_steps, points, point_rolls, degree, max_degree, refine, common_throws, seed,
-    die=None))]
-#[allow(clippy::too_many_arguments)]
-fn fit_config<'py>(
-    data: &str,
-    free: Vec<String>,
-    shared: Vec<String>,
-    ranges: Vec<(String, f64, f64)>,
-    restitution: f64,
-    friction: f64,
-    kappa: Option<f64>,
-    spin_scale: f64,
-    engine: &str,
-    dt: f64,
-    max_steps: u64,
-    points: usize,
-    point_rolls: u64,
-    degree: Option<usize>,
-    max_degree: Option<usize>,
-    refine: bool,
-    common_throws: bool,
-    seed: u64,
-    die: Option<Bound<'py, PyDict>>,
-) -> PyResult<String> {
-    use calibration::params::{Fixed, FixedThrow, Kind, Method, ModelSpec};
+/// A fit's die from `roll`'s names (com, pips, edge_radius, die: a file or a mesh, layout,
+/// density, shape, size, scale): as made, its density, and its shape if not a cuboid.
+fn fit_die(
+    die: Option<Bound<'_, PyDict>>,
+) -> PyResult<(Features, Option<f64>, Option<dicephys::model::shape::Shape>)> {
     // The die, by roll's names: com, pips, edge_radius, die (a file), layout, density.
     let o = Options {
         given: die.map(|d| d.copy()).transpose()?,
@@ -734,6 +727,39 @@ fn fit_config<'py>(
     )
     .map_err(py_err)?;
     o.finish()?;
+    Ok((features, density, shape))
+}
+
+/// A fit's configuration (`dicephys fit`'s), from the counts (a CSV file, CSV text, or
+/// "paper") and the model, checked; as JSON.
+#[pyfunction]
+#[pyo3(signature = (data, free, shared, ranges, restitution, friction, kappa, spin_scale,
+    engine, dt, max_steps, points, point_rolls, degree, max_degree, refine, common_throws, seed,
+    die=None))]
+#[allow(clippy::too_many_arguments)]
+fn fit_config<'py>(
+    data: &str,
+    free: Vec<String>,
+    shared: Vec<String>,
+    ranges: Vec<(String, f64, f64)>,
+    restitution: f64,
+    friction: f64,
+    kappa: Option<f64>,
+    spin_scale: f64,
+    engine: &str,
+    dt: f64,
+    max_steps: u64,
+    points: usize,
+    point_rolls: u64,
+    degree: Option<usize>,
+    max_degree: Option<usize>,
+    refine: bool,
+    common_throws: bool,
+    seed: u64,
+    die: Option<Bound<'py, PyDict>>,
+) -> PyResult<String> {
+    use calibration::params::{Fixed, FixedThrow, Kind, Method, ModelSpec};
+    let (features, density, shape) = fit_die(die)?;
     let kind = |arg: &str, s: &str| named::<Kind>(arg, "parameter", s);
     let mut free_kinds = free
         .iter()

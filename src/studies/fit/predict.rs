@@ -97,6 +97,20 @@ pub fn extrapolation(fit: &FitResult, block: &crate::model::block::Block) -> Opt
     (!out.is_empty()).then(|| format!("outside the blocks the fit saw: {}", out.join(", ")))
 }
 
+/// True if a prediction gives the faces too: of a made die, a fit of faces or a die of any
+/// shape, in 3D.
+fn predicts_faces(fit: &FitResult, cfg: &PredictConfig) -> bool {
+    let method = &fit.config.method;
+    cfg.mode == crate::model::scene::Mode::ThreeD
+        && (!method.die.is_default()
+            || method.shape.is_some()
+            || fit
+                .config
+                .rows
+                .iter()
+                .any(|r| r.outcomes == crate::calibration::data::Outcomes::Faces))
+}
+
 /// Simulates `cfg.block` (or the fit's die of any shape) at posterior draws of `fit`. `None`
 /// if stopped early.
 pub fn predict_block(
@@ -110,15 +124,7 @@ pub fn predict_block(
     let thrower = group(fit, false, &cfg.thrower, "thrower")?;
     let method = &fit.config.method;
     let shape = method.shape.as_deref();
-    // A made die, a fit of faces or a die of any shape: its faces too.
-    let with_faces = cfg.mode == crate::model::scene::Mode::ThreeD
-        && (!method.die.is_default()
-            || shape.is_some()
-            || fit
-                .config
-                .rows
-                .iter()
-                .any(|r| r.outcomes == crate::calibration::data::Outcomes::Faces));
+    let with_faces = predicts_faces(fit, cfg);
     let mut freq: [Vec<f64>; 3] = Default::default();
     let mut face_freq: Vec<Vec<f64>> = vec![Vec::new(); super::simulate::face_count(method)];
     let mut ratios = Vec::new();
