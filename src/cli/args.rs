@@ -110,8 +110,9 @@ pub struct SceneArgs {
     /// The floor: box (DicePhys's 10 km static box) or plane.
     #[arg(long, default_value = "box", value_parser = parse_floor)]
     pub floor: Floor,
-    /// The box floor's thickness, m (DicePhys's: 100). A table top (0.02) is thin enough for
-    /// a die to pass through at a coarse step: a real tunnel, counted as failed.
+    /// The box floor's thickness, m [default: 100, DicePhys's; the plane floor has none]. A
+    /// table top (0.02) is thin enough for a die to pass through at a coarse step: a real
+    /// tunnel, counted as failed.
     #[arg(long, value_name = "M", allow_hyphen_values = true)]
     pub floor_thickness: Option<f64>,
     /// Linear damping, a rate in 1/s (velocity ∝ e^(−λt) out of contact; 0 to 30; DicePhys: 0).

@@ -64,7 +64,7 @@ pub struct FitArgs {
     #[arg(long, default_value = "bullet", value_parser = parse_engine)]
     pub engine: EngineKind,
     /// The time step, s or 1/N.
-    #[arg(long, default_value = "1/1000", value_parser = parse_step)]
+    #[arg(long, default_value = "0.001", value_parser = parse_step)]
     pub dt: f64,
     /// The step cap.
     #[command(flatten)]
@@ -119,9 +119,10 @@ pub struct PredictArgs {
     /// thrower and the three counts (length_vertical, breadth_vertical, width_vertical), or a
     /// counts file; writes the table, its figure and, where counted, each row's z and the χ²
     /// of the whole into --out.
-    #[arg(long, value_name = "BLOCKS.csv", conflicts_with_all = ["two_d", "surface", "thrower"])]
+    /// (`--blocks`, its name until this version, still reads: elsewhere `--blocks` is a list.)
+    #[arg(long = "blocks-file", alias = "blocks", value_name = "BLOCKS.csv", conflicts_with_all = ["two_d", "surface", "thrower"])]
     pub blocks: Option<PathBuf>,
-    /// With --blocks: the output directory [default: predict-out].
+    /// With --blocks-file: the output directory [default: predict-out].
     #[arg(long, value_name = "OUT", requires = "blocks")]
     pub out: Option<PathBuf>,
     /// Simulate it in 2D (DicePhys's plane-locked block).
@@ -370,7 +371,7 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
         (Some(b), _) | (None, Some(b)) => b,
         (None, None) => {
             return Err(Error::Usage(
-                "give --block (the block to predict) or --blocks (a file of them)".into(),
+                "give --block (the block to predict) or --blocks-file (a file of them)".into(),
             ))
         }
     };
@@ -396,20 +397,20 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
     super::study::predict(&fit, &cfg, &place)
 }
 
-/// Runs `dicephys predict --blocks`.
+/// Runs `dicephys predict --blocks-file`.
 fn predict_blocks(a: &PredictArgs, fit: &FitResult, file: &std::path::Path) -> Result<()> {
     use dicephys::calibration::heldout;
     let bytes =
         dicephys::run::io::read_capped(file, data::MAX_DATA_BYTES, super::stop()).map_err(|e| {
             match e {
                 dicephys::Error::Stopped => Error::Interrupted("interrupted; nothing read".into()),
-                e => Error::Usage(format!("--blocks {e}")),
+                e => Error::Usage(format!("--blocks-file {e}")),
             }
         })?;
     let text = std::str::from_utf8(&bytes)
-        .map_err(|_| Error::Usage(format!("--blocks {}: not UTF-8", file.display())))?;
+        .map_err(|_| Error::Usage(format!("--blocks-file {}: not UTF-8", file.display())))?;
     let rows = heldout::parse(text, &file.display().to_string())
-        .map_err(|e| Error::Usage(format!("--blocks {e}")))?;
+        .map_err(|e| Error::Usage(format!("--blocks-file {e}")))?;
     let cfg = dicephys::studies::fit::outputs::BlocksConfig {
         rows,
         draws: a.draws,

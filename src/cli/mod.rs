@@ -41,7 +41,7 @@ pub enum Command {
     /// Calibrate e, μ and the throw to measured counts (maximum likelihood through a surrogate
     /// of the simulator), or check that a fit recovers known values (--recover).
     Fit(fit::FitArgs),
-    /// Predict a block the fit did not see (or many, --blocks): its outcome probabilities with
+    /// Predict a block the fit did not see (or many, --blocks-file): its outcome probabilities with
     /// their errors, and a held-out test where they were counted.
     Predict(fit::PredictArgs),
     /// Is this die fair? Roll it (thrown in a tumble by default) and set each face against a

@@ -41,17 +41,27 @@ pub enum SlurmCommand {
     /// the report into --dir. `paper --calibrated` as two chained arrays: every model's first
     /// pass into --dir/first-pass, then every model's second pass into --dir, whose finishing
     /// job rolls any widening passes and the method check and writes calibrated.md.
+    // Its --out is --dir on a cluster: refused if given, so not shown.
+    #[command(mut_arg("out", |a| a.hide(true)))]
     Paper(Box<SlurmStudyArgs<PaperArgs>>),
     /// `crosscheck` as a job array; the finishing job's comparison is DIR/result.txt.
     Crosscheck(Box<SlurmStudyArgs<CrosscheckArgs>>),
     /// `converge` as a job array; the finishing job writes the study into --dir.
+    // Its --out is --dir on a cluster: refused if given, so not shown.
+    #[command(mut_arg("out", |a| a.hide(true)))]
     Converge(Box<SlurmStudyArgs<ConvergeArgs>>),
     /// `tradeoff` as a job array; the finishing job writes the study into --dir.
+    // Its --out is --dir on a cluster: refused if given, so not shown.
+    #[command(mut_arg("out", |a| a.hide(true)))]
     Tradeoff(Box<SlurmStudyArgs<TradeoffArgs>>),
     /// `stability` as a job array; the finishing job writes the study into --dir.
+    // Its --out is --dir on a cluster: refused if given, so not shown.
+    #[command(mut_arg("out", |a| a.hide(true)))]
     Stability(Box<SlurmStudyArgs<StabilityArgs>>),
     /// `fit` as job arrays: the first pass into --dir/first-pass, then (its box narrowed from
     /// that result) the second into --dir; one array with --no-refine.
+    // Its --out is --dir on a cluster: refused if given, so not shown.
+    #[command(mut_arg("out", |a| a.hide(true)))]
     Fit(Box<SlurmStudyArgs<FitArgs>>),
     /// The finishing job: check that every task has finished, then merge (roll) or assemble
     /// (the studies) into DIR.

@@ -31,10 +31,10 @@ pub struct TraceArgs {
     /// The step cap.
     #[command(flatten)]
     pub max_steps: MaxSteps<DEFAULT_MAX_STEPS>,
-    /// Free flight: stepped (every step by the engine) or fast (integrated in closed form where
-    /// the engine's flight is ballistic, as `roll` does by default; the flown steps are printed
-    /// too).
-    #[arg(long, value_enum, default_value = "stepped")]
+    /// Free flight: fast (integrated in closed form where the engine's flight is ballistic, as
+    /// `roll` does, so that the trace is the roll's; the flown steps are printed too) or
+    /// stepped (every step by the engine).
+    #[arg(long, value_enum, default_value = "fast")]
     pub flight: FlightArg,
 }
 

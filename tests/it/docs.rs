@@ -1126,7 +1126,7 @@ fn json_md_lists_the_keys_of_fit_recover_and_predict() {
         "predict",
         "--fit",
         &fit_json,
-        "--blocks",
+        "--blocks-file",
         blocks.to_str().unwrap(),
         "--draws",
         "2",
@@ -1138,6 +1138,6 @@ fn json_md_lists_the_keys_of_fit_recover_and_predict() {
         &format!("{d}/blocks"),
         "--json",
     ]);
-    c.document("predict-blocks", "predict --blocks", &many);
+    c.document("predict-blocks", "predict --blocks-file", &many);
     c.finish(&["fit", "recover", "predict", "predict-blocks"]);
 }

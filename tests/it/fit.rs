@@ -336,6 +336,7 @@ fn predict_blocks_tests_held_out_counts_in_one_command() {
         "predict",
         "--fit",
         out.join("fit.json").to_str().unwrap(),
+        // The old spelling of --blocks-file, still read for a version.
         "--blocks",
         blocks.to_str().unwrap(),
         "--draws",

@@ -762,6 +762,8 @@ fn bench_and_trace_stop_on_ctrl_c() {
             "1e-6",
             "--max-steps",
             "20000000",
+            "--flight",
+            "stepped",
         ][..],
     ] {
         stops_on_ctrl_c(args);
