@@ -151,3 +151,29 @@ pub fn read_die_bytes(path: &std::path::Path, max: u64) -> Result<Vec<u8>> {
         e => e,
     })
 }
+
+impl Features {
+    /// A die as the command line and the Python package describe it: a die file's, if one is
+    /// named, with a centre of mass, pips' diameter and depth and an edge radius given in mm
+    /// laid over it ([`Features::with_mm`]), and a layout over the file's where the die has
+    /// pips for it to place (a plain die's numbers are the summary's business, not its
+    /// mass's). Returns the features and the density given (`density`, else the file's).
+    pub fn described(
+        file: Option<&std::path::Path>,
+        com: Option<[f64; 3]>,
+        pips: Option<[f64; 2]>,
+        edge_radius: Option<f64>,
+        layout: Option<Layout>,
+        density: Option<f64>,
+    ) -> Result<(Features, Option<f64>)> {
+        let file = match file {
+            Some(path) => DieFile::read(path)?,
+            None => DieFile::default(),
+        };
+        let mut f = file.features()?.with_mm(com, pips, edge_radius);
+        if let (Some(l), Some(_)) = (layout, f.pips) {
+            f.layout = l;
+        }
+        Ok((f, density.or(file.density)))
+    }
+}

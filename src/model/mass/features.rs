@@ -1,8 +1,6 @@
 //! The die as it is described: what it departs from the ideal block by (`Features`), its
 //! insert and pips, the standard pips' pattern, and the features a front end's options give.
 
-use super::die_file::DieFile;
-use crate::error::Result;
 use crate::model::faces::Layout;
 use serde::{Deserialize, Serialize};
 
@@ -131,30 +129,6 @@ pub fn pattern(n: u8) -> &'static [(f64, f64)] {
 }
 
 impl Features {
-    /// A die as the command line and the Python package describe it: a die file's, if one is
-    /// named, with a centre of mass, pips' diameter and depth and an edge radius given in mm
-    /// laid over it ([`Features::with_mm`]), and a layout over the file's where the die has
-    /// pips for it to place (a plain die's numbers are the summary's business, not its
-    /// mass's). Returns the features and the density given (`density`, else the file's).
-    pub fn described(
-        file: Option<&std::path::Path>,
-        com: Option<[f64; 3]>,
-        pips: Option<[f64; 2]>,
-        edge_radius: Option<f64>,
-        layout: Option<Layout>,
-        density: Option<f64>,
-    ) -> Result<(Features, Option<f64>)> {
-        let file = match file {
-            Some(path) => DieFile::read(path)?,
-            None => DieFile::default(),
-        };
-        let mut f = file.features()?.with_mm(com, pips, edge_radius);
-        if let (Some(l), Some(_)) = (layout, f.pips) {
-            f.layout = l;
-        }
-        Ok((f, density.or(file.density)))
-    }
-
     /// These features with the ones given in mm (the command line's and the Python
     /// package's units) laid over them: a centre of mass, pips' diameter and depth (on the
     /// pips already here, keeping their shape, paint and spacing, or as empty caps), an edge

@@ -2,6 +2,7 @@
 //! moments, and its principal frame.
 
 use super::features::{Features, Insert};
+use super::moments::Moments;
 use super::pips::{cavity, pip_moments, pip_overlaps, pip_places};
 use super::turn::Turn;
 use crate::error::{Error, Field, Result};
@@ -34,22 +35,6 @@ impl MassProps {
     /// How an engine's body (the principal frame) is turned from the die's axes.
     pub fn turn(&self) -> Turn {
         Turn((!self.aligned()).then_some(self.principal))
-    }
-}
-
-/// Moments of a part about the geometric centre: its mass, Σ m r, and Σ m r rᵀ.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct Moments {
-    pub(super) mass: f64,
-    pub(super) first: Vector3<f64>,
-    pub(super) second: Matrix3<f64>,
-}
-
-impl Moments {
-    fn add(&mut self, w: f64, o: &Moments) {
-        self.mass += w * o.mass;
-        self.first += w * o.first;
-        self.second += w * o.second;
     }
 }
 

@@ -10,12 +10,13 @@
 //! the parallel-axis theorem, and its eigenvectors are the body's principal frame.
 //!
 //! By concern: the description (`features`), its checks (`validate`), the die file
-//! (`die_file`), the pips' geometry (`pips`), the mass integration (`integrate`) and the frame
+//! (`die_file`), the pips' geometry (`pips`), a part's moments (`moments`), the mass integration (`integrate`) and the frame
 //! an engine's body is turned by (`turn`).
 
 mod die_file;
 mod features;
 mod integrate;
+mod moments;
 mod pips;
 #[cfg(test)]
 mod tests;

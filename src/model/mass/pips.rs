@@ -2,7 +2,7 @@
 //! overlap.
 
 use super::features::{pattern, PipShape, Pips};
-use super::integrate::Moments;
+use super::moments::Moments;
 use crate::model::faces::Layout;
 use nalgebra::{Matrix3, Vector3};
 use std::f64::consts::PI;
