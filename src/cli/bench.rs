@@ -2,7 +2,7 @@
 
 use super::args::{Json, Seed, Threads};
 use super::error::{Error, Result};
-use super::outln;
+use super::term::outln;
 use clap::Args;
 use dicephys::studies::bench;
 
@@ -77,9 +77,9 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         repeat: a.repeat,
         dicephys: a.dicephys.clone(),
     };
-    let b = bench::run(&cfg, super::stop(), &|line| {
+    let b = bench::run(&cfg, super::term::stop(), &|line| {
         if !quiet {
-            let _ = super::stdout(&format!("{line}\n"));
+            let _ = super::term::stdout(&format!("{line}\n"));
         }
     })?;
     if *a.json {

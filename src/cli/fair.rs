@@ -4,7 +4,7 @@
 
 use super::error::{Error, Result};
 use super::roll::{rolled, RollArgs};
-use super::{out, outln};
+use super::term::{out, outln};
 use clap::Args;
 use dicephys::model::throws::ThrowStyle;
 use dicephys::studies::fair::{assess, Null};
@@ -170,7 +170,7 @@ fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str) -> Result<()
         super::study::every(),
     );
     let progress = |n: u64| bar.set(n as f64, total as f64);
-    let runner = dicephys::run::runner::Runner::new(threads, super::stop().clone());
+    let runner = dicephys::run::runner::Runner::new(threads, super::term::stop().clone());
     let runner = runner.with_progress(&progress);
     let layout = a.roll.layout(spec);
     let points = vary(spec, layout, what, &values, a.null, &runner);

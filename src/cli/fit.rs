@@ -261,7 +261,7 @@ impl FitArgs {
         let rows = if self.data.as_os_str() == "paper" && !self.data.exists() {
             data::paper_rows()?
         } else {
-            data::read(&self.data, super::stop()).map_err(|e| match e {
+            data::read(&self.data, super::term::stop()).map_err(|e| match e {
                 dicephys::Error::Stopped => Error::Interrupted("interrupted; nothing read".into()),
                 e => Error::Usage(format!("--data {e}")),
             })?
@@ -360,7 +360,7 @@ fn truth_values(cfg: &FitConfig, truth: &str) -> Result<Vec<f64>> {
 /// Runs `dicephys predict`.
 pub fn predict(a: &PredictArgs) -> Result<()> {
     let fit: FitResult =
-        dicephys::calibration::read_fit(&a.fit, super::stop()).map_err(|e| match e {
+        dicephys::calibration::read_fit(&a.fit, super::term::stop()).map_err(|e| match e {
             dicephys::Error::Stopped => Error::Interrupted("interrupted; nothing read".into()),
             e => Error::Usage(format!("--fit {e}")),
         })?;
@@ -392,7 +392,7 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
         threads: a.threads.checked()?,
         share: dicephys::run::runner::ChunkShare::All,
         json: *a.json,
-        command_line: super::command_line(),
+        command_line: super::term::command_line(),
     };
     super::study::predict(&fit, &cfg, &place)
 }
@@ -400,12 +400,10 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
 /// Runs `dicephys predict --blocks-file`.
 fn predict_blocks(a: &PredictArgs, fit: &FitResult, file: &std::path::Path) -> Result<()> {
     use dicephys::calibration::heldout;
-    let bytes =
-        dicephys::run::io::read_capped(file, data::MAX_DATA_BYTES, super::stop()).map_err(|e| {
-            match e {
-                dicephys::Error::Stopped => Error::Interrupted("interrupted; nothing read".into()),
-                e => Error::Usage(format!("--blocks-file {e}")),
-            }
+    let bytes = dicephys::run::io::read_capped(file, data::MAX_DATA_BYTES, super::term::stop())
+        .map_err(|e| match e {
+            dicephys::Error::Stopped => Error::Interrupted("interrupted; nothing read".into()),
+            e => Error::Usage(format!("--blocks-file {e}")),
         })?;
     let text = std::str::from_utf8(&bytes)
         .map_err(|_| Error::Usage(format!("--blocks-file {}: not UTF-8", file.display())))?;

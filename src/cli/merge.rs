@@ -3,7 +3,7 @@
 
 use super::args::Json;
 use super::error::{Error, Result};
-use super::{out, outln};
+use super::term::{out, outln};
 use clap::Args;
 use dicephys::report::summary::{RunSummary, ShardResult};
 use std::path::PathBuf;

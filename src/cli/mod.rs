@@ -1,8 +1,8 @@
 //! The command line: a thin layer over the library. Each subcommand has a module of its own.
 
 use clap::{CommandFactory, Parser, Subcommand};
-use dicephys::run::stop::Stop;
 use error::Error;
+use term::{stdout, stop};
 
 pub mod args;
 pub mod bench;
@@ -16,6 +16,7 @@ pub mod roll;
 pub mod slurm;
 pub mod study;
 pub mod sweeps;
+pub mod term;
 pub mod theory;
 pub mod trace;
 pub mod validate;
@@ -77,11 +78,6 @@ pub enum Command {
     },
     /// The manual page, roff on stdout (e.g. `dicephys man > ~/.local/share/man/man1/dicephys.1`).
     Man,
-}
-
-/// The process's stop flag, raised by Ctrl-C or SIGTERM.
-pub fn stop() -> &'static Stop {
-    Stop::global()
 }
 
 /// Runs the command line; returns the process exit code (0 ok, 2 bad input, 1 failure, 130
@@ -196,42 +192,4 @@ fn clap_error(e: clap::Error) -> i32 {
             2
         }
     }
-}
-
-/// Writes `text` to stdout and flushes it. A closed pipe (`| head -1`) ends the command
-/// quietly; any other failure (a full disk) is an error, never a panic.
-pub fn stdout(text: &str) -> error::Result<()> {
-    use std::io::Write;
-    let mut out = std::io::stdout().lock();
-    out.write_all(text.as_bytes())?;
-    out.flush()?;
-    Ok(())
-}
-
-/// `println!` to [`stdout`], returning its error.
-macro_rules! outln {
-    ($($t:tt)*) => {
-        $crate::cli::stdout(&format!("{}\n", format_args!($($t)*)))?
-    };
-}
-/// `print!` to [`stdout`], returning its error.
-macro_rules! out {
-    ($($t:tt)*) => {
-        $crate::cli::stdout(&format!($($t)*))?
-    };
-}
-pub(crate) use {out, outln};
-
-/// Checks an output path before anything runs (exit 2 if it cannot be written).
-pub fn output(path: &std::path::Path) -> error::Result<dicephys::run::io::Output> {
-    Ok(dicephys::run::io::Output::check(path)?)
-}
-
-/// This process's command line, to be named in reports (never parsed): its arguments as
-/// given, a byte that is not UTF-8 (in a path, say) shown as U+FFFD rather than a panic.
-pub fn command_line() -> String {
-    std::env::args_os()
-        .map(|a| a.to_string_lossy().into_owned())
-        .collect::<Vec<_>>()
-        .join(" ")
 }

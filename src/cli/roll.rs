@@ -3,7 +3,7 @@
 use super::args::Json;
 use super::args::{parse_engine, RunArgs, SceneArgs, ThrowArgs};
 use super::error::{Error, Result};
-use super::{out, outln};
+use super::term::{out, outln};
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::report::progress::{Progress, Unit};
@@ -179,7 +179,7 @@ pub fn rolled(
     let per_roll = a
         .per_roll
         .as_deref()
-        .map(|p| super::output(p).map(|o| (o, a.layout(spec))))
+        .map(|p| super::term::output(p).map(|o| (o, a.layout(spec))))
         .transpose()?;
     let dir = a.resume.as_ref().or(a.checkpoint.as_ref());
     let total = spec.indices().len();
@@ -189,7 +189,7 @@ pub fn rolled(
     let expected = std::sync::atomic::AtomicU64::new(total);
     let progress = |n: u64| bar.set(n as f64, expected.load(Relaxed) as f64);
     let expect = |n: u64| expected.store(n, Relaxed);
-    let runner = Runner::new(threads, super::stop().clone());
+    let runner = Runner::new(threads, super::term::stop().clone());
     let runner = runner.with_progress(&progress);
     let summary = outputs::roll(
         spec,

@@ -8,12 +8,12 @@
 use super::crosscheck::CrosscheckArgs;
 use super::error::{Error, Result};
 use super::fit::FitArgs;
-use super::out;
 use super::paper::PaperArgs;
 use super::roll::RollArgs;
 use super::study;
 use super::study::StudyPlace;
 use super::sweeps::{ConvergeArgs, StabilityArgs, TradeoffArgs};
+use super::term::out;
 use clap::{Args, Subcommand};
 use dicephys::run::slurm::Options;
 use dicephys::studies::calibrated::CalibratedStudy;
@@ -169,7 +169,7 @@ pub fn run(a: &SlurmArgs) -> Result<()> {
             // A cluster task takes the threads it asks for; "one per core" means one.
             let threads = threads.max(1);
             super::args::threads(threads)?;
-            let line = super::command_line();
+            let line = super::term::command_line();
             let s = Submitted {
                 config: cfg,
                 threads,
@@ -338,6 +338,6 @@ fn finish(dir: &std::path::Path) -> Result<()> {
             cluster::finished(dir, &place, tasks, ran.is_err())?;
             ran
         }
-        Finishing::Roll(text) => super::stdout(&text),
+        Finishing::Roll(text) => super::term::stdout(&text),
     }
 }

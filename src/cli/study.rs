@@ -3,7 +3,7 @@
 //! (`dicephys::studies::outputs`).
 
 use super::error::{Error, Result};
-use super::out;
+use super::term::out;
 use clap::Args;
 use dicephys::report::progress::Progress;
 use dicephys::run::runner::ChunkShare;
@@ -48,7 +48,7 @@ pub fn local(out: &Path, threads: usize, json: bool) -> Result<Place> {
         threads: super::args::threads(threads)?,
         share: ChunkShare::All,
         json,
-        command_line: super::command_line(),
+        command_line: super::term::command_line(),
     })
 }
 
@@ -100,7 +100,7 @@ fn with_hooks(
     let done = run(&Hooks {
         log: &log,
         progress: &set,
-        stop: super::stop().clone(),
+        stop: super::term::stop().clone(),
     });
     progress.finish();
     let done = done?;

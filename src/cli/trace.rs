@@ -72,7 +72,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     let record = roll_observed(engine.as_mut(), &scene, &throw, &settle, |step, s| {
         // A roll cannot be stopped from its observer: a stop request ends the process here,
         // the rows so far written, as every command stops (exit 130).
-        if step.is_multiple_of(1024) && super::stop().requested() {
+        if step.is_multiple_of(1024) && super::term::stop().requested() {
             let _ = out.flush();
             eprintln!("dicephys: interrupted at step {step}; the rows up to it are written");
             std::process::exit(130);
