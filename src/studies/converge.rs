@@ -11,10 +11,10 @@ use super::departure::{
 };
 use super::precision::{plan_cpu, resolve_departure, resolve_reference};
 use super::stream::Stream;
+use super::study::{Progress, Study};
 use super::sweep::{
     cell_spec, check_budget, check_rolls_and_steps, measure, nonempty, Measured, ONE_PERCENT,
 };
-use super::{Progress, Study};
 use crate::engine::EngineKind;
 use crate::error::{Error, Field, Result};
 use crate::model::block::Block;

@@ -1,7 +1,7 @@
 //! `crosscheck`: the very same throws on several engines, side by side: each engine's run, and
 //! each engine against the first (the baseline): σ apart, per-throw agreement, cost.
 
-use super::Study;
+use super::study::Study;
 use crate::engine::EngineKind;
 use crate::error::{Error, Field, Result};
 use crate::report::crosscheck::{Crosscheck, Versus};

@@ -5,7 +5,8 @@
 
 use super::place::{to_json, Outputs};
 pub use super::place::{Done, Hooks, Place};
-use super::{Kind, Study, StudyConfig};
+use super::study::Study;
+use super::{Kind, StudyConfig};
 use crate::error::{Error, Field, Result};
 use crate::report;
 use crate::report::per_roll::PerRoll;

@@ -13,7 +13,7 @@ use crate::report::table::{table_report, TableReport};
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::spec::{RunSpec, ThrowSpec};
 use crate::sim::roll::{early_stop_exact, RollConfig, Rule};
-use crate::studies::Study;
+use crate::studies::study::Study;
 use crate::theory::stats;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;

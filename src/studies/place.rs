@@ -3,7 +3,7 @@
 //! what the caller prints when it is done (`Done`). Every study's outputs (`studies::outputs`,
 //! `studies::fit::outputs`) are written against these, which import neither.
 
-use super::{Progress, Study};
+use super::study::{Progress, Study};
 use crate::error::{Error, Field, Result};
 use crate::run::io::Output;
 use crate::run::runner::{ChunkShare, Runner};

@@ -4,7 +4,7 @@
 
 use super::departure::{chunks_to_resolve, paired_departure, rolls_for_ratio};
 use super::stream::{Stream, STREAM_ROLLS};
-use super::Study;
+use super::study::Study;
 use crate::error::Result;
 use crate::report::summary::{Reached, Target};
 use crate::run::runner::{Checkpoint, Rolled, Runner, CHUNK_ROLLS};

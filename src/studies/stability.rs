@@ -8,8 +8,8 @@
 //! its binomial standard error (`Cell::err`); the default rolls per cell make a 0 mean below
 //! 1 % at 95 %.
 
+use super::study::{Progress, Study};
 use super::sweep::{cell_spec, check_rolls_and_steps, measure, nonempty};
-use super::{Progress, Study};
 use crate::engine::EngineKind;
 use crate::error::{Error, Field, Result};
 use crate::model::block::Block;

@@ -3,8 +3,8 @@
 //! extended chunk range by chunk range (`Runner::run_range`), with each throw's outcome kept
 //! for the paired error of a departure (`super::departure`).
 
+use super::study::Study;
 use super::sweep::{cell_spec, Measured};
-use super::Study;
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
 use crate::model::block::Outcome;

@@ -22,7 +22,7 @@ use crate::run::io::write_atomic;
 use crate::run::spec::{RunSpec, ThrowSpec};
 use crate::run::tally::Tally;
 use crate::sim::roll::RollConfig;
-use crate::studies::Study;
+use crate::studies::study::Study;
 use crate::theory::stats;
 
 /// The relative departure asked of a method: the paper's "within 1 %".

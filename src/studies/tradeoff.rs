@@ -19,8 +19,8 @@ use super::precision::{
     PRECISION_SEARCH_MAX,
 };
 use super::stream::Stream;
+use super::study::{Progress, Study};
 use super::sweep::{check_budget, check_rolls_and_steps, nonempty};
-use super::{Progress, Study};
 use crate::engine::EngineKind;
 use crate::error::{Error, Field, Result};
 use crate::model::block::Block;

@@ -14,7 +14,7 @@ use crate::run::runner::Checkpoint;
 use crate::run::spec::{RunSpec, ThrowSpec};
 use crate::run::tally::Tally;
 use crate::sim::roll::{Fate, RollConfig, RollRecord, Rule};
-use crate::studies::Study;
+use crate::studies::study::Study;
 use crate::theory;
 use serde::{Deserialize, Serialize};
 

@@ -44,7 +44,7 @@ pub use crate::report::validate::Config;
 use crate::report::validate::{format_row, Row, Validation, Verdict};
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::spec::{RunSpec, ThrowSpec};
-use crate::studies::{Progress, Study};
+use crate::studies::study::{Progress, Study};
 use limits::{limit_roll, limit_scene};
 use trend::trend_scene;
 

@@ -6,8 +6,8 @@ use crate::error::Result;
 use crate::model::scene::{Mode, Scene};
 use crate::report::validate::{Case, Row, TrendPoint, Verdict};
 use crate::sim::roll::{RollConfig, Rule};
+use crate::studies::study::Study;
 use crate::studies::sweep::{cell_spec, measure};
-use crate::studies::Study;
 use crate::theory;
 
 /// The trend's scene: the paper's 2D scene for its block, with e and μ.
