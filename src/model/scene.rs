@@ -1,5 +1,6 @@
 //! The scene a throw happens in: the block, the surface, the time step, 2D or 3D, and the
-//! engine settings. Defaults are DicePhys's, as the paper ran it (DESIGN.md).
+//! engine settings. Defaults are DicePhys's, as the paper ran it (the paper's section
+//! "Computation"; docs/guide.md, "Presets").
 
 use crate::error::{Error, Field, Result};
 use crate::model::block::Block;
