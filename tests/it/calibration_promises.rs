@@ -51,7 +51,8 @@ fn tiny(data: &Path, out: &Path) -> Vec<String> {
 }
 
 fn run(args: &[String]) -> Output {
-    bin().args(args).output().expect("run dicephys")
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    dicephys(&args)
 }
 
 /// Waits for `child`, killing it after `limit` (then its exit code is `None`).

@@ -282,12 +282,7 @@ fn fast_flight_keeps_outcomes_at_coarse_steps() {
     assert!(engine_steps < steps, "no step was flown");
 }
 
-fn cli(args: &[&str]) -> std::process::Output {
-    super::helpers::bin()
-        .args(args)
-        .output()
-        .expect("run dicephys")
-}
+use super::helpers::dicephys as cli;
 
 #[test]
 fn the_early_stop_is_on_by_default_only_where_it_is_exact() {

@@ -10,17 +10,9 @@ use dicephys::sim::roll::{roll, run_from, Failure, Fate, RollConfig};
 use nalgebra::{UnitQuaternion, Vector3};
 use std::path::Path;
 
+/// A command's `--json` document (the shared runner, its failure the test's).
 fn dicephys(args: &[&str]) -> serde_json::Value {
-    let out = super::helpers::bin()
-        .args(args)
-        .output()
-        .expect("run dicephys");
-    assert!(
-        out.status.success(),
-        "{args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("one JSON document")
+    super::helpers::json(&super::helpers::dicephys(args))
 }
 
 fn out_dir(name: &str) -> Scratch {

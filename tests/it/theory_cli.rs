@@ -2,12 +2,7 @@
 
 use std::process::Output;
 
-fn dicephys(args: &[&str]) -> Output {
-    super::helpers::bin()
-        .args(args)
-        .output()
-        .expect("the dicephys binary runs")
-}
+use super::helpers::dicephys;
 
 fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
