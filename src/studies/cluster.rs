@@ -60,7 +60,12 @@ fn stage(s: &Submitted, job: &Job, dry: bool) -> Result<Staged> {
     };
     let lay = prepare(&plan, job, s.threads, |lay| {
         if !dry {
-            return crate::run::owner::claim(&lay.dir, cfg.name(), &cfg.identity());
+            return super::place::claim(
+                &lay.dir,
+                cfg.name(),
+                &cfg.identity(),
+                super::place::Claimant::Checked,
+            );
         }
         let place = Place::cluster(lay, s.threads, s.json, ChunkShare::DryRun, s.command_line);
         let quiet = Hooks {

@@ -311,8 +311,7 @@ fn judge(
 /// Claims `dir` for this `fair` run (`run::owner`): refused if another command or another run
 /// owns it.
 pub fn claim(dir: &std::path::Path, identity: &serde_json::Value) -> Result<()> {
-    crate::run::owner::refuse_cluster_run(dir)?;
-    crate::run::owner::claim(dir, "fair", identity)
+    super::place::claim(dir, "fair", identity, super::place::Claimant::Here)
 }
 
 /// Writes `fairness.json` (the document `json`, as `--json` prints it) and the die map

@@ -3,7 +3,7 @@
 //! A cluster task rolls its share and writes nothing; the finishing job writes the result.
 //! What the caller should print comes back as [`Done`].
 
-use super::place::{to_json, Outputs};
+use super::place::{to_json, Claimant, Outputs};
 pub use super::place::{Done, Hooks, Place};
 use super::study::Study;
 use super::{Kind, StudyConfig};
@@ -282,7 +282,8 @@ pub fn run(config: &StudyConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
     // The directory it writes into is this run's, or refused.
     if let Some(dir) = study.owns(place) {
         study.validate()?;
-        crate::run::owner::claim(dir, study.name(), &config.identity())?;
+        // A run here was refused a Slurm run's directory before its place was made.
+        super::place::claim(dir, study.name(), &config.identity(), Claimant::Checked)?;
     }
     study.run(place, hooks)
 }
@@ -449,8 +450,7 @@ pub fn stability(cfg: &studies::stability::Config, place: &Place, hooks: &Hooks)
 /// `validate`: validate.json, report.md and its figures.
 pub fn validate(cfg: &studies::validate::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
     cfg.validate()?;
-    let identity = serde_json::to_value(cfg).map_err(|e| Error::Failed(e.to_string()))?;
-    crate::run::owner::claim(&place.out, "validate", &identity)?;
+    super::place::claim(&place.out, "validate", cfg, Claimant::Checked)?;
     let outputs = place.outputs(&["validate.json", "report.md"])?;
     let Some(res) = logged(place, hooks, &report::validate::header(), |study, log| {
         studies::validate::run(cfg, study, log, hooks.progress)

@@ -155,3 +155,29 @@ impl Outputs {
 pub(crate) fn to_json<T: Serialize>(v: &T) -> Result<String> {
     serde_json::to_string_pretty(v).map_err(|e| Error::Failed(e.to_string()))
 }
+
+/// Whether a claim refuses a Slurm run's directory (its tasks and finishing job write there).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Claimant {
+    /// A command run here, which has not yet looked: a Slurm run's directory is refused.
+    Here,
+    /// Settled by the caller: the Slurm run itself, or a run here whose [`Place`] was made
+    /// only after its maker refused a Slurm run's directory (`cli::study::local`).
+    Checked,
+}
+
+/// Claims `dir` for `command` run with `identity` (`run::owner`): refused if another command
+/// or another run owns it (and, for a run here, if a Slurm run does). The one place a
+/// directory is claimed, for every command that writes an `--out`.
+pub fn claim<T: Serialize + ?Sized>(
+    dir: &std::path::Path,
+    command: &str,
+    identity: &T,
+    by: Claimant,
+) -> Result<()> {
+    let identity = serde_json::to_value(identity).map_err(|e| Error::Failed(e.to_string()))?;
+    if by == Claimant::Here {
+        crate::run::owner::refuse_cluster_run(dir)?;
+    }
+    crate::run::owner::claim(dir, command, &identity)
+}

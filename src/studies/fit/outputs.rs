@@ -88,9 +88,12 @@ impl Kind for CalibratedStudy {
 /// if another command or another run owns it, or if a Slurm run does (neither `fit --recover`
 /// nor `paper --calibrated` runs on a cluster).
 fn claim<T: Serialize>(place: &Place, command: &str, identity: &T) -> Result<()> {
-    let identity = serde_json::to_value(identity).map_err(|e| Error::Failed(e.to_string()))?;
-    crate::run::owner::refuse_cluster_run(&place.out)?;
-    crate::run::owner::claim(&place.out, command, &identity)
+    crate::studies::place::claim(
+        &place.out,
+        command,
+        identity,
+        crate::studies::place::Claimant::Here,
+    )
 }
 
 /// A stop request met in the estimate (no rolls to keep there) ends the study as one met
