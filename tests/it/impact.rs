@@ -387,3 +387,25 @@ fn rapier_meets_the_impulse_law() {
         );
     }
 }
+
+/// `crosscheck` of a loaded die under the paper's preset says on stderr that Bullet's bounce
+/// is above its e there and names `--preset split`; under split, or for a die not loaded, it
+/// says nothing.
+#[test]
+fn crosscheck_of_a_loaded_die_names_the_split_preset() {
+    let note = |extra: &[&str]| {
+        let mut args = vec!["crosscheck", "--block", "16x16x16", "--throw", "tumble"];
+        args.extend_from_slice(&["--rolls", "40", "--seed", "1"]);
+        args.extend_from_slice(extra);
+        let out = crate::helpers::dicephys(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stderr).contains("--preset split")
+    };
+    assert!(note(&["--com", "0,0,-4.5"]));
+    assert!(!note(&["--com", "0,0,-4.5", "--preset", "split"]));
+    assert!(!note(&[]));
+}
