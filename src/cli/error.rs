@@ -40,9 +40,9 @@ impl fmt::Display for Error {
 impl From<dicephys::Error> for Error {
     fn from(e: dicephys::Error) -> Error {
         if matches!(e, dicephys::Error::Stopped) {
-            Error::Interrupted(
-                "interrupted; the finished work is kept: run the same command to continue".into(),
-            )
+            Error::Interrupted(dicephys::run::stop::interrupted(
+                &dicephys::run::stop::Kept::Work,
+            ))
         } else if let dicephys::Error::Field { field, value, why } = &e {
             let line = if value.is_empty() {
                 format!("{}: {}", flag(*field), flags_in(why))

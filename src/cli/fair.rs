@@ -176,9 +176,9 @@ fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str) -> Result<()
     let points = vary(spec, layout, what, &values, a.null, &runner);
     bar.finish();
     let Some(points) = points? else {
-        return Err(Error::Interrupted(
-            "interrupted; nothing written (a --vary run does not resume)".into(),
-        ));
+        return Err(Error::Interrupted(dicephys::run::stop::interrupted(
+            &dicephys::run::stop::Kept::Nothing(Some("a --vary run does not resume")),
+        )));
     };
     let doc = serde_json::json!({ "vary": what, "null": a.null, "spec": spec, "points": points });
     let json = dicephys::run::seal::to_string(&doc, true)?;

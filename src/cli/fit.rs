@@ -262,7 +262,7 @@ impl FitArgs {
             data::paper_rows()?
         } else {
             data::read(&self.data, super::term::stop()).map_err(|e| match e {
-                dicephys::Error::Stopped => Error::Interrupted("interrupted; nothing read".into()),
+                dicephys::Error::Stopped => Error::Interrupted(nothing_read()),
                 e => Error::Usage(format!("--data {e}")),
             })?
         };
@@ -361,7 +361,7 @@ fn truth_values(cfg: &FitConfig, truth: &str) -> Result<Vec<f64>> {
 pub fn predict(a: &PredictArgs) -> Result<()> {
     let fit: FitResult =
         dicephys::calibration::read_fit(&a.fit, super::term::stop()).map_err(|e| match e {
-            dicephys::Error::Stopped => Error::Interrupted("interrupted; nothing read".into()),
+            dicephys::Error::Stopped => Error::Interrupted(nothing_read()),
             e => Error::Usage(format!("--fit {e}")),
         })?;
     if let Some(file) = &a.blocks {
@@ -402,7 +402,7 @@ fn predict_blocks(a: &PredictArgs, fit: &FitResult, file: &std::path::Path) -> R
     use dicephys::calibration::heldout;
     let bytes = dicephys::run::io::read_capped(file, data::MAX_DATA_BYTES, super::term::stop())
         .map_err(|e| match e {
-            dicephys::Error::Stopped => Error::Interrupted("interrupted; nothing read".into()),
+            dicephys::Error::Stopped => Error::Interrupted(nothing_read()),
             e => Error::Usage(format!("--blocks-file {e}")),
         })?;
     let text = std::str::from_utf8(&bytes)
@@ -420,4 +420,9 @@ fn predict_blocks(a: &PredictArgs, fit: &FitResult, file: &std::path::Path) -> R
     let mut place = super::study::local(&out, *a.threads, *a.json)?;
     place.checkpoint = None;
     super::study::predict_blocks(fit, &cfg, &place)
+}
+
+/// A stop while a command reads its input: nothing read, nothing written.
+fn nothing_read() -> String {
+    dicephys::run::stop::interrupted(&dicephys::run::stop::Kept::NothingRead)
 }

@@ -204,17 +204,22 @@ pub fn rolled(
     let summary = summary?.with_layout(a.layout(spec));
     let rolled = summary.rolls;
     if summary.partial {
-        let why = Error::Interrupted(match dir {
-            Some(d) => format!(
-                "interrupted after {rolled} of {total} rolls; continue with: dicephys {command} \
-                 --resume {}{}",
+        let resume = dir.map(|d| {
+            format!(
+                "dicephys {command} --resume {}{}",
                 d.display(),
                 a.run
                     .precision
                     .map_or(String::new(), |p| format!(" {flag} {}", 100.0 * p))
-            ),
-            None => format!("interrupted after {rolled} of {total} rolls"),
+            )
         });
+        let why = Error::Interrupted(dicephys::run::stop::interrupted(
+            &dicephys::run::stop::Kept::Rolls {
+                done: rolled,
+                of: total,
+                resume,
+            },
+        ));
         return Ok((summary, Err(why)));
     }
     Ok((summary, Ok(())))

@@ -58,3 +58,52 @@ impl<'a> Watch<'a> {
         }
     }
 }
+
+/// What a command stopped before its end had kept, for [`interrupted`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum Kept<'a> {
+    /// Nothing was written; with why it cannot be continued, if that is so.
+    Nothing(Option<&'a str>),
+    /// Nothing was read yet (stopped while reading its input).
+    NothingRead,
+    /// What was rolled is kept in this directory: the same command continues.
+    Dir(&'a std::path::Path),
+    /// The finished work is kept where the command keeps it: the same command continues.
+    Work,
+    /// `done` of `of` rolls made, and the command that continues them, if one does.
+    Rolls {
+        /// Rolls made.
+        done: u64,
+        /// Rolls asked.
+        of: u64,
+        /// The command line that continues them.
+        resume: Option<String>,
+    },
+}
+
+/// What every command stopped before its end says (exit 130): the one writer of the word
+/// "interrupted", with what was kept and how to go on.
+pub fn interrupted(kept: &Kept) -> String {
+    match kept {
+        Kept::Nothing(None) => "interrupted; nothing written".into(),
+        Kept::Nothing(Some(why)) => format!("interrupted; nothing written ({why})"),
+        Kept::NothingRead => "interrupted; nothing read".into(),
+        Kept::Dir(d) => format!(
+            "interrupted; {} kept what was rolled: run the same command to continue",
+            d.display()
+        ),
+        Kept::Work => {
+            "interrupted; the finished work is kept: run the same command to continue".into()
+        }
+        Kept::Rolls {
+            done,
+            of,
+            resume: Some(c),
+        } => format!("interrupted after {done} of {of} rolls; continue with: {c}"),
+        Kept::Rolls {
+            done,
+            of,
+            resume: None,
+        } => format!("interrupted after {done} of {of} rolls"),
+    }
+}

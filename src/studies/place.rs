@@ -126,13 +126,10 @@ impl Place {
 /// (`kept`), to be continued by the same command, or that nothing was written.
 pub(crate) fn interrupted(kept: Option<&std::path::Path>) -> Done {
     Done {
-        interrupted: Some(match kept {
-            Some(d) => format!(
-                "interrupted; {} kept what was rolled: run the same command to continue",
-                d.display()
-            ),
-            None => "interrupted; nothing written".into(),
-        }),
+        interrupted: Some(crate::run::stop::interrupted(&match kept {
+            Some(d) => crate::run::stop::Kept::Dir(d),
+            None => crate::run::stop::Kept::Nothing(None),
+        })),
         ..Done::default()
     }
 }
