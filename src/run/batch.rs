@@ -39,9 +39,9 @@ pub fn threads(asked: usize) -> usize {
 pub const MAX_THREADS: usize = 1024;
 
 /// Worker threads asked (0: one per core), checked and resolved: what every front end calls.
-pub fn checked_threads(asked: usize) -> crate::Result<usize> {
+pub fn checked_threads(asked: usize) -> Result<usize> {
     if asked > MAX_THREADS {
-        return Err(crate::Error::field(
+        return Err(Error::field(
             crate::error::Field::Threads,
             asked,
             format!("at most {MAX_THREADS}"),

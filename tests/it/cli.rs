@@ -245,13 +245,7 @@ fn a_tiny_paper_run_is_complete_and_repeatable() {
             "{text}"
         );
         assert!(text.contains("mdf 42.5 on 8"), "{text}");
-        for block in [
-            "140x24x20",
-            "140x22x13",
-            "140x27x13",
-            "140x29x11",
-            "140x30x10",
-        ] {
+        for block in crate::helpers::MDF_BLOCKS {
             assert!(text.contains(block), "{block}: {text}");
         }
         assert!(

@@ -12,6 +12,15 @@ pub fn bin() -> Command {
     }
 }
 
+/// The five MDF blocks the paper simulated, in its order.
+pub const MDF_BLOCKS: [&str; 5] = [
+    "140x24x20",
+    "140x22x13",
+    "140x27x13",
+    "140x29x11",
+    "140x30x10",
+];
+
 /// Runs the binary with `args` and waits for it.
 pub fn dicephys(args: &[&str]) -> std::process::Output {
     bin().args(args).output().expect("run dicephys")

@@ -104,6 +104,22 @@ impl EdgeImpact {
     }
 }
 
+/// Asserts a step's (Δv, ω'_x) within `tol` (relative) of the impulse law's, naming `what`.
+fn assert_meets_law(what: &str, got: (f64, f64), law: (f64, f64), tol: f64) {
+    assert!(
+        rel(got.0, law.0).abs() < tol,
+        "{what}: Δv {} against {}",
+        got.0,
+        law.0
+    );
+    assert!(
+        rel(got.1, law.1).abs() < tol,
+        "{what}: ω'_x {} against {}",
+        got.1,
+        law.1
+    );
+}
+
 fn rel(a: f64, b: f64) -> f64 {
     (a - b) / b
 }
@@ -233,13 +249,11 @@ fn bullet_meets_the_impulse_law_and_adds_its_baumgarte_term() {
             rel(got_dv, dv),
             rel(got_wx, wx)
         );
-        assert!(
-            rel(got_dv, dv).abs() < 1e-5,
-            "Bullet {theta}°: Δv {got_dv} against {dv}"
-        );
-        assert!(
-            rel(got_wx, wx).abs() < 1e-5,
-            "Bullet {theta}°: ω'_x {got_wx} against {wx}"
+        assert_meets_law(
+            &format!("Bullet {theta}°"),
+            (got_dv, got_wx),
+            (dv, wx),
+            1e-5,
         );
         for gap in [1e-4, 1e-3] {
             // Found after one step, V dt − gap deep: the edge leaves at e V + 0.2 d/dt.
@@ -282,14 +296,8 @@ fn with_the_split_preset_bullet_meets_the_impulse_law_from_any_depth() {
                 got_dv / dv,
                 got_wx / wx
             );
-            assert!(
-                rel(got_dv, dv).abs() < 1e-4,
-                "{theta}° from {gap} m: Δv {got_dv} against {dv}"
-            );
-            assert!(
-                rel(got_wx, wx).abs() < 1e-4,
-                "{theta}° from {gap} m: ω'_x {got_wx} against {wx}"
-            );
+            let what = format!("{theta}° from {gap} m");
+            assert_meets_law(&what, (got_dv, got_wx), (dv, wx), 1e-4);
         }
     }
 }
@@ -377,13 +385,11 @@ fn rapier_meets_the_impulse_law() {
         let (dv, wx) = hit.law();
         let s = hit.after(engine.as_mut(), -1e-9);
         let (got_dv, got_wx) = (s.linear_velocity.y + V, s.angular_velocity.x);
-        assert!(
-            rel(got_dv, dv).abs() < 5e-3,
-            "Rapier {theta}°: Δv {got_dv} against {dv}"
-        );
-        assert!(
-            rel(got_wx, wx).abs() < 5e-3,
-            "Rapier {theta}°: ω'_x {got_wx} against {wx}"
+        assert_meets_law(
+            &format!("Rapier {theta}°"),
+            (got_dv, got_wx),
+            (dv, wx),
+            5e-3,
         );
     }
 }

@@ -155,13 +155,7 @@ fn jumped_flight_rolls_every_throw_as_walked_flight() {
         fast_flight: true,
         ..RollConfig::default()
     };
-    for block in [
-        "140x24x20",
-        "140x22x13",
-        "140x27x13",
-        "140x29x11",
-        "140x30x10",
-    ] {
+    for block in crate::helpers::MDF_BLOCKS {
         for mode in [Mode::ThreeD, Mode::TwoD] {
             let scene = Scene::paper(block.parse().unwrap(), mode);
             let mut e = new_engine(EngineKind::Bullet, &scene).unwrap();
