@@ -264,7 +264,7 @@ fn a_fit_simulates_a_die_of_any_shape_as_roll_does_throw_for_throw() {
     };
     let values = Fixed {
         throw: FixedThrow::Tumble,
-        com: [Some(0.0), Some(0.0), Some(-1.5)],
+        com: [Some(0.5), Some(-0.3), Some(-1.5)],
         ..Fixed::default()
     };
     let spec = method.spec(block, dicephys::model::scene::Mode::ThreeD, &values, 3, 600);
@@ -273,7 +273,8 @@ fn a_fit_simulates_a_die_of_any_shape_as_roll_does_throw_for_throw() {
         .run(&spec, None, &mut |_| Ok(()))
         .unwrap();
     let v = json(&dicephys(&[
-        "roll", "--shape", "d20", "--com", "0,0,-1.5", "--rolls", "600", "--seed", "3", "--json",
+        "roll", "--shape", "d20", "--com", "0.5,-0.3,-1.5", "--rolls", "600", "--seed", "3",
+        "--json",
     ]));
     let cli: Vec<u64> = v["shape"]["faces"]
         .as_array()
