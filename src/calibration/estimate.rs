@@ -209,6 +209,46 @@ pub struct ParamFit {
     pub identified: Identified,
     /// The profile: value and Δ(−2 ln L) at each grid point.
     pub profile: Vec<[f64; 2]>,
+    /// The end of its kind's whole range its maximum lies on, if it does: there the likelihood
+    /// still rises as the range ends, and the value is the range's, not the data's — the
+    /// model asks for more than this parameter can give ([`ParamFit::range_end`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub asks_for_more: Option<RangeEnd>,
+}
+
+/// One end of a parameter's range.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RangeEnd {
+    /// Its lower end.
+    Lower,
+    /// Its upper end.
+    Upper,
+}
+
+impl RangeEnd {
+    /// "lower" or "upper".
+    pub fn name(self) -> &'static str {
+        match self {
+            RangeEnd::Lower => "lower",
+            RangeEnd::Upper => "upper",
+        }
+    }
+}
+
+impl ParamFit {
+    /// The end of the kind's whole range (not a narrowed box's) that `value` lies on, within
+    /// the search's rounding: the search clamps to the box, whose face there is the range's.
+    pub fn range_end(param: &Param, value: f64) -> Option<RangeEnd> {
+        let w = param.kind.coordinate(param.whole, value);
+        if w <= 1e-6 {
+            Some(RangeEnd::Lower)
+        } else if w >= 1.0 - 1e-6 {
+            Some(RangeEnd::Upper)
+        } else {
+            None
+        }
+    }
 }
 
 /// A row's fit.
@@ -545,6 +585,7 @@ fn param_fits(params: &[Param], profiles: Profiles, best: &Minimum, b: f64) -> V
         let two = interval(&prof, fmin, 4.0 * b);
         let phys = |u: f64| param.kind.value(param.range, u);
         fits.push(ParamFit {
+            asks_for_more: ParamFit::range_end(param, phys(best.x[j])),
             param: param.clone(),
             name: param.name(),
             value: phys(best.x[j]),

@@ -517,6 +517,7 @@ mod tests {
         };
         let x = kind.coordinate(range, value);
         let fit = ParamFit {
+            asks_for_more: None,
             name: param.name(),
             param,
             value,

@@ -1,7 +1,7 @@
 //! What a fit says: `report.md`, its figures, and a prediction's lines.
 
 use crate::calibration::check::Verdict;
-use crate::calibration::estimate::{Estimate, Identified};
+use crate::calibration::estimate::{Estimate, Identified, ParamFit, RangeEnd};
 use crate::calibration::paper::CalibratedPaper;
 use crate::calibration::params::{FixedThrow, Kind};
 use crate::calibration::predict::{BlockPrediction, Predicted};
@@ -125,6 +125,7 @@ fn parameters(res: &FitResult) -> String {
         let r = p.param.range;
         let r = format!("{}–{}", num(r.lo), num(r.hi));
         let says = match p.identified {
+            _ if p.asks_for_more.is_some() => asks_for_more(p),
             Identified::Cut if res.passes.len() > 2 => format!(
                 "still cut: its maximum or 2σ region reaches an edge of the last pass's narrowed \
                  box, after {} widenings; the value is that box's, not the data's",
@@ -143,7 +144,7 @@ fn parameters(res: &FitResult) -> String {
             "| {} | {} | {} | {} – {} | {} – {} | {} |",
             p.name,
             r,
-            num(p.value),
+            fitted(p),
             num(p.one_sigma[0]),
             num(p.one_sigma[1]),
             num(p.two_sigma[0]),
@@ -153,6 +154,26 @@ fn parameters(res: &FitResult) -> String {
     }
     let _ = write!(s, "{}", maxima_text(e));
     s
+}
+
+/// A parameter's fitted value as the report prints it: a value at its range's end is marked as
+/// the range's, not the data's.
+fn fitted(p: &ParamFit) -> String {
+    match p.asks_for_more {
+        Some(end) => format!("{} (the range's {} end)", num(p.value), end.name()),
+        None => num(p.value),
+    }
+}
+
+/// What a parameter whose maximum lies on its range's own end says: the model asks for more.
+fn asks_for_more(p: &ParamFit) -> String {
+    let end = p.asks_for_more.map_or("", RangeEnd::name);
+    format!(
+        "**the model asks for more**: the likelihood still rises at the range's {end} end, so \
+         the value is the range's, not the data's; widen `--range {}` where the physics allows, \
+         or free what the model lacks (the throw: `--free spin`)",
+        p.param.kind
+    )
 }
 
 /// What the search's starts found: how many ended at each maximum; the islands of the region

@@ -499,3 +499,41 @@ fn a_box_that_cut_a_parameter_is_widened_until_it_does_not() {
     let total: u64 = fitted.passes.iter().map(|p| p.rolls).sum();
     assert_eq!(fitted.rolls, total);
 }
+
+#[test]
+fn a_parameter_at_its_ranges_end_is_reported_as_the_model_asking_for_more() {
+    // The paper's rows want e near 0.5; searched over 0.05–0.1 only, its likelihood rises to
+    // the range's upper end. The report and fit.json say so rather than give 0.1 as a value.
+    let dir = Scratch::new("fit-range-end");
+    let csv = two_blocks(&dir);
+    let out = dir.join("out");
+    let v = json(&dicephys(&[
+        "fit",
+        "--data",
+        &csv,
+        "--free",
+        "e",
+        "--range",
+        "e=0.05:0.1",
+        "--points",
+        "12",
+        "--degree",
+        "2",
+        "--rolls",
+        "100",
+        "--dt",
+        "1/250",
+        "--no-refine",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    let p = &v["estimate"]["params"][0];
+    assert_eq!(p["asks_for_more"], "upper", "{p}");
+    assert_eq!(p["value"], 0.1, "{p}");
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        md.contains("0.100 (the range's upper end)") && md.contains("the model asks for more"),
+        "{md}"
+    );
+}

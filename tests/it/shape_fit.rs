@@ -273,7 +273,15 @@ fn a_fit_simulates_a_die_of_any_shape_as_roll_does_throw_for_throw() {
         .run(&spec, None, &mut |_| Ok(()))
         .unwrap();
     let v = json(&dicephys(&[
-        "roll", "--shape", "d20", "--com", "0.5,-0.3,-1.5", "--rolls", "600", "--seed", "3",
+        "roll",
+        "--shape",
+        "d20",
+        "--com",
+        "0.5,-0.3,-1.5",
+        "--rolls",
+        "600",
+        "--seed",
+        "3",
         "--json",
     ]));
     let cli: Vec<u64> = v["shape"]["faces"]
