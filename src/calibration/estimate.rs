@@ -314,6 +314,15 @@ pub struct Estimate {
     /// when none was drawn).
     #[serde(default)]
     pub bootstrap: Option<Bootstrap>,
+    /// The overdispersion φ of a fit that misfits ([`overdispersion`]); 1 for one that fits.
+    /// Every bound on Δ(−2 ln L) above (the region's, the profiles') is multiplied by it, and
+    /// the draws are from exp(−Δ/2φ), so every interval and prediction is widened by it.
+    #[serde(default = "one")]
+    pub overdispersion: f64,
+}
+
+fn one() -> f64 {
+    1.0
 }
 
 impl Estimate {
@@ -338,6 +347,10 @@ pub struct Bootstrap {
     pub chi2_p: f64,
     /// The sets' mean χ², to set beside the data's and its degrees of freedom.
     pub chi2_mean: f64,
+    /// For a fit that misfits: the share of as many data sets drawn with its overdispersion
+    /// whose values lie inside the widened region (the widening's own check).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub widened_coverage: Option<f64>,
     /// The share of sets whose joint 2σ region (the threshold reported, Bartlett factor
     /// included) holds the values they were drawn at: stated 95.45 %.
     pub coverage: f64,
@@ -598,30 +611,47 @@ fn param_fits(params: &[Param], profiles: Profiles, best: &Minimum, b: f64) -> V
     fits
 }
 
-/// Fits `rows`: the maximum, the profiles, the goodness of fit and posterior draws. Each
-/// stage says its line to `watch` and ends at once on a stop request (`Error::Stopped`).
-pub fn estimate(
+/// The bootstrap's goodness-of-fit p below which a fit misfits, and its errors are widened by
+/// its [`overdispersion`].
+pub const MISFIT_P: f64 = 0.05;
+
+/// The overdispersion φ of a fit whose goodness of fit fails (the bootstrap's p below
+/// [`MISFIT_P`]): its χ² over what data drawn from the model itself give, the bootstrap's mean
+/// χ² (which carries the simulation's noise as the fit does). The quasi-likelihood's
+/// dispersion (McCullagh and Nelder 1989, §9.2): the counts scatter φ times as much as the
+/// model says, so every bound on Δ(−2 ln L) is multiplied by φ and an interval widens by about
+/// √φ. 1 for a fit that fits (its own chance scatter widens nothing), for one without a
+/// bootstrap (a first pass, whose surrogate spans the whole range and whose misfit is that
+/// surrogate's), and for one whose maximum a narrowed box holds on its face (`boxed`: the
+/// misfit is the box's, and the next pass widens it).
+pub fn overdispersion(chi2: f64, boot: Option<&Bootstrap>, boxed: bool) -> f64 {
+    match boot {
+        Some(b) if b.chi2_p < MISFIT_P && b.chi2_mean > 0.0 && !boxed => {
+            (chi2 / b.chi2_mean).max(1.0)
+        }
+        _ => 1.0,
+    }
+}
+
+/// True if the maximum `x` lies on a face of a parameter's box that is not its range's own
+/// end (a narrowed box holds it there).
+fn on_a_narrowed_face(params: &[Param], x: &[f64]) -> bool {
+    params.iter().zip(x).any(|(p, &u)| {
+        (u <= 1e-6 && p.range.lo > p.whole.lo) || (u >= 1.0 - 1e-6 && p.range.hi < p.whole.hi)
+    })
+}
+
+/// The islands of the region (other maxima within its bound `region`), and the profiles traced
+/// from those within `4 scale` of the best (the nearest [`MAX_TRACED`]), each parameter's the
+/// lower of its profiles, so that its intervals span them.
+fn islands_and_profiles(
     lik: &Likelihood,
-    params: &[Param],
+    (best, maxima, profiles): (&Minimum, &[Maximum], Profiles),
+    (region, scale): (f64, f64),
     search: &Search,
     watch: &Watch,
-) -> Result<Estimate> {
-    let dims = params.len();
+) -> Result<(Vec<Maximum>, Profiles)> {
     let f = |x: &[f64]| lik.minus_two_ln_l(x);
-    let (best, profiles, maxima) = maximum_and_profiles(lik, dims, search, watch)?;
-    if search.bootstrap > 0 && dims > 0 {
-        (watch.say)(&format!(
-            "fit: the likelihood ratio's scale from {} simulated data sets",
-            search.bootstrap
-        ));
-    }
-    let sets = bootstrap_sets(lik, &best.x, dims, search.bootstrap, search.seed);
-    let b = factor(&sets, dims);
-    watch.check()?;
-    // Islands: other maxima inside the joint 2σ region. The region is their union: each
-    // parameter's profile is also traced from every island and the lower of the two taken,
-    // so that its intervals span them all.
-    let region = b * region_delta(dims, TWO_SIGMA);
     let islands: Vec<Maximum> = maxima
         .iter()
         .skip(1)
@@ -633,7 +663,7 @@ pub fn estimate(
     // At most MAX_TRACED islands are traced: each costs a full set of profiles.
     let traced: Vec<&Maximum> = islands
         .iter()
-        .filter(|m| m.minus_two_ln_l - best.f <= 4.0 * b)
+        .filter(|m| m.minus_two_ln_l - best.f <= 4.0 * scale)
         .take(MAX_TRACED)
         .collect();
     let mut profiles = profiles;
@@ -661,22 +691,80 @@ pub fn estimate(
         }
         watch.check()?;
     }
-    let fits = param_fits(params, profiles, &best, b);
+    Ok((islands, profiles))
+}
+
+/// Fits `rows`: the maximum, the profiles, the goodness of fit and posterior draws. Each
+/// stage says its line to `watch` and ends at once on a stop request (`Error::Stopped`).
+pub fn estimate(
+    lik: &Likelihood,
+    params: &[Param],
+    search: &Search,
+    watch: &Watch,
+) -> Result<Estimate> {
+    let dims = params.len();
+    let (best, profiles, maxima) = maximum_and_profiles(lik, dims, search, watch)?;
+    if search.bootstrap > 0 && dims > 0 {
+        (watch.say)(&format!(
+            "fit: the likelihood ratio's scale from {} simulated data sets",
+            search.bootstrap
+        ));
+    }
+    let sets = bootstrap_sets(lik, &best.x, dims, search.bootstrap, search.seed, 1.0);
+    let b = factor(&sets, dims);
+    watch.check()?;
     let rows = row_fits(lik, &best.x);
     let chi2: f64 = rows.iter().map(|r| r.chi2).sum();
-    let bootstrap = verdict(&sets, chi2, b * region_delta(dims, TWO_SIGMA));
     let cells: i64 = rows.iter().map(|r| r.counts.len() as i64 - 1).sum();
     let dof = cells - dims as i64;
+    let p_value = (dof > 0).then(|| stats::chi_square_p_value(chi2, dof as usize));
+    let mut bootstrap = verdict(&sets, chi2, b * region_delta(dims, TWO_SIGMA));
+    let phi = overdispersion(
+        chi2,
+        bootstrap.as_ref(),
+        on_a_narrowed_face(params, &best.x),
+    );
+    // Islands: other maxima inside the joint 2σ region. The region is their union: each
+    // parameter's profile is also traced from every island and the lower of the two taken,
+    // so that its intervals span them all.
+    let scale = b * phi;
+    let region = scale * region_delta(dims, TWO_SIGMA);
+    if let Some(boot) = bootstrap.as_mut().filter(|_| phi > 1.0) {
+        (watch.say)(&format!(
+            "fit: the model misfits (overdispersion {phi:.2}): the widened region checked on \
+             {} data sets drawn with it",
+            boot.sets
+        ));
+        let wide = bootstrap_sets(lik, &best.x, dims, boot.sets, search.seed ^ 0x0d15, phi);
+        watch.check()?;
+        boot.widened_coverage =
+            Some(wide.iter().filter(|s| s.0 <= region).count() as f64 / wide.len().max(1) as f64);
+    }
+    let (islands, profiles) = islands_and_profiles(
+        lik,
+        (&best, &maxima, profiles),
+        (region, scale),
+        search,
+        watch,
+    )?;
+    let fits = param_fits(params, profiles, &best, scale);
     if search.draws > 0 {
         (watch.say)(&format!("fit: {} posterior draws", search.draws));
     }
-    let mut chains = vec![Maximum {
+    // Drawn from exp(−Δ/2φ): a misfit's draws, and so its predictions, widened by φ.
+    let chains: Vec<Maximum> = std::iter::once(Maximum {
         x: best.x.clone(),
         minus_two_ln_l: best.f,
         starts: 0,
-    }];
-    chains.extend(islands.iter().cloned());
-    let draws = draws_from(&f, &chains, search.draws, search.seed);
+    })
+    .chain(islands.iter().cloned())
+    .map(|m| Maximum {
+        minus_two_ln_l: m.minus_two_ln_l / phi,
+        ..m
+    })
+    .collect();
+    let widened = |x: &[f64]| lik.minus_two_ln_l(x) / phi;
+    let draws = draws_from(&widened, &chains, search.draws, search.seed);
     watch.check()?;
     let other_maxima = maxima.iter().skip(1).map(|m| m.minus_two_ln_l).collect();
     Ok(Estimate {
@@ -686,7 +774,7 @@ pub fn estimate(
         rows,
         chi2,
         dof,
-        p_value: (dof > 0).then(|| stats::chi_square_p_value(chi2, dof as usize)),
+        p_value,
         region_delta: region,
         bartlett: b,
         other_maxima,
@@ -694,13 +782,18 @@ pub fn estimate(
         islands,
         draws,
         bootstrap,
+        overdispersion: phi,
     })
 }
 
 /// One data set drawn from the fitted model at `x`, in the shape of `lik`'s counted rows: each
 /// row's probabilities from the Dirichlet about its surrogate (the simulation's noise), then its
 /// counts multinomial with the row's number of throws.
-fn bootstrap_rows(lik: &Likelihood, x: &[f64], rng: &mut ChaCha8Rng) -> Vec<DataRow> {
+///
+/// With an overdispersion `phi` above 1 each row's counts scatter φ times as much as the
+/// multinomial's: Dirichlet-multinomial with the concentration a = (N − φ)/(φ − 1), whose
+/// variance is φ N p(1 − p).
+fn bootstrap_rows(lik: &Likelihood, x: &[f64], phi: f64, rng: &mut ChaCha8Rng) -> Vec<DataRow> {
     let mut out = Vec::new();
     for (r, row) in lik.rows.iter().enumerate() {
         let pr = lik.predict(r, x);
@@ -715,9 +808,23 @@ fn bootstrap_rows(lik: &Likelihood, x: &[f64], rng: &mut ChaCha8Rng) -> Vec<Data
             let s: f64 = g.iter().sum();
             g.iter().map(|v| v / s).collect()
         };
-        out.push(row.with_grouped(&multinomial(n, &p, rng)));
+        out.push(row.with_grouped(&overdispersed(n, &p, phi, rng)));
     }
     out
+}
+
+/// `n` counts over outcomes of probabilities `p` that scatter `phi` times as much as the
+/// multinomial's (φ ≥ 1): Dirichlet-multinomial with the concentration a = (N − φ)/(φ − 1),
+/// whose variance N p(1 − p)(N + a)/(1 + a) is φ N p(1 − p).
+fn overdispersed(n: u64, p: &[f64], phi: f64, rng: &mut ChaCha8Rng) -> Vec<u64> {
+    if phi <= 1.0 {
+        return multinomial(n, p, rng);
+    }
+    let a = ((n as f64 - phi) / (phi - 1.0)).max(1e-3);
+    let g: Vec<f64> = p.iter().map(|q| gamma(a * q.max(1e-300), rng)).collect();
+    let s: f64 = g.iter().sum();
+    let q: Vec<f64> = g.iter().map(|v| v / s).collect();
+    multinomial(n, &q, rng)
 }
 
 /// `n` throws shared among outcomes of probabilities `p`: each outcome's count binomial given
@@ -774,7 +881,7 @@ fn gamma(shape: f64, rng: &mut ChaCha8Rng) -> f64 {
 /// Never below 1 (a flat or bounded direction makes it smaller than χ²'s; the χ² bound then
 /// stays, conservative).
 pub fn bartlett(lik: &Likelihood, x: &[f64], dims: usize, sets: usize, seed: u64) -> f64 {
-    factor(&bootstrap_sets(lik, x, dims, sets, seed), dims)
+    factor(&bootstrap_sets(lik, x, dims, sets, seed, 1.0), dims)
 }
 
 /// The Bartlett factor of the sets' Δ(−2 ln L) ([`bartlett`]).
@@ -785,14 +892,16 @@ fn factor(sets: &[(f64, f64)], dims: usize) -> f64 {
     (sets.iter().map(|s| s.0).sum::<f64>() / sets.len() as f64 / dims as f64).max(1.0)
 }
 
-/// `sets` data sets drawn from the fitted model at `x` ([`bootstrap_rows`]), each fitted
-/// back: Δ(−2 ln L) of `x` above the set's maximum, and the set's Pearson χ² there.
+/// `sets` data sets drawn from the fitted model at `x` ([`bootstrap_rows`], overdispersed by
+/// `phi`), each fitted back: Δ(−2 ln L) of `x` above the set's maximum, and the set's Pearson
+/// χ² there.
 fn bootstrap_sets(
     lik: &Likelihood,
     x: &[f64],
     dims: usize,
     sets: usize,
     seed: u64,
+    phi: f64,
 ) -> Vec<(f64, f64)> {
     use rayon::prelude::*;
     if dims == 0 || sets == 0 {
@@ -803,7 +912,7 @@ fn bootstrap_sets(
         .filter_map(|b| {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             rng.set_stream(b as u64);
-            let rows = bootstrap_rows(lik, x, &mut rng);
+            let rows = bootstrap_rows(lik, x, phi, &mut rng);
             let boot = Likelihood {
                 rows: &rows,
                 designs: lik.designs,
@@ -831,6 +940,7 @@ fn verdict(sets: &[(f64, f64)], chi2: f64, region: f64) -> Option<Bootstrap> {
         sets: sets.len(),
         chi2_p: (above + 1.0) / (n + 1.0),
         chi2_mean: sets.iter().map(|s| s.1).sum::<f64>() / n,
+        widened_coverage: None,
         coverage: sets.iter().filter(|s| s.0 <= region).count() as f64 / n,
     })
 }
@@ -1077,5 +1187,45 @@ mod tests {
             (mean - 3.0).abs() < 3.0 * 6f64.sqrt() / 10.0,
             "mean Δ {mean}"
         );
+    }
+
+    #[test]
+    fn overdispersed_counts_scatter_phi_times_the_multinomials() {
+        // 40,000 rows of 500 throws at p = 0.3, φ = 4: the variance of a count is φ N p(1 − p)
+        // = 420 (the multinomial's 105), its mean N p = 150; checked to 3 % (the sample
+        // variance's standard error here is 0.7 %).
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let k: Vec<f64> = (0..40000)
+            .map(|_| overdispersed(500, &[0.3, 0.7], 4.0, &mut rng)[0] as f64)
+            .collect();
+        let mean = k.iter().sum::<f64>() / k.len() as f64;
+        let var = k.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (k.len() - 1) as f64;
+        assert!((mean - 150.0).abs() < 0.5, "{mean}");
+        assert!((var / 420.0 - 1.0).abs() < 0.03, "{var}");
+        // φ = 1 is the multinomial.
+        let k1: Vec<f64> = (0..4000)
+            .map(|_| overdispersed(500, &[0.3, 0.7], 1.0, &mut rng)[0] as f64)
+            .collect();
+        let m1 = k1.iter().sum::<f64>() / k1.len() as f64;
+        let v1 = k1.iter().map(|x| (x - m1).powi(2)).sum::<f64>() / (k1.len() - 1) as f64;
+        assert!((v1 / 105.0 - 1.0).abs() < 0.07, "{v1}");
+    }
+
+    #[test]
+    fn the_overdispersion_is_the_misfits_chi2_over_the_models_own_and_one_for_a_fit() {
+        let boot = |p: f64| Bootstrap {
+            sets: 100,
+            chi2_p: p,
+            chi2_mean: 8.0,
+            coverage: 0.95,
+            widened_coverage: None,
+        };
+        assert_eq!(overdispersion(20.0, Some(&boot(0.01)), false), 2.5);
+        // A fit that fits, one without a bootstrap (a first pass), one held by its box: 1.
+        assert_eq!(overdispersion(20.0, Some(&boot(0.2)), false), 1.0);
+        assert_eq!(overdispersion(20.0, None, false), 1.0);
+        assert_eq!(overdispersion(20.0, Some(&boot(0.01)), true), 1.0);
+        // A χ² below the bootstrap's mean never narrows.
+        assert_eq!(overdispersion(4.0, Some(&boot(0.01)), false), 1.0);
     }
 }

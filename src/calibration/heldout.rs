@@ -230,13 +230,15 @@ pub fn test(row: &BlockRow, p: BlockPrediction) -> PredictedRow {
         };
     };
     let (b, w) = (c[1] as f64, c[2] as f64);
+    // A misfitting fit's counts scatter φ times the binomial's (its overdispersion).
+    let phi = p.overdispersion.max(1.0);
     let measured_ratio = (b > 0.0 && w > 0.0).then(|| {
         // Binomial: q = b/(b + w), r = q/(1 − q), Var r = q(1 − q)/(n (1 − q)⁴).
         let n = b + w;
         let q = b / n;
         Measured {
             value: b / w,
-            err: (q * (1.0 - q) / n).sqrt() / (1.0 - q).powi(2),
+            err: (phi * q * (1.0 - q) / n).sqrt() / (1.0 - q).powi(2),
         }
     });
     let z = measured_ratio
@@ -254,7 +256,7 @@ pub fn test(row: &BlockRow, p: BlockPrediction) -> PredictedRow {
             .map(|&k| {
                 let q = p.p[k].value / norm;
                 let s = p.p[k].err / norm;
-                let var = n * q + n * n * s * s;
+                let var = phi * n * q + n * n * s * s;
                 if var > 0.0 {
                     (c[k] as f64 - n * q).powi(2) / var
                 } else {
@@ -380,6 +382,7 @@ mod tests {
             rolls: 10,
             unsettled: 0,
             extrapolation: None,
+            overdispersion: 1.0,
         };
         let row = BlockRow {
             label: "a".into(),
@@ -397,6 +400,17 @@ mod tests {
         let far = test(&row, pred(0.35));
         let want = 100.0f64.powi(2) / 350.0 + 100.0f64.powi(2) / 650.0;
         assert!((far.chi2.unwrap() - want).abs() < 1e-9, "{:?}", far.chi2);
+        // From a fit that misfits with overdispersion 4, the counts scatter 4 times the
+        // binomial's: the same departure is a quarter of the χ², the ratio's z half.
+        let widened = test(
+            &row,
+            BlockPrediction {
+                overdispersion: 4.0,
+                ..pred(0.35)
+            },
+        );
+        assert!((widened.chi2.unwrap() - want / 4.0).abs() < 1e-9);
+        assert!((widened.z.unwrap() - far.z.unwrap() / 2.0).abs() < 1e-9);
         let all = collect(vec![same, far], "f".into(), "c".into());
         assert_eq!(all.dof, Some(2));
         assert!(all.p_value.unwrap() < 1e-6);

@@ -545,6 +545,7 @@ mod tests {
             islands: vec![],
             draws: vec![],
             bootstrap: None,
+            overdispersion: 1.0,
         }
     }
 

@@ -142,6 +142,15 @@ pub struct BlockPrediction {
     /// `null` inside.
     #[serde(default)]
     pub extrapolation: Option<String>,
+    /// The fit's overdispersion φ (1 for a fit that fits): its draws, so these errors, are
+    /// widened by it already, and counts measured against this prediction are taken to
+    /// scatter φ times the binomial's ([`crate::calibration::heldout::test`]).
+    #[serde(default = "one")]
+    pub overdispersion: f64,
+}
+
+fn one() -> f64 {
+    1.0
 }
 
 /// What to predict.

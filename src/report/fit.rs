@@ -1,7 +1,7 @@
 //! What a fit says: `report.md`, its figures, and a prediction's lines.
 
 use crate::calibration::check::Verdict;
-use crate::calibration::estimate::{Estimate, Identified, ParamFit, RangeEnd};
+use crate::calibration::estimate::{Estimate, Identified, ParamFit, RangeEnd, MISFIT_P};
 use crate::calibration::paper::CalibratedPaper;
 use crate::calibration::params::{FixedThrow, Kind};
 use crate::calibration::predict::{BlockPrediction, Predicted};
@@ -330,34 +330,7 @@ pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
     );
     s += &parameters(res);
     s += &passes(res);
-    let _ = writeln!(s, "\n## Goodness of fit\n");
-    let _ = writeln!(
-        s,
-        "Pearson's χ² = {:.2} on {} degrees of freedom (independent counts less free parameters), \
-         p = {}. Each count's z is (measured − N p)/σ with σ the Dirichlet-multinomial's (the \
-         binomial widened by the simulation's noise).\n",
-        e.chi2,
-        e.dof,
-        match e.p_value {
-            Some(p) => format!("{p:.3}"),
-            None => "undefined (no degrees of freedom left)".into(),
-        }
-    );
-    if let Some(b) = &e.bootstrap {
-        let _ = writeln!(s, "{}\n", bootstrap_line(b, e.chi2));
-    }
-    let _ = writeln!(s, "| row | surface | outcome | counted | fitted p | z |");
-    let _ = writeln!(s, "|---|---|---|---:|---|---:|");
-    for r in &e.rows {
-        let n: u64 = r.counts.iter().sum();
-        for (g, name) in r.outcomes.iter().enumerate() {
-            let _ = writeln!(
-                s,
-                "| {} | {} | {} | {} / {} | {:.4} ± {:.4} | {:+.2} |",
-                r.label, r.surface, name, r.counts[g], n, r.p[g], r.p_err[g], r.z[g]
-            );
-        }
-    }
+    s += &goodness_of_fit(e);
     let _ = writeln!(s, "\n## Surrogates\n");
     let _ = writeln!(
         s,
@@ -392,6 +365,44 @@ pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
         let _ = writeln!(s, "\n## Figures\n");
         for f in figures {
             let _ = writeln!(s, "![{f}]({f}.png)");
+        }
+    }
+    s
+}
+
+/// The report's goodness of fit: Pearson's χ², the bootstrap's verdict, a misfit's widening,
+/// and each row's counts against the fit.
+fn goodness_of_fit(e: &Estimate) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "\n## Goodness of fit\n");
+    let _ = writeln!(
+        s,
+        "Pearson's χ² = {:.2} on {} degrees of freedom (independent counts less free parameters), \
+         p = {}. Each count's z is (measured − N p)/σ with σ the Dirichlet-multinomial's (the \
+         binomial widened by the simulation's noise).\n",
+        e.chi2,
+        e.dof,
+        match e.p_value {
+            Some(p) => format!("{p:.3}"),
+            None => "undefined (no degrees of freedom left)".into(),
+        }
+    );
+    if let Some(b) = &e.bootstrap {
+        let _ = writeln!(s, "{}\n", bootstrap_line(b, e.chi2));
+    }
+    if let Some(line) = misfit_line(e) {
+        let _ = writeln!(s, "{line}\n");
+    }
+    let _ = writeln!(s, "| row | surface | outcome | counted | fitted p | z |");
+    let _ = writeln!(s, "|---|---|---|---:|---|---:|");
+    for r in &e.rows {
+        let n: u64 = r.counts.iter().sum();
+        for (g, name) in r.outcomes.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} / {} | {:.4} ± {:.4} | {:+.2} |",
+                r.label, r.surface, name, r.counts[g], n, r.p[g], r.p_err[g], r.z[g]
+            );
         }
     }
     s
@@ -481,6 +492,42 @@ pub fn bootstrap_line(b: &crate::calibration::estimate::Bootstrap, chi2: f64) ->
     )
 }
 
+/// What a fit that misfits says of its widening: the overdispersion, what it widens, and the
+/// widened region's coverage on data drawn with it. `None` for a fit that fits.
+pub fn misfit_line(e: &Estimate) -> Option<String> {
+    let phi = e.overdispersion;
+    if phi <= 1.0 {
+        return None;
+    }
+    let b = e.bootstrap?;
+    let (against, p) = (
+        format!("the bootstrap's mean χ² {:.2}", b.chi2_mean),
+        b.chi2_p,
+    );
+    let mut line = format!(
+        "**The model misfits** (p = {p:.3}, below {MISFIT_P}): the counts scatter more than it \
+         says, by the overdispersion φ = {phi:.2} (χ² {:.2} over {against}). Every interval \
+         above, the joint region and the posterior draws (so every prediction made from this \
+         fit) are widened by it: each bound on Δ(−2 ln L) times φ, an interval by about √φ = \
+         {:.2}. A parameter's value is then the least-bad compromise, not a measurement: what \
+         the data ask for lies outside the model.",
+        e.chi2,
+        phi.sqrt()
+    );
+    if let Some(w) = b.widened_coverage.map(|c| (c, b.sets)) {
+        let sigma = (w.0 * (1.0 - w.0) / w.1 as f64).sqrt();
+        let _ = write!(
+            line,
+            " Data sets drawn with that overdispersion and fitted back: the widened region held \
+             their values in {:.1} % ± {:.1} % of {} (stated 95.45 %).",
+            100.0 * w.0,
+            100.0 * sigma,
+            w.1
+        );
+    }
+    Some(line)
+}
+
 /// A prediction's lines for the terminal.
 pub fn prediction_text(p: &BlockPrediction) -> String {
     let mut s = String::new();
@@ -531,6 +578,14 @@ pub fn prediction_text(p: &BlockPrediction) -> String {
     }
     if let Some(x) = &p.extrapolation {
         let _ = writeln!(s, "  an extrapolation: {x}");
+    }
+    if p.overdispersion > 1.0 {
+        let _ = writeln!(
+            s,
+            "  the fit misfits: its errors widened by its overdispersion φ = {:.2}, and counts \
+             measured against this taken to scatter φ times the binomial's",
+            p.overdispersion
+        );
     }
     s
 }
@@ -903,6 +958,18 @@ pub fn predictions_markdown(p: &crate::calibration::heldout::Predictions, stem: 
              freedom{} (each count's variance the multinomial's widened by the prediction's \
              error).",
             p.p_value.map_or(String::new(), |v| format!(", p = {v:.3}"))
+        );
+    }
+    if let Some(phi) = p
+        .rows
+        .first()
+        .map(|r| r.prediction.overdispersion)
+        .filter(|&v| v > 1.0)
+    {
+        let _ = writeln!(
+            s,
+            "\nThe fit misfits: its overdispersion φ = {phi:.2} widens every prediction above, and \
+             each measured count's variance is taken φ times the multinomial's."
         );
     }
     let far: Vec<String> = p

@@ -537,3 +537,70 @@ fn a_parameter_at_its_ranges_end_is_reported_as_the_model_asking_for_more() {
         "{md}"
     );
 }
+
+#[test]
+fn a_misfit_is_widened_by_its_overdispersion_and_a_fit_that_fits_is_not() {
+    // Issue 49: three rows on one surface, their counts rolled at e = 0.5 (dt = 1/250); in the
+    // second file two rows of the same block disagree (breadth 1,590 of 3,000 against 1,358):
+    // no e fits both. There the bootstrap's p is below 0.05, the overdispersion φ is the
+    // data's χ² over the bootstrap's mean, every bound is φ times the Bartlett's, the 2σ
+    // interval is wider than the profile's own Δ = 4b, and data drawn with φ check it.
+    let dir = Scratch::new("fit-misfit");
+    let fit = |name: &str, rows: &str| {
+        let csv = dir.join(name);
+        std::fs::write(&csv, format!("{HEAD}{rows}")).unwrap();
+        let out = dir.join(format!("{name}-out"));
+        json(&dicephys(&[
+            "fit",
+            "--data",
+            csv.to_str().unwrap(),
+            "--free",
+            "e",
+            "--points",
+            "16",
+            "--degree",
+            "2",
+            "--rolls",
+            "1500",
+            "--dt",
+            "1/250",
+            "--no-refine",
+            "--out",
+            out.to_str().unwrap(),
+            "--json",
+        ]))
+    };
+    let a = "a,felt,140,24,20,3d,1,1088,1911\n";
+    let fits = fit(
+        "fits.csv",
+        &format!("{a}b,felt,100,43.9,43.2,3d,29,1470,1501\nc,felt,100,43.9,43.2,3d,22,1418,1560\n"),
+    );
+    let e = &fits["estimate"];
+    assert_eq!(e["overdispersion"], 1.0, "{e}");
+    assert!(e["bootstrap"].get("widened_coverage").is_none(), "{e}");
+
+    let misfit = fit(
+        "misfit.csv",
+        &format!("{a}b,felt,100,43.9,43.2,3d,29,1590,1381\nc,felt,100,43.9,43.2,3d,22,1358,1620\n"),
+    );
+    let e = &misfit["estimate"];
+    let boot = &e["bootstrap"];
+    let f = |v: &serde_json::Value| v.as_f64().unwrap();
+    let (phi, b) = (f(&e["overdispersion"]), f(&e["bartlett"]));
+    assert!(f(&boot["chi2_p"]) < 0.05, "{e}");
+    assert!(
+        (phi - f(&e["chi2"]) / f(&boot["chi2_mean"])).abs() < 1e-9 && phi > 2.0,
+        "{e}"
+    );
+    assert!((f(&e["region_delta"]) - 4.0 * b * phi).abs() < 1e-6, "{e}");
+    assert!(f(&boot["widened_coverage"]) >= 0.9, "{e}");
+    let p = &e["params"][0];
+    let unwidened_lo = p["profile"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|q| f(&q[1]) <= 4.0 * b)
+        .map(|q| f(&q[0]))
+        .fold(f64::INFINITY, f64::min);
+    assert!(f(&p["two_sigma"][0]) < unwidened_lo - 0.02, "{p}");
+}

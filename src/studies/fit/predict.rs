@@ -213,6 +213,7 @@ pub fn predict_block(
         draws: cfg.draws,
         rolls: cfg.rolls,
         unsettled,
+        overdispersion: fit.estimate.overdispersion,
         extrapolation: if shape.is_some() {
             None
         } else {
