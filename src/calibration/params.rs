@@ -1,8 +1,9 @@
 //! What a fit varies: the contact's restitution e and friction μ (per surface, or shared by
-//! all), and the throw's concentration κ and spin scale (per thrower), each within a range,
-//! each mapped onto a unit coordinate in which the surrogate and the search work.
+//! all), and the throw's concentration κ and its spin, launch height and launch speed scales
+//! (per thrower), each within a range, each mapped onto a unit coordinate in which the
+//! surrogate and the search work.
 //!
-//! Coordinates: e and μ linearly; the spin scale logarithmically; κ as log₁₀(1 + κ), which
+//! Coordinates: e and μ linearly; the spin, height and speed scales logarithmically; κ as log₁₀(1 + κ), which
 //! runs from the tumble (κ = 0) through the hand's throws to nearly the paper's (κ = 10⁴: its
 //! angles' spread is about 1/√κ ≈ 0.6°). The paper's throw itself, κ → ∞, is not a point of
 //! that range but a model of its own (κ fixed: `--kappa paper`): measured, the outcomes jump
@@ -49,6 +50,12 @@ pub enum Kind {
     Kappa,
     /// A factor on the paper's spin range, 31 to 160 rad/s (per thrower).
     Spin,
+    /// A factor on the paper's launch height, 0.2 to 0.4 m above the die's longest side (per
+    /// thrower): below 1 a lower throw, landing slower.
+    Height,
+    /// A factor on the paper's launch speed, −0.2 to 0.2 m/s along the table (per thrower):
+    /// above 1 a faster throw, sliding and rolling further.
+    Speed,
     /// The die's centre of mass along its x (breadth) axis, mm from the geometric centre (one
     /// die for every row).
     ComX,
@@ -62,23 +69,27 @@ pub enum Kind {
 
 impl Kind {
     /// Every kind, in the order a row's coordinates take them.
-    pub const ALL: [Kind; 8] = [
+    pub const ALL: [Kind; 10] = [
         Kind::E,
         Kind::Mu,
         Kind::Kappa,
         Kind::Spin,
+        Kind::Height,
+        Kind::Speed,
         Kind::ComX,
         Kind::ComY,
         Kind::ComZ,
         Kind::PipDepth,
     ];
 
-    /// "e", "mu", "kappa", "spin", "com_x", "com_y", "com_z" or "pip_depth".
+    /// "e", "mu", "kappa", "spin", "height", "speed", "com_x", "com_y", "com_z" or
+    /// "pip_depth".
     pub fn name(self) -> &'static str {
         self.into()
     }
 
-    /// True for the surface's parameters (e, μ); false for the throw's (κ, spin).
+    /// True for the surface's parameters (e, μ); false for the throw's (κ, spin, height,
+    /// speed).
     pub fn of_surface(self) -> bool {
         matches!(self, Kind::E | Kind::Mu)
     }
@@ -90,7 +101,8 @@ impl Kind {
     }
 
     /// The widest range accepted: e in [0, 1], μ in [0, 5], κ in [0, 10⁶], spin scale in
-    /// [0.05, 20], a centre of mass within ±1000 mm (the die's own sides bound it further:
+    /// [0.05, 20], height scale in [0.05, 10] (a drop of 1 to 4 cm up to 2 to 4 m), speed scale
+    /// in [0.05, 50] (up to ±10 m/s), a centre of mass within ±1000 mm (the die's own sides bound it further:
     /// checked with the die), a pip depth in [0.001, 100] mm.
     pub fn limits(self) -> (f64, f64) {
         match self {
@@ -98,6 +110,8 @@ impl Kind {
             Kind::Mu => (0.0, 5.0),
             Kind::Kappa => (0.0, MAX_KAPPA),
             Kind::Spin => (0.05, 20.0),
+            Kind::Height => (0.05, 10.0),
+            Kind::Speed => (0.05, 50.0),
             Kind::ComX | Kind::ComY | Kind::ComZ => (-1000.0, 1000.0),
             Kind::PipDepth => (0.001, 100.0),
         }
@@ -112,6 +126,10 @@ impl Kind {
             Kind::Mu => Range::new(0.1, 1.0),
             Kind::Kappa => Range::new(0.0, 1e4),
             Kind::Spin => Range::new(0.5, 2.0),
+            // From a quarter of the paper's drop (5 to 10 cm) to twice it.
+            Kind::Height => Range::new(0.25, 2.0),
+            // From a quarter of the paper's speed along the table to ten times it (±2 m/s).
+            Kind::Speed => Range::new(0.25, 10.0),
             // A hidden weight of a few percent of a 16 mm die's mass moves its centre by about a
             // millimetre (docs/results/dice.md: 0.25 mm is seen in ~5,000 throws).
             Kind::ComX | Kind::ComY | Kind::ComZ => Range::new(-2.0, 2.0),
@@ -123,7 +141,7 @@ impl Kind {
         match self {
             Kind::E | Kind::Mu | Kind::ComX | Kind::ComY | Kind::ComZ | Kind::PipDepth => v,
             Kind::Kappa => (1.0 + v).log10(),
-            Kind::Spin => v.ln(),
+            Kind::Spin | Kind::Height | Kind::Speed => v.ln(),
         }
     }
 
@@ -131,7 +149,7 @@ impl Kind {
         match self {
             Kind::E | Kind::Mu | Kind::ComX | Kind::ComY | Kind::ComZ | Kind::PipDepth => w,
             Kind::Kappa => 10f64.powf(w) - 1.0,
-            Kind::Spin => w.exp(),
+            Kind::Spin | Kind::Height | Kind::Speed => w.exp(),
         }
     }
 
@@ -176,6 +194,12 @@ pub struct Fixed {
     pub throw: FixedThrow,
     /// The spin scale.
     pub spin: f64,
+    /// The launch height's scale (1: the paper's 0.2 to 0.4 m).
+    #[serde(default = "unit", skip_serializing_if = "is_unit")]
+    pub height: f64,
+    /// The launch speed's scale (1: the paper's ±0.2 m/s).
+    #[serde(default = "unit", skip_serializing_if = "is_unit")]
+    pub speed: f64,
     /// The die's centre of mass where a fit frees it, mm, per body axis (`None`: the die's
     /// own, as its description gives it).
     #[serde(default, skip_serializing_if = "is_none3")]
@@ -183,6 +207,14 @@ pub struct Fixed {
     /// The die's pips' depth where a fit frees it, mm (`None`: the die's own).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pip_depth: Option<f64>,
+}
+
+fn unit() -> f64 {
+    1.0
+}
+
+fn is_unit(v: &f64) -> bool {
+    *v == 1.0
 }
 
 fn is_none3(c: &[Option<f64>; 3]) -> bool {
@@ -197,6 +229,8 @@ impl Default for Fixed {
             mu: 0.29,
             throw: FixedThrow::Paper,
             spin: 1.0,
+            height: 1.0,
+            speed: 1.0,
             com: [None; 3],
             pip_depth: None,
         }
@@ -241,6 +275,8 @@ pub fn values(fixed: &Fixed, axes: &[(Kind, Range)], x: &[f64]) -> Fixed {
             Kind::Mu => v.mu = value,
             Kind::Kappa => v.throw = FixedThrow::Hand(value),
             Kind::Spin => v.spin = value,
+            Kind::Height => v.height = value,
+            Kind::Speed => v.speed = value,
             Kind::ComX => v.com[0] = Some(value),
             Kind::ComY => v.com[1] = Some(value),
             Kind::ComZ => v.com[2] = Some(value),
@@ -312,7 +348,13 @@ impl ModelSpec {
             }
         }
         let f = self.fixed;
-        for (k, v) in [(Kind::E, f.e), (Kind::Mu, f.mu), (Kind::Spin, f.spin)] {
+        for (k, v) in [
+            (Kind::E, f.e),
+            (Kind::Mu, f.mu),
+            (Kind::Spin, f.spin),
+            (Kind::Height, f.height),
+            (Kind::Speed, f.speed),
+        ] {
             let (lo, hi) = k.limits();
             if !(v >= lo && v <= hi) {
                 return bad(format!("{k} {v}: must be in [{lo}, {hi}]"));
@@ -501,8 +543,11 @@ impl Method {
             FixedThrow::Hand(k) => ThrowSpec::hand(seed, k),
             FixedThrow::Tumble => ThrowSpec::keyed_style(seed, ThrowStyle::Tumble),
         };
-        let paper = ThrowRanges::default().spin;
-        throws.ranges.spin = Range::new(paper.lo * v.spin, paper.hi * v.spin);
+        let paper = ThrowRanges::default();
+        let scaled = |r: Range, k: f64| Range::new(r.lo * k, r.hi * k);
+        throws.ranges.spin = scaled(paper.spin, v.spin);
+        throws.ranges.drop_height = scaled(paper.drop_height, v.height);
+        throws.ranges.velocity = scaled(paper.velocity, v.speed);
         RunSpec {
             engine: self.engine,
             scene,
@@ -558,5 +603,51 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("range of e"));
+    }
+
+    #[test]
+    fn the_throws_height_and_speed_scale_its_launch_as_spin_scales_its_spin() {
+        // Issue 49: a thrower who throws lower or faster. Free, they are per thrower, searched
+        // logarithmically, and each scales its range of the paper's throw.
+        let rows = crate::calibration::data::paper_rows().unwrap();
+        let m = ModelSpec::free(&[Kind::E, Kind::Height, Kind::Speed]);
+        m.validate().unwrap();
+        let names: Vec<String> = m.params(&rows).iter().map(Param::name).collect();
+        assert!(names.contains(&"height[all]".to_string()), "{names:?}");
+        assert!(names.contains(&"speed[all]".to_string()), "{names:?}");
+        let r = Kind::Height.default_range();
+        assert!((Kind::Height.value(r, 0.5) - (0.25f64 * 2.0).sqrt()).abs() < 1e-12);
+        let axes = [
+            (Kind::Height, Kind::Height.default_range()),
+            (Kind::Speed, Kind::Speed.default_range()),
+        ];
+        let v = values(&Fixed::default(), &axes, &[0.0, 1.0]);
+        assert_eq!((v.height, v.speed), (0.25, 10.0));
+        let method = Method {
+            engine: EngineKind::Bullet,
+            dt: 1e-3,
+            max_steps: 1000,
+            die: Default::default(),
+            density: None,
+            shape: None,
+        };
+        let block = Block::from_mm(140.0, 24.0, 20.0).unwrap();
+        let spec = method.spec(block, Mode::ThreeD, &v, 1, 10);
+        let (h, u) = (spec.throws.ranges.drop_height, spec.throws.ranges.velocity);
+        assert!(
+            (h.lo - 0.05).abs() < 1e-12 && (h.hi - 0.1).abs() < 1e-12,
+            "{h}"
+        );
+        assert!(
+            (u.lo + 2.0).abs() < 1e-12 && (u.hi - 2.0).abs() < 1e-12,
+            "{u}"
+        );
+        // At the paper's (1, 1) the throw is the paper's, and a fit.json without them reads so.
+        let paper = method.spec(block, Mode::ThreeD, &Fixed::default(), 1, 10);
+        assert_eq!(paper.throws.ranges, ThrowRanges::default());
+        let old: Fixed =
+            serde_json::from_str(r#"{"e":0.5,"mu":0.29,"spin":1.0,"throw":"paper"}"#).unwrap();
+        assert_eq!(old, Fixed::default());
+        assert!(!serde_json::to_string(&old).unwrap().contains("height"));
     }
 }
