@@ -27,6 +27,25 @@ fn two_blocks(dir: &Scratch) -> String {
     path.display().to_string()
 }
 
+/// `fit --free e` of `csv` into `out`, one pass at dt = 1/250 with `design` (its points,
+/// rolls, degree, range): its JSON.
+fn fit_e(csv: &str, out: &std::path::Path, design: &[&str]) -> serde_json::Value {
+    let head = [
+        "fit",
+        "--data",
+        csv,
+        "--free",
+        "e",
+        "--dt",
+        "1/250",
+        "--no-refine",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ];
+    json(&dicephys(&[&head[..], design].concat()))
+}
+
 #[test]
 fn the_fit_recovers_known_parameters_in_its_2_sigma_region() {
     // 20 fixed-seed repetitions: counts simulated at e = 0.5, μ = 0.3, κ = 30 in the shape of
@@ -304,27 +323,20 @@ fn predict_blocks_tests_held_out_counts_in_one_command() {
     )
     .unwrap();
     let out = dir.join("fit");
-    json(&dicephys(&[
-        "fit",
-        "--data",
+    fit_e(
         csv.to_str().unwrap(),
-        "--free",
-        "e",
-        "--points",
-        "8",
-        "--degree",
-        "2",
-        "--max-degree",
-        "2",
-        "--rolls",
-        "100",
-        "--dt",
-        "1/250",
-        "--no-refine",
-        "--out",
-        out.to_str().unwrap(),
-        "--json",
-    ]));
+        &out,
+        &[
+            "--points",
+            "8",
+            "--degree",
+            "2",
+            "--max-degree",
+            "2",
+            "--rolls",
+            "100",
+        ],
+    );
     let blocks = dir.join("blocks.csv");
     std::fs::write(
         &blocks,
@@ -507,27 +519,20 @@ fn a_parameter_at_its_ranges_end_is_reported_as_the_model_asking_for_more() {
     let dir = Scratch::new("fit-range-end");
     let csv = two_blocks(&dir);
     let out = dir.join("out");
-    let v = json(&dicephys(&[
-        "fit",
-        "--data",
+    let v = fit_e(
         &csv,
-        "--free",
-        "e",
-        "--range",
-        "e=0.05:0.1",
-        "--points",
-        "12",
-        "--degree",
-        "2",
-        "--rolls",
-        "100",
-        "--dt",
-        "1/250",
-        "--no-refine",
-        "--out",
-        out.to_str().unwrap(),
-        "--json",
-    ]));
+        &out,
+        &[
+            "--range",
+            "e=0.05:0.1",
+            "--points",
+            "12",
+            "--degree",
+            "2",
+            "--rolls",
+            "100",
+        ],
+    );
     let p = &v["estimate"]["params"][0];
     assert_eq!(p["asks_for_more"], "upper", "{p}");
     assert_eq!(p["value"], 0.1, "{p}");
@@ -550,25 +555,8 @@ fn a_misfit_is_widened_by_its_overdispersion_and_a_fit_that_fits_is_not() {
         let csv = dir.join(name);
         std::fs::write(&csv, format!("{HEAD}{rows}")).unwrap();
         let out = dir.join(format!("{name}-out"));
-        json(&dicephys(&[
-            "fit",
-            "--data",
-            csv.to_str().unwrap(),
-            "--free",
-            "e",
-            "--points",
-            "16",
-            "--degree",
-            "2",
-            "--rolls",
-            "1500",
-            "--dt",
-            "1/250",
-            "--no-refine",
-            "--out",
-            out.to_str().unwrap(),
-            "--json",
-        ]))
+        let design = ["--points", "16", "--degree", "2", "--rolls", "1500"];
+        fit_e(csv.to_str().unwrap(), &out, &design)
     };
     let a = "a,felt,140,24,20,3d,1,1088,1911\n";
     let fits = fit(
