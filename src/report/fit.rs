@@ -500,18 +500,17 @@ pub fn misfit_line(e: &Estimate) -> Option<String> {
         return None;
     }
     let b = e.bootstrap?;
-    let (against, p) = (
-        format!("the bootstrap's mean χ² {:.2}", b.chi2_mean),
-        b.chi2_p,
-    );
     let mut line = format!(
-        "**The model misfits** (p = {p:.3}, below {MISFIT_P}): the counts scatter more than it \
-         says, by the overdispersion φ = {phi:.2} (χ² {:.2} over {against}). Every interval \
+        "**The model misfits** (p = {:.3}, below {MISFIT_P}): the counts scatter more than it \
+         says, by the overdispersion φ = {phi:.2} (χ² {:.2} over the bootstrap's mean χ² {:.2}). \
+         Every interval \
          above, the joint region and the posterior draws (so every prediction made from this \
          fit) are widened by it: each bound on Δ(−2 ln L) times φ, an interval by about √φ = \
          {:.2}. A parameter's value is then the least-bad compromise, not a measurement: what \
          the data ask for lies outside the model.",
+        b.chi2_p,
         e.chi2,
+        b.chi2_mean,
         phi.sqrt()
     );
     if let Some(w) = b.widened_coverage.map(|c| (c, b.sets)) {
