@@ -184,6 +184,10 @@ pub struct Design {
     pub faces: bool,
     /// Each point and its counts of length, breadth and width vertical (or of faces 1 to 6).
     pub points: Vec<DesignPoint>,
+    /// The points of earlier passes' designs of the same block that lie inside this one's box,
+    /// in its unit coordinates ([`borrowed`]): the surrogate is fitted through them as well.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub borrowed: Vec<DesignPoint>,
     /// Rolls that did not settle on a face (unknown, unconverged or failed), over all points.
     pub unsettled: u64,
     /// Rolls made.
@@ -197,6 +201,42 @@ impl Design {
     pub fn name(&self) -> String {
         format!("{} {}", self.block, self.mode.name())
     }
+}
+
+/// The points of the `earlier` designs of `d`'s block, mode and outcomes, over the same kinds,
+/// that lie inside `d`'s box, in `d`'s unit coordinates. Each earlier box is counted once (a
+/// design a later pass kept is the same rolls), and `d`'s own box not at all. Every point was
+/// rolled on throws of its own (its seed a hash of its box and index), so the borrowed counts
+/// are independent of `d`'s: a surrogate through both has all the rolls of a fit's passes in
+/// the region, and the estimate is less a property of the box the last pass drew.
+pub fn borrowed(d: &Design, earlier: &[Design]) -> Vec<DesignPoint> {
+    let same_kinds = |e: &Design| {
+        e.axes.len() == d.axes.len() && e.axes.iter().zip(&d.axes).all(|(a, b)| a.0 == b.0)
+    };
+    let mut seen: Vec<&Axes> = vec![&d.axes];
+    let mut out = Vec::new();
+    for e in earlier {
+        let same = e.block == d.block && e.mode == d.mode && e.faces == d.faces;
+        if !same || !same_kinds(e) || seen.contains(&&e.axes) {
+            continue;
+        }
+        seen.push(&e.axes);
+        for p in &e.points {
+            let x: Vec<f64> =
+                p.x.iter()
+                    .zip(e.axes.iter().zip(&d.axes))
+                    .map(|(&u, ((kind, from), (_, to)))| kind.coordinate(*to, kind.value(*from, u)))
+                    .collect();
+            // Inside, to the rounding of the round trip through the physical value.
+            if x.iter().all(|&u| (-1e-9..=1.0 + 1e-9).contains(&u)) {
+                out.push(DesignPoint {
+                    x: x.iter().map(|u| u.clamp(0.0, 1.0)).collect(),
+                    counts: p.counts.clone(),
+                });
+            }
+        }
+    }
+    out
 }
 
 /// What one design simulates: a block, a mode, and its axes.
@@ -294,6 +334,7 @@ pub fn three(p: &[f64], mode: Mode) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::throws::Range;
 
     #[test]
     fn the_design_starts_at_the_corners_and_fills_the_box() {
@@ -321,5 +362,53 @@ mod tests {
             point_seed(1, b, Mode::ThreeD, 0),
             point_seed(1, b, Mode::TwoD, 0)
         );
+    }
+
+    /// A design over e and κ with `x` its points' unit coordinates, each counted (1, 2, 3).
+    fn design(block: &str, e: (f64, f64), kappa: (f64, f64), xs: &[[f64; 2]]) -> Design {
+        use crate::calibration::params::Kind;
+        let points: Vec<DesignPoint> = xs
+            .iter()
+            .map(|x| DesignPoint {
+                x: x.to_vec(),
+                counts: vec![1, 2, 3],
+            })
+            .collect();
+        Design {
+            block: block.parse().unwrap(),
+            mode: Mode::ThreeD,
+            axes: vec![
+                (Kind::E, Range::new(e.0, e.1)),
+                (Kind::Kappa, Range::new(kappa.0, kappa.1)),
+            ],
+            faces: false,
+            surrogate: Surrogate::fit(&points, 2, 3, 1),
+            points,
+            borrowed: vec![],
+            unsettled: 0,
+            rolls: 6 * xs.len() as u64,
+        }
+    }
+
+    #[test]
+    fn a_pass_borrows_the_earlier_points_inside_its_box_once_in_its_own_coordinates() {
+        use crate::calibration::params::Kind;
+        // The later box: e 0.3–0.5, κ 0–99 (κ is warped: log₁₀(1 + κ), so 9 is its middle).
+        let d = design("140x24x20", (0.3, 0.5), (0.0, 99.0), &[[0.0, 0.0]]);
+        // The whole range's design: e 0.05 + 0.75 u. Inside at u = 1/3 (e 0.3) and 0.4 (e 0.35)
+        // with κ 9 (its unit coordinate 0.25 on 0–9999); out at e 0.8 and at κ 9999.
+        let k9 = Kind::Kappa.coordinate(Range::new(0.0, 9999.0), 9.0);
+        let whole = [[1.0 / 3.0, k9], [0.4, k9], [1.0, k9], [0.4, 1.0]];
+        let first = design("140x24x20", (0.05, 0.8), (0.0, 9999.0), &whole);
+        // The same box again (a pass that kept it), another block, and `d` itself add nothing.
+        let other = design("100x24x20", (0.05, 0.8), (0.0, 9999.0), &whole);
+        let got = borrowed(&d, &[first.clone(), first.clone(), other, d.clone()]);
+        assert_eq!(got.len(), 2, "{got:?}");
+        assert!(
+            got[0].x[0].abs() < 1e-9 && (got[0].x[1] - 0.5).abs() < 1e-9,
+            "{got:?}"
+        );
+        assert!((got[1].x[0] - 0.25).abs() < 1e-9, "{got:?}");
+        assert_eq!(got[1].counts, vec![1, 2, 3]);
     }
 }

@@ -1083,6 +1083,7 @@ mod tests {
             axes: vec![(Kind::E, Kind::E.default_range())],
             surrogate: Surrogate::fit_best(&pts, 1, 3, 4, 6),
             points: pts,
+            borrowed: vec![],
             unsettled: 0,
             rolls: 24 * 10_000_000,
         }];
@@ -1157,6 +1158,7 @@ mod tests {
                     .collect(),
                 surrogate: Surrogate::fit_best(&pts, 3, 3, 3, 4),
                 points: pts,
+                borrowed: vec![],
                 unsettled: 0,
                 rolls: 64 * 500,
             });

@@ -238,10 +238,15 @@ pub struct FitResult {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub first_pass: Option<Vec<estimate::ParamFit>>,
     /// Every pass, in order: the first over the whole ranges, a second over the box narrowed
-    /// from it, and any that widened a box that cut a parameter (a fit.json from before passes
-    /// were recorded has none).
+    /// from it, and any that widened a box that cut a parameter or tightened one looser than
+    /// its region (a fit.json from before passes were recorded has none).
     #[serde(default)]
     pub passes: Vec<Pass>,
+    /// Why the passes did not settle, if they did not: after the last pass, a box still cutting
+    /// a parameter or still looser than its region (the estimate is then where the passes
+    /// stopped, not an answer).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unresolved: Option<String>,
     /// The blocks simulated, with their surrogates.
     pub designs: Vec<Design>,
     /// The estimate.
@@ -268,13 +273,20 @@ pub struct Pass {
     pub rolls: u64,
     /// The parameters whose maximum or 2σ interval reached a face of this pass's box that is
     /// not their range's own (the next pass widened them there; the last pass's, after
-    /// [`MAX_WIDENINGS`], were left cut).
+    /// [`MAX_MORE_PASSES`], were left cut).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub cut: Vec<Cut>,
+    /// Each parameter's maximum in this pass, in the order of `bounds` (empty in a fit.json
+    /// written before passes recorded their estimates).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub values: Vec<f64>,
+    /// Each parameter's 1σ profile interval in this pass.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub one_sigma: Vec<[f64; 2]>,
 }
 
 impl Pass {
-    /// A pass over `params`' ranges that rolled `rolls`, nothing cut (yet).
+    /// A pass over `params`' ranges that rolled `rolls`, nothing cut (yet), no estimate.
     pub fn over(params: &[Param], rolls: u64) -> Pass {
         Pass {
             bounds: params
@@ -286,6 +298,17 @@ impl Pass {
                 .collect(),
             rolls,
             cut: vec![],
+            values: vec![],
+            one_sigma: vec![],
+        }
+    }
+
+    /// [`Pass::over`], with the estimate `est` made over its box.
+    pub fn of(params: &[Param], est: &Estimate, rolls: u64) -> Pass {
+        Pass {
+            values: est.params.iter().map(|p| p.value).collect(),
+            one_sigma: est.params.iter().map(|p| p.one_sigma).collect(),
+            ..Pass::over(params, rolls)
         }
     }
 }
@@ -301,14 +324,14 @@ pub struct Cut {
     pub upper: bool,
 }
 
-/// Passes after the second at most, each widening the boxes that cut a parameter. In unit
-/// coordinates of the range, [`widen`] moves a cut face out by the old box's width plus at
-/// least 0.05, and the box grows by at least 0.1 a pass (unless it reaches an end of the
-/// range); so four passes move a cut face by at least 0.8 plus four times the second pass's
-/// box width (at least 0.05 wide as [`narrow`] draws it), which takes it to the range's end:
-/// a region that lies off one face is met within four. One that jumps from face to face (a
-/// surrogate too poor to place it) may not be; the fit then says it is still cut.
-pub const MAX_WIDENINGS: usize = 4;
+/// Passes after the second at most, each widening a box that cut a parameter or tightening
+/// one looser than its region asks ([`tighten`]). In unit coordinates of the range, [`widen`] moves a cut face out by the old box's width plus at
+/// least 0.05, and the box grows by at least 0.1 a pass (unless it reaches an end of the range); so four passes move a cut face by
+/// at least 0.8 plus four times the second pass's box width (at least 0.05 wide as [`narrow`]
+/// draws it), which takes it to the range's end: a region that lies off one face is met within
+/// four. One that jumps from face to face (a surrogate too poor to place it) may not be; the
+/// fit then says it is unresolved, and why.
+pub const MAX_MORE_PASSES: usize = 4;
 
 /// How close, in a box's unit coordinate, a maximum or an interval's end must come to a face
 /// to be on it (the search clamps to the faces, and an open side of a profile interval ends on
@@ -348,7 +371,7 @@ pub fn cuts(est: &Estimate) -> Vec<Cut> {
 /// maximum: the box is recentred on it), pushed out on each cut side by the old box's width
 /// as well: past a cut face the region's end is unseen, so the next pass looks as far again
 /// beyond it as the box spanned, and each pass reaches further than the last (the bound is at
-/// [`MAX_WIDENINGS`]) until the range's own end stops it. A box that then covers 80 % of the
+/// [`MAX_MORE_PASSES`]) until the range's own end stops it. A box that then covers 80 % of the
 /// range takes it all, as in [`narrow`].
 pub fn widen(model: &ModelSpec, est: &Estimate, cut: &[Cut]) -> Vec<params::Narrowed> {
     let mut out = model.narrowed.clone();
@@ -375,6 +398,71 @@ pub fn widen(model: &ModelSpec, est: &Estimate, cut: &[Cut]) -> Vec<params::Narr
     out
 }
 
+/// The box drawn around a 2σ interval from `lo` to `hi` (unit coordinates of a range): the
+/// interval widened by half its width on each side, and by at least 0.05, within the range;
+/// `None` where that covers 80 % of the range, which then keeps it all.
+fn around(lo: f64, hi: f64) -> Option<(f64, f64)> {
+    let pad = (0.5 * (hi - lo)).max(0.05);
+    let (a, b) = ((lo - pad).max(0.0), (hi + pad).min(1.0));
+    (b - a < 0.8).then_some((a, b))
+}
+
+/// How many rows inform each of `params` (a parameter only one row of several informs is not
+/// narrowed: [`narrow`]).
+fn uses(rows: &[DataRow], model: &ModelSpec, params: &[Param]) -> Vec<usize> {
+    let mut uses = vec![0usize; params.len()];
+    for r in rows {
+        for d in model.row_dims(params, r) {
+            uses[d] += 1;
+        }
+    }
+    uses
+}
+
+/// How much wider a box may be than the one [`around`] draws from its own pass's 2σ interval
+/// before the next pass tightens it. A surrogate is a polynomial over its box, least biased
+/// where the box is about the region: counts rolled in a tumble (80,000 on eight blocks),
+/// fitted for e, μ and κ from three first boxes at three seeds, put μ at 0.308 ± 0.063 (the nine
+/// estimates' standard deviation, against a median 1σ of 0.027) when the passes stopped at the
+/// first box that cut nothing, and at 0.281 ± 0.020 (1σ 0.019) with the boxes tightened, for
+/// 1.8 times the rolls (docs/results/calibration.md).
+pub const LOOSE: f64 = 1.5;
+
+/// The next pass's box after `est`, whose box cut nothing: a parameter whose box is more than
+/// [`LOOSE`] times as wide (on its whole range) as the one [`around`] draws from its 2σ interval
+/// gets that box, recentred on the region; every other keeps its range exactly, so the designs
+/// it alone touches are not rolled again. The same box as `model`'s means the passes have
+/// settled: the box holds the region, and is no looser than the region asks.
+pub fn tighten(rows: &[DataRow], model: &ModelSpec, est: &Estimate) -> Vec<params::Narrowed> {
+    let params: Vec<Param> = est.params.iter().map(|f| f.param.clone()).collect();
+    let uses = uses(rows, model, &params);
+    let mut out = model.narrowed.clone();
+    for (fit, &n) in est.params.iter().zip(&uses) {
+        let p = &fit.param;
+        if n < 2 && rows.len() > 1 {
+            continue;
+        }
+        let w = |v: f64| p.kind.coordinate(p.whole, v).clamp(0.0, 1.0);
+        let Some((a, b)) = around(w(fit.two_sigma[0]), w(fit.two_sigma[1])) else {
+            continue;
+        };
+        if w(p.range.hi) - w(p.range.lo) <= LOOSE * (b - a) {
+            continue;
+        }
+        out.retain(|x| x.param != fit.name);
+        out.push(params::Narrowed {
+            param: fit.name.clone(),
+            range: sub_range(p.kind, p.whole, a, b),
+        });
+    }
+    out
+}
+
+/// True if `a` and `b` narrow the same parameters to the same ranges, in any order.
+pub fn same_box(a: &[params::Narrowed], b: &[params::Narrowed]) -> bool {
+    a.len() == b.len() && a.iter().all(|x| b.contains(x))
+}
+
 /// The second pass's box: each parameter's first-pass 2σ profile interval, widened by half its
 /// width on each side (and to at least a tenth of its range), within its range. A parameter
 /// whose widened interval still covers 80 % of its range keeps the whole range, and so does one
@@ -389,24 +477,16 @@ pub fn narrow(
     params: &[Param],
     first: &Estimate,
 ) -> Vec<params::Narrowed> {
-    let mut uses = vec![0usize; params.len()];
-    for r in rows {
-        for d in model.row_dims(params, r) {
-            uses[d] += 1;
-        }
-    }
+    let uses = uses(rows, model, params);
     let mut out = Vec::new();
     for ((p, fit), &n) in params.iter().zip(&first.params).zip(&uses) {
         if n < 2 && rows.len() > 1 {
             continue;
         }
         let u = |v: f64| p.kind.coordinate(p.range, v).clamp(0.0, 1.0);
-        let (lo, hi) = (u(fit.two_sigma[0]), u(fit.two_sigma[1]));
-        let pad = (0.5 * (hi - lo)).max(0.05);
-        let (a, b) = ((lo - pad).max(0.0), (hi + pad).min(1.0));
-        if b - a >= 0.8 {
+        let Some((a, b)) = around(u(fit.two_sigma[0]), u(fit.two_sigma[1])) else {
             continue;
-        }
+        };
         out.push(params::Narrowed {
             param: p.name(),
             range: sub_range(p.kind, p.range, a, b),

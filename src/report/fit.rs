@@ -6,7 +6,7 @@ use crate::calibration::paper::CalibratedPaper;
 use crate::calibration::params::{FixedThrow, Kind};
 use crate::calibration::predict::{BlockPrediction, Predicted};
 use crate::calibration::recovery::Recovery;
-use crate::calibration::{FitResult, MAX_WIDENINGS};
+use crate::calibration::{FitResult, LOOSE, MAX_MORE_PASSES};
 use crate::error::Result;
 use crate::report::figures::fit::{self as fig, Profile, RowRatio};
 use crate::report::figures::Point;
@@ -128,7 +128,7 @@ fn parameters(res: &FitResult) -> String {
             _ if p.asks_for_more.is_some() => asks_for_more(p),
             Identified::Cut if res.passes.len() > 2 => format!(
                 "still cut: its maximum or 2σ region reaches an edge of the last pass's narrowed \
-                 box, after {} widenings; the value is that box's, not the data's",
+                 box, after {} more passes; the value is that box's, not the data's",
                 res.passes.len() - 2
             ),
             // At the range's own end, not a box's: the range asked for bounds it.
@@ -232,8 +232,8 @@ pub fn maxima_text(e: &Estimate) -> String {
     s
 }
 
-/// The passes a refined fit took: each one's box and rolls, the parameters its box cut, and,
-/// if the last one still cuts some, what to do (nothing for a fit of one pass).
+/// The passes a refined fit took: each one's box, rolls and estimate, the parameters its box
+/// cut, and whether they settled (nothing for a fit of one pass).
 fn passes(res: &FitResult) -> String {
     let mut s = String::new();
     if res.passes.len() < 2 {
@@ -244,17 +244,21 @@ fn passes(res: &FitResult) -> String {
         "\n### Passes\n\nThe first pass simulates the whole ranges; the second, the box narrowed \
          to the first's 2σ intervals. A pass whose box cuts a parameter (its maximum or 2σ \
          interval on an edge of the box that is not its range's) is followed by one over a box \
-         moved and widened on that side, at most {MAX_WIDENINGS} times; a block whose parameters' \
-         ranges stay as they were is not rolled again.\n"
+         moved and widened on that side; one whose box is more than {LOOSE} times as wide as \
+         its 2σ interval asks, by one over the box drawn around that interval — at most \
+         {MAX_MORE_PASSES} more, until a pass's estimate asks for the box it was rolled over. A \
+         block whose parameters' ranges stay as they were is not rolled again, and each pass's \
+         surrogates are fitted through the earlier passes' points inside its box as well.\n"
     );
-    let _ = writeln!(s, "| pass | box | rolls | cut by its box |");
-    let _ = writeln!(s, "|---:|---|---:|---|");
+    let _ = writeln!(s, "| pass | box | rolls | maximum | cut by its box |");
+    let _ = writeln!(s, "|---:|---|---:|---|---|");
     for (i, p) in res.passes.iter().enumerate() {
         let bounds: Vec<String> = p
             .bounds
             .iter()
             .map(|b| format!("{} {}–{}", b.param, num(b.range.lo), num(b.range.hi)))
             .collect();
+        let values: Vec<String> = p.values.iter().map(|&v| num(v)).collect();
         let cut: Vec<String> = p
             .cut
             .iter()
@@ -269,10 +273,15 @@ fn passes(res: &FitResult) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} |",
             i + 1,
             bounds.join(", "),
             p.rolls,
+            if values.is_empty() {
+                "—".into()
+            } else {
+                values.join(", ")
+            },
             if cut.is_empty() {
                 "—".into()
             } else {
@@ -280,17 +289,21 @@ fn passes(res: &FitResult) -> String {
             }
         );
     }
-    if let Some(last) = res.passes.last().filter(|p| !p.cut.is_empty()) {
-        let names: Vec<&str> = last.cut.iter().map(|c| c.param.as_str()).collect();
-        let _ = writeln!(
-            s,
-            "\n**Still cut** after {} passes: {}. The narrowed box, not the data, bounds {}: \
-             rerun with more `--points` or `--rolls` (a surer first pass), or with `--no-refine` \
-             (one pass over the whole `--range`).",
-            res.passes.len(),
-            names.join(", "),
-            if names.len() == 1 { "it" } else { "them" }
-        );
+    match &res.unresolved {
+        Some(why) => {
+            let _ = writeln!(
+                s,
+                "\n**Unresolved**: {why}. Rerun with more `--points` or `--point-rolls` (a \
+                 surer surrogate), or with `--no-refine` (one pass over the whole `--range`)."
+            );
+        }
+        None => {
+            let _ = writeln!(
+                s,
+                "\nThe passes settled: pass {}'s estimate asks for the box it was rolled over.",
+                res.passes.len()
+            );
+        }
     }
     s
 }

@@ -913,7 +913,8 @@ fn document_fit_passes(c: &mut Checker, dir: &Scratch) {
     ]);
     assert!(two.get("first_pass").is_some(), "a second pass: {two}");
     c.document("fit", "fit --data paper (two passes)", &two);
-    // Two 2D blocks whose second pass's box cuts μ (at its upper edge): a widening pass.
+    // Two 2D blocks whose second pass's box cuts μ (at its upper edge, at seed 6): a widening
+    // pass, then passes that tighten the box.
     let cut_csv = dir.join("cut.csv");
     std::fs::write(
         &cut_csv,
@@ -935,6 +936,8 @@ fn document_fit_passes(c: &mut Checker, dir: &Scratch) {
         "100",
         "--dt",
         "1/250",
+        "--seed",
+        "6",
         "--out",
         &format!("{d}/widened"),
         "--json",

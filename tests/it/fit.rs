@@ -498,16 +498,23 @@ fn a_box_that_cut_a_parameter_is_widened_until_it_does_not() {
         "{said}"
     );
     assert!(fitted.passes.last().unwrap().cut.is_empty(), "{said}");
+    assert_eq!(fitted.unresolved, None, "{said}");
+    // Each pass records its maximum, so the table shows where the passes went.
+    assert!(fitted.passes.iter().all(|p| p.values.len() == 2), "{said}");
     // e[B] keeps its whole range in every pass, and its block's design is never rolled again:
-    // each pass after the first rolls only the two blocks of surface A.
+    // each pass after the first rolls only the two blocks of surface A, or none where its box
+    // is an earlier pass's (that pass's designs, their surrogates through every later point).
     let per_design = POINTS as u64 * ROLLS;
     assert_eq!(fitted.passes[0].rolls, 2 * per_design, "{said}");
     for pass in &fitted.passes[1..] {
-        assert_eq!(pass.rolls, 2 * per_design, "{said}");
+        assert!(pass.rolls == 2 * per_design || pass.rolls == 0, "{said}");
         let b = pass.bounds.iter().find(|b| b.param == "e[B]").unwrap();
         assert_eq!(b.range, Kind::E.default_range(), "{said}");
     }
-    assert_eq!(fitted.designs.len(), 3);
+    // One design a key: three while e[A]'s box is narrowed, two where it is the whole range
+    // (then both surfaces' rows of 140x30x10 read one design).
+    let keys = dicephys::calibration::design::keys(&fitted.config.rows, &fitted.config.model);
+    assert_eq!(fitted.designs.len(), keys.len(), "{said}");
     let total: u64 = fitted.passes.iter().map(|p| p.rolls).sum();
     assert_eq!(fitted.rolls, total);
 }
@@ -591,4 +598,78 @@ fn a_misfit_is_widened_by_its_overdispersion_and_a_fit_that_fits_is_not() {
         .map(|q| f(&q[0]))
         .fold(f64::INFINITY, f64::min);
     assert!(f(&p["two_sigma"][0]) < unwidened_lo - 0.02, "{p}");
+}
+
+/// Issue 49: the estimate is the data's, not its boxes'. Counts rolled at a hand's throw (κ 5,
+/// e 0.45, μ 0.3; four blocks, 3,000 throws each, dt = 1/250) are fitted for e and μ from three
+/// first boxes (the default ranges, e 0.2–0.8 with μ 0.1–0.7, e 0.05–0.6 with μ 0.2–1) at three
+/// seeds. Every fit's passes settle, and every pair of the nine estimates agrees within two
+/// combined standard errors (each its 1σ interval's half-width; the pairs share the data, so
+/// they differ only by their designs' noise, which each error also holds). At `cbc57c1`, with
+/// the passes stopped at the first box that cut nothing and each surrogate through its own
+/// box's points only, 66 of the 72 comparisons held and μ's worst pair stood 3.9 combined σ
+/// apart; here all 72 hold (worst 1.6). About 350,000 rolls.
+#[test]
+fn the_same_counts_from_three_first_boxes_at_three_seeds_give_one_estimate() {
+    let dir = Scratch::new("fit-boxes");
+    let mut csv = HEAD.to_string();
+    for block in ["140x24x20", "100x43.9x43.2", "60x24x20", "30x24x20"] {
+        let args = "--throw hand --kappa 5 --restitution 0.45 --friction 0.3 --dt 1/250 \
+                    --rolls 3000 --seed 11 --json";
+        let mut roll = vec!["roll", "--block", block];
+        roll.extend(args.split(' '));
+        let c = &json(&dicephys(&roll))["counts"];
+        let mm: Vec<&str> = block.split('x').collect();
+        csv += &format!(
+            "{block},T,{},{},{},3d,{},{},{}\n",
+            mm[0], mm[1], mm[2], c["length"], c["breadth"], c["width"]
+        );
+    }
+    let data = dir.join("hand.csv");
+    std::fs::write(&data, csv).unwrap();
+    let boxes: [&[&str]; 3] = [
+        &[],
+        &["--range", "e=0.2:0.8", "--range", "mu=0.1:0.7"],
+        &["--range", "e=0.05:0.6", "--range", "mu=0.2:1"],
+    ];
+    let mut fits = Vec::new();
+    for (b, first) in boxes.iter().enumerate() {
+        for seed in ["1", "2", "3"] {
+            let out = dir.join(format!("b{b}-s{seed}"));
+            let args = "--free e,mu --kappa 5 --dt 1/250 --points 16 --degree 2 \
+                        --point-rolls 300 --json";
+            let mut fit = vec!["fit", "--data", data.to_str().unwrap(), "--seed", seed];
+            fit.extend(args.split(' '));
+            fit.extend_from_slice(first);
+            fit.extend(["--out", out.to_str().unwrap()]);
+            let v = json(&dicephys(&fit));
+            assert!(v.get("unresolved").is_none(), "box {b} seed {seed}: {v}");
+            fits.push((
+                format!("box {b} seed {seed}"),
+                v["estimate"]["params"].clone(),
+            ));
+        }
+    }
+    for (i, (a, pa)) in fits.iter().enumerate() {
+        for (b, pb) in &fits[i + 1..] {
+            for k in 0..2 {
+                let (x, y) = (&pa[k], &pb[k]);
+                let half = |p: &serde_json::Value| {
+                    (p["one_sigma"][1].as_f64().unwrap() - p["one_sigma"][0].as_f64().unwrap())
+                        / 2.0
+                };
+                let d = (x["value"].as_f64().unwrap() - y["value"].as_f64().unwrap()).abs();
+                let z = d / half(x).hypot(half(y));
+                assert!(
+                    z <= 2.0,
+                    "{}: {a} {} (1σ {}) against {b} {} (1σ {}): {z:.2} combined σ apart",
+                    x["name"],
+                    x["value"],
+                    x["one_sigma"],
+                    y["value"],
+                    y["one_sigma"]
+                );
+            }
+        }
+    }
 }

@@ -10,8 +10,8 @@ pub mod simulate;
 
 use crate::calibration::design::{self, Design};
 use crate::calibration::params::Narrowed;
-use crate::calibration::{cuts, estimate_with, widen, FitConfig, FitCost, FitResult, Pass};
-use crate::calibration::{narrow, MAX_WIDENINGS};
+use crate::calibration::{cuts, estimate_with, same_box, tighten, widen};
+use crate::calibration::{narrow, FitConfig, FitCost, FitResult, Pass, MAX_MORE_PASSES};
 use crate::error::{Error, Field, Result};
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::runner::{ChunkShare, Runner};
@@ -98,6 +98,11 @@ pub struct Fitted {
     pub rolls: u64,
     /// Of which did not settle on a face.
     pub unsettled: u64,
+    /// Why the passes did not settle, if they did not ([`FitResult::unresolved`]).
+    pub unresolved: Option<String>,
+    /// Every design rolled so far, over every pass (a later pass's surrogates borrow their
+    /// points inside its box: [`design::borrowed`]).
+    pub rolled: Vec<Design>,
 }
 
 impl Fitted {
@@ -112,12 +117,14 @@ impl Fitted {
         Ok(Fitted {
             config: r.config,
             params: r.params,
+            rolled: r.designs.clone(),
             designs: r.designs,
             estimate: r.estimate,
             first_pass: None,
             passes,
             rolls: r.cost.rolls,
             unsettled: r.cost.unsettled,
+            unresolved: r.unresolved,
         })
     }
 }
@@ -135,6 +142,7 @@ pub fn result(f: Fitted, command_line: &str, wall: Instant, cpu: f64) -> FitResu
         params: f.params,
         first_pass: f.first_pass,
         passes: f.passes,
+        unresolved: f.unresolved,
         designs: f.designs,
         estimate: f.estimate,
         command_line: command_line.to_string(),
@@ -180,11 +188,13 @@ pub fn first_pass(
         config: cfg.clone(),
         rolls: sim.rolls,
         unsettled: sim.unsettled,
-        passes: vec![Pass::over(&params, sim.rolls)],
+        passes: vec![Pass::of(&params, &estimate, sim.rolls)],
         params,
+        rolled: sim.designs.clone(),
         designs: sim.designs,
         estimate,
         first_pass: None,
+        unresolved: None,
     }))
 }
 
@@ -210,8 +220,12 @@ fn settled_enough(designs: &[Design]) -> Result<()> {
 
 /// The second pass over the box narrowed from `first` (a pass with nothing to narrow is the
 /// last: it gets the full search, the bootstrap's region and the posterior draws `predict`
-/// needs), then as many passes again as it takes, up to [`MAX_WIDENINGS`], to widen every box
-/// that cut a parameter ([`cuts`], [`widen`]). `None` as for [`first_pass`].
+/// needs), then as many passes again as it takes, up to [`MAX_MORE_PASSES`], for the box to
+/// settle: each widens a box that cut a parameter ([`cuts`], [`widen`]) or tightens one looser
+/// than its region ([`tighten`]), until a pass's own estimate asks for the box it was rolled
+/// over; each pass's surrogates are fitted through the earlier passes' points inside its box
+/// as well ([`pooled`]). Passes that do not settle leave the fit unresolved, and say why.
+/// `None` as for [`first_pass`].
 pub fn second_pass(
     first: Fitted,
     runner: &Runner,
@@ -238,19 +252,57 @@ pub fn second_pass(
         return Ok(None);
     };
     let own = own_rolls(runner);
-    for widened in 0..=MAX_WIDENINGS {
+    for more in 0..=MAX_MORE_PASSES {
         let cut = cuts(&out.estimate);
         out.passes.last_mut().expect("a pass").cut = cut.clone();
-        if cut.is_empty() || widened == MAX_WIDENINGS {
+        let next = if cut.is_empty() {
+            tighten(&out.config.rows, &out.config.model, &out.estimate)
+        } else {
+            widen(&out.config.model, &out.estimate, &cut)
+        };
+        if same_box(&next, &out.config.model.narrowed) {
             break;
         }
-        let wider = widen(&out.config.model, &out.estimate, &cut);
-        let Some(next) = refined_pass(out, wider, &own, dir, session)? else {
+        if more == MAX_MORE_PASSES {
+            out.unresolved = Some(unsettled(&out, &next, &cut));
+            break;
+        }
+        let Some(later) = refined_pass(out, next, &own, dir, session)? else {
             return Ok(None);
         };
-        out = next;
+        out = later;
     }
     Ok(Some(out))
+}
+
+/// Why the passes of `out` stop unsettled: no pass left, and the box `next` still asked for
+/// because the last box cut `cut` (or, nothing cut, was looser than its region). A box an
+/// earlier pass had is no cycle: its surrogates borrow every later pass's points inside it,
+/// and the estimate moves on.
+fn unsettled(
+    out: &Fitted,
+    next: &[crate::calibration::params::Narrowed],
+    cut: &[crate::calibration::Cut],
+) -> String {
+    let names: Vec<&str> = if cut.is_empty() {
+        next.iter()
+            .filter(|n| !out.config.model.narrowed.contains(n))
+            .map(|n| n.param.as_str())
+            .collect()
+    } else {
+        cut.iter().map(|c| c.param.as_str()).collect()
+    };
+    let why = if cut.is_empty() {
+        "is still looser than the region of"
+    } else {
+        "still cuts"
+    };
+    format!(
+        "the passes did not settle in {}: the box {why} {}; the estimate is the last box's, \
+         not the data's",
+        out.passes.len(),
+        names.join(", ")
+    )
 }
 
 /// One refined pass: `prev`'s fit simulated again over the box `narrowed` (a design whose key
@@ -271,19 +323,52 @@ fn refined_pass(
     settled_enough(&sim.designs)?;
     out.rolls += sim.rolls;
     out.unsettled += sim.unsettled;
+    let designs = pooled(&out.config, sim.designs, &mut out.rolled);
     let (params, estimate) = estimate_with(
         &out.config.rows,
         &out.config.model,
-        &sim.designs,
+        &designs,
         &out.config.search,
         &runner.watch(),
     )?;
-    out.passes.push(Pass::over(&params, sim.rolls));
+    out.passes.push(Pass::of(&params, &estimate, sim.rolls));
     let before = std::mem::replace(&mut out.estimate, estimate).params;
     out.first_pass.get_or_insert(before);
     out.params = params;
-    out.designs = sim.designs;
+    out.designs = designs;
     Ok(Some(out))
+}
+
+/// A refined pass's `designs`, each with the points of the designs `rolled` before it that lie
+/// inside its box ([`design::borrowed`]) and its surrogate fitted through them too; `designs`
+/// join `rolled`. Not with common throws (`cfg.design.common`): one box's points share their
+/// throws, and another's would not.
+fn pooled(cfg: &FitConfig, designs: Vec<Design>, rolled: &mut Vec<Design>) -> Vec<Design> {
+    let session = Session::default();
+    let plan = Plan {
+        model: &cfg.model,
+        method: &cfg.method,
+        design: &cfg.design,
+        seed: cfg.seed,
+        session: &session,
+    };
+    let out = designs
+        .iter()
+        .map(|d| {
+            let borrowed = design::borrowed(d, rolled);
+            if borrowed.is_empty() || cfg.design.common {
+                return d.clone();
+            }
+            let all: Vec<_> = d.points.iter().chain(&borrowed).cloned().collect();
+            Design {
+                surrogate: simulate::surrogate(&all, d.faces, d.mode, &plan),
+                borrowed,
+                ..d.clone()
+            }
+        })
+        .collect();
+    rolled.extend(designs);
+    out
 }
 
 /// The runner the widening passes roll with: `runner`, but in a cluster's finishing job, which

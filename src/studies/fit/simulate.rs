@@ -142,34 +142,14 @@ pub fn simulate(
         if runner.share.is_partial() {
             continue;
         }
-        // A 2D block has no length outcome: its surrogate is over breadth and width.
-        let (outcomes, pts): (usize, Vec<DesignPoint>) = match mode {
-            _ if key.faces => (face_count(plan.method), design_points.clone()),
-            Mode::ThreeD => (3, design_points.clone()),
-            Mode::TwoD => (
-                2,
-                design_points
-                    .iter()
-                    .map(|p| DesignPoint {
-                        x: p.x.clone(),
-                        counts: p.counts[1..].to_vec(),
-                    })
-                    .collect(),
-            ),
-        };
-        let surrogate = Surrogate::fit_best(
-            &pts,
-            dims,
-            outcomes,
-            plan.design.degree,
-            plan.design.max_degree,
-        );
+        let surrogate = surrogate(&design_points, key.faces, mode, plan);
         let design = Design {
             block,
             mode,
             axes: key.axes.clone(),
             faces: key.faces,
             points: design_points,
+            borrowed: vec![],
             unsettled,
             rolls,
             surrogate,
@@ -182,6 +162,34 @@ pub fn simulate(
         out.push(design);
     }
     Ok((!runner.share.is_partial()).then_some(out))
+}
+
+/// The surrogate through a design's `points` (its own, and any borrowed from earlier passes:
+/// [`crate::calibration::design::borrowed`]): over the faces of a die counted by faces, over
+/// the three sides in 3D, over breadth and width in 2D (a 2D block has no length outcome).
+pub fn surrogate(points: &[DesignPoint], faces: bool, mode: Mode, plan: &Plan) -> Surrogate {
+    let dims = plan.model.free.len();
+    let (outcomes, pts): (usize, Vec<DesignPoint>) = match mode {
+        _ if faces => (face_count(plan.method), points.to_vec()),
+        Mode::ThreeD => (3, points.to_vec()),
+        Mode::TwoD => (
+            2,
+            points
+                .iter()
+                .map(|p| DesignPoint {
+                    x: p.x.clone(),
+                    counts: p.counts[1..].to_vec(),
+                })
+                .collect(),
+        ),
+    };
+    Surrogate::fit_best(
+        &pts,
+        dims,
+        outcomes,
+        plan.design.degree,
+        plan.design.max_degree,
+    )
 }
 
 /// Rolls of a tally that settled on a side, a number or (a die of any shape) a face.
