@@ -276,6 +276,16 @@ impl Key {
         fnv(&format!("{seed}/{}/{point}", self.tag()))
     }
 
+    /// The key `d` was simulated for.
+    pub fn of_design(d: &Design) -> Key {
+        Key {
+            block: d.block,
+            mode: d.mode,
+            axes: d.axes.clone(),
+            faces: d.faces,
+        }
+    }
+
     /// True if `d` is this key's design.
     pub fn is(&self, d: &Design) -> bool {
         d.block == self.block && d.mode == self.mode && d.axes == self.axes && d.faces == self.faces

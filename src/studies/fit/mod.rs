@@ -344,14 +344,6 @@ fn refined_pass(
 /// join `rolled`. Not with common throws (`cfg.design.common`): one box's points share their
 /// throws, and another's would not.
 fn pooled(cfg: &FitConfig, designs: Vec<Design>, rolled: &mut Vec<Design>) -> Vec<Design> {
-    let session = Session::default();
-    let plan = Plan {
-        model: &cfg.model,
-        method: &cfg.method,
-        design: &cfg.design,
-        seed: cfg.seed,
-        session: &session,
-    };
     let out = designs
         .iter()
         .map(|d| {
@@ -360,8 +352,9 @@ fn pooled(cfg: &FitConfig, designs: Vec<Design>, rolled: &mut Vec<Design>) -> Ve
                 return d.clone();
             }
             let all: Vec<_> = d.points.iter().chain(&borrowed).cloned().collect();
+            let key = design::Key::of_design(d);
             Design {
-                surrogate: simulate::surrogate(&all, d.faces, d.mode, &plan),
+                surrogate: simulate::surrogate(&all, &key, &cfg.method, &cfg.design),
                 borrowed,
                 ..d.clone()
             }

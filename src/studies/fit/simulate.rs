@@ -30,13 +30,7 @@ impl Session {
     pub fn hold(&self, seed: u64, designs: &[Design]) {
         let mut cache = self.cache.lock().unwrap_or_else(|e| e.into_inner());
         for d in designs {
-            let key = Key {
-                block: d.block,
-                mode: d.mode,
-                axes: d.axes.clone(),
-                faces: d.faces,
-            };
-            cache.push((key, seed, d.clone()));
+            cache.push((Key::of_design(d), seed, d.clone()));
         }
     }
 
@@ -142,7 +136,7 @@ pub fn simulate(
         if runner.share.is_partial() {
             continue;
         }
-        let surrogate = surrogate(&design_points, key.faces, mode, plan);
+        let surrogate = surrogate(&design_points, key, plan.method, plan.design);
         let design = Design {
             block,
             mode,
@@ -167,10 +161,15 @@ pub fn simulate(
 /// The surrogate through a design's `points` (its own, and any borrowed from earlier passes:
 /// [`crate::calibration::design::borrowed`]): over the faces of a die counted by faces, over
 /// the three sides in 3D, over breadth and width in 2D (a 2D block has no length outcome).
-pub fn surrogate(points: &[DesignPoint], faces: bool, mode: Mode, plan: &Plan) -> Surrogate {
-    let dims = plan.model.free.len();
-    let (outcomes, pts): (usize, Vec<DesignPoint>) = match mode {
-        _ if faces => (face_count(plan.method), points.to_vec()),
+pub fn surrogate(
+    points: &[DesignPoint],
+    key: &Key,
+    method: &Method,
+    spec: &DesignSpec,
+) -> Surrogate {
+    let dims = key.axes.len();
+    let (outcomes, pts): (usize, Vec<DesignPoint>) = match key.mode {
+        _ if key.faces => (face_count(method), points.to_vec()),
         Mode::ThreeD => (3, points.to_vec()),
         Mode::TwoD => (
             2,
@@ -183,13 +182,7 @@ pub fn surrogate(points: &[DesignPoint], faces: bool, mode: Mode, plan: &Plan) -
                 .collect(),
         ),
     };
-    Surrogate::fit_best(
-        &pts,
-        dims,
-        outcomes,
-        plan.design.degree,
-        plan.design.max_degree,
-    )
+    Surrogate::fit_best(&pts, dims, outcomes, spec.degree, spec.max_degree)
 }
 
 /// Rolls of a tally that settled on a side, a number or (a die of any shape) a face.
