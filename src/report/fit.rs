@@ -341,6 +341,9 @@ pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
         res.cost.cpu_s,
         fixed_text(res),
     );
+    if let Some(why) = &res.unresolved {
+        let _ = writeln!(s, "**Unresolved**: {why} (the passes below).\n");
+    }
     s += &parameters(res);
     s += &passes(res);
     s += &goodness_of_fit(e);
