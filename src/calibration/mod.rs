@@ -630,6 +630,48 @@ mod tests {
     }
 
     #[test]
+    fn a_box_much_wider_than_its_region_is_tightened_around_it_and_one_that_fits_is_kept() {
+        let row = DataRow {
+            label: "a".into(),
+            surface: "A".into(),
+            thrower: "all".into(),
+            block: "140x24x20".parse().unwrap(),
+            mode: crate::model::scene::Mode::ThreeD,
+            outcomes: Default::default(),
+            counts: vec![0, 1, 2],
+            groups: vec![vec![0], vec![1], vec![2]],
+            labels: vec![],
+        };
+        let rows = [row];
+        let model = ModelSpec::free(&[Kind::E]);
+        // e over its whole range 0.05–0.8, its 2σ interval 0.425–0.5 (unit coordinates 0.5–0.6):
+        // the box drawn around it is 0.45–0.65, e 0.3875–0.5375, a fifth of the range.
+        let loose = estimate_of(vec![fit_of(
+            "A",
+            Kind::E.default_range(),
+            0.46,
+            [0.425, 0.5],
+        )]);
+        let next = tighten(&rows, &model, &loose);
+        assert_eq!(next.len(), 1, "{next:?}");
+        let r = next[0].range;
+        assert!(
+            (r.lo - 0.3875).abs() < 1e-12 && (r.hi - 0.5375).abs() < 1e-12,
+            "{r:?}"
+        );
+        // Over that box, the same interval asks for the same box: the passes have settled.
+        let tight = ModelSpec {
+            narrowed: next.clone(),
+            ..model.clone()
+        };
+        let fits = estimate_of(vec![fit_of("A", r, 0.46, [0.425, 0.5])]);
+        assert!(same_box(&tighten(&rows, &tight, &fits), &next));
+        // An interval whose drawn box would cover 80 % of the range keeps the whole range.
+        let wide = estimate_of(vec![fit_of("A", Kind::E.default_range(), 0.4, [0.2, 0.6])]);
+        assert!(tighten(&rows, &model, &wide).is_empty());
+    }
+
+    #[test]
     fn a_box_that_cut_a_parameter_is_widened_on_that_side_and_no_other_box_moves() {
         let boxed = Range::new(0.6125, 0.7575);
         let own_end = Range::new(0.05, 0.3);

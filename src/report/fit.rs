@@ -245,7 +245,8 @@ fn passes(res: &FitResult) -> String {
          to the first's 2σ intervals. A pass whose box cuts a parameter (its maximum or 2σ \
          interval on an edge of the box that is not its range's) is followed by one over a box \
          moved and widened on that side; one whose box is more than {LOOSE} times as wide as \
-         its 2σ interval asks, by one over the box drawn around that interval — at most \
+         its 2σ interval asks (until a box has been widened), by one over the box drawn around \
+         that interval — at most \
          {MAX_MORE_PASSES} more, until a pass's estimate asks for the box it was rolled over. A \
          block whose parameters' ranges stay as they were is not rolled again, and each pass's \
          surrogates are fitted through the earlier passes' points inside its box as well.\n"
@@ -666,7 +667,7 @@ pub fn calibrated_markdown(c: &CalibratedPaper, figures: &[&str]) -> String {
         f.config.design.rolls,
         if f.config.design.refine {
             ", two passes or more (the second over the box the first narrowed to, any later one \
-             widening a box that cut a parameter)"
+             widening a box that cut a parameter or tightening one looser than its region)"
         } else {
             ""
         }

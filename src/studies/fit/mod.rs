@@ -221,9 +221,9 @@ fn settled_enough(designs: &[Design]) -> Result<()> {
 /// The second pass over the box narrowed from `first` (a pass with nothing to narrow is the
 /// last: it gets the full search, the bootstrap's region and the posterior draws `predict`
 /// needs), then as many passes again as it takes, up to [`MAX_MORE_PASSES`], for the box to
-/// settle: each widens a box that cut a parameter ([`cuts`], [`widen`]) or tightens one looser
-/// than its region ([`tighten`]), until a pass's own estimate asks for the box it was rolled
-/// over; each pass's surrogates are fitted through the earlier passes' points inside its box
+/// settle: each widens a box that cut a parameter ([`cuts`], [`widen`]) or, until one has been
+/// widened, tightens one looser than its region ([`tighten`]), until a pass's own estimate
+/// asks for the box it was rolled over; each pass's surrogates are fitted through the earlier passes' points inside its box
 /// as well ([`pooled`]). Passes that do not settle leave the fit unresolved, and say why.
 /// `None` as for [`first_pass`].
 pub fn second_pass(
@@ -252,13 +252,17 @@ pub fn second_pass(
         return Ok(None);
     };
     let own = own_rolls(runner);
+    // Once a box has had to be widened, the passes only widen: tightened again, the paper's
+    // κ and e[Thin Towel] went from box to box (cut, widened, tightened, cut) and never settled.
+    let mut widened = false;
     for more in 0..=MAX_MORE_PASSES {
         let cut = cuts(&out.estimate);
         out.passes.last_mut().expect("a pass").cut = cut.clone();
-        let next = if cut.is_empty() {
-            tighten(&out.config.rows, &out.config.model, &out.estimate)
-        } else {
-            widen(&out.config.model, &out.estimate, &cut)
+        widened |= !cut.is_empty();
+        let next = match () {
+            _ if !cut.is_empty() => widen(&out.config.model, &out.estimate, &cut),
+            _ if widened => out.config.model.narrowed.clone(),
+            _ => tighten(&out.config.rows, &out.config.model, &out.estimate),
         };
         if same_box(&next, &out.config.model.narrowed) {
             break;
