@@ -299,10 +299,16 @@ fn passes(res: &FitResult) -> String {
             );
         }
         None => {
+            let widened = res.passes.iter().any(|p| !p.cut.is_empty());
             let _ = writeln!(
                 s,
-                "\nThe passes settled: pass {}'s estimate asks for the box it was rolled over.",
-                res.passes.len()
+                "\nThe passes settled: pass {}'s {}.",
+                res.passes.len(),
+                if widened {
+                    "box cuts no parameter (after a widening, the passes only widen)"
+                } else {
+                    "estimate asks for the box it was rolled over"
+                }
             );
         }
     }
