@@ -325,8 +325,9 @@ pub struct Cut {
 }
 
 /// Passes after the second at most, each widening a box that cut a parameter or tightening
-/// one looser than its region asks ([`tighten`]). In unit coordinates of the range, [`widen`] moves a cut face out by the old box's width plus at
-/// least 0.05, and the box grows by at least 0.1 a pass (unless it reaches an end of the range); so four passes move a cut face by
+/// one looser than its region asks ([`tighten`]). In unit coordinates of the range, [`widen`]
+/// moves a cut face out by the old box's width plus at least 0.05, and the box grows by at
+/// least 0.1 a pass (unless it reaches an end of the range); so four passes move a cut face by
 /// at least 0.8 plus four times the second pass's box width (at least 0.05 wide as [`narrow`]
 /// draws it), which takes it to the range's end: a region that lies off one face is met within
 /// four. One that jumps from face to face (a surrogate too poor to place it) may not be; the
@@ -384,7 +385,7 @@ pub fn widen(model: &ModelSpec, est: &Estimate, cut: &[Cut]) -> Vec<params::Narr
         let w = |v: f64| p.kind.coordinate(p.whole, v).clamp(0.0, 1.0);
         let (lo, hi) = (w(fit.two_sigma[0]), w(fit.two_sigma[1]));
         let width = w(p.range.hi) - w(p.range.lo);
-        let pad = (0.5 * (hi - lo)).max(0.05);
+        let pad = pad(lo, hi);
         let a = (lo - pad - if c.lower { width } else { 0.0 }).max(0.0);
         let b = (hi + pad + if c.upper { width } else { 0.0 }).min(1.0);
         out.retain(|n| n.param != c.param);
@@ -398,11 +399,17 @@ pub fn widen(model: &ModelSpec, est: &Estimate, cut: &[Cut]) -> Vec<params::Narr
     out
 }
 
+/// How far a box reaches past each end of a 2σ interval from `lo` to `hi` (unit coordinates):
+/// half the interval's width, and at least 0.05.
+fn pad(lo: f64, hi: f64) -> f64 {
+    (0.5 * (hi - lo)).max(0.05)
+}
+
 /// The box drawn around a 2σ interval from `lo` to `hi` (unit coordinates of a range): the
 /// interval widened by half its width on each side, and by at least 0.05, within the range;
 /// `None` where that covers 80 % of the range, which then keeps it all.
 fn around(lo: f64, hi: f64) -> Option<(f64, f64)> {
-    let pad = (0.5 * (hi - lo)).max(0.05);
+    let pad = pad(lo, hi);
     let (a, b) = ((lo - pad).max(0.0), (hi + pad).min(1.0));
     (b - a < 0.8).then_some((a, b))
 }
