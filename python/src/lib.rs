@@ -27,7 +27,8 @@ use dicephys::run::runner::{ChunkShare, Runner};
 use dicephys::run::spec::{RunSpec, ThrowSpec};
 use dicephys::run::stop::Stop;
 use dicephys::sim::roll::{RollConfig, RollRecord, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
-use dicephys::studies::outputs::{self, Done, Hooks, Place};
+use dicephys::studies::outputs;
+use dicephys::studies::place::{Done, Hooks, Place};
 use dicephys::studies::StudyConfig;
 use dicephys::Error;
 use pyo3::conversion::FromPyObjectOwned;
@@ -641,24 +642,24 @@ fn study(
 ) -> PyResult<String> {
     let cfg: StudyConfig = serde_json::from_str(config)
         .map_err(|e| bad("config", "…", format!("not a study's configuration: {e}")))?;
-    run_study(py, cfg, out, threads, progress, log)
+    let call = cfg.name();
+    run_study(py, &cfg, out, threads, (progress, log), call)
 }
 
-/// Runs a study into `out` (its cells beside its files, where the command line keeps them);
-/// its JSON result.
+/// Runs a study into `out` (its cells beside its files, where the command line keeps them),
+/// as `dicephys.<call>` with Python's `progress` and `log` callables; its JSON result.
 fn run_study(
     py: Python<'_>,
-    cfg: StudyConfig,
+    cfg: &StudyConfig,
     out: PathBuf,
     threads: usize,
-    progress: Option<&Bound<'_, PyAny>>,
-    log: Option<&Bound<'_, PyAny>>,
+    (progress, log): (Option<&Bound<'_, PyAny>>, Option<&Bound<'_, PyAny>>),
+    call: &str,
 ) -> PyResult<String> {
     cfg.validate().map_err(py_err)?;
-    let cells = cfg.study().cells();
-    let place = place(Some(out), cells, threads, cfg.name())?;
+    let place = place(Some(out), cfg.cells(), threads, call)?;
     finished(detached(py, progress, log, |s| {
-        s.hooked(|h| outputs::run(&cfg, &place, h))
+        s.hooked(|h| cfg.run(&place, h))
     })?)
 }
 
@@ -859,7 +860,7 @@ fn fit(
         config,
         stage: dicephys::studies::fit::Stage::Whole,
     });
-    run_study(py, cfg, out, threads, progress, log)
+    run_study(py, &cfg, out, threads, (progress, log), "fit")
 }
 
 /// `dicephys fit --recover`: counts simulated at `truth` (the free parameters' values, in
@@ -900,10 +901,12 @@ fn recover(
                 .ok_or_else(|| bad("truth", k, "give a value for every free parameter"))
         })
         .collect::<PyResult<Vec<f64>>>()?;
-    let place = place(Some(out), "cells", threads, "recover")?;
-    finished(detached(py, progress, log, |s| {
-        s.hooked(|h| dicephys::studies::fit::outputs::recover(&cfg, &values, repeats, &place, h))
-    })?)
+    let cfg = StudyConfig::Recover(dicephys::studies::fit::RecoverStudy {
+        config: cfg,
+        truth: values,
+        repeats,
+    });
+    run_study(py, &cfg, out, threads, (progress, log), "recover")
 }
 
 /// `dicephys predict`: the fit (its `fit.json`'s text) simulated at a block it did not see;
@@ -946,9 +949,10 @@ fn predict(
         rolls,
         seed,
     };
+    let cfg = StudyConfig::Predict(dicephys::studies::fit::PredictStudy { fit, config: cfg });
     let place = place(None, "", threads, "predict")?;
     finished(detached(py, progress, None, |s| {
-        s.hooked(|h| dicephys::studies::fit::outputs::predict(&fit, &cfg, &place, h))
+        s.hooked(|h| cfg.run(&place, h))
     })?)
 }
 

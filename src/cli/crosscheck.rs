@@ -77,9 +77,10 @@ pub fn run(a: &CrosscheckArgs) -> Result<()> {
              Bullet (the paper's preset); --preset split compares the engines on the same bounce"
         );
     }
+    let cfg = StudyConfig::Crosscheck(cfg);
     let place = Place {
         checkpoint: a.checkpoint.clone(),
-        ..study::local(Path::new(""), *a.run.threads, *a.json)?
+        ..study::local(Path::new(""), &cfg, *a.run.threads, *a.json)?
     };
-    study::run(&StudyConfig::Crosscheck(cfg), &place)
+    study::run(&cfg, &place)
 }

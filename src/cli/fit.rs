@@ -17,6 +17,10 @@ use dicephys::model::block::Block;
 use dicephys::model::scene::Mode;
 use dicephys::model::throws::Range;
 use dicephys::sim::roll::DEFAULT_MAX_STEPS;
+use dicephys::studies::fit::{
+    BlocksConfig, BlocksStudy, FitStudy, PredictStudy, RecoverStudy, Stage,
+};
+use dicephys::studies::StudyConfig;
 use std::path::PathBuf;
 
 /// `dicephys fit`'s arguments.
@@ -315,17 +319,19 @@ impl FitArgs {
 
 /// Runs `dicephys fit`.
 pub fn run(a: &FitArgs) -> Result<()> {
-    let cfg = a.config()?;
-    let mut place = a.place.local("fit")?;
-    // The simulations' cells under --out/cells.
-    place.checkpoint = Some(place.out.join("cells"));
-    match &a.recover {
-        Some(truth) => {
-            let truth = truth_values(&cfg, truth)?;
-            super::study::recover(&cfg, &truth, a.repeats, &place)
-        }
-        None => super::study::fit(cfg, &place),
-    }
+    let config = a.config()?;
+    let cfg = match &a.recover {
+        Some(truth) => StudyConfig::Recover(RecoverStudy {
+            truth: truth_values(&config, truth)?,
+            config,
+            repeats: a.repeats,
+        }),
+        None => StudyConfig::Fit(FitStudy {
+            config,
+            stage: Stage::Whole,
+        }),
+    };
+    super::study::run(&cfg, &a.place.local("fit", &cfg)?)
 }
 
 /// `--recover NAME=V,…`: a value for every free parameter, in the model's order.
@@ -367,7 +373,7 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
             e => Error::Usage(format!("--fit {e}")),
         })?;
     if let Some(file) = &a.blocks {
-        return predict_blocks(a, &fit, file);
+        return predict_blocks(a, fit, file);
     }
     let block = match (a.block, dicephys::calibration::predict::own_block(&fit)) {
         (Some(b), _) | (None, Some(b)) => b,
@@ -387,8 +393,9 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
         rolls: a.rolls,
         seed: *a.seed,
     };
+    let cfg = StudyConfig::Predict(PredictStudy { fit, config: cfg });
     // It writes nothing: no directory of its own.
-    let place = dicephys::studies::outputs::Place {
+    let place = dicephys::studies::place::Place {
         out: ".".into(),
         checkpoint: None,
         threads: a.threads.checked()?,
@@ -396,11 +403,11 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
         json: *a.json,
         command_line: super::term::command_line(),
     };
-    super::study::predict(&fit, &cfg, &place)
+    super::study::run(&cfg, &place)
 }
 
 /// Runs `dicephys predict --blocks-file`.
-fn predict_blocks(a: &PredictArgs, fit: &FitResult, file: &std::path::Path) -> Result<()> {
+fn predict_blocks(a: &PredictArgs, fit: FitResult, file: &std::path::Path) -> Result<()> {
     use dicephys::calibration::heldout;
     let bytes = dicephys::run::io::read_capped(file, data::MAX_DATA_BYTES, super::term::stop())
         .map_err(|e| match e {
@@ -411,17 +418,18 @@ fn predict_blocks(a: &PredictArgs, fit: &FitResult, file: &std::path::Path) -> R
         .map_err(|_| Error::Usage(format!("--blocks-file {}: not UTF-8", file.display())))?;
     let rows = heldout::parse(text, &file.display().to_string())
         .map_err(|e| Error::Usage(format!("--blocks-file {e}")))?;
-    let cfg = dicephys::studies::fit::outputs::BlocksConfig {
+    let config = BlocksConfig {
         rows,
         draws: a.draws,
         rolls: a.rolls,
         seed: *a.seed,
         fit: a.fit.display().to_string(),
     };
+    let cfg = StudyConfig::PredictBlocks(BlocksStudy { fit, config });
     let out = a.out.clone().unwrap_or_else(|| "predict-out".into());
-    let mut place = super::study::local(&out, *a.threads, *a.json)?;
+    let mut place = super::study::local(&out, &cfg, *a.threads, *a.json)?;
     place.checkpoint = None;
-    super::study::predict_blocks(fit, &cfg, &place)
+    super::study::run(&cfg, &place)
 }
 
 /// A stop while a command reads its input: nothing read, nothing written.

@@ -8,7 +8,10 @@ use super::study::StudyPlace;
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::sim::roll::DEFAULT_MAX_STEPS;
+use dicephys::studies::calibrated::CalibratedStudy;
+use dicephys::studies::fit::Stage;
 use dicephys::studies::paper::PaperConfig;
+use dicephys::studies::StudyConfig;
 
 /// `dicephys paper`'s arguments.
 #[derive(Args, Debug)]
@@ -69,11 +72,13 @@ pub struct PaperArgs {
 
 /// Runs `dicephys paper --calibrated`.
 fn calibrated(a: &PaperArgs) -> Result<()> {
-    let cfg = a.calibrated_config();
-    let mut place = a.place.local("paper")?;
     // Its cells beside paper's own, apart.
-    place.checkpoint = Some(place.out.join("calibration"));
-    study::calibrated(&cfg, &place)
+    let cfg = StudyConfig::Calibrated(CalibratedStudy {
+        config: a.calibrated_config(),
+        stage: Stage::Whole,
+    });
+    cfg.validate()?;
+    study::run(&cfg, &a.place.local("paper", &cfg)?)
 }
 
 impl PaperArgs {
@@ -132,7 +137,7 @@ pub fn run(a: &PaperArgs) -> Result<()> {
     if a.calibrated {
         return calibrated(a);
     }
-    let cfg = a.config();
+    let cfg = StudyConfig::Paper(a.config());
     cfg.validate()?;
-    study::paper(&cfg, &a.place.local("paper")?)
+    study::run(&cfg, &a.place.local("paper", &cfg)?)
 }

@@ -7,8 +7,8 @@ use super::term::out;
 use clap::Args;
 use dicephys::report::progress::Progress;
 use dicephys::run::runner::ChunkShare;
-use dicephys::studies::outputs::{self, Done, Hooks, Place};
-use dicephys::studies::{paper::PaperConfig, validate, StudyConfig};
+use dicephys::studies::place::{Done, Hooks, Place};
+use dicephys::studies::StudyConfig;
 use std::path::Path;
 use std::time::Duration;
 
@@ -28,23 +28,24 @@ pub struct StudyPlace {
 }
 
 impl StudyPlace {
-    /// The study run here, on all its chunks, writing into `--out` or `<command>-out`.
-    pub fn local(&self, command: &str) -> Result<Place> {
+    /// `cfg` run here, on all its chunks, writing into `--out` or `<command>-out`.
+    pub fn local(&self, command: &str, cfg: &StudyConfig) -> Result<Place> {
         let out = self.out.clone();
         let out = out.unwrap_or_else(|| format!("{command}-out").into());
-        local(&out, *self.threads, *self.json)
+        local(&out, cfg, *self.threads, *self.json)
     }
 }
 
-/// A study run here, on all its chunks, writing into `out` (its cells under `out/checkpoint`).
-/// A Slurm run's directory is refused: its tasks and finishing job write there.
-pub fn local(out: &Path, threads: usize, json: bool) -> Result<Place> {
+/// `cfg` run here, on all its chunks, writing into `out` (its cells under the directory it
+/// names, [`StudyConfig::cells`]). A Slurm run's directory is refused: its tasks and
+/// finishing job write there.
+pub fn local(out: &Path, cfg: &StudyConfig, threads: usize, json: bool) -> Result<Place> {
     if !out.as_os_str().is_empty() {
         dicephys::run::owner::refuse_cluster_run(out)?;
     }
     Ok(Place {
         out: out.to_path_buf(),
-        checkpoint: Some(out.join("checkpoint")),
+        checkpoint: Some(out.join(cfg.cells())),
         threads: super::args::threads(threads)?,
         share: ChunkShare::All,
         json,
@@ -52,27 +53,12 @@ pub fn local(out: &Path, threads: usize, json: bool) -> Result<Place> {
     })
 }
 
-/// Runs a study a cluster can split, with a bar (or progress lines) and its log on stderr.
+/// Runs a study, with a bar (or progress lines) and its log on stderr: every command that
+/// runs a study, here or as a cluster's task, runs it this way.
 pub fn run(cfg: &StudyConfig, place: &Place) -> Result<()> {
-    with_hooks(cfg.name(), cfg.unit(), true, place.json, |hooks| {
-        outputs::run(cfg, place, hooks)
+    with_hooks(cfg.name(), cfg.unit(), place.json, |hooks| {
+        cfg.run(place, hooks)
     })
-}
-
-/// Runs `paper`.
-pub fn paper(cfg: &PaperConfig, place: &Place) -> Result<()> {
-    run(&StudyConfig::Paper(cfg.clone()), place)
-}
-
-/// Runs `validate`.
-pub fn validate(cfg: &validate::Config, place: &Place) -> Result<()> {
-    with_hooks(
-        "validate",
-        outputs::Unit::Cells,
-        true,
-        place.json,
-        |hooks| outputs::validate(cfg, place, hooks),
-    )
 }
 
 /// How often a command whose stderr is not a terminal says how far it has come:
@@ -89,12 +75,11 @@ pub fn every() -> Duration {
 /// prints what it says.
 fn with_hooks(
     command: &'static str,
-    unit: outputs::Unit,
-    bar: bool,
+    unit: dicephys::report::progress::Unit,
     json: bool,
     run: impl FnOnce(&Hooks) -> dicephys::Result<Done>,
 ) -> Result<()> {
-    let progress = Progress::new(command, unit, bar, json, every());
+    let progress = Progress::new(command, unit, true, json, every());
     let log = |l: &str| progress.suspend(|| eprintln!("{l}"));
     let set = |done: f64, total: f64| progress.set(done, total);
     let done = run(&Hooks {
@@ -112,71 +97,4 @@ fn with_hooks(
         Some(m) => Err(Error::Interrupted(m)),
         None => Ok(()),
     }
-}
-
-/// Runs `fit` on one machine: the study a Slurm run splits, run whole.
-pub fn fit(cfg: dicephys::calibration::FitConfig, place: &Place) -> Result<()> {
-    run(
-        &StudyConfig::Fit(dicephys::studies::fit::FitStudy {
-            config: cfg,
-            stage: dicephys::studies::fit::Stage::Whole,
-        }),
-        place,
-    )
-}
-
-/// Runs `fit --recover`.
-pub fn recover(
-    cfg: &dicephys::calibration::FitConfig,
-    truth: &[f64],
-    repeats: usize,
-    place: &Place,
-) -> Result<()> {
-    let unit = outputs::Unit::Rolls {
-        per_cell: cfg.design.rolls,
-    };
-    with_hooks("fit", unit, true, place.json, |hooks| {
-        dicephys::studies::fit::outputs::recover(cfg, truth, repeats, place, hooks)
-    })
-}
-
-/// Runs `predict`.
-pub fn predict(
-    fit: &dicephys::calibration::FitResult,
-    cfg: &dicephys::calibration::predict::PredictConfig,
-    place: &Place,
-) -> Result<()> {
-    let unit = outputs::Unit::Rolls {
-        per_cell: cfg.rolls,
-    };
-    with_hooks("predict", unit, true, place.json, |hooks| {
-        dicephys::studies::fit::outputs::predict(fit, cfg, place, hooks)
-    })
-}
-
-/// Runs `predict --blocks`.
-pub fn predict_blocks(
-    fit: &dicephys::calibration::FitResult,
-    cfg: &dicephys::studies::fit::outputs::BlocksConfig,
-    place: &Place,
-) -> Result<()> {
-    let unit = outputs::Unit::Rolls {
-        per_cell: cfg.rolls,
-    };
-    with_hooks("predict", unit, true, place.json, |hooks| {
-        dicephys::studies::fit::outputs::predict_blocks(fit, cfg, place, hooks)
-    })
-}
-
-/// Runs `paper --calibrated`.
-pub fn calibrated(
-    cfg: &dicephys::studies::calibrated::CalibratedConfig,
-    place: &Place,
-) -> Result<()> {
-    let unit = outputs::Unit::Rolls {
-        per_cell: cfg.design.rolls,
-    };
-    with_hooks("paper --calibrated", unit, true, place.json, |hooks| {
-        dicephys::studies::fit::outputs::calibrated(cfg, place, hooks)
-    })
 }

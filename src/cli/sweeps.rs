@@ -240,24 +240,18 @@ impl StabilityArgs {
 
 /// Runs `dicephys converge`.
 pub fn converge(a: &ConvergeArgs) -> Result<()> {
-    study::run(
-        &StudyConfig::Converge(a.config()),
-        &a.place.local("converge")?,
-    )
+    let cfg = StudyConfig::Converge(a.config());
+    study::run(&cfg, &a.place.local("converge", &cfg)?)
 }
 
 /// Runs `dicephys tradeoff`.
 pub fn tradeoff(a: &TradeoffArgs) -> Result<()> {
-    study::run(
-        &StudyConfig::Tradeoff(a.config()?),
-        &a.place.local("tradeoff")?,
-    )
+    let cfg = StudyConfig::Tradeoff(a.config()?);
+    study::run(&cfg, &a.place.local("tradeoff", &cfg)?)
 }
 
 /// Runs `dicephys stability`.
 pub fn stability(a: &StabilityArgs) -> Result<()> {
-    study::run(
-        &StudyConfig::Stability(a.config()),
-        &a.place.local("stability")?,
-    )
+    let cfg = StudyConfig::Stability(a.config());
+    study::run(&cfg, &a.place.local("stability", &cfg)?)
 }

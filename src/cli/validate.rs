@@ -12,6 +12,7 @@ use dicephys::engine::EngineKind;
 use dicephys::model::block::Block;
 use dicephys::studies::sweep::parse_dt;
 use dicephys::studies::validate as v;
+use dicephys::studies::StudyConfig;
 
 /// `dicephys validate`'s arguments.
 #[derive(Args, Debug)]
@@ -94,7 +95,7 @@ impl ValidateArgs {
 
 /// Runs `dicephys validate`.
 pub fn run(a: &ValidateArgs) -> Result<()> {
-    let cfg = a.config();
+    let cfg = StudyConfig::Validate(a.config());
     cfg.validate()?;
-    study::validate(&cfg, &a.place.local("validate")?)
+    study::run(&cfg, &a.place.local("validate", &cfg)?)
 }

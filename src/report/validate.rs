@@ -18,7 +18,7 @@ pub const Z_PASS: f64 = 3.0;
 
 /// What `validate` runs: its defaults and checks are the study's (`studies::validate`);
 /// the results echo it.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Config {
     /// The engines (Bullet brings its presets and the fast flight to the free-flight case).
     pub engines: Vec<EngineKind>,

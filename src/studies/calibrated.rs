@@ -19,9 +19,14 @@ use crate::calibration::params::{self, Kind, Method, ModelSpec};
 use crate::calibration::{FitConfig, FitResult};
 use crate::error::{Error, Field, Result};
 use crate::model::scene::Mode;
+use crate::report::fit as report;
+use crate::report::progress::Unit;
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::runner::Runner;
+use crate::run::seal;
 use crate::studies::fit::{self, Fitted, Session, Stage};
+use crate::studies::kind;
+use crate::studies::place::{to_json, unless_stopped, Done, Hooks, Place};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::time::Instant;
@@ -582,4 +587,99 @@ fn conclude(
         single_row_surfaces: single,
         rolls,
     }))
+}
+
+impl kind::Kind for CalibratedStudy {
+    fn name(&self) -> &'static str {
+        "paper --calibrated"
+    }
+    fn validate(&self) -> Result<()> {
+        CalibratedStudy::validate(self)
+    }
+    fn unit(&self) -> Unit {
+        Unit::Rolls {
+            per_cell: self.config.design.rolls,
+        }
+    }
+    fn cells(&self) -> &'static str {
+        "calibration"
+    }
+    fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
+        run_study(self, place, hooks)
+    }
+}
+
+/// `paper --calibrated`, or a stage of it on a cluster: calibrated.json, calibrated.md and
+/// figures in `place.out`, the cells under `place.checkpoint`; the first stage writes only
+/// every model's first pass ([`FIRST_PASSES`]); a cluster task's share writes nothing.
+fn run_study(study: &CalibratedStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
+    study.validate()?;
+    let cfg = &study.config;
+    let first = study.stage == Stage::First;
+    let files: &[&'static str] = if first {
+        &[FIRST_PASSES]
+    } else {
+        &["calibrated.json", "calibrated.md"]
+    };
+    let outputs = place.outputs(files)?;
+    let all = total_rolls(cfg)? as f64;
+    let firsts = first_pass_rolls(cfg)? as f64;
+    let total = match study.stage {
+        Stage::Whole => all,
+        Stage::First => firsts,
+        Stage::Second { .. } => all - firsts,
+    };
+    let progress = |n: u64| (hooks.progress)(n as f64, total.max(n as f64));
+    let mut sim = place.study(&hooks.stop, &progress);
+    sim.runner = sim.runner.with_say(hooks.log);
+    let (runner, dir) = (&sim.runner, sim.checkpoint.as_deref());
+    let command_line = place.command_line.clone();
+    if first {
+        let res =
+            unless_stopped(runner.install(|| study.first_passes(&command_line, runner, dir))?)?;
+        if place.partial() {
+            return Ok(Done::default());
+        }
+        let Some(res) = res else {
+            return Ok(place.interrupted());
+        };
+        (hooks.progress)(total, total);
+        let json = seal::to_string(&res, true)?;
+        outputs.write(FIRST_PASSES, json.as_bytes())?;
+        let text: String = res
+            .passes
+            .iter()
+            .map(|(name, r)| format!("model {name}:\n{}", report::first_pass_text(r)))
+            .collect();
+        let mut done = place.done(&json, &text, FIRST_PASSES);
+        done.note = done.note.map(|_| {
+            format!(
+                "wrote {}/{FIRST_PASSES}: every model's first pass, which its second narrows \
+                 its box from",
+                place.out.display()
+            )
+        });
+        return Ok(done);
+    }
+    let res = unless_stopped(runner.install(|| study.run(command_line, runner, dir))?)?;
+    if place.partial() {
+        return Ok(Done::default());
+    }
+    let Some(res) = res else {
+        return Ok(place.interrupted());
+    };
+    (hooks.progress)(total, total);
+    let figures = report::write_calibrated_figures(&place.out, &res)?;
+    let md = report::calibrated_markdown(&res, &figures);
+    let json = to_json(&res)?;
+    outputs.write("calibrated.json", json.as_bytes())?;
+    outputs.write("calibrated.md", md.as_bytes())?;
+    let mut done = place.done(&json, &md, "calibrated.md");
+    done.note = done.note.map(|_| {
+        format!(
+            "wrote {}/calibrated.md, calibrated.json and figures",
+            place.out.display()
+        )
+    });
+    Ok(done)
 }

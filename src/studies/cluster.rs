@@ -73,7 +73,7 @@ fn stage(s: &Submitted, job: &Job, dry: bool) -> Result<Staged> {
             progress: &|_, _| {},
             stop: Stop::new(),
         };
-        match outputs::run(cfg, &place, &quiet) {
+        match cfg.run(&place, &quiet) {
             Ok(_) | Err(Error::Stopped) => Ok(()),
             Err(e) => Err(e),
         }
@@ -90,7 +90,7 @@ fn stage(s: &Submitted, job: &Job, dry: bool) -> Result<Staged> {
 /// second into `DIR`, its boxes narrowed from the first's results, so that it can only start
 /// when the first has finished ([`submit`] chains them).
 pub fn stages(s: &Submitted, job: &Job) -> Result<Vec<Staged>> {
-    let Some((first_cfg, file)) = s.config.study().at_stage(Stage::First) else {
+    let Some((first_cfg, file)) = s.config.at_stage(Stage::First) else {
         return stage(s, job, true).map(|one| vec![one]);
     };
     let pass = |config| Submitted {
@@ -107,7 +107,6 @@ pub fn stages(s: &Submitted, job: &Job) -> Result<Vec<Staged>> {
         let from = first.1.dir.join(file);
         let (second_cfg, _) = s
             .config
-            .study()
             .at_stage(Stage::Second { first: from })
             .expect("a study of two stages");
         let second = stage(&pass(second_cfg), job, false)?;

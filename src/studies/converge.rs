@@ -111,6 +111,21 @@ impl Claim {
 }
 
 impl Config {
+    /// What makes two runs of it one run (`StudyConfig::identity`): rolled to a precision, less
+    /// the precision, the budgets and the rolls it sets.
+    pub fn identity(&self) -> Config {
+        if self.precision.is_none() {
+            return self.clone();
+        }
+        Config {
+            precision: Some(0.0),
+            budget_s: 0.0,
+            reference_budget_s: 0.0,
+            rolls: 0,
+            ..self.clone()
+        }
+    }
+
     /// Checks every value before anything runs.
     pub fn validate(&self) -> Result<()> {
         nonempty(&self.blocks, Field::Blocks)?;

@@ -3,10 +3,11 @@
 //! A cluster task rolls its share and writes nothing; the finishing job writes the result.
 //! What the caller should print comes back as [`Done`].
 
-use super::place::{to_json, Claimant, Outputs};
+use super::kind::Kind;
+use super::place::{to_json, Outputs};
 pub use super::place::{Done, Hooks, Place};
 use super::study::Study;
-use super::{Kind, StudyConfig};
+use super::StudyConfig;
 use crate::error::{Error, Field, Result};
 use crate::report;
 use crate::report::per_roll::PerRoll;
@@ -31,9 +32,6 @@ impl Kind for studies::paper::PaperConfig {
     fn validate(&self) -> Result<()> {
         studies::paper::PaperConfig::validate(self)
     }
-    fn config(&self) -> StudyConfig {
-        StudyConfig::Paper(self.clone())
-    }
     fn unit(&self) -> Unit {
         Unit::Rolls {
             per_cell: self.rolls,
@@ -50,9 +48,6 @@ impl Kind for studies::crosscheck::Config {
     }
     fn validate(&self) -> Result<()> {
         studies::crosscheck::Config::validate(self)
-    }
-    fn config(&self) -> StudyConfig {
-        StudyConfig::Crosscheck(self.clone())
     }
     fn unit(&self) -> Unit {
         Unit::Rolls {
@@ -73,22 +68,6 @@ impl Kind for studies::converge::Config {
     }
     fn validate(&self) -> Result<()> {
         studies::converge::Config::validate(self)
-    }
-    fn config(&self) -> StudyConfig {
-        StudyConfig::Converge(self.clone())
-    }
-    /// Rolled to a precision: less the precision, the budgets and the rolls it sets.
-    fn identity(&self) -> StudyConfig {
-        if self.precision.is_none() {
-            return self.config();
-        }
-        StudyConfig::Converge(studies::converge::Config {
-            precision: Some(0.0),
-            budget_s: 0.0,
-            reference_budget_s: 0.0,
-            rolls: 0,
-            ..self.clone()
-        })
     }
     fn unit(&self) -> Unit {
         if self.precision.is_some() {
@@ -120,20 +99,6 @@ impl Kind for studies::tradeoff::Config {
     fn validate(&self) -> Result<()> {
         studies::tradeoff::Config::validate(self)
     }
-    fn config(&self) -> StudyConfig {
-        StudyConfig::Tradeoff(self.clone())
-    }
-    /// Less the precision, the budgets, `plan_only` and `preroll_chunks`.
-    fn identity(&self) -> StudyConfig {
-        StudyConfig::Tradeoff(studies::tradeoff::Config {
-            precision: 0.0,
-            budget_s: 0.0,
-            reference_budget_s: 0.0,
-            plan_only: false,
-            preroll_chunks: None,
-            ..self.clone()
-        })
-    }
     fn unit(&self) -> Unit {
         Unit::Cpu
     }
@@ -150,17 +115,6 @@ impl Kind for studies::tradeoff::Config {
         }
         Ok(())
     }
-    /// Its tasks only rolled ahead: the finishing job runs it whole (no `preroll_chunks`),
-    /// reading their chunks back and rolling on where a method needs more.
-    fn finishing(&self, _tasks: u64) -> (StudyConfig, ChunkShare) {
-        (
-            StudyConfig::Tradeoff(studies::tradeoff::Config {
-                preroll_chunks: None,
-                ..self.clone()
-            }),
-            ChunkShare::All,
-        )
-    }
     fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
         tradeoff(self, place, hooks)
     }
@@ -173,11 +127,20 @@ impl Kind for studies::stability::Config {
     fn validate(&self) -> Result<()> {
         studies::stability::Config::validate(self)
     }
-    fn config(&self) -> StudyConfig {
-        StudyConfig::Stability(self.clone())
-    }
     fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
         stability(self, place, hooks)
+    }
+}
+
+impl Kind for studies::validate::Config {
+    fn name(&self) -> &'static str {
+        "validate"
+    }
+    fn validate(&self) -> Result<()> {
+        studies::validate::Config::validate(self)
+    }
+    fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
+        validate(self, place, hooks)
     }
 }
 
@@ -274,18 +237,6 @@ pub fn roll_into(
     summary.partial = !done.complete;
     summary.precision = reached;
     Ok(summary)
-}
-
-/// Runs a study that a cluster can split.
-pub fn run(config: &StudyConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
-    let study = config.study();
-    // The directory it writes into is this run's, or refused.
-    if let Some(dir) = study.owns(place) {
-        study.validate()?;
-        // A run here was refused a Slurm run's directory before its place was made.
-        super::place::claim(dir, study.name(), &config.identity(), Claimant::Checked)?;
-    }
-    study.run(place, hooks)
 }
 
 /// `paper`: results.json, results.csv, report.md and the figures, in `place.out`; its cells
@@ -450,7 +401,6 @@ pub fn stability(cfg: &studies::stability::Config, place: &Place, hooks: &Hooks)
 /// `validate`: validate.json, report.md and its figures.
 pub fn validate(cfg: &studies::validate::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
     cfg.validate()?;
-    super::place::claim(&place.out, "validate", cfg, Claimant::Checked)?;
     let outputs = place.outputs(&["validate.json", "report.md"])?;
     let Some(res) = logged(place, hooks, &report::validate::header(), |study, log| {
         studies::validate::run(cfg, study, log, hooks.progress)

@@ -134,6 +134,15 @@ pub(crate) fn interrupted(kept: Option<&std::path::Path>) -> Done {
     }
 }
 
+/// A stop request met where no roll is kept (a fit's estimate) ends the study as one met
+/// between rolls does: with nothing.
+pub(crate) fn unless_stopped<T>(r: Result<Option<T>>) -> Result<Option<T>> {
+    match r {
+        Err(Error::Stopped) => Ok(None),
+        r => r,
+    }
+}
+
 /// A study's output files, checked writable before it rolls, each written by its name.
 pub(crate) struct Outputs(Vec<(&'static str, Output)>);
 

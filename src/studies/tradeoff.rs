@@ -67,6 +67,29 @@ pub struct Config {
 }
 
 impl Config {
+    /// What makes two runs of it one run (`StudyConfig::identity`): less the precision, the
+    /// budgets, `plan_only` and `preroll_chunks`.
+    pub fn identity(&self) -> Config {
+        Config {
+            precision: 0.0,
+            budget_s: 0.0,
+            reference_budget_s: 0.0,
+            plan_only: false,
+            preroll_chunks: None,
+            ..self.clone()
+        }
+    }
+
+    /// What a cluster run's finishing job runs: its tasks only rolled ahead, so it runs whole
+    /// (no `preroll_chunks`), reading their chunks back and rolling on where a method needs
+    /// more.
+    pub fn finishing(&self) -> Config {
+        Config {
+            preroll_chunks: None,
+            ..self.clone()
+        }
+    }
+
     /// Checks every value before anything runs.
     pub fn validate(&self) -> Result<()> {
         nonempty(&self.blocks, Field::Blocks)?;

@@ -410,6 +410,53 @@ pub struct FitStudy {
     pub stage: Stage,
 }
 
+/// `fit --recover`: counts simulated at `truth` (every free parameter's value, in the model's
+/// order) for the rows of `config`, fitted back `repeats` times, each its own data and
+/// simulations; it reports how often the 2σ region holds the truth.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RecoverStudy {
+    /// What to fit (its rows give the blocks and numbers of throws).
+    pub config: FitConfig,
+    /// The truth.
+    pub truth: Vec<f64>,
+    /// Repetitions.
+    pub repeats: usize,
+}
+
+/// `predict --block`: the fit simulated at a block it did not see, at its posterior draws.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PredictStudy {
+    /// The fit, as its fit.json holds it.
+    pub fit: FitResult,
+    /// What to predict.
+    pub config: crate::calibration::predict::PredictConfig,
+}
+
+/// `predict --blocks-file`: the fit simulated at each of many blocks, held against their
+/// counts where measured.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BlocksStudy {
+    /// The fit, as its fit.json holds it.
+    pub fit: FitResult,
+    /// The blocks, and the draws and rolls of each.
+    pub config: BlocksConfig,
+}
+
+/// What `predict --blocks` predicts: the blocks, and the draws and rolls of each.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BlocksConfig {
+    /// The blocks, with their counts where measured.
+    pub rows: Vec<crate::calibration::heldout::BlockRow>,
+    /// Posterior draws a block.
+    pub draws: usize,
+    /// Rolls a draw.
+    pub rolls: u64,
+    /// The throws' seed.
+    pub seed: u64,
+    /// The fit's file, as given.
+    pub fit: String,
+}
+
 /// Which part of a fit a study runs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

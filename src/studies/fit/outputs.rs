@@ -2,17 +2,13 @@
 //! before anything rolls, the study run with its progress, its results rendered and written
 //! whole (as [`crate::studies::outputs`] does for the other studies).
 
-use super::{FitStudy, Stage, FIRST_PASS};
-use crate::calibration::predict::PredictConfig;
-use crate::calibration::{FitConfig, FitResult};
-use crate::error::{Error, Result};
+use super::{BlocksStudy, FitStudy, PredictStudy, RecoverStudy, Stage, FIRST_PASS};
+use crate::error::Result;
 use crate::report::fit as report;
 use crate::report::progress::Unit;
 use crate::run::seal;
-use crate::studies::calibrated::{self, CalibratedConfig, CalibratedStudy, FIRST_PASSES};
-use crate::studies::place::{interrupted, to_json, Done, Hooks, Place};
-use crate::studies::{Kind, StudyConfig};
-use serde::Serialize;
+use crate::studies::kind::Kind;
+use crate::studies::place::{interrupted, to_json, unless_stopped, Done, Hooks, Place};
 
 impl Kind for FitStudy {
     fn name(&self) -> &'static str {
@@ -20,9 +16,6 @@ impl Kind for FitStudy {
     }
     fn validate(&self) -> Result<()> {
         FitStudy::validate(self)
-    }
-    fn config(&self) -> StudyConfig {
-        StudyConfig::Fit(self.clone())
     }
     fn unit(&self) -> Unit {
         Unit::Rolls {
@@ -32,76 +25,69 @@ impl Kind for FitStudy {
     fn cells(&self) -> &'static str {
         "cells"
     }
-    /// A refined fit is two stages on a cluster: its first pass, then its second.
-    fn at_stage(&self, stage: Stage) -> Option<(StudyConfig, &'static str)> {
-        self.config.design.refine.then(|| {
-            (
-                StudyConfig::Fit(FitStudy {
-                    config: self.config.clone(),
-                    stage,
-                }),
-                FIRST_PASS,
-            )
-        })
-    }
     fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
         fit(self, place, hooks)
     }
 }
 
-impl Kind for CalibratedStudy {
+impl Kind for RecoverStudy {
     fn name(&self) -> &'static str {
-        "paper --calibrated"
+        "fit --recover"
     }
     fn validate(&self) -> Result<()> {
-        CalibratedStudy::validate(self)
-    }
-    fn config(&self) -> StudyConfig {
-        StudyConfig::Calibrated(self.clone())
+        self.config.validate()?;
+        super::recovery::check_truth(&self.config, &self.truth, self.repeats)
     }
     fn unit(&self) -> Unit {
         Unit::Rolls {
             per_cell: self.config.design.rolls,
         }
     }
+    /// Its repetitions keep no cells.
     fn cells(&self) -> &'static str {
-        "calibration"
-    }
-    /// Refined, two stages: every model's first pass, then every model's second and the rest.
-    fn at_stage(&self, stage: Stage) -> Option<(StudyConfig, &'static str)> {
-        self.config.design.refine.then(|| {
-            (
-                StudyConfig::Calibrated(CalibratedStudy {
-                    config: self.config.clone(),
-                    stage,
-                }),
-                FIRST_PASSES,
-            )
-        })
+        "cells"
     }
     fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
-        calibrated_study(self, place, hooks)
+        recover(self, place, hooks)
     }
 }
 
-/// Claims `place.out` for this run (`run::owner`), once every value has been checked: refused
-/// if another command or another run owns it, or if a Slurm run does (neither `fit --recover`
-/// nor `paper --calibrated` runs on a cluster).
-fn claim<T: Serialize>(place: &Place, command: &str, identity: &T) -> Result<()> {
-    crate::studies::place::claim(
-        &place.out,
-        command,
-        identity,
-        crate::studies::place::Claimant::Here,
-    )
+impl Kind for PredictStudy {
+    fn name(&self) -> &'static str {
+        "predict"
+    }
+    fn validate(&self) -> Result<()> {
+        super::predict::check(&self.fit, &self.config)
+    }
+    fn unit(&self) -> Unit {
+        Unit::Rolls {
+            per_cell: self.config.rolls,
+        }
+    }
+    /// It writes nothing.
+    fn owns<'a>(&self, _place: &'a Place) -> Option<&'a std::path::Path> {
+        None
+    }
+    fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
+        predict(self, place, hooks)
+    }
 }
 
-/// A stop request met in the estimate (no rolls to keep there) ends the study as one met
-/// between rolls does.
-fn unless_stopped<T>(r: Result<Option<T>>) -> Result<Option<T>> {
-    match r {
-        Err(Error::Stopped) => Ok(None),
-        r => r,
+impl Kind for BlocksStudy {
+    fn name(&self) -> &'static str {
+        "predict --blocks"
+    }
+    fn validate(&self) -> Result<()> {
+        let c = &self.config;
+        super::predict::check_blocks(&self.fit, &c.rows, c.draws, c.rolls, c.seed)
+    }
+    fn unit(&self) -> Unit {
+        Unit::Rolls {
+            per_cell: self.config.rolls,
+        }
+    }
+    fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
+        predict_blocks(self, place, hooks)
     }
 }
 
@@ -162,16 +148,8 @@ pub fn fit(study: &FitStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
 }
 
 /// `fit --recover`: recovery.json in `place.out`, the coverage printed.
-pub fn recover(
-    cfg: &FitConfig,
-    truth: &[f64],
-    repeats: usize,
-    place: &Place,
-    hooks: &Hooks,
-) -> Result<Done> {
-    cfg.validate()?;
-    super::recovery::check_truth(cfg, truth, repeats)?;
-    claim(place, "fit --recover", &(cfg, truth, repeats))?;
+fn recover(study: &RecoverStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
+    let (cfg, truth, repeats) = (&study.config, &study.truth, study.repeats);
     let outputs = place.outputs(&["recovery.json"])?;
     let data: u64 = cfg.rows.iter().map(|r| r.counts.iter().sum::<u64>()).sum();
     let passes = if cfg.design.refine { 2 } else { 1 };
@@ -198,8 +176,8 @@ pub fn recover(
 }
 
 /// `predict`: the block's probabilities printed (no files).
-pub fn predict(fit: &FitResult, cfg: &PredictConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
-    super::predict::check(fit, cfg)?;
+fn predict(study: &PredictStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
+    let (fit, cfg) = (&study.fit, &study.config);
     let total = (cfg.draws as u64 * cfg.rolls) as f64;
     let progress = |n: u64| (hooks.progress)(n as f64, total);
     let study = place.study(&hooks.stop, &progress);
@@ -219,37 +197,14 @@ pub fn predict(fit: &FitResult, cfg: &PredictConfig, place: &Place, hooks: &Hook
     })
 }
 
-/// What `predict --blocks` predicts: the blocks, and the draws and rolls of each.
-#[derive(Clone, Debug, Serialize)]
-pub struct BlocksConfig {
-    /// The blocks, with their counts where measured.
-    pub rows: Vec<crate::calibration::heldout::BlockRow>,
-    /// Posterior draws a block.
-    pub draws: usize,
-    /// Rolls a draw.
-    pub rolls: u64,
-    /// The throws' seed.
-    pub seed: u64,
-    /// The fit's file, as given.
-    pub fit: String,
-}
-
 /// `predict --blocks`: predictions.json, predictions.csv, report.md and the figure
 /// `predictions` in `place.out` (claimed as a study's); the table printed.
-pub fn predict_blocks(
-    fit: &FitResult,
-    cfg: &BlocksConfig,
-    place: &Place,
-    hooks: &Hooks,
-) -> Result<Done> {
+fn predict_blocks(study: &BlocksStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
+    let (fit, cfg) = (&study.fit, &study.config);
     let (stem, files) = (
         "predictions",
         ["predictions.json", "predictions.csv", "report.md"],
     );
-    // Every row checked before the directory is claimed.
-    super::predict::check_blocks(fit, &cfg.rows, cfg.draws, cfg.rolls, cfg.seed)?;
-    let identity = (cfg, &fit.config, &fit.estimate.x);
-    claim(place, "predict --blocks", &identity)?;
     let outputs = place.outputs(&files)?;
     let total = (cfg.rows.len() as u64 * cfg.draws as u64 * cfg.rolls) as f64;
     let progress = |n: u64| (hooks.progress)(n as f64, total);
@@ -273,93 +228,6 @@ pub fn predict_blocks(
     done.note = done.note.map(|_| {
         format!(
             "wrote {}/predictions.json, predictions.csv, report.md and the figure",
-            place.out.display()
-        )
-    });
-    Ok(done)
-}
-
-/// `paper --calibrated` on one machine: its directory claimed (refused if a Slurm run owns
-/// it), then [`calibrated_study`], whole.
-pub fn calibrated(cfg: &CalibratedConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
-    cfg.validate()?;
-    claim(place, "paper --calibrated", cfg)?;
-    let study = CalibratedStudy {
-        config: cfg.clone(),
-        stage: Stage::Whole,
-    };
-    calibrated_study(&study, place, hooks)
-}
-
-/// `paper --calibrated`, or a stage of it on a cluster: calibrated.json, calibrated.md and
-/// figures in `place.out`, the cells under `place.checkpoint`; the first stage writes only
-/// every model's first pass ([`FIRST_PASSES`]); a cluster task's share writes nothing.
-pub fn calibrated_study(study: &CalibratedStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
-    study.validate()?;
-    let cfg = &study.config;
-    let first = study.stage == Stage::First;
-    let files: &[&'static str] = if first {
-        &[FIRST_PASSES]
-    } else {
-        &["calibrated.json", "calibrated.md"]
-    };
-    let outputs = place.outputs(files)?;
-    let all = calibrated::total_rolls(cfg)? as f64;
-    let firsts = calibrated::first_pass_rolls(cfg)? as f64;
-    let total = match study.stage {
-        Stage::Whole => all,
-        Stage::First => firsts,
-        Stage::Second { .. } => all - firsts,
-    };
-    let progress = |n: u64| (hooks.progress)(n as f64, total.max(n as f64));
-    let mut sim = place.study(&hooks.stop, &progress);
-    sim.runner = sim.runner.with_say(hooks.log);
-    let (runner, dir) = (&sim.runner, sim.checkpoint.as_deref());
-    let command_line = place.command_line.clone();
-    if first {
-        let res =
-            unless_stopped(runner.install(|| study.first_passes(&command_line, runner, dir))?)?;
-        if place.partial() {
-            return Ok(Done::default());
-        }
-        let Some(res) = res else {
-            return Ok(place.interrupted());
-        };
-        (hooks.progress)(total, total);
-        let json = seal::to_string(&res, true)?;
-        outputs.write(FIRST_PASSES, json.as_bytes())?;
-        let text: String = res
-            .passes
-            .iter()
-            .map(|(name, r)| format!("model {name}:\n{}", report::first_pass_text(r)))
-            .collect();
-        let mut done = place.done(&json, &text, FIRST_PASSES);
-        done.note = done.note.map(|_| {
-            format!(
-                "wrote {}/{FIRST_PASSES}: every model's first pass, which its second narrows \
-                 its box from",
-                place.out.display()
-            )
-        });
-        return Ok(done);
-    }
-    let res = unless_stopped(runner.install(|| study.run(command_line, runner, dir))?)?;
-    if place.partial() {
-        return Ok(Done::default());
-    }
-    let Some(res) = res else {
-        return Ok(place.interrupted());
-    };
-    (hooks.progress)(total, total);
-    let figures = report::write_calibrated_figures(&place.out, &res)?;
-    let md = report::calibrated_markdown(&res, &figures);
-    let json = to_json(&res)?;
-    outputs.write("calibrated.json", json.as_bytes())?;
-    outputs.write("calibrated.md", md.as_bytes())?;
-    let mut done = place.done(&json, &md, "calibrated.md");
-    done.note = done.note.map(|_| {
-        format!(
-            "wrote {}/calibrated.md, calibrated.json and figures",
             place.out.display()
         )
     });
