@@ -5,7 +5,6 @@ use crate::engine::EngineKind;
 use crate::model::faces;
 use crate::model::scene::{Floor, Mode, Preset};
 use crate::model::throws::{ThrowKind, ThrowRanges, ThrowStyle};
-use crate::run::slurm::{Layout, Plan};
 use crate::run::spec::RunSpec;
 use crate::run::tally::{Counts, Tally};
 use crate::sim::roll::{Failure, Rule};
@@ -642,34 +641,6 @@ pub struct ShardResult {
     pub cpu_s: f64,
     /// Worker threads.
     pub threads: usize,
-}
-
-impl RunSummary {
-    /// The shards of a `roll` through Slurm merged: every task's result there, whole and of
-    /// its shard (a damaged one moved aside, so that its task, rerun, writes it again).
-    pub fn merge_tasks(lay: &Layout, spec: &RunSpec, tasks: u64) -> crate::Result<RunSummary> {
-        let (mut parts, mut missing, mut why) = (Vec::new(), Vec::new(), Vec::new());
-        for k in 0..tasks {
-            let p = lay.shard_result(k);
-            match ShardResult::read(&p, &Plan::shard_spec(spec, k, tasks)) {
-                Ok(s) => parts.push(s),
-                Err(e) => {
-                    missing.push(k.to_string());
-                    // A result there but not usable is moved aside, so that the task, rerun,
-                    // writes it again rather than finding it there already.
-                    let aside = p.with_extension("json.damaged");
-                    why.push(match p.exists() && std::fs::rename(&p, &aside).is_ok() {
-                        true => format!("{e}; moved to {}", aside.display()),
-                        false => e,
-                    });
-                }
-            }
-        }
-        if !missing.is_empty() {
-            return Err(lay.not_finished(tasks, &missing, &why.join("; ")));
-        }
-        RunSummary::merge(&parts)
-    }
 }
 
 impl ShardResult {

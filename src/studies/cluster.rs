@@ -7,6 +7,7 @@ use super::fit::Stage;
 use super::outputs::{self, Hooks, Place};
 use super::StudyConfig;
 use crate::error::{Error, Field, Result};
+use crate::report::summary::{RunSummary, ShardResult};
 use crate::run::io::Output;
 use crate::run::runner::{Checkpoint, ChunkShare};
 use crate::run::slurm::{script_path, Layout, Options, Plan};
@@ -313,7 +314,7 @@ pub fn finishing(dir: &Path) -> Result<Finishing> {
             ))
         }
         Plan::Roll { spec, tasks, fair } => {
-            let merged = crate::report::summary::RunSummary::merge_tasks(&lay, &spec, tasks)?;
+            let merged = merge_shards(&lay, &spec, tasks)?;
             // What the one machine's `roll --json` (or `fair --json`) prints, and its text.
             let (json, text) = match fair {
                 None => (crate::run::seal::to_string(&merged, true)?, merged.human()),
@@ -335,6 +336,32 @@ pub fn finishing(dir: &Path) -> Result<Finishing> {
             )))
         }
     }
+}
+
+/// The shards of a `roll` through Slurm merged: every task's result there, whole and of its
+/// shard (a damaged one moved aside, so that its task, rerun, writes it again).
+fn merge_shards(lay: &Layout, spec: &RunSpec, tasks: u64) -> Result<RunSummary> {
+    let (mut parts, mut missing, mut why) = (Vec::new(), Vec::new(), Vec::new());
+    for k in 0..tasks {
+        let p = lay.shard_result(k);
+        match ShardResult::read(&p, &Plan::shard_spec(spec, k, tasks)) {
+            Ok(s) => parts.push(s),
+            Err(e) => {
+                missing.push(k.to_string());
+                // A result there but not usable is moved aside, so that the task, rerun,
+                // writes it again rather than finding it there already.
+                let aside = p.with_extension("json.damaged");
+                why.push(match p.exists() && std::fs::rename(&p, &aside).is_ok() {
+                    true => format!("{e}; moved to {}", aside.display()),
+                    false => e,
+                });
+            }
+        }
+    }
+    if !missing.is_empty() {
+        return Err(lay.not_finished(tasks, &missing, &why.join("; ")));
+    }
+    RunSummary::merge(&parts)
 }
 
 /// After the finishing step's study ran and `failed`: a chunk missing or damaged after its
