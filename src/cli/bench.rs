@@ -65,7 +65,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     }
     let quiet = *a.json;
     if !quiet {
-        outln!("{}", bench::header());
+        outln!("{}", dicephys::report::bench::header());
     }
     // A progress line that cannot be written (a closed pipe) is dropped; the result is
     // written, or its failure reported, at the end.

@@ -1,6 +1,7 @@
 //! What results say: a run's summary, the theory and the paper's table as reports, the paper's
 //! Markdown and CSV, and the figures.
 
+pub mod bench;
 pub mod converge;
 pub mod crosscheck;
 pub mod fair;
