@@ -84,6 +84,8 @@ pub enum Field {
     Contact,
     /// `counts`.
     Counts,
+    /// `data`.
+    Data,
     /// `density`.
     Density,
     /// `die`.
@@ -205,6 +207,8 @@ pub enum Field {
     Settle,
     /// `shape`.
     Shape,
+    /// `shared`.
+    Shared,
     /// `size`.
     Size,
     /// `spin`.

@@ -55,6 +55,16 @@ RangeArg = Union[None, float, Tuple[float, float]]
 DEFAULT_MAX_STEPS: int = _native.DEFAULT_MAX_STEPS
 DEFAULT_MARGIN: float = _native.DEFAULT_MARGIN
 DEFAULT_SEED: int = _native.DEFAULT_SEED
+DEFAULT_DT: float = _native.DEFAULT_DT
+DEFAULT_FRICTION: float = _native.DEFAULT_FRICTION
+DEFAULT_RESTITUTION: float = _native.DEFAULT_RESTITUTION
+DEFAULT_ROLLS: int = _native.DEFAULT_ROLLS
+DEFAULT_SPIN_SCALE: float = _native.DEFAULT_SPIN_SCALE
+DEFAULT_POINTS: int = _native.DEFAULT_POINTS
+DEFAULT_POINT_ROLLS: int = _native.DEFAULT_POINT_ROLLS
+DEFAULT_REPEATS: int = _native.DEFAULT_REPEATS
+DEFAULT_DRAWS: int = _native.DEFAULT_DRAWS
+DEFAULT_PREDICT_ROLLS: int = _native.DEFAULT_PREDICT_ROLLS
 
 
 class Value(NamedTuple):
@@ -361,9 +371,9 @@ def roll(
     seed: int = DEFAULT_SEED,
     mode: str = "3d",
     engine: str = "bullet",
-    dt: float = 1e-3,
-    restitution: float = 0.5,
-    friction: float = 0.29,
+    dt: float = DEFAULT_DT,
+    restitution: float = DEFAULT_RESTITUTION,
+    friction: float = DEFAULT_FRICTION,
     density: Optional[float] = None,
     throw: Optional[str] = None,
     kappa: Optional[float] = None,
@@ -479,9 +489,9 @@ def fair(
     seed: int = DEFAULT_SEED,
     mode: str = "3d",
     engine: str = "bullet",
-    dt: float = 1e-3,
-    restitution: float = 0.5,
-    friction: float = 0.29,
+    dt: float = DEFAULT_DT,
+    restitution: float = DEFAULT_RESTITUTION,
+    friction: float = DEFAULT_FRICTION,
     density: Optional[float] = None,
     throw: str = "tumble",
     kappa: Optional[float] = None,
@@ -577,10 +587,10 @@ def _log(line: str) -> None:
 def paper(
     out: PathLike = "paper-out",
     *,
-    rolls: int = 10_000,
+    rolls: int = DEFAULT_ROLLS,
     seed: int = DEFAULT_SEED,
     engines: Sequence[str] = ("bullet", "rapier"),
-    dt: float = 1e-3,
+    dt: float = DEFAULT_DT,
     max_steps: int = DEFAULT_MAX_STEPS,
     faithful: bool = False,
     threads: int = 0,
@@ -668,15 +678,15 @@ def fit(
     *,
     shared: Sequence[str] = (),
     ranges: Optional[Mapping[str, Tuple[float, float]]] = None,
-    restitution: float = 0.5,
-    friction: float = 0.29,
+    restitution: float = DEFAULT_RESTITUTION,
+    friction: float = DEFAULT_FRICTION,
     kappa: Union[None, str, float] = "paper",
-    spin_scale: float = 1.0,
+    spin_scale: float = DEFAULT_SPIN_SCALE,
     engine: str = "bullet",
-    dt: float = 1e-3,
+    dt: float = DEFAULT_DT,
     max_steps: int = DEFAULT_MAX_STEPS,
-    points: int = 64,
-    point_rolls: int = 500,
+    points: int = DEFAULT_POINTS,
+    point_rolls: int = DEFAULT_POINT_ROLLS,
     degree: Optional[int] = None,
     max_degree: Optional[int] = None,
     refine: bool = True,
@@ -736,19 +746,19 @@ def recover(
     data: Any,
     truth: Mapping[str, float],
     *,
-    repeats: int = 20,
+    repeats: int = DEFAULT_REPEATS,
     free: Optional[Sequence[str]] = None,
     shared: Sequence[str] = (),
     ranges: Optional[Mapping[str, Tuple[float, float]]] = None,
-    restitution: float = 0.5,
-    friction: float = 0.29,
+    restitution: float = DEFAULT_RESTITUTION,
+    friction: float = DEFAULT_FRICTION,
     kappa: Union[None, str, float] = "paper",
-    spin_scale: float = 1.0,
+    spin_scale: float = DEFAULT_SPIN_SCALE,
     engine: str = "bullet",
-    dt: float = 1e-3,
+    dt: float = DEFAULT_DT,
     max_steps: int = DEFAULT_MAX_STEPS,
-    points: int = 64,
-    point_rolls: int = 500,
+    points: int = DEFAULT_POINTS,
+    point_rolls: int = DEFAULT_POINT_ROLLS,
     degree: Optional[int] = None,
     max_degree: Optional[int] = None,
     refine: bool = True,
@@ -800,8 +810,8 @@ def predict(
     mode: str = "3d",
     surface: Optional[str] = None,
     thrower: Optional[str] = None,
-    draws: int = 16,
-    rolls: int = 2000,
+    draws: int = DEFAULT_DRAWS,
+    rolls: int = DEFAULT_PREDICT_ROLLS,
     seed: int = DEFAULT_SEED,
     threads: int = 0,
     progress: Progress = None,

@@ -8,6 +8,16 @@ from typing import Any, Callable, Dict, List, Optional, Tuple
 DEFAULT_MAX_STEPS: int
 DEFAULT_MARGIN: float
 DEFAULT_SEED: int
+DEFAULT_DT: float
+DEFAULT_FRICTION: float
+DEFAULT_RESTITUTION: float
+DEFAULT_ROLLS: int
+DEFAULT_SPIN_SCALE: float
+DEFAULT_POINTS: int
+DEFAULT_POINT_ROLLS: int
+DEFAULT_REPEATS: int
+DEFAULT_DRAWS: int
+DEFAULT_PREDICT_ROLLS: int
 
 _Progress = Optional[Callable[[float, float], Any]]
 _Log = Optional[Callable[[str], Any]]

@@ -17,16 +17,16 @@ use dicephys::error::parse_name;
 use dicephys::error::Field;
 use dicephys::model::block::Block;
 use dicephys::model::faces::Layout;
-use dicephys::model::mass::Features;
-use dicephys::model::scene::{Floor, Mode, Preset, Scene};
+use dicephys::model::scene::Mode;
 use dicephys::model::throws::DEFAULT_SEED;
-use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
+use dicephys::model::throws::{Range, ThrowRanges, ThrowStyle};
 use dicephys::report::per_roll::PerRoll;
 use dicephys::report::summary::Target;
+use dicephys::run::request::{DieRequest, EndRequest, RollRequest, SceneRequest, ThrowRequest};
 use dicephys::run::runner::{ChunkShare, Runner};
-use dicephys::run::spec::{RunSpec, ThrowSpec};
+use dicephys::run::spec::RunSpec;
 use dicephys::run::stop::Stop;
-use dicephys::sim::roll::{RollConfig, RollRecord, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
+use dicephys::sim::roll::{RollRecord, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
 use dicephys::studies::outputs;
 use dicephys::studies::place::{Done, Hooks, Place};
 use dicephys::studies::StudyConfig;
@@ -295,133 +295,108 @@ impl<'py> Options<'py> {
 }
 
 /// The scene, the throws and the roll of `roll` and `fair` from their options (`dicephys
-/// roll`'s, by the library's names and units: mm for the die as made), checked by the library.
+/// roll`'s, by the library's names and units: mm for the die as made): the library's request,
+/// whose defaults and checks are the library's.
 fn spec(
     block_: Option<&str>,
     o: &Options,
     layout: Option<Layout>,
     precision: bool,
 ) -> PyResult<RunSpec> {
-    let scene = scene_of(block_, o, layout)?;
-    let throws = throws_of(o, &scene)?;
-    let roll = roll_of(o, &scene)?;
-    let spec = RunSpec {
-        engine: named::<EngineKind>("engine", "engine", &o.get("engine", "bullet".to_string())?)?,
-        roll,
-        scene,
-        throws,
-        rolls: o.get("rolls", if precision { 10_000_000 } else { 10_000 })?,
+    let request = RollRequest {
+        scene: scene_of(block_, o, layout)?,
+        throws: throws_of(o)?,
+        end: end_of(o)?,
+        engine: match o.maybe::<String>("engine")? {
+            Some(e) => named::<EngineKind>("engine", "engine", &e)?,
+            None => RollRequest::default().engine,
+        },
+        rolls: o.maybe("rolls")?,
+        to_precision: precision,
         shard: None,
     };
-    spec.validate(false).map_err(py_err)?;
-    Ok(spec)
+    request.spec().map_err(py_err)
 }
 
-/// The scene of `roll`'s options: the die (a block, a shape, a mesh or a die file) as made, on
-/// its floor.
-fn scene_of(block_: Option<&str>, o: &Options, layout: Option<Layout>) -> PyResult<Scene> {
-    // A die of any shape (`shape`, or a mesh `die`) in place of the block; no die at all: a
-    // 16 mm d6, as the command line's.
-    let die = o.maybe::<PathBuf>("die")?;
-    let mut shape = dicephys::model::shape::described(
-        die.as_deref(),
-        o.maybe::<String>("shape")?.as_deref(),
-        o.maybe("size")?,
-        o.maybe("scale")?,
-    )
-    .map_err(py_err)?;
-    let the_block = match (block_, &shape) {
-        (Some(_), Some(_)) => {
-            return Err(bad(
-                "block",
-                "",
-                "the block is the cuboid; shape (or a mesh die) replaces it: give one",
-            ))
-        }
-        (Some(b), None) => block(b)?,
-        (None, s) => {
-            if s.is_none() {
-                shape = dicephys::model::shape::described(None, Some("d6"), None, None)
-                    .map_err(py_err)?;
-            }
-            block("1x1x1")?
-        }
-    };
-    let mut scene = Scene::paper(the_block, mode(&o.get("mode", "3d".to_string())?)?);
-    if let Some(s) = shape {
-        scene = scene.with_shape(s);
+/// The option `name` read by the library's names (`named`), or `default`.
+fn named_or<T>(o: &Options, name: &str, what: &str, default: T) -> PyResult<T>
+where
+    T: std::str::FromStr + strum::VariantNames,
+{
+    match o.maybe::<String>(name)? {
+        Some(s) => named::<T>(name, what, &s),
+        None => Ok(default),
     }
-    scene.dt = o.get("dt", scene.dt)?;
-    scene.friction = o.get("friction", scene.friction)?;
-    scene.restitution = o.get("restitution", scene.restitution)?;
-    scene.preset = named::<Preset>(
-        "preset",
-        "preset",
-        &o.get("preset", "dicephys281".to_string())?,
-    )?;
-    scene.floor = named::<Floor>("floor", "floor", &o.get("floor", "box".to_string())?)?;
-    scene.linear_damping = o.get("linear_damping", 0.0)?;
-    scene.rolling_resistance = o.get("rolling_resistance", 0.0)? / 1000.0;
-    scene.angular_damping = o.get("angular_damping", 0.0)?;
-    scene.sleeping = o.get("sleep", true)?;
-    let (features, density) = Features::described(
-        die.as_deref(),
-        o.maybe("com")?,
-        o.maybe("pips")?,
-        o.maybe("edge_radius")?,
-        layout,
-        o.maybe::<f64>("density")?,
-    )
-    .map_err(py_err)?;
-    scene.features = features;
-    if let Some(l) = layout {
-        // The numbering is the run's (in its specification), as the command line's.
-        scene.features.layout = l;
-    }
-    if let Some(d) = density {
-        scene.density = d;
-    }
-    if let Some(t) = o.maybe::<f64>("floor_thickness")? {
-        scene.set_floor_thickness(t).map_err(py_err)?;
-    }
-    Ok(scene)
 }
 
-/// The throws of `roll`'s options: their source, seed, ranges and style.
-fn throws_of(o: &Options, scene: &Scene) -> PyResult<ThrowSpec> {
-    let paper = ThrowRanges::default();
-    let kappa = o.maybe::<f64>("kappa")?;
-    Ok(ThrowSpec {
-        kind: named::<ThrowKind>(
-            "source",
-            "throw source",
-            &o.get("source", "keyed".to_string())?,
-        )?,
-        seed: o.get("seed", DEFAULT_SEED)?,
-        ranges: ThrowRanges {
-            velocity: range("velocity", o.object("velocity")?.as_ref(), paper.velocity)?,
-            spin: range("spin", o.object("spin")?.as_ref(), paper.spin)?,
-            drop_height: range(
-                "drop_height",
-                o.object("drop_height")?.as_ref(),
-                paper.drop_height,
-            )?,
+/// The scene asked by `roll`'s options: the die (a block, a shape, a mesh or a die file) as
+/// made, on its floor.
+fn scene_of(block_: Option<&str>, o: &Options, layout: Option<Layout>) -> PyResult<SceneRequest> {
+    let d = SceneRequest::default();
+    Ok(SceneRequest {
+        die: DieRequest {
+            block: block_.map(block).transpose()?,
+            shape: o.maybe("shape")?,
+            size: o.maybe("size")?,
+            scale: o.maybe("scale")?,
+            file: o.maybe("die")?,
+            density: o.maybe("density")?,
+            com: o.maybe("com")?,
+            pips: o.maybe("pips")?,
+            edge_radius: o.maybe("edge_radius")?,
+            layout,
         },
-        // `kappa` is a hand's concentration: given alone, it asks for a hand's throw.
-        style: match o.maybe::<String>("throw")? {
-            Some(t) => named::<ThrowStyle>("throw", "throw style", &t)?,
-            None if kappa.is_some() => ThrowStyle::Hand,
-            None => ThrowStyle::default_for(scene),
+        two_d: match o.maybe::<String>("mode")? {
+            Some(m) => mode(&m)? == Mode::TwoD,
+            None => d.two_d,
         },
-        kappa,
+        dt: o.get("dt", d.dt)?,
+        friction: o.get("friction", d.friction)?,
+        restitution: o.get("restitution", d.restitution)?,
+        allow_restitution_above_one: d.allow_restitution_above_one,
+        preset: named_or(o, "preset", "preset", d.preset)?,
+        floor: named_or(o, "floor", "floor", d.floor)?,
+        floor_thickness: o.maybe("floor_thickness")?,
+        linear_damping: o.get("linear_damping", d.linear_damping)?,
+        angular_damping: o.get("angular_damping", d.angular_damping)?,
+        rolling_resistance_mm: o.get("rolling_resistance", d.rolling_resistance_mm)?,
+        sleep: o.get("sleep", d.sleep)?,
     })
 }
 
-/// How a roll ends, from `roll`'s options: the rest rule, the flight, the step cap.
-fn roll_of(o: &Options, scene: &Scene) -> PyResult<RollConfig> {
+/// The throws asked by `roll`'s options: their source, seed, ranges and style.
+fn throws_of(o: &Options) -> PyResult<ThrowRequest> {
+    let d = ThrowRequest::default();
+    Ok(ThrowRequest {
+        source: named_or(o, "source", "throw source", d.source)?,
+        seed: o.get("seed", d.seed)?,
+        ranges: ThrowRanges {
+            velocity: range(
+                "velocity",
+                o.object("velocity")?.as_ref(),
+                d.ranges.velocity,
+            )?,
+            spin: range("spin", o.object("spin")?.as_ref(), d.ranges.spin)?,
+            drop_height: range(
+                "drop_height",
+                o.object("drop_height")?.as_ref(),
+                d.ranges.drop_height,
+            )?,
+        },
+        style: o
+            .maybe::<String>("throw")?
+            .map(|t| named::<ThrowStyle>("throw", "throw style", &t))
+            .transpose()?,
+        kappa: o.maybe("kappa")?,
+    })
+}
+
+/// How a roll ends, asked by `roll`'s options: the rest rule, the flight, the step cap.
+fn end_of(o: &Options) -> PyResult<EndRequest> {
+    let d = EndRequest::default();
     let settle =
         match o.maybe::<String>("settle")?.as_deref() {
-            None => None,
+            None => d.settle,
             Some("certificate") => Some(Rule::Certificate),
             Some("dicephys") => Some(Rule::Dicephys),
             Some(s) => return Err(bad(
@@ -430,28 +405,20 @@ fn roll_of(o: &Options, scene: &Scene) -> PyResult<RollConfig> {
                 "give 'certificate' (the exact early stop) or 'dicephys' (DicePhys's rest rule)",
             )),
         };
-    let fast = match o.get("flight", "fast".to_string())?.as_str() {
-        "fast" => true,
-        "stepped" => false,
-        s => return Err(bad("flight", format!("'{s}'"), "give 'fast' or 'stepped'")),
+    let fast_flight = match o.maybe::<String>("flight")?.as_deref() {
+        None => d.fast_flight,
+        Some("fast") => true,
+        Some("stepped") => false,
+        Some(s) => return Err(bad("flight", format!("'{s}'"), "give 'fast' or 'stepped'")),
     };
-    RollConfig::chosen(
-        scene.dt,
+    Ok(EndRequest {
         settle,
-        fast,
-        o.get("faithful", false)?,
-        false,
-        o.get(
-            "max_steps",
-            if scene.shape.is_some() {
-                dicephys::sim::roll::SHAPE_MAX_STEPS
-            } else {
-                DEFAULT_MAX_STEPS
-            },
-        )?,
-        o.get("margin", DEFAULT_MARGIN)?,
-    )
-    .map_err(py_err)
+        fast_flight,
+        faithful: o.get("faithful", d.faithful)?,
+        audit: d.audit,
+        max_steps: o.maybe("max_steps")?,
+        margin: o.get("margin", d.margin)?,
+    })
 }
 
 /// Rolls `spec` as `dicephys roll` does: its summary's JSON document (numbered by `layout`)
@@ -694,45 +661,32 @@ fn paper_config(
 }
 
 /// A fit's die from `roll`'s names (com, pips, edge_radius, die: a file or a mesh, layout,
-/// density, shape, size, scale): as made, its density, and its shape if not a cuboid.
-fn fit_die(
-    die: Option<Bound<'_, PyDict>>,
-) -> PyResult<(Features, Option<f64>, Option<dicephys::model::shape::Shape>)> {
-    // The die, by roll's names: com, pips, edge_radius, die (a file), layout, density.
+/// density, shape, size, scale), as the library's request.
+fn fit_die(die: Option<Bound<'_, PyDict>>) -> PyResult<DieRequest> {
     let o = Options {
         given: die.map(|d| d.copy()).transpose()?,
     };
-    let layout = o
-        .maybe::<String>("layout")?
-        .map(|l| named::<Layout>("layout", "layout", &l))
-        .transpose()?;
-    let die_file = o.maybe::<PathBuf>("die")?;
-    let (mut features, density) = Features::described(
-        die_file.as_deref(),
-        o.maybe("com")?,
-        o.maybe("pips")?,
-        o.maybe("edge_radius")?,
-        None,
-        o.maybe::<f64>("density")?,
-    )
-    .map_err(py_err)?;
-    if let Some(l) = layout {
-        features.layout = l;
-    }
-    // A die of any shape (`shape`, or a mesh `die`): its rows count its faces by label.
-    let shape = dicephys::model::shape::described(
-        die_file.as_deref(),
-        o.maybe::<String>("shape")?.as_deref(),
-        o.maybe("size")?,
-        o.maybe("scale")?,
-    )
-    .map_err(py_err)?;
+    let request = DieRequest {
+        block: None,
+        shape: o.maybe("shape")?,
+        size: o.maybe("size")?,
+        scale: o.maybe("scale")?,
+        file: o.maybe("die")?,
+        density: o.maybe("density")?,
+        com: o.maybe("com")?,
+        pips: o.maybe("pips")?,
+        edge_radius: o.maybe("edge_radius")?,
+        layout: o
+            .maybe::<String>("layout")?
+            .map(|l| named::<Layout>("layout", "layout", &l))
+            .transpose()?,
+    };
     o.finish()?;
-    Ok((features, density, shape))
+    Ok(request)
 }
 
 /// A fit's configuration (`dicephys fit`'s), from the counts (a CSV file, CSV text, or
-/// "paper") and the model, checked; as JSON.
+/// "paper") and the model: the library's request, checked by the library; as JSON.
 #[pyfunction]
 #[pyo3(signature = (data, free, shared, ranges, restitution, friction, kappa, spin_scale,
     engine, dt, max_steps, points, point_rolls, degree, max_degree, refine, common_throws, seed,
@@ -759,40 +713,8 @@ fn fit_config<'py>(
     seed: u64,
     die: Option<Bound<'py, PyDict>>,
 ) -> PyResult<String> {
-    use calibration::params::{Fixed, FixedThrow, Kind, Method, ModelSpec};
-    let (features, density, shape) = fit_die(die)?;
+    use calibration::params::{FixedThrow, Kind};
     let kind = |arg: &str, s: &str| named::<Kind>(arg, "parameter", s);
-    let mut free_kinds = free
-        .iter()
-        .map(|s| kind("free", s))
-        .collect::<PyResult<Vec<_>>>()?;
-    free_kinds.sort();
-    let mut model = ModelSpec::free(&free_kinds);
-    for (name, lo, hi) in ranges {
-        let k = kind("ranges", &name)?;
-        let i = free_kinds
-            .iter()
-            .position(|f| *f == k)
-            .ok_or_else(|| bad("ranges", &name, "not among the free parameters"))?;
-        model.ranges[i] = Range { lo, hi };
-    }
-    model.shared = shared
-        .iter()
-        .map(|s| kind("shared", s))
-        .collect::<PyResult<_>>()?;
-    model.fixed = Fixed {
-        e: restitution,
-        mu: friction,
-        // No κ: the paper's throw, or the tumble for a die of any shape (it has no long axis).
-        throw: match (kappa, &shape) {
-            (Some(k), _) => FixedThrow::Hand(k),
-            (None, Some(_)) => FixedThrow::Tumble,
-            (None, None) => FixedThrow::Paper,
-        },
-        spin: spin_scale,
-        ..Fixed::default()
-    };
-    model.validate().map_err(py_err)?;
     let rows = if data == "paper" {
         calibration::data::paper_rows()
     } else if data.contains('\n') {
@@ -804,42 +726,37 @@ fn fit_config<'py>(
         Error::Io { .. } => py_err(e),
         e => PyValueError::new_err(format!("data: {}", arguments_in(&e.to_string()))),
     })?;
-    let rows = match &shape {
-        Some(sh) => calibration::data::on_shape(&rows, sh)
-            .map_err(|e| PyValueError::new_err(format!("data: {e}")))?,
-        None => rows,
-    };
-    let degrees = calibration::design::DesignSpec::degrees(
+    let request = calibration::request::FitRequest {
+        rows,
+        free: free
+            .iter()
+            .map(|s| kind("free", s))
+            .collect::<PyResult<_>>()?,
+        shared: shared
+            .iter()
+            .map(|s| kind("shared", s))
+            .collect::<PyResult<_>>()?,
+        ranges: ranges
+            .iter()
+            .map(|(name, lo, hi)| Ok((kind("ranges", name)?, Range { lo: *lo, hi: *hi })))
+            .collect::<PyResult<_>>()?,
+        restitution,
+        friction,
+        throw: kappa.map(FixedThrow::Hand),
+        spin_scale,
+        die: fit_die(die)?,
+        engine: named::<EngineKind>("engine", "engine", engine)?,
+        dt,
+        max_steps,
+        points,
+        point_rolls,
         degree,
         max_degree,
-        shape.as_ref().map_or(6, |s| s.faces.len()),
-    );
-    let cfg = FitConfig {
-        rows,
-        model,
-        method: Method {
-            engine: named::<EngineKind>("engine", "engine", engine)?,
-            dt,
-            max_steps,
-            die: features,
-            density,
-            shape: shape.map(std::sync::Arc::new),
-        },
-        design: calibration::design::DesignSpec {
-            points,
-            rolls: point_rolls,
-            degree: degrees.0,
-            max_degree: degrees.1,
-            refine,
-            common: common_throws,
-        },
-        search: calibration::estimate::Search {
-            seed,
-            ..Default::default()
-        },
+        refine,
+        common_throws,
         seed,
     };
-    cfg.validate().map_err(py_err)?;
+    let cfg = request.config().map_err(py_err)?;
     serde_json::to_string(&cfg).map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }
 
@@ -976,5 +893,20 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_MAX_STEPS", DEFAULT_MAX_STEPS)?;
     m.add("DEFAULT_SEED", DEFAULT_SEED)?;
     m.add("DEFAULT_MARGIN", DEFAULT_MARGIN)?;
+    // The library's other defaults, for the package's signatures to show.
+    let (scene, fit) = (
+        SceneRequest::default(),
+        calibration::request::FitRequest::default(),
+    );
+    m.add("DEFAULT_DT", scene.dt)?;
+    m.add("DEFAULT_FRICTION", scene.friction)?;
+    m.add("DEFAULT_RESTITUTION", scene.restitution)?;
+    m.add("DEFAULT_ROLLS", dicephys::run::request::DEFAULT_ROLLS)?;
+    m.add("DEFAULT_SPIN_SCALE", fit.spin_scale)?;
+    m.add("DEFAULT_POINTS", fit.points)?;
+    m.add("DEFAULT_POINT_ROLLS", fit.point_rolls)?;
+    m.add("DEFAULT_REPEATS", calibration::recovery::DEFAULT_REPEATS)?;
+    m.add("DEFAULT_DRAWS", calibration::predict::DEFAULT_DRAWS)?;
+    m.add("DEFAULT_PREDICT_ROLLS", calibration::predict::DEFAULT_ROLLS)?;
     Ok(())
 }

@@ -31,6 +31,7 @@ pub mod paper;
 pub mod params;
 pub mod predict;
 pub mod recovery;
+pub mod request;
 
 use crate::error::{Error, Field, Result};
 use crate::model::throws::Range;

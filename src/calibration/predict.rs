@@ -153,6 +153,11 @@ fn one() -> f64 {
     1.0
 }
 
+/// Posterior draws a prediction simulates when none are asked.
+pub const DEFAULT_DRAWS: usize = 16;
+/// Rolls a draw when none are asked.
+pub const DEFAULT_ROLLS: u64 = 2000;
+
 /// What to predict.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PredictConfig {

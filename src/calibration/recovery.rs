@@ -3,6 +3,9 @@
 
 use serde::{Deserialize, Serialize};
 
+/// Repetitions of a recovery check when none are asked.
+pub const DEFAULT_REPEATS: usize = 20;
+
 /// One repetition.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Repetition {

@@ -6,9 +6,9 @@ use clap::{Args, ValueEnum};
 use dicephys::engine::EngineKind;
 use dicephys::error::parse_name;
 use dicephys::model::block::Block;
-use dicephys::model::mass::Features;
-use dicephys::model::scene::{Floor, Mode, Preset, Scene};
+use dicephys::model::scene::{Floor, Preset, Scene};
 use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
+use dicephys::run::request::{DieRequest, EndRequest, RollRequest, SceneRequest, ThrowRequest};
 use dicephys::run::spec::ThrowSpec;
 use dicephys::sim::roll::{RollConfig, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
 
@@ -91,13 +91,13 @@ pub struct SceneArgs {
     #[arg(long = "2d")]
     pub two_d: bool,
     /// Fixed time step, s, as a decimal or a fraction (the paper: 0.001, or 1/1000).
-    #[arg(long, default_value = "0.001", value_parser = parse_step)]
+    #[arg(long, default_value_t = SceneRequest::default().dt, value_parser = parse_step)]
     pub dt: f64,
     /// The contact's friction coefficient μ (the die's; the floor's is 1).
-    #[arg(long, default_value_t = 0.29)]
+    #[arg(long, default_value_t = SceneRequest::default().friction)]
     pub friction: f64,
     /// The contact's restitution e (the die's; the floor's is 1).
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = SceneRequest::default().restitution)]
     pub restitution: f64,
     /// Allow a restitution above 1 (an engine-stability study, not physics).
     #[arg(long)]
@@ -105,10 +105,10 @@ pub struct SceneArgs {
     /// Bullet solver settings: dicephys281 (Bullet 2.81 as the paper ran it), bullet3 (Debian
     /// 3.24's defaults) or split (dicephys281 with every penetration pushed out apart from the
     /// bounce, so that a bounce is exactly e: dicephys281's averages e + 0.1).
-    #[arg(long, default_value = "dicephys281", value_parser = parse_preset)]
+    #[arg(long, default_value_t = SceneRequest::default().preset, value_parser = parse_preset)]
     pub preset: Preset,
     /// The floor: box (DicePhys's 10 km static box) or plane.
-    #[arg(long, default_value = "box", value_parser = parse_floor)]
+    #[arg(long, default_value_t = SceneRequest::default().floor, value_parser = parse_floor)]
     pub floor: Floor,
     /// The box floor's thickness, m [default: 100, DicePhys's; the plane floor has none]. A
     /// table top (0.02) is thin enough for a die to pass through at a coarse step: a real
@@ -182,17 +182,6 @@ pub struct DieArgs {
 }
 
 impl DieArgs {
-    /// Lays the die's description over `scene`: the die file first, the flags over it (its
-    /// pips keep their shape, paint and spacing).
-    pub fn apply(&self, scene: &mut Scene) -> Result<()> {
-        let (features, density) = self.features()?;
-        scene.features = features;
-        if let Some(d) = density {
-            scene.density = d;
-        }
-        Ok(())
-    }
-
     /// A refused value a TOML die file gave (its flag not given beside it), named by the file
     /// and its key as the user wrote them, not by a flag they did not give (reliability round
     /// 5, class G): "--die d.toml: com 0,0,8: must lie inside the die".
@@ -229,18 +218,6 @@ impl DieArgs {
             super::error::flags_in(why)
         ))
     }
-
-    /// The die's features and its density where one is given (the flags over the file's).
-    pub fn features(&self) -> Result<(Features, Option<f64>)> {
-        Ok(Features::described(
-            self.die.as_deref(),
-            self.com,
-            self.pips,
-            self.edge_radius,
-            None,
-            self.density,
-        )?)
-    }
 }
 
 /// Two or three numbers separated by commas.
@@ -274,18 +251,18 @@ pub struct ThrowArgs {
     pub seed: Seed,
     /// Where the throws' numbers come from: keyed (each throw from (seed, index)) or dicephys
     /// (DicePhys's glibc rand() sequence, the paper's throw only).
-    #[arg(long = "source", alias = "throws", default_value = "keyed", value_parser = parse_throw_kind)]
+    #[arg(long = "source", alias = "throws", default_value_t = ThrowRequest::default().source, value_parser = parse_throw_kind)]
     pub source: ThrowKind,
     /// Launch velocity, m/s: LO:HI, or one number (the paper's throw: along x; a tumble or a
     /// hand's throw: its speed, in a random horizontal direction).
-    #[arg(long, default_value = "-0.2:0.2", allow_hyphen_values = true)]
+    #[arg(long, default_value_t = ThrowRanges::default().velocity, allow_hyphen_values = true)]
     pub velocity: Range,
     /// Spin, rad/s: LO:HI, or one number (the paper's throw: about the length axis; a tumble
     /// or a hand's throw: its magnitude, about an axis drawn at random).
-    #[arg(long, default_value = "31:160", allow_hyphen_values = true)]
+    #[arg(long, default_value_t = ThrowRanges::default().spin, allow_hyphen_values = true)]
     pub spin: Range,
     /// Drop height added to the longest side, m: LO:HI, or one number.
-    #[arg(long, default_value = "0.2:0.4", allow_hyphen_values = true)]
+    #[arg(long, default_value_t = ThrowRanges::default().drop_height, allow_hyphen_values = true)]
     pub drop_height: Range,
     /// How the die is thrown: paper (length along z, spin about it, velocity along x), tumble
     /// (random orientation, spin axis uniform on the sphere, velocity in a random horizontal
@@ -434,117 +411,96 @@ pub fn parse_engine(s: &str) -> std::result::Result<EngineKind, dicephys::Error>
 }
 
 impl SceneArgs {
-    /// The scene, with every value checked before anything runs.
-    pub fn scene(&self) -> Result<Scene> {
+    /// The scene asked, as the library's request.
+    pub fn request(&self) -> SceneRequest {
         let m = &self.made;
-        let mut shape = dicephys::model::shape::described(
-            m.die.as_deref(),
-            m.shape.as_deref(),
-            m.size,
-            m.scale,
-        )?;
-        let block = match (self.block, &shape) {
-            (Some(_), Some(_)) => {
-                return Err(Error::Usage(
-                    "--block is the cuboid; --shape or a mesh --die replaces it: give one".into(),
-                ))
-            }
-            (Some(b), None) => b,
-            // The shape's bounding box replaces it (`Scene::with_shape`).
-            (None, Some(_)) => "1x1x1".parse()?,
-            // No die given: a 16 mm d6.
-            (None, None) => {
-                shape = dicephys::model::shape::described(None, Some("d6"), None, None)?;
-                "1x1x1".parse()?
-            }
-        };
-        let mode = if self.two_d { Mode::TwoD } else { Mode::ThreeD };
-        let mut scene = Scene::paper(block, mode);
-        if let Some(s) = shape {
-            scene = scene.with_shape(s);
+        SceneRequest {
+            die: DieRequest {
+                block: self.block,
+                shape: m.shape.clone(),
+                size: m.size,
+                scale: m.scale,
+                file: m.die.clone(),
+                density: m.density,
+                com: m.com,
+                pips: m.pips,
+                edge_radius: m.edge_radius,
+                layout: None,
+            },
+            two_d: self.two_d,
+            dt: self.dt,
+            friction: self.friction,
+            restitution: self.restitution,
+            allow_restitution_above_one: self.allow_restitution_above_one,
+            preset: self.preset,
+            floor: self.floor,
+            floor_thickness: self.floor_thickness,
+            linear_damping: self.linear_damping,
+            angular_damping: self.angular_damping,
+            rolling_resistance_mm: self.rolling_resistance,
+            sleep: !self.no_sleep,
         }
-        scene.dt = self.dt;
-        scene.friction = self.friction;
-        scene.restitution = self.restitution;
-        scene.preset = self.preset;
-        scene.floor = self.floor;
-        scene.linear_damping = self.linear_damping;
-        scene.rolling_resistance = self.rolling_resistance / 1000.0;
-        scene.angular_damping = self.angular_damping;
-        scene.sleeping = !self.no_sleep;
-        self.made.apply(&mut scene)?;
-        if let Some(t) = self.floor_thickness {
-            scene.set_floor_thickness(t)?;
-        }
-        scene
-            .validate(self.allow_restitution_above_one)
-            .map_err(|e| self.made.named(e))?;
-        Ok(scene)
+    }
+
+    /// The scene, with every value checked before anything runs (a die file's value named by
+    /// its key).
+    pub fn scene(&self) -> Result<Scene> {
+        self.request().scene().map_err(|e| self.made.named(e))
     }
 }
 
 impl ThrowArgs {
-    /// The throws, checked, in the style `default` unless `--throw` gives one.
-    pub fn spec_or(&self, default: ThrowStyle) -> Result<ThrowSpec> {
-        // --kappa is a hand's concentration: given alone, it asks for a hand's throw.
-        let style = self.style.unwrap_or(if self.kappa.is_some() {
-            ThrowStyle::Hand
-        } else {
-            default
-        });
-        let spec = ThrowSpec {
-            kind: self.source,
+    /// The throws asked, as the library's request.
+    pub fn request(&self) -> ThrowRequest {
+        ThrowRequest {
+            source: self.source,
             seed: *self.seed,
             ranges: ThrowRanges {
                 velocity: self.velocity,
                 spin: self.spin,
                 drop_height: self.drop_height,
             },
-            style,
+            style: self.style,
             kappa: self.kappa,
-        };
-        spec.validate()?;
-        Ok(spec)
+        }
+    }
+
+    /// The throws, checked, in the style `default` unless `--throw` (or `--kappa`) gives one.
+    pub fn spec_or(&self, default: ThrowStyle) -> Result<ThrowSpec> {
+        Ok(self.request().spec_or(default)?)
     }
 }
 
 impl RunArgs {
-    /// The rolls asked, or the cap under --precision.
-    pub fn rolls(&self) -> u64 {
-        self.rolls.unwrap_or(if self.precision.is_some() {
-            10_000_000
-        } else {
-            10_000
-        })
-    }
-
-    /// How each roll is carried out and ended, checked, for `scene`: the early stop by
-    /// default only where it is exact (`roll::EARLY_STOP_MAX_DT`); the step cap DicePhys's,
-    /// or for a die of any shape left at its default, `roll::SHAPE_MAX_STEPS` (a cylinder
-    /// rolling on its side never stops: no engine here has rolling resistance).
-    pub fn roll(&self, scene: &Scene) -> Result<RollConfig> {
-        let mut cfg = self.roll_at(scene.dt)?;
-        if scene.shape.is_some() && cfg.max_steps == DEFAULT_MAX_STEPS {
-            cfg.max_steps = dicephys::sim::roll::SHAPE_MAX_STEPS;
+    /// How each roll ends, as the library's request: the step cap left at its default is the
+    /// library's to choose (a die of any shape's is larger).
+    pub fn end(&self) -> EndRequest {
+        EndRequest {
+            settle: self.settle.map(|s| match s {
+                SettleArg::Certificate => Rule::Certificate,
+                SettleArg::Dicephys => Rule::Dicephys,
+            }),
+            fast_flight: self.flight == FlightArg::Fast,
+            faithful: self.faithful,
+            audit: self.audit,
+            max_steps: Some(*self.max_steps).filter(|&m| m != DEFAULT_MAX_STEPS),
+            margin: self.margin,
         }
-        Ok(cfg)
     }
 
-    /// `roll` for a scene with time step `dt`, the step cap as given.
-    pub fn roll_at(&self, dt: f64) -> Result<RollConfig> {
-        let settle = self.settle.map(|s| match s {
-            SettleArg::Certificate => Rule::Certificate,
-            SettleArg::Dicephys => Rule::Dicephys,
-        });
-        Ok(RollConfig::chosen(
-            dt,
-            settle,
-            self.flight == FlightArg::Fast,
-            self.faithful,
-            self.audit,
-            *self.max_steps,
-            self.margin,
-        )?)
+    /// The rolls asked, or the library's default (under --precision, its cap).
+    pub fn rolls(&self) -> u64 {
+        RollRequest {
+            rolls: self.rolls,
+            to_precision: self.precision.is_some(),
+            ..RollRequest::default()
+        }
+        .rolls()
+    }
+
+    /// How each roll of `scene` is carried out and ended, checked.
+    pub fn roll(&self, scene: &Scene) -> Result<RollConfig> {
+        Ok(self.end().roll(scene)?)
     }
 
     /// The worker threads, checked (0: one per core).

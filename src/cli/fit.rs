@@ -7,15 +7,15 @@ use super::error::{Error, Result};
 use super::study::StudyPlace;
 use clap::Args;
 use dicephys::calibration::data;
-use dicephys::calibration::design::DesignSpec;
-use dicephys::calibration::estimate::Search;
-use dicephys::calibration::params::{Fixed, FixedThrow, Kind, Method, ModelSpec};
+use dicephys::calibration::params::{FixedThrow, Kind};
 use dicephys::calibration::predict::PredictConfig;
+use dicephys::calibration::request::FitRequest;
 use dicephys::calibration::{FitConfig, FitResult};
 use dicephys::engine::EngineKind;
 use dicephys::model::block::Block;
 use dicephys::model::scene::Mode;
 use dicephys::model::throws::Range;
+use dicephys::run::request::DieRequest;
 use dicephys::sim::roll::DEFAULT_MAX_STEPS;
 use dicephys::studies::fit::{
     BlocksConfig, BlocksStudy, FitStudy, PredictStudy, RecoverStudy, Stage,
@@ -46,17 +46,17 @@ pub struct FitArgs {
     #[arg(long = "range", value_name = "NAME=LO:HI")]
     pub ranges: Vec<String>,
     /// e where it is not free.
-    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = FitRequest::default().restitution, allow_hyphen_values = true)]
     pub restitution: f64,
     /// μ where it is not free.
-    #[arg(long, default_value_t = 0.29, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = FitRequest::default().friction, allow_hyphen_values = true)]
     pub friction: f64,
     /// Where kappa is not free: a hand's throw with this concentration κ, as `roll --kappa`
     /// [default: the paper's throw].
     #[arg(long, value_name = "KAPPA", allow_hyphen_values = true)]
     pub kappa: Option<String>,
     /// The spin scale where spin is not free.
-    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = FitRequest::default().spin_scale, allow_hyphen_values = true)]
     pub spin_scale: f64,
     /// The die thrown, as `roll` takes it (a centre of mass that is not free, pips, rounded
     /// edges, a die file); one die for every row, 3D only.
@@ -67,19 +67,19 @@ pub struct FitArgs {
     #[arg(long, value_parser = super::args::parse_layout)]
     pub layout: Option<dicephys::model::faces::Layout>,
     /// The engine.
-    #[arg(long, default_value = "bullet", value_parser = parse_engine)]
+    #[arg(long, default_value_t = FitRequest::default().engine, value_parser = parse_engine)]
     pub engine: EngineKind,
     /// The time step, s or 1/N.
-    #[arg(long, default_value = "0.001", value_parser = parse_step)]
+    #[arg(long, default_value_t = FitRequest::default().dt, value_parser = parse_step)]
     pub dt: f64,
     /// The step cap.
     #[command(flatten)]
     pub max_steps: MaxSteps<DEFAULT_MAX_STEPS>,
     /// Parameter points each block is simulated at.
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = FitRequest::default().points)]
     pub points: usize,
     /// Rolls at each parameter point (as `paper --calibrated --point-rolls`).
-    #[arg(long = "point-rolls", alias = "rolls", default_value_t = 500)]
+    #[arg(long = "point-rolls", alias = "rolls", default_value_t = FitRequest::default().point_rolls)]
     pub rolls: u64,
     /// The surrogate's polynomial degree (raised while it lacks fit, up to --max-degree)
     /// [default: 3; 2 for a die of more than six faces].
@@ -107,7 +107,7 @@ pub struct FitArgs {
     #[arg(long, value_name = "NAME=V,...")]
     pub recover: Option<String>,
     /// With --recover: repetitions (each its own data and simulations).
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = dicephys::calibration::recovery::DEFAULT_REPEATS)]
     pub repeats: usize,
 }
 
@@ -145,10 +145,10 @@ pub struct PredictArgs {
     #[arg(long, value_name = "E,MU", conflicts_with_all = ["surface", "blocks"], value_parser = parse_contact)]
     pub contact: Option<[f64; 2]>,
     /// Posterior draws to simulate the block at.
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = dicephys::calibration::predict::DEFAULT_DRAWS)]
     pub draws: usize,
     /// Rolls at each draw.
-    #[arg(long, default_value_t = 2000)]
+    #[arg(long, default_value_t = dicephys::calibration::predict::DEFAULT_ROLLS)]
     pub rolls: u64,
     /// The keyed throws' seed.
     #[command(flatten)]
@@ -215,55 +215,8 @@ fn once(flag: &str, kinds: impl Iterator<Item = Kind>) -> Result<()> {
 }
 
 impl FitArgs {
-    /// The model; `shape`: the die is of any shape, thrown in a tumble unless --kappa says
-    /// otherwise.
-    fn model(&self, shape: bool) -> Result<ModelSpec> {
-        once("--free", self.free.iter().copied())?;
-        once("--shared", self.shared.iter().copied())?;
-        let mut free = self.free.clone();
-        free.sort();
-        let mut model = ModelSpec::free(&free);
-        let given: Vec<&str> = self.ranges.iter().map(String::as_str).collect();
-        for (kind, r) in pairs("--range", &given, |v| {
-            v.parse::<Range>().map_err(|e| e.to_string())
-        })? {
-            let i = free.iter().position(|k| *k == kind).ok_or_else(|| {
-                Error::Usage(format!("--range {kind}=…: {kind} is not among --free"))
-            })?;
-            model.ranges[i] = r;
-        }
-        // `--kappa paper`, the paper's throw, was the spelling before --kappa meant only a
-        // hand's κ; it is still read.
-        let throw = match self.kappa.as_deref() {
-            None if shape => FixedThrow::Tumble,
-            None | Some("paper") => FixedThrow::Paper,
-            Some("tumble") => FixedThrow::Tumble,
-            Some(k) => FixedThrow::Hand(k.parse().map_err(|_| {
-                Error::Usage(format!(
-                    "--kappa {k}: a hand's concentration, a number >= 0"
-                ))
-            })?),
-        };
-        model.shared = self.shared.clone();
-        model.fixed = Fixed {
-            e: self.restitution,
-            mu: self.friction,
-            throw,
-            spin: self.spin_scale,
-            ..Fixed::default()
-        };
-        model.validate()?;
-        Ok(model)
-    }
-
-    pub fn config(&self) -> Result<FitConfig> {
-        let m = &self.made;
-        let shape = dicephys::model::shape::described(
-            m.die.as_deref(),
-            m.shape.as_deref(),
-            m.size,
-            m.scale,
-        )?;
+    /// The fit asked, as the library's request: the counts read (`--data`), the names parsed.
+    fn request(&self) -> Result<FitRequest> {
         let rows = if self.data.as_os_str() == "paper" && !self.data.exists() {
             data::paper_rows()?
         } else {
@@ -272,48 +225,60 @@ impl FitArgs {
                 e => Error::Usage(format!("--data {e}")),
             })?
         };
-        let rows = match &shape {
-            Some(s) => data::on_shape(&rows, s).map_err(|e| Error::Usage(format!("--data {e}")))?,
-            None => rows,
+        let given: Vec<&str> = self.ranges.iter().map(String::as_str).collect();
+        let ranges = pairs("--range", &given, |v| {
+            v.parse::<Range>().map_err(|e| e.to_string())
+        })?;
+        // `--kappa paper`, the paper's throw, was the spelling before --kappa meant only a
+        // hand's κ; it is still read.
+        let throw = match self.kappa.as_deref() {
+            None => None,
+            Some("paper") => Some(FixedThrow::Paper),
+            Some("tumble") => Some(FixedThrow::Tumble),
+            Some(k) => Some(FixedThrow::Hand(k.parse().map_err(|_| {
+                Error::Usage(format!(
+                    "--kappa {k}: a hand's concentration, a number >= 0"
+                ))
+            })?)),
         };
-        let (degree, max_degree) = DesignSpec::degrees(
-            self.degree,
-            self.max_degree,
-            shape.as_ref().map_or(6, |s| s.faces.len()),
-        );
-        let cfg = FitConfig {
+        let m = &self.made;
+        Ok(FitRequest {
             rows,
-            model: self.model(shape.is_some())?,
-            method: {
-                let (mut die, density) = self.made.features()?;
-                if let Some(layout) = self.layout {
-                    die.layout = layout;
-                }
-                Method {
-                    engine: self.engine,
-                    dt: self.dt,
-                    max_steps: *self.max_steps,
-                    die,
-                    density,
-                    shape: shape.map(std::sync::Arc::new),
-                }
+            free: self.free.clone(),
+            shared: self.shared.clone(),
+            ranges,
+            restitution: self.restitution,
+            friction: self.friction,
+            throw,
+            spin_scale: self.spin_scale,
+            die: DieRequest {
+                block: None,
+                shape: m.shape.clone(),
+                size: m.size,
+                scale: m.scale,
+                file: m.die.clone(),
+                density: m.density,
+                com: m.com,
+                pips: m.pips,
+                edge_radius: m.edge_radius,
+                layout: self.layout,
             },
-            design: DesignSpec {
-                points: self.points,
-                rolls: self.rolls,
-                degree,
-                max_degree,
-                refine: !self.no_refine,
-                common: self.common_throws,
-            },
-            search: Search {
-                seed: *self.seed,
-                ..Search::default()
-            },
+            engine: self.engine,
+            dt: self.dt,
+            max_steps: *self.max_steps,
+            points: self.points,
+            point_rolls: self.rolls,
+            degree: self.degree,
+            max_degree: self.max_degree,
+            refine: !self.no_refine,
+            common_throws: self.common_throws,
             seed: *self.seed,
-        };
-        cfg.validate()?;
-        Ok(cfg)
+        })
+    }
+
+    /// The fit's configuration, checked by the library.
+    pub fn config(&self) -> Result<FitConfig> {
+        Ok(self.request()?.config()?)
     }
 }
 

@@ -26,7 +26,7 @@ pub struct PaperArgs {
     #[arg(long, value_delimiter = ',', default_value = "bullet,rapier", value_parser = parse_engine)]
     pub engines: Vec<EngineKind>,
     /// Fixed time step, s or 1/N.
-    #[arg(long, default_value = "0.001", value_parser = super::args::parse_step)]
+    #[arg(long, default_value_t = dicephys::run::request::SceneRequest::default().dt, value_parser = super::args::parse_step)]
     pub dt: f64,
     /// Threads, --out, --json.
     #[command(flatten)]
@@ -45,10 +45,10 @@ pub struct PaperArgs {
     #[arg(long)]
     pub calibrated: bool,
     /// With --calibrated: parameter points each block is simulated at, per pass.
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = dicephys::calibration::design::DesignSpec::default().points)]
     pub points: usize,
     /// With --calibrated: rolls at each point.
-    #[arg(long, default_value_t = 500)]
+    #[arg(long, default_value_t = dicephys::calibration::design::DesignSpec::default().rolls)]
     pub point_rolls: u64,
     /// With --calibrated: the method check's reference step, s or 1/N.
     #[arg(long, default_value = "1/5000", value_parser = super::args::parse_step)]

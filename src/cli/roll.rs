@@ -8,6 +8,7 @@ use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::report::progress::{Progress, Unit};
 use dicephys::report::summary::Target;
+use dicephys::run::request::RollRequest;
 use dicephys::run::runner::{Checkpoint, Runner};
 use dicephys::run::spec::{RunSpec, Shard};
 use dicephys::studies::outputs;
@@ -101,28 +102,23 @@ impl RollArgs {
             return Checkpoint::spec_in(dir)
                 .map_err(|e| Error::Usage(format!("--resume {}: {e}", dir.display())));
         }
-        let mut scene = self.scene.scene()?;
-        if let Some(layout) = self.layout {
-            // The numbers on the faces are the run's: stored in its specification, so that a
-            // resumed, merged or Slurm run reads its faces as this one (and the pips follow
-            // the numbers: the layout places them).
-            scene.features.layout = layout;
-        }
-        // A die of any shape has no long axis to spin about: a tumble by default.
-        let default = match dicephys::model::throws::ThrowStyle::default_for(&scene) {
-            dicephys::model::throws::ThrowStyle::Paper => default,
-            other => other,
-        };
-        let spec = RunSpec {
-            engine: self.engine,
-            roll: self.run.roll(&scene)?,
+        // The numbers on the faces are the run's: stored in its specification, so that a
+        // resumed, merged or Slurm run reads its faces as this one (and the pips follow the
+        // numbers: the layout places them).
+        let mut scene = self.scene.request();
+        scene.die.layout = self.layout;
+        let request = RollRequest {
             scene,
-            throws: self.throw.spec_or(default)?,
-            rolls: self.run.rolls(),
+            throws: self.throw.request(),
+            end: self.run.end(),
+            engine: self.engine,
+            rolls: self.run.rolls,
+            to_precision: self.run.precision.is_some(),
             shard: self.shard,
         };
-        spec.validate(self.scene.allow_restitution_above_one)?;
-        Ok(spec)
+        request
+            .spec_or(default)
+            .map_err(|e| self.scene.made.named(e))
     }
 
     /// The numbers on the faces of `spec`'s die: `--layout`, else the die's own (a die

@@ -6,6 +6,7 @@ pub mod cputime;
 pub mod io;
 pub mod owner;
 pub mod pack;
+pub mod request;
 pub mod runner;
 pub mod seal;
 pub mod slurm;

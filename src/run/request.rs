@@ -1,0 +1,344 @@
+//! What a roll is asked, by the library's names and units, with the library's defaults. The
+//! command line's flags and the Python package's arguments are converted into these requests
+//! and nothing more: the library builds the run from them and checks it, so that both front
+//! ends make the same run from the same request, and neither holds a default or a check of
+//! its own.
+
+use crate::engine::EngineKind;
+use crate::error::{Error, Field, Result};
+use crate::model::block::Block;
+use crate::model::faces::Layout;
+use crate::model::mass::Features;
+use crate::model::scene::{Floor, Mode, Preset, Scene};
+use crate::model::throws::{ThrowKind, ThrowRanges, ThrowStyle, DEFAULT_SEED};
+use crate::run::spec::{RunSpec, ThrowSpec};
+use crate::sim::roll::{RollConfig, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS, SHAPE_MAX_STEPS};
+use std::path::PathBuf;
+
+/// A block where a shape gives the die (its bounding box replaces it: `Scene::with_shape`).
+const ANY_BLOCK: Block = Block {
+    length: 0.001,
+    breadth: 0.001,
+    width: 0.001,
+};
+
+/// Rolls a run takes when none are asked, and the most a run to a precision may take.
+pub const DEFAULT_ROLLS: u64 = 10_000;
+/// The most rolls a run to a precision takes when no cap is asked.
+pub const DEFAULT_PRECISION_CAP: u64 = 10_000_000;
+
+/// The die as it is made: a block, a named shape, a mesh or a die file, and what departs from
+/// the uniform, sharp solid. Lengths in mm.
+#[derive(Clone, Debug, Default)]
+pub struct DieRequest {
+    /// The cuboid, LENGTHxBREADTHxWIDTH; `None` with no shape and no mesh: a 16 mm d6.
+    pub block: Option<Block>,
+    /// A named shape (`d20`, `coin:D,H`, …) in place of the block.
+    pub shape: Option<String>,
+    /// A named shape's size, mm.
+    pub size: Option<f64>,
+    /// A mesh's lengths times this.
+    pub scale: Option<f64>,
+    /// A die file: a mesh, or TOML; what is given beside it overrides its values.
+    pub file: Option<PathBuf>,
+    /// Its density, kg/m³ (the file's, else 800).
+    pub density: Option<f64>,
+    /// Its centre of mass from its geometric centre, mm.
+    pub com: Option<[f64; 3]>,
+    /// Its pips, DIAMETER,DEPTH in mm.
+    pub pips: Option<[f64; 2]>,
+    /// Its edges' and corners' radius, mm.
+    pub edge_radius: Option<f64>,
+    /// Its numbering (the file's, else right-handed).
+    pub layout: Option<Layout>,
+}
+
+/// The scene asked: the die, its surface, its floor, the time step.
+#[derive(Clone, Debug)]
+pub struct SceneRequest {
+    /// The die.
+    pub die: DieRequest,
+    /// DicePhys's 2D mode.
+    pub two_d: bool,
+    /// The fixed time step, s.
+    pub dt: f64,
+    /// The contact's μ.
+    pub friction: f64,
+    /// The contact's e.
+    pub restitution: f64,
+    /// Allow e above 1 (an engine-stability study).
+    pub allow_restitution_above_one: bool,
+    /// Bullet's solver settings.
+    pub preset: Preset,
+    /// The floor.
+    pub floor: Floor,
+    /// The box floor's thickness, m (`None`: DicePhys's).
+    pub floor_thickness: Option<f64>,
+    /// Damping rates, 1/s.
+    pub linear_damping: f64,
+    /// Damping rates, 1/s.
+    pub angular_damping: f64,
+    /// Rolling resistance's lever arm, mm.
+    pub rolling_resistance_mm: f64,
+    /// Let the engine put the die to sleep.
+    pub sleep: bool,
+}
+
+impl Default for SceneRequest {
+    /// The paper's scene (`Scene::paper`): its values are the defaults.
+    fn default() -> Self {
+        let paper = Scene::paper(ANY_BLOCK, Mode::ThreeD);
+        SceneRequest {
+            die: DieRequest::default(),
+            two_d: false,
+            dt: paper.dt,
+            friction: paper.friction,
+            restitution: paper.restitution,
+            allow_restitution_above_one: false,
+            preset: paper.preset,
+            floor: paper.floor,
+            floor_thickness: None,
+            linear_damping: paper.linear_damping,
+            angular_damping: paper.angular_damping,
+            rolling_resistance_mm: paper.rolling_resistance * 1e3,
+            sleep: paper.sleeping,
+        }
+    }
+}
+
+impl SceneRequest {
+    /// The scene, with every value checked before anything runs.
+    pub fn scene(&self) -> Result<Scene> {
+        let d = &self.die;
+        let mut shape =
+            crate::model::shape::described(d.file.as_deref(), d.shape.as_deref(), d.size, d.scale)?;
+        let block = match (d.block, &shape) {
+            (Some(_), Some(_)) => {
+                return Err(Error::field(
+                    Field::Block,
+                    "",
+                    "is the cuboid; `shape` or a mesh `die` replaces it: give one",
+                ))
+            }
+            (Some(b), None) => b,
+            // The shape's bounding box replaces it (`Scene::with_shape`).
+            (None, Some(_)) => ANY_BLOCK,
+            // No die given: a 16 mm d6.
+            (None, None) => {
+                shape = crate::model::shape::described(None, Some("d6"), None, None)?;
+                ANY_BLOCK
+            }
+        };
+        let mode = if self.two_d { Mode::TwoD } else { Mode::ThreeD };
+        let mut scene = Scene::paper(block, mode);
+        if let Some(s) = shape {
+            scene = scene.with_shape(s);
+        }
+        scene.dt = self.dt;
+        scene.friction = self.friction;
+        scene.restitution = self.restitution;
+        scene.preset = self.preset;
+        scene.floor = self.floor;
+        scene.linear_damping = self.linear_damping;
+        scene.rolling_resistance = self.rolling_resistance_mm / 1000.0;
+        scene.angular_damping = self.angular_damping;
+        scene.sleeping = self.sleep;
+        let (features, density) = Features::described(
+            d.file.as_deref(),
+            d.com,
+            d.pips,
+            d.edge_radius,
+            d.layout,
+            d.density,
+        )?;
+        scene.features = features;
+        if let Some(l) = d.layout {
+            // The numbering is the run's (in its specification).
+            scene.features.layout = l;
+        }
+        if let Some(density) = density {
+            scene.density = density;
+        }
+        if let Some(t) = self.floor_thickness {
+            scene.set_floor_thickness(t)?;
+        }
+        scene.validate(self.allow_restitution_above_one)?;
+        Ok(scene)
+    }
+}
+
+/// Where the throws come from and how the die is thrown.
+#[derive(Clone, Debug)]
+pub struct ThrowRequest {
+    /// Keyed, or DicePhys's sequence.
+    pub source: ThrowKind,
+    /// The seed.
+    pub seed: u64,
+    /// The ranges its numbers are drawn from.
+    pub ranges: ThrowRanges,
+    /// How the die is thrown (`None`: the command's own default, or a hand's if `kappa`).
+    pub style: Option<ThrowStyle>,
+    /// A hand's concentration κ.
+    pub kappa: Option<f64>,
+}
+
+impl Default for ThrowRequest {
+    fn default() -> Self {
+        ThrowRequest {
+            source: ThrowKind::Keyed,
+            seed: DEFAULT_SEED,
+            ranges: ThrowRanges::default(),
+            style: None,
+            kappa: None,
+        }
+    }
+}
+
+impl ThrowRequest {
+    /// The throws, checked, in the style asked; else a hand's if κ is given, else `default`.
+    pub fn spec_or(&self, default: ThrowStyle) -> Result<ThrowSpec> {
+        let style = self.style.unwrap_or(if self.kappa.is_some() {
+            ThrowStyle::Hand
+        } else {
+            default
+        });
+        let spec = ThrowSpec {
+            kind: self.source,
+            seed: self.seed,
+            ranges: self.ranges,
+            style,
+            kappa: self.kappa,
+        };
+        spec.validate()?;
+        Ok(spec)
+    }
+}
+
+/// How each roll is carried out and ended.
+#[derive(Clone, Debug)]
+pub struct EndRequest {
+    /// The rest rule (`None`: the early stop where it is exact, else DicePhys's rule).
+    pub settle: Option<Rule>,
+    /// Free flight integrated outside the engine (else every step by the engine).
+    pub fast_flight: bool,
+    /// DicePhys exactly as the paper ran it.
+    pub faithful: bool,
+    /// Settle by DicePhys's rule and record the certificate's verdict beside it.
+    pub audit: bool,
+    /// The step cap (`None`: DicePhys's, or a die of any shape's).
+    pub max_steps: Option<u64>,
+    /// The certificate's reserve.
+    pub margin: f64,
+}
+
+impl Default for EndRequest {
+    fn default() -> Self {
+        EndRequest {
+            settle: None,
+            fast_flight: true,
+            faithful: false,
+            audit: false,
+            max_steps: None,
+            margin: DEFAULT_MARGIN,
+        }
+    }
+}
+
+impl EndRequest {
+    /// How each roll of `scene` is carried out and ended, checked: the step cap DicePhys's,
+    /// or for a die of any shape `SHAPE_MAX_STEPS` (a cylinder rolling on its side stops only
+    /// by rolling resistance).
+    pub fn roll(&self, scene: &Scene) -> Result<RollConfig> {
+        let cap = self.max_steps.unwrap_or(if scene.shape.is_some() {
+            SHAPE_MAX_STEPS
+        } else {
+            DEFAULT_MAX_STEPS
+        });
+        self.roll_at(scene.dt, cap)
+    }
+
+    /// How each roll at time step `dt` is carried out, with the step cap `max_steps`.
+    pub fn roll_at(&self, dt: f64, max_steps: u64) -> Result<RollConfig> {
+        RollConfig::chosen(
+            dt,
+            self.settle,
+            self.fast_flight,
+            self.faithful,
+            self.audit,
+            max_steps,
+            self.margin,
+        )
+    }
+}
+
+/// A whole roll asked: the scene, the throws, how each roll ends, the engine and how many.
+#[derive(Clone, Debug)]
+pub struct RollRequest {
+    /// The scene.
+    pub scene: SceneRequest,
+    /// The throws.
+    pub throws: ThrowRequest,
+    /// How each roll ends.
+    pub end: EndRequest,
+    /// The engine.
+    pub engine: EngineKind,
+    /// Rolls (`None`: [`DEFAULT_ROLLS`], or [`DEFAULT_PRECISION_CAP`] for a run to a
+    /// precision).
+    pub rolls: Option<u64>,
+    /// Rolled to a precision: `rolls` is then its cap.
+    pub to_precision: bool,
+    /// Only the throws of one shard.
+    pub shard: Option<crate::run::spec::Shard>,
+}
+
+impl Default for RollRequest {
+    fn default() -> Self {
+        RollRequest {
+            scene: SceneRequest::default(),
+            throws: ThrowRequest::default(),
+            end: EndRequest::default(),
+            engine: EngineKind::Bullet,
+            rolls: None,
+            to_precision: false,
+            shard: None,
+        }
+    }
+}
+
+impl RollRequest {
+    /// The rolls asked, or the default ([`DEFAULT_ROLLS`]; a run to a precision's cap
+    /// [`DEFAULT_PRECISION_CAP`]).
+    pub fn rolls(&self) -> u64 {
+        self.rolls.unwrap_or(if self.to_precision {
+            DEFAULT_PRECISION_CAP
+        } else {
+            DEFAULT_ROLLS
+        })
+    }
+
+    /// The run, checked, its throws in the style asked, else the paper's (a die of any shape,
+    /// which has no long axis to spin about: a tumble).
+    pub fn spec(&self) -> Result<RunSpec> {
+        self.spec_or(ThrowStyle::Paper)
+    }
+
+    /// The run, checked, its throws in the style asked, else `default` (a die of any shape: a
+    /// tumble).
+    pub fn spec_or(&self, default: ThrowStyle) -> Result<RunSpec> {
+        let scene = self.scene.scene()?;
+        let default = match ThrowStyle::default_for(&scene) {
+            ThrowStyle::Paper => default,
+            other => other,
+        };
+        let spec = RunSpec {
+            engine: self.engine,
+            roll: self.end.roll(&scene)?,
+            throws: self.throws.spec_or(default)?,
+            scene,
+            rolls: self.rolls(),
+            shard: self.shard,
+        };
+        spec.validate(self.scene.allow_restitution_above_one)?;
+        Ok(spec)
+    }
+}
