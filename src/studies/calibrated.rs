@@ -543,13 +543,16 @@ fn conclude(
         params::values(&main.config.model.fixed, &axes, &x)
     };
     let fitted: u64 = fits.iter().map(|f| f.2.rolls).sum();
+    let method_check = fit::check::Check {
+        method: &cfg.method,
+        reference_dt: cfg.reference_dt,
+        rolls: cfg.check_rolls,
+        seed: cfg.seed,
+    };
     let Some(check) = fit::check::run(
         &main.config.rows,
-        &cfg.method,
-        cfg.reference_dt,
+        &method_check,
         &at,
-        cfg.check_rolls,
-        cfg.seed,
         &fit::own_rolls(runner),
         fitted,
     )?

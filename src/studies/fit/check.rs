@@ -10,20 +10,35 @@ use crate::model::block::Outcome;
 use crate::run::runner::Runner;
 use crate::sim::roll::Fate;
 
-/// Checks `method` against `reference_dt` at the values `at(row)` gives each row's block, with
-/// `rolls` throws a block; the progress it reports goes on from `rolled`, the rolls made
-/// before it. `None` if stopped early.
-#[allow(clippy::too_many_arguments)]
+/// What the method check compares: the fit's method against the same at a finer step, with
+/// `rolls` keyed throws a block from `seed`.
+pub struct Check<'a> {
+    /// The fit's method.
+    pub method: &'a Method,
+    /// The reference's time step, s.
+    pub reference_dt: f64,
+    /// Throws a block.
+    pub rolls: u64,
+    /// The throws' seed.
+    pub seed: u64,
+}
+
+/// Checks the method of `check` against its reference at the values `at(row)` gives each
+/// row's block; the progress it reports goes on from `rolled`, the rolls made before it.
+/// `None` if stopped early.
 pub fn run(
     rows: &[DataRow],
-    method: &Method,
-    reference_dt: f64,
+    check: &Check,
     at: &dyn Fn(&DataRow) -> Fixed,
-    rolls: u64,
-    seed: u64,
     runner: &Runner,
     mut rolled: u64,
 ) -> Result<Option<MethodCheck>> {
+    let Check {
+        method,
+        reference_dt,
+        rolls,
+        seed,
+    } = *check;
     let reference = Method {
         dt: reference_dt,
         ..method.clone()
