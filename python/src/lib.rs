@@ -329,23 +329,29 @@ where
     }
 }
 
+/// The die asked by `roll`'s names (shape, size, scale, die: a file or a mesh, density, com,
+/// pips, edge_radius), with its `block` and the faces' `layout`.
+fn die_of(o: &Options, block: Option<Block>, layout: Option<Layout>) -> PyResult<DieRequest> {
+    Ok(DieRequest {
+        block,
+        shape: o.maybe("shape")?,
+        size: o.maybe("size")?,
+        scale: o.maybe("scale")?,
+        file: o.maybe("die")?,
+        density: o.maybe("density")?,
+        com: o.maybe("com")?,
+        pips: o.maybe("pips")?,
+        edge_radius: o.maybe("edge_radius")?,
+        layout,
+    })
+}
+
 /// The scene asked by `roll`'s options: the die (a block, a shape, a mesh or a die file) as
 /// made, on its floor.
 fn scene_of(block_: Option<&str>, o: &Options, layout: Option<Layout>) -> PyResult<SceneRequest> {
     let d = SceneRequest::default();
     Ok(SceneRequest {
-        die: DieRequest {
-            block: block_.map(block).transpose()?,
-            shape: o.maybe("shape")?,
-            size: o.maybe("size")?,
-            scale: o.maybe("scale")?,
-            file: o.maybe("die")?,
-            density: o.maybe("density")?,
-            com: o.maybe("com")?,
-            pips: o.maybe("pips")?,
-            edge_radius: o.maybe("edge_radius")?,
-            layout,
-        },
+        die: die_of(o, block_.map(block).transpose()?, layout)?,
         two_d: match o.maybe::<String>("mode")? {
             Some(m) => mode(&m)? == Mode::TwoD,
             None => d.two_d,
@@ -666,21 +672,11 @@ fn fit_die(die: Option<Bound<'_, PyDict>>) -> PyResult<DieRequest> {
     let o = Options {
         given: die.map(|d| d.copy()).transpose()?,
     };
-    let request = DieRequest {
-        block: None,
-        shape: o.maybe("shape")?,
-        size: o.maybe("size")?,
-        scale: o.maybe("scale")?,
-        file: o.maybe("die")?,
-        density: o.maybe("density")?,
-        com: o.maybe("com")?,
-        pips: o.maybe("pips")?,
-        edge_radius: o.maybe("edge_radius")?,
-        layout: o
-            .maybe::<String>("layout")?
-            .map(|l| named::<Layout>("layout", "layout", &l))
-            .transpose()?,
-    };
+    let layout = o
+        .maybe::<String>("layout")?
+        .map(|l| named::<Layout>("layout", "layout", &l))
+        .transpose()?;
+    let request = die_of(&o, None, layout)?;
     o.finish()?;
     Ok(request)
 }

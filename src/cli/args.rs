@@ -6,6 +6,7 @@ use clap::{Args, ValueEnum};
 use dicephys::engine::EngineKind;
 use dicephys::error::parse_name;
 use dicephys::model::block::Block;
+use dicephys::model::faces::Layout;
 use dicephys::model::scene::{Floor, Preset, Scene};
 use dicephys::model::throws::{Range, ThrowKind, ThrowRanges, ThrowStyle};
 use dicephys::run::request::{DieRequest, EndRequest, RollRequest, SceneRequest, ThrowRequest};
@@ -182,6 +183,23 @@ pub struct DieArgs {
 }
 
 impl DieArgs {
+    /// The die asked, as the library's request: `block` (a fit's rows name their own: none)
+    /// and the faces' `layout` beside these flags.
+    pub fn request(&self, block: Option<Block>, layout: Option<Layout>) -> DieRequest {
+        DieRequest {
+            block,
+            shape: self.shape.clone(),
+            size: self.size,
+            scale: self.scale,
+            file: self.die.clone(),
+            density: self.density,
+            com: self.com,
+            pips: self.pips,
+            edge_radius: self.edge_radius,
+            layout,
+        }
+    }
+
     /// A refused value a TOML die file gave (its flag not given beside it), named by the file
     /// and its key as the user wrote them, not by a flag they did not give (reliability round
     /// 5, class G): "--die d.toml: com 0,0,8: must lie inside the die".
@@ -413,20 +431,8 @@ pub fn parse_engine(s: &str) -> std::result::Result<EngineKind, dicephys::Error>
 impl SceneArgs {
     /// The scene asked, as the library's request.
     pub fn request(&self) -> SceneRequest {
-        let m = &self.made;
         SceneRequest {
-            die: DieRequest {
-                block: self.block,
-                shape: m.shape.clone(),
-                size: m.size,
-                scale: m.scale,
-                file: m.die.clone(),
-                density: m.density,
-                com: m.com,
-                pips: m.pips,
-                edge_radius: m.edge_radius,
-                layout: None,
-            },
+            die: self.made.request(self.block, None),
             two_d: self.two_d,
             dt: self.dt,
             friction: self.friction,

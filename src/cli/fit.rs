@@ -15,7 +15,6 @@ use dicephys::engine::EngineKind;
 use dicephys::model::block::Block;
 use dicephys::model::scene::Mode;
 use dicephys::model::throws::Range;
-use dicephys::run::request::DieRequest;
 use dicephys::sim::roll::DEFAULT_MAX_STEPS;
 use dicephys::studies::fit::{
     BlocksConfig, BlocksStudy, FitStudy, PredictStudy, RecoverStudy, Stage,
@@ -241,7 +240,6 @@ impl FitArgs {
                 ))
             })?)),
         };
-        let m = &self.made;
         Ok(FitRequest {
             rows,
             free: self.free.clone(),
@@ -251,18 +249,7 @@ impl FitArgs {
             friction: self.friction,
             throw,
             spin_scale: self.spin_scale,
-            die: DieRequest {
-                block: None,
-                shape: m.shape.clone(),
-                size: m.size,
-                scale: m.scale,
-                file: m.die.clone(),
-                density: m.density,
-                com: m.com,
-                pips: m.pips,
-                edge_radius: m.edge_radius,
-                layout: self.layout,
-            },
+            die: self.made.request(None, self.layout),
             engine: self.engine,
             dt: self.dt,
             max_steps: *self.max_steps,
