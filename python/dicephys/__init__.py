@@ -605,7 +605,8 @@ def paper(
 
 def study(config: Mapping[str, Any], out: PathLike, *, threads: int = 0, progress: Progress = None) -> Document:
     """Any study the command line runs (``paper``, ``crosscheck``, ``converge``,
-    ``tradeoff``, ``stability``, ``fit``, ``paper --calibrated``) from its configuration as a
+    ``tradeoff``, ``stability``, ``fit``, ``paper --calibrated``; and ``validate``,
+    ``recover``, ``predict``, ``predict_blocks``, which run only here) from its configuration as a
     Slurm plan stores it: a mapping tagged by ``"study"``, the ``config`` of the slurm.json
     that ``dicephys slurm <study> … --dir D`` writes (without ``--submit`` it submits
     nothing). Writes its files into ``out``; returns its JSON result."""
