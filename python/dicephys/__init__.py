@@ -65,6 +65,7 @@ DEFAULT_POINT_ROLLS: int = _native.DEFAULT_POINT_ROLLS
 DEFAULT_REPEATS: int = _native.DEFAULT_REPEATS
 DEFAULT_DRAWS: int = _native.DEFAULT_DRAWS
 DEFAULT_PREDICT_ROLLS: int = _native.DEFAULT_PREDICT_ROLLS
+DEFAULT_ENGINES: Tuple[str, ...] = tuple(_native.DEFAULT_ENGINES)
 
 
 class Value(NamedTuple):
@@ -589,7 +590,7 @@ def paper(
     *,
     rolls: int = DEFAULT_ROLLS,
     seed: int = DEFAULT_SEED,
-    engines: Sequence[str] = ("bullet", "rapier"),
+    engines: Sequence[str] = DEFAULT_ENGINES,
     dt: float = DEFAULT_DT,
     max_steps: int = DEFAULT_MAX_STEPS,
     faithful: bool = False,

@@ -18,6 +18,7 @@ DEFAULT_POINT_ROLLS: int
 DEFAULT_REPEATS: int
 DEFAULT_DRAWS: int
 DEFAULT_PREDICT_ROLLS: int
+DEFAULT_ENGINES: List[str]
 
 _Progress = Optional[Callable[[float, float], Any]]
 _Log = Optional[Callable[[str], Any]]

@@ -904,5 +904,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_REPEATS", calibration::recovery::DEFAULT_REPEATS)?;
     m.add("DEFAULT_DRAWS", calibration::predict::DEFAULT_DRAWS)?;
     m.add("DEFAULT_PREDICT_ROLLS", calibration::predict::DEFAULT_ROLLS)?;
+    let engines: Vec<String> = dicephys::studies::paper::DEFAULT_ENGINES
+        .iter()
+        .map(|e| e.to_string())
+        .collect();
+    m.add("DEFAULT_ENGINES", engines)?;
     Ok(())
 }

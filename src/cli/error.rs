@@ -213,6 +213,27 @@ mod tests {
         );
     }
 
+    /// A default clap must spell as text (a list, shown comma-separated) is the library's.
+    #[test]
+    fn the_engines_spelt_as_defaults_are_the_librarys() {
+        use clap::Parser;
+        let parsed = |args: &[&str]| crate::cli::Cli::try_parse_from(args).unwrap().command;
+        let want = dicephys::studies::paper::DEFAULT_ENGINES.to_vec();
+        match parsed(&["dicephys", "paper"]) {
+            crate::cli::Command::Paper(a) => assert_eq!(a.engines, want),
+            _ => unreachable!(),
+        }
+        match parsed(&["dicephys", "validate"]) {
+            crate::cli::Command::Validate(a) => {
+                assert_eq!(
+                    a.engines,
+                    dicephys::studies::validate::Config::default().engines
+                )
+            }
+            _ => unreachable!(),
+        }
+    }
+
     #[test]
     fn a_message_names_fields_by_flag_and_leaves_other_words_alone() {
         assert_eq!(

@@ -17,7 +17,7 @@ use dicephys::studies::StudyConfig;
 #[derive(Args, Debug)]
 pub struct PaperArgs {
     /// Rolls per simulated cell (block × engine × 2D/3D); 100000 is the paper's own scale.
-    #[arg(long, default_value_t = 10000)]
+    #[arg(long, default_value_t = dicephys::run::request::DEFAULT_ROLLS)]
     pub rolls: u64,
     /// The keyed throws' seed.
     #[command(flatten)]
@@ -54,19 +54,19 @@ pub struct PaperArgs {
     #[arg(long, default_value = "1/5000", value_parser = super::args::parse_step)]
     pub reference_dt: f64,
     /// With --calibrated: throws per block in the method check.
-    #[arg(long, default_value_t = 4000)]
+    #[arg(long, default_value_t = dicephys::studies::calibrated::DEFAULT_CHECK_ROLLS)]
     pub check_rolls: u64,
     /// With --calibrated: data sets of the parametric bootstrap (the main fit's data simulated
     /// from its values and fitted again), which measures the goodness of fit's p-value, the
     /// region's coverage and the likelihood ratio's scale (0: none, χ²'s own).
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = dicephys::calibration::estimate::Search::default().bootstrap)]
     pub bootstrap: usize,
     /// With --calibrated: starting points of each fit's search for its maximum (the centre and
     /// a Halton sequence; the report says where each ended).
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = dicephys::calibration::estimate::Search::default().starts)]
     pub starts: usize,
     /// With --calibrated: grid points of each parameter's profile likelihood across its box.
-    #[arg(long, default_value_t = 21)]
+    #[arg(long, default_value_t = dicephys::calibration::estimate::Search::default().profile_points)]
     pub profile_points: usize,
 }
 

@@ -31,6 +31,9 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::time::Instant;
 
+/// Throws a block in the method check when none are asked.
+pub const DEFAULT_CHECK_ROLLS: u64 = 4000;
+
 /// What to simulate.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CalibratedConfig {

@@ -18,6 +18,12 @@ use crate::theory::stats;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
+/// The engines the paper's study runs when none are asked: both, side by side.
+pub const DEFAULT_ENGINES: [crate::engine::EngineKind; 2] = [
+    crate::engine::EngineKind::Bullet,
+    crate::engine::EngineKind::Rapier,
+];
+
 /// What to simulate.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PaperConfig {

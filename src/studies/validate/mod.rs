@@ -73,7 +73,7 @@ impl Default for Config {
     fn default() -> Config {
         let b = |s: &str| s.parse::<Block>().expect("a valid block");
         Config {
-            engines: vec![EngineKind::Bullet, EngineKind::Rapier],
+            engines: crate::studies::paper::DEFAULT_ENGINES.to_vec(),
             rolls: 6000,
             trend_rolls: 1000,
             seed: crate::model::throws::DEFAULT_SEED,
