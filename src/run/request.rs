@@ -148,12 +148,12 @@ impl SceneRequest {
             d.com,
             d.pips,
             d.edge_radius,
-            d.layout,
+            None,
             d.density,
         )?;
         scene.features = features;
         if let Some(l) = d.layout {
-            // The numbering is the run's (in its specification).
+            // The numbering is the run's (in its specification), pips or none.
             scene.features.layout = l;
         }
         if let Some(density) = density {

@@ -619,7 +619,6 @@ impl kind::Kind for CalibratedStudy {
 /// figures in `place.out`, the cells under `place.checkpoint`; the first stage writes only
 /// every model's first pass ([`FIRST_PASSES`]); a cluster task's share writes nothing.
 fn run_study(study: &CalibratedStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
-    study.validate()?;
     let cfg = &study.config;
     let first = study.stage == Stage::First;
     let files: &[&'static str] = if first {

@@ -241,8 +241,7 @@ pub fn roll_into(
 
 /// `paper`: results.json, results.csv, report.md and the figures, in `place.out`; its cells
 /// under `place.checkpoint`, so that the same study run again continues where it stopped.
-pub fn paper(cfg: &studies::paper::PaperConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
-    cfg.validate()?;
+fn paper(cfg: &studies::paper::PaperConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
     let outputs = place.outputs(&["results.json", "results.csv", "report.md"])?;
     let total = studies::paper::total_rolls(cfg)? as f64;
     let progress = |n: u64| (hooks.progress)(n as f64, total);
@@ -285,8 +284,7 @@ pub fn paper(cfg: &studies::paper::PaperConfig, place: &Place, hooks: &Hooks) ->
 }
 
 /// `crosscheck`: each engine's run and each against the baseline, printed (no files).
-pub fn crosscheck(cfg: &studies::crosscheck::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
-    cfg.validate()?;
+fn crosscheck(cfg: &studies::crosscheck::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
     let rolls = cfg.spec.indices().len();
     let total = (rolls * cfg.engines.len() as u64) as f64;
     // The runner counts each engine's run from 0: the runs before it are whole.
@@ -317,8 +315,7 @@ pub fn crosscheck(cfg: &studies::crosscheck::Config, place: &Place, hooks: &Hook
 }
 
 /// `converge`: converge.json, report.md and its figure.
-pub fn converge(cfg: &studies::converge::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
-    cfg.validate()?;
+fn converge(cfg: &studies::converge::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
     let outputs = place.outputs(&["converge.json", "report.md"])?;
     let Some(res) = logged(place, hooks, &report::converge::header(), |study, log| {
         studies::converge::run(cfg, study, log, hooks.progress)
@@ -333,8 +330,7 @@ pub fn converge(cfg: &studies::converge::Config, place: &Place, hooks: &Hooks) -
 
 /// `tradeoff`: tradeoff.json, report.md and its figure; or the plan; or the rolls ahead. A run
 /// on one block writes that block's study; on several, each block's and the summary across.
-pub fn tradeoff(cfg: &studies::tradeoff::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
-    cfg.validate()?;
+fn tradeoff(cfg: &studies::tradeoff::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
     let outputs = place.outputs(&["tradeoff.json", "report.md"])?;
     let Some(res) = logged(place, hooks, &report::tradeoff::header(), |study, log| {
         studies::tradeoff::run(cfg, study, log, hooks.progress)
@@ -384,8 +380,7 @@ pub fn tradeoff(cfg: &studies::tradeoff::Config, place: &Place, hooks: &Hooks) -
 }
 
 /// `stability`: stability.json, report.md and its heat maps.
-pub fn stability(cfg: &studies::stability::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
-    cfg.validate()?;
+fn stability(cfg: &studies::stability::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
     let outputs = place.outputs(&["stability.json", "report.md"])?;
     let Some(res) = logged(place, hooks, &report::stability::header(), |study, log| {
         studies::stability::run(cfg, study, log, hooks.progress)
@@ -399,8 +394,7 @@ pub fn stability(cfg: &studies::stability::Config, place: &Place, hooks: &Hooks)
 }
 
 /// `validate`: validate.json, report.md and its figures.
-pub fn validate(cfg: &studies::validate::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
-    cfg.validate()?;
+fn validate(cfg: &studies::validate::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
     let outputs = place.outputs(&["validate.json", "report.md"])?;
     let Some(res) = logged(place, hooks, &report::validate::header(), |study, log| {
         studies::validate::run(cfg, study, log, hooks.progress)

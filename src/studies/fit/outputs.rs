@@ -43,7 +43,7 @@ impl Kind for RecoverStudy {
             per_cell: self.config.design.rolls,
         }
     }
-    /// Its repetitions keep no cells.
+    /// A fit's directory name (its repetitions keep no cells there).
     fn cells(&self) -> &'static str {
         "cells"
     }
@@ -94,8 +94,7 @@ impl Kind for BlocksStudy {
 /// `fit`: fit.json, report.md and its figures in `place.out`; the simulations' cells under
 /// `place.checkpoint`. A first pass of two writes only `first-pass.json`; a cluster task's
 /// share writes nothing.
-pub fn fit(study: &FitStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
-    study.validate()?;
+fn fit(study: &FitStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
     let first = study.stage == Stage::First;
     let files: &[&'static str] = if first {
         &[FIRST_PASS]
