@@ -11,7 +11,7 @@
 use crate::calibration::data::DataRow;
 use crate::calibration::design::Design;
 use crate::calibration::estimate::{
-    draws_from, maximise_from, Estimate, Likelihood, Maximum, Search,
+    draws_from, held_again, maximise_from, Estimate, Likelihood, Maximum, Search,
 };
 use crate::calibration::params::{ModelSpec, Param};
 use crate::calibration::predict::{predict_row, Predicted};
@@ -108,6 +108,7 @@ pub fn leave_one_out(
             let mut from = whole.starts();
             from.push(vec![0.5; params.len()]);
             let (best, maxima) = maximise_from(&lik, &from)?;
+            let (lik, (best, maxima)) = held_again(&lik, best, maxima)?;
             let islands: Vec<Maximum> = maxima
                 .into_iter()
                 .filter(|m| m.minus_two_ln_l - best.f <= whole.region_delta)

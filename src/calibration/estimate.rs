@@ -9,6 +9,7 @@ use crate::error::{Error, Result};
 use crate::inference::likelihood::{concentration, ln_dirichlet_multinomial, merge, pearson};
 use crate::inference::optimize::{interval, minimize_until, profile, Interval, Minimum};
 use crate::inference::posterior;
+use crate::inference::surrogate::{DesignPoint, Surrogate};
 use crate::model::scene::Mode;
 use crate::run::stop::{Stop, Watch};
 use crate::theory::stats;
@@ -42,6 +43,9 @@ pub struct Likelihood<'a> {
     /// Once raised, the likelihood is +∞ everywhere, so that every search over it (a
     /// maximum, a profile, a chain) runs out at once and its caller sees the stop.
     pub stop: Stop,
+    /// Each row's Dirichlet concentration held at one point ([`Likelihood::held_at`]); none
+    /// while it follows the parameters.
+    held: Option<Vec<f64>>,
 }
 
 /// One row's probabilities at a point, over its outcome groups, with the simulation's noise.
@@ -81,7 +85,45 @@ impl<'a> Likelihood<'a> {
             row_dims: rows.iter().map(|r| model.row_dims(params, r)).collect(),
             include: vec![true; rows.len()],
             stop: Stop::new(),
+            held: None,
         }
+    }
+
+    /// The same likelihood with each row's Dirichlet concentration held at its value at `x`
+    /// (unit coordinates), wherever it is evaluated.
+    ///
+    /// The surrogate's error is one smooth function of the parameters, and what the estimate
+    /// carries is its value near the maximum, whose variance is the concentration there.
+    /// Letting the concentration follow the parameters instead (the Dirichlet-multinomial
+    /// marginal at each point) adds the slope of its normalisation to −2 ln L: a curvature the
+    /// noise does not have, which narrows every interval. Measured on seven d20 fits (three
+    /// parameters of the centre of mass, 6,000 throws, 64 points × 500 rolls): the 1σ widths
+    /// came out up to 20 % narrower than the data's and the surrogate's noise combined (the
+    /// estimate's scatter over re-rolled designs, which the surrogate's covariance states to a
+    /// few per cent), and held at the maximum, within 5 % of it.
+    pub fn held_at(&self, x: &[f64]) -> Likelihood<'a> {
+        let free = self.holding(Vec::new());
+        let held = (0..self.rows.len()).map(|r| free.predict(r, x).c).collect();
+        free.holding(held)
+    }
+
+    /// The same likelihood with each row's concentration held at `held` (one a row; an empty
+    /// list lets it follow the parameters, as a fit written before they were held did).
+    pub fn holding(&self, held: Vec<f64>) -> Likelihood<'a> {
+        Likelihood {
+            rows: self.rows,
+            designs: self.designs,
+            row_design: self.row_design.clone(),
+            row_dims: self.row_dims.clone(),
+            include: self.include.clone(),
+            stop: self.stop.clone(),
+            held: (!held.is_empty() && held.len() == self.rows.len()).then_some(held),
+        }
+    }
+
+    /// Each row's concentration as held (empty while it follows the parameters).
+    pub fn held(&self) -> Vec<f64> {
+        self.held.clone().unwrap_or_default()
     }
 
     /// The same likelihood, stopped by `stop`.
@@ -120,7 +162,10 @@ impl<'a> Likelihood<'a> {
             .map(|g| g.iter().map(|k| k - shift).collect())
             .collect();
         let (p, cov) = merge(&pr.p, &pr.cov, &groups);
-        let c = concentration(&p, &cov);
+        let c = match &self.held {
+            Some(held) => held[r],
+            None => concentration(&p, &cov),
+        };
         RowPrediction { p, cov, c }
     }
 
@@ -290,10 +335,13 @@ pub struct Estimate {
     /// P(χ²_dof ≥ χ²); none with no degrees of freedom left.
     pub p_value: Option<f64>,
     /// Δ(−2 ln L) bounding the joint 2σ region: χ²'s quantile at 95.45 % for as many
-    /// parameters, times the Bartlett factor.
+    /// parameters, times the Bartlett factor; or, where the bootstrap's Δ averages below the
+    /// parameters' count (bounded or unfixed parameters), χ²'s quantile with that average for
+    /// its degrees of freedom ([`joint_bound`]); times the overdispersion.
     pub region_delta: f64,
-    /// The Bartlett factor measured at the maximum ([`bartlett`]): every bound on Δ(−2 ln L)
-    /// (the region's, the profiles' 1 and 4) is multiplied by it.
+    /// The Bartlett factor measured at the maximum ([`factor`], never below 1): the
+    /// profiles' bounds on Δ(−2 ln L) (1 and 4) are multiplied by it, and so is the region's
+    /// where the bootstrap's Δ averages above the parameters' count.
     pub bartlett: f64,
     /// Local maxima the search met besides the best, with their −2 ln L (a second maximum
     /// within the region makes the region two islands).
@@ -310,6 +358,10 @@ pub struct Estimate {
     pub islands: Vec<Maximum>,
     /// Posterior draws (flat prior on the box), unit coordinates.
     pub draws: Vec<Vec<f64>>,
+    /// Each row's Dirichlet concentration, held at the maximum wherever the likelihood is
+    /// evaluated ([`Likelihood::held_at`]); empty in a fit written before they were held.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub concentrations: Vec<f64>,
     /// What the parametric bootstrap behind the Bartlett factor says of the errors (`null`
     /// when none was drawn).
     #[serde(default)]
@@ -351,8 +403,9 @@ pub struct Bootstrap {
     /// whose values lie inside the widened region (the widening's own check).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub widened_coverage: Option<f64>,
-    /// The share of sets whose joint 2σ region (the threshold reported, Bartlett factor
-    /// included) holds the values they were drawn at: stated 95.45 %.
+    /// The share of as many sets again, drawn apart from those that set the region's bound,
+    /// whose joint 2σ region (the threshold reported) holds the values they were drawn at:
+    /// stated 95.45 %.
     pub coverage: f64,
 }
 
@@ -367,7 +420,7 @@ pub struct Search {
     pub draws: usize,
     /// Seed of the posterior's chain and of the bootstrap.
     pub seed: u64,
-    /// Data sets drawn to measure the Bartlett factor ([`bartlett`]; 0: none, χ²'s bounds).
+    /// Data sets drawn to measure the Bartlett factor and the region's bound ([`factor`], [`joint_bound`]; 0: none, χ²'s bounds).
     pub bootstrap: usize,
 }
 
@@ -395,17 +448,26 @@ pub fn maximise(lik: &Likelihood, dims: usize, starts: usize) -> Result<(Minimum
 /// The maximum of `lik` from each of `starts` (unit coordinates); also the other local maxima
 /// met, best first, each with the starts that ended there.
 pub fn maximise_from(lik: &Likelihood, starts: &[Vec<f64>]) -> Result<(Minimum, Vec<Maximum>)> {
+    let weighted: Vec<(Vec<f64>, usize)> = starts.iter().map(|s| (s.clone(), 1)).collect();
+    maximise_weighted(lik, &weighted)
+}
+
+/// [`maximise_from`], each start standing for as many starts as its weight.
+fn maximise_weighted(
+    lik: &Likelihood,
+    starts: &[(Vec<f64>, usize)],
+) -> Result<(Minimum, Vec<Maximum>)> {
     let f = |x: &[f64]| lik.minus_two_ln_l(x);
     let stopped = || lik.stop.requested();
-    let mut found: Vec<Minimum> = Vec::new();
-    for s in starts {
-        found.push(minimize_until(&f, s, 0.15, 1e-7, &stopped));
+    let mut found: Vec<(Minimum, usize)> = Vec::new();
+    for (s, w) in starts {
+        found.push((minimize_until(&f, s, 0.15, 1e-7, &stopped), *w));
     }
     if lik.stop.requested() {
         return Err(Error::Stopped);
     }
-    found.sort_by(|a, b| a.f.total_cmp(&b.f));
-    let best = found[0].clone();
+    found.sort_by(|a, b| a.0.f.total_cmp(&b.0.f));
+    let best = found[0].0.clone();
     if !best.f.is_finite() {
         return Err(Error::Failed(
             "the fit did not converge: the likelihood is zero everywhere it looked (a measured \
@@ -421,11 +483,11 @@ pub fn maximise_from(lik: &Likelihood, starts: &[Vec<f64>]) -> Result<(Minimum, 
     }
     let ends: Vec<Maximum> = found
         .iter()
-        .filter(|m| m.converged && m.f.is_finite())
-        .map(|m| Maximum {
+        .filter(|(m, _)| m.converged && m.f.is_finite())
+        .map(|(m, w)| Maximum {
             x: m.x.clone(),
             minus_two_ln_l: m.f,
-            starts: 1,
+            starts: *w,
         })
         .collect();
     Ok((best, distinct(&f, ends)))
@@ -547,18 +609,19 @@ type Profiles = Vec<Vec<(f64, f64)>>;
 
 /// The maximum and each parameter's profile about it, searched again from any profile point
 /// below it; with every distinct maximum met (the best first).
-fn maximum_and_profiles(
-    lik: &Likelihood,
+fn maximum_and_profiles<'a>(
+    lik: &Likelihood<'a>,
     dims: usize,
     search: &Search,
     watch: &Watch,
-) -> Result<(Minimum, Profiles, Vec<Maximum>)> {
-    let f = |x: &[f64]| lik.minus_two_ln_l(x);
+) -> Result<(Likelihood<'a>, Minimum, Profiles, Vec<Maximum>)> {
     (watch.say)(&format!(
         "fit: the maximum over {dims} parameters, from {} starts",
         search.starts.max(1)
     ));
-    let (mut best, mut maxima) = maximise(lik, dims, search.starts)?;
+    let (lik, (mut best, mut maxima)) = maximise_held(lik, dims, search.starts)?;
+    let lik = &lik;
+    let f = |x: &[f64]| lik.minus_two_ln_l(x);
     let mut rounds = 0;
     let (best, profiles) = loop {
         rounds += 1;
@@ -584,7 +647,32 @@ fn maximum_and_profiles(
             _ => break (best, profiles),
         }
     };
-    Ok((best, profiles, maxima))
+    Ok((lik.holding(lik.held()), best, profiles, maxima))
+}
+
+/// The maximum of `lik` ([`maximise`]) with each row's concentration then held there
+/// ([`Likelihood::held_at`]), and the maxima found again under it: the held likelihood, its
+/// best and its maxima.
+pub fn maximise_held<'a>(
+    lik: &Likelihood<'a>,
+    dims: usize,
+    starts: usize,
+) -> Result<(Likelihood<'a>, (Minimum, Vec<Maximum>))> {
+    let (best, maxima) = maximise(lik, dims, starts)?;
+    held_again(lik, best, maxima)
+}
+
+/// The maxima `best` and `maxima` of `lik`, searched again from each with the concentrations
+/// held at `best`.
+pub fn held_again<'a>(
+    lik: &Likelihood<'a>,
+    best: Minimum,
+    maxima: Vec<Maximum>,
+) -> Result<(Likelihood<'a>, (Minimum, Vec<Maximum>))> {
+    let held = lik.held_at(&best.x);
+    let from: Vec<(Vec<f64>, usize)> = maxima.iter().map(|m| (m.x.clone(), m.starts)).collect();
+    let found = maximise_weighted(&held, &from)?;
+    Ok((held, found))
 }
 
 /// Each parameter's fit from its profile: the value at the maximum, its 1σ and 2σ intervals
@@ -703,7 +791,8 @@ pub fn estimate(
     watch: &Watch,
 ) -> Result<Estimate> {
     let dims = params.len();
-    let (best, profiles, maxima) = maximum_and_profiles(lik, dims, search, watch)?;
+    let (lik, best, profiles, maxima) = maximum_and_profiles(lik, dims, search, watch)?;
+    let lik = &lik;
     if search.bootstrap > 0 && dims > 0 {
         (watch.say)(&format!(
             "fit: the likelihood ratio's scale from {} simulated data sets",
@@ -712,13 +801,20 @@ pub fn estimate(
     }
     let sets = bootstrap_sets(lik, &best.x, dims, search.bootstrap, search.seed, 1.0);
     let b = factor(&sets, dims);
+    let joint = joint_bound(&sets, dims);
+    // The region's coverage is checked on as many sets again, drawn apart from those that
+    // set its bound.
+    let check = match sets.len() {
+        0 => Vec::new(),
+        n => bootstrap_sets(lik, &best.x, dims, n, search.seed ^ 0xc4ec_0b07, 1.0),
+    };
     watch.check()?;
     let rows = row_fits(lik, &best.x);
     let chi2: f64 = rows.iter().map(|r| r.chi2).sum();
     let cells: i64 = rows.iter().map(|r| r.counts.len() as i64 - 1).sum();
     let dof = cells - dims as i64;
     let p_value = (dof > 0).then(|| stats::chi_square_p_value(chi2, dof as usize));
-    let mut bootstrap = verdict(&sets, chi2, b * region_delta(dims, TWO_SIGMA));
+    let mut bootstrap = verdict(&sets, &check, chi2, joint);
     let phi = overdispersion(
         chi2,
         bootstrap.as_ref(),
@@ -728,7 +824,7 @@ pub fn estimate(
     // parameter's profile is also traced from every island and the lower of the two taken,
     // so that its intervals span them all.
     let scale = b * phi;
-    let region = scale * region_delta(dims, TWO_SIGMA);
+    let region = phi * joint;
     if let Some(boot) = bootstrap.as_mut().filter(|_| phi > 1.0) {
         (watch.say)(&format!(
             "fit: the model misfits (overdispersion {phi:.2}): the widened region checked on \
@@ -781,14 +877,15 @@ pub fn estimate(
         maxima,
         islands,
         draws,
+        concentrations: lik.held(),
         bootstrap,
         overdispersion: phi,
     })
 }
 
 /// One data set drawn from the fitted model at `x`, in the shape of `lik`'s counted rows: each
-/// row's probabilities from the Dirichlet about its surrogate (the simulation's noise), then its
-/// counts multinomial with the row's number of throws.
+/// row's counts multinomial with the row's number of throws, at its surrogate's probabilities
+/// (the bootstrap world's truth; its simulation's noise is in its designs, [`redrawn`]).
 ///
 /// With an overdispersion `phi` above 1 each row's counts scatter φ times as much as the
 /// multinomial's: Dirichlet-multinomial with the concentration a = (N − φ)/(φ − 1), whose
@@ -797,20 +894,43 @@ fn bootstrap_rows(lik: &Likelihood, x: &[f64], phi: f64, rng: &mut ChaCha8Rng) -
     let mut out = Vec::new();
     for (r, row) in lik.rows.iter().enumerate() {
         let pr = lik.predict(r, x);
-        let n = row.n();
-        let p = if pr.c >= crate::inference::likelihood::MAX_CONCENTRATION {
-            pr.p.clone()
-        } else {
-            let g: Vec<f64> =
-                pr.p.iter()
-                    .map(|q| gamma(pr.c * q.max(1e-300), rng))
-                    .collect();
-            let s: f64 = g.iter().sum();
-            g.iter().map(|v| v / s).collect()
-        };
-        out.push(row.with_grouped(&overdispersed(n, &p, phi, rng)));
+        out.push(row.with_grouped(&overdispersed(row.n(), &pr.p, phi, rng)));
     }
     out
+}
+
+/// The designs of a bootstrap world whose truth is the fitted surrogates: each design's points
+/// (its own and those it borrowed) drawn afresh from its surrogate, as many throws each, and
+/// the surrogate fitted again through them at its degree. Its noise then scatters as the
+/// simulation's did, in its value and in its slope: the likelihood carries the first (the
+/// concentration), not the second, which moves the estimate too when the box is not much
+/// wider than the region (a 12-faced synthetic die, 64 points × 500 throws: the truth's
+/// Δ(−2 ln L) averaged 3.6 against χ²₃'s 3; at 100 throws a point 5.2, at 500,000 2.9).
+fn redrawn(designs: &[Design], rng: &mut ChaCha8Rng) -> Vec<Design> {
+    designs
+        .iter()
+        .map(|d| {
+            let s = &d.surrogate;
+            let pts: Vec<DesignPoint> = d
+                .points
+                .iter()
+                .chain(&d.borrowed)
+                .map(|p| {
+                    let n = p.counts[p.counts.len().saturating_sub(s.outcomes)..]
+                        .iter()
+                        .sum();
+                    DesignPoint {
+                        x: p.x.clone(),
+                        counts: multinomial(n, &s.p(&p.x), rng),
+                    }
+                })
+                .collect();
+            Design {
+                surrogate: Surrogate::fit(&pts, s.dims, s.outcomes, s.degree),
+                ..d.clone()
+            }
+        })
+        .collect()
 }
 
 /// `n` counts over outcomes of probabilities `p` that scatter `phi` times as much as the
@@ -873,18 +993,14 @@ fn gamma(shape: f64, rng: &mut ChaCha8Rng) -> f64 {
     }
 }
 
-/// The Bartlett factor of the likelihood ratio at `x`: over `sets` data sets drawn from the
-/// fitted model there ([`bootstrap_rows`]), the mean of Δ(−2 ln L) at `x` above each set's
-/// maximum, over `dims` (its asymptotic mean, χ²'s). Counts of rare outcomes (a die on its end,
-/// expected well under one time in a row) make the statistic's law lumpier and wider than
-/// χ²; dividing by this factor restores its mean, and the regions' bounds are widened by it.
-/// Never below 1 (a flat or bounded direction makes it smaller than χ²'s; the χ² bound then
-/// stays, conservative).
-pub fn bartlett(lik: &Likelihood, x: &[f64], dims: usize, sets: usize, seed: u64) -> f64 {
-    factor(&bootstrap_sets(lik, x, dims, sets, seed, 1.0), dims)
-}
-
-/// The Bartlett factor of the sets' Δ(−2 ln L) ([`bartlett`]).
+/// The Bartlett factor of the likelihood ratio: over the bootstrap's `sets` ([`bootstrap_sets`]),
+/// the mean of Δ(−2 ln L) at the values they were drawn at above each set's maximum, over
+/// `dims` (its asymptotic mean, χ²'s). Counts of rare outcomes (a die on its end, expected well
+/// under one time in a row) and a surrogate whose noise is not small beside the data's (its
+/// slope moves the estimate: [`redrawn`]) make the statistic's law wider than χ²; dividing by
+/// this factor restores its mean, and the profiles' bounds are widened by it. Never below 1
+/// (a flat or bounded direction makes it smaller than χ²'s: the region's bound then follows
+/// the sets, [`joint_bound`], the profiles' stay χ²'s).
 fn factor(sets: &[(f64, f64)], dims: usize) -> f64 {
     if sets.is_empty() || dims == 0 {
         return 1.0;
@@ -892,9 +1008,10 @@ fn factor(sets: &[(f64, f64)], dims: usize) -> f64 {
     (sets.iter().map(|s| s.0).sum::<f64>() / sets.len() as f64 / dims as f64).max(1.0)
 }
 
-/// `sets` data sets drawn from the fitted model at `x` ([`bootstrap_rows`], overdispersed by
-/// `phi`), each fitted back: Δ(−2 ln L) of `x` above the set's maximum, and the set's Pearson
-/// χ² there.
+/// `sets` bootstrap worlds whose truth is the fitted model at `x`: the designs rolled again
+/// from their surrogates ([`redrawn`]) and the data drawn ([`bootstrap_rows`], overdispersed by
+/// `phi`), each fitted back as a fit is (its concentrations held at its maximum): Δ(−2 ln L)
+/// of `x` above the set's maximum, and the set's Pearson χ² there.
 fn bootstrap_sets(
     lik: &Likelihood,
     x: &[f64],
@@ -912,25 +1029,47 @@ fn bootstrap_sets(
         .filter_map(|b| {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             rng.set_stream(b as u64);
+            let designs = redrawn(lik.designs, &mut rng);
             let rows = bootstrap_rows(lik, x, phi, &mut rng);
-            let boot = Likelihood {
+            let free = Likelihood {
                 rows: &rows,
-                designs: lik.designs,
-                row_design: lik.row_design.clone(),
-                row_dims: lik.row_dims.clone(),
-                include: lik.include.clone(),
-                stop: lik.stop.clone(),
+                designs: &designs,
+                ..lik.holding(Vec::new())
             };
-            let (best, _) = maximise_from(&boot, &[x.to_vec(), vec![0.5; dims]]).ok()?;
+            let (best, maxima) = maximise_from(&free, &[x.to_vec(), vec![0.5; dims]]).ok()?;
+            let (boot, (best, _)) = held_again(&free, best, maxima).ok()?;
             let chi2 = row_fits(&boot, &best.x).iter().map(|r| r.chi2).sum();
             Some(((boot.minus_two_ln_l(x) - best.f).max(0.0), chi2))
         })
         .collect()
 }
 
-/// The bootstrap's verdict ([`Bootstrap`]) on a fit whose χ² is `chi2` and whose region's
-/// threshold is `region`.
-fn verdict(sets: &[(f64, f64)], chi2: f64, region: f64) -> Option<Bootstrap> {
+/// Δ(−2 ln L) bounding the joint 2σ region, from the law of the bootstrap's `sets`: Wilks's
+/// χ²_dims quantile at 95.45 %, times the Bartlett factor where the sets' Δ averages above
+/// `dims`; where it averages below, the quantile of χ² with that average for its degrees of
+/// freedom (a parameter on its range's end adds about half a degree, one the data do not fix
+/// less). χ²_dims's bound there holds the truth more often than it states: the calibrated
+/// paper's 11 parameters, five of them bounded on one side only and two not at all, held
+/// 298 of 300 bootstrap truths against 95.45 %, its sets' Δ averaging well under 11.
+fn joint_bound(sets: &[(f64, f64)], dims: usize) -> f64 {
+    let wilks = region_delta(dims, TWO_SIGMA);
+    if sets.is_empty() || dims == 0 {
+        return wilks;
+    }
+    let mean = sets.iter().map(|s| s.0).sum::<f64>() / sets.len() as f64;
+    if mean >= dims as f64 {
+        return wilks * mean / dims as f64;
+    }
+    use statrs::distribution::{ChiSquared, ContinuousCDF};
+    ChiSquared::new(mean.max(0.5))
+        .map(|d| d.inverse_cdf(TWO_SIGMA))
+        .unwrap_or(wilks)
+}
+
+/// The bootstrap's verdict ([`Bootstrap`]) on a fit whose χ² is `chi2`: its goodness of fit
+/// from `sets`, and the coverage of the region's bound `region` (set from `sets`) on the
+/// independent sets `check`.
+fn verdict(sets: &[(f64, f64)], check: &[(f64, f64)], chi2: f64, region: f64) -> Option<Bootstrap> {
     if sets.is_empty() {
         return None;
     }
@@ -941,7 +1080,7 @@ fn verdict(sets: &[(f64, f64)], chi2: f64, region: f64) -> Option<Bootstrap> {
         chi2_p: (above + 1.0) / (n + 1.0),
         chi2_mean: sets.iter().map(|s| s.1).sum::<f64>() / n,
         widened_coverage: None,
-        coverage: sets.iter().filter(|s| s.0 <= region).count() as f64 / n,
+        coverage: check.iter().filter(|s| s.0 <= region).count() as f64 / check.len().max(1) as f64,
     })
 }
 
@@ -1166,7 +1305,7 @@ mod tests {
         let model = ModelSpec::free(&[Kind::E, Kind::Mu, Kind::Kappa]);
         let params = model.params(&rows);
         let lik = Likelihood::new(&rows, &designs, &model, &params);
-        let (best, _) = maximise(&lik, 3, 4).unwrap();
+        let (lik, (best, _)) = maximise_held(&lik, 3, 4).unwrap();
         (
             lik.minus_two_ln_l(truth) - best.f,
             region_delta(3, TWO_SIGMA),
@@ -1189,6 +1328,161 @@ mod tests {
             (mean - 3.0).abs() < 3.0 * 6f64.sqrt() / 10.0,
             "mean Δ {mean}"
         );
+    }
+
+    /// A die-like law: `k` outcomes over three parameters, each outcome's log-odds quadratic
+    /// in them (so a degree-2 surrogate holds it exactly, and only the noise is tried).
+    fn faces(k: usize, x: &[f64]) -> Vec<f64> {
+        let eta: Vec<f64> = (0..k)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / k as f64;
+                let (u, v, w) = (x[0] - 0.5, x[1] - 0.5, x[2] - 0.5);
+                0.2 * (a.cos() * u + a.sin() * v + 0.8 * (2.0 * a).cos() * w)
+                    + 0.1 * a.sin() * u * v
+                    - 0.1 * (2.0 * a).sin() * w * w
+            })
+            .collect();
+        let m = eta.iter().cloned().fold(f64::MIN, f64::max);
+        let e: Vec<f64> = eta.iter().map(|h| (h - m).exp()).collect();
+        let s: f64 = e.iter().sum();
+        e.iter().map(|v| v / s).collect()
+    }
+
+    /// One repetition of a 12-faced die's fit: 6,000 throws at `truth`, a design of 64 points ×
+    /// `rolls` throws, its concentrations held at the maximum; the truth's Δ(−2 ln L) above it,
+    /// and the region's bound from `sets` bootstrap sets.
+    fn faces_repetition(seed: u64, truth: &[f64], rolls: u64, sets: usize) -> (f64, f64) {
+        let k = 12;
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let block = "16x16x16".parse().unwrap();
+        let rows = vec![DataRow {
+            label: "die".into(),
+            surface: "S".into(),
+            thrower: "all".into(),
+            block,
+            mode: crate::model::scene::Mode::ThreeD,
+            outcomes: crate::calibration::data::Outcomes::Faces,
+            counts: multinomial(6000, &faces(k, truth), &mut rng),
+            groups: (0..k).map(|i| vec![i]).collect(),
+            labels: Vec::new(),
+        }];
+        let pts: Vec<DesignPoint> = points(3, 64)
+            .into_iter()
+            .map(|x| DesignPoint {
+                counts: multinomial(rolls, &faces(k, &x), &mut rng),
+                x,
+            })
+            .collect();
+        let designs = vec![Design {
+            block,
+            mode: crate::model::scene::Mode::ThreeD,
+            faces: true,
+            axes: [Kind::E, Kind::Mu, Kind::Kappa]
+                .iter()
+                .map(|k| (*k, k.default_range()))
+                .collect(),
+            surrogate: Surrogate::fit_best(&pts, 3, k, 2, 2),
+            points: pts,
+            borrowed: vec![],
+            unsettled: 0,
+            rolls: 64 * rolls,
+        }];
+        let model = ModelSpec::free(&[Kind::E, Kind::Mu, Kind::Kappa]);
+        let params = model.params(&rows);
+        let lik = Likelihood::new(&rows, &designs, &model, &params);
+        let (held, (best, _)) = maximise_held(&lik, 3, 2).unwrap();
+        let bound = joint_bound(&bootstrap_sets(&held, &best.x, 3, sets, seed, 1.0), 3);
+        (held.minus_two_ln_l(truth) - best.f, bound)
+    }
+
+    #[test]
+    fn the_bootstrap_that_rolls_the_design_again_bounds_the_region_as_stated() {
+        // A 12-faced synthetic die whose design (64 points × 100 throws) is noisy beside its
+        // data (6,000 throws), as a loaded d20's is: 100 fixed-seed repetitions. Wilks's bound
+        // (χ²₃) held the truth in 80.5 % of 200 (the surrogate's slope is noisy too, and moves
+        // the estimate); the bound from 30 bootstrap sets whose designs are drawn again must
+        // hold it as stated, 95.45 %: in ≥ 90 of 100 (2.5 binomial standard errors below).
+        let truth = [0.45, 0.6, 0.4];
+        let d: Vec<(f64, f64)> = (0..100)
+            .map(|s| faces_repetition(9000 + s, &truth, 100, 30))
+            .collect();
+        let wilks = region_delta(3, TWO_SIGMA);
+        let covered = d.iter().filter(|x| x.0 <= x.1).count();
+        let by_wilks = d.iter().filter(|x| x.0 <= wilks).count();
+        let mean = d.iter().map(|x| x.1).sum::<f64>() / d.len() as f64;
+        eprintln!("12 faces: {covered}/100 covered ({by_wilks} by χ²₃), mean bound {mean:.2}");
+        assert!(covered >= 90, "{covered} of 100 covered");
+        assert!(by_wilks < covered, "{by_wilks} by χ²₃ against {covered}");
+    }
+
+    #[test]
+    fn a_region_over_parameters_the_data_do_not_fix_is_bounded_by_the_bootstraps_law() {
+        // Three parameters of which the law uses one (x₀): the truth's Δ(−2 ln L) is then about
+        // χ²₁ (its mean measured 1.31 over these 40), and χ²₃'s bound (8.02) holds it 99.5 % of
+        // the time, not 95.45 % (the calibrated paper held 298 of 300). The bound from the
+        // bootstrap's sets follows their law, below χ²₃'s: not down to χ²₁'s 4.0, because the
+        // bootstrap world's truth is the fitted surrogate, whose noise gives the flat directions
+        // a slope (measured 5.70). 40 repetitions of 30 sets: the mean bound between 4 and 7,
+        // and the truth held in ≥ 34.
+        let law = |x: &[f64]| -> Vec<f64> {
+            let (l, a) = (-1.5 + 0.8 * x[0], -0.3 - 0.9 * x[0]);
+            let m = l.max(a).max(0.0);
+            let (el, ea, ew) = ((l - m).exp(), (a - m).exp(), (-m).exp());
+            let s = el + ea + ew;
+            vec![el / s, ea / s, ew / s]
+        };
+        let block = "140x24x20".parse().unwrap();
+        let truth = [0.4, 0.5, 0.5];
+        let axes: crate::calibration::params::Axes = [Kind::E, Kind::Mu, Kind::Kappa]
+            .iter()
+            .map(|k| (*k, k.default_range()))
+            .collect();
+        let d: Vec<(f64, f64)> = (0..40)
+            .map(|seed| {
+                let mut rng = ChaCha8Rng::seed_from_u64(700 + seed);
+                let rows = vec![DataRow {
+                    label: "r".into(),
+                    surface: "S".into(),
+                    thrower: "all".into(),
+                    block,
+                    mode: crate::model::scene::Mode::ThreeD,
+                    outcomes: Default::default(),
+                    counts: multinomial(2000, &law(&truth), &mut rng),
+                    groups: vec![vec![0], vec![1], vec![2]],
+                    labels: Vec::new(),
+                }];
+                let pts: Vec<DesignPoint> = points(3, 64)
+                    .into_iter()
+                    .map(|x| DesignPoint {
+                        counts: multinomial(2000, &law(&x), &mut rng),
+                        x,
+                    })
+                    .collect();
+                let designs = vec![Design {
+                    block,
+                    mode: crate::model::scene::Mode::ThreeD,
+                    faces: false,
+                    axes: axes.clone(),
+                    surrogate: Surrogate::fit_best(&pts, 3, 3, 2, 2),
+                    points: pts,
+                    borrowed: vec![],
+                    unsettled: 0,
+                    rolls: 64 * 2000,
+                }];
+                let model = ModelSpec::free(&[Kind::E, Kind::Mu, Kind::Kappa]);
+                let params = model.params(&rows);
+                let lik = Likelihood::new(&rows, &designs, &model, &params);
+                let (held, (best, _)) = maximise_held(&lik, 3, 4).unwrap();
+                let sets = bootstrap_sets(&held, &best.x, 3, 30, seed, 1.0);
+                (held.minus_two_ln_l(&truth) - best.f, joint_bound(&sets, 3))
+            })
+            .collect();
+        let mean = d.iter().map(|x| x.1).sum::<f64>() / d.len() as f64;
+        let covered = d.iter().filter(|x| x.0 <= x.1).count();
+        let md = d.iter().map(|x| x.0).sum::<f64>() / d.len() as f64;
+        eprintln!("one of three fixed: mean bound {mean:.2}, {covered}/40 covered, mean Δ {md:.2}");
+        assert!((4.0..7.0).contains(&mean), "mean bound {mean}");
+        assert!(covered >= 34, "{covered} of 40 covered");
     }
 
     #[test]

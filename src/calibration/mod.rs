@@ -632,6 +632,7 @@ mod tests {
             maxima: vec![],
             islands: vec![],
             draws: vec![],
+            concentrations: vec![],
             bootstrap: None,
             overdispersion: 1.0,
         }

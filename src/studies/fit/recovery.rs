@@ -128,7 +128,8 @@ pub fn run(
             &fitted.designs,
             &fitted.config.model,
             params,
-        );
+        )
+        .holding(est.concentrations.clone());
         // The truth in the full parameter vector, each parameter's own coordinate (outside
         // its narrowed box: not covered).
         let value_of = |kind| truth[model.free.iter().position(|k| *k == kind).expect("free")];
