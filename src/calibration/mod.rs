@@ -352,9 +352,10 @@ pub fn cuts(est: &Estimate) -> Vec<Cut> {
         // Where the box's faces are on the whole range: a face within rounding of the range's
         // end is that end (a fit.json whose narrowed κ ends at 9999.999999999998).
         let w = |v: f64| p.kind.coordinate(p.whole, v);
-        let lower = w(p.range.lo) > ON_FACE && (x <= ON_FACE || u(fit.two_sigma[0]) <= ON_FACE);
+        let lower =
+            w(p.range.lo) > ON_FACE && (x <= ON_FACE || u(fit.box_interval()[0]) <= ON_FACE);
         let upper = w(p.range.hi) < 1.0 - ON_FACE
-            && (x >= 1.0 - ON_FACE || u(fit.two_sigma[1]) >= 1.0 - ON_FACE);
+            && (x >= 1.0 - ON_FACE || u(fit.box_interval()[1]) >= 1.0 - ON_FACE);
         if lower || upper {
             out.push(Cut {
                 param: p.name(),
@@ -384,7 +385,7 @@ pub fn widen(model: &ModelSpec, est: &Estimate, cut: &[Cut]) -> Vec<params::Narr
         let p = &fit.param;
         // Coordinates on the kind's whole range, where the boxes are drawn.
         let w = |v: f64| p.kind.coordinate(p.whole, v).clamp(0.0, 1.0);
-        let (lo, hi) = (w(fit.two_sigma[0]), w(fit.two_sigma[1]));
+        let [lo, hi] = fit.box_interval().map(w);
         let width = w(p.range.hi) - w(p.range.lo);
         let pad = pad(lo, hi);
         let a = (lo - pad - if c.lower { width } else { 0.0 }).max(0.0);
@@ -451,7 +452,8 @@ pub fn tighten(rows: &[DataRow], model: &ModelSpec, est: &Estimate) -> Vec<param
             continue;
         }
         let w = |v: f64| p.kind.coordinate(p.whole, v).clamp(0.0, 1.0);
-        let Some((a, b)) = around(w(fit.two_sigma[0]), w(fit.two_sigma[1])) else {
+        let [lo, hi] = fit.box_interval().map(w);
+        let Some((a, b)) = around(lo, hi) else {
             continue;
         };
         if w(p.range.hi) - w(p.range.lo) <= LOOSE * (b - a) {
@@ -492,7 +494,8 @@ pub fn narrow(
             continue;
         }
         let u = |v: f64| p.kind.coordinate(p.range, v).clamp(0.0, 1.0);
-        let Some((a, b)) = around(u(fit.two_sigma[0]), u(fit.two_sigma[1])) else {
+        let [lo, hi] = fit.box_interval().map(u);
+        let Some((a, b)) = around(lo, hi) else {
             continue;
         };
         out.push(params::Narrowed {
@@ -613,6 +616,7 @@ mod tests {
             two_sigma: two,
             identified: Identified::Yes,
             profile: vec![],
+            box_two_sigma: None,
         };
         (fit, x)
     }
