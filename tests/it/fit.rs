@@ -607,7 +607,7 @@ fn a_misfit_is_widened_by_its_overdispersion_and_a_fit_that_fits_is_not() {
 }
 
 /// Issue 49: the estimate is the data's, not its boxes'. Counts rolled at a hand's throw (κ 5,
-/// e 0.45, μ 0.3; four blocks, 3,000 throws each, dt = 1/250) are fitted for e and μ from three
+/// e 0.45, μ 0.3; four blocks, 1,000 throws each, dt = 1/250) are fitted for e and μ from three
 /// first boxes (the default ranges, e 0.2–0.8 with μ 0.1–0.7, e 0.05–0.6 with μ 0.2–1) at three
 /// seeds. Every fit's passes settle, and every pair of the nine estimates agrees within two
 /// combined standard errors (each its 1σ interval's side towards the other; the pairs share
