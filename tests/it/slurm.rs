@@ -525,9 +525,9 @@ fn small_fit(dir: &Path) -> Vec<String> {
          width_vertical\na,MDF,140,24,20,2d,0,361,639\nb,MDF,140,30,10,2d,0,40,460\n",
     )
     .unwrap();
-    // Seed 8: passes 3 and 4 tighten e's box, the fourth cuts it at its lower edge, and a
-    // fifth widens it: five passes, each rolled.
-    let flags = "--free e,mu --points 20 --degree 2 --rolls 100 --dt 1/250 --seed 8 --json";
+    // Seed 7: passes 3 and 4 tighten the box, the fourth cuts it, and a fifth widens it: five
+    // passes, each rolled (seed 8 did so until the bootstrap rolled the design again).
+    let flags = "--free e,mu --points 20 --degree 2 --rolls 100 --dt 1/250 --seed 7 --json";
     let mut v = vec!["--data".to_string(), csv.display().to_string()];
     v.extend(flags.split(' ').map(String::from));
     v
