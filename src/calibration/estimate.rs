@@ -1282,6 +1282,51 @@ mod tests {
         assert!((far - want).abs() < 0.01, "{far} against {want}: {said}");
     }
 
+    /// A design over e, μ and κ's default ranges through `pts`: its surrogate of `outcomes`
+    /// outcomes fitted at `degree` (raised to `max_degree`).
+    fn design(
+        block: crate::model::block::Block,
+        faces: bool,
+        pts: Vec<DesignPoint>,
+        (outcomes, degree, max_degree): (usize, usize, usize),
+    ) -> Design {
+        let rolls = pts.iter().map(|p| p.counts.iter().sum::<u64>()).sum();
+        Design {
+            block,
+            mode: crate::model::scene::Mode::ThreeD,
+            faces,
+            axes: [Kind::E, Kind::Mu, Kind::Kappa]
+                .iter()
+                .map(|k| (*k, k.default_range()))
+                .collect(),
+            surrogate: Surrogate::fit_best(&pts, 3, outcomes, degree, max_degree),
+            points: pts,
+            borrowed: vec![],
+            unsettled: 0,
+            rolls,
+        }
+    }
+
+    /// `rows` fitted for e, μ and κ through `designs`, the concentrations held at the maximum:
+    /// the truth's Δ(−2 ln L) above it, and the region's bound from `sets` bootstrap sets
+    /// (χ²₃'s without any).
+    fn truth_and_bound(
+        rows: &[DataRow],
+        designs: &[Design],
+        truth: &[f64],
+        (sets, seed): (usize, u64),
+    ) -> (f64, f64) {
+        let model = ModelSpec::free(&[Kind::E, Kind::Mu, Kind::Kappa]);
+        let params = model.params(rows);
+        let lik = Likelihood::new(rows, designs, &model, &params);
+        let (held, (best, _)) = maximise_held(&lik, 3, 4).unwrap();
+        let bound = match sets {
+            0 => region_delta(3, TWO_SIGMA),
+            n => joint_bound(&bootstrap_sets(&held, &best.x, 3, n, seed, 1.0), 3),
+        };
+        (held.minus_two_ln_l(truth) - best.f, bound)
+    }
+
     /// One repetition: data at `truth`, designs of 64 × 500 draws, the fit; returns the truth's
     /// Δ(−2 ln L) above the maximum and the region's bound.
     fn repetition(seed: u64, truth: &[f64]) -> (f64, f64) {
@@ -1310,29 +1355,9 @@ mod tests {
                     DesignPoint { x, counts }
                 })
                 .collect();
-            designs.push(Design {
-                block,
-                mode: crate::model::scene::Mode::ThreeD,
-                faces: false,
-                axes: [Kind::E, Kind::Mu, Kind::Kappa]
-                    .iter()
-                    .map(|k| (*k, k.default_range()))
-                    .collect(),
-                surrogate: Surrogate::fit_best(&pts, 3, 3, 3, 4),
-                points: pts,
-                borrowed: vec![],
-                unsettled: 0,
-                rolls: 64 * 500,
-            });
+            designs.push(design(block, false, pts, (3, 3, 4)));
         }
-        let model = ModelSpec::free(&[Kind::E, Kind::Mu, Kind::Kappa]);
-        let params = model.params(&rows);
-        let lik = Likelihood::new(&rows, &designs, &model, &params);
-        let (lik, (best, _)) = maximise_held(&lik, 3, 4).unwrap();
-        (
-            lik.minus_two_ln_l(truth) - best.f,
-            region_delta(3, TWO_SIGMA),
-        )
+        truth_and_bound(&rows, &designs, truth, (0, seed))
     }
 
     #[test]
@@ -1396,26 +1421,8 @@ mod tests {
                 x,
             })
             .collect();
-        let designs = vec![Design {
-            block,
-            mode: crate::model::scene::Mode::ThreeD,
-            faces: true,
-            axes: [Kind::E, Kind::Mu, Kind::Kappa]
-                .iter()
-                .map(|k| (*k, k.default_range()))
-                .collect(),
-            surrogate: Surrogate::fit_best(&pts, 3, k, 2, 2),
-            points: pts,
-            borrowed: vec![],
-            unsettled: 0,
-            rolls: 64 * rolls,
-        }];
-        let model = ModelSpec::free(&[Kind::E, Kind::Mu, Kind::Kappa]);
-        let params = model.params(&rows);
-        let lik = Likelihood::new(&rows, &designs, &model, &params);
-        let (held, (best, _)) = maximise_held(&lik, 3, 2).unwrap();
-        let bound = joint_bound(&bootstrap_sets(&held, &best.x, 3, sets, seed, 1.0), 3);
-        (held.minus_two_ln_l(truth) - best.f, bound)
+        let designs = vec![design(block, true, pts, (k, 2, 2))];
+        truth_and_bound(&rows, &designs, truth, (sets, seed))
     }
 
     #[test]
@@ -1456,10 +1463,6 @@ mod tests {
         };
         let block = "140x24x20".parse().unwrap();
         let truth = [0.4, 0.5, 0.5];
-        let axes: crate::calibration::params::Axes = [Kind::E, Kind::Mu, Kind::Kappa]
-            .iter()
-            .map(|k| (*k, k.default_range()))
-            .collect();
         let d: Vec<(f64, f64)> = (0..40)
             .map(|seed| {
                 let mut rng = ChaCha8Rng::seed_from_u64(700 + seed);
@@ -1481,23 +1484,8 @@ mod tests {
                         x,
                     })
                     .collect();
-                let designs = vec![Design {
-                    block,
-                    mode: crate::model::scene::Mode::ThreeD,
-                    faces: false,
-                    axes: axes.clone(),
-                    surrogate: Surrogate::fit_best(&pts, 3, 3, 2, 2),
-                    points: pts,
-                    borrowed: vec![],
-                    unsettled: 0,
-                    rolls: 64 * 2000,
-                }];
-                let model = ModelSpec::free(&[Kind::E, Kind::Mu, Kind::Kappa]);
-                let params = model.params(&rows);
-                let lik = Likelihood::new(&rows, &designs, &model, &params);
-                let (held, (best, _)) = maximise_held(&lik, 3, 4).unwrap();
-                let sets = bootstrap_sets(&held, &best.x, 3, 30, seed, 1.0);
-                (held.minus_two_ln_l(&truth) - best.f, joint_bound(&sets, 3))
+                let designs = vec![design(block, false, pts, (3, 2, 2))];
+                truth_and_bound(&rows, &designs, &truth, (30, seed))
             })
             .collect();
         let mean = d.iter().map(|x| x.1).sum::<f64>() / d.len() as f64;

@@ -925,51 +925,35 @@ fn document_fit_passes(c: &mut Checker, dir: &Scratch) {
          width_vertical\na,MDF,140,24,20,2d,0,361,639\nb,MDF,140,30,10,2d,0,40,460\n",
     )
     .unwrap();
-    let widened = run(&[
-        "fit",
-        "--data",
-        cut_csv.to_str().unwrap(),
-        "--free",
-        "e,mu",
-        "--points",
-        "20",
-        "--degree",
-        "2",
-        "--rolls",
-        "100",
-        "--dt",
-        "1/250",
-        "--seed",
-        "3",
-        "--out",
-        &format!("{d}/widened"),
-        "--json",
-    ]);
+    let fit_cut = |seed: &str, out: &str| {
+        run(&[
+            "fit",
+            "--data",
+            cut_csv.to_str().unwrap(),
+            "--free",
+            "e,mu",
+            "--points",
+            "20",
+            "--degree",
+            "2",
+            "--rolls",
+            "100",
+            "--dt",
+            "1/250",
+            "--seed",
+            seed,
+            "--out",
+            out,
+            "--json",
+        ])
+    };
+    let widened = fit_cut("3", &format!("{d}/widened"));
     assert!(widened["passes"][1].get("cut").is_some(), "{widened}");
     c.document("fit", "fit (a box widened)", &widened);
     // The same blocks at seed 33: the passes do not settle (e cut again after four more), and
     // the fit says so rather than giving the last box's estimate as an answer (issue 49).
     let out = format!("{d}/unresolved");
-    let unresolved = run(&[
-        "fit",
-        "--data",
-        cut_csv.to_str().unwrap(),
-        "--free",
-        "e,mu",
-        "--points",
-        "20",
-        "--degree",
-        "2",
-        "--rolls",
-        "100",
-        "--dt",
-        "1/250",
-        "--seed",
-        "33",
-        "--out",
-        &out,
-        "--json",
-    ]);
+    let unresolved = fit_cut("33", &out);
     let why = unresolved["unresolved"].as_str().unwrap_or_default();
     assert!(why.starts_with("the passes did not settle"), "{unresolved}");
     let report = std::fs::read_to_string(format!("{out}/report.md")).unwrap();
