@@ -108,7 +108,7 @@ pub fn leave_one_out(
             let mut from = whole.starts();
             from.push(vec![0.5; params.len()]);
             let (best, maxima) = maximise_from(&lik, &from)?;
-            let (lik, (best, maxima)) = held_again(&lik, best, maxima)?;
+            let (lik, (best, maxima)) = held_again(&lik, &best.x, &maxima)?;
             let islands: Vec<Maximum> = maxima
                 .into_iter()
                 .filter(|m| m.minus_two_ln_l - best.f <= whole.region_delta)

@@ -632,8 +632,8 @@ fn maximum_and_profiles<'a>(
         "fit: the maximum over {dims} parameters, from {} starts",
         search.starts.max(1)
     ));
-    let (lik, (mut best, mut maxima)) = maximise_held(lik, dims, search.starts)?;
-    let lik = &lik;
+    let (held, (mut best, mut maxima)) = maximise_held(lik, dims, search.starts)?;
+    let lik = &held;
     let f = |x: &[f64]| lik.minus_two_ln_l(x);
     let mut rounds = 0;
     let (best, profiles) = loop {
@@ -660,7 +660,7 @@ fn maximum_and_profiles<'a>(
             _ => break (best, profiles),
         }
     };
-    Ok((lik.holding(lik.held()), best, profiles, maxima))
+    Ok((held, best, profiles, maxima))
 }
 
 /// The maximum of `lik` ([`maximise`]) with each row's concentration then held there
@@ -672,17 +672,16 @@ pub fn maximise_held<'a>(
     starts: usize,
 ) -> Result<(Likelihood<'a>, (Minimum, Vec<Maximum>))> {
     let (best, maxima) = maximise(lik, dims, starts)?;
-    held_again(lik, best, maxima)
+    held_again(lik, &best.x, &maxima)
 }
 
-/// The maxima `best` and `maxima` of `lik`, searched again from each with the concentrations
-/// held at `best`.
+/// The `maxima` of `lik`, searched again from each with the concentrations held at `best`.
 pub fn held_again<'a>(
     lik: &Likelihood<'a>,
-    best: Minimum,
-    maxima: Vec<Maximum>,
+    best: &[f64],
+    maxima: &[Maximum],
 ) -> Result<(Likelihood<'a>, (Minimum, Vec<Maximum>))> {
-    let held = lik.held_at(&best.x);
+    let held = lik.held_at(best);
     let from: Vec<(Vec<f64>, usize)> = maxima.iter().map(|m| (m.x.clone(), m.starts)).collect();
     let found = maximise_weighted(&held, &from)?;
     Ok((held, found))
@@ -1060,7 +1059,7 @@ fn bootstrap_sets(
                 ..lik.holding(Vec::new())
             };
             let (best, maxima) = maximise_from(&free, &[x.to_vec(), vec![0.5; dims]]).ok()?;
-            let (boot, (best, _)) = held_again(&free, best, maxima).ok()?;
+            let (boot, (best, _)) = held_again(&free, &best.x, &maxima).ok()?;
             let chi2 = row_fits(&boot, &best.x).iter().map(|r| r.chi2).sum();
             Some(((boot.minus_two_ln_l(x) - best.f).max(0.0), chi2))
         })
