@@ -22,6 +22,7 @@
 //! recoveries no difference is resolved, and none favours common throws.
 
 pub mod check;
+pub mod compare;
 pub mod crossval;
 pub mod data;
 pub mod design;
@@ -252,6 +253,11 @@ pub struct FitResult {
     pub designs: Vec<Design>,
     /// The estimate.
     pub estimate: Estimate,
+    /// Every row predicted by a fit of the others (leave one out; empty for a fit of fewer
+    /// than three rows, a first pass, or a fit.json written before fits scored their rows):
+    /// what `dicephys compare` sets two models' fits side by side by.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub loo: Vec<crossval::LooRow>,
     /// What it cost.
     pub cost: FitCost,
     /// The command line that made it.

@@ -3,6 +3,7 @@
 //! theory on the same rows; the models compared; the method checked.
 
 use crate::calibration::check::MethodCheck;
+pub use crate::calibration::crossval::Decision;
 use crate::calibration::crossval::{LooRow, ModelScore};
 use crate::calibration::FitResult;
 use crate::theory::stats::Ratio;
@@ -17,30 +18,6 @@ pub struct TheoryRow {
     pub ratio: Ratio,
     /// (measured − theory)/combined error.
     pub z: f64,
-}
-
-/// One comparison between models and what it decided.
-#[derive(Clone, Debug, Serialize)]
-pub struct Decision {
-    /// The question.
-    pub question: String,
-    /// The simpler model's name.
-    pub simpler: String,
-    /// The richer model's name.
-    pub richer: String,
-    /// The richer model's leave-one-out log score less the simpler's (positive: the richer
-    /// predicts the rows it did not see better), on the outcomes both model.
-    pub score_gain: f64,
-    /// Its standard error over the rows (√(n · var of the per-row differences)).
-    pub score_gain_err: f64,
-    /// The likelihood-ratio test where the simpler is nested in the richer: −2 ln Λ, degrees
-    /// of freedom, p.
-    pub lr_test: Option<(f64, usize, f64)>,
-    /// `richer` or `simpler` when the held-out gain stands 3σ from nothing, else
-    /// `unresolved`.
-    pub outcome: String,
-    /// The verdict, in a sentence.
-    pub verdict: String,
 }
 
 /// The calibrated paper.

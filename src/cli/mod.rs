@@ -6,6 +6,7 @@ use term::{stdout, stop};
 
 pub mod args;
 pub mod bench;
+pub mod compare;
 pub mod crosscheck;
 pub mod error;
 pub mod fair;
@@ -45,6 +46,9 @@ pub enum Command {
     /// Predict a block the fit did not see (or many, --blocks-file): its outcome probabilities with
     /// their errors, and a held-out test where they were counted.
     Predict(fit::PredictArgs),
+    /// Two fits of the same counts by different models (--free), compared by how well each
+    /// predicts the rows it did not see (leave one out): which the data ask for, or unresolved.
+    Compare(compare::CompareArgs),
     /// Is this die fair? Roll it (thrown in a tumble by default) and set each face against a
     /// fair die's: its probability and departure in σ, χ², and the throws a tester would need.
     Fair(fair::FairArgs),
@@ -115,6 +119,7 @@ pub fn dispatch(command: Command) -> error::Result<()> {
         Command::Stability(a) => sweeps::stability(&a),
         Command::Tradeoff(a) => sweeps::tradeoff(&a),
         Command::Fit(a) => fit::run(&a),
+        Command::Compare(a) => compare::run(&a),
         Command::Predict(a) => fit::predict(&a),
         Command::Fair(a) => fair::run(a),
         Command::Merge(a) => merge::run(&a),

@@ -1,6 +1,7 @@
 //! What a fit says: `report.md`, its figures, and a prediction's lines.
 
 use crate::calibration::check::Verdict;
+use crate::calibration::crossval::ModelScore;
 use crate::calibration::estimate::{Estimate, Identified, ParamFit, RangeEnd, MISFIT_P};
 use crate::calibration::paper::CalibratedPaper;
 use crate::calibration::params::{FixedThrow, Kind};
@@ -111,12 +112,39 @@ fn parameters(res: &FitResult) -> String {
     let e = &res.estimate;
     let mut s = String::new();
     let _ = writeln!(s, "## Parameters\n");
+    let k = e.bartlett * e.overdispersion;
+    let profiles = if k > 1.0 {
+        format!(
+            "Δ(−2 ln L) = {:.2} for 1σ, {:.2} for 2σ: χ²'s 1 and 4 times {}",
+            k,
+            4.0 * k,
+            widened_by(e)
+        )
+    } else {
+        "Δ(−2 ln L) = 1 for 1σ, 4 for 2σ".into()
+    };
+    let n = res.params.len();
+    use crate::calibration::estimate::{region_delta, TWO_SIGMA};
+    // The overdispersion's widening is said below, with the goodness of fit.
+    let chi2 = region_delta(n, TWO_SIGMA);
+    let own = e.region_delta / e.overdispersion;
+    let region = if e.bootstrap.is_none() || (own - chi2).abs() < 1e-9 * chi2 {
+        "χ² at 95.45 %".to_string()
+    } else {
+        format!(
+            "χ²'s {chi2:.2} at 95.45 % {} {own:.2} by the bootstrap's fits, which rolled the \
+             design again",
+            if own > chi2 {
+                "widened to"
+            } else {
+                "narrowed to"
+            }
+        )
+    };
     let _ = writeln!(
         s,
-        "Maximum likelihood, with profile-likelihood intervals (Δ(−2 ln L) = 1 for 1σ, 4 for 2σ) \
-         inside the searched range. The joint 2σ region of all {} is Δ(−2 ln L) ≤ {:.2} (χ² at \
-         95.45 %).\n",
-        res.params.len(),
+        "Maximum likelihood, with profile-likelihood intervals ({profiles}) inside the searched \
+         range. The joint 2σ region of all {n} is Δ(−2 ln L) ≤ {:.2} ({region}).\n",
         e.region_delta
     );
     let _ = writeln!(s, "| parameter | range | fitted | 1σ | 2σ | |");
@@ -154,6 +182,18 @@ fn parameters(res: &FitResult) -> String {
     }
     let _ = write!(s, "{}", maxima_text(e));
     s
+}
+
+/// What widened the profiles' bounds: the Bartlett factor, the overdispersion, or both.
+fn widened_by(e: &Estimate) -> String {
+    match (e.bartlett > 1.0, e.overdispersion > 1.0) {
+        (true, true) => format!(
+            "the Bartlett factor {:.2} and the overdispersion {:.2}",
+            e.bartlett, e.overdispersion
+        ),
+        (true, false) => format!("the Bartlett factor {:.2}", e.bartlett),
+        _ => format!("the overdispersion {:.2}", e.overdispersion),
+    }
 }
 
 /// A parameter's fitted value as the report prints it: a value at its range's end is marked as
@@ -354,6 +394,7 @@ pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
     s += &parameters(res);
     s += &passes(res);
     s += &goodness_of_fit(e);
+    s += &left_out(res);
     let _ = writeln!(s, "\n## Surrogates\n");
     let _ = writeln!(
         s,
@@ -427,6 +468,66 @@ fn goodness_of_fit(e: &Estimate) -> String {
                 r.label, r.surface, name, r.counts[g], n, r.p[g], r.p_err[g], r.z[g]
             );
         }
+    }
+    s
+}
+
+/// The report's rows each predicted by a fit of the others (none for a fit of fewer than
+/// three rows).
+fn left_out(res: &FitResult) -> String {
+    let mut s = String::new();
+    if res.loo.is_empty() {
+        return s;
+    }
+    let score = ModelScore::of(
+        "",
+        "",
+        res.params.len(),
+        res.estimate.minus_two_ln_l,
+        &res.loo,
+    );
+    let _ = writeln!(s, "\n## Each row predicted without itself\n");
+    let _ = writeln!(
+        s,
+        "Every row predicted by a fit of the other {} (leave one out), at that fit's posterior \
+         draws: its ratio N(breadth)/N(width) and its end count (length vertical), each with the \
+         prediction's error (parameters and simulation) combined with the measurement's. Ratios \
+         within 1σ: {} of {}, within 2σ: {} (a Gaussian error puts 68 % and 95 % there). \
+         Summed log predictive probability of the rows' counts: {:.1} — what `dicephys compare` \
+         sets this fit beside another model's fit of the same counts by.\n",
+        res.loo.len() - 1,
+        score.within_one_sigma,
+        score.rows_scored,
+        score.within_two_sigma,
+        score.loo_log_score
+    );
+    let _ = writeln!(
+        s,
+        "| row | surface | measured ratio | predicted | z | ends: counted | predicted P(length) | z | log score |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---:|---|---|---:|---:|");
+    let cell = |v: Option<String>| v.unwrap_or_else(|| "–".into());
+    for r in &res.loo {
+        let _ = writeln!(
+            s,
+            "| {} | {}{} | {} | {} | {} | {} | {} | {} | {:.2} |",
+            r.label,
+            r.surface,
+            if r.alone { " (alone)" } else { "" },
+            cell(
+                r.measured_ratio
+                    .map(|m| format!("{:.3} ± {:.3}", m.value, m.err))
+            ),
+            cell(r.ratio.map(|p| format!("{:.3} ± {:.3}", p.value, p.err))),
+            cell(r.z.map(|z| format!("{z:+.2}"))),
+            cell(r.end.map(|e| format!("{} / {}", e.counted, e.throws))),
+            cell(
+                r.end
+                    .map(|e| format!("{:.4} ± {:.4}", e.predicted.value, e.predicted.err))
+            ),
+            cell(r.end.map(|e| format!("{:+.2}", e.z))),
+            r.log_score
+        );
     }
     s
 }

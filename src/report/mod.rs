@@ -2,6 +2,7 @@
 //! Markdown and CSV, and the figures.
 
 pub mod bench;
+pub mod compare;
 pub mod converge;
 pub mod crosscheck;
 pub mod fair;

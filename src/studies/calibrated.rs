@@ -10,7 +10,9 @@
 //! - `shared`: one e and one μ for every surface, κ free;
 //! - `long-2d`: as `hand`, with the three long pine blocks (≥ 300 mm) in the paper's 2D model.
 
-use crate::calibration::crossval::{leave_one_out, likelihood_ratio, LooRow, ModelScore};
+use crate::calibration::crossval::{
+    decide, gain, leave_one_out, likelihood_ratio, LooRow, ModelScore,
+};
 use crate::calibration::data::{paper_rows, DataRow};
 use crate::calibration::design::DesignSpec;
 use crate::calibration::estimate::Search;
@@ -202,97 +204,6 @@ pub fn first_pass_rolls(cfg: &CalibratedConfig) -> Result<u64> {
         .sum())
 }
 
-/// The richer model's gain in summed log score over the simpler's, with its standard error over
-/// the rows.
-fn gain(simple: &[LooRow], rich: &[LooRow], sides: bool) -> (f64, f64) {
-    let d: Vec<f64> = simple
-        .iter()
-        .zip(rich)
-        .map(|(s, r)| {
-            if sides {
-                r.side_log_score - s.side_log_score
-            } else {
-                r.log_score - s.log_score
-            }
-        })
-        .filter(|v| v.is_finite())
-        .collect();
-    let n = d.len() as f64;
-    let mean = d.iter().sum::<f64>() / n;
-    let var = d.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
-    (d.iter().sum(), (n * var).sqrt())
-}
-
-/// How far from nothing a held-out gain must stand for a model decision, in its σ.
-const RESOLVED_SIGMA: f64 = 3.0;
-
-/// The rows the gains are summed over (the paper's table).
-const ROWS: f64 = 19.0;
-
-fn verdict(
-    question: &str,
-    simpler: &str,
-    richer: &str,
-    g: (f64, f64),
-    lr: Option<(f64, usize, f64)>,
-) -> Decision {
-    let (gain, err) = g;
-    // A model is chosen only when its held-out gain stands 3σ from nothing: at 2σ, a gain
-    // near that size flips between seeds (seeds 1–3 of the default run did), and a decision
-    // that moves with the seed is not a result. Otherwise it is unresolved, with the rows it
-    // would take were the gain per row to stay as measured (the error grows as √rows).
-    let rows = |n: f64| (n * (RESOLVED_SIGMA * err / gain).powi(2)).ceil();
-    let (outcome, text) = if gain > RESOLVED_SIGMA * err {
-        (
-            "richer",
-            format!(
-                "{richer} predicts the rows it did not see better (log score +{gain:.1} ± \
-                 {err:.1}, {:.1}σ): it earns its place",
-                gain / err
-            ),
-        )
-    } else if gain < -RESOLVED_SIGMA * err {
-        (
-            "simpler",
-            format!(
-                "{simpler} predicts better ({gain:+.1} ± {err:.1} for {richer}, {:.1}σ): \
-                 {richer}'s extra freedom costs",
-                gain.abs() / err
-            ),
-        )
-    } else {
-        let lr = lr.map_or(String::new(), |(_, _, p)| {
-            format!("; on all rows, the likelihood ratio gives p = {p:.3}")
-        });
-        let need = if gain.abs() > 0.0 && err > 0.0 {
-            format!(
-                "; about {:.0} rows like these would resolve it at {RESOLVED_SIGMA:.0}σ if the \
-                 gain per row held",
-                rows(ROWS)
-            )
-        } else {
-            String::new()
-        };
-        (
-            "unresolved",
-            format!(
-                "unresolved: the rows it did not see do not separate them ({gain:+.1} ± \
-                 {err:.1} for {richer}){lr}{need}; {simpler} is the default"
-            ),
-        )
-    };
-    Decision {
-        question: question.into(),
-        simpler: simpler.into(),
-        richer: richer.into(),
-        score_gain: gain,
-        score_gain_err: err,
-        lr_test: lr,
-        outcome: outcome.into(),
-        verdict: text,
-    }
-}
-
 /// The fit of one model, as the study runs it: the models compared need their maxima and
 /// leave-one-out scores, not the main model's bootstrap and posterior draws.
 fn fit_config(
@@ -470,8 +381,9 @@ fn decisions(fits: &[(&str, &str, Fitted, Vec<LooRow>)], models: &[ModelScore]) 
     let by = |name: &str| fits.iter().position(|f| f.0 == name).expect("model");
     let (hand, paper_throw, shared, long_2d) =
         (by("hand"), by("paper-throw"), by("shared"), by("long-2d"));
+    let rows = fits[hand].3.len();
     vec![
-        verdict(
+        decide(
             "κ: does a hand's throw, spread by κ, predict better than the paper's throw?",
             "paper-throw",
             "hand",
@@ -479,20 +391,23 @@ fn decisions(fits: &[(&str, &str, Fitted, Vec<LooRow>)], models: &[ModelScore]) 
             // Nested at the boundary κ → ∞: the χ²₁ p-value is conservative (twice the
             // boundary's ½χ²₀ + ½χ²₁ mixture).
             Some(likelihood_ratio(&models[paper_throw], &models[hand])),
+            rows,
         ),
-        verdict(
+        decide(
             "e and μ: one pair per surface, or one pair for all?",
             "shared",
             "hand",
             gain(&fits[shared].3, &fits[hand].3, false),
             Some(likelihood_ratio(&models[shared], &models[hand])),
+            rows,
         ),
-        verdict(
+        decide(
             "The long blocks: 3D, or the paper's 2D model (scored on the side outcomes)?",
             "long-2d",
             "hand",
             gain(&fits[long_2d].3, &fits[hand].3, true),
             None,
+            rows,
         ),
     ]
 }

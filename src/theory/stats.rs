@@ -12,10 +12,10 @@
 //! Nothing here panics. Degenerate counts give IEEE values, as documented on each function:
 //! infinities where a ratio has a zero denominator, NaN where a quantity is undefined.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// A ratio with its one-standard-error binomial error.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Ratio {
     /// The ratio.
     pub value: f64,

@@ -916,6 +916,11 @@ fn document_fit_passes(c: &mut Checker, dir: &Scratch) {
     ]);
     assert!(two.get("first_pass").is_some(), "a second pass: {two}");
     c.document("fit", "fit --data paper (two passes)", &two);
+    // 19 rows, so each was scored by a fit without it: two such fits compared (here the same
+    // fit twice: the keys are what is checked).
+    let fit = format!("{d}/two");
+    let compared = run(&["compare", &fit, &fit, "--json"]);
+    c.document("compare", "compare", &compared);
     // Two 2D blocks whose second pass's box cuts e (at its lower edge, at seed 3): a widening
     // pass.
     let cut_csv = dir.join("cut.csv");
@@ -1157,5 +1162,5 @@ fn json_md_lists_the_keys_of_fit_recover_and_predict() {
         "--json",
     ]);
     c.document("predict-blocks", "predict --blocks-file", &many);
-    c.finish(&["fit", "recover", "predict", "predict-blocks"]);
+    c.finish(&["fit", "recover", "predict", "predict-blocks", "compare"]);
 }

@@ -8,6 +8,7 @@ pub mod predict;
 pub mod recovery;
 pub mod simulate;
 
+use crate::calibration::crossval::{leave_one_out, LooRow};
 use crate::calibration::design::{self, Design};
 use crate::calibration::params::Narrowed;
 use crate::calibration::{cuts, estimate_with, same_box, tighten, widen};
@@ -132,6 +133,7 @@ impl Fitted {
 /// `f` dressed as a [`FitResult`], its cost measured from `wall` and `cpu` (CPU seconds).
 pub fn result(f: Fitted, command_line: &str, wall: Instant, cpu: f64) -> FitResult {
     FitResult {
+        loo: Vec::new(),
         cost: FitCost {
             rolls: f.rolls,
             unsettled: f.unsettled,
@@ -553,5 +555,33 @@ pub fn run(
     let Some(f) = study.fit(runner, dir)? else {
         return Ok(None);
     };
-    Ok(Some(result(f, &command_line, wall, cpu)))
+    let loo = match study.stage {
+        Stage::First => Vec::new(),
+        _ => rows_without_themselves(&f, runner)?,
+    };
+    Ok(Some(FitResult {
+        loo,
+        ..result(f, &command_line, wall, cpu)
+    }))
+}
+
+/// The fewest rows a fit scores by leaving each out: with two, each row's prediction is a fit
+/// of one.
+const LOO_ROWS: usize = 3;
+
+/// Every row of `f` predicted by a fit of the others, as the calibrated paper scores its
+/// models (no rolls: the surrogates are `f`'s); none for a fit of fewer than [`LOO_ROWS`].
+fn rows_without_themselves(f: &Fitted, runner: &Runner) -> Result<Vec<LooRow>> {
+    if f.config.rows.len() < LOO_ROWS {
+        return Ok(Vec::new());
+    }
+    leave_one_out(
+        &f.config.rows,
+        &f.designs,
+        &f.config.model,
+        &f.params,
+        &f.config.search,
+        &f.estimate,
+        &runner.watch(),
+    )
 }
