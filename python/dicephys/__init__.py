@@ -33,6 +33,7 @@ __all__ = [
     "Fit",
     "Roll",
     "Value",
+    "compare",
     "fair",
     "fit",
     "paper",
@@ -803,6 +804,22 @@ def recover(
     finally:
         close()
     return Document(text)
+
+
+def compare(first: Union[Fit, PathLike], second: Union[Fit, PathLike]) -> Document:
+    """Two fits of the same counts by different models (``free``), set side by side by how
+    well each predicts the rows it did not see: ``dicephys compare --json`` (docs/json.md,
+    "compare"). ``doc.decision["outcome"]`` is ``richer``, ``simpler`` or ``unresolved``.
+
+    first, second: each a ``Fit``, or the path of a fit's fit.json (a fit of three rows or
+    more: its rows are scored by fits without them).
+    """
+    paths = [f.path if isinstance(f, Fit) else os.fspath(f) for f in (first, second)]
+    texts = []
+    for path in paths:
+        with open(path, encoding="utf-8") as f:
+            texts.append(f.read())
+    return Document(_native.compare(texts[0], texts[1], (paths[0], paths[1])))
 
 
 def predict(

@@ -64,6 +64,7 @@ def recover(
     progress: _Progress = ...,
     log: _Log = ...,
 ) -> str: ...
+def compare(first: str, second: str, names: Tuple[str, str]) -> str: ...
 def predict(
     fit: str,
     block: Optional[str] = ...,

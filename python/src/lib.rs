@@ -824,6 +824,22 @@ fn recover(
 
 /// `dicephys predict`: the fit (its `fit.json`'s text) simulated at a block it did not see;
 /// the prediction's JSON.
+/// `dicephys compare --json`: two fits' fit.json texts (named `names`, as the files they came
+/// from), compared by their rows' leave-one-out log scores.
+#[pyfunction]
+fn compare(first: &str, second: &str, names: [String; 2]) -> PyResult<String> {
+    let read = |text: &str, arg: &str| -> PyResult<calibration::FitResult> {
+        let fit: calibration::FitResult = dicephys::run::seal::open(text)
+            .map_err(|e| bad(arg, "…", format!("not a fit's fit.json as written: {e}")))?;
+        fit.check().map_err(|e| bad(arg, "…", e.to_string()))?;
+        Ok(fit)
+    };
+    let (a, b) = (read(first, "first")?, read(second, "second")?);
+    let c = calibration::compare::compare(&a, &b, [&names[0], &names[1]])
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    dicephys::run::seal::to_string(&c, true).map_err(|e| PyRuntimeError::new_err(e.to_string()))
+}
+
 #[pyfunction]
 #[pyo3(signature = (fit, block=None, *, mode="3d", surface=None, thrower=None, draws=16,
     rolls=2000, seed=DEFAULT_SEED, threads=0, progress=None, contact=None))]
@@ -885,6 +901,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(recover, m)?)?;
     m.add_function(wrap_pyfunction!(predict, m)?)?;
+    m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     m.add("DEFAULT_MAX_STEPS", DEFAULT_MAX_STEPS)?;
     m.add("DEFAULT_SEED", DEFAULT_SEED)?;

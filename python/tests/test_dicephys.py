@@ -250,6 +250,22 @@ def test_fit_then_predict_through_python(tmp_path: Path) -> None:
     assert p.data == want
 
 
+def test_two_models_compared_through_python_are_the_cli_s(tmp_path: Path) -> None:
+    third = dict(ROWS[0], label="c", breadth_mm=30, width_mm=10)
+    rows = [dict(r, breadth_vertical=b, width_vertical=1000 - b) for r, b in zip(ROWS + [third], (410, 260, 80))]
+    small = dict(points=12, point_rolls=300, degree=2, max_degree=2, refine=False)
+    one = dicephys.fit(rows, free=["e"], out=tmp_path / "e", **small)  # type: ignore[arg-type]
+    two = dicephys.fit(rows, free=["e", "mu"], out=tmp_path / "emu", **small)  # type: ignore[arg-type]
+    assert [r["label"] for r in one.loo] == ["a", "b", "c"]
+    got = dicephys.compare(two, one)
+    assert got.decision["outcome"] in ("richer", "simpler", "unresolved")
+    assert [m["name"] for m in got.models] == ["e", "e,mu"]
+    want = cli("compare", two.path, one.path, "--json")
+    assert got.data == want
+    with pytest.raises(ValueError, match="no row was predicted without itself"):
+        dicephys.compare(dicephys.fit(rows[:2], free=["e"], out=tmp_path / "two", **small), one)  # type: ignore[arg-type]
+
+
 def test_a_die_s_weight_fitted_through_python_is_the_cli_s(tmp_path: Path) -> None:
     faces = dicephys.roll("16x16x16", rolls=1500, seed=5, throw="tumble", com=(0, 0, -1)).data["faces"]
     row = dict(label="suspect", surface="MDF", length_mm=16, breadth_mm=16, width_mm=16, mode="3d")

@@ -760,3 +760,77 @@ fn held_out_blocks_fall_in_their_chi2_band_at_the_stated_rate() {
         "mean held-out χ² {mean:.2}: {chi2:?}"
     );
 }
+
+/// `compare`: two fits of three rows by nested models, each row scored by a fit without it;
+/// the simpler model is the one with fewer parameters whatever the order given, and fits of
+/// different rows, or of too few to score, are refused with one line naming the file.
+#[test]
+fn compare_sets_two_models_side_by_side_and_refuses_fits_of_other_rows() {
+    let dir = Scratch::new("fit-compare");
+    let rows = "a,MDF,140,24,20,2d,0,410,590\nb,MDF,140,22,13,2d,0,260,740\n";
+    let three = dir.join("three.csv");
+    std::fs::write(&three, format!("{HEAD}{rows}c,MDF,140,30,10,2d,0,80,920\n")).unwrap();
+    let two = dir.join("two.csv");
+    std::fs::write(&two, format!("{HEAD}{rows}")).unwrap();
+    let small = [
+        "--points",
+        "12",
+        "--rolls",
+        "200",
+        "--degree",
+        "2",
+        "--max-degree",
+        "2",
+    ];
+    let fit = |data: &std::path::Path, free: &str, name: &str| {
+        let out = dir.join(name);
+        let head = ["fit", "--data", data.to_str().unwrap(), "--free", free];
+        let tail = [
+            "--dt",
+            "1/250",
+            "--no-refine",
+            "--json",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        let v = json(&dicephys(&[&head[..], &small, &tail].concat()));
+        (out.display().to_string(), v)
+    };
+    let (e, fe) = fit(&three, "e", "e");
+    let (emu, _) = fit(&three, "e,mu", "emu");
+    let (short, fs) = fit(&two, "e", "short");
+    let labels: Vec<&str> = fe["loo"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["label"].as_str().unwrap())
+        .collect();
+    assert_eq!(labels, ["a", "b", "c"]);
+    assert!(fs.get("loo").is_none(), "two rows: none scored");
+    let c = json(&dicephys(&["compare", &emu, &e, "--json"]));
+    assert_eq!(c["models"][0]["name"], "e");
+    assert_eq!(c["models"][1]["name"], "e,mu");
+    assert_eq!(c["rows"].as_array().unwrap().len(), 3);
+    let gain: f64 = c["rows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["gain"].as_f64().unwrap())
+        .sum();
+    assert!((gain - c["decision"]["score_gain"].as_f64().unwrap()).abs() < 1e-9);
+    assert_eq!(c["decision"]["lr_test"][1], 1, "nested: one more parameter");
+    let text = String::from_utf8(dicephys(&["compare", &e, &emu]).stdout).unwrap();
+    assert!(text.contains("Verdict: "), "{text}");
+    for (args, says) in [
+        ([&e, &short], "no row was predicted without itself"),
+        (
+            [&e, &format!("{}/nothing", dir.path().display())],
+            "nothing",
+        ),
+    ] {
+        let out = dicephys(&["compare", args[0], args[1]]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains(says) && err.lines().count() == 1, "{err}");
+    }
+}
