@@ -235,6 +235,43 @@ mod tests {
     }
 
     #[test]
+    fn the_ranges_spelt_in_fits_help_are_the_librarys() {
+        use clap::CommandFactory;
+        use dicephys::calibration::params::Kind;
+        let cmd = crate::cli::Cli::command();
+        let fit = cmd.find_subcommand("fit").unwrap();
+        let arg = fit.get_arguments().find(|a| a.get_id() == "ranges");
+        let help = arg.unwrap().get_help().unwrap().to_string();
+        let spelt = help
+            .split("Defaults: ")
+            .nth(1)
+            .unwrap()
+            .trim_end_matches('.');
+        let mut seen = 0;
+        for item in spelt.split(", ") {
+            let (names, range) = item.split_once('=').unwrap();
+            let (lo, hi) = range.split_once(':').unwrap();
+            let (lo, hi): (f64, f64) = (lo.parse().unwrap(), hi.parse().unwrap());
+            let kinds: Vec<String> = match names {
+                "com_x|y|z" => vec!["com_x".into(), "com_y".into(), "com_z".into()],
+                one => vec![one.into()],
+            };
+            for k in kinds {
+                let r = dicephys::error::parse_name::<Kind>("parameter", &k)
+                    .unwrap()
+                    .default_range();
+                assert_eq!(
+                    (r.lo, r.hi),
+                    (lo, hi),
+                    "--range's help spells {k} as {item}"
+                );
+                seen += 1;
+            }
+        }
+        assert_eq!(seen, 10, "every kind's default range spelt: {spelt}");
+    }
+
+    #[test]
     fn a_message_names_fields_by_flag_and_leaves_other_words_alone() {
         assert_eq!(
             flags_in("give `max_steps` or `style`, not a `roll` checkpoint"),
