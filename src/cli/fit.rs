@@ -40,7 +40,7 @@ pub struct FitArgs {
     #[arg(long, value_delimiter = ',', value_parser = parse_kind)]
     pub shared: Vec<Kind>,
     /// A free parameter's range, NAME=LO:HI (repeat for several). Defaults: e=0.05:0.8,
-    /// mu=0.1:1, kappa=0:10000, spin=0.25:4, height=0.1:2, speed=0.25:10, com_x|y|z=-2:2,
+    /// mu=0.1:1, kappa=0:10000, spin=0.25:3, height=0.1:2, speed=0.25:10, com_x|y|z=-2:2,
     /// pip_depth=0.2:1.5.
     #[arg(long = "range", value_name = "NAME=LO:HI")]
     pub ranges: Vec<String>,
