@@ -96,7 +96,9 @@ pub fn compare(a: &FitResult, b: &FitResult, files: [&str; 2]) -> Result<Compari
     // Nested when every kind the simpler frees the richer frees too: then the likelihood ratio
     // on all rows is a second opinion (its χ² p-value ignores the surrogates' own noise).
     let nested = sn.split(',').all(|k| rn.split(',').any(|r| r == k));
-    let lr = nested.then(|| crossval::likelihood_ratio(&models[0], &models[1]));
+    let lr = nested
+        .then(|| crossval::likelihood_ratio(&models[0], &models[1]))
+        .filter(|t| t.1 > 0);
     let decision = crossval::decide(
         &format!("does freeing {rn} predict the rows it did not see better than {sn}?"),
         &sn,

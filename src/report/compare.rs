@@ -46,7 +46,7 @@ pub fn comparison_text(c: &Comparison) -> String {
         "\nSummed: {:+.1} ± {:.1} (the error from the rows' scatter, √(n · var)).",
         d.score_gain, d.score_gain_err
     );
-    if let Some((stat, dof, p)) = d.lr_test.filter(|t| t.1 > 0) {
+    if let Some((stat, dof, p)) = d.lr_test {
         let _ = writeln!(
             s,
             "On all rows, the likelihood ratio: −2 ln Λ = {stat:.1} on {dof}, p = {p:.3}."
