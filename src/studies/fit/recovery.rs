@@ -22,6 +22,7 @@ pub fn simulate_data(
     runner: &Runner,
 ) -> Result<Option<Vec<DataRow>>> {
     let mut out = Vec::new();
+    let mut before = 0;
     for (i, row) in cfg.rows.iter().enumerate() {
         let n = row.counts.iter().sum::<u64>();
         let spec = cfg.method.spec(
@@ -31,7 +32,12 @@ pub fn simulate_data(
             point_seed(seed, row.block, row.mode, i),
             n,
         );
-        let done = runner.run(&spec, None, &mut |_| Ok(()))?;
+        // Each row's run counts from naught; the progress goes on from the rows before it.
+        let progress = |k: u64| (runner.progress)(before + k);
+        let done = runner
+            .with_progress(&progress)
+            .run(&spec, None, &mut |_| Ok(()))?;
+        before += n;
         if !done.complete {
             return Ok(None);
         }
@@ -100,20 +106,34 @@ pub fn run(
         crate::calibration::params::values(&model.fixed, &model.whole_axes(), &coords);
     let mut reps = Vec::new();
     let mut rolls = 0u64;
+    let mut data_rolls = 0u64;
     let mut names = Vec::new();
     let mut region = 0.0;
     let session = super::Session::default();
     for rep in 0..repeats {
         let seed = cfg.seed.wrapping_add(1_000_003 * rep as u64);
-        let Some(rows) = simulate_data(cfg, &truth_values, seed ^ 0x5eed_da7a, runner)? else {
+        // The session counts the fits' rolls over every repetition; the data's are counted
+        // here, so the progress goes on from all rolled so far (the data's run used to start
+        // it again at 0 % each repetition).
+        let (fits, data_before) = (session.rolled(), data_rolls);
+        let progress = |n: u64| (runner.progress)(fits + data_before + n);
+        let at = runner.with_progress(&progress);
+        let Some(rows) = simulate_data(cfg, &truth_values, seed ^ 0x5eed_da7a, &at)? else {
             return Ok(None);
         };
+        data_rolls += rows
+            .iter()
+            .map(|r| r.counts.iter().sum::<u64>())
+            .sum::<u64>();
         let data_cfg = FitConfig {
             rows,
             seed,
             ..cfg.clone()
         };
-        let Some(fitted) = super::fit(&data_cfg, runner, None, &session)? else {
+        let data_so_far = data_rolls;
+        let progress = |n: u64| (runner.progress)(data_so_far + n);
+        let at = runner.with_progress(&progress);
+        let Some(fitted) = super::fit(&data_cfg, &at, None, &session)? else {
             return Ok(None);
         };
         rolls += fitted.rolls
