@@ -136,56 +136,11 @@ pub fn run(
         let Some(fitted) = super::fit(&data_cfg, &at, None, &session)? else {
             return Ok(None);
         };
-        rolls += fitted.rolls
-            + data_cfg
-                .rows
-                .iter()
-                .map(|r| r.counts.iter().sum::<u64>())
-                .sum::<u64>();
-        let (params, est) = (&fitted.params, &fitted.estimate);
-        let lik = Likelihood::new(
-            &data_cfg.rows,
-            &fitted.designs,
-            &fitted.config.model,
-            params,
-        )
-        .holding(est.concentrations.clone());
-        // The truth in the full parameter vector, each parameter's own coordinate (outside
-        // its narrowed box: not covered).
-        let value_of = |kind| truth[model.free.iter().position(|k| *k == kind).expect("free")];
-        let x_true: Vec<f64> = params
-            .iter()
-            .map(|p| p.kind.coordinate(p.range, value_of(p.kind)))
-            .collect();
-        let inside = x_true.iter().all(|u| (-1e-12..=1.0 + 1e-12).contains(u));
-        let delta = if inside {
-            lik.minus_two_ln_l(&x_true) - est.minus_two_ln_l
-        } else {
-            f64::INFINITY
-        };
+        rolls += fitted.rolls + data_rolls - data_before;
+        let est = &fitted.estimate;
         names = est.params.iter().map(|p| p.name.clone()).collect();
         region = est.region_delta;
-        let in_interval = est
-            .params
-            .iter()
-            .map(|p| {
-                let v = truth[model
-                    .free
-                    .iter()
-                    .position(|k| *k == p.param.kind)
-                    .expect("free")];
-                // Ends interpolated on the profile's grid: a truth at a face is inside an open
-                // side.
-                p.two_sigma[0] - 1e-12 <= v && v <= p.two_sigma[1] + 1e-12
-            })
-            .collect();
-        reps.push(Repetition {
-            seed,
-            truth_delta: delta,
-            covered: delta <= est.region_delta,
-            in_interval,
-            values: est.params.iter().map(|p| p.value).collect(),
-        });
+        reps.push(judged(&data_cfg, &fitted, truth, seed));
     }
     let n = reps.len().max(1) as f64;
     let coverage = reps.iter().filter(|r| r.covered).count() as f64 / n;
@@ -208,4 +163,41 @@ pub fn run(
         interval_coverage,
         rolls,
     }))
+}
+
+/// One repetition judged: the truth's Δ(−2 ln L) from the fit's maximum (each parameter at its
+/// own coordinate; outside its narrowed box: not covered), and each 2σ interval's hold on it.
+fn judged(data: &FitConfig, fitted: &super::Fitted, truth: &[f64], seed: u64) -> Repetition {
+    let model = &data.model;
+    let (params, est) = (&fitted.params, &fitted.estimate);
+    let lik = Likelihood::new(&data.rows, &fitted.designs, &fitted.config.model, params)
+        .holding(est.concentrations.clone());
+    let value_of = |kind| truth[model.free.iter().position(|k| *k == kind).expect("free")];
+    let x_true: Vec<f64> = params
+        .iter()
+        .map(|p| p.kind.coordinate(p.range, value_of(p.kind)))
+        .collect();
+    let inside = x_true.iter().all(|u| (-1e-12..=1.0 + 1e-12).contains(u));
+    let delta = if inside {
+        lik.minus_two_ln_l(&x_true) - est.minus_two_ln_l
+    } else {
+        f64::INFINITY
+    };
+    let in_interval = est
+        .params
+        .iter()
+        .map(|p| {
+            let v = value_of(p.param.kind);
+            // Ends interpolated on the profile's grid: a truth at a face is inside an open
+            // side.
+            p.two_sigma[0] - 1e-12 <= v && v <= p.two_sigma[1] + 1e-12
+        })
+        .collect();
+    Repetition {
+        seed,
+        truth_delta: delta,
+        covered: delta <= est.region_delta,
+        in_interval,
+        values: est.params.iter().map(|p| p.value).collect(),
+    }
 }
