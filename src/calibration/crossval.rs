@@ -14,62 +14,13 @@ use crate::calibration::estimate::{
     draws_from, held_again, maximise_from, Estimate, Likelihood, Maximum, Search,
 };
 use crate::calibration::params::{ModelSpec, Param};
-use crate::calibration::predict::{predict_row, Predicted};
+use crate::calibration::predict::predict_row;
 use crate::error::Result;
 use crate::inference::likelihood::ln_dirichlet_multinomial;
-use crate::theory::stats::{self, Ratio};
+use crate::theory::stats;
 use serde::{Deserialize, Serialize};
 
-/// An end count: a row's length-vertical outcomes, measured and predicted.
-#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
-pub struct EndCount {
-    /// Counted length vertical.
-    pub counted: u64,
-    /// Throws.
-    pub throws: u64,
-    /// Predicted P(length vertical).
-    pub predicted: Predicted,
-    /// (counted/throws − predicted)/√(p(1 − p)/throws + σ_predicted²).
-    pub z: f64,
-}
-
-/// One row, predicted by the fit of the others.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct LooRow {
-    /// The row's label.
-    pub label: String,
-    /// Its surface.
-    pub surface: String,
-    /// The only row on its surface: without it the data say nothing of that surface's e and μ.
-    pub alone: bool,
-    /// The outcome groups.
-    pub outcomes: Vec<String>,
-    /// Counted per group.
-    pub counts: Vec<u64>,
-    /// Predicted per group.
-    pub p: Vec<Predicted>,
-    /// The measured ratio ± the paper's binomial error (when breadth and width are counted
-    /// apart).
-    pub measured_ratio: Option<Ratio>,
-    /// The predicted ratio.
-    pub ratio: Option<Predicted>,
-    /// (measured − predicted)/combined error, on the ratio.
-    pub z: Option<f64>,
-    /// The end count (a 3D row with its length outcome apart).
-    pub end: Option<EndCount>,
-    /// ln P(counts | the fit without the row), the multinomial coefficient included.
-    #[serde(deserialize_with = "nan_if_null")]
-    pub log_score: f64,
-    /// The same for the breadth count given the side throws only (comparable between models
-    /// that simulate the row in 2D and in 3D).
-    #[serde(deserialize_with = "nan_if_null")]
-    pub side_log_score: f64,
-}
-
-/// A number JSON wrote as null (NaN, or an infinity), read back as NaN.
-fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
-    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
-}
+pub use crate::calibration::scores::{EndCount, LooRow};
 
 fn ln_choose(counts: &[u64]) -> f64 {
     use statrs::function::gamma::ln_gamma;

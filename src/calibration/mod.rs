@@ -33,6 +33,7 @@ pub mod params;
 pub mod predict;
 pub mod recovery;
 pub mod request;
+pub mod scores;
 
 use crate::error::{Error, Field, Result};
 use crate::model::throws::Range;
@@ -257,7 +258,7 @@ pub struct FitResult {
     /// than three rows, a first pass, or a fit.json written before fits scored their rows):
     /// what `dicephys compare` sets two models' fits side by side by.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub loo: Vec<crossval::LooRow>,
+    pub loo: Vec<scores::LooRow>,
     /// What it cost.
     pub cost: FitCost,
     /// The command line that made it.

@@ -13,54 +13,9 @@ use crate::calibration::FitResult;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::scene::Mode;
-use crate::theory::stats;
 use serde::{Deserialize, Serialize};
 
-/// A predicted probability.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Predicted {
-    /// The prediction (the posterior mean).
-    pub value: f64,
-    /// Its whole standard error, √(params² + simulation²).
-    pub err: f64,
-    /// The part from the parameters' uncertainty.
-    pub err_params: f64,
-    /// The part from the simulation's noise.
-    pub err_sim: f64,
-}
-
-impl Predicted {
-    /// No prediction (NaN), where a table of blocks has a cell a die of any shape lacks.
-    pub const NONE: Predicted = Predicted {
-        value: f64::NAN,
-        err: f64::NAN,
-        err_params: f64::NAN,
-        err_sim: f64::NAN,
-    };
-
-    /// The mean of `values` with their spread as the parameters' error and `sim_var` as the
-    /// simulation's.
-    pub fn of(values: &[f64], sim_var: f64) -> Predicted {
-        let n = values.len() as f64;
-        let mean = values.iter().sum::<f64>() / n;
-        let var = if values.len() > 1 {
-            values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)
-        } else {
-            0.0
-        };
-        Predicted {
-            value: mean,
-            err: (var + sim_var).sqrt(),
-            err_params: var.sqrt(),
-            err_sim: sim_var.sqrt(),
-        }
-    }
-
-    /// (measured − predicted)/√(σ_measured² + σ_predicted²).
-    pub fn z(&self, measured: f64, measured_err: f64) -> f64 {
-        stats::z_score(measured, measured_err, self.value, self.err)
-    }
-}
+pub use crate::calibration::scores::Predicted;
 
 /// Row `r`'s predicted group probabilities and ratio (breadth over width, when both are
 /// counted apart) over the posterior `draws` (unit coordinates of the likelihood's parameters).
