@@ -13,7 +13,7 @@ import subprocess
 import threading
 import time
 from pathlib import Path
-from typing import Any, Dict
+from typing import Any, Dict, Iterator
 
 import numpy as np
 import pytest
@@ -155,6 +155,18 @@ def test_parameter_names_and_a_contact_are_read_as_the_cli_reads_them() -> None:
         dicephys._contact("0.5,0.3")  # type: ignore[arg-type]
 
 
+@pytest.fixture
+def sigint_raises() -> Iterator[None]:
+    # Python installs the handler that raises KeyboardInterrupt only when SIGINT is not
+    # ignored at its start; a shell that starts a job in the background without job control
+    # ignores it (CI launched that way rolled 5,000,000 rolls to the end). Installed here, so
+    # the test does not depend on how its process was started.
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, old)
+
+
+@pytest.mark.usefixtures("sigint_raises")
 def test_a_signal_stops_a_run_with_keyboard_interrupt() -> None:
     # SIGINT half a second into a run far longer: Python's own handler raises
     # KeyboardInterrupt in the caller once the run has stopped, within a second or two.
@@ -300,6 +312,7 @@ def test_a_d4_s_weight_fitted_and_predicted_through_python_is_the_cli_s(tmp_path
     assert sorted(p.data["labels"]) == ["1", "2", "3", "4"]
 
 
+@pytest.mark.usefixtures("sigint_raises")
 def test_paper_is_the_cli_s_and_a_stopped_one_writes_nothing(tmp_path: Path) -> None:
     # Stopped half a second in: KeyboardInterrupt, and no results.json half-written.
     stopped = tmp_path / "stopped"
