@@ -129,7 +129,7 @@ impl Kind {
             // (steel blocks on one table, issue 49) ended on 0.5–2's upper end. Not four: at
             // 4 × 160 rad/s a long block thrown in a tumble spins on the table for seconds
             // (measured, 140x24x20 at e 0.75, μ 0.12, dt 1/250: 129 ms a roll against 0.4 ms
-            // at 3 ×), and a fit's design spends its hours in that corner.
+            // at 3 ×), and a fit's design stalls in that corner.
             Kind::Spin => Range::new(0.25, 3.0),
             // From a tenth of the paper's drop (a release 2 to 4 cm above the table, a die
             // rolled from a low hand) to twice it.
