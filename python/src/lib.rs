@@ -824,17 +824,20 @@ fn recover(
 
 /// `dicephys predict`: the fit (its `fit.json`'s text) simulated at a block it did not see;
 /// the prediction's JSON.
+/// A fit.json's text, given as the argument `arg`: sealed as written, and whole.
+fn fit_of(text: &str, arg: &str) -> PyResult<calibration::FitResult> {
+    let fit: calibration::FitResult = dicephys::run::seal::open(text)
+        .map_err(|e| bad(arg, "…", format!("not a fit's fit.json as written: {e}")))?;
+    fit.check()
+        .map_err(|e| bad(arg, "…", arguments_in(&e.to_string())))?;
+    Ok(fit)
+}
+
 /// `dicephys compare --json`: two fits' fit.json texts (named `names`, as the files they came
 /// from), compared by their rows' leave-one-out log scores.
 #[pyfunction]
 fn compare(first: &str, second: &str, names: [String; 2]) -> PyResult<String> {
-    let read = |text: &str, arg: &str| -> PyResult<calibration::FitResult> {
-        let fit: calibration::FitResult = dicephys::run::seal::open(text)
-            .map_err(|e| bad(arg, "…", format!("not a fit's fit.json as written: {e}")))?;
-        fit.check().map_err(|e| bad(arg, "…", e.to_string()))?;
-        Ok(fit)
-    };
-    let (a, b) = (read(first, "first")?, read(second, "second")?);
+    let (a, b) = (fit_of(first, "first")?, fit_of(second, "second")?);
     let c = calibration::compare::compare(&a, &b, [&names[0], &names[1]])
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     dicephys::run::seal::to_string(&c, true).map_err(|e| PyRuntimeError::new_err(e.to_string()))
@@ -858,10 +861,7 @@ fn predict(
     progress: Option<&Bound<'_, PyAny>>,
     contact: Option<[f64; 2]>,
 ) -> PyResult<String> {
-    let fit: calibration::FitResult = dicephys::run::seal::open(fit)
-        .map_err(|e| bad("fit", "…", format!("not a fit's fit.json as written: {e}")))?;
-    fit.check()
-        .map_err(|e| bad("fit", "…", arguments_in(&e.to_string())))?;
+    let fit = fit_of(fit, "fit")?;
     // A fit of a die of any shape predicts that die; a fit of blocks needs the block.
     let block = match (block, calibration::predict::own_block(&fit)) {
         (Some(b), _) => self::block(b)?,

@@ -7,6 +7,7 @@
 //! said.
 
 use crate::calibration::crossval::{self, Decision, ModelScore};
+use crate::calibration::params::Kind;
 use crate::calibration::FitResult;
 use crate::error::{Error, Result};
 use serde::Serialize;
@@ -36,16 +37,24 @@ pub struct Comparison {
     pub decision: Decision,
 }
 
-/// A fit's model, named by its free parameters' kinds ("e,mu,kappa").
-fn model_name(f: &FitResult) -> String {
-    let mut kinds: Vec<String> = Vec::new();
+/// A fit's free parameters' kinds, each once, in its order.
+fn kinds(f: &FitResult) -> Vec<Kind> {
+    let mut kinds = Vec::new();
     for p in &f.params {
-        let k = p.kind.to_string();
-        if !kinds.contains(&k) {
-            kinds.push(k);
+        if !kinds.contains(&p.kind) {
+            kinds.push(p.kind);
         }
     }
-    kinds.join(",")
+    kinds
+}
+
+/// A model named by its kinds ("e,mu,kappa").
+fn model_name(kinds: &[Kind]) -> String {
+    kinds
+        .iter()
+        .map(Kind::to_string)
+        .collect::<Vec<_>>()
+        .join(",")
 }
 
 /// Refuses a fit with no rows scored without themselves, saying why it has none.
@@ -82,9 +91,8 @@ pub fn compare(a: &FitResult, b: &FitResult, files: [&str; 2]) -> Result<Compari
         (a, b, files)
     };
     let score = |f: &FitResult| {
-        let name = model_name(f);
         ModelScore::of(
-            &name,
+            &model_name(&kinds(f)),
             &format!("{} free parameters", f.params.len()),
             f.params.len(),
             f.estimate.minus_two_ln_l,
@@ -95,7 +103,7 @@ pub fn compare(a: &FitResult, b: &FitResult, files: [&str; 2]) -> Result<Compari
     let (sn, rn) = (models[0].name.clone(), models[1].name.clone());
     // Nested when every kind the simpler frees the richer frees too: then the likelihood ratio
     // on all rows is a second opinion (its χ² p-value ignores the surrogates' own noise).
-    let nested = sn.split(',').all(|k| rn.split(',').any(|r| r == k));
+    let nested = kinds(simple).iter().all(|k| kinds(rich).contains(k));
     let lr = nested
         .then(|| crossval::likelihood_ratio(&models[0], &models[1]))
         .filter(|t| t.1 > 0);

@@ -27,9 +27,7 @@ fn read(path: &Path) -> Result<dicephys::calibration::FitResult> {
         path.to_path_buf()
     };
     dicephys::calibration::read_fit(&file, super::term::stop()).map_err(|e| match e {
-        dicephys::Error::Stopped => Error::Interrupted(dicephys::run::stop::interrupted(
-            &dicephys::run::stop::Kept::NothingRead,
-        )),
+        dicephys::Error::Stopped => Error::Interrupted(super::fit::nothing_read()),
         e => Error::Usage(format!("compare: {e}")),
     })
 }

@@ -385,6 +385,6 @@ fn predict_blocks(a: &PredictArgs, fit: FitResult, file: &std::path::Path) -> Re
 }
 
 /// A stop while a command reads its input: nothing read, nothing written.
-fn nothing_read() -> String {
+pub(super) fn nothing_read() -> String {
     dicephys::run::stop::interrupted(&dicephys::run::stop::Kept::NothingRead)
 }
