@@ -366,6 +366,7 @@ mod tests {
                     err: 0.0,
                     err_params: 0.0,
                     err_sim: 0.0,
+                    err_model: 0.0,
                 })
                 .collect(),
             ratio: Some(Predicted {
@@ -373,6 +374,7 @@ mod tests {
                 err: 0.0,
                 err_params: 0.0,
                 err_sim: 0.0,
+                err_model: 0.0,
             }),
             faces: None,
             labels: Vec::new(),
@@ -383,6 +385,7 @@ mod tests {
             unsettled: 0,
             extrapolation: None,
             overdispersion: 1.0,
+            discrepancy: None,
         };
         let row = BlockRow {
             label: "a".into(),

@@ -26,6 +26,7 @@ pub mod compare;
 pub mod crossval;
 pub mod data;
 pub mod design;
+pub mod discrepancy;
 pub mod estimate;
 pub mod heldout;
 pub mod paper;
@@ -259,6 +260,11 @@ pub struct FitResult {
     /// what `dicephys compare` sets two models' fits side by side by.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub loo: Vec<scores::LooRow>,
+    /// How far the rows predicted without themselves miss beyond their errors, outcome by
+    /// outcome, which widens every prediction of a block the fit did not see (`null` where
+    /// fewer than three rows were scored).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub discrepancy: Option<discrepancy::Discrepancy>,
     /// What it cost.
     pub cost: FitCost,
     /// The command line that made it.

@@ -8,6 +8,7 @@
 //!   Var_θ = S² − mean p̂(1 − p̂)/n, and the rolls' noise; the mean's own error adds
 //!   (Var_θ + p̄(1 − p̄)/n)/M for M draws.
 
+use crate::calibration::discrepancy::{self, Discrepancy};
 use crate::calibration::estimate::Likelihood;
 use crate::calibration::FitResult;
 use crate::error::{Error, Result};
@@ -102,6 +103,50 @@ pub struct BlockPrediction {
     /// scatter φ times the binomial's ([`crate::calibration::heldout::test`]).
     #[serde(default = "one")]
     pub overdispersion: f64,
+    /// The fit's discrepancy where it has one: every error above is widened by it already
+    /// (each share's `err_model`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub discrepancy: Option<Discrepancy>,
+}
+
+impl BlockPrediction {
+    /// This prediction widened by the fit's discrepancy `d` (where any outcome has one): each
+    /// share by its outcome's, each face by its label's, the ratio by breadth's and width's.
+    pub fn widened(self, d: Option<&Discrepancy>) -> BlockPrediction {
+        let Some(d) = d.filter(|d| d.any()) else {
+            return self;
+        };
+        const SIDES: [&str; 3] = ["length", "breadth", "width"];
+        let p: Vec<Predicted> = self
+            .p
+            .iter()
+            .zip(SIDES)
+            .map(|(q, name)| discrepancy::widen(*q, d.tau(name)))
+            .collect();
+        let ratio = self.ratio.map(|r| {
+            discrepancy::widen_ratio(
+                r,
+                (self.p[1].value, d.tau("breadth")),
+                (self.p[2].value, d.tau("width")),
+            )
+        });
+        let faces = self.faces.as_ref().map(|f| {
+            f.iter()
+                .enumerate()
+                .map(|(k, q)| {
+                    let label = self.labels.get(k).map_or("", |l| l.as_str());
+                    discrepancy::widen(*q, d.tau(label))
+                })
+                .collect()
+        });
+        BlockPrediction {
+            p,
+            ratio,
+            faces,
+            discrepancy: Some(d.clone()),
+            ..self
+        }
+    }
 }
 
 fn one() -> f64 {

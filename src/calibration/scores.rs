@@ -12,12 +12,20 @@ use serde::{Deserialize, Serialize};
 pub struct Predicted {
     /// The prediction (the posterior mean).
     pub value: f64,
-    /// Its whole standard error, √(params² + simulation²).
+    /// Its whole standard error, √(params² + simulation² + model²).
     pub err: f64,
     /// The part from the parameters' uncertainty.
     pub err_params: f64,
     /// The part from the simulation's noise.
     pub err_sim: f64,
+    /// The part from the model's discrepancy, learnt from the rows the fit predicted without
+    /// themselves ([`crate::calibration::discrepancy`]); 0, and left out, where there is none.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub err_model: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 impl Predicted {
@@ -27,6 +35,7 @@ impl Predicted {
         err: f64::NAN,
         err_params: f64::NAN,
         err_sim: f64::NAN,
+        err_model: 0.0,
     };
 
     /// The mean of `values` with their spread as the parameters' error and `sim_var` as the
@@ -44,6 +53,7 @@ impl Predicted {
             err: (var + sim_var).sqrt(),
             err_params: var.sqrt(),
             err_sim: sim_var.sqrt(),
+            err_model: 0.0,
         }
     }
 

@@ -2,6 +2,7 @@
 
 use crate::calibration::check::Verdict;
 use crate::calibration::crossval::ModelScore;
+use crate::calibration::discrepancy::Discrepancy;
 use crate::calibration::estimate::{Estimate, Identified, ParamFit, RangeEnd, MISFIT_P};
 use crate::calibration::paper::CalibratedPaper;
 use crate::calibration::params::{FixedThrow, Kind};
@@ -529,7 +530,48 @@ fn left_out(res: &FitResult) -> String {
             r.log_score
         );
     }
+    let _ = write!(
+        s,
+        "\n{}\n",
+        discrepancy_text(res.discrepancy.as_ref()).unwrap_or_else(|| {
+            "The rows predicted without themselves miss within their errors: no discrepancy \
+             widens a prediction from this fit."
+                .into()
+        })
+    );
     s
+}
+
+/// What a fit's discrepancy says: which outcomes' rows, predicted without themselves, miss
+/// beyond their errors, and by how much a prediction of a block the fit did not see is
+/// widened. `None` where none does (or none was learnt: fewer than three rows).
+pub fn discrepancy_text(d: Option<&Discrepancy>) -> Option<String> {
+    let d = d.filter(|d| d.any())?;
+    let asked: Vec<String> = d
+        .outcomes
+        .iter()
+        .filter(|o| o.tau > 0.0)
+        .map(|o| {
+            format!(
+                "{} (Σz² {:.1} on {}, p {}: τ = {:.3}, {:.3} for a prediction)",
+                o.outcome,
+                o.chi2,
+                o.rows,
+                p_shown(o.p_value),
+                o.tau,
+                o.predictive_tau
+            )
+        })
+        .collect();
+    Some(format!(
+        "**The model misses rows it did not see beyond their errors**, in {}: the rows \
+         predicted without themselves say how far a block's log-odds are missed beyond its \
+         counts' noise (τ; a spread learnt from few rows is taken √(m/(m − 2)) times wider), \
+         and every prediction of a block this fit did not see is widened by it (`err_model`). \
+         A bias that differs from block to block is not extra scatter in the counts: it does \
+         not shrink with the throws counted.",
+        asked.join("; ")
+    ))
 }
 
 /// The rows' measured ratio and the fit's, for [`fig::rows`].
@@ -594,10 +636,24 @@ pub fn write_figures(dir: &Path, res: &FitResult) -> Result<Vec<&'static str>> {
 }
 
 fn predicted(p: &Predicted) -> String {
+    let model = if p.err_model > 0.0 {
+        format!(", discrepancy {:.4}", p.err_model)
+    } else {
+        String::new()
+    };
     format!(
-        "{:.4} ± {:.4} (parameters {:.4}, simulation {:.4})",
+        "{:.4} ± {:.4} (parameters {:.4}, simulation {:.4}{model})",
         p.value, p.err, p.err_params, p.err_sim
     )
+}
+
+/// A p-value as the reports give one: three decimals, or two digits' exponent below 0.001.
+fn p_shown(p: f64) -> String {
+    if p >= 1e-3 {
+        format!("{p:.3}")
+    } else {
+        format!("{p:.1e}")
+    }
 }
 
 /// What the parametric bootstrap says of the fit's errors, in a sentence.
@@ -708,6 +764,20 @@ pub fn prediction_text(p: &BlockPrediction) -> String {
             "  the fit misfits: its errors widened by its overdispersion φ = {:.2}, and counts \
              measured against this taken to scatter φ times the binomial's",
             p.overdispersion
+        );
+    }
+    if let Some(d) = p.discrepancy.as_ref().filter(|d| d.any()) {
+        let taus: Vec<String> = d
+            .outcomes
+            .iter()
+            .filter(|o| o.predictive_tau > 0.0)
+            .map(|o| format!("{} {:.3}", o.outcome, o.predictive_tau))
+            .collect();
+        let _ = writeln!(
+            s,
+            "  the fit misses rows it did not see beyond their errors: each share widened by its \
+             discrepancy on the log-odds (τ: {})",
+            taus.join(", ")
         );
     }
     s
@@ -1094,6 +1164,13 @@ pub fn predictions_markdown(p: &crate::calibration::heldout::Predictions, stem: 
             "\nThe fit misfits: its overdispersion φ = {phi:.2} widens every prediction above, and \
              each measured count's variance is taken φ times the multinomial's."
         );
+    }
+    if let Some(t) = discrepancy_text(
+        p.rows
+            .first()
+            .and_then(|r| r.prediction.discrepancy.as_ref()),
+    ) {
+        let _ = writeln!(s, "\n{t}");
     }
     let far: Vec<String> = p
         .rows

@@ -921,6 +921,26 @@ fn document_fit_passes(c: &mut Checker, dir: &Scratch) {
     let fit = format!("{d}/two");
     let compared = run(&["compare", &fit, &fit, "--json"]);
     c.document("compare", "compare", &compared);
+    // With κ alone free the paper's three surfaces' rows, predicted without themselves, miss
+    // beyond their errors (breadth and width, p ~ 1e-6): a prediction from it is widened by
+    // the discrepancy (`err_model`, `discrepancy`).
+    let two_json = format!("{fit}/fit.json");
+    let widened = run(&[
+        "predict",
+        "--fit",
+        &two_json,
+        "--block",
+        "140x30x10",
+        "--draws",
+        "3",
+        "--rolls",
+        "50",
+        "--threads",
+        "1",
+        "--json",
+    ]);
+    assert!(widened["discrepancy"].is_object(), "{widened}");
+    c.document("predict", "predict from a fit with a discrepancy", &widened);
     // Two 2D blocks whose second pass's box cuts e (at its lower edge, at seed 3): a widening
     // pass.
     let cut_csv = dir.join("cut.csv");

@@ -10,6 +10,7 @@ pub mod simulate;
 
 use crate::calibration::crossval::{leave_one_out, LooRow};
 use crate::calibration::design::{self, Design};
+use crate::calibration::discrepancy::Discrepancy;
 use crate::calibration::params::Narrowed;
 use crate::calibration::{cuts, estimate_with, same_box, tighten, widen};
 use crate::calibration::{narrow, FitConfig, FitCost, FitResult, Pass, MAX_MORE_PASSES};
@@ -134,6 +135,7 @@ impl Fitted {
 pub fn result(f: Fitted, command_line: &str, wall: Instant, cpu: f64) -> FitResult {
     FitResult {
         loo: Vec::new(),
+        discrepancy: None,
         cost: FitCost {
             rolls: f.rolls,
             unsettled: f.unsettled,
@@ -559,8 +561,10 @@ pub fn run(
         Stage::First => Vec::new(),
         _ => rows_without_themselves(&f, runner)?,
     };
+    let discrepancy = Discrepancy::estimate(&loo, f.estimate.overdispersion);
     Ok(Some(FitResult {
         loo,
+        discrepancy,
         ..result(f, &command_line, wall, cpu)
     }))
 }

@@ -185,41 +185,50 @@ pub fn predict_block(
             q * (1.0 - q) / n / (1.0 - q).powi(4)
         })
     });
-    Ok(Some(BlockPrediction {
-        block: cfg.block,
-        mode: cfg.mode,
-        shape: shape.map(|s| s.name.clone()),
-        // A surface given by its e and μ is named by them.
-        surface: match cfg.contact {
-            Some([e, mu]) => format!("e {e}, μ {mu}"),
-            None => surface,
-        },
-        thrower,
-        p: freq
-            .iter()
-            .filter(|v| !v.is_empty())
-            .map(|v| combine(v, &binomial))
-            .collect(),
-        ratio,
-        labels: match shape {
-            Some(s) => s.labels().iter().map(|l| l.to_string()).collect(),
-            None if with_faces => (1..=6).map(|k| k.to_string()).collect(),
-            None => Vec::new(),
-        },
-        faces,
-        theory_ratio: shape
-            .is_none()
-            .then(|| crate::theory::ratio_from_r(cfg.block.r())),
-        draws: cfg.draws,
-        rolls: cfg.rolls,
-        unsettled,
-        overdispersion: fit.estimate.overdispersion,
-        extrapolation: if shape.is_some() {
-            None
-        } else {
-            extrapolation(fit, &cfg.block)
-        },
-    }))
+    Ok(Some(
+        BlockPrediction {
+            block: cfg.block,
+            mode: cfg.mode,
+            shape: shape.map(|s| s.name.clone()),
+            // A surface given by its e and μ is named by them.
+            surface: match cfg.contact {
+                Some([e, mu]) => format!("e {e}, μ {mu}"),
+                None => surface,
+            },
+            thrower,
+            p: freq
+                .iter()
+                .filter(|v| !v.is_empty())
+                .map(|v| combine(v, &binomial))
+                .collect(),
+            ratio,
+            labels: face_labels(shape, with_faces),
+            faces,
+            theory_ratio: shape
+                .is_none()
+                .then(|| crate::theory::ratio_from_r(cfg.block.r())),
+            draws: cfg.draws,
+            rolls: cfg.rolls,
+            unsettled,
+            overdispersion: fit.estimate.overdispersion,
+            discrepancy: None,
+            extrapolation: shape
+                .is_none()
+                .then(|| extrapolation(fit, &cfg.block))
+                .flatten(),
+        }
+        .widened(fit.discrepancy.as_ref()),
+    ))
+}
+
+/// What a prediction's faces show: a die of any shape's labels, 1 to 6 for a cube's faces,
+/// none without faces.
+fn face_labels(shape: Option<&crate::model::shape::Shape>, with_faces: bool) -> Vec<String> {
+    match shape {
+        Some(s) => s.labels().iter().map(|l| l.to_string()).collect(),
+        None if with_faces => (1..=6).map(|k| k.to_string()).collect(),
+        None => Vec::new(),
+    }
 }
 
 /// The runs of a prediction: `cfg.block` at `cfg.draws` of the fit's posterior draws, evenly
@@ -280,6 +289,7 @@ fn combine(v: &[f64], noise: &dyn Fn(f64) -> f64) -> Predicted {
         err: (params_var + sim_var).sqrt(),
         err_params: params_var.sqrt(),
         err_sim: sim_var.sqrt(),
+        err_model: 0.0,
     }
 }
 
