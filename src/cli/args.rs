@@ -39,11 +39,15 @@ pub struct Json {
     pub json: bool,
 }
 
-/// The step cap, `D` steps unless given (`*max_steps` reads it).
+/// The step cap, the library's [`DEFAULT_MAX_STEPS`] unless given (`*max_steps` reads it).
+/// Not generic over its default: clap's derive keeps a `default_value_t`'s text in a static
+/// that every instantiation of a generic shares, so `MaxSteps<2_000_000>` and
+/// `MaxSteps<20_000>` both showed and used the first one built (20,000,000). The sweeps,
+/// whose caps differ, declare their own (`cli::sweeps`).
 #[derive(Args, Debug, Clone, Copy)]
-pub struct MaxSteps<const D: u64> {
+pub struct MaxSteps {
     /// Steps after which a roll not at rest counts as unconverged.
-    #[arg(long, default_value_t = D)]
+    #[arg(long, default_value_t = DEFAULT_MAX_STEPS)]
     pub max_steps: u64,
 }
 
@@ -68,7 +72,7 @@ impl std::ops::Deref for Json {
     }
 }
 
-impl<const D: u64> std::ops::Deref for MaxSteps<D> {
+impl std::ops::Deref for MaxSteps {
     type Target = u64;
     fn deref(&self) -> &u64 {
         &self.max_steps
@@ -332,7 +336,7 @@ pub struct RunArgs {
     pub threads: Threads,
     /// The step cap.
     #[command(flatten)]
-    pub max_steps: MaxSteps<DEFAULT_MAX_STEPS>,
+    pub max_steps: MaxSteps,
     /// What ends a roll: certificate (the exact early stop: energy below the barrier out of
     /// the current face) or dicephys (at rest by DicePhys's rule). Default: certificate at
     /// dt <= 1/250 s, where it is audited exact; dicephys at coarser steps.

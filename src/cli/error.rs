@@ -234,6 +234,41 @@ mod tests {
         }
     }
 
+    /// Every study's flags, none given, make the library's default configuration: the lists
+    /// clap spells as text (blocks, steps, ladders, trend points) included.
+    #[test]
+    fn the_studies_defaults_spelt_in_clap_are_the_librarys() {
+        use clap::Parser;
+        use dicephys::studies::{calibrated, converge, stability, tradeoff, validate};
+        let parsed = |args: &[&str]| crate::cli::Cli::try_parse_from(args).unwrap().command;
+        match parsed(&["dicephys", "validate"]) {
+            crate::cli::Command::Validate(a) => assert_eq!(a.config(), validate::Config::default()),
+            _ => unreachable!(),
+        }
+        match parsed(&["dicephys", "converge"]) {
+            crate::cli::Command::Converge(a) => assert_eq!(a.config(), converge::Config::default()),
+            _ => unreachable!(),
+        }
+        match parsed(&["dicephys", "stability"]) {
+            crate::cli::Command::Stability(a) => {
+                assert_eq!(a.config(), stability::Config::default())
+            }
+            _ => unreachable!(),
+        }
+        match parsed(&["dicephys", "tradeoff"]) {
+            crate::cli::Command::Tradeoff(a) => {
+                assert_eq!(a.config().unwrap(), tradeoff::Config::default())
+            }
+            _ => unreachable!(),
+        }
+        match parsed(&["dicephys", "paper"]) {
+            crate::cli::Command::Paper(a) => {
+                assert_eq!(a.reference_dt, calibrated::DEFAULT_REFERENCE_DT)
+            }
+            _ => unreachable!(),
+        }
+    }
+
     #[test]
     fn the_ranges_spelt_in_fits_help_are_the_librarys() {
         use clap::CommandFactory;

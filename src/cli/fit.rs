@@ -15,7 +15,6 @@ use dicephys::engine::EngineKind;
 use dicephys::model::block::Block;
 use dicephys::model::scene::Mode;
 use dicephys::model::throws::Range;
-use dicephys::sim::roll::DEFAULT_MAX_STEPS;
 use dicephys::studies::fit::{
     BlocksConfig, BlocksStudy, FitStudy, PredictStudy, RecoverStudy, Stage,
 };
@@ -73,7 +72,7 @@ pub struct FitArgs {
     pub dt: f64,
     /// The step cap.
     #[command(flatten)]
-    pub max_steps: MaxSteps<DEFAULT_MAX_STEPS>,
+    pub max_steps: MaxSteps,
     /// Parameter points each block is simulated at.
     #[arg(long, default_value_t = FitRequest::default().points)]
     pub points: usize,

@@ -7,7 +7,6 @@ use super::study;
 use super::study::StudyPlace;
 use clap::Args;
 use dicephys::engine::EngineKind;
-use dicephys::sim::roll::DEFAULT_MAX_STEPS;
 use dicephys::studies::calibrated::CalibratedStudy;
 use dicephys::studies::fit::Stage;
 use dicephys::studies::paper::PaperConfig;
@@ -33,7 +32,7 @@ pub struct PaperArgs {
     pub place: StudyPlace,
     /// The step cap.
     #[command(flatten)]
-    pub max_steps: MaxSteps<DEFAULT_MAX_STEPS>,
+    pub max_steps: MaxSteps,
     /// DicePhys exactly as the paper ran it (its rest rule, every flight step stepped) instead
     /// of the exact early stop and closed-form flight.
     #[arg(long)]

@@ -2,8 +2,8 @@
 //! configurations (`dicephys::studies::{converge, tradeoff, stability}`); each writes
 //! `<command>.json`, `report.md` and its figures into --out (`super::study`).
 
+use super::args::Seed;
 use super::args::{parse_engine, parse_percent};
-use super::args::{MaxSteps, Seed};
 use super::error::{Error, Result};
 use super::study;
 use super::study::StudyPlace;
@@ -39,9 +39,9 @@ pub struct ConvergeArgs {
     /// Threads, --out, --json.
     #[command(flatten)]
     pub place: StudyPlace,
-    /// The step cap.
-    #[command(flatten)]
-    pub max_steps: MaxSteps<2_000_000>,
+    /// Steps after which a roll not at rest counts as unconverged.
+    #[arg(long, default_value_t = converge::Config::default().max_steps)]
+    pub max_steps: u64,
     /// Precision as the input, per cent at 2σ ("1" or "1%"): every cell rolled in rounds of one
     /// keyed stream until its departure from the finest dt is resolved to it (--rolls ignored).
     #[arg(long, value_parser = parse_percent)]
@@ -98,9 +98,9 @@ pub struct TradeoffArgs {
     /// Threads, --out, --json.
     #[command(flatten)]
     pub place: StudyPlace,
-    /// The step cap.
-    #[command(flatten)]
-    pub max_steps: MaxSteps<2_000_000>,
+    /// Steps after which a roll not at rest counts as unconverged.
+    #[arg(long, default_value_t = tradeoff::Config::default().max_steps)]
+    pub max_steps: u64,
     /// Roll the pilot (a chunk of every method, kept), print the plan (the CPU the precision
     /// asked costs, and the precision an hour buys) and stop.
     #[arg(long)]
@@ -158,9 +158,9 @@ pub struct StabilityArgs {
     /// Threads, --out, --json.
     #[command(flatten)]
     pub place: StudyPlace,
-    /// The step cap.
-    #[command(flatten)]
-    pub max_steps: MaxSteps<20_000>,
+    /// Steps after which a roll not at rest counts as unconverged.
+    #[arg(long, default_value_t = stability::Config::default().max_steps)]
+    pub max_steps: u64,
     /// The box floor's thickness, m (DicePhys's 100); 0.02, a table top, lets a die at a
     /// coarse step really pass through it.
     #[arg(long, default_value_t = dicephys::model::scene::DICEPHYS_FLOOR_THICKNESS)]
@@ -176,7 +176,7 @@ impl ConvergeArgs {
             engines: self.engines.clone(),
             rolls: self.rolls,
             seed: *self.seed,
-            max_steps: *self.max_steps,
+            max_steps: self.max_steps,
             precision: self.precision,
             budget_s: self.budget,
             reference_budget_s: self.reference_budget,
@@ -212,7 +212,7 @@ impl TradeoffArgs {
             budget_s: self.budget,
             reference_budget_s: self.reference_budget,
             seed: *self.seed,
-            max_steps: *self.max_steps,
+            max_steps: self.max_steps,
             plan_only: self.plan,
             preroll_chunks: self
                 .preroll
@@ -232,7 +232,7 @@ impl StabilityArgs {
             blocks: self.blocks.clone(),
             rolls: self.rolls,
             seed: *self.seed,
-            max_steps: *self.max_steps,
+            max_steps: self.max_steps,
             floor_thickness: self.floor_thickness,
         }
     }

@@ -8,7 +8,7 @@ use dicephys::engine::{new_engine, EngineKind};
 use dicephys::model::die::DieShape;
 use dicephys::model::state::BodyState;
 use dicephys::report::trace;
-use dicephys::sim::roll::{roll_observed, RollConfig, DEFAULT_MAX_STEPS};
+use dicephys::sim::roll::{roll_observed, RollConfig};
 use std::io::Write;
 
 /// `dicephys trace`'s arguments.
@@ -30,7 +30,7 @@ pub struct TraceArgs {
     pub every: u64,
     /// The step cap.
     #[command(flatten)]
-    pub max_steps: MaxSteps<DEFAULT_MAX_STEPS>,
+    pub max_steps: MaxSteps,
     /// Free flight: fast (integrated in closed form where the engine's flight is ballistic, as
     /// `roll` does, so that the trace is the roll's; the flown steps are printed too) or
     /// stepped (every step by the engine).

@@ -36,6 +36,9 @@ use std::time::Instant;
 /// Throws a block in the method check when none are asked.
 pub const DEFAULT_CHECK_ROLLS: u64 = 4000;
 
+/// The method check's reference step when none is asked, s: a fifth of a millisecond.
+pub const DEFAULT_REFERENCE_DT: f64 = 1.0 / 5000.0;
+
 /// What to simulate.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CalibratedConfig {

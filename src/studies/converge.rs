@@ -52,6 +52,26 @@ pub struct Config {
     pub fast: bool,
 }
 
+impl Default for Config {
+    /// `dicephys converge` with no flags: three of the paper's blocks at four steps from
+    /// 1/60 to 1/5000 s on both engines, 200 rolls a cell, DicePhys's rule.
+    fn default() -> Config {
+        let b = |s: &str| s.parse::<Block>().expect("a valid block");
+        Config {
+            blocks: vec![b("140x24x20"), b("140x22x13"), b("140x30x10")],
+            dts: vec![1.0 / 60.0, 1.0 / 250.0, 1.0 / 1000.0, 1.0 / 5000.0],
+            engines: crate::studies::paper::DEFAULT_ENGINES.to_vec(),
+            rolls: 200,
+            seed: crate::model::throws::DEFAULT_SEED,
+            max_steps: 2_000_000,
+            precision: None,
+            budget_s: 600.0,
+            reference_budget_s: 1800.0,
+            fast: false,
+        }
+    }
+}
+
 impl Cell {
     /// A cell from its measurement and its departure (value, error) from the finest dt.
     fn of(

@@ -42,6 +42,34 @@ pub struct Config {
     pub floor_thickness: f64,
 }
 
+impl Default for Config {
+    /// `dicephys stability` with no flags: the dt × restitution grid from 1 ms to 1/30 s, the
+    /// friction line, the aspect line's five blocks, 300 rolls a cell (a fraction's standard
+    /// error at most 2.9 %), DicePhys's floor.
+    fn default() -> Config {
+        let b = |s: &str| s.parse::<Block>().expect("a valid block");
+        Config {
+            engines: crate::studies::paper::DEFAULT_ENGINES.to_vec(),
+            dts: vec![1.0 / 1000.0, 1.0 / 240.0, 1.0 / 60.0, 1.0 / 30.0],
+            restitutions: vec![0.0, 0.5, 0.8, 0.95],
+            frictions: vec![0.0, 0.29, 0.8, 1.5],
+            blocks: [
+                "140x24x20",
+                "140x40x20",
+                "140x100x20",
+                "200x200x20",
+                "24x24x20",
+            ]
+            .map(b)
+            .to_vec(),
+            rolls: 300,
+            seed: crate::model::throws::DEFAULT_SEED,
+            max_steps: 20_000,
+            floor_thickness: DICEPHYS_FLOOR_THICKNESS,
+        }
+    }
+}
+
 impl Config {
     /// Checks every value before anything runs.
     pub fn validate(&self) -> Result<()> {

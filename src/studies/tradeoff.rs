@@ -66,6 +66,30 @@ pub struct Config {
     pub preroll_chunks: Option<u64>,
 }
 
+impl Default for Config {
+    /// `dicephys tradeoff` with no flags: 140x24x20 in 3D and 2D, Bullet at 1/100, 1/250 and
+    /// 1/1000 s and Rapier at 1/250 and 1/1000 s against Bullet at 1/5000 s (with 1/2000 and
+    /// 1/10000 as its ladder), each departure to 2 % at 2σ (what about an hour on 2 cores
+    /// buys: docs/results/tradeoff.md), 600 CPU s a method and 1,800 the reference.
+    fn default() -> Config {
+        Config {
+            blocks: vec!["140x24x20".parse().expect("a valid block")],
+            modes: vec![Mode::ThreeD, Mode::TwoD],
+            dts: vec![1.0 / 100.0, 1.0 / 250.0, 1.0 / 1000.0],
+            rapier_dts: vec![1.0 / 250.0, 1.0 / 1000.0],
+            reference_dt: 1.0 / 5000.0,
+            ladder: vec![1.0 / 2000.0, 1.0 / 10000.0],
+            precision: 0.02,
+            budget_s: 600.0,
+            reference_budget_s: 1800.0,
+            seed: crate::model::throws::DEFAULT_SEED,
+            max_steps: 2_000_000,
+            plan_only: false,
+            preroll_chunks: None,
+        }
+    }
+}
+
 impl Config {
     /// What makes two runs of it one run (`StudyConfig::identity`): less the precision, the
     /// budgets, `plan_only` and `preroll_chunks`.
