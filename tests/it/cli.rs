@@ -1,6 +1,9 @@
-//! The command line as a user meets it: the built binary, its exit codes, its outputs.
+//! The command line as a user meets it: the built binary, its exit codes, its outputs. A full
+//! or closed stdout (`--help` and `--version` too) is one line or a quiet end, never a panic;
+//! values at the edges, or past a floor that would make a run endless, are one line and exit 2.
 
-use super::helpers::{dicephys, json, Scratch};
+use super::helpers::{bin, dicephys, json, scratch, stderr, Scratch};
+use std::process::Stdio;
 
 #[test]
 fn bad_input_gets_one_line_and_exit_code_2() {
@@ -586,5 +589,142 @@ fn the_old_spellings_still_read_and_ignored_flags_are_refused() {
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(says), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn a_full_stdout_is_an_error_not_a_panic() {
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
+    for args in [
+        &["roll", "--block", "140x24x20", "--rolls", "10", "--json"][..],
+        &["trace", "--block", "140x24x20", "--max-steps", "50"][..],
+        &["theory", "--table"][..],
+    ] {
+        let out = bin()
+            .args(args)
+            .stdout(full.try_clone().unwrap())
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {}", stderr(&out));
+        assert_eq!(
+            stderr(&out).trim_end().lines().count(),
+            1,
+            "{args:?}: {}",
+            stderr(&out)
+        );
+    }
+}
+
+#[test]
+fn help_and_version_into_a_full_stdout_fail() {
+    for arg in ["--help", "--version"] {
+        let out = bin()
+            .arg(arg)
+            .stdout(
+                std::fs::OpenOptions::new()
+                    .write(true)
+                    .open("/dev/full")
+                    .unwrap(),
+            )
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{arg}: {}", stderr(&out));
+    }
+    // Into a pipe it succeeds.
+    let out = bin().arg("--help").output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+}
+
+#[test]
+fn a_closed_pipe_ends_quietly() {
+    let mut child = bin()
+        .args(["trace", "--block", "140x24x20"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    assert!(stderr(&out).is_empty(), "{}", stderr(&out));
+    assert_ne!(out.status.code(), Some(101), "panicked");
+}
+
+#[test]
+fn inputs_at_the_edges_get_one_line_and_exit_2() {
+    for args in [
+        &[
+            "trace",
+            "--block",
+            "140x24x20",
+            "--throws",
+            "dicephys",
+            "--index",
+            "18446744073709551615",
+        ][..],
+        &["bench", "--rolls", "18446744073709551615"][..],
+        &["roll", "--block", "1e-300x1e-300x1e-300", "--rolls", "10"][..],
+        &["paper", "--threads", "5000", "--rolls", "10"][..],
+        &["paper", "--rolls", "18446744073709551615"][..],
+    ] {
+        let out = bin().args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert_eq!(
+            stderr(&out).trim_end().lines().count(),
+            1,
+            "{args:?}: {}",
+            stderr(&out)
+        );
+    }
+}
+
+#[test]
+fn time_steps_below_the_floor_and_other_endless_values_are_refused() {
+    let cases: [&[&str]; 9] = [
+        &["validate", "--flight-dts", "1e-12"],
+        &["roll", "--block", "140x24x20", "--dt", "1e-9"],
+        &["converge", "--dts", "1/1000,1e-8"],
+        &["stability", "--dts", "1e-7"],
+        &["roll", "--block", "140x24x20", "--density", "1e-300"],
+        &["stability", "--restitutions", "1"],
+        &["tradeoff", "--preroll", "1000000001"],
+        &[
+            "slurm",
+            "stability",
+            "--rolls",
+            "0",
+            "--tasks",
+            "2",
+            "--dir",
+            "/nonexistent/x",
+        ],
+        &["merge", "/dev/zero"],
+    ];
+    // Run in a scratch directory, each given a minute: a value let through may never end.
+    let d = scratch("floors");
+    for args in cases {
+        let child = bin()
+            .args(args)
+            .current_dir(&*d)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let id = child.id();
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || tx.send(child.wait_with_output().unwrap()));
+        let Ok(out) = rx.recv_timeout(std::time::Duration::from_secs(60)) else {
+            unsafe { libc::kill(id as i32, libc::SIGKILL) };
+            panic!("{args:?}: accepted, and still running after a minute");
+        };
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert_eq!(
+            stderr(&out).lines().count(),
+            1,
+            "{args:?}: {}",
+            stderr(&out)
+        );
     }
 }

@@ -1,7 +1,8 @@
 //! Dice as they are made: a centre of mass off the centre (`--com`), drilled pips (`--pips`),
-//! rounded edges (`--edge-radius`) and a die file (`--die`), on real Bullet and Rapier.
+//! rounded edges (`--edge-radius`) and a die file (`--die`, read through a cap and named when
+//! it cannot be read), on real Bullet and Rapier.
 
-use crate::helpers::{dicephys, json, Scratch};
+use crate::helpers::{bin, dicephys, exit_within, json, scratch, stderr, Scratch};
 use dicephys::engine::{new_engine, EngineKind};
 use dicephys::model::die::up_in_body;
 use dicephys::model::faces::Layout;
@@ -9,6 +10,7 @@ use dicephys::model::mass::{Features, PipShape, Pips};
 use dicephys::model::scene::{Mode, Scene};
 use dicephys::model::state::BodyState;
 use nalgebra::{UnitQuaternion, Vector3};
+use std::path::Path;
 
 fn faces(v: &serde_json::Value) -> [f64; 6] {
     std::array::from_fn(|k| v["faces"][(k + 1).to_string()].as_f64().unwrap())
@@ -481,4 +483,46 @@ fn a_fit_of_face_counts_finds_where_the_weight_sits() {
         assert!((z + 1.0).abs() < 0.3, "recovered com_z {z}");
         assert_eq!(r["covered"], true, "{r}");
     }
+}
+
+/// Reliability round 5, class D: a `--die` file is read through the capped reader and named:
+/// missing, a directory, not text, endless (/dev/zero) or a pipe no one writes to.
+#[test]
+fn a_die_file_is_read_capped_and_named() {
+    let d = scratch("die-read");
+    let refused = |die: &std::path::Path, says: &str| {
+        let o = bin()
+            .args(["roll", "--rolls", "1", "--block", "16x16x16", "--die"])
+            .arg(die)
+            .output()
+            .unwrap();
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{}: {e}", die.display());
+        assert_eq!(e.trim_end().lines().count(), 1, "{e}");
+        assert!(
+            e.contains("--die") && e.contains(says),
+            "{}: {e}",
+            die.display()
+        );
+    };
+    refused(&d.join("missing.toml"), "No such file");
+    refused(&d, "directory");
+    std::fs::write(d.join("binary.toml"), [0xff, 0xfe, 0x00, 0x80]).unwrap();
+    refused(&d.join("binary.toml"), "not a text file");
+    refused(Path::new("/dev/zero"), "larger than 1 MiB");
+    // A named pipe with no writer: SIGTERM ends the wait (exit 130).
+    let fifo = d.join("die.toml");
+    let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    let mut child = bin()
+        .args(["roll", "--block", "16x16x16", "--die"])
+        .arg(&fifo)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+    let status = exit_within(&mut child, 5, "a --die pipe held off SIGTERM");
+    assert_eq!(status.code(), Some(130));
 }

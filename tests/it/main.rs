@@ -3,20 +3,21 @@
 
 mod helpers;
 
+mod bench;
 mod bullet;
-mod calibration_promises;
 mod cli;
 mod coarse;
+mod crosscheck;
 mod docs;
 mod faces;
 mod fit;
 mod fuzz;
 mod impact;
+mod io;
 mod made;
-mod promises;
-mod promises_files;
+mod paper;
 mod rapier;
-mod reliability;
+mod roll;
 mod shape_fit;
 mod shapes;
 mod slurm;

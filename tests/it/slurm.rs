@@ -1,11 +1,15 @@
 //! `dicephys slurm` against a real scheduler: the one-node cluster of
 //! `scripts/slurm-local.sh start` (`.ci/run` starts it). Without `sbatch`, or with no cluster
-//! answering, each test says why on stderr and passes without running.
+//! answering, each test says why on stderr and passes without running. The scripts `slurm`
+//! writes are also run by hand, as Slurm runs them, with no scheduler: a directory's name
+//! quoted for the shell and sbatch or refused, and `slurm finish` naming a damaged shard or
+//! chunk whose task, rerun, replaces it.
 
 use super::helpers::json;
-use super::helpers::{bin, Scratch};
+use super::helpers::{bin, edit_rolls, scratch, stderr, walk, Scratch};
+use std::os::unix::fs::PermissionsExt;
 use std::path::Path;
-use std::process::{Command, Stdio};
+use std::process::{Command, Output, Stdio};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -752,4 +756,289 @@ fn the_calibrated_paper_through_slurm_is_the_one_machine_paper() {
     assert!(run.join("first-pass").join("first-passes.json").exists());
     assert!(run.join("calibrated.md").exists());
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+// The scripts `slurm` writes, run by hand as Slurm runs them: no scheduler needed.
+
+/// The value of `#SBATCH --NAME=...` in `script`, read as sbatch's own parser reads it
+/// (Slurm's `_get_argument`: a backslash escapes the next character, double quotes group, an
+/// unescaped `#` ends the line; single quotes are plain characters).
+fn sbatch_value(script: &str, name: &str) -> Option<String> {
+    let line = script
+        .lines()
+        .filter_map(|l| l.strip_prefix("#SBATCH "))
+        .find(|l| l.trim_start().starts_with(&format!("--{name}=")))?;
+    let (mut arg, mut escaped, mut quoted) = (String::new(), false, false);
+    for c in line.trim_start().chars() {
+        if escaped {
+            escaped = false;
+            arg.push(c);
+        } else if c == '\\' {
+            escaped = true;
+        } else if c == '"' {
+            quoted = !quoted;
+        } else if c == '#' || (!quoted && c.is_ascii_whitespace()) {
+            break;
+        } else {
+            arg.push(c);
+        }
+    }
+    assert!(!quoted, "sbatch: unmatched quote in {line}");
+    Some(arg.split_once('=').unwrap().1.to_string())
+}
+
+/// A binary that records what it was given (in `$FAKE_ARGS`) and prints a result.
+fn fake_dicephys(d: &Path) -> std::path::PathBuf {
+    let fake = d.join("fake-dicephys");
+    std::fs::write(
+        &fake,
+        "#!/bin/sh\nprintf '%s\\n' \"$@\" >\"$FAKE_ARGS\"\necho '{}'\n",
+    )
+    .unwrap();
+    std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
+    fake
+}
+
+/// `slurm roll` of a small 2D run into `dir`, its tasks run by `fake`.
+fn slurm_roll(d: &Path, fake: &Path, dir: &Path, extra: &[&str]) -> Output {
+    bin()
+        .args([
+            "slurm",
+            "roll",
+            "--block",
+            "140x22x13",
+            "--2d",
+            "--rolls",
+            "20",
+        ])
+        .args(["--tasks", "2", "--bin"])
+        .arg(fake)
+        .arg("--dir")
+        .arg(dir)
+        .args(extra)
+        .current_dir(d)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn a_slurm_dir_name_is_quoted_for_the_shell_and_sbatch() {
+    let d = scratch("slurm-names");
+    let fake = fake_dicephys(&d);
+    let run = |dir: &Path, extra: &[&str]| slurm_roll(&d, &fake, dir, extra);
+    // A name with everything the shell or sbatch would read: it is written safely.
+    let nasty = d.join("run x#y %j \"q' $(touch pwned) `touch pwned2`");
+    let out = run(&nasty, &["--time", "1:00:00"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let array = std::fs::read_to_string(nasty.join("array.sh")).unwrap();
+    let real = nasty.canonicalize().unwrap();
+    let want = format!(
+        "{}/logs/task-%a.out",
+        real.to_str().unwrap().replace('%', "%%")
+    );
+    assert_eq!(
+        sbatch_value(&array, "output").as_deref(),
+        Some(&*want),
+        "{array}"
+    );
+    assert_eq!(sbatch_value(&array, "time").as_deref(), Some("1:00:00"));
+    let fin = std::fs::read_to_string(nasty.join("finish.sh")).unwrap();
+    let want = format!(
+        "{}/logs/finish.out",
+        real.to_str().unwrap().replace('%', "%%")
+    );
+    assert_eq!(
+        sbatch_value(&fin, "output").as_deref(),
+        Some(&*want),
+        "{fin}"
+    );
+    let args = d.join("args.txt");
+    let task = Command::new("bash")
+        .arg(nasty.join("array.sh"))
+        .env("SLURM_ARRAY_TASK_ID", "1")
+        .env("SLURM_JOB_ID", "7")
+        .env("FAKE_ARGS", &args)
+        .current_dir(&*d)
+        .output()
+        .unwrap();
+    assert_eq!(task.status.code(), Some(0), "{}", stderr(&task));
+    assert!(!d.join("pwned").exists() && !d.join("pwned2").exists());
+    let given = std::fs::read_to_string(&args).unwrap();
+    let ckpt = format!("{}/shard-1", real.to_str().unwrap());
+    assert!(given.lines().any(|l| l == ckpt), "{given}");
+    assert!(nasty.join("shard-1.json").exists());
+}
+
+#[test]
+fn a_slurm_dir_name_or_flag_that_cannot_be_written_safely_is_refused() {
+    let d = scratch("slurm-names-refused");
+    let fake = fake_dicephys(&d);
+    let run = |dir: &Path, extra: &[&str]| slurm_roll(&d, &fake, dir, extra);
+    // What cannot be written safely is refused, with one line, before anything is stored.
+    for (dir, extra) in [
+        (d.join("a\nb"), &[][..]),
+        (d.join("a\\b"), &[][..]),
+        (d.join("ok1"), &["--account", "a#b"][..]),
+        (d.join("ok2"), &["--partition", "p\"q"][..]),
+        (d.join("ok3"), &["--time", "1:00 %j"][..]),
+        (d.join("ok4"), &["--time", "1'00"][..]),
+    ] {
+        let out = run(&dir, extra);
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{dir:?} {extra:?}: {}",
+            stderr(&out)
+        );
+        assert_eq!(stderr(&out).lines().count(), 1, "{}", stderr(&out));
+        assert!(!dir.exists(), "{dir:?}: made although refused");
+    }
+    // A study refused by its dry run leaves no directory either.
+    let st = d.join("st");
+    let out = bin()
+        .args([
+            "slurm",
+            "stability",
+            "--rolls",
+            "0",
+            "--tasks",
+            "2",
+            "--dir",
+        ])
+        .arg(&st)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(!st.exists(), "a refused run left its directory");
+}
+
+/// Runs task `k` of the array script in `dir` as Slurm would.
+fn array_task(dir: &Path, k: u64) -> Output {
+    let out = Command::new("bash")
+        .arg(dir.join("array.sh"))
+        .env("SLURM_ARRAY_TASK_ID", k.to_string())
+        .env("SLURM_JOB_ID", "7")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "task {k}: {}", stderr(&out));
+    out
+}
+
+fn slurm(args: &[&std::ffi::OsStr]) -> Output {
+    bin().arg("slurm").args(args).output().unwrap()
+}
+
+#[test]
+fn slurm_finish_names_a_damaged_shard_and_rerunning_its_task_replaces_it() {
+    let d = scratch("damaged-shard");
+    let dir = d.join("run");
+    let out = bin()
+        .args([
+            "slurm",
+            "roll",
+            "--block",
+            "140x22x13",
+            "--2d",
+            "--rolls",
+            "40",
+        ])
+        .args(["--tasks", "2", "--dir"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let finish = || slurm(&["finish".as_ref(), dir.as_os_str()]);
+    array_task(&dir, 0);
+    array_task(&dir, 1);
+    assert_eq!(finish().status.code(), Some(0));
+    let counts = |p: &Path| {
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap();
+        v["tally"].clone()
+    };
+    let truth = counts(&dir.join("result.json"));
+    // A count edited in task 1's result, the file still JSON: named, never merged.
+    let shard = dir.join("shard-1.json");
+    let text = std::fs::read_to_string(&shard).unwrap();
+    let w = text.find("\"width\": ").unwrap() + 9;
+    std::fs::write(&shard, format!("{}1{}", &text[..w], &text[w..])).unwrap();
+    let bad = finish();
+    assert_eq!(bad.status.code(), Some(1), "{}", stderr(&bad));
+    assert!(stderr(&bad).contains("shard-1.json"), "{}", stderr(&bad));
+    assert!(stderr(&bad).contains("--array=1 "), "{}", stderr(&bad));
+    // The advice, followed, works: the task writes its result again, and finish merges.
+    let rerun = array_task(&dir, 1);
+    assert!(
+        !String::from_utf8_lossy(&rerun.stdout).contains("there already"),
+        "the rerun task kept the damaged result"
+    );
+    let ok = finish();
+    assert_eq!(ok.status.code(), Some(0), "{}", stderr(&ok));
+    assert_eq!(counts(&dir.join("result.json")), truth);
+}
+
+#[test]
+fn slurm_finish_names_a_damaged_study_chunk_and_rerunning_its_task_replaces_it() {
+    let d = scratch("damaged-study");
+    let dir = d.join("run");
+    let out = bin()
+        .args([
+            "slurm",
+            "crosscheck",
+            "--block",
+            "140x22x13",
+            "--rolls",
+            "2000",
+        ])
+        .args(["--json", "--tasks", "2", "--dir"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let finish = || slurm(&["finish".as_ref(), dir.as_os_str()]);
+    array_task(&dir, 0);
+    array_task(&dir, 1);
+    let first = finish();
+    let tallies = |o: &Output| {
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        [v["runs"][0]["tally"].clone(), v["runs"][1]["tally"].clone()]
+    };
+    let truth = tallies(&first);
+    // Damage a chunk of each task in turn (the first and the last of the four): finish names
+    // it and its task, and rerunning that task (by the array script, which skips a task
+    // marked done) rolls it again.
+    let mut chunks: Vec<_> = walk(&dir.join("checkpoint"))
+        .into_iter()
+        .filter(|p| {
+            p.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("chunk-")
+        })
+        .collect();
+    chunks.sort();
+    assert_eq!(chunks.len(), 4);
+    for chunk in [&chunks[0], &chunks[3]] {
+        let text = std::fs::read_to_string(chunk).unwrap();
+        let bad = edit_rolls(&text);
+        assert_ne!(bad, text);
+        std::fs::write(chunk, bad).unwrap();
+        let refused = finish();
+        assert_eq!(refused.status.code(), Some(1), "{}", stderr(&refused));
+        let e = stderr(&refused);
+        assert!(e.contains(&*chunk.to_string_lossy()), "{e}");
+        let k = e
+            .split("--array=")
+            .nth(1)
+            .and_then(|s| s.split(' ').next())
+            .and_then(|s| s.parse::<u64>().ok())
+            .unwrap_or_else(|| panic!("no task named: {e}"));
+        let rerun = array_task(&dir, k);
+        assert!(
+            !String::from_utf8_lossy(&rerun.stdout).contains("done already"),
+            "the task's mark kept it from rolling the chunk again"
+        );
+        assert_eq!(tallies(&finish()), truth);
+    }
 }

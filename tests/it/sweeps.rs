@@ -1,7 +1,7 @@
-//! The sweeps at tiny size (their JSON and figures), and the failure detectors on failures
-//! made on purpose.
+//! The sweeps at tiny size (their JSON and figures) and stopped by Ctrl-C, and the failure
+//! detectors on failures made on purpose.
 
-use super::helpers::Scratch;
+use super::helpers::{interrupted, scratch, stderr, Scratch, ENDLESS_ROLLS};
 use dicephys::engine::{new_engine, EngineKind};
 use dicephys::model::scene::{Floor, Mode, Scene};
 use dicephys::model::state::BodyState;
@@ -668,4 +668,55 @@ fn stability_counts_dips_apart_and_tunnelling_only_through_a_thin_floor() {
         assert_eq!(a["tunnelled"], 0.0, "{mode}: {a}");
         assert!(b["tunnelled"].as_f64().unwrap() > 0.5, "{mode}: {b}");
     }
+}
+
+#[test]
+fn a_sweep_stops_with_exit_130() {
+    let d = scratch("sweep");
+    let out = interrupted(
+        &[
+            "converge",
+            "--blocks",
+            "140x24x20",
+            "--dts",
+            "1/1000",
+            "--engines",
+            "bullet",
+            "--rolls",
+            ENDLESS_ROLLS,
+            "--out",
+            d.to_str().unwrap(),
+        ],
+        libc::SIGINT,
+        1500,
+    );
+    assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));
+}
+
+#[test]
+fn a_roll_forced_non_finite_is_counted_as_failed() {
+    let scene = Scene::paper("140x24x20".parse().unwrap(), Mode::ThreeD);
+    let mut e = new_engine(EngineKind::Bullet, &scene).unwrap();
+    let start = BodyState {
+        position: Vector3::new(0.0, 0.3, 0.0),
+        rotation: UnitQuaternion::identity(),
+        linear_velocity: Vector3::new(f64::NAN, 0.0, 0.0),
+        angular_velocity: Vector3::new(0.0, 0.0, 50.0),
+        sleeping: false,
+    };
+    let end = run_from(
+        e.as_mut(),
+        &scene,
+        &start,
+        &RollConfig::default(),
+        |_, _| {},
+    );
+    assert_eq!(end.fate, Fate::Failed(Failure::NonFinite));
+    // The world is still usable for the next throw.
+    let ok = BodyState {
+        linear_velocity: Vector3::zeros(),
+        ..start
+    };
+    let end = run_from(e.as_mut(), &scene, &ok, &RollConfig::default(), |_, _| {});
+    assert!(matches!(end.fate, Fate::Settled(_)));
 }

@@ -1,11 +1,12 @@
 //! `validate`'s cases at small, fixed-seed sizes on the real engines, with tolerances in
-//! standard errors; the throw styles and the damping they rest on; the command line.
+//! standard errors; the throw styles and the damping they rest on; the command line, Ctrl-C in
+//! its free-flight stage included.
 //!
 //! Tolerance: |z| ≤ 4 standard errors of the closed form's binomial error √(p(1−p)/n) (the
 //! command's own verdict is 3; the seeds are fixed, so these are exact regressions, and 4
 //! leaves room for an engine upgrade's rounding to move a few dice).
 
-use super::helpers::{dicephys, json, Scratch};
+use super::helpers::{bin, dicephys, exit_within, json, scratch, Scratch};
 use dicephys::engine::{new_engine, EngineKind};
 use dicephys::model::block::{Block, Outcome};
 use dicephys::model::scene::{Mode, Scene};
@@ -430,4 +431,57 @@ fn a_tumble_run_resumes_from_its_checkpoint_bit_for_bit() {
     assert_eq!(resumed["tally"], whole["tally"]);
     assert_eq!(resumed["spec"]["throws"]["style"], "tumble");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn validate_stops_on_ctrl_c_in_its_free_flight_stage() {
+    let d = scratch("validate-int");
+    let out = d.join("out");
+    let log = d.join("stderr.txt");
+    let mut child = bin()
+        .args([
+            "validate",
+            "--engines",
+            "bullet",
+            "--blocks-2d",
+            "140x24x20",
+        ])
+        .args([
+            "--blocks-3d",
+            "20x20x20",
+            "--trend",
+            "none",
+            "--rolls",
+            "10",
+        ])
+        .args(["--threads", "1", "--flight-dts", "1e-6", "--out"])
+        .arg(&out)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::fs::File::create(&log).unwrap())
+        .spawn()
+        .unwrap();
+    // The limit cases done (three 3D rows logged), the free flight has begun: 2 s at 1 µs,
+    // two million steps an integrator.
+    let t = std::time::Instant::now();
+    while std::fs::read_to_string(&log)
+        .unwrap_or_default()
+        .matches("3d_quasi_static")
+        .count()
+        < 3
+    {
+        assert!(t.elapsed().as_secs() < 120, "the limit cases never ended");
+        assert!(child.try_wait().unwrap().is_none(), "validate ended early");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let status = exit_within(
+        &mut child,
+        5,
+        "validate ignored Ctrl-C in its free-flight stage",
+    );
+    assert_eq!(status.code(), Some(130));
+    assert!(
+        !out.join("validate.json").exists(),
+        "a stopped run wrote its outputs"
+    );
 }
