@@ -73,11 +73,15 @@ pub fn run(mut a: FairArgs) -> Result<()> {
                 .into(),
         ));
     }
-    if let Some(dir) = &a.out {
-        let identity =
-            serde_json::json!({ "spec": spec, "null": a.null, "layout": a.roll.layout(&spec) });
-        claim_out(dir, &identity)?;
-    }
+    let _held = match &a.out {
+        Some(dir) => {
+            let identity = serde_json::json!({
+                "spec": spec, "null": a.null, "layout": a.roll.layout(&spec)
+            });
+            Some(claim_out(dir, &identity)?)
+        }
+        None => None,
+    };
     if let Some(w) = spec.endless_roll_warning() {
         eprintln!("dicephys: warning: {w}");
     }
@@ -108,8 +112,9 @@ pub fn run(mut a: FairArgs) -> Result<()> {
     done
 }
 
-/// `--out DIR` made and claimed for this `fair` run (another run's directory is refused).
-fn claim_out(dir: &std::path::Path, identity: &serde_json::Value) -> Result<()> {
+/// `--out DIR` made, claimed and held for this `fair` run (another run's directory is refused,
+/// and so is this one's while another process runs it): held while the returned file lives.
+fn claim_out(dir: &std::path::Path, identity: &serde_json::Value) -> Result<std::fs::File> {
     std::fs::create_dir_all(dir)
         .map_err(|e| Error::Usage(format!("--out {}: cannot create it ({e})", dir.display())))?;
     Ok(dicephys::studies::fair::claim(dir, identity)?)
@@ -123,7 +128,7 @@ fn counted(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, text: &str) -> Res
     let doc = serde_json::json!({ "fairness": fair });
     let json = dicephys::run::seal::to_string(&doc, true)?;
     if let Some(dir) = &a.out {
-        claim_out(
+        let _held = claim_out(
             dir,
             &serde_json::json!({ "counts": counts, "null": a.null }),
         )?;
@@ -153,12 +158,13 @@ fn counted(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, text: &str) -> Res
 fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str) -> Result<()> {
     use dicephys::studies::fair::{parse_vary, vary, write_bias};
     let (what, values) = parse_vary(v)?;
+    let mut _held = None;
     if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir).map_err(|e| {
             Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
         })?;
         let identity = serde_json::json!({ "spec": spec, "null": a.null, "vary": v });
-        dicephys::studies::fair::claim(dir, &identity)?;
+        _held = Some(dicephys::studies::fair::claim(dir, &identity)?);
     }
     let threads = a.roll.run.threads()?;
     let total = spec.rolls * values.len() as u64;

@@ -4,6 +4,7 @@
 pub mod batch;
 pub mod cputime;
 pub mod io;
+pub mod lock;
 pub mod owner;
 pub mod pack;
 pub mod request;

@@ -9,6 +9,7 @@ use crate::error::{Error, Result};
 use crate::run::batch::{self, threads};
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::io::write_atomic;
+use crate::run::lock::lock;
 use crate::run::spec::RunSpec;
 use crate::run::stop::Stop;
 use crate::run::tally::Tally;
@@ -445,7 +446,10 @@ impl Checkpoint {
             ))
         })?;
         crate::run::owner::check_unowned(dir)?;
-        let lock = lock(&dir.join(lock_name))?;
+        let lock = lock(
+            &dir.join(lock_name),
+            &format!("checkpoint {}", dir.display()),
+        )?;
         crate::run::io::clean_temporaries(dir);
         // Written when absent, then read back: tasks of a cluster run that open a new cell at
         // the same moment each write the same whole file (an atomic rename), and the one
@@ -481,7 +485,10 @@ impl Checkpoint {
         if !ours && dir.exists() {
             // Never empty a cell another live process is rolling: its lock says so.
             if dir.join("lock").exists() {
-                drop(lock(&dir.join("lock"))?);
+                drop(lock(
+                    &dir.join("lock"),
+                    &format!("checkpoint {}", dir.display()),
+                )?);
             }
             std::fs::remove_dir_all(dir).map_err(|e| Error::io(dir, e))?;
         }
@@ -505,49 +512,5 @@ impl Checkpoint {
 
     fn chunk_path(&self, first: u64, len: usize) -> PathBuf {
         self.dir.join(format!("chunk-{first:012}-{len}.json"))
-    }
-}
-
-/// Takes the directory's lock file, writing this process's id into it; if another process
-/// holds it, says which.
-fn lock(path: &Path) -> Result<File> {
-    use std::io::{Read, Seek, Write};
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let mut f = std::fs::OpenOptions::new()
-        .read(true)
-        .write(true)
-        .create(true)
-        .truncate(false)
-        .open(path)
-        .map_err(|e| Error::io(path, e))?;
-    match f.try_lock() {
-        Ok(()) => {
-            f.set_len(0).map_err(|e| Error::io(path, e))?;
-            f.rewind().map_err(|e| Error::io(path, e))?;
-            writeln!(f, "pid {}", std::process::id()).map_err(|e| Error::io(path, e))?;
-            Ok(f)
-        }
-        Err(std::fs::TryLockError::WouldBlock) => {
-            // The holder writes its id just after taking the lock: give it a moment.
-            let mut holder = String::new();
-            for _ in 0..20 {
-                holder.clear();
-                let _ = f.rewind();
-                let _ = f.read_to_string(&mut holder);
-                if !holder.trim().is_empty() {
-                    break;
-                }
-                std::thread::sleep(std::time::Duration::from_millis(25));
-            }
-            let holder = match holder.trim() {
-                "" => "a process that has not yet written its id".to_string(),
-                h => h.to_string(),
-            };
-            Err(Error::Mismatch(format!(
-                "checkpoint {}: in use by another run ({holder})",
-                dir.display(),
-            )))
-        }
-        Err(std::fs::TryLockError::Error(e)) => Err(Error::io(path, e)),
     }
 }

@@ -308,10 +308,11 @@ fn judge(
     })
 }
 
-/// Claims `dir` for this `fair` run (`run::owner`): refused if another command or another run
-/// owns it.
-pub fn claim(dir: &std::path::Path, identity: &serde_json::Value) -> Result<()> {
-    super::place::claim(dir, "fair", identity, super::place::Claimant::Here)
+/// Claims `dir` for this `fair` run (`run::owner`) and holds it while the returned file lives:
+/// refused if another command or another run owns it, or another process runs this one there.
+pub fn claim(dir: &std::path::Path, identity: &serde_json::Value) -> Result<std::fs::File> {
+    super::place::claim(dir, "fair", identity, super::place::Claimant::Here)?;
+    crate::run::owner::hold(dir)
 }
 
 /// Writes `fairness.json` (the document `json`, as `--json` prints it) and the die map

@@ -5,6 +5,7 @@
 use super::place::{claim, Claimant, Done, Hooks, Place};
 use crate::error::Result;
 use crate::report::progress::Unit;
+use crate::run::runner::ChunkShare;
 use std::path::Path;
 
 /// A study: its name, its checks, what it counts, the directory and cells it owns, whether a
@@ -55,8 +56,13 @@ pub fn run(
     hooks: &Hooks,
 ) -> Result<Done> {
     study.validate()?;
+    let mut _held = None;
     if let Some(dir) = study.owns(place) {
         claim(dir, study.name(), identity, Claimant::Checked)?;
+        // A whole run here holds its directory while it runs; a cluster's tasks share it.
+        if matches!(place.share, ChunkShare::All) {
+            _held = Some(crate::run::owner::hold(dir)?);
+        }
     }
     study.run(place, hooks)
 }

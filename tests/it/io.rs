@@ -82,6 +82,62 @@ fn a_directorys_claim_honours_the_umask() {
     assert_eq!(mode(&out.join("dicephys-run.json")), 0o644);
 }
 
+/// Two runs of one command with the same flags in one `--out` at once: the second is refused
+/// before it rolls, naming the first's process (a study's cells used to refuse it only at the
+/// first cell both rolled, after it had rolled others beside the first; `fair` not at all).
+/// The first is long by construction and killed once the second has been refused; the same
+/// command then takes the directory up again (the system frees a lock with its holder).
+#[test]
+fn a_second_run_in_a_directory_a_run_is_using_is_refused_naming_it() {
+    use super::helpers::{refused, wait_at_most, ENDLESS_ROLLS};
+    let d = scratch("busy-out");
+    for (n, command) in [
+        ["fair", "--block", "16x16x16"],
+        ["paper", "--engines", "bullet"],
+    ]
+    .iter()
+    .enumerate()
+    {
+        let out = d.join(format!("out-{n}"));
+        let run = || {
+            let mut c = bin();
+            c.args(command)
+                .args(["--rolls", ENDLESS_ROLLS, "--threads", "1", "--out"])
+                .arg(&out);
+            c
+        };
+        // A run started, once its lock names it.
+        let holding = || {
+            let mut child = run()
+                .stdout(std::process::Stdio::null())
+                .stderr(std::process::Stdio::null())
+                .spawn()
+                .unwrap();
+            let holds = format!("pid {}", child.id());
+            let start = std::time::Instant::now();
+            while std::fs::read_to_string(out.join("lock")).map_or(true, |t| t.trim() != holds) {
+                assert!(child.try_wait().unwrap().is_none(), "{command:?}: it ended");
+                assert!(
+                    start.elapsed().as_secs() < 120,
+                    "{command:?}: no lock taken"
+                );
+                std::thread::sleep(std::time::Duration::from_millis(20));
+            }
+            (child, holds)
+        };
+        let kill = |mut child: std::process::Child| {
+            unsafe { libc::kill(child.id() as i32, libc::SIGKILL) };
+            wait_at_most(&mut child, std::time::Duration::from_secs(60));
+        };
+        let (first, holds) = holding();
+        let second = run().output().unwrap();
+        refused(&second, 2, &format!("in use by another run ({holds})"));
+        kill(first);
+        let (again, _) = holding();
+        kill(again);
+    }
+}
+
 #[test]
 fn an_output_name_of_250_bytes_is_written() {
     let d = scratch("long-name");
