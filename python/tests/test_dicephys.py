@@ -262,6 +262,23 @@ def test_fit_then_predict_through_python(tmp_path: Path) -> None:
     assert p.data == want
 
 
+def test_a_fit_s_discrepancy_widens_its_predictions_through_python_as_on_the_cli(tmp_path: Path) -> None:
+    # With κ alone free, the paper's rows predicted without themselves miss beyond their
+    # errors (three surfaces, e and μ held): the fit learns a discrepancy and widens every
+    # prediction by it.
+    f = dicephys.fit("paper", free=["kappa"], points=8, point_rolls=100, degree=1, dt=1 / 250, seed=2,
+                     out=tmp_path / "fit")
+    asked = [o for o in f.discrepancy["outcomes"] if o["tau"] > 0]
+    assert asked and all(o["p_value"] < 0.05 for o in asked)
+    p = dicephys.predict(f, "140x30x10", draws=3, rolls=50)
+    assert p.data["discrepancy"] == f.discrepancy
+    for q in p.data["p"][1:]:
+        assert q["err_model"] > 0
+        assert abs(q["err"] ** 2 - (q["err_params"] ** 2 + q["err_sim"] ** 2 + q["err_model"] ** 2)) < 1e-12
+    want = cli("predict", "--fit", f.path, "--block", "140x30x10", "--draws", "3", "--rolls", "50", "--json")
+    assert p.data == want
+
+
 def test_two_models_compared_through_python_are_the_cli_s(tmp_path: Path) -> None:
     third = dict(ROWS[0], label="c", breadth_mm=30, width_mm=10)
     rows = [dict(r, breadth_vertical=b, width_vertical=1000 - b) for r, b in zip(ROWS + [third], (410, 260, 80))]
