@@ -271,6 +271,15 @@ class Fit(Document):
         with open(os.path.join(self.out, "report.md"), encoding="utf-8") as f:
             return f.read()
 
+    @property
+    def discrepancy(self) -> Optional[Dict[str, Any]]:
+        """How far the fit's rows, each predicted without itself, miss beyond their errors,
+        outcome by outcome (``tau`` on the log-odds, 0 where they do not), by which every
+        ``predict`` from the fit is widened (its ``err_model``); ``None`` for a fit of fewer
+        than three rows (docs/json.md, fit.json's ``discrepancy``)."""
+        d = self.data.get("discrepancy")
+        return dict(d) if d is not None else None
+
     def __repr__(self) -> str:
         e = self.data.get("estimate", {})
         shown = []
