@@ -18,8 +18,7 @@
 //!   χ²_m (φ the fit's overdispersion, 1 for a fit that fits). Only where it is beyond χ²_m's
 //!   95 % point do the rows ask for one; else τ = 0.
 //! - *How much*: τ makes Σ (c/n − q)²/(φ q(1 − q)/n + v(q, τ)) = m, its mean (Paule and
-//!   Mandel's estimator, 1982): the spread of the
-//!   misses beyond the counts' noise. It holds
+//!   Mandel's estimator, 1982): the spread of the misses beyond the counts' noise. It holds
 //!   the model's discrepancy and the uncertainty of a fit that did not see the row, and a
 //!   prediction adds it to its own error, so where the fit's uncertainty is not small beside
 //!   the discrepancy it is counted twice: the widening errs wide, not narrow. (Measured on

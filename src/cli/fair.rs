@@ -158,14 +158,12 @@ fn counted(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, text: &str) -> Res
 fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str) -> Result<()> {
     use dicephys::studies::fair::{parse_vary, vary, write_bias};
     let (what, values) = parse_vary(v)?;
-    let mut _held = None;
-    if let Some(dir) = &a.out {
-        std::fs::create_dir_all(dir).map_err(|e| {
-            Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
-        })?;
-        let identity = serde_json::json!({ "spec": spec, "null": a.null, "vary": v });
-        _held = Some(dicephys::studies::fair::claim(dir, &identity)?);
-    }
+    let identity = serde_json::json!({ "spec": spec, "null": a.null, "vary": v });
+    let _held = a
+        .out
+        .as_ref()
+        .map(|dir| claim_out(dir, &identity))
+        .transpose()?;
     let threads = a.roll.run.threads()?;
     let total = spec.rolls * values.len() as u64;
     let bar = dicephys::report::progress::Progress::new(

@@ -446,10 +446,7 @@ impl Checkpoint {
             ))
         })?;
         crate::run::owner::check_unowned(dir)?;
-        let lock = lock(
-            &dir.join(lock_name),
-            &format!("checkpoint {}", dir.display()),
-        )?;
+        let lock = checkpoint_lock(dir, lock_name)?;
         crate::run::io::clean_temporaries(dir);
         // Written when absent, then read back: tasks of a cluster run that open a new cell at
         // the same moment each write the same whole file (an atomic rename), and the one
@@ -485,10 +482,7 @@ impl Checkpoint {
         if !ours && dir.exists() {
             // Never empty a cell another live process is rolling: its lock says so.
             if dir.join("lock").exists() {
-                drop(lock(
-                    &dir.join("lock"),
-                    &format!("checkpoint {}", dir.display()),
-                )?);
+                drop(checkpoint_lock(dir, "lock")?);
             }
             std::fs::remove_dir_all(dir).map_err(|e| Error::io(dir, e))?;
         }
@@ -513,4 +507,9 @@ impl Checkpoint {
     fn chunk_path(&self, first: u64, len: usize) -> PathBuf {
         self.dir.join(format!("chunk-{first:012}-{len}.json"))
     }
+}
+
+/// The lock file `name` of the checkpoint `dir`, taken (or who holds it, said).
+fn checkpoint_lock(dir: &Path, name: &str) -> Result<File> {
+    lock(&dir.join(name), &format!("checkpoint {}", dir.display()))
 }

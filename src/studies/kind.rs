@@ -56,13 +56,15 @@ pub fn run(
     hooks: &Hooks,
 ) -> Result<Done> {
     study.validate()?;
-    let mut _held = None;
-    if let Some(dir) = study.owns(place) {
-        claim(dir, study.name(), identity, Claimant::Checked)?;
-        // A whole run here holds its directory while it runs; a cluster's tasks share it.
-        if matches!(place.share, ChunkShare::All) {
-            _held = Some(crate::run::owner::hold(dir)?);
+    let _held = match study.owns(place) {
+        Some(dir) => {
+            claim(dir, study.name(), identity, Claimant::Checked)?;
+            // A whole run here holds its directory while it runs; a cluster's tasks share it.
+            matches!(place.share, ChunkShare::All)
+                .then(|| crate::run::owner::hold(dir))
+                .transpose()?
         }
-    }
+        None => None,
+    };
     study.run(place, hooks)
 }
