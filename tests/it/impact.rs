@@ -415,3 +415,78 @@ fn crosscheck_of_a_loaded_die_names_the_split_preset() {
     assert!(!note(&["--com", "0,0,-4.5", "--preset", "split"]));
     assert!(!note(&[]));
 }
+
+/// Friction's exact limit on a die that slides and spins (Coulomb's law at each contact point):
+/// the centred cube flat on its −y face, sliding along x at v with a slow spin ω about the
+/// vertical. Each corner slips at v x̂ + ω ŷ × r, and its friction μN opposes that slip; to first
+/// order in ω a / v the torque about y is −μ m g ω a² / (4 v), whatever the split of the weight
+/// between the corners (their r_x² are equal), so with I_y = m a²/6 and v = v₀ − μ g t,
+/// d ln ω / dt = −(3/2) μ g / v, and ω/ω₀ = (v/v₀)^{3/2}: a sliding die keeps its spin. (The
+/// four-corner equations integrated at 10 µs give 0.7928 against the law's 0.7950 after 50 ms
+/// from v₀ 1 m/s, ω₀ 10 rad/s, μ 0.29, for any split of the weight front to back.) Returns, per
+/// engine, (ω/ω₀, the law's (v/v₀)^{3/2}) after 50 steps of 1 ms.
+fn sliding_and_spinning() -> Vec<(EngineKind, f64, f64)> {
+    let (v0, w0, mu, steps, dt) = (1.0, 10.0, 0.29, 50, 0.001);
+    let mut scene = cube(0.0, mu, scene_gravity(), dt);
+    scene.restitution = 0.0;
+    [EngineKind::Bullet, EngineKind::Rapier]
+        .into_iter()
+        .map(|kind| {
+            let mut engine = new_engine(kind, &scene).unwrap();
+            engine
+                .reset(&BodyState {
+                    linear_velocity: Vector3::new(v0, 0.0, 0.0),
+                    angular_velocity: Vector3::new(0.0, w0, 0.0),
+                    ..at_rest(
+                        Vector3::new(0.0, SIDE / 2.0 - 1e-9, 0.0),
+                        UnitQuaternion::identity(),
+                    )
+                })
+                .unwrap();
+            for _ in 0..steps {
+                engine.step().unwrap();
+            }
+            let s = engine.state();
+            let v = s.linear_velocity.xz().norm();
+            let (got, law) = (s.angular_velocity.y / w0, (v / v0).powf(1.5));
+            println!(
+                "{kind:?}: after {steps} ms v {v:.4} m/s (v₀ − μ g t {:.4}), ω/ω₀ {got:.4} against \
+                 (v/v₀)^1.5 = {law:.4}",
+                v0 - mu * scene.gravity * steps as f64 * dt
+            );
+            (kind, got, law)
+        })
+        .collect()
+}
+
+/// The exact limit on both engines: ω/ω₀ within 0.02 of Coulomb's (v/v₀)^{3/2}. Neither meets it
+/// (`the_engines_brake_a_sliding_spin_as_measured`).
+#[test]
+#[ignore = "neither engine meets Coulomb's law for a die that slides and spins: Rapier 0.36.1's \
+            default friction (one constraint at the patch's centre and a twist) stops the spin, \
+            Bullet keeps 7 % too much of it (issue 46, class N)"]
+fn a_sliding_cube_keeps_its_spin_as_coulombs_law_says() {
+    for (kind, got, law) in sliding_and_spinning() {
+        assert!(
+            (got - law).abs() < 0.02,
+            "{kind:?}: ω/ω₀ {got} against Coulomb's (v/v₀)^1.5 = {law}"
+        );
+    }
+}
+
+/// What each engine does instead, pinned so that an engine or a setting that changes it shows.
+/// Rapier 0.36.1 (`FrictionModel::Simplified`, its default) brakes the spin apart from the slide
+/// at the full μ N r: the spin is gone within ~13 ms (ω/ω₀ below 0.01 after 50 ms, where the
+/// law keeps 0.795). Bullet brakes it at 70 % of the law's rate (0.852, the same at 0.1 ms steps
+/// and for ω₀ 3 and 20 rad/s; its slide is μ g to 0.2 %). Measured, not explained; its
+/// consequence is the engines' different tumbles of a loaded die (docs/results/rapier.md).
+#[test]
+fn the_engines_brake_a_sliding_spin_as_measured() {
+    for (kind, got, law) in sliding_and_spinning() {
+        let ok = match kind {
+            EngineKind::Rapier => got.abs() < 0.01,
+            _ => (got - 0.852).abs() < 0.01 && got - law > 0.04,
+        };
+        assert!(ok, "{kind:?}: ω/ω₀ {got} (law {law})");
+    }
+}
