@@ -477,9 +477,11 @@ fn a_sliding_cube_keeps_its_spin_as_coulombs_law_says() {
 /// What each engine does instead, pinned so that an engine or a setting that changes it shows.
 /// Rapier 0.36.1 (`FrictionModel::Simplified`, its default) brakes the spin apart from the slide
 /// at the full μ N r: the spin is gone within ~13 ms (ω/ω₀ below 0.01 after 50 ms, where the
-/// law keeps 0.795). Bullet brakes it at 70 % of the law's rate (0.852, the same at 0.1 ms steps
-/// and for ω₀ 3 and 20 rad/s; its slide is μ g to 0.2 %). Measured, not explained; its
-/// consequence is the engines' different tumbles of a loaded die (docs/results/rapier.md).
+/// law keeps 0.795). Bullet's first step meets the law (Δω 93 % of it), but the die then rocks
+/// on its corners as it slides (ω about the horizontal axes ±0.5 rad/s from step to step, its
+/// centre bobbing at ±7 mm/s) and the spin is braked at ~70 % of the law's rate: 0.852 here,
+/// 0.82–0.86 under `split` or on a plane floor; its slide is μ g to 0.2 %. Both shape how a
+/// loaded die tumbles on each engine (docs/results/rapier.md).
 #[test]
 fn the_engines_brake_a_sliding_spin_as_measured() {
     for (kind, got, law) in sliding_and_spinning() {
