@@ -9,17 +9,17 @@ pub enum Error {
     #[error("{0}")]
     Invalid(String),
     /// A value of a configuration refused before anything runs, named by its field as the
-    /// library spells it (`max_steps`, `rolls`): "max_steps 0: need at least one step". A
-    /// field named in `why` is written in backquotes, `like_this`, so that a caller can name
-    /// each as its user knows it (the command line maps them to its flags).
-    #[error("{}", field_line(field.name(), value, why))]
+    /// library spells it (`max_steps`, `rolls`): "max_steps 0: need at least one step". The
+    /// field, and any field `why` names, are typed ([`Text`]), so that a caller names each as
+    /// its user knows it (the command line by its flag, Python by its argument).
+    #[error("{}", field_line(field.name(), value, &why.to_string()))]
     Field {
         /// The field, e.g. `max_steps`.
         field: Field,
         /// Its value as given (empty if the field as a whole is wrong, e.g. an empty list).
         value: String,
         /// What is wrong with it, and what would do.
-        why: String,
+        why: Text,
     },
     /// Inputs that do not belong together: a checkpoint of another run, shards of two runs.
     #[error("{0}")]
@@ -38,9 +38,96 @@ pub enum Error {
     /// A stop was requested (Ctrl-C, SIGTERM) before the work was done; what was done is kept.
     #[error("stopped before the end")]
     Stopped,
-    /// Anything else that stops a run: encoding output, drawing a figure.
+    /// Anything else that stops a run: encoding output, drawing a figure, rolls that did not
+    /// settle (its text may name the field to change).
     #[error("{0}")]
-    Failed(String),
+    Failed(Text),
+}
+
+/// A message that may name fields of the configurations: its words, and each field it names as
+/// a [`Field`], so that whoever shows it names that field as its user knows it (the command
+/// line by its flag, Python by its argument) without reading the text again. Shown as it is,
+/// a field is its library name in backquotes: "raise `max_steps`". Built with [`text!`].
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Text(Vec<Part>);
+
+/// A part of a [`Text`]: words, or a field.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Part {
+    /// Words, as written.
+    Words(String),
+    /// A field, named by whoever shows the text.
+    Field(Field),
+}
+
+impl From<&str> for Part {
+    fn from(s: &str) -> Part {
+        Part::Words(s.to_string())
+    }
+}
+
+impl From<String> for Part {
+    fn from(s: String) -> Part {
+        Part::Words(s)
+    }
+}
+
+impl From<Field> for Part {
+    fn from(f: Field) -> Part {
+        Part::Field(f)
+    }
+}
+
+impl Text {
+    /// The parts in order.
+    pub fn new(parts: Vec<Part>) -> Text {
+        Text(parts)
+    }
+
+    /// The text with each field named by `name`.
+    pub fn named(&self, name: &dyn Fn(Field) -> String) -> String {
+        self.0
+            .iter()
+            .map(|p| match p {
+                Part::Words(w) => w.clone(),
+                Part::Field(f) => name(*f),
+            })
+            .collect()
+    }
+
+    /// Words put before the text.
+    pub fn after(self, words: &str) -> Text {
+        let mut parts = vec![Part::from(words)];
+        parts.extend(self.0);
+        Text(parts)
+    }
+}
+
+impl std::fmt::Display for Text {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.named(&|field| format!("`{}`", field.name())))
+    }
+}
+
+impl From<&str> for Text {
+    fn from(s: &str) -> Text {
+        Text(vec![s.into()])
+    }
+}
+
+impl From<String> for Text {
+    fn from(s: String) -> Text {
+        Text(vec![s.into()])
+    }
+}
+
+/// A [`Text`] of words and fields: `text!["raise ", Field::MaxSteps, " or use a finer ",
+/// Field::Dt]`.
+#[macro_export]
+macro_rules! text {
+    ($($part:expr),* $(,)?) => {
+        $crate::error::Text::new(vec![$($crate::error::Part::from($part)),*])
+    };
 }
 
 /// A value of a configuration that a check can refuse, as the library spells it
@@ -271,11 +358,28 @@ fn field_line(field: &str, value: &str, why: &str) -> String {
 
 impl Error {
     /// A value of `field` refused: see [`Error::Field`].
-    pub fn field(field: Field, value: impl ToString, why: impl Into<String>) -> Error {
+    pub fn field(field: Field, value: impl ToString, why: impl Into<Text>) -> Error {
         Error::Field {
             field,
             value: shown_value(value.to_string()),
             why: why.into(),
+        }
+    }
+
+    /// A run stopped by `why`: see [`Error::Failed`].
+    pub fn failed(why: impl Into<Text>) -> Error {
+        Error::Failed(why.into())
+    }
+
+    /// The error's line with each field it names named by `name` (the command line's flags,
+    /// Python's arguments); any other error as it shows itself.
+    pub fn named(&self, name: &dyn Fn(Field) -> String) -> String {
+        match self {
+            Error::Field { field, value, why } => {
+                field_line(&name(*field), value, &why.named(name))
+            }
+            Error::Failed(why) => why.named(name),
+            e => e.to_string(),
         }
     }
 

@@ -50,17 +50,9 @@ fn argument(field: Field) -> &'static str {
     }
 }
 
-/// A library message with each field it names in backquotes named by its argument (any
-/// other word in backquotes kept as written).
-fn arguments_in(why: &str) -> String {
-    why.split('`')
-        .enumerate()
-        .map(|(i, part)| match part.parse::<Field>() {
-            Ok(f) if i % 2 == 1 => argument(f).to_string(),
-            _ if i % 2 == 1 => format!("`{part}`"),
-            _ => part.to_string(),
-        })
-        .collect()
+/// The library's error with each field it names named by its argument.
+fn arguments_in(e: &Error) -> String {
+    e.named(&|f| argument(f).to_string())
 }
 
 /// The library's error as Python's: bad input a `ValueError` naming the argument, a stop
@@ -69,7 +61,7 @@ fn py_err(e: Error) -> PyErr {
     match &e {
         Error::Stopped => PyKeyboardInterrupt::new_err("stopped before the end"),
         Error::Field { field, value, why } => {
-            let why = arguments_in(why);
+            let why = why.named(&|f| argument(f).to_string());
             PyValueError::new_err(if value.is_empty() {
                 format!("{}: {why}", argument(*field))
             } else {
@@ -77,8 +69,8 @@ fn py_err(e: Error) -> PyErr {
             })
         }
         Error::Io { .. } => PyOSError::new_err(e.to_string()),
-        e if e.is_input() => PyValueError::new_err(arguments_in(&e.to_string())),
-        e => PyRuntimeError::new_err(arguments_in(&e.to_string())),
+        e if e.is_input() => PyValueError::new_err(arguments_in(e)),
+        e => PyRuntimeError::new_err(arguments_in(e)),
     }
 }
 
@@ -173,7 +165,7 @@ impl Session {
         let lines = std::mem::take(&mut *self.log.lock().unwrap());
         if let Some(cb) = log {
             for l in lines {
-                cb.call1((arguments_in(&l),))?;
+                cb.call1((l,))?;
             }
         }
         let _ = py;
@@ -595,7 +587,7 @@ fn place(out: Option<PathBuf>, cells: &str, threads_: usize, call: &str) -> PyRe
 /// A study's JSON result, or Python's exception if it was stopped.
 fn finished(done: Done) -> PyResult<String> {
     match done.interrupted {
-        Some(m) => Err(PyKeyboardInterrupt::new_err(arguments_in(&m))),
+        Some(m) => Err(PyKeyboardInterrupt::new_err(m)),
         None => Ok(done.stdout.trim_end().to_string()),
     }
 }
@@ -720,7 +712,7 @@ fn fit_config<'py>(
     }
     .map_err(|e| match e {
         Error::Io { .. } => py_err(e),
-        e => PyValueError::new_err(format!("data: {}", arguments_in(&e.to_string()))),
+        e => PyValueError::new_err(format!("data: {}", arguments_in(&e))),
     })?;
     let request = calibration::request::FitRequest {
         rows,
@@ -828,8 +820,7 @@ fn recover(
 fn fit_of(text: &str, arg: &str) -> PyResult<calibration::FitResult> {
     let fit: calibration::FitResult = dicephys::run::seal::open(text)
         .map_err(|e| bad(arg, "…", format!("not a fit's fit.json as written: {e}")))?;
-    fit.check()
-        .map_err(|e| bad(arg, "…", arguments_in(&e.to_string())))?;
+    fit.check().map_err(|e| bad(arg, "…", arguments_in(&e)))?;
     Ok(fit)
 }
 

@@ -482,14 +482,13 @@ fn maximise_weighted(
     found.sort_by(|a, b| a.0.f.total_cmp(&b.0.f));
     let best = found[0].0.clone();
     if !best.f.is_finite() {
-        return Err(Error::Failed(
+        return Err(Error::failed(
             "the fit did not converge: the likelihood is zero everywhere it looked (a measured \
-             outcome the simulations never give?)"
-                .into(),
+             outcome the simulations never give?)",
         ));
     }
     if !best.converged {
-        return Err(Error::Failed(format!(
+        return Err(Error::failed(format!(
             "the fit did not converge: the search ran out of steps at −2 ln L = {:.3}",
             best.f
         )));

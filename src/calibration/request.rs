@@ -114,7 +114,11 @@ impl FitRequest {
         let mut model = ModelSpec::free(&free);
         for (kind, r) in &self.ranges {
             let i = free.iter().position(|k| k == kind).ok_or_else(|| {
-                Error::field(Field::Range, "", format!("{kind} is not among `free`"))
+                Error::field(
+                    Field::Range,
+                    "",
+                    crate::text![format!("{kind} is not among "), Field::Free],
+                )
             })?;
             model.ranges[i] = *r;
         }

@@ -43,22 +43,18 @@ impl From<dicephys::Error> for Error {
             Error::Interrupted(dicephys::run::stop::interrupted(
                 &dicephys::run::stop::Kept::Work,
             ))
-        } else if let dicephys::Error::Field { field, value, why } = &e {
-            let line = if value.is_empty() {
-                format!("{}: {}", flag(*field), flags_in(why))
-            } else {
-                format!("{} {value}: {}", flag(*field), flags_in(why))
-            };
-            Error::Usage(line)
         } else if e.is_input() {
-            Error::Usage(e.to_string())
-        } else if let dicephys::Error::Failed(m) = &e {
-            // A failure may name what to change, as a field in backquotes.
-            Error::Run(flags_in(m))
+            Error::Usage(named(&e))
         } else {
-            Error::Run(e.to_string())
+            // A failure may name what to change, as a field.
+            Error::Run(named(&e))
         }
     }
+}
+
+/// The library's error with each field it names named by its flag.
+pub fn named(e: &dicephys::Error) -> String {
+    e.named(&|f| flag(f).to_string())
 }
 
 /// The flag that sets each field of the library's configurations: the one table from the
@@ -152,18 +148,9 @@ pub fn flag(field: Field) -> &'static str {
     }
 }
 
-/// A library message with each field it names in backquotes, `like_this`, named by its flag.
-pub fn flags_in(why: &str) -> String {
-    let mut out = String::new();
-    for (i, part) in why.split('`').enumerate() {
-        match part.parse::<Field>() {
-            Ok(f) if i % 2 == 1 => out += flag(f),
-            // Not a field (a command's name, say): kept as written.
-            _ if i % 2 == 1 => out += &format!("`{part}`"),
-            _ => out += part,
-        }
-    }
-    out
+/// A library text with each field it names named by its flag.
+pub fn flags_in(text: &dicephys::error::Text) -> String {
+    text.named(&|f| flag(f).to_string())
 }
 
 impl From<std::io::Error> for Error {
@@ -308,9 +295,24 @@ mod tests {
 
     #[test]
     fn a_message_names_fields_by_flag_and_leaves_other_words_alone() {
+        use dicephys::error::Field;
+        let why = dicephys::text![
+            "give ",
+            Field::MaxSteps,
+            " or ",
+            Field::Style,
+            ", not a `roll` checkpoint"
+        ];
         assert_eq!(
-            flags_in("give `max_steps` or `style`, not a `roll` checkpoint"),
+            flags_in(&why),
             "give --max-steps or --throw, not a `roll` checkpoint"
         );
+        let e = dicephys::Error::field(
+            Field::Recover,
+            "e=2",
+            dicephys::text!["outside (", Field::Range, " sets it)"],
+        );
+        assert_eq!(named(&e), "--recover e=2: outside (--range sets it)");
+        assert_eq!(e.to_string(), "recover e=2: outside (`range` sets it)");
     }
 }

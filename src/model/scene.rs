@@ -202,7 +202,11 @@ impl Scene {
             return Err(crate::Error::field(
                 crate::error::Field::FloorThickness,
                 t,
-                "the plane floor is a half-space; give `floor` box",
+                crate::text![
+                    "the plane floor is a half-space; give ",
+                    crate::error::Field::Floor,
+                    " box"
+                ],
             ));
         }
         self.floor_thickness = t;
@@ -229,11 +233,15 @@ impl Scene {
             1.0
         };
         if !(self.restitution.is_finite() && self.restitution >= 0.0 && self.restitution <= e_max) {
-            return bad(
+            return Err(Error::field(
                 Field::Restitution,
                 self.restitution,
-                "must be in [0, 1] (above 1 only with `allow_restitution_above_one`)".into(),
-            );
+                crate::text![
+                    "must be in [0, 1] (above 1 only with ",
+                    Field::AllowRestitutionAboveOne,
+                    ")"
+                ],
+            ));
         }
         if !(self.floor_thickness.is_finite()
             && (0.001..=DICEPHYS_FLOOR_THICKNESS).contains(&self.floor_thickness))

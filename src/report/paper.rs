@@ -528,12 +528,12 @@ pub fn results_csv(res: &PaperResults) -> Result<String> {
             cpu_ms_per_roll: format!("{:.4}", c.run.cpu_ms_per_roll),
         };
         csv.serialize(row)
-            .map_err(|e| Error::Failed(format!("results.csv: {e}")))?;
+            .map_err(|e| Error::failed(format!("results.csv: {e}")))?;
     }
     let bytes = csv
         .into_inner()
-        .map_err(|e| Error::Failed(format!("results.csv: {}", e.error())))?;
-    String::from_utf8(bytes).map_err(|e| Error::Failed(format!("results.csv: {e}")))
+        .map_err(|e| Error::failed(format!("results.csv: {}", e.error())))?;
+    String::from_utf8(bytes).map_err(|e| Error::failed(format!("results.csv: {e}")))
 }
 
 /// The paper's figures, drawn from the results; returns their names (each has .svg and .png).

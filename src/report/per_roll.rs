@@ -71,7 +71,7 @@ pub struct PerRoll<W: Write> {
 }
 
 fn failed(e: csv::Error) -> Error {
-    Error::Failed(format!("per-roll CSV: {e}"))
+    Error::failed(format!("per-roll CSV: {e}"))
 }
 
 impl<W: Write> PerRoll<W> {
@@ -141,6 +141,6 @@ impl<W: Write> PerRoll<W> {
     pub fn finish(self) -> Result<W> {
         self.csv
             .into_inner()
-            .map_err(|e| Error::Failed(format!("per-roll CSV: {}", e.error())))
+            .map_err(|e| Error::failed(format!("per-roll CSV: {}", e.error())))
     }
 }

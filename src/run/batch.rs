@@ -124,7 +124,7 @@ pub(crate) fn pool(threads: usize) -> Result<std::sync::Arc<rayon::ThreadPool>> 
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
-            .map_err(|e| Error::Failed(format!("cannot start {threads} threads ({e})")))?,
+            .map_err(|e| Error::failed(format!("cannot start {threads} threads ({e})")))?,
     );
     pools.push((threads, p.clone()));
     Ok(p)

@@ -336,7 +336,7 @@ pub fn read_capped(path: &Path, max: u64, stop: &crate::run::stop::Stop) -> Resu
             }
             Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
             Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
-                return Err(Error::Failed(format!("{}: the read ended", path.display())))
+                return Err(Error::failed(format!("{}: the read ended", path.display())))
             }
         }
     };

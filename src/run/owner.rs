@@ -95,7 +95,7 @@ pub fn claim(dir: &Path, command: &str, config: &Value) -> Result<()> {
                 config: config.clone(),
             };
             let json =
-                serde_json::to_string_pretty(&owner).map_err(|e| Error::Failed(e.to_string()))?;
+                serde_json::to_string_pretty(&owner).map_err(|e| Error::failed(e.to_string()))?;
             // Put in place only if still absent (a hard link fails on an existing name), so
             // that of two runs claiming one directory at the same moment one wins, and the
             // other reads the winner's claim and is refused unless it is the same run.

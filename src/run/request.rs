@@ -117,7 +117,13 @@ impl SceneRequest {
                 return Err(Error::field(
                     Field::Block,
                     "",
-                    "is the cuboid; `shape` or a mesh `die` replaces it: give one",
+                    crate::text![
+                        "is the cuboid; ",
+                        Field::Shape,
+                        " or a mesh ",
+                        Field::Die,
+                        " replaces it: give one"
+                    ],
                 ))
             }
             (Some(b), None) => b,

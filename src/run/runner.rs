@@ -129,7 +129,7 @@ impl ChunkShare {
                 l.get_or_insert((task, why.clone()));
             }
         }
-        Error::Failed(format!("{why} (task {task} rolls it)"))
+        Error::failed(format!("{why} (task {task} rolls it)"))
     }
 
     /// True for a task's share or a dry run: their tallies are partial by design, for no
@@ -458,7 +458,7 @@ impl Checkpoint {
                 spec: spec.clone(),
             };
             let json =
-                serde_json::to_string_pretty(&stored).map_err(|e| Error::Failed(e.to_string()))?;
+                serde_json::to_string_pretty(&stored).map_err(|e| Error::failed(e.to_string()))?;
             write_atomic(&file, json.as_bytes())?;
         }
         if Checkpoint::spec_in(dir)? != *spec {

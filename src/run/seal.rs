@@ -33,14 +33,14 @@ pub fn checksum(v: &Value) -> String {
 
 /// `value` as a JSON object with its checksum added.
 pub fn sealed<T: Serialize>(value: &T) -> crate::Result<Value> {
-    let mut v = serde_json::to_value(value).map_err(|e| crate::Error::Failed(e.to_string()))?;
+    let mut v = serde_json::to_value(value).map_err(|e| crate::Error::failed(e.to_string()))?;
     let sum = checksum(&v);
     match &mut v {
         Value::Object(m) => {
             m.insert(FIELD.into(), Value::String(sum));
             Ok(v)
         }
-        _ => Err(crate::Error::Failed("only an object can be sealed".into())),
+        _ => Err(crate::Error::failed("only an object can be sealed")),
     }
 }
 
@@ -52,7 +52,7 @@ pub fn to_string<T: Serialize>(value: &T, pretty: bool) -> crate::Result<String>
     } else {
         serde_json::to_string(&v)
     }
-    .map_err(|e| crate::Error::Failed(e.to_string()))
+    .map_err(|e| crate::Error::failed(e.to_string()))
 }
 
 /// What is wrong with a stored document.

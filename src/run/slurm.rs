@@ -177,7 +177,7 @@ impl Layout {
             ))),
             Err(_) if !self.plan().exists() => {
                 let json =
-                    serde_json::to_string_pretty(plan).map_err(|e| Error::Failed(e.to_string()))?;
+                    serde_json::to_string_pretty(plan).map_err(|e| Error::failed(e.to_string()))?;
                 Output::check(&self.plan())?.write(format!("{json}\n").as_bytes())
             }
             Err(e) => Err(e),
@@ -201,7 +201,7 @@ impl Layout {
     /// The finishing job's refusal: which of the `tasks` have not finished (`missing`, and
     /// `why`), and how to finish them.
     pub fn not_finished(&self, tasks: u64, missing: &[String], why: &str) -> Error {
-        Error::Failed(format!(
+        Error::failed(format!(
             "slurm finish: {} of {tasks} tasks have not finished: {} ({why}); \
              rerun them with `sbatch --array={} {}` (each resumes from its checkpoint), \
              then `sbatch {}`",

@@ -73,17 +73,22 @@ impl ThrowSpec {
                 return Err(Error::field(
                     Field::Style,
                     "hand",
-                    "needs `kappa` K (0: the tumble's spread; large: the paper's throw)",
+                    crate::text![
+                        "needs ",
+                        Field::Kappa,
+                        " K (0: the tumble's spread; large: the paper's throw)"
+                    ],
                 ))
             }
             (ThrowStyle::Hand, Some(k)) if !(0.0..=MAX_KAPPA).contains(&k) => {
                 return Err(Error::field(
                     Field::Kappa,
                     k,
-                    format!(
-                        "a hand's concentration is 0 to {MAX_KAPPA:e} (`style` paper is the \
-                         limit of large kappa)"
-                    ),
+                    crate::text![
+                        format!("a hand's concentration is 0 to {MAX_KAPPA:e} ("),
+                        Field::Style,
+                        " paper is the limit of large kappa)"
+                    ],
                 ))
             }
             (ThrowStyle::Hand, Some(_)) | (_, None) => {}
@@ -91,7 +96,13 @@ impl ThrowSpec {
                 return Err(Error::field(
                     Field::Kappa,
                     "",
-                    format!("only `style` hand takes a concentration, not `style` {s}"),
+                    crate::text![
+                        "only ",
+                        Field::Style,
+                        " hand takes a concentration, not ",
+                        Field::Style,
+                        format!(" {s}")
+                    ],
                 ))
             }
         }
@@ -107,11 +118,12 @@ impl ThrowSpec {
                     return Err(Error::field(
                         field,
                         g,
-                        format!(
-                            "`style` rest releases the die at rest and uses no range; leave \
-                             `{}` out",
-                            field.name()
-                        ),
+                        crate::text![
+                            Field::Style,
+                            " rest releases the die at rest and uses no range; leave ",
+                            field,
+                            " out"
+                        ],
                     ));
                 }
             }
@@ -120,8 +132,12 @@ impl ThrowSpec {
             return Err(Error::field(
                 Field::Style,
                 self.style,
-                "the dicephys throw source draws the paper's throw only; use the keyed throws \
-                 (`kind` keyed)",
+                crate::text![
+                    "the dicephys throw source draws the paper's throw only; use the keyed \
+                     throws (",
+                    Field::Kind,
+                    " keyed)"
+                ],
             ));
         }
         if self.kind == ThrowKind::Dicephys && self.seed > u32::MAX as u64 {

@@ -213,11 +213,14 @@ impl RollConfig {
             return Err(crate::Error::field(
                 Field::Settle,
                 "certificate",
-                format!(
-                    "{who} settles by DicePhys's rule (an audit watches the certificate without \
-                     stopping); leave out `settle` or `{}`",
-                    if audit { "audit" } else { "faithful" }
-                ),
+                crate::text![
+                    format!(
+                        "{who} settles by DicePhys's rule (an audit watches the certificate \
+                         without stopping); leave out "
+                    ),
+                    Field::Settle,
+                    format!(" or `{}`", if audit { "audit" } else { "faithful" })
+                ],
             ));
         }
         let certificate = settle.map_or(early_stop_exact(dt), |r| r == Rule::Certificate);

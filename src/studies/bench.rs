@@ -48,7 +48,7 @@ pub fn run_dicephys(
         "-v", "-0.2", "0.2", "-a", "31", "160", "-y", "0.2", "0.4", "-f", "0.29", "-r", "0.5",
         "-t", "0.001", "-w", "0.024", "-h", "0.020", "-d", length, "-D", "-n",
     ];
-    let failed = |why: String| crate::Error::Failed(format!("{}: {why}", binary.display()));
+    let failed = |why: String| crate::Error::failed(format!("{}: {why}", binary.display()));
     let cpu = children_cpu_s();
     let wall = Instant::now();
     let mut children = Vec::new();

@@ -581,6 +581,7 @@ fn run_study(study: &CalibratedStudy, place: &Place, hooks: &Hooks) -> Result<Do
                  its box from",
                 place.out.display()
             )
+            .into()
         });
         return Ok(done);
     }
@@ -603,6 +604,7 @@ fn run_study(study: &CalibratedStudy, place: &Place, hooks: &Hooks) -> Result<Do
             "wrote {}/calibrated.md, calibrated.json and figures",
             place.out.display()
         )
+        .into()
     });
     Ok(done)
 }

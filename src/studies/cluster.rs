@@ -53,7 +53,7 @@ fn stage(s: &Submitted, job: &Job, dry: bool) -> Result<Staged> {
     // A study that decides its rounds from all the rolls so far cannot be split.
     cfg.check_splittable()?;
     let plan = Plan::Study {
-        config: serde_json::to_value(cfg).map_err(|e| Error::Failed(e.to_string()))?,
+        config: serde_json::to_value(cfg).map_err(|e| Error::failed(e.to_string()))?,
         json: s.json,
         command_line: s.command_line.to_string(),
         threads: s.threads,
@@ -163,7 +163,7 @@ fn prepare(
         }
         None => std::env::current_exe()
             .and_then(|p| p.canonicalize())
-            .map_err(|e| Error::Failed(format!("cannot find this binary's path ({e})")))?,
+            .map_err(|e| Error::failed(format!("cannot find this binary's path ({e})")))?,
     };
     script_path(Field::Bin, &bin)?;
     // A run refused by its dry run leaves no directory behind that this call made.
@@ -235,11 +235,11 @@ fn sbatch(args: &[OsString]) -> Result<String> {
         .arg("--parsable")
         .args(args)
         .output()
-        .map_err(|e| Error::Failed(format!("sbatch: {e} (is Slurm installed here?)")))?;
+        .map_err(|e| Error::failed(format!("sbatch: {e} (is Slurm installed here?)")))?;
     let stdout = String::from_utf8_lossy(&out.stdout);
     if !out.status.success() {
         let stderr = String::from_utf8_lossy(&out.stderr);
-        return Err(Error::Failed(format!(
+        return Err(Error::failed(format!(
             "sbatch failed: {}",
             stderr.trim().replace('\n', "; ")
         )));
@@ -247,7 +247,7 @@ fn sbatch(args: &[OsString]) -> Result<String> {
     // --parsable prints "id" or "id;cluster".
     let id = stdout.trim().split(';').next().unwrap_or("").to_string();
     if id.is_empty() || !id.chars().all(|c| c.is_ascii_digit()) {
-        return Err(Error::Failed(format!(
+        return Err(Error::failed(format!(
             "sbatch printed no job id: {}",
             stdout.trim()
         )));

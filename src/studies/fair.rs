@@ -225,8 +225,8 @@ fn judge(
 ) -> Result<Fairness> {
     let n: u64 = counts.iter().sum();
     if n == 0 {
-        return Err(Error::Failed(
-            "no roll came to rest on a face: nothing to judge".into(),
+        return Err(Error::failed(
+            "no roll came to rest on a face: nothing to judge",
         ));
     }
     let nf = n as f64;

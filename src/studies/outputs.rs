@@ -81,8 +81,11 @@ impl Kind for studies::converge::Config {
             return Err(Error::field(
                 Field::Precision,
                 "",
-                "decides each cell's rounds from all its rolls, which no task sees; give \
-                 `rolls` instead (a run to a precision prints the rolls each cell needs)",
+                crate::text![
+                    "decides each cell's rounds from all its rolls, which no task sees; give ",
+                    Field::Rolls,
+                    " instead (a run to a precision prints the rolls each cell needs)"
+                ],
             ));
         }
         Ok(())
@@ -107,10 +110,14 @@ impl Kind for studies::tradeoff::Config {
             return Err(Error::field(
                 Field::PrerollChunks,
                 "",
-                "needed: the rounds are decided from every roll so far, which no task sees, \
-                 so the tasks roll the first throws of every stream ahead and the finishing job \
-                 runs the study, reading them back and rolling on itself where a method needs \
-                 more (a plan, `plan_only`, prints the rolls each needs)",
+                crate::text![
+                    "needed: the rounds are decided from every roll so far, which no task sees, \
+                     so the tasks roll the first throws of every stream ahead and the finishing \
+                     job runs the study, reading them back and rolling on itself where a method \
+                     needs more (a plan, ",
+                    Field::PlanOnly,
+                    ", prints the rolls each needs)"
+                ],
             ));
         }
         Ok(())
@@ -279,6 +286,7 @@ fn paper(cfg: &studies::paper::PaperConfig, place: &Place, hooks: &Hooks) -> Res
             "wrote {}/report.md, results.json, results.csv and figures",
             place.out.display()
         )
+        .into()
     });
     Ok(done)
 }
@@ -355,13 +363,17 @@ fn tradeoff(cfg: &studies::tradeoff::Config, place: &Place, hooks: &Hooks) -> Re
     }
     if let Some(k) = cfg.preroll_chunks {
         return Ok(Done {
-            note: Some(format!(
-                "rolled the first {} throws of every stream into {}/checkpoint ({:.0} CPU s); \
-                 the same study without `preroll_chunks` reads them back",
-                k * crate::run::runner::CHUNK_ROLLS,
-                place.out.display(),
-                res.cpu_s
-            )),
+            note: Some(crate::text![
+                format!(
+                    "rolled the first {} throws of every stream into {}/checkpoint ({:.0} CPU \
+                     s); the same study without ",
+                    k * crate::run::runner::CHUNK_ROLLS,
+                    place.out.display(),
+                    res.cpu_s
+                ),
+                Field::PrerollChunks,
+                " reads them back"
+            ]),
             ..Done::default()
         });
     }

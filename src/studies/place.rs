@@ -46,9 +46,8 @@ pub struct Hooks<'a> {
 pub struct Done {
     /// For stdout: the report, or the JSON result.
     pub stdout: String,
-    /// For stderr: what was written where (a field it names in backquotes, as in
-    /// `Error::Field`).
-    pub note: Option<String>,
+    /// For stderr: what was written where (a field it names typed, as in `Error::Field`).
+    pub note: Option<crate::error::Text>,
     /// Stopped before the end, and what was kept: the caller ends with its own exit code.
     pub interrupted: Option<String>,
 }
@@ -115,8 +114,9 @@ impl Place {
     pub(crate) fn done(&self, json: &str, report: &str, file: &str) -> Done {
         Done {
             stdout: format!("{}\n", if self.json { json } else { report }),
-            note: (!self.json)
-                .then(|| format!("wrote {}/{file}, report.md and figures", self.out.display())),
+            note: (!self.json).then(|| {
+                format!("wrote {}/{file}, report.md and figures", self.out.display()).into()
+            }),
             interrupted: None,
         }
     }
@@ -152,14 +152,14 @@ impl Outputs {
         self.0
             .iter()
             .find(|(n, _)| *n == name)
-            .ok_or_else(|| Error::Failed(format!("{name}: not among the study's outputs")))?
+            .ok_or_else(|| Error::failed(format!("{name}: not among the study's outputs")))?
             .1
             .write(bytes)
     }
 }
 
 pub(crate) fn to_json<T: Serialize>(v: &T) -> Result<String> {
-    serde_json::to_string_pretty(v).map_err(|e| Error::Failed(e.to_string()))
+    serde_json::to_string_pretty(v).map_err(|e| Error::failed(e.to_string()))
 }
 
 /// Whether a claim refuses a Slurm run's directory (its tasks and finishing job write there).
@@ -181,7 +181,7 @@ pub fn claim<T: Serialize + ?Sized>(
     identity: &T,
     by: Claimant,
 ) -> Result<()> {
-    let identity = serde_json::to_value(identity).map_err(|e| Error::Failed(e.to_string()))?;
+    let identity = serde_json::to_value(identity).map_err(|e| Error::failed(e.to_string()))?;
     if by == Claimant::Here {
         crate::run::owner::refuse_cluster_run(dir)?;
     }

@@ -109,7 +109,7 @@ pub fn measure(spec: &RunSpec, study: &Study) -> Result<Measured> {
         cpu_s: process_cpu_seconds() - cpu + run.resumed_cpu_s,
     };
     if let Some(f) = &kept {
-        let json = serde_json::to_string(&m).map_err(|e| Error::Failed(e.to_string()))?;
+        let json = serde_json::to_string(&m).map_err(|e| Error::failed(e.to_string()))?;
         write_atomic(f, json.as_bytes())?;
     }
     Ok(m)

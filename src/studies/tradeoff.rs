@@ -136,7 +136,12 @@ impl Config {
             return Err(Error::field(
                 Field::ReferenceDt,
                 dt_label(self.reference_dt),
-                "must be finer than every `dts` and `rapier_dts`",
+                crate::text![
+                    "must be finer than every ",
+                    Field::Dts,
+                    " and ",
+                    Field::RapierDts
+                ],
             ));
         }
         if self.ladder.contains(&self.reference_dt) {

@@ -178,7 +178,7 @@ impl MarkovChain {
         let p = self.transition_matrix();
         let q: Matrix3<f64> = p.fixed_view::<3, 3>(0, 0).into_owned();
         (Matrix3::identity() - q).try_inverse().ok_or_else(|| {
-            Error::Failed("Markov chain: I - Q is singular (no absorbing path)".to_string())
+            Error::failed("Markov chain: I - Q is singular (no absorbing path)".to_string())
         })
     }
 
@@ -206,7 +206,7 @@ impl MarkovChain {
         for t in 0..T {
             let d: f64 = (t + 1..5).map(|j| w[(t, j)]).sum();
             if d.is_nan() || d <= 0.0 {
-                return Err(Error::Failed(format!(
+                return Err(Error::failed(format!(
                     "Markov chain: state {} cannot leave the transient states",
                     t + 1
                 )));

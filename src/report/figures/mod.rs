@@ -142,10 +142,10 @@ fn write_both(dir: &Path, stem: &str, fig: &impl Figure) -> crate::Result<()> {
     if stem.is_empty() || stem.contains(['/', '\\']) {
         return Err(Error::Invalid(format!("figures: bad file stem '{stem}'")));
     }
-    ensure_font().map_err(Error::Failed)?;
+    ensure_font().map_err(Error::failed)?;
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let failed = |ext: &str, e: String| {
-        Error::Failed(format!(
+        Error::failed(format!(
             "{}: {e}",
             dir.join(format!("{stem}.{ext}")).display()
         ))

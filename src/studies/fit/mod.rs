@@ -212,12 +212,17 @@ fn settled_enough(designs: &[Design]) -> Result<()> {
     let rolls: u64 = designs.iter().map(|d| d.rolls).sum();
     let unsettled: u64 = designs.iter().map(|d| d.unsettled).sum();
     if rolls > 0 && unsettled as f64 > MAX_UNSETTLED_SHARE * rolls as f64 {
-        return Err(Error::Failed(format!(
-            "{unsettled} of the fit's {rolls} rolls ({:.1} %) did not settle on a face (more \
-             than {:.0} %): no estimate from them; raise `max_steps` or use a finer `dt`",
-            100.0 * unsettled as f64 / rolls as f64,
-            100.0 * MAX_UNSETTLED_SHARE
-        )));
+        return Err(Error::failed(crate::text![
+            format!(
+                "{unsettled} of the fit's {rolls} rolls ({:.1} %) did not settle on a face \
+                 (more than {:.0} %): no estimate from them; raise ",
+                100.0 * unsettled as f64 / rolls as f64,
+                100.0 * MAX_UNSETTLED_SHARE
+            ),
+            Field::MaxSteps,
+            " or use a finer ",
+            Field::Dt
+        ]));
     }
     Ok(())
 }

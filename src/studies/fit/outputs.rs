@@ -136,6 +136,7 @@ fn fit(study: &FitStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
                 "wrote {}/{FIRST_PASS}: the first pass, which the second narrows its box from",
                 place.out.display()
             )
+            .into()
         });
         return Ok(done);
     }
@@ -170,7 +171,7 @@ fn recover(study: &RecoverStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
     let mut done = place.done(&json, &text, "recovery.json");
     done.note = done
         .note
-        .map(|_| format!("wrote {}/recovery.json", place.out.display()));
+        .map(|_| format!("wrote {}/recovery.json", place.out.display()).into());
     Ok(done)
 }
 
@@ -229,6 +230,7 @@ fn predict_blocks(study: &BlocksStudy, place: &Place, hooks: &Hooks) -> Result<D
             "wrote {}/predictions.json, predictions.csv, report.md and the figure",
             place.out.display()
         )
+        .into()
     });
     Ok(done)
 }

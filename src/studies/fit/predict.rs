@@ -111,6 +111,17 @@ fn predicts_faces(fit: &FitResult, cfg: &PredictConfig) -> bool {
                 .any(|r| r.outcomes == crate::calibration::data::Outcomes::Faces))
 }
 
+/// Rolls that did not settle, `what` of them, and what to change.
+fn unsettled_error(what: String) -> Error {
+    Error::failed(crate::text![
+        what,
+        "; raise ",
+        Field::MaxSteps,
+        " in the fit, or use a finer ",
+        Field::Dt
+    ])
+}
+
 /// Simulates `cfg.block` (or the fit's die of any shape) at posterior draws of `fit`. `None`
 /// if stopped early.
 pub fn predict_block(
@@ -147,9 +158,9 @@ pub fn predict_block(
         unsettled += done.tally.rolls - settled;
         let sides = c.breadth + c.width;
         if settled == 0 || shape.is_none() && sides == 0 {
-            return Err(Error::Failed(format!(
-                "none of the {} rolls at posterior draw {m} settled on a {}: no probabilities \
-                 to give; raise `max_steps` in the fit, or use a finer `dt`",
+            return Err(unsettled_error(format!(
+                "none of the {} rolls at posterior draw {m} settled on a {}: no probabilities to \
+                 give",
                 done.tally.rolls,
                 if shape.is_some() { "face" } else { "side" }
             )));
@@ -169,9 +180,9 @@ pub fn predict_block(
     }
     let all = cfg.draws as u64 * cfg.rolls;
     if unsettled as f64 > super::MAX_UNSETTLED_SHARE * all as f64 {
-        return Err(Error::Failed(format!(
+        return Err(unsettled_error(format!(
             "{unsettled} of the prediction's {all} rolls did not settle on a face: no \
-             probabilities from them; raise `max_steps` in the fit, or use a finer `dt`"
+             probabilities from them"
         )));
     }
     let n = cfg.rolls as f64;
@@ -347,7 +358,7 @@ pub fn predict_blocks(
         let progress = |n| (runner.progress)(base + n);
         let Some(p) = predict_block(fit, &cfg(r), &runner.with_progress(&progress), None).map_err(
             |e| match e {
-                Error::Failed(m) => Error::Failed(format!("row '{}': {m}", r.label)),
+                Error::Failed(m) => Error::Failed(m.after(&format!("row '{}': ", r.label))),
                 e => e,
             },
         )?

@@ -77,7 +77,11 @@ pub fn check_truth(cfg: &FitConfig, truth: &[f64], repeats: usize) -> Result<()>
             return Err(Error::field(
                 Field::Recover,
                 format!("{kind}={v}"),
-                format!("outside its range {range} (`range` sets it)"),
+                crate::text![
+                    format!("outside its range {range} ("),
+                    Field::Range,
+                    " sets it)"
+                ],
             ));
         }
     }

@@ -140,7 +140,7 @@ pub fn measure_limit(spec: &RunSpec, study: &Study) -> Result<LimitCell> {
             cell: cell.clone(),
             outcomes: cell.outcomes.clone(),
         };
-        let json = serde_json::to_string(&k).map_err(|e| Error::Failed(e.to_string()))?;
+        let json = serde_json::to_string(&k).map_err(|e| Error::failed(e.to_string()))?;
         write_atomic(f, json.as_bytes())?;
     }
     Ok(cell)
