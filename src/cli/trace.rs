@@ -74,7 +74,8 @@ pub fn run(a: &TraceArgs) -> Result<()> {
         // the rows so far written, as every command stops (exit 130).
         if step.is_multiple_of(1024) && super::term::stop().requested() {
             let _ = out.flush();
-            eprintln!("dicephys: interrupted at step {step}; the rows up to it are written");
+            let kept = dicephys::run::stop::Kept::Steps(step);
+            eprintln!("dicephys: {}", dicephys::run::stop::interrupted(&kept));
             std::process::exit(130);
         }
         let l = line(step, s);

@@ -70,6 +70,8 @@ pub enum Kept<'a> {
     Dir(&'a std::path::Path),
     /// The finished work is kept where the command keeps it: the same command continues.
     Work,
+    /// A trace's rows up to this step are written (a trace does not resume).
+    Steps(u64),
     /// `done` of `of` rolls made, and the command that continues them, if one does.
     Rolls {
         /// Rolls made.
@@ -95,6 +97,7 @@ pub fn interrupted(kept: &Kept) -> String {
         Kept::Work => {
             "interrupted; the finished work is kept: run the same command to continue".into()
         }
+        Kept::Steps(step) => format!("interrupted at step {step}; the rows up to it are written"),
         Kept::Rolls {
             done,
             of,
