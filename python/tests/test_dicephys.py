@@ -136,6 +136,9 @@ def test_per_roll_arrays_match_the_cli_s_csv(tmp_path: Path) -> None:
         ({"block": "140x24x20", "kappa": "bogus"}, "kappa='bogus'"),
         # The library's own checks, named by the argument (house round 4).
         ({"block": "140x24x20", "floor": "plane", "floor_thickness": 0.02}, "floor_thickness=0.02: .* give floor box"),
+        # Every field a message names is typed, and named as an argument here (issue 45).
+        ({"block": "140x24x20", "throw": "hand"}, "^throw=hand: needs kappa K"),
+        ({"block": "140x24x20", "throw": "rest", "velocity": (1, 2)}, "throw rest releases .* leave velocity out$"),
     ],
 )
 def test_bad_arguments_raise_value_error_naming_them(kwargs: dict, name: str) -> None:

@@ -46,6 +46,33 @@ fn bad_input_gets_one_line_and_exit_code_2() {
     }
 }
 
+/// Every field a library message names comes typed and is named by its flag, the one refused
+/// and the ones the message advises (issue 45: never the library's name, never re-read from
+/// text): a hand's throw without its concentration, a range given to a die released at rest,
+/// a plane floor given a thickness.
+#[test]
+fn a_message_names_every_field_it_mentions_by_its_flag() {
+    for (args, says) in [
+        (
+            &["--throw", "hand"][..],
+            "dicephys: --throw hand: needs --kappa K (",
+        ),
+        (
+            &["--throw", "rest", "--velocity", "1:2"][..],
+            "dicephys: --velocity 1:2: --throw rest releases the die at rest and uses no range; \
+             leave --velocity out",
+        ),
+        (
+            &["--floor", "plane", "--floor-thickness", "1"][..],
+            "dicephys: --floor-thickness 1: the plane floor is a half-space; give --floor box",
+        ),
+    ] {
+        let out = dicephys(&[&["roll", "--rolls", "10"][..], args].concat());
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(stderr(&out).starts_with(says), "{args:?}: {}", stderr(&out));
+    }
+}
+
 /// A misspelt flag or command keeps clap's suggestion in its one line (issue 50).
 #[test]
 fn a_misspelt_flag_or_command_is_told_what_it_may_mean() {
