@@ -7,7 +7,10 @@
 //! - the cube falling without rotation onto one edge (tilted about x, so the problem is 2D in
 //!   the y–z plane), frictionless, restitution e: the single-contact impulse law gives
 //!   J = (1 + e) V / (1/m + r_z²/I_x), v' = −V + J/m, ω'_x = −r_z J / I_x, with r the edge
-//!   from the centre of mass and I_x the moment about the x axis through it.
+//!   from the centre of mass and I_x the moment about the x axis through it;
+//! - the same edge landing while sliding across it, with friction: Newton's restitution and
+//!   Coulomb's friction on the whole impulse (J_z = −μ J_y, J_y = (1 + e) V/(K_yy − μ K_yz));
+//! - the centred cube sliding and spinning flat on a face: Coulomb's law at its corners.
 //!
 //! The cube: 16 mm, density 800, centre of mass 4.5 mm toward its −z face, so I_x =
 //! m (2·16²/12 − 4.5²) mm² = 22.42 m mm² (42.67 m mm² about the centre) and I_z = 42.67 m mm².
@@ -536,4 +539,101 @@ fn rapier_brakes_a_sliding_spin_at_once_and_bullet_rocks() {
     );
     let (_, _, rocking, _) = sliding_and_spinning(EngineKind::Bullet);
     assert!(rocking > 0.1, "Bullet: rocking {rocking}");
+}
+
+/// Friction in an impact: the loaded cube, tilted 30° about x, lands on its lowest edge at V
+/// while moving across the edge at 1 m/s (along z), μ 0.29, gravity off. With Newton's
+/// restitution e and Coulomb's friction, sliding throughout (the slip keeps its sign: checked
+/// below), the impulse is J_y = (1 + e) V / (K_yy − μ K_yz), J_z = −μ J_y, with K the edge's
+/// inverse mass in the y–z plane (K_yy = 1/m + r_z²/I_x, K_yz = −r_y r_z/I_x): friction acts
+/// on the whole impulse, the bounce's part included. Returns, for e, (Δv_y, Δv_z, ω'_x) after
+/// one step beside the law's.
+fn frictional_edge_impact(kind: EngineKind, e: f64) -> ([f64; 3], [f64; 3]) {
+    let (mu, w) = (0.29, 1.0);
+    let mut scene = cube(COM_Z, mu, 0.0, 0.001);
+    scene.restitution = e;
+    let hit = EdgeImpact::new(&scene, COM_Z, 30.0);
+    let (m, i, ry, rz) = (hit.m, hit.ix, hit.r.y, hit.r.z);
+    let (kyy, kyz) = (1.0 / m + rz * rz / i, -ry * rz / i);
+    let jy = (1.0 + e) * V / (kyy - mu * kyz);
+    let jz = -mu * jy;
+    // The edge's slip after the impact, still along +z: sliding throughout.
+    let slip = w + kyz * jy + (1.0 / m + ry * ry / i) * jz;
+    assert!(slip > 0.0, "the law's slip reversed: {slip}");
+    let law = [jy / m, jz / m, (ry * jz - rz * jy) / i];
+    let mut engine = new_engine(kind, &scene).unwrap();
+    engine
+        .reset(&BodyState {
+            linear_velocity: Vector3::new(0.0, -V, w),
+            ..at_rest(Vector3::new(0.0, -hit.r.y - 1e-9, 0.0), hit.rotation)
+        })
+        .unwrap();
+    engine.step().unwrap();
+    let s = engine.state();
+    let got = [
+        s.linear_velocity.y + V,
+        s.linear_velocity.z - w,
+        s.angular_velocity.x,
+    ];
+    println!(
+        "{kind:?} e {e}: Δv_y {:.4} (law {:.4}), Δv_z {:.4} (law {:.4}), ω'_x {:.2} (law {:.2})",
+        got[0], law[0], got[1], law[1], got[2], law[2]
+    );
+    (got, law)
+}
+
+/// Bullet meets the frictional impact law within 1e-4, e = 0 and e = 0.5 (under the paper's
+/// preset: touching as the step starts, so its Baumgarte term is nil).
+#[test]
+fn bullet_meets_the_frictional_impact_law() {
+    for e in [0.0, 0.5] {
+        let (got, law) = frictional_edge_impact(EngineKind::Bullet, e);
+        for k in 0..3 {
+            assert!(
+                rel(got[k], law[k]).abs() < 1e-4,
+                "Bullet e {e}: {got:?} against {law:?}"
+            );
+        }
+    }
+}
+
+/// The same law on Rapier, within 1 %; it fails (see the pin below).
+#[test]
+#[ignore = "Rapier 0.36.1 bounces with a frictionless impulse after its substeps (friction acts \
+            on the compression only: 28 % short at e = 0.5) and overshoots the normal impulse \
+            by 9 % at e = 0 (issue 46, class N)"]
+fn rapier_meets_the_frictional_impact_law() {
+    for e in [0.0, 0.5] {
+        let (got, law) = frictional_edge_impact(EngineKind::Rapier, e);
+        for k in 0..3 {
+            assert!(
+                rel(got[k], law[k]).abs() < 0.01,
+                "Rapier e {e}: {got:?} against {law:?}"
+            );
+        }
+    }
+}
+
+/// What Rapier does instead, pinned: its friction impulse is the same with a bounce as without
+/// (within 1e-3: the end-of-step restitution pass is normal only), so at e = 0.5 it is 28 %
+/// short of μ times the whole normal impulse; at e = 0 its normal impulse is 5–15 % above the
+/// law's (measured 8.7 %; 4–10 % over its solver's settings: substeps, PGS iterations,
+/// friction in the biased pass, the Coulomb model).
+#[test]
+fn rapier_bounces_without_friction() {
+    let (plastic, law0) = frictional_edge_impact(EngineKind::Rapier, 0.0);
+    let (bouncy, law5) = frictional_edge_impact(EngineKind::Rapier, 0.5);
+    assert!(
+        rel(bouncy[1], plastic[1]).abs() < 1e-3,
+        "{bouncy:?} {plastic:?}"
+    );
+    assert!(
+        rel(bouncy[1], law5[1]) < -0.2,
+        "{bouncy:?} against {law5:?}"
+    );
+    let over = rel(plastic[0], law0[0]);
+    assert!(
+        (0.05..0.15).contains(&over),
+        "Rapier e 0: Δv_y {over:+.3} off the law"
+    );
 }
