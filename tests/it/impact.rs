@@ -498,7 +498,7 @@ fn sliding_and_spinning(kind: EngineKind) -> (f64, f64, f64, f64) {
 /// corner (−39.5 rad/s² here; a friction that brakes the spin apart from the slide, at μ N r,
 /// would give −745). Bullet meets it (+0.6 %); Rapier 0.36.1's default friction model (one
 /// constraint at the contact patch's centre and a twist) brakes it 19 times too hard, and is
-/// held to it in `rapier_brakes_a_sliding_spin_at_once`.
+/// pinned in `rapier_brakes_a_sliding_spin_at_once_and_bullet_rocks`.
 #[test]
 fn a_sliding_cube_s_spin_brakes_as_coulombs_law_says_on_bullet() {
     let (first, law, _, _) = sliding_and_spinning(EngineKind::Bullet);
