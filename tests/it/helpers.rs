@@ -242,3 +242,13 @@ pub fn no_temp_files(dir: &Path) {
         assert!(!n.contains(".tmp"), "temporary file left behind: {n}");
     }
 }
+
+/// True once a checkpoint chunk (`chunk-*`) is on disk directly in `dir`.
+pub fn has_chunk(dir: &Path) -> bool {
+    std::fs::read_dir(dir)
+        .map(|d| {
+            d.flatten()
+                .any(|e| e.file_name().to_string_lossy().starts_with("chunk-"))
+        })
+        .unwrap_or(false)
+}

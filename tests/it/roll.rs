@@ -251,14 +251,7 @@ fn a_run_killed_with_sigkill_resumes_bit_for_bit() {
         .spawn()
         .unwrap();
     // Wait for at least one finished chunk, then SIGKILL (Child::kill sends SIGKILL).
-    let chunk_written = || {
-        std::fs::read_dir(&dir)
-            .map(|d| {
-                d.flatten()
-                    .any(|e| e.file_name().to_string_lossy().starts_with("chunk-"))
-            })
-            .unwrap_or(false)
-    };
+    let chunk_written = || crate::helpers::has_chunk(&dir);
     for _ in 0..600 {
         if chunk_written() {
             break;
@@ -318,14 +311,7 @@ fn a_resumed_run_writes_the_same_per_roll_rows_and_counts_its_whole_cost() {
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
-    let chunk_written = || {
-        std::fs::read_dir(&ck)
-            .map(|d| {
-                d.flatten()
-                    .any(|e| e.file_name().to_string_lossy().starts_with("chunk-"))
-            })
-            .unwrap_or(false)
-    };
+    let chunk_written = || crate::helpers::has_chunk(&ck);
     for _ in 0..1200 {
         if chunk_written() {
             break;

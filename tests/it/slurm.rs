@@ -266,14 +266,7 @@ fn a_task_cancelled_mid_run_and_requeued_resumes_and_the_counts_still_match() {
         .spawn()
         .unwrap();
     // Cancel task 0 once its first chunk is checkpointed and before it has finished.
-    let chunk = || {
-        std::fs::read_dir(dir.join("shard-0"))
-            .map(|d| {
-                d.flatten()
-                    .any(|e| e.file_name().to_string_lossy().starts_with("chunk-"))
-            })
-            .unwrap_or(false)
-    };
+    let chunk = || crate::helpers::has_chunk(&dir.join("shard-0"));
     let start = Instant::now();
     while !chunk() {
         assert!(
