@@ -16,18 +16,50 @@ namespace {
 btVector3 vec(const std::array<double, 3>& a) { return btVector3(a[0], a[1], a[2]); }
 std::array<double, 3> arr(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
 
+// btRigidBody::computeGyroscopicImpulseImplicit_Body (one Newton step of implicit Euler on
+// Euler's equations in body axes, I ω' + h ω' × I ω' = I ω), with the moments divided by the
+// largest. Bullet's own solves J x = f with btMatrix3x3::solve33, which divides by det J
+// only above DBL_EPSILON and otherwise multiplies by it: for a die (moments ~1e-7 kg m²,
+// det J ~1e-21 kg³ m⁶) x comes out det² of itself, nothing, so that a die never precesses
+// and a body with unequal moments does not keep its angular momentum in flight (measured in
+// tests/it/impact.rs). J and f scale alike with the moments, so x is unchanged.
+btVector3 gyroscopic_impulse(const btRigidBody& die, btScalar step) {
+  btVector3 idl = die.getLocalInertia();
+  idl /= btMax(idl.x(), btMax(idl.y(), idl.z()));
+  const btVector3 omega1 = die.getAngularVelocity();
+  const btQuaternion q = die.getWorldTransform().getRotation();
+  btVector3 omegab = quatRotate(q.inverse(), omega1);
+  btMatrix3x3 Ib;
+  Ib.setValue(idl.x(), 0, 0, 0, idl.y(), 0, 0, 0, idl.z());
+  const btVector3 ibo = Ib * omegab;
+  const btVector3 f = step * omegab.cross(ibo);
+  btMatrix3x3 skew0;
+  omegab.getSkewSymmetricMatrix(&skew0[0], &skew0[1], &skew0[2]);
+  btMatrix3x3 skew1;
+  ibo.getSkewSymmetricMatrix(&skew1[0], &skew1[1], &skew1[2]);
+  const btMatrix3x3 J = Ib + (skew0 * Ib - skew1) * step;
+  omegab = omegab - J.solve33(f);
+  return quatRotate(q, omegab) - omega1;
+}
+
 // Bullet's world, with two of a step's parts done without the work that changes nothing
 // here (each the base class's code, less that work):
 // - predictUnconstraintMotion damps each body, v *= pow(1 - d, dt), and predicts its
 //   transform for the swept bounding box. With no damping (DicePhys's: d = 0) that is
 //   v *= pow(1, dt) = 1 exactly, so it is left out there; a body with damping is damped as
 //   Bullet does. The prediction is left out with the swept box (m_useContinuous, below).
+//   Under `laws` it also adds the die's gyroscopic impulse (`gyroscopic_scaled`), which
+//   Bullet's stock world (`stock_world`) does not.
 // - createPredictiveContacts predicts every body's transform once more, to compare its
 //   motion with the body's CCD threshold; but it acts on that only with m_useContinuous.
 //   Without it, what is left is what the base class does whatever the motion.
 class DiceWorld : public btDiscreteDynamicsWorld {
  public:
   using btDiscreteDynamicsWorld::btDiscreteDynamicsWorld;
+  // The die turns as Euler's equations say: Bullet's implicit gyroscopic impulse at a scale
+  // where its own arithmetic does not drop it (`gyroscopic_impulse`), added to the angular
+  // velocity as each step starts, in flight and in contact, whichever solver runs.
+  bool gyroscopic_scaled = false;
 
  protected:
   // One dynamic body, not kinematic; every other object static; no joints, no predictive
@@ -127,6 +159,10 @@ class DiceWorld : public btDiscreteDynamicsWorld {
       // (We never turn on Bullet's "additional damping", which applyDamping also does.)
       if (body->getLinearDamping() != 0 || body->getAngularDamping() != 0) {
         body->applyDamping(dt);
+      }
+      // Where Bullet's convertBodies would add its own (from the velocity after damping).
+      if (gyroscopic_scaled) {
+        body->setAngularVelocity(body->getAngularVelocity() + gyroscopic_impulse(*body, dt));
       }
       if (getDispatchInfo().m_useContinuous) {
         body->predictIntegratedTransform(dt, body->getInterpolationWorldTransform());
@@ -587,8 +623,10 @@ BulletWorld::BulletWorld(const BulletScene& s)
     world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
                                                        solver_.get(), config_.get());
   } else {
-    world_ = std::make_unique<DiceWorld>(dispatcher_.get(), broadphase_.get(), solver_.get(),
-                                         config_.get());
+    auto world = std::make_unique<DiceWorld>(dispatcher_.get(), broadphase_.get(),
+                                             solver_.get(), config_.get());
+    world->gyroscopic_scaled = s.gyroscopic_scaled;
+    world_ = std::move(world);
   }
   world_->setGravity(btVector3(0, -s.gravity, 0));
   // The floor never moves: do not recompute its bounding box every step.
@@ -608,6 +646,7 @@ BulletWorld::BulletWorld(const BulletScene& s)
   if (s.split_every_depth) info.m_splitImpulsePenetrationThreshold = 0;
   info.m_restitutionVelocityThreshold = s.restitution_velocity_threshold;
   info.m_numIterations = s.solver_iterations;
+  if (s.two_friction_directions) info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
 
   // The floor: top face at y = 0. DicePhys's is a 10000 x 100 x 10000 m static box.
   btTransform floor_at;

@@ -64,17 +64,20 @@ impl CrosscheckArgs {
 /// Runs `dicephys crosscheck`.
 pub fn run(a: &CrosscheckArgs) -> Result<()> {
     let cfg = a.config()?;
-    // A loaded die that bounces is where the engines part most, and dicephys281 is half of
-    // it: its bounce is e plus Baumgarte's push out of the floor (docs/guide.md, "Presets").
+    // A loaded die that bounces is where the engines part most: under any preset but laws
+    // Bullet's bounce, friction or turn departs from the closed forms (docs/guide.md,
+    // "Presets").
     let scene = &cfg.spec.scene;
     let loaded = scene
         .features
         .com
         .is_some_and(|c| c.iter().any(|x| *x != 0.0));
-    if loaded && scene.preset == dicephys::model::scene::Preset::Dicephys281 && !*a.json {
+    if loaded && scene.preset != dicephys::model::scene::Preset::Laws && !*a.json {
         eprintln!(
-            "dicephys: note: a loaded die under --preset dicephys281 bounces above its e on \
-             Bullet (the paper's preset); --preset split compares the engines on the same bounce"
+            "dicephys: note: a loaded die under --preset {} is rolled off the closed forms \
+             (Bullet's bounce, friction or turn); --preset laws holds each engine to them, \
+             and --engines moreau,... adds the arbiter",
+            scene.preset.name()
         );
     }
     let cfg = StudyConfig::Crosscheck(cfg);

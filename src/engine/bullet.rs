@@ -50,6 +50,10 @@ mod ffi {
         dt: f64,
         /// Bullet 2.83+'s per-body implicit gyroscopic force (2.81: off).
         gyroscopic_implicit: bool,
+        /// The same force computed at unit scale, where Bullet's own drops it for a body as
+        /// small as a die (`cpp/shim.cc`, `gyroscopic_impulse`): the die turns as Euler's
+        /// equations say, in flight and in contact.
+        gyroscopic_scaled: bool,
         /// Relative normal speed below which Bullet 3 drops restitution (2.81: none, 0).
         restitution_velocity_threshold: f64,
         split_impulse: bool,
@@ -57,6 +61,10 @@ mod ffi {
         /// penetration is corrected apart from the velocity, so a bounce leaves at e; else
         /// Bullet's default, split only beyond 4 cm, the correction folded into the bounce.
         split_every_depth: bool,
+        /// Two friction rows per contact point (Coulomb's cone, as a pyramid), not Bullet's
+        /// default one along the slip (`SOLVER_USE_2_FRICTION_DIRECTIONS`; Bullet's own
+        /// solver then runs, not the shim's `DieSolver`).
+        two_friction_directions: bool,
         solver_iterations: i32,
         /// Bullet's sleeping (deactivation) at its defaults, or never.
         deactivation: bool,
@@ -108,8 +116,10 @@ pub fn version() -> String {
 /// Bullet's settings for a preset.
 struct Solver {
     gyroscopic_implicit: bool,
+    gyroscopic_scaled: bool,
     restitution_velocity_threshold: f64,
     split_every_depth: bool,
+    two_friction_directions: bool,
 }
 
 fn solver(preset: Preset) -> Solver {
@@ -120,22 +130,40 @@ fn solver(preset: Preset) -> Solver {
         // throw for throw. 2.81's m_erp2 = 0.8 must NOT be copied: 3.24 uses it differently.
         Preset::Dicephys281 => Solver {
             gyroscopic_implicit: false,
+            gyroscopic_scaled: false,
             restitution_velocity_threshold: 0.0,
             split_every_depth: false,
+            two_friction_directions: false,
         },
         // Debian 3.24's stock defaults.
         Preset::Bullet3 => Solver {
             gyroscopic_implicit: true,
+            gyroscopic_scaled: false,
             restitution_velocity_threshold: 0.2,
             split_every_depth: false,
+            two_friction_directions: false,
         },
         // dicephys281 with the bounce kept exact: a contact found d deep is pushed out by a
         // split impulse, not by a velocity of 0.2 d/dt added to its bounce (Baumgarte), which
         // raises the restitution to e + 0.2 U on average (tests/it/impact.rs).
         Preset::Split => Solver {
             gyroscopic_implicit: false,
+            gyroscopic_scaled: false,
             restitution_velocity_threshold: 0.0,
             split_every_depth: true,
+            two_friction_directions: false,
+        },
+        // split, with the die turning as Euler's equations say (Bullet's implicit gyroscopic
+        // impulse, which its own arithmetic drops for a body as small as a die:
+        // `gyroscopic_scaled`) and friction in Coulomb's cone (Bullet's default is one
+        // friction row per point, along the slip as the step starts, so nothing resists a
+        // slip across it). Each measured in tests/it/impact.rs.
+        Preset::Laws => Solver {
+            gyroscopic_implicit: false,
+            gyroscopic_scaled: true,
+            restitution_velocity_threshold: 0.0,
+            split_every_depth: true,
+            two_friction_directions: true,
         },
     }
 }
@@ -207,9 +235,11 @@ impl Bullet {
             gravity: scene.gravity,
             dt: scene.dt,
             gyroscopic_implicit: s.gyroscopic_implicit,
+            gyroscopic_scaled: s.gyroscopic_scaled,
             restitution_velocity_threshold: s.restitution_velocity_threshold,
             split_impulse: true,
             split_every_depth: s.split_every_depth,
+            two_friction_directions: s.two_friction_directions,
             solver_iterations: 10,
             deactivation: scene.sleeping,
             linear_damping,
@@ -226,7 +256,7 @@ impl Bullet {
         let now = world.state();
         Ok(Bullet {
             world,
-            gyroscopic: s.gyroscopic_implicit,
+            gyroscopic: s.gyroscopic_implicit || s.gyroscopic_scaled,
             damped: scene.damped(),
             turn: mp.turn(),
             now,

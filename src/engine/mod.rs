@@ -7,6 +7,7 @@ use crate::model::state::BodyState;
 use serde::{Deserialize, Serialize};
 
 pub mod bullet;
+pub mod moreau;
 pub mod rapier2d;
 pub mod rapier3d;
 mod rapier_shared;
@@ -92,13 +93,18 @@ pub enum EngineKind {
     /// Rapier, 2D as DicePhys ran it: a 3D body with locked axes (3D: as `Rapier`). A check
     /// of the 2D engine against the locked 3D body.
     RapierLocked,
+    /// The arbiter (`moreau`): a polyhedral die on a flat floor, Moreau–Jean time stepping
+    /// with Newton's restitution and Coulomb's friction at every touching corner, solved to
+    /// convergence. 3D only; meant for fine steps (`--dt 1e-4`).
+    Moreau,
 }
 
 /// Every engine.
-pub const ENGINES: [EngineKind; 3] = [
+pub const ENGINES: [EngineKind; 4] = [
     EngineKind::Bullet,
     EngineKind::Rapier,
     EngineKind::RapierLocked,
+    EngineKind::Moreau,
 ];
 
 impl EngineKind {
@@ -121,6 +127,7 @@ impl EngineKind {
                 "Rapier {} (f64; 2D: rapier3d, a locked 3D body)",
                 rapier3d::version()
             ),
+            EngineKind::Moreau => format!("Moreau–Jean (dicephys {})", env!("CARGO_PKG_VERSION")),
         }
     }
 }
@@ -135,5 +142,6 @@ pub fn new_engine(kind: EngineKind, scene: &Scene) -> Result<Box<dyn Engine>> {
         EngineKind::Rapier | EngineKind::RapierLocked => {
             Ok(Box::new(rapier3d::Rapier3d::new(scene)?))
         }
+        EngineKind::Moreau => Ok(Box::new(moreau::Moreau::new(scene)?)),
     }
 }

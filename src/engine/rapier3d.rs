@@ -6,7 +6,7 @@
 
 use super::{BodyState, Engine};
 use crate::model::mass::{MassProps, Turn};
-use crate::model::scene::{Floor, Mode, Scene};
+use crate::model::scene::{Floor, Mode, Preset, Scene};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use rapier3d_f64::prelude::*;
 
@@ -209,7 +209,7 @@ impl Rapier3d {
         // and restitution are 1, so the contact's μ and e are the die's (`multiply`). Its box
         // is DicePhys's static 10000 x 100 x 10000 m (`floor_thickness` makes it thinner).
         let t = scene.floor_thickness;
-        let world = world_with_floor(
+        let mut world = world_with_floor(
             scene,
             Vector::new(0.0, -scene.gravity, 0.0),
             ColliderBuilder::cuboid(5000.0, 0.5 * t, 5000.0).translation(Vector::new(
@@ -219,6 +219,12 @@ impl Rapier3d {
             )),
         );
 
+        // `laws`: Coulomb's friction at each contact point, which meets Coulomb's braking of
+        // a sliding die's spin (tests/it/impact.rs); Rapier's default is one constraint at
+        // the patch's centre and a twist, which brakes it 19 times too hard.
+        if scene.preset == Preset::Laws {
+            world.integration_parameters.friction_model = FrictionModel::Coulomb;
+        }
         let [bx, by, bz] = scene.body_sides();
         let made = !scene.features.plain() || scene.shape.is_some();
         let mp = MassProps::of(scene)?;

@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 /// Gravity, m/s², along −y.
 pub const GRAVITY: f64 = 9.81;
 
-/// Bullet solver settings, by name.
+/// The engines' contact settings, by name (Bullet's solver; under `laws` Rapier's friction too).
 #[derive(
     Clone,
     Copy,
@@ -37,6 +37,13 @@ pub enum Preset {
     /// Bullet 2.81's behaviour (dicephys281) with every penetration corrected by a split
     /// impulse, so that a bounce leaves at exactly e times the approach speed.
     Split,
+    /// Each engine held to the closed forms a loaded die needs (tests/it/impact.rs): Bullet
+    /// as `split`, with friction in Coulomb's cone (two directions per contact point, not
+    /// one along the slip) and the die turning as Euler's equations say (Bullet's gyroscopic
+    /// impulse at a scale where its own arithmetic does not drop it); Rapier with Coulomb's
+    /// friction at each contact point (`FrictionModel::Coulomb`, not one constraint at the
+    /// patch's centre and a twist). For a die whose moments differ (a loaded or long die).
+    Laws,
 }
 
 impl Preset {

@@ -580,5 +580,6 @@ fn engine_label(engine: EngineKind) -> &'static str {
         EngineKind::Bullet => "Bullet",
         EngineKind::Rapier => "Rapier",
         EngineKind::RapierLocked => "Rapier (locked 3D)",
+        EngineKind::Moreau => "Moreau–Jean",
     }
 }

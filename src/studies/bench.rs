@@ -361,13 +361,21 @@ pub fn dice_costs(
     };
     let dice = bench_dice()?;
     let mut out = Vec::new();
+    // The arbiter beside the engines, on the dice it models (no rounded edges).
     for (engine, n) in [
         (EngineKind::Bullet, rolls),
         (EngineKind::Rapier, (rolls / 4).max(1)),
+        (EngineKind::Moreau, rolls),
     ] {
+        let models = |scene: &Scene| {
+            engine != EngineKind::Moreau || crate::engine::moreau::models(scene).is_ok()
+        };
         let mut best = vec![(f64::INFINITY, Vec::new()); dice.len()];
         for _ in 0..repeat.max(1) {
             for ((_, scene), best) in dice.iter().zip(best.iter_mut()) {
+                if !models(scene) {
+                    continue;
+                }
                 let job = batch::Job {
                     engine,
                     scene,
@@ -387,7 +395,10 @@ pub fn dice_costs(
             }
         }
         let sharp_ms = 1000.0 * best[0].0 / n as f64;
-        for ((name, _), (cpu_s, recs)) in dice.iter().zip(&best) {
+        for ((name, scene), (cpu_s, recs)) in dice.iter().zip(&best) {
+            if !models(scene) {
+                continue;
+            }
             let t = Tally::of(recs)?;
             let ms = 1000.0 * cpu_s / n as f64;
             let row = DiceCost {
