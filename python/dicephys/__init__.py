@@ -424,7 +424,7 @@ def roll(
     rolls: throws (default 10,000; with ``precision``, the most it may take, 10,000,000).
     seed: the keyed throws' seed; the same seed gives the same counts on any thread count.
     mode: "3d" or "2d" (DicePhys's plane-locked block).
-    engine: "bullet", "rapier" or "rapier-locked".
+    engine: "bullet", "rapier", "rapier-locked" or "moreau" (the arbiter).
     dt: the fixed time step, s.  restitution, friction: the die's e and μ (the floor's are 1).
     density: kg/m³ (default 800, or the ``die`` file's).
     throw: "paper" (the default), "tumble", "hand" (with ``kappa``) or "rest".
