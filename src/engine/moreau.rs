@@ -6,7 +6,8 @@
 //! (issue 46, class N), and each fails a closed form (Rapier's bounce carries no friction and
 //! brakes a sliding spin 19 times too fast; Bullet's sliding cube drops corners and rocks).
 //! This engine is the contact model both claim, written so that each of its parts is the
-//! textbook one and nothing is tuned:
+//! textbook one and nothing is tuned (what it found: docs/results/rapier.md, "The arbiter and
+//! the `laws` preset"):
 //! - Contacts are the die's hull vertices against the plane y = 0 (a polyhedron meets a plane
 //!   only at its vertices: an edge or a face on the floor is two or more of them), each kept by
 //!   its vertex from step to step, so a sliding face keeps its corners.
@@ -20,8 +21,8 @@
 //!   Friction therefore acts throughout a bounce, as Newton–Coulomb's impact law has it.
 //! - Between impulses the body turns as Euler's equations say (a splitting that keeps the
 //!   angular momentum exactly and the energy without drift), so a loaded die precesses as it
-//!   should however long it flies: Bullet keeps ω constant out of contact, which for a body
-//!   with unequal moments does not keep its angular momentum.
+//!   should however long it flies (Bullet under any preset but `laws` keeps ω constant, which
+//!   for a body with unequal moments does not keep its angular momentum).
 //! - A vertex left below the floor (a bounce taken up to one step early, rounding) is lifted
 //!   out by moving the body up, without touching its velocity: no energy is added.
 //!
