@@ -221,7 +221,8 @@ impl Rapier3d {
 
         // `laws`: Coulomb's friction at each contact point, which meets Coulomb's braking of
         // a sliding die's spin (tests/it/impact.rs); Rapier's default is one constraint at
-        // the patch's centre and a twist, which brakes it 19 times too hard.
+        // the patch's centre and a twist, which brakes it 19 times too hard. This model's
+        // bounce carries friction in the patched crate (vendor/rapier3d-f64/PATCH.md).
         if scene.preset == Preset::Laws {
             world.integration_parameters.friction_model = FrictionModel::Coulomb;
         }

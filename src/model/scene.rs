@@ -42,7 +42,8 @@ pub enum Preset {
     /// one along the slip) and the die turning as Euler's equations say (Bullet's gyroscopic
     /// impulse at a scale where its own arithmetic does not drop it); Rapier with Coulomb's
     /// friction at each contact point (`FrictionModel::Coulomb`, not one constraint at the
-    /// patch's centre and a twist). For a die whose moments differ (a loaded or long die).
+    /// patch's centre and a twist) and in its bounce (vendor/rapier3d-f64/PATCH.md). For a
+    /// die whose moments differ (a loaded or long die).
     Laws,
 }
 
