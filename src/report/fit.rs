@@ -125,16 +125,20 @@ fn parameters(res: &FitResult) -> String {
         "Δ(−2 ln L) = 1 for 1σ, 4 for 2σ".into()
     };
     let n = res.params.len();
-    use crate::calibration::estimate::{region_delta, TWO_SIGMA};
+    use crate::calibration::estimate::{bound_rank, region_delta, TWO_SIGMA};
     // The overdispersion's widening is said below, with the goodness of fit.
     let chi2 = region_delta(n, TWO_SIGMA);
     let own = e.region_delta / e.overdispersion;
+    let sets = e.bootstrap.map_or(0, |b| b.sets);
     let region = if e.bootstrap.is_none() || (own - chi2).abs() < 1e-9 * chi2 {
         "χ² at 95.45 %".to_string()
     } else {
+        let which = match bound_rank(sets) {
+            Some(k) => format!("the {k}th smallest Δ of the bootstrap's {sets} fits"),
+            None => "the bootstrap's fits".into(),
+        };
         format!(
-            "χ²'s {chi2:.2} at 95.45 % {} {own:.2} by the bootstrap's fits, which rolled the \
-             design again",
+            "χ²'s {chi2:.2} at 95.45 % {} {own:.2} by {which}, which rolled the design again",
             if own > chi2 {
                 "widened to"
             } else {

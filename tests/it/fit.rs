@@ -563,7 +563,7 @@ fn a_misfit_is_widened_by_its_overdispersion_and_a_fit_that_fits_is_not() {
     // Issue 49: three rows on one surface, their counts rolled at e = 0.5 (dt = 1/250); in the
     // second file two rows of the same block disagree (breadth 1,590 of 3,000 against 1,358):
     // no e fits both. There the bootstrap's p is below 0.05, the overdispersion φ is the
-    // data's χ² over the bootstrap's mean, every bound is φ times the Bartlett's, the 2σ
+    // data's χ² over the bootstrap's mean, every profile's bound is φ times the Bartlett's, the 2σ
     // interval is wider than the profile's own Δ = 4b, and data drawn with φ check it.
     let dir = Scratch::new("fit-misfit");
     let fit = |name: &str, rows: &str| {
@@ -595,13 +595,11 @@ fn a_misfit_is_widened_by_its_overdispersion_and_a_fit_that_fits_is_not() {
         (phi - f(&e["chi2"]) / f(&boot["chi2_mean"])).abs() < 1e-9 && phi > 2.0,
         "{e}"
     );
-    // χ²₁'s 4 times b where the bootstrap's Δ averages above 1 (b > 1), below 4 where it
-    // averages under (b = 1; the bound then follows the sets' law), times φ.
+    // The region's bound is the bootstrap sets' own 95.45 % quantile of Δ (the rule's
+    // coverage is tested in estimate::tests), times φ; data drawn with φ check the widened
+    // region.
     let region = f(&e["region_delta"]) / phi;
-    assert!(
-        (region - 4.0 * b).abs() < 1e-6 || (b == 1.0 && region < 4.0),
-        "{e}"
-    );
+    assert!(region > 0.0 && region.is_finite(), "{e}");
     assert!(f(&boot["widened_coverage"]) >= 0.9, "{e}");
     let p = &e["params"][0];
     let unwidened_lo = p["profile"]
