@@ -1451,7 +1451,7 @@ mod tests {
         // errors (0.32 %). The bound that matches only the mean (χ²₁₁ × the Bartlett factor)
         // holds it less often than stated, which is why it is no longer the rule.
         let mut rng = ChaCha8Rng::seed_from_u64(11);
-        let mut draw = |rng: &mut ChaCha8Rng| {
+        let draw = |rng: &mut ChaCha8Rng| {
             let scale = if rng.random::<f64>() < 0.15 { 2.5 } else { 1.0 };
             (scale * 2.0 * gamma(5.5, rng), 0.0)
         };
