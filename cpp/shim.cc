@@ -188,7 +188,8 @@ class DiceWorld : public btDiscreteDynamicsWorld {
 //   transform and companion id to the die) is solveGroupCacheFriendlyFinish's.
 // Any other world (joints, two moving bodies, a kinematic body), solver mode, or contact
 // (its own CFM/ERP, stiffness, friction anchors, rolling or anisotropic friction) goes through
-// Bullet's own solveGroup.
+// Bullet's own solveGroup; under two friction directions (`laws`) with its passes replaced by
+// one that holds each point's friction to Coulomb's law (solveSingleIteration, below).
 class DieSolver : public btSequentialImpulseConstraintSolver {
  public:
   btScalar solveGroup(btCollisionObject** bodies, int numBodies, btPersistentManifold** manifolds,
@@ -206,6 +207,72 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
     iterate(info, numManifolds);
     finish(die, info);
     return 0.f;
+  }
+
+ protected:
+  // Under `laws` (two friction rows per point) one pass of Bullet's own solver, with each
+  // point's friction held to Coulomb's cone. Bullet clamps each of the two rows to μ times the
+  // point's normal impulse on its own: a square, whose corners reach √2 μ, and a sliding
+  // corner's friction 14 % beyond the cone and 28° off its slip (tests/it/impact.rs). Here
+  // the two rows of a point are solved as Bullet solves them, then their impulse, if it lies
+  // outside the disc of radius μ times the normal impulse, is scaled back onto it (the
+  // correction applied to the bodies as the rows apply theirs). Any other solver mode, or a
+  // world with joints, is Bullet's own pass.
+  btScalar solveSingleIteration(int iteration, btCollisionObject** bodies, int numBodies,
+                                btPersistentManifold** manifoldPtr, int numManifolds,
+                                btTypedConstraint** constraints, int numConstraints,
+                                const btContactSolverInfo& info,
+                                btIDebugDraw* debugDrawer) override {
+    const int others = SOLVER_RANDMIZE_ORDER | SOLVER_INTERLEAVE_CONTACT_AND_FRICTION_CONSTRAINTS;
+    if (!(info.m_solverMode & SOLVER_USE_2_FRICTION_DIRECTIONS) || (info.m_solverMode & others) ||
+        numConstraints != 0 || m_tmpSolverNonContactConstraintPool.size() != 0) {
+      return btSequentialImpulseConstraintSolver::solveSingleIteration(
+          iteration, bodies, numBodies, manifoldPtr, numManifolds, constraints, numConstraints,
+          info, debugDrawer);
+    }
+    btScalar residual = 0.f;
+    if (iteration >= info.m_numIterations) return residual;
+    const auto solve = [&](btSingleConstraintRowSolver row, btSolverConstraint& c) {
+      const btScalar r = row(m_tmpSolverBodyPool[c.m_solverBodyIdA],
+                             m_tmpSolverBodyPool[c.m_solverBodyIdB], c);
+      residual = btMax(residual, r * r);
+    };
+    for (int j = 0; j < m_tmpSolverContactConstraintPool.size(); j++) {
+      solve(m_resolveSingleConstraintRowLowerLimit,
+            m_tmpSolverContactConstraintPool[m_orderTmpConstraintPool[j]]);
+    }
+    // The friction pool holds each point's two rows side by side (convertContact).
+    const int rows = m_tmpSolverContactFrictionConstraintPool.size();
+    for (int j = 0; j < rows;) {
+      btSolverConstraint& a = m_tmpSolverContactFrictionConstraintPool[j];
+      const btScalar total = m_tmpSolverContactConstraintPool[a.m_frictionIndex].m_appliedImpulse;
+      if (j + 1 < rows &&
+          m_tmpSolverContactFrictionConstraintPool[j + 1].m_frictionIndex == a.m_frictionIndex) {
+        if (total > btScalar(0)) {
+          residual = btMax(residual, coulomb(a, m_tmpSolverContactFrictionConstraintPool[j + 1],
+                                             a.m_friction * total));
+        }
+        j += 2;
+        continue;
+      }
+      if (total > btScalar(0)) {
+        a.m_lowerLimit = -(a.m_friction * total);
+        a.m_upperLimit = a.m_friction * total;
+        solve(m_resolveSingleConstraintRowGeneric, a);
+      }
+      j += 1;
+    }
+    for (int j = 0; j < m_tmpSolverContactRollingFrictionConstraintPool.size(); j++) {
+      btSolverConstraint& c = m_tmpSolverContactRollingFrictionConstraintPool[j];
+      const btScalar total = m_tmpSolverContactConstraintPool[c.m_frictionIndex].m_appliedImpulse;
+      if (total > btScalar(0)) {
+        const btScalar most = btMin(c.m_friction * total, c.m_friction);
+        c.m_lowerLimit = -most;
+        c.m_upperLimit = most;
+        solve(m_resolveSingleConstraintRowGeneric, c);
+      }
+    }
+    return residual;
   }
 
  private:
@@ -226,6 +293,85 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
 
   static constexpr int kDie = 0;  // the die's solver body
   static btScalar square(btScalar x) { return x * x; }
+
+  // The velocity along row `i` that a unit impulse along row `j` adds, through `body`
+  // (internalApplyImpulse; a fixed body takes none).
+  static btScalar response(const btSolverBody& body, const btVector3& ni, const btVector3& ci,
+                           const btVector3& nj, const btVector3& aj) {
+    if (!body.m_originalBody) return 0;
+    return ni.dot(nj * body.internalGetInvMass() * body.m_linearFactor) +
+           ci.dot(aj * body.m_angularFactor);
+  }
+
+  // One point's friction, its two rows `a` and `b` solved together to Coulomb's law with the
+  // rest of the world held: f in the disc |f| <= cap, and where it is on the rim, against the
+  // point's slip as it ends (maximal dissipation). With u = w + K f the point's slip (K its
+  // 2x2 inverse mass along the rows): the impulse that stops it, -K^-1 w, if it lies in the
+  // disc; else the fixed point of f <- proj(f - u/k), k = K's largest eigenvalue, which
+  // lies on the rim with u along -f (the arbiter's step, src/engine/moreau.rs, here iterated
+  // to convergence for the one point). Returns the squared change, as a row's residual.
+  btScalar coulomb(btSolverConstraint& a, btSolverConstraint& b, btScalar cap) {
+    btSolverBody& A = m_tmpSolverBodyPool[a.m_solverBodyIdA];
+    btSolverBody& B = m_tmpSolverBodyPool[a.m_solverBodyIdB];
+    const btSolverConstraint* row[2] = {&a, &b};
+    btScalar K[2][2], u[2], f0[2] = {a.m_appliedImpulse, b.m_appliedImpulse};
+    for (int i = 0; i < 2; i++) {
+      const btSolverConstraint& ri = *row[i];
+      for (int j = 0; j < 2; j++) {
+        const btSolverConstraint& rj = *row[j];
+        K[i][j] = response(A, ri.m_contactNormal1, ri.m_relpos1CrossNormal, rj.m_contactNormal1,
+                           rj.m_angularComponentA) +
+                  response(B, ri.m_contactNormal2, ri.m_relpos2CrossNormal, rj.m_contactNormal2,
+                           rj.m_angularComponentB);
+      }
+      // The row's velocity now: as the step began (its right-hand side over its gain, as
+      // Bullet's row solver reads it) plus what the impulses so far added.
+      const btScalar added =
+          ri.m_contactNormal1.dot(A.internalGetDeltaLinearVelocity()) +
+          ri.m_relpos1CrossNormal.dot(A.internalGetDeltaAngularVelocity()) +
+          ri.m_contactNormal2.dot(B.internalGetDeltaLinearVelocity()) +
+          ri.m_relpos2CrossNormal.dot(B.internalGetDeltaAngularVelocity());
+      u[i] = -ri.m_rhs / ri.m_jacDiagABInv + added;
+    }
+    // w: the slip with this point's friction taken away.
+    const btScalar w[2] = {u[0] - K[0][0] * f0[0] - K[0][1] * f0[1],
+                           u[1] - K[1][0] * f0[0] - K[1][1] * f0[1]};
+    const btScalar det = K[0][0] * K[1][1] - K[0][1] * K[1][0];
+    btScalar f[2] = {-(K[1][1] * w[0] - K[0][1] * w[1]) / det,
+                     -(K[0][0] * w[1] - K[1][0] * w[0]) / det};
+    if (!(btSqrt(square(f[0]) + square(f[1])) <= cap)) {
+      const btScalar half = 0.5 * (K[0][0] + K[1][1]);
+      const btScalar largest =
+          half + btSqrt(0.25 * square(K[0][0] - K[1][1]) + K[0][1] * K[1][0]);
+      f[0] = f0[0];
+      f[1] = f0[1];
+      for (int it = 0; it < 200; it++) {
+        btScalar g[2] = {f[0] - (w[0] + K[0][0] * f[0] + K[0][1] * f[1]) / largest,
+                         f[1] - (w[1] + K[1][0] * f[0] + K[1][1] * f[1]) / largest};
+        const btScalar norm = btSqrt(square(g[0]) + square(g[1]));
+        if (norm > cap) {
+          g[0] *= cap / norm;
+          g[1] *= cap / norm;
+        }
+        const btScalar change = square(g[0] - f[0]) + square(g[1] - f[1]);
+        f[0] = g[0];
+        f[1] = g[1];
+        if (change <= square(1e-12 * cap)) break;
+      }
+    }
+    btScalar residual = 0;
+    for (int i = 0; i < 2; i++) {
+      btSolverConstraint& c = i == 0 ? a : b;
+      const btScalar delta = f[i] - f0[i];
+      c.m_appliedImpulse = f[i];
+      A.internalApplyImpulse(c.m_contactNormal1 * A.internalGetInvMass(), c.m_angularComponentA,
+                             delta);
+      B.internalApplyImpulse(c.m_contactNormal2 * B.internalGetInvMass(), c.m_angularComponentB,
+                             delta);
+      residual = btMax(residual, square(delta / c.m_jacDiagABInv));
+    }
+    return residual;
+  }
 
   // Whether Bullet's solveGroup would treat this as the one die this class solves.
   bool fits(btRigidBody* die, btPersistentManifold** manifolds, int numManifolds,

@@ -157,7 +157,9 @@ fn solver(preset: Preset) -> Solver {
         // impulse, which its own arithmetic drops for a body as small as a die:
         // `gyroscopic_scaled`) and friction in Coulomb's cone (Bullet's default is one
         // friction row per point, along the slip as the step starts, so nothing resists a
-        // slip across it). Each measured in tests/it/impact.rs.
+        // slip across it; its two rows, each clamped on its own, make a square: the shim
+        // solves a point's two together in the disc, DieSolver::coulomb). Each measured in
+        // tests/it/impact.rs.
         Preset::Laws => Solver {
             gyroscopic_implicit: false,
             gyroscopic_scaled: true,

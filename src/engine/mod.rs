@@ -119,13 +119,14 @@ impl EngineKind {
             EngineKind::Bullet => format!("Bullet {} (double precision)", bullet::version()),
             // The version is the rapier3d-f64 crate's own (its VERSION const, the crate's
             // CARGO_PKG_VERSION); a test checks that rapier2d-f64 is the same release. The
-            // 3D crate is patched (vendor/rapier3d-f64/PATCH.md: its Coulomb model's bounce).
+            // 3D crate is patched (vendor/rapier3d-f64/PATCH.md: its Coulomb model's bounce and
+            // its friction against the slip).
             EngineKind::Rapier => format!(
-                "Rapier {} (f64, bounce friction patched; 2D: rapier2d, a 2D body)",
+                "Rapier {} (f64, Coulomb friction patched; 2D: rapier2d, a 2D body)",
                 rapier3d::version()
             ),
             EngineKind::RapierLocked => format!(
-                "Rapier {} (f64, bounce friction patched; 2D: rapier3d, a locked 3D body)",
+                "Rapier {} (f64, Coulomb friction patched; 2D: rapier3d, a locked 3D body)",
                 rapier3d::version()
             ),
             EngineKind::Moreau => format!("Moreau–Jean (dicephys {})", env!("CARGO_PKG_VERSION")),

@@ -39,7 +39,8 @@ pub enum Preset {
     Split,
     /// Each engine held to the closed forms a loaded die needs (tests/it/impact.rs): Bullet
     /// as `split`, with friction in Coulomb's cone (two directions per contact point, not
-    /// one along the slip) and the die turning as Euler's equations say (Bullet's gyroscopic
+    /// one along the slip, solved together in the disc μ N and against the slip, not each
+    /// clamped on its own) and the die turning as Euler's equations say (Bullet's gyroscopic
     /// impulse at a scale where its own arithmetic does not drop it); Rapier with Coulomb's
     /// friction at each contact point (`FrictionModel::Coulomb`, not one constraint at the
     /// patch's centre and a twist) and in its bounce (vendor/rapier3d-f64/PATCH.md). For a

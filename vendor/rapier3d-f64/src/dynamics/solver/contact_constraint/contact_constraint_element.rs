@@ -13,6 +13,11 @@ use simba::simd::SimdValue;
 #[cfg(feature = "block-solver")]
 pub(crate) const BLOCK_SOLVER_MIN_CONDITION: crate::math::Real = 0.01;
 
+/// dicephys patch (PATCH.md): the projected steps that bring a point's friction onto
+/// Coulomb's law (against its slip) from the block solve's impulse scaled onto the disc.
+#[cfg(feature = "dim3")]
+const COULOMB_ITERATIONS: usize = 20;
+
 #[derive(Copy, Clone, Debug)]
 pub(crate) struct ContactConstraintTangentPart<N: ScalarType> {
     pub torque_dir1: [N::AngVector; DIM - 1],
@@ -156,7 +161,40 @@ impl<N: ScalarType> ContactConstraintTangentPart<N> {
                 let _disable_fe_except =
                         crate::utils::DisableFloatingPointExceptionsFlags::
                         disable_floating_point_exceptions();
-                new_impulse.simd_cap_magnitude(limit)
+                // dicephys patch (PATCH.md): Coulomb's law, not the nearest point of the
+                // cone. The block solve's impulse scaled back onto the disc is friction
+                // against K⁻¹·slip, not against the slip, where K is anisotropic (a loaded
+                // die's corner: 7° off). From there, iterate f ← cap(f − u(f)/λ_max(K)),
+                // u(f) = w + K f the slip with the point's friction f: its fixed point is the
+                // block solve's impulse where that lies inside the disc (sticking), and on
+                // the rim the impulse against the slip (maximal dissipation). A point that
+                // sticks (the block solve inside the disc) takes no step; the steps stop when
+                // they change the impulse by less than 1e-12 of the disc's radius.
+                let w_0 = dvel_0 - k11 * self.impulse[0] - k12 * self.impulse[1];
+                let w_1 = dvel_1 - k12 * self.impulse[0] - k22 * self.impulse[1];
+                let half = (k11 + k22) * N::splat(0.5);
+                let spread = (k11 - k22) * N::splat(0.5);
+                let largest = half + (spread * spread + k12 * k12).simd_sqrt();
+                let gain = crate::utils::simd_inv(largest);
+                use simba::simd::SimdBool;
+                let sliding = new_impulse.norm_squared().simd_gt(limit * limit);
+                let mut f = new_impulse.simd_cap_magnitude(limit);
+                if sliding.any() {
+                    let tolerance = limit * limit * N::splat(1e-24);
+                    for _ in 0..COULOMB_ITERATIONS {
+                        let u = na::vector![
+                            w_0 + k11 * f[0] + k12 * f[1],
+                            w_1 + k12 * f[0] + k22 * f[1]
+                        ];
+                        let g = (f - u * gain).simd_cap_magnitude(limit);
+                        let change = (g - f).norm_squared();
+                        f = g;
+                        if change.simd_le(tolerance).all() {
+                            break;
+                        }
+                    }
+                }
+                f
             };
 
             let dlambda = new_impulse - self.impulse;
