@@ -781,6 +781,40 @@ fn a_loaded_cube_keeps_its_angular_momentum_in_flight() {
     }
 }
 
+/// The loaded cube turned so that one corner is lowest: its rotation, and that corner from the
+/// centre of mass.
+fn lowest_corner() -> (UnitQuaternion<f64>, Vector3<f64>) {
+    let rotation = UnitQuaternion::from_euler_angles(0.5, 0.0, 0.35);
+    let com = Vector3::new(0.0, 0.0, COM_Z);
+    let r = (0..8)
+        .map(|k| {
+            let sign = |bit: u32| if k & (1 << bit) == 0 { -1.0 } else { 1.0 };
+            rotation * (Vector3::new(sign(0), sign(1), sign(2)) * (SIDE / 2.0) - com)
+        })
+        .min_by(|a, b| a.y.total_cmp(&b.y))
+        .unwrap();
+    (rotation, r)
+}
+
+/// One step of `kind` from the cube at `rotation` with its corner `r` just touching the floor,
+/// moving at `v`: the state after it.
+fn land_on_corner(
+    kind: EngineKind,
+    scene: &Scene,
+    (rotation, r): (UnitQuaternion<f64>, Vector3<f64>),
+    v: Vector3<f64>,
+) -> BodyState {
+    let mut engine = new_engine(kind, scene).unwrap();
+    engine
+        .reset(&BodyState {
+            linear_velocity: v,
+            ..at_rest(Vector3::new(0.0, -r.y - 1e-9, 0.0), rotation)
+        })
+        .unwrap();
+    engine.step().unwrap();
+    engine.state()
+}
+
 /// Friction in Coulomb's cone: the loaded cube, turned so that one corner is lowest, lands on
 /// it at V while sliding at 0.3 m/s along z, e = 0, μ = 1. The corner sticks (checked: the
 /// law's friction lies inside the cone), so the impulse is the one that stops the corner dead
@@ -798,15 +832,7 @@ fn sticking_corner(kind: EngineKind, preset: Preset) -> (Vector3<f64>, Vector3<f
     scene.restitution = 0.0;
     scene.preset = preset;
     let mp = MassProps::of(&scene).unwrap();
-    let rotation = UnitQuaternion::from_euler_angles(0.5, 0.0, 0.35);
-    let com = Vector3::new(0.0, 0.0, COM_Z);
-    let r = (0..8)
-        .map(|k| {
-            let sign = |bit: u32| if k & (1 << bit) == 0 { -1.0 } else { 1.0 };
-            rotation * (Vector3::new(sign(0), sign(1), sign(2)) * (SIDE / 2.0) - com)
-        })
-        .min_by(|a, b| a.y.total_cmp(&b.y))
-        .unwrap();
+    let (rotation, r) = lowest_corner();
     let iw = rotation.to_rotation_matrix() * mp.inertia * rotation.to_rotation_matrix().transpose();
     let k = Matrix3::identity() / mp.mass
         - r.cross_matrix() * iw.try_inverse().unwrap() * r.cross_matrix();
@@ -817,15 +843,7 @@ fn sticking_corner(kind: EngineKind, preset: Preset) -> (Vector3<f64>, Vector3<f
         tangent < 0.9 * j.y,
         "the law's friction leaves the cone: {j:?}"
     );
-    let mut engine = new_engine(kind, &scene).unwrap();
-    engine
-        .reset(&BodyState {
-            linear_velocity: v,
-            ..at_rest(Vector3::new(0.0, -r.y - 1e-9, 0.0), rotation)
-        })
-        .unwrap();
-    engine.step().unwrap();
-    let got = engine.state().linear_velocity - v;
+    let got = land_on_corner(kind, &scene, (rotation, r), v).linear_velocity - v;
     println!(
         "{kind:?} {preset:?}: Δv {got:?} against the law's {:?}",
         j / mp.mass
@@ -872,25 +890,9 @@ fn sliding_corner(kind: EngineKind, preset: Preset) -> (f64, f64) {
     scene.restitution = 0.0;
     scene.preset = preset;
     let mp = MassProps::of(&scene).unwrap();
-    let rotation = UnitQuaternion::from_euler_angles(0.5, 0.0, 0.35);
-    let com = Vector3::new(0.0, 0.0, COM_Z);
-    let r = (0..8)
-        .map(|k| {
-            let sign = |bit: u32| if k & (1 << bit) == 0 { -1.0 } else { 1.0 };
-            rotation * (Vector3::new(sign(0), sign(1), sign(2)) * (SIDE / 2.0) - com)
-        })
-        .min_by(|a, b| a.y.total_cmp(&b.y))
-        .unwrap();
+    let (rotation, r) = lowest_corner();
     let v = Vector3::new(0.0, -V, 1.5);
-    let mut engine = new_engine(kind, &scene).unwrap();
-    engine
-        .reset(&BodyState {
-            linear_velocity: v,
-            ..at_rest(Vector3::new(0.0, -r.y - 1e-9, 0.0), rotation)
-        })
-        .unwrap();
-    engine.step().unwrap();
-    let s = engine.state();
+    let s = land_on_corner(kind, &scene, (rotation, r), v);
     let j = (s.linear_velocity - v) * mp.mass;
     let jt = Vector3::new(j.x, 0.0, j.z);
     let u = s.linear_velocity + s.angular_velocity.cross(&r);
