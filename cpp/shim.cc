@@ -214,10 +214,9 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
   // point's friction held to Coulomb's cone. Bullet clamps each of the two rows to μ times the
   // point's normal impulse on its own: a square, whose corners reach √2 μ, and a sliding
   // corner's friction 14 % beyond the cone and 28° off its slip (tests/it/impact.rs). Here
-  // the two rows of a point are solved as Bullet solves them, then their impulse, if it lies
-  // outside the disc of radius μ times the normal impulse, is scaled back onto it (the
-  // correction applied to the bodies as the rows apply theirs). Any other solver mode, or a
-  // world with joints, is Bullet's own pass.
+  // a point's two rows are solved together (`coulomb`, below): in the disc of radius μ times
+  // the normal impulse, and on its rim against the slip. Any other solver mode, or a world
+  // with joints, is Bullet's own pass.
   btScalar solveSingleIteration(int iteration, btCollisionObject** bodies, int numBodies,
                                 btPersistentManifold** manifoldPtr, int numManifolds,
                                 btTypedConstraint** constraints, int numConstraints,

@@ -908,8 +908,9 @@ fn a_sliding_corner_s_friction_lies_on_coulombs_cone_against_its_slip() {
     // 1.4° off the slip as the step ends (the die's free turn after the impulses changes ω).
     // Bullet under `laws`: 0.0°; it was 13.6 % outside the cone and 28° off the slip when each
     // of its two friction rows was held to μ J_n on its own (a square, not a disc), and 25.8°
-    // off with the pair scaled back onto the disc afterwards. Rapier under `laws`: 1.4°; it
-    // was 6.8° off when its block solve's impulse was scaled onto the disc (upstream).
+    // off with the pair scaled back onto the disc afterwards. Rapier under `laws`: 0.5° (1.4°
+    // with one sweep a substep, warm-started); it was 6.8° off when its block solve's impulse
+    // was scaled onto the disc (upstream).
     for (kind, preset) in [
         (EngineKind::Moreau, Preset::Dicephys281),
         (EngineKind::Bullet, Preset::Laws),
