@@ -129,7 +129,7 @@ fn parameters(res: &FitResult) -> String {
     // The overdispersion's widening is said below, with the goodness of fit.
     let chi2 = region_delta(n, TWO_SIGMA);
     let own = e.region_delta / e.overdispersion;
-    let sets = e.bootstrap.map_or(0, |b| b.sets);
+    let sets = e.bootstrap.as_ref().map_or(0, |b| b.sets);
     let region = if e.bootstrap.is_none() || (own - chi2).abs() < 1e-9 * chi2 {
         "χ² at 95.45 %".to_string()
     } else {
@@ -663,11 +663,15 @@ fn p_shown(p: f64) -> String {
 /// What the parametric bootstrap says of the fit's errors, in a sentence.
 pub fn bootstrap_line(b: &crate::calibration::estimate::Bootstrap, chi2: f64) -> String {
     let sigma = (b.coverage * (1.0 - b.coverage) / b.sets as f64).sqrt();
+    // The bound is the k-th smallest of the sets' Δ where there are enough of them: a new set
+    // drawn as they were falls under it with probability k/(n + 1), not 95.45 % exactly.
+    let stated = crate::calibration::estimate::bound_rank(b.sets)
+        .map_or(95.45, |k| 100.0 * k as f64 / (b.sets + 1) as f64);
     format!(
         "Parametric bootstrap ({} data sets drawn from the fitted model and fitted back): χ² \
          at least the data's {chi2:.2} in a share p = {:.3} of them (their mean χ² {:.2}); the \
-         joint 2σ region held the values they were drawn at in {:.1} % ± {:.1} % of them \
-         (stated 95.45 %).",
+         joint 2σ region held the values they were drawn at in {:.1} % ± {:.1} % of as many \
+         sets again (stated {stated:.2} %).",
         b.sets,
         b.chi2_p,
         b.chi2_mean,
@@ -683,7 +687,7 @@ pub fn misfit_line(e: &Estimate) -> Option<String> {
     if phi <= 1.0 {
         return None;
     }
-    let b = e.bootstrap?;
+    let b = e.bootstrap.as_ref()?;
     let mut line = format!(
         "**The model misfits** (p = {:.3}, below {MISFIT_P}): the counts scatter more than it \
          says, by the overdispersion φ = {phi:.2} (χ² {:.2} over the bootstrap's mean χ² {:.2}). \

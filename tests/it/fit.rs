@@ -600,6 +600,19 @@ fn a_misfit_is_widened_by_its_overdispersion_and_a_fit_that_fits_is_not() {
     // region.
     let region = f(&e["region_delta"]) / phi;
     assert!(region > 0.0 && region.is_finite(), "{e}");
+    // Each set's Δ is in fit.json, so anyone can recompute the bound (the k-th smallest, k =
+    // ⌈0.9545 (n + 1)⌉) and the check sets' coverage under it.
+    let list = |key: &str| -> Vec<f64> { boot[key].as_array().unwrap().iter().map(f).collect() };
+    let (mut delta, check) = (list("delta"), list("check_delta"));
+    assert_eq!(delta.len() as f64, f(&boot["sets"]), "{boot}");
+    delta.sort_by(f64::total_cmp);
+    let k = (0.9545 * (delta.len() + 1) as f64).ceil() as usize;
+    assert!((delta[k - 1] - region).abs() <= 1e-9 * region, "{boot}");
+    let held = check.iter().filter(|&&d| d <= region).count() as f64;
+    assert!(
+        (held / check.len() as f64 - f(&boot["coverage"])).abs() < 1e-12,
+        "{boot}"
+    );
     assert!(f(&boot["widened_coverage"]) >= 0.9, "{e}");
     let p = &e["params"][0];
     let unwidened_lo = p["profile"]
