@@ -64,21 +64,9 @@ impl CrosscheckArgs {
 /// Runs `dicephys crosscheck`.
 pub fn run(a: &CrosscheckArgs) -> Result<()> {
     let cfg = a.config()?;
-    // A loaded die that bounces is where the engines part most: under any preset but laws
-    // Bullet's bounce, friction or turn departs from the closed forms (docs/guide.md,
-    // "Presets").
-    let scene = &cfg.spec.scene;
-    let loaded = scene
-        .features
-        .com
-        .is_some_and(|c| c.iter().any(|x| *x != 0.0));
-    if loaded && scene.preset != dicephys::model::scene::Preset::Laws && !*a.json {
-        eprintln!(
-            "dicephys: note: a loaded die under --preset {} is rolled off the closed forms \
-             (Bullet's bounce, friction or turn); --preset laws holds each engine to them, \
-             and --engines moreau,... adds the arbiter",
-            scene.preset.name()
-        );
+    // A loaded die that bounces is where the engines part most.
+    if let Some(n) = cfg.spec.loaded_die_note(&cfg.engines).filter(|_| !*a.json) {
+        eprintln!("dicephys: note: {n}");
     }
     let cfg = StudyConfig::Crosscheck(cfg);
     let place = Place {

@@ -85,6 +85,12 @@ pub fn run(mut a: FairArgs) -> Result<()> {
     if let Some(w) = spec.endless_roll_warning() {
         eprintln!("dicephys: warning: {w}");
     }
+    if let Some(n) = spec
+        .loaded_die_note(&[spec.engine])
+        .filter(|_| !*a.roll.json)
+    {
+        eprintln!("dicephys: note: {n}");
+    }
     // The precision (--within) here is every face's probability's.
     let (summary, done) = rolled(
         &a.roll,

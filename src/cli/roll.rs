@@ -137,6 +137,9 @@ pub fn run(a: &RollArgs) -> Result<()> {
     if let Some(w) = spec.endless_roll_warning() {
         eprintln!("dicephys: warning: {w}");
     }
+    if let Some(n) = spec.loaded_die_note(&[spec.engine]).filter(|_| !*a.json) {
+        eprintln!("dicephys: note: {n}");
+    }
     let (summary, done) = rolled(a, &spec, "roll", Target::Ratio)?;
     // Broken physics says so on the terminal too, whatever goes to stdout.
     if *a.json {
