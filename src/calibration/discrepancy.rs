@@ -155,9 +155,10 @@ impl Cell {
 /// rows' own errors, sized by Paule–Mandel with the counts' noise φ times the binomial's and
 /// without the rows' own errors (Σ z²(τ²) = m, solved by bisection, Σ z² falling as τ² grows).
 fn outcome(name: &str, cells: &[Cell], phi: f64) -> OutcomeDiscrepancy {
-    let total = |tau2: f64, own: bool| cells.iter().map(|c| c.z2(tau2, phi, own)).sum::<f64>();
+    let sum = |tau2: f64, phi: f64, own: bool| cells.iter().map(|c| c.z2(tau2, phi, own)).sum();
+    let total = |tau2: f64, own: bool| sum(tau2, phi, own);
     let m = cells.len();
-    let chi2 = cells.iter().map(|c| c.z2(0.0, 1.0, true)).sum::<f64>();
+    let chi2: f64 = sum(0.0, 1.0, true);
     let p_value = if m > 0 {
         stats::chi_square_p_value(chi2, m)
     } else {

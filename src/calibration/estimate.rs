@@ -1569,13 +1569,11 @@ mod tests {
             let b: Vec<f64> = check.iter().map(|x| x.0).collect();
             let z = rank_sum_z(&a, &b);
             let bound = joint_bound(&sets, 3);
-            held += b.iter().filter(|&&d| d <= bound).count();
+            let h = b.iter().filter(|&&d| d <= bound).count();
+            held += h;
             z2 += z * z;
             zs += z;
-            eprintln!(
-                "fit {s}: z {z:+.2}, held {} of {N}",
-                b.iter().filter(|&&d| d <= bound).count()
-            );
+            eprintln!("fit {s}: z {z:+.2}, held {h} of {N}");
         }
         let kk = bound_rank(N).unwrap() as f64;
         let (alpha, beta) = (kk, N as f64 + 1.0 - kk);
