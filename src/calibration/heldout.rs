@@ -367,6 +367,7 @@ mod tests {
                     err_params: 0.0,
                     err_sim: 0.0,
                     err_model: 0.0,
+                    fit_value: None,
                 })
                 .collect(),
             ratio: Some(Predicted {
@@ -375,6 +376,7 @@ mod tests {
                 err_params: 0.0,
                 err_sim: 0.0,
                 err_model: 0.0,
+                fit_value: None,
             }),
             faces: None,
             labels: Vec::new(),

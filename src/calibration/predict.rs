@@ -8,7 +8,7 @@
 //!   Var_θ = S² − mean p̂(1 − p̂)/n, and the rolls' noise; the mean's own error adds
 //!   (Var_θ + p̄(1 − p̄)/n)/M for M draws.
 
-use crate::calibration::discrepancy::{self, Discrepancy};
+use crate::calibration::discrepancy::{self, Corrected, Discrepancy};
 use crate::calibration::estimate::Likelihood;
 use crate::calibration::FitResult;
 use crate::error::{Error, Result};
@@ -110,34 +110,47 @@ pub struct BlockPrediction {
 }
 
 impl BlockPrediction {
-    /// This prediction widened by the fit's discrepancy `d` (where any outcome has one): each
-    /// share by its outcome's, each face by its label's, the ratio by breadth's and width's.
+    /// This prediction as the fit's discrepancy `d` leaves it (where any outcome has one):
+    /// each share moved along its outcome's line and widened by its spread, each face by its
+    /// label's, the others scaled so that they still sum to 1, and the ratio moved and widened
+    /// with breadth's and width's.
     pub fn widened(self, d: Option<&Discrepancy>) -> BlockPrediction {
         let Some(d) = d.filter(|d| d.any()) else {
             return self;
         };
         const SIDES: [&str; 3] = ["length", "breadth", "width"];
-        let p: Vec<Predicted> = self
-            .p
-            .iter()
-            .zip(SIDES)
-            .map(|(q, name)| discrepancy::widen(*q, d.tau(name)))
-            .collect();
-        let ratio = self.ratio.map(|r| {
-            discrepancy::widen_ratio(
-                r,
-                (self.p[1].value, d.tau("breadth")),
-                (self.p[2].value, d.tau("width")),
-            )
+        let shares = |ps: &[Predicted], names: &[&str]| -> (Vec<Predicted>, Vec<Corrected>) {
+            let values: Vec<f64> = ps.iter().map(|q| q.value).collect();
+            let c = d.correct(names, &values);
+            let moved = ps
+                .iter()
+                .zip(&c)
+                .map(|(q, c)| discrepancy::apply(*q, *c))
+                .collect();
+            (moved, c)
+        };
+        let (p, c) = shares(&self.p, &SIDES[..self.p.len().min(3)]);
+        let ratio = self.ratio.filter(|_| c.len() == 3).map(|r| {
+            // N(breadth)/N(width) moves as the two shares do.
+            let f = (c[1].value / self.p[1].value) / (c[2].value / self.p[2].value);
+            let moved = if f.is_finite() {
+                Predicted {
+                    value: r.value * f,
+                    err_params: r.err_params * f,
+                    err_sim: r.err_sim * f,
+                    fit_value: (f != 1.0).then_some(r.value),
+                    ..r
+                }
+            } else {
+                r
+            };
+            discrepancy::widen_ratio(moved, (c[1].value, c[1].sigma), (c[2].value, c[2].sigma))
         });
         let faces = self.faces.as_ref().map(|f| {
-            f.iter()
-                .enumerate()
-                .map(|(k, q)| {
-                    let label = self.labels.get(k).map_or("", |l| l.as_str());
-                    discrepancy::widen(*q, d.tau(label))
-                })
-                .collect()
+            let labels: Vec<&str> = (0..f.len())
+                .map(|k| self.labels.get(k).map_or("", |l| l.as_str()))
+                .collect();
+            shares(f, &labels).0
         });
         BlockPrediction {
             p,

@@ -22,6 +22,10 @@ pub struct Predicted {
     /// themselves ([`crate::calibration::discrepancy`]); 0, and left out, where there is none.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub err_model: f64,
+    /// The fit's own prediction, where the model's discrepancy moved it to `value` (along the
+    /// line its rows' misses lie on); left out where nothing moved it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fit_value: Option<f64>,
 }
 
 fn is_zero(x: &f64) -> bool {
@@ -36,6 +40,7 @@ impl Predicted {
         err_params: f64::NAN,
         err_sim: f64::NAN,
         err_model: 0.0,
+        fit_value: None,
     };
 
     /// The mean of `values` with their spread as the parameters' error and `sim_var` as the
@@ -54,6 +59,7 @@ impl Predicted {
             err_params: var.sqrt(),
             err_sim: sim_var.sqrt(),
             err_model: 0.0,
+            fit_value: None,
         }
     }
 

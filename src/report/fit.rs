@@ -554,26 +554,25 @@ pub fn discrepancy_text(d: Option<&Discrepancy>) -> Option<String> {
     let asked: Vec<String> = d
         .outcomes
         .iter()
-        .filter(|o| o.tau > 0.0)
+        .filter(|o| o.asked)
         .map(|o| {
             format!(
-                "{} (Σz² {:.1} on {}, p {}: τ = {:.3}, {:.3} for a prediction)",
+                "{} (Σz² {:.1} on {}, p {}: log-odds {})",
                 o.outcome,
                 o.chi2,
                 o.rows,
                 p_shown(o.p_value),
-                o.tau,
-                o.predictive_tau
+                o.describe()
             )
         })
         .collect();
     Some(format!(
         "**The model misses rows it did not see beyond their errors**, in {}: the rows \
-         predicted without themselves say how far a block's log-odds are missed beyond its \
-         counts' noise (τ; a spread learnt from few rows is taken √(m/(m − 2)) times wider), \
-         and every prediction of a block this fit did not see is widened by it (`err_model`). \
-         A bias that differs from block to block is not extra scatter in the counts: it does \
-         not shrink with the throws counted.",
+         predicted without themselves say how far a block's log-odds are missed, as a line in \
+         the predicted log-odds η with a spread τ about it beyond the counts' noise, and every \
+         prediction of a block this fit did not see is moved along that line and widened by \
+         the line's error there and τ (`err_model`). A bias that differs from block to block \
+         is not extra scatter in the counts: it does not shrink with the throws counted.",
         asked.join("; ")
     ))
 }
@@ -645,8 +644,11 @@ fn predicted(p: &Predicted) -> String {
     } else {
         String::new()
     };
+    let moved = p
+        .fit_value
+        .map_or(String::new(), |f| format!("the fit's own {f:.4}; "));
     format!(
-        "{:.4} ± {:.4} (parameters {:.4}, simulation {:.4}{model})",
+        "{:.4} ± {:.4} ({moved}parameters {:.4}, simulation {:.4}{model})",
         p.value, p.err, p.err_params, p.err_sim
     )
 }
@@ -775,17 +777,17 @@ pub fn prediction_text(p: &BlockPrediction) -> String {
         );
     }
     if let Some(d) = p.discrepancy.as_ref().filter(|d| d.any()) {
-        let taus: Vec<String> = d
+        let lines: Vec<String> = d
             .outcomes
             .iter()
-            .filter(|o| o.predictive_tau > 0.0)
-            .map(|o| format!("{} {:.3}", o.outcome, o.predictive_tau))
+            .filter(|o| o.asked)
+            .map(|o| format!("{}: {}", o.outcome, o.describe()))
             .collect();
         let _ = writeln!(
             s,
-            "  the fit misses rows it did not see beyond their errors: each share widened by its \
-             discrepancy on the log-odds (τ: {})",
-            taus.join(", ")
+            "  the fit misses rows it did not see beyond their errors: each share moved along \
+             its discrepancy's line on the log-odds and widened by it ({})",
+            lines.join("; ")
         );
     }
     s

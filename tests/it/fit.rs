@@ -782,10 +782,12 @@ fn held_out_blocks_fall_in_their_chi2_band_at_the_stated_rate() {
 
 /// Issue 49's second item: a throw outside the fit's family (counts rolled in a tumble, fitted
 /// with the paper's throw) is a bias that differs from block to block, which the rows
-/// predicted without themselves show and the fit learns as a discrepancy on the log-odds; every
-/// prediction of a block the fit did not see is widened by it. At seed 13 the held-out χ² on 6
-/// falls from 31.4 (p 2e-5, the fit's overdispersion alone) to 8.4 (p 0.21). Over seeds 1–25
-/// the widened predictions held 20 (7 without): docs/results/calibration.md.
+/// predicted without themselves show and the fit learns as a discrepancy on the log-odds, a line
+/// in the predicted log-odds with a spread about it; every prediction of a block the fit did
+/// not see is moved along the line and widened by it. At seed 13 the held-out χ² on 6 falls
+/// from 31.4 (p 2e-5, the fit's overdispersion alone) to 8.4 with a spread alone (p 0.21) and
+/// 1.8 with the line (p 0.94: a line learnt from four rows errs wide). Over 103 seeds the moved
+/// predictions held 101 (93 with a spread alone): docs/results/calibration.md, "A line through the misses".
 #[test]
 fn a_fit_that_misses_rows_it_did_not_see_widens_its_predictions_by_its_discrepancy() {
     let dir = Scratch::new("fit-discrepancy");
@@ -835,9 +837,12 @@ fn a_fit_that_misses_rows_it_did_not_see_widens_its_predictions_by_its_discrepan
     let outcomes = fit["discrepancy"]["outcomes"].as_array().unwrap();
     let length = outcomes.iter().find(|o| o["outcome"] == "length").unwrap();
     assert!(
-        length["p_value"].as_f64().unwrap() < 0.05 && length["tau"].as_f64().unwrap() > 0.0,
+        length["p_value"].as_f64().unwrap() < 0.05 && length["asked"] == true,
         "the end counts' misses ask for a discrepancy: {length}"
     );
+    // The tumble lands long blocks on their ends more often than the paper's throw: the miss
+    // on the end's log-odds is positive at the rows' centre.
+    assert!(length["shift"].as_f64().unwrap() > 0.0, "{length}");
     let p = json(&dicephys(&[
         "predict",
         "--fit",
@@ -852,8 +857,10 @@ fn a_fit_that_misses_rows_it_did_not_see_widens_its_predictions_by_its_discrepan
         dir.join("pred").to_str().unwrap(),
         "--json",
     ]));
-    // The held-out χ² without the discrepancy, from each error's other parts (as
-    // `heldout::test` forms it: each count's variance φ N q + N² σ²).
+    // The held-out χ² without the discrepancy: against the fit's own share (`fit_value`
+    // where the line moved it) with the error's other parts (as `heldout::test` forms it:
+    // each count's variance φ N q + N² σ²; those parts as carried along the line, a little
+    // wider than the fit's own for a share moved up).
     let mut without = 0.0;
     for r in p["rows"].as_array().unwrap() {
         let pred = &r["prediction"];
@@ -875,6 +882,7 @@ fn a_fit_that_misses_rows_it_did_not_see_widens_its_predictions_by_its_discrepan
             );
             let m = q.get("err_model").map_or(0.0, |m| m.as_f64().unwrap());
             assert!((e * e - (a * a + b * b + m * m)).abs() < 1e-12, "{q}");
+            let v = q.get("fit_value").map_or(v, |f| f.as_f64().unwrap());
             without += (c - n * v).powi(2) / (phi * n * v + n * n * (a * a + b * b));
         }
     }

@@ -301,6 +301,7 @@ fn combine(v: &[f64], noise: &dyn Fn(f64) -> f64) -> Predicted {
         err_params: params_var.sqrt(),
         err_sim: sim_var.sqrt(),
         err_model: 0.0,
+        fit_value: None,
     }
 }
 
