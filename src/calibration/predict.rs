@@ -138,7 +138,7 @@ impl BlockPrediction {
                     value: r.value * f,
                     err_params: r.err_params * f,
                     err_sim: r.err_sim * f,
-                    fit_value: (f != 1.0).then_some(r.value),
+                    fit_value: ((f - 1.0).abs() > 1e-12).then_some(r.value),
                     ..r
                 }
             } else {
