@@ -107,11 +107,13 @@ pub struct SceneArgs {
     /// Allow a restitution above 1 (an engine-stability study, not physics).
     #[arg(long)]
     pub allow_restitution_above_one: bool,
-    /// Bullet solver settings: dicephys281 (Bullet 2.81 as the paper ran it), bullet3 (Debian
-    /// 3.24's defaults) or split (dicephys281 with every penetration pushed out apart from the
-    /// bounce, so that a bounce is exactly e: dicephys281's averages e + 0.1).
-    #[arg(long, default_value_t = SceneRequest::default().preset, value_parser = parse_preset)]
-    pub preset: Preset,
+    /// The engines' contact settings: dicephys281 (Bullet 2.81 as the paper ran it), bullet3
+    /// (Debian 3.24's defaults), split (dicephys281 with every penetration pushed out apart from
+    /// the bounce, so that a bounce is exactly e: dicephys281's averages e + 0.1) or laws (each
+    /// engine held to the impact, friction and flight closed forms a loaded or long die needs)
+    /// [default: dicephys281; crosscheck: laws].
+    #[arg(long, value_parser = parse_preset)]
+    pub preset: Option<Preset>,
     /// The floor: box (DicePhys's 10 km static box) or plane.
     #[arg(long, default_value_t = SceneRequest::default().floor, value_parser = parse_floor)]
     pub floor: Floor,
@@ -355,7 +357,7 @@ pub struct RunArgs {
     #[arg(long, value_enum, default_value = "fast")]
     pub flight: FlightArg,
     /// DicePhys exactly as the paper ran it: --settle dicephys --flight stepped (with the
-    /// defaults --floor box --preset dicephys281).
+    /// defaults --floor box --preset dicephys281, crosscheck's included).
     #[arg(long, conflicts_with_all = ["settle", "flight"])]
     pub faithful: bool,
 }
@@ -435,6 +437,12 @@ pub fn parse_engine(s: &str) -> std::result::Result<EngineKind, dicephys::Error>
 impl SceneArgs {
     /// The scene asked, as the library's request.
     pub fn request(&self) -> SceneRequest {
+        self.request_or(SceneRequest::default().preset)
+    }
+
+    /// The scene asked, with `preset` where none is given (a command whose own default differs:
+    /// `crosscheck`'s, [`dicephys::studies::crosscheck::PRESET`]).
+    pub fn request_or(&self, preset: Preset) -> SceneRequest {
         SceneRequest {
             die: self.made.request(self.block, None),
             two_d: self.two_d,
@@ -442,7 +450,7 @@ impl SceneArgs {
             friction: self.friction,
             restitution: self.restitution,
             allow_restitution_above_one: self.allow_restitution_above_one,
-            preset: self.preset,
+            preset: self.preset.unwrap_or(preset),
             floor: self.floor,
             floor_thickness: self.floor_thickness,
             linear_damping: self.linear_damping,
@@ -455,7 +463,14 @@ impl SceneArgs {
     /// The scene, with every value checked before anything runs (a die file's value named by
     /// its key).
     pub fn scene(&self) -> Result<Scene> {
-        self.request().scene().map_err(|e| self.made.named(e))
+        self.scene_or(SceneRequest::default().preset)
+    }
+
+    /// The scene, checked, with `preset` where none is given.
+    pub fn scene_or(&self, preset: Preset) -> Result<Scene> {
+        self.request_or(preset)
+            .scene()
+            .map_err(|e| self.made.named(e))
     }
 }
 

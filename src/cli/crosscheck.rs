@@ -41,7 +41,13 @@ impl CrosscheckArgs {
                 "--engines: name at least two engines to compare".into(),
             ));
         }
-        let scene = self.scene.scene()?;
+        // `--faithful` is DicePhys as the paper ran it, preset and all.
+        let preset = if self.run.faithful {
+            dicephys::run::request::SceneRequest::default().preset
+        } else {
+            crosscheck::PRESET
+        };
+        let scene = self.scene.scene_or(preset)?;
         let style = dicephys::model::throws::ThrowStyle::default_for(&scene);
         let cfg = crosscheck::Config {
             engines: self.engines.clone(),

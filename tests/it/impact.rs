@@ -398,9 +398,9 @@ fn rapier_under_laws_meets_the_impulse_law() {
 }
 
 /// `crosscheck`, `roll` and `fair` of a loaded die under the paper's preset, or split, say on
-/// stderr that it is rolled off the closed forms and name `--preset laws`; under laws, on the
-/// arbiter alone, for a die not loaded, or for one whose pips move its centre of mass by a few
-/// hundredths of a millimetre, they say nothing.
+/// stderr that it is rolled off the closed forms and name `--preset laws`; under laws (which
+/// `crosscheck` runs unless told otherwise), on the arbiter alone, for a die not loaded, or for
+/// one whose pips move its centre of mass by a few hundredths of a millimetre, they say nothing.
 #[test]
 fn a_loaded_die_off_the_laws_preset_names_it() {
     let note = |command: &str, extra: &[&str]| {
@@ -415,10 +415,15 @@ fn a_loaded_die_off_the_laws_preset_names_it() {
         );
         String::from_utf8_lossy(&out.stderr).contains("--preset laws")
     };
-    assert!(note("crosscheck", &["--com", "0,0,-4.5"]));
+    // crosscheck runs under laws unless told otherwise (issue 46).
+    assert!(!note("crosscheck", &["--com", "0,0,-4.5"]));
     assert!(note(
         "crosscheck",
         &["--com", "0,0,-4.5", "--preset", "split"]
+    ));
+    assert!(note(
+        "crosscheck",
+        &["--com", "0,0,-4.5", "--preset", "dicephys281"]
     ));
     assert!(!note(
         "crosscheck",
