@@ -57,6 +57,7 @@ pub const MIN_ROWS: usize = 3;
 
 /// One outcome's discrepancy.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(from = "OutcomeRecord")]
 pub struct OutcomeDiscrepancy {
     /// The outcome ("length", "breadth", "width", or a face's label).
     pub outcome: String,
@@ -80,6 +81,51 @@ pub struct OutcomeDiscrepancy {
     pub rows: usize,
     /// P(χ²_rows ≥ chi2).
     pub p_value: f64,
+}
+
+/// An outcome's discrepancy as a fit.json holds it: this version's, or one written before
+/// 2026-11-28 (a spread alone, `predictive_tau`, no `asked`), read as that spread alone so
+/// that an older fit predicts as it did.
+#[derive(Deserialize)]
+struct OutcomeRecord {
+    outcome: String,
+    #[serde(default)]
+    asked: Option<bool>,
+    #[serde(default)]
+    shift: f64,
+    #[serde(default)]
+    slope: f64,
+    #[serde(default)]
+    centre: f64,
+    #[serde(default)]
+    cov: [f64; 3],
+    tau: f64,
+    #[serde(default)]
+    predictive_tau: Option<f64>,
+    chi2: f64,
+    rows: usize,
+    p_value: f64,
+}
+
+impl From<OutcomeRecord> for OutcomeDiscrepancy {
+    fn from(r: OutcomeRecord) -> Self {
+        let (asked, tau) = match r.asked {
+            Some(asked) => (asked, r.tau),
+            None => (r.tau > 0.0, r.predictive_tau.unwrap_or(r.tau)),
+        };
+        OutcomeDiscrepancy {
+            outcome: r.outcome,
+            asked,
+            shift: r.shift,
+            slope: r.slope,
+            centre: r.centre,
+            cov: r.cov,
+            tau,
+            chi2: r.chi2,
+            rows: r.rows,
+            p_value: r.p_value,
+        }
+    }
 }
 
 impl OutcomeDiscrepancy {
@@ -189,20 +235,18 @@ impl Discrepancy {
             .collect();
         let mut moved = vec![false; p.len()];
         for (k, (&name, &q)) in names.iter().zip(p).enumerate() {
-            if let Some((v, sigma)) =
-                self.of(name)
-                    .and_then(|o| o.at(q).map(|m| (o, m)))
-                    .map(|(o, (v, sigma))| {
-                        // d logistic(η + a + b(η − η̄))/dq = v(1 − v)(1 + b)/(q(1 − q)).
-                        let f = v * (1.0 - v) * (1.0 + o.slope) / (q * (1.0 - q));
-                        out[k].factor = f.abs();
-                        (v, sigma)
-                    })
-            {
-                out[k].value = v;
-                out[k].sigma = sigma;
-                moved[k] = true;
-            }
+            let Some(o) = self.of(name) else { continue };
+            let Some((value, sigma)) = o.at(q) else {
+                continue;
+            };
+            // d logistic(η + a + b(η − η̄))/dq = v(1 − v)(1 + b)/(q(1 − q)).
+            let factor = (value * (1.0 - value) * (1.0 + o.slope) / (q * (1.0 - q))).abs();
+            out[k] = Corrected {
+                value,
+                factor,
+                sigma,
+            };
+            moved[k] = true;
         }
         let taken: f64 = (0..p.len())
             .filter(|&k| moved[k])
@@ -704,6 +748,32 @@ mod tests {
             alone < inside,
             "a spread alone held {alone}, the line {inside}"
         );
+    }
+
+    #[test]
+    fn a_fit_written_before_the_line_is_read_as_its_spread_alone() {
+        let old = r#"{"outcome": "length", "tau": 0.5, "predictive_tau": 0.7, "chi2": 21.9,
+            "rows": 4, "p_value": 0.0002}"#;
+        let o: OutcomeDiscrepancy = serde_json::from_str(old).unwrap();
+        assert!(
+            o.asked && o.tau == 0.7 && o.shift == 0.0 && o.slope == 0.0,
+            "{o:?}"
+        );
+        let (p, sigma) = o.at(0.01).unwrap();
+        assert!((p - 0.01).abs() < 1e-15 && (sigma - 0.7).abs() < 1e-15);
+        let none = r#"{"outcome": "width", "tau": 0.0, "predictive_tau": 0.0, "chi2": 3.1,
+            "rows": 4, "p_value": 0.54}"#;
+        let o: OutcomeDiscrepancy = serde_json::from_str(none).unwrap();
+        assert!(!o.asked && o.at(0.3).is_none());
+        // This version's record reads back as written.
+        let rows: Vec<LooRow> = [(60, 0.01), (150, 0.03), (400, 0.1), (900, 0.25)]
+            .iter()
+            .map(|&(c, q)| row(c, 3000, q, 0.0))
+            .collect();
+        let new = Discrepancy::estimate(&rows, 1.0).unwrap();
+        let back: Discrepancy =
+            serde_json::from_str(&serde_json::to_string(&new).unwrap()).unwrap();
+        assert_eq!(back, new);
     }
 
     #[test]
