@@ -274,9 +274,11 @@ class Fit(Document):
     @property
     def discrepancy(self) -> Optional[Dict[str, Any]]:
         """How far the fit's rows, each predicted without itself, miss beyond their errors,
-        outcome by outcome (``tau`` on the log-odds, 0 where they do not), by which every
-        ``predict`` from the fit is widened (its ``err_model``); ``None`` for a fit of fewer
-        than three rows (docs/json.md, fit.json's ``discrepancy``)."""
+        outcome by outcome (where ``asked``: a line on the log-odds, ``shift`` and ``slope``
+        about ``centre``, with a spread ``tau`` about it), along which every ``predict`` from
+        the fit is moved (its ``fit_value`` the fit's own) and by which it is widened (its
+        ``err_model``); ``None`` for a fit of fewer than three rows (docs/json.md, fit.json's
+        ``discrepancy``)."""
         d = self.data.get("discrepancy")
         return dict(d) if d is not None else None
 

@@ -267,11 +267,11 @@ def test_fit_then_predict_through_python(tmp_path: Path) -> None:
 
 def test_a_fit_s_discrepancy_widens_its_predictions_through_python_as_on_the_cli(tmp_path: Path) -> None:
     # With κ alone free, the paper's rows predicted without themselves miss beyond their
-    # errors (three surfaces, e and μ held): the fit learns a discrepancy and widens every
-    # prediction by it.
+    # errors (three surfaces, e and μ held): the fit learns a discrepancy (a line on the
+    # log-odds) and moves and widens every prediction by it.
     f = dicephys.fit("paper", free=["kappa"], points=8, point_rolls=100, degree=1, dt=1 / 250, seed=2,
                      out=tmp_path / "fit")
-    asked = [o for o in f.discrepancy["outcomes"] if o["tau"] > 0]
+    asked = [o for o in f.discrepancy["outcomes"] if o["asked"]]
     assert asked and all(o["p_value"] < 0.05 for o in asked)
     p = dicephys.predict(f, "140x30x10", draws=3, rolls=50)
     assert p.data["discrepancy"] == f.discrepancy
