@@ -41,13 +41,9 @@ impl CrosscheckArgs {
                 "--engines: name at least two engines to compare".into(),
             ));
         }
-        // `--faithful` is DicePhys as the paper ran it, preset and all.
-        let preset = if self.run.faithful {
-            dicephys::run::request::SceneRequest::default().preset
-        } else {
-            crosscheck::PRESET
-        };
-        let scene = self.scene.scene_or(preset)?;
+        let scene = self
+            .scene
+            .scene_or(crosscheck::default_preset(self.run.faithful))?;
         let style = dicephys::model::throws::ThrowStyle::default_for(&scene);
         let cfg = crosscheck::Config {
             engines: self.engines.clone(),

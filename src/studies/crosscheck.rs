@@ -27,6 +27,16 @@ use std::time::Instant;
 /// 12.1–12.4 % (issue 46; docs/results/rapier.md). `roll` and `fair` keep the paper's, dicephys281.
 pub const PRESET: Preset = Preset::Laws;
 
+/// The preset a crosscheck runs under where none is given: [`PRESET`], or the paper's where the
+/// run is DicePhys as the paper ran it (`--faithful`), preset and all.
+pub fn default_preset(faithful: bool) -> Preset {
+    if faithful {
+        crate::run::request::SceneRequest::default().preset
+    } else {
+        PRESET
+    }
+}
+
 /// What `crosscheck` runs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Config {
