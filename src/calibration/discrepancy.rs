@@ -547,10 +547,6 @@ mod tests {
         }
     }
 
-    fn logistic(x: f64) -> f64 {
-        1.0 / (1.0 + (-x).exp())
-    }
-
     /// Rows whose log-odds miss the prediction by N(0, τ²), counted `n` times each.
     fn rows(rng: &mut rand::rngs::StdRng, m: usize, n: u64, tau: f64) -> Vec<LooRow> {
         (0..m)
