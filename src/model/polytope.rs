@@ -620,6 +620,9 @@ pub enum Reads {
     Up,
     /// The face on the floor (the d4, whose label counts as the face it rests on).
     Down,
+    /// The face facing up, or the one on the floor where no face is opposite it (an odd
+    /// prism's sides: it rests with an edge up, and shows the side it lies on).
+    UpOrLying,
 }
 
 /// A named die: its mesh (centroid at the origin), the label of each face, and how it is read.
@@ -658,7 +661,7 @@ const PHI: f64 = 1.618_033_988_749_895;
 /// | `d10` | pentagonal trapezohedron, apexes on ±z | face to opposite face | 16 mm | 1..10, opposite faces sum to 11; odd labels meet at the −z apex |
 /// | `d12` | regular dodecahedron | face to opposite face | 18 mm | 1..12, opposite faces sum to 13 |
 /// | `d20` | regular icosahedron | face to opposite face | 20 mm | 1..20, opposite faces sum to 21 |
-/// | `prism:N,D,L` | regular N-gon prism along z, N ≥ 3 | (no `size`: D is the circumscribed diameter, L the length) | — | sides 1..N counter-clockwise seen from +z, side 1 facing +x; caps "top" (+z), "bottom" |
+/// | `prism:N,D,L` | regular N-gon prism along z, N ≥ 3 | (no `size`: D is the circumscribed diameter, L the length) | — | sides 1..N counter-clockwise seen from +z, side 1 facing +x; caps "top" (+z), "bottom"; read up, an odd prism's sides on the side it lies on (an edge is up) |
 ///
 /// The d10's shape: a ring of 10 corners at angles kπ/5 and radius r, alternately at z = ±z0,
 /// and apexes at z = ±H with H = r (the proportions of the usual d10: apex to apex about 1.49
@@ -983,7 +986,8 @@ fn prism_die(spec: &str, name: &str) -> Result<Named, String> {
     Ok(Named {
         mesh,
         labels,
-        reads: Reads::Up,
+        // An odd prism on a side has an edge up: it shows the side it lies on.
+        reads: Reads::UpOrLying,
     })
 }
 

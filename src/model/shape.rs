@@ -20,6 +20,13 @@ pub const STABLE_MARGIN: f64 = 1e-6;
 /// The most outcomes a die may have (a roll records its face in a byte).
 pub const MAX_FACES: usize = 255;
 
+/// Two facets are opposite when their outward normals are antiparallel within this angle
+/// (rad, about 0.06°): a die that reads the face up reads the facet opposite the one it rests
+/// on only where there is one. A die built from a mesh whose opposite faces were printed
+/// parallel to a tenth of a millimetre over 10 cm is well inside it; an odd prism's side, whose
+/// "opposite" is an edge 60° or more away, is far outside.
+pub const OPPOSITE_TOLERANCE: f64 = 1e-3;
+
 /// Which face's label a die shows.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -29,6 +36,9 @@ pub enum Reads {
     Up,
     /// The face on the floor (a d4's point up).
     Down,
+    /// The face facing up, or, resting on a facet with no facet opposite (an odd prism's
+    /// sides, which rest with an edge up), the facet it lies on.
+    UpOrLying,
 }
 
 /// The body that collides.
@@ -71,12 +81,25 @@ pub struct Shape {
     /// Its second moments at unit density about its centroid, ∫ x xᵀ dV (m⁵, body axes):
     /// xx, yy, zz, xy, xz, yz.
     pub second: [f64; 6],
-    /// The outcomes, in the order every count of them keeps.
+    /// The outcomes, in the order every count of them keeps: the facets the die rests on at
+    /// its centre of mass (the centroid, or a loaded die's own: [`Shape::resting_at`]).
     pub faces: Vec<Face>,
+    /// The labels printed on its facets, by outward normal (`None`: numbered 1…N over the
+    /// resting facets, in the hull's order): what a resting facet shows wherever the centre of
+    /// mass moves it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub printed: Option<Vec<Face>>,
+    /// Which face's label it shows.
+    #[serde(default, skip_serializing_if = "is_up")]
+    pub reads: Reads,
     /// The hull's facets, found once on first use (`Shape::facets`): every roll's die asks
     /// for them.
     #[serde(skip)]
     facets: std::sync::OnceLock<std::sync::Arc<Vec<polytope::Facet>>>,
+}
+
+fn is_up(r: &Reads) -> bool {
+    *r == Reads::Up
 }
 
 impl PartialEq for Shape {
@@ -87,6 +110,8 @@ impl PartialEq for Shape {
             && self.volume == o.volume
             && self.second == o.second
             && self.faces == o.faces
+            && self.printed == o.printed
+            && self.reads == o.reads
     }
 }
 
@@ -110,6 +135,7 @@ pub fn named(spec: &str, size_mm: Option<f64>) -> Result<Shape> {
     let reads = match named.reads {
         PolyReads::Up => Reads::Up,
         PolyReads::Down => Reads::Down,
+        PolyReads::UpOrLying => Reads::UpOrLying,
     };
     let name = match size_mm {
         Some(s) if !spec_t.contains(':') => format!("{spec_t}@{s}"),
@@ -159,6 +185,8 @@ pub fn coin(d: f64, h: f64) -> std::result::Result<Shape, String> {
         volume: mp.volume,
         second: second_moments(&mp.inertia, mp.volume),
         facets: Default::default(),
+        printed: None,
+        reads: Reads::Up,
         faces: vec![
             Face {
                 normal: [0.0, 0.0, -1.0],
@@ -222,78 +250,122 @@ pub fn from_mesh(
         }
     }
     let facets = polytope::facets(&hull, polytope::COPLANAR_TOLERANCE);
-    let com = Vector3::zeros();
-    let stable: Vec<&polytope::Facet> = facets
-        .iter()
-        .filter(|f| polytope::stable(f, &com, STABLE_MARGIN * size))
-        .collect();
-    if stable.is_empty() {
-        return Err("no facet of its hull is stable: it cannot come to rest".into());
-    }
-    if stable.len() > MAX_FACES {
-        return Err(format!(
-            "its hull has {} stable facets, more than {MAX_FACES}: simplify the mesh",
-            stable.len()
-        ));
-    }
-    // The label printed on each stable facet: the given one whose normal is nearest, or
-    // 1…N in order of the facets' normals (down first, then by angle).
-    let printed: Vec<String> = match labels {
-        Some(l) => stable
-            .iter()
-            .map(|f| {
-                l.iter()
-                    .max_by(|a, b| f.normal.dot(&a.0).total_cmp(&f.normal.dot(&b.0)))
-                    .filter(|(n, _)| f.normal.dot(n) > 1.0 - 1e-6)
-                    .map(|(_, s)| s.clone())
-                    .ok_or_else(|| {
-                        format!(
-                            "no label for the facet with normal ({:.4}, {:.4}, {:.4})",
-                            f.normal.x, f.normal.y, f.normal.z
-                        )
-                    })
-            })
-            .collect::<std::result::Result<_, _>>()?,
-        None => (1..=stable.len()).map(|k| k.to_string()).collect(),
-    };
-    let faces = stable
-        .iter()
-        .enumerate()
-        .map(|(k, f)| {
-            let label = match reads {
-                Reads::Down => printed[k].clone(),
-                // The facet facing up when this one is down: the most nearly opposite.
-                Reads::Up => {
-                    let up = (0..stable.len())
-                        .min_by(|&a, &b| {
-                            stable[a]
-                                .normal
-                                .dot(&f.normal)
-                                .total_cmp(&stable[b].normal.dot(&f.normal))
-                        })
-                        .unwrap_or(k);
-                    printed[up].clone()
-                }
-            };
-            Face {
-                normal: f.normal.into(),
-                label,
-            }
-        })
-        .collect();
-    Ok(Shape {
+    let mut shape = Shape {
         name,
         solid: Solid::Hull {
             points: hull.vertices.iter().map(|&v| v.into()).collect(),
         },
         volume: mp.volume,
         second: second_moments(&mp.inertia, mp.volume),
-        faces,
-        facets: Default::default(),
-    })
+        faces: Vec::new(),
+        printed: labels.map(|l| {
+            l.iter()
+                .map(|(n, label)| Face {
+                    normal: (*n).into(),
+                    label: label.clone(),
+                })
+                .collect()
+        }),
+        reads,
+        // The facets just found, so that the outcomes are numbered in this hull's order.
+        facets: std::sync::OnceLock::from(std::sync::Arc::new(facets)),
+    };
+    shape.faces = shape.outcomes_at(&Vector3::zeros())?;
+    Ok(shape)
 }
 
 impl Shape {
+    /// The same die with its centre of mass at `com` (m, body axes, from the centroid): its
+    /// outcomes are the facets it rests on there, each showing its printed label (a loaded
+    /// die rests on facets the uniform one rolls off, and off facets it rests on). A coin is
+    /// unchanged (its caps and edge are outcomes wherever its centre is).
+    pub fn resting_at(&self, com: &Vector3<f64>) -> std::result::Result<Shape, String> {
+        if matches!(self.solid, Solid::Cylinder { .. }) || com.norm() == 0.0 {
+            return Ok(self.clone());
+        }
+        let mut s = self.clone();
+        s.faces = self.outcomes_at(com)?;
+        Ok(s)
+    }
+
+    /// The outcomes with the centre of mass at `com`: each facet the die rests on (the foot
+    /// of the centre inside it by [`STABLE_MARGIN`] of its size), in the hull's order, with
+    /// the label it shows as [`Shape::reads`] says.
+    fn outcomes_at(&self, com: &Vector3<f64>) -> std::result::Result<Vec<Face>, String> {
+        let facets = self.facets();
+        let margin = STABLE_MARGIN * self.circumradius();
+        let stable: Vec<&polytope::Facet> = facets
+            .iter()
+            .filter(|f| polytope::stable(f, com, margin))
+            .collect();
+        if stable.is_empty() {
+            return Err("no facet of its hull is stable: it cannot come to rest".into());
+        }
+        if stable.len() > MAX_FACES {
+            return Err(format!(
+                "its hull has {} stable facets, more than {MAX_FACES}: simplify the mesh",
+                stable.len()
+            ));
+        }
+        // The label printed on a facet: the given one whose normal is nearest, or 1…N over
+        // the resting facets in order.
+        let printed = |f: &polytope::Facet| -> Option<String> {
+            match &self.printed {
+                Some(l) => l
+                    .iter()
+                    .map(|p| (Vector3::from(p.normal), &p.label))
+                    .max_by(|a, b| f.normal.dot(&a.0).total_cmp(&f.normal.dot(&b.0)))
+                    .filter(|(n, _)| f.normal.dot(n) > 1.0 - 1e-6)
+                    .map(|(_, s)| s.clone()),
+                None => stable
+                    .iter()
+                    .position(|g| std::ptr::eq(*g, f))
+                    .map(|k| (k + 1).to_string()),
+            }
+        };
+        let normal_text = |f: &polytope::Facet| {
+            format!(
+                "({:.4}, {:.4}, {:.4})",
+                f.normal.x, f.normal.y, f.normal.z
+            )
+        };
+        let labelled: Vec<(&polytope::Facet, String)> = facets
+            .iter()
+            .filter_map(|f| printed(f).map(|l| (f, l)))
+            .collect();
+        stable
+            .iter()
+            .map(|f| {
+                let own = printed(f).ok_or_else(|| {
+                    format!("no label for the facet with normal {}", normal_text(f))
+                })?;
+                // The labelled facet facing up, if one is opposite this one.
+                let up = labelled
+                    .iter()
+                    .min_by(|a, b| a.0.normal.dot(&f.normal).total_cmp(&b.0.normal.dot(&f.normal)))
+                    .filter(|(g, _)| g.normal.dot(&f.normal) < -OPPOSITE_TOLERANCE.cos())
+                    .map(|(_, l)| l.clone());
+                let label = match (self.reads, up) {
+                    (Reads::Down, _) | (Reads::UpOrLying, None) => own,
+                    (Reads::Up | Reads::UpOrLying, Some(up)) => up,
+                    (Reads::Up, None) => {
+                        return Err(format!(
+                            "it reads the face up, but resting on the facet with normal {} \
+                             ({own}) no facet faces up (none is opposite within {:.2}°): give \
+                             reads = \"down\", or a die whose resting faces have opposites",
+                            normal_text(f),
+                            OPPOSITE_TOLERANCE.to_degrees()
+                        ))
+                    }
+                };
+                Ok(Face {
+                    normal: f.normal.into(),
+                    label,
+                })
+            })
+            .collect()
+    }
+
     /// The hull's vertices (a cylinder: none), m, body axes, from the centroid.
     pub fn points(&self) -> Vec<Vector3<f64>> {
         match &self.solid {
@@ -576,5 +648,53 @@ mod tests {
         assert_eq!(back.facets().len(), 10);
         // Another size is another die.
         assert_ne!(named("d10", Some(20.0)).unwrap(), s);
+    }
+
+    #[test]
+    fn every_side_of_an_odd_prism_is_its_own_outcome() {
+        // Resting on a side of an odd prism an edge is up, not a face: the die shows the side
+        // it lies on. Each resting facet is one outcome with its own label (issue 69: side "3"
+        // of prism:3 was never reported, side "1" counted twice).
+        for n in [3usize, 4, 5, 6, 7] {
+            let s = named(&format!("prism:{n},10,10"), None).unwrap();
+            let mut labels: Vec<&str> = s.labels();
+            assert_eq!(labels.len(), n + 2, "prism:{n}");
+            labels.sort_unstable();
+            labels.dedup();
+            assert_eq!(labels.len(), n + 2, "prism:{n}: {:?}", s.labels());
+            for f in &s.faces {
+                let normal = Vector3::from(f.normal);
+                if normal.z.abs() > 0.5 {
+                    // On a cap, the other cap is up.
+                    let up = if normal.z < 0.0 { "top" } else { "bottom" };
+                    assert_eq!(f.label, up, "prism:{n}");
+                } else if n % 2 == 1 {
+                    // On a side: the side it lies on (side k faces azimuth 2π(k − 1)/N).
+                    let k = (normal.y.atan2(normal.x).rem_euclid(std::f64::consts::TAU)
+                        / (std::f64::consts::TAU / n as f64))
+                        .round() as usize
+                        % n;
+                    assert_eq!(f.label, (k + 1).to_string(), "prism:{n}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_die_read_up_without_an_opposite_face_is_refused_naming_the_facet() {
+        // A regular tetrahedron read up: resting on any face a corner is up.
+        let v = [
+            Vector3::new(1.0, 1.0, 1.0),
+            Vector3::new(1.0, -1.0, -1.0),
+            Vector3::new(-1.0, 1.0, -1.0),
+            Vector3::new(-1.0, -1.0, 1.0),
+        ]
+        .map(|p| p * 8.0);
+        let mesh = polytope::hull(&v).unwrap();
+        let e = from_mesh(&mesh, "tetra".into(), None, Reads::Up).unwrap_err();
+        assert!(e.contains("no facet faces up") && e.contains("normal ("), "{e}");
+        // Read on the face down it is four outcomes, 1 … 4.
+        let down = from_mesh(&mesh, "tetra".into(), None, Reads::Down).unwrap();
+        assert_eq!(down.labels(), ["1", "2", "3", "4"]);
     }
 }
