@@ -143,16 +143,6 @@ impl FitRequest {
         let d = &self.die;
         let shape =
             crate::model::shape::described(d.file.as_deref(), d.shape.as_deref(), d.size, d.scale)?;
-        let rows = match &shape {
-            Some(s) => data::on_shape(&self.rows, s)
-                .map_err(|e| Error::field(Field::Data, "", e.to_string()))?,
-            None => self.rows.clone(),
-        };
-        let (degree, max_degree) = DesignSpec::degrees(
-            self.degree,
-            self.max_degree,
-            shape.as_ref().map_or(6, |s| s.faces.len()),
-        );
         let (mut die, density) = Features::described(
             d.file.as_deref(),
             d.com,
@@ -164,6 +154,32 @@ impl FitRequest {
         if let Some(layout) = d.layout {
             die.layout = layout;
         }
+        // A loaded die's outcomes are the facets it rests on at its own centre of mass.
+        let shape = match shape {
+            Some(s) => {
+                let mut scene = crate::model::scene::Scene::paper(
+                    "16x16x16".parse().expect("a block"),
+                    crate::model::scene::Mode::ThreeD,
+                )
+                .with_shape(s);
+                scene.features = die;
+                let scene = scene.resting_at_com().map_err(|e| {
+                    Error::field(Field::Shape, "", format!("at its centre of mass: {e}"))
+                })?;
+                scene.shape.map(|s| (*s).clone())
+            }
+            None => None,
+        };
+        let rows = match &shape {
+            Some(s) => data::on_shape(&self.rows, s)
+                .map_err(|e| Error::field(Field::Data, "", e.to_string()))?,
+            None => self.rows.clone(),
+        };
+        let (degree, max_degree) = DesignSpec::degrees(
+            self.degree,
+            self.max_degree,
+            shape.as_ref().map_or(6, |s| s.faces.len()),
+        );
         let cfg = FitConfig {
             rows,
             model: self.model(shape.is_some())?,

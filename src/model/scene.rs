@@ -373,6 +373,17 @@ impl Scene {
         self
     }
 
+    /// The scene with its die's outcomes at its own centre of mass (`Shape::resting_at`): a
+    /// die of any shape loaded off its centroid rests on the facets it rests on there, and a
+    /// facet it rolls off is no outcome. Unchanged for the cuboid, a coin, or a centred die.
+    pub fn resting_at_com(mut self) -> std::result::Result<Scene, String> {
+        if let Some(shape) = &self.shape {
+            let com = MassProps::compute(&self).com;
+            self.shape = Some(std::sync::Arc::new(shape.resting_at(&com)?));
+        }
+        Ok(self)
+    }
+
     /// The die's mass, multiplied in DicePhys's order so that the numbers agree to the bit.
     pub fn mass(&self) -> f64 {
         if let Some(s) = &self.shape {

@@ -169,6 +169,18 @@ impl SceneRequest {
             scene.set_floor_thickness(t)?;
         }
         scene.validate(self.allow_restitution_above_one)?;
+        // A loaded die's outcomes are the facets it rests on at its own centre of mass.
+        let scene = scene.resting_at_com().map_err(|e| {
+            Error::field(
+                if d.file.is_some() { Field::Die } else { Field::Shape },
+                d.file
+                    .as_ref()
+                    .map(|p| p.display().to_string())
+                    .or(d.shape.clone())
+                    .unwrap_or_default(),
+                format!("at its centre of mass: {e}"),
+            )
+        })?;
         Ok(scene)
     }
 }
