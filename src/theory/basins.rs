@@ -106,52 +106,130 @@ impl Gauss {
         if facets.iter().any(|f| f.offset - f.normal.dot(com) <= eps) {
             return Err("the centre of mass is not inside the die".into());
         }
-        let mut points: Vec<V3> = Vec::new();
-        for p in polygons.iter().flatten() {
-            if !points.iter().any(|q| (q - p).norm() <= eps) {
-                points.push(*p);
-            }
-        }
-        let plane = |f: usize, p: &V3| (normals[f].dot(p) - normals[f].dot(&polygons[f][0])).abs();
-        let mut vertex = Vec::new();
-        let mut cone = Vec::new();
-        let mut on = Vec::new();
-        for p in points {
-            let faces: Vec<usize> = (0..facets.len()).filter(|&f| plane(f, &p) <= eps).collect();
-            if faces.len() < 3 {
-                continue; // on an edge or inside a face: no region of its own
-            }
-            // The faces about the vertex in order: by angle about their mean normal, which
-            // lies inside the (convex) normal cone.
-            let axis = faces.iter().map(|&f| normals[f]).sum::<V3>().normalize();
-            let e1 = axis.cross(&any_perpendicular(&axis)).normalize();
-            let e2 = axis.cross(&e1);
-            let mut ordered = faces.clone();
-            let angle = |f: &usize| normals[*f].dot(&e2).atan2(normals[*f].dot(&e1));
-            ordered.sort_by(|a, b| angle(a).total_cmp(&angle(b)));
-            vertex.push(p);
-            cone.push(ordered);
-            on.push(faces);
-        }
-        let mut across = Vec::new();
-        for v in 0..vertex.len() {
-            let k = cone[v].len();
-            let mut row = Vec::with_capacity(k);
-            for i in 0..k {
-                let (f1, f2) = (cone[v][i], cone[v][(i + 1) % k]);
-                // The edge's other end: the nearest vertex on both faces.
-                let w = (0..vertex.len())
-                    .filter(|&w| w != v && on[w].contains(&f1) && on[w].contains(&f2))
-                    .min_by(|&a, &b| {
-                        (vertex[a] - vertex[v])
-                            .norm()
-                            .total_cmp(&(vertex[b] - vertex[v]).norm())
+        // The vertices are the facets' corners, told apart exactly: `polytope::facets` copies
+        // each from the hull's vertices, so a corner shared by several facets is the same
+        // number in each. (Telling them apart by distance, or a vertex's facets by its
+        // distance from their planes, merges distinct corners of a hull with short edges and
+        // puts a vertex on near-coplanar facets it is not a corner of: its region then
+        // overlaps its neighbours' and the basins do not sum to the sphere.)
+        let key = |p: &V3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+        let mut index: HashMap<[u64; 3], usize> = HashMap::new();
+        let mut vertex: Vec<V3> = Vec::new();
+        let mut corners: Vec<Vec<usize>> = polygons
+            .iter()
+            .map(|poly| {
+                poly.iter()
+                    .map(|p| {
+                        *index.entry(key(p)).or_insert_with(|| {
+                            vertex.push(*p);
+                            vertex.len() - 1
+                        })
                     })
-                    .ok_or("two of the hull's facets meet at a corner but share no edge")?;
-                row.push(w);
+                    .collect()
+            })
+            .collect();
+        let directed = |corners: &[Vec<usize>]| {
+            let mut owner: HashMap<(usize, usize), usize> = HashMap::new();
+            for (f, c) in corners.iter().enumerate() {
+                for i in 0..c.len() {
+                    if owner.insert((c[i], c[(i + 1) % c.len()]), f).is_some() {
+                        return Err("two of the hull's facets run along one edge the same way");
+                    }
+                }
             }
-            across.push(row);
+            Ok(owner)
+        };
+        // A corner where one facet's boundary runs straight on (`polytope::facets` drops
+        // those) can still be a corner of the facets across: put it back, so that every edge
+        // has one facet on each side. The edge a→b's far side is the chain of unmatched edges
+        // from b back to a.
+        let owner = directed(&corners)?;
+        let mut loose: HashMap<usize, Vec<usize>> = HashMap::new();
+        for &(a, b) in owner.keys() {
+            if !owner.contains_key(&(b, a)) {
+                loose.entry(a).or_default().push(b);
+            }
         }
+        if !loose.is_empty() {
+            for (f, c) in corners.iter_mut().enumerate() {
+                let mut filled = Vec::with_capacity(c.len());
+                for i in 0..c.len() {
+                    let (a, b) = (c[i], c[(i + 1) % c.len()]);
+                    filled.push(a);
+                    if owner.contains_key(&(b, a)) {
+                        continue;
+                    }
+                    let mut chain = Vec::new();
+                    let mut x = b;
+                    while x != a {
+                        // The next corner along the far side: on another facet, nearest
+                        // the segment a–b.
+                        let d = vertex[b] - vertex[a];
+                        let off = |y: &usize| (vertex[*y] - vertex[a]).cross(&d).norm();
+                        x = loose
+                            .get(&x)
+                            .into_iter()
+                            .flatten()
+                            .filter(|&&y| owner[&(x, y)] != f)
+                            .min_by(|y, z| off(y).total_cmp(&off(z)))
+                            .copied()
+                            .filter(|_| chain.len() < vertex.len())
+                            .ok_or("a facet's edge has no facet across it")?;
+                        if x != a {
+                            chain.push(x);
+                        }
+                    }
+                    filled.extend(chain.iter().rev());
+                }
+                *c = filled;
+            }
+        }
+        let owner = directed(&corners)?;
+        if owner.keys().any(|&(a, b)| !owner.contains_key(&(b, a))) {
+            return Err("a facet's edge has no facet across it".into());
+        }
+        let polygons: Vec<Vec<V3>> = corners
+            .iter()
+            .map(|c| c.iter().map(|&k| vertex[k]).collect())
+            .collect();
+        // Each vertex's facets in order about it, by the edges they share: after facet f,
+        // with the edge v→q (counter-clockwise in f), comes the facet with the edge q→v.
+        let mut first = vec![None; vertex.len()];
+        for (f, c) in corners.iter().enumerate() {
+            for &k in c {
+                first[k].get_or_insert(f);
+            }
+        }
+        let mut cone = Vec::with_capacity(vertex.len());
+        let mut across = Vec::with_capacity(vertex.len());
+        for (v, f0) in first.iter().enumerate() {
+            let f0 = f0.ok_or("a hull vertex is no facet's corner")?;
+            let (mut faces, mut ends) = (Vec::new(), Vec::new());
+            let mut f = f0;
+            loop {
+                let c = &corners[f];
+                let i = c
+                    .iter()
+                    .position(|&k| k == v)
+                    .ok_or("a broken vertex fan")?;
+                let q = c[(i + 1) % c.len()];
+                faces.push(f);
+                ends.push(q);
+                f = owner[&(q, v)];
+                if f == f0 {
+                    break;
+                }
+                if faces.len() > corners.len() {
+                    return Err("the facets about a hull vertex do not close".into());
+                }
+            }
+            if faces.len() < 3 {
+                return Err("a hull vertex is the corner of fewer than three facets".into());
+            }
+            cone.push(faces);
+            across.push(ends);
+        }
+        let on = cone.clone();
         Ok(Gauss {
             normals,
             polygons,
