@@ -357,7 +357,7 @@ fn scene_of(block_: Option<&str>, o: &Options, layout: Option<Layout>) -> PyResu
         floor_thickness: o.maybe("floor_thickness")?,
         linear_damping: o.get("linear_damping", d.linear_damping)?,
         angular_damping: o.get("angular_damping", d.angular_damping)?,
-        rolling_resistance_mm: o.get("rolling_resistance", d.rolling_resistance_mm)?,
+        rolling_resistance_mm: o.maybe("rolling_resistance")?,
         sleep: o.get("sleep", d.sleep)?,
     })
 }
@@ -489,7 +489,10 @@ fn roll<'py>(
     let null_given = o.maybe::<String>("fair")?;
     let null = null_given
         .as_deref()
-        .map(|n| named::<dicephys::studies::fair::Null>("null", "null", n))
+        .map(|n| {
+            n.parse::<dicephys::studies::fair::Null>()
+                .map_err(|e| bad("null", format!("'{n}'"), e))
+        })
         .transpose()?;
     let precision = o.maybe::<f64>("precision")?;
     let threads = o.get("threads", 0usize)?;
@@ -528,7 +531,7 @@ fn roll<'py>(
             summary.human(),
         ),
         Some(null) => {
-            let fair = dicephys::studies::fair::assess(&summary, null).map_err(py_err)?;
+            let fair = dicephys::studies::fair::assess(&summary, &null).map_err(py_err)?;
             let doc = serde_json::json!({ "fairness": fair, "summary": summary });
             (
                 dicephys::run::seal::to_string(&doc, true),

@@ -130,14 +130,10 @@ pub struct SceneArgs {
     pub angular_damping: f64,
     /// Rolling resistance, mm: the lever arm of the floor's push against a die rolling or
     /// turning in place, so that a cylinder rolling on its side or a coin spinning on its rim
-    /// stops (0 to 1; hard surfaces about 0.01, felt more; DicePhys: 0). Bullet only.
-    #[arg(
-        long,
-        value_name = "MM",
-        default_value_t = 0.0,
-        allow_hyphen_values = true
-    )]
-    pub rolling_resistance: f64,
+    /// stops (0 to 1; hard surfaces about 0.01, felt more; DicePhys: 0). Bullet only
+    /// [default: 0.05 for a coin on Bullet, else 0].
+    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
+    pub rolling_resistance: Option<f64>,
     /// Never let the engine put the die to sleep (for slow, over-damped rolls, which it would
     /// freeze mid-fall).
     #[arg(long)]
@@ -427,7 +423,7 @@ pub fn parse_layout(
 }
 /// `--null` as clap reads it.
 pub fn parse_null(s: &str) -> std::result::Result<dicephys::studies::fair::Null, dicephys::Error> {
-    parse_name("null", s)
+    s.parse().map_err(dicephys::Error::Invalid)
 }
 /// `--engine` as clap reads it.
 pub fn parse_engine(s: &str) -> std::result::Result<EngineKind, dicephys::Error> {

@@ -21,12 +21,15 @@ pub struct FairArgs {
     /// (`--precision`, a relative error of the ratio in `roll`, meant this here before.)
     #[arg(long, value_name = "PP", value_parser = super::args::parse_points, conflicts_with = "precision")]
     pub within: Option<f64>,
-    /// What fair means: uniform (each face 1/N; in 2D each side 1/4) or quasi-static (what
-    /// the die would show released at rest and rolling down without a bounce: for a cuboid
-    /// each face the solid angle the face opposite subtends from the centre of mass, so also
-    /// called solid-angle; for any other die the exact basins of its rolling; 3D).
-    #[arg(long, default_value = "uniform", value_parser = super::args::parse_null)]
-    pub null: Null,
+    /// What fair means: uniform (each facet the die rests on 1/N, a label its facets' share;
+    /// in 2D each side 1/4; noted where the die's faces are not alike, as on a prism or a
+    /// coin), quasi-static (what the die would show released at rest and rolling down
+    /// without a bounce: for a cuboid each face the solid angle the face opposite subtends
+    /// from the centre of mass, so also called solid-angle; for any other die the exact
+    /// basins of its rolling; 3D), or a target LABEL=P,… (a design's: 6=1/4,1=3/20,…,
+    /// summing to 1, every label of the die) [default: uniform; a resumed run's own].
+    #[arg(long, value_parser = super::args::parse_null, conflicts_with = "resume")]
+    pub null: Option<Null>,
     /// Also write fairness.json (the --json document) and the die map (die_map.svg, .png:
     /// the six faces as a net, each with its probability and departure) into this directory.
     #[arg(long, value_name = "DIR")]
@@ -61,22 +64,36 @@ pub fn run(mut a: FairArgs) -> Result<()> {
     let a = &a;
     let spec = a.roll.spec_or(ThrowStyle::Tumble)?;
     if let Some(c) = &a.counts {
-        return counted(a, &spec, c);
+        return counted(a, &spec, c, &a.null.clone().unwrap_or_default());
     }
     if let Some(v) = &a.vary {
-        return vary(a, &spec, v);
+        let null = a.null.clone().unwrap_or_default();
+        dicephys::studies::fair::check_null(&spec, &null)?;
+        return vary(a, &spec, v, &null);
     }
+    // A checkpointed run keeps its null beside its specification, so that --resume judges it
+    // as it was asked (the Ctrl-C message gives that command).
+    let null = match (&a.roll.resume, &a.roll.checkpoint) {
+        (Some(dir), _) => stored_null(dir)?,
+        (None, Some(dir)) => {
+            let null = a.null.clone().unwrap_or_default();
+            check_null(dir, &null)?;
+            null
+        }
+        (None, None) => a.null.clone().unwrap_or_default(),
+    };
     // The null is checked before anything rolls.
-    if a.null == Null::QuasiStatic && spec.scene.mode == dicephys::model::scene::Mode::TwoD {
+    if null == Null::QuasiStatic && spec.scene.mode == dicephys::model::scene::Mode::TwoD {
         return Err(Error::Usage(
             "--null quasi-static (solid-angle): the quasi-static theory is 3D; in 2D give uniform"
                 .into(),
         ));
     }
+    dicephys::studies::fair::check_null(&spec, &null)?;
     let _held = match &a.out {
         Some(dir) => {
             let identity = serde_json::json!({
-                "spec": spec, "null": a.null, "layout": a.roll.layout(&spec)
+                "spec": spec, "null": (null.spec()), "layout": a.roll.layout(&spec)
             });
             Some(claim_out(dir, &identity)?)
         }
@@ -98,7 +115,24 @@ pub fn run(mut a: FairArgs) -> Result<()> {
         "fair",
         dicephys::report::summary::Target::Faces,
     )?;
-    let fair = assess(&summary, a.null)?;
+    if let (None, Some(dir)) = (&a.roll.resume, &a.roll.checkpoint) {
+        store_null(dir, &null)?;
+    }
+    // No verdict over the rolls at rest alone when many did not come to rest: the counts are
+    // shown, and the run fails saying what to change.
+    if !summary.partial {
+        if let Err(e) =
+            dicephys::report::summary::check_settled(&summary.tally, &summary.spec.scene)
+        {
+            if *a.roll.json {
+                outln!("{}", dicephys::run::seal::to_string(&summary, true)?);
+            } else {
+                out!("{}", summary.human());
+            }
+            return Err(Error::Run(format!("no verdict: {e}")));
+        }
+    }
+    let fair = assess(&summary, &null)?;
     let doc = serde_json::json!({ "fairness": fair, "summary": summary });
     let json = dicephys::run::seal::to_string(&doc, true)?;
     if let (Some(dir), false) = (&a.out, summary.partial) {
@@ -118,6 +152,55 @@ pub fn run(mut a: FairArgs) -> Result<()> {
     done
 }
 
+/// The file in a `fair` run's checkpoint that keeps its null.
+const NULL_FILE: &str = "fair-null.json";
+
+/// Refused if the checkpoint `dir` keeps another null than `null`.
+fn check_null(dir: &std::path::Path, null: &Null) -> Result<()> {
+    let file = dir.join(NULL_FILE);
+    if file.exists() {
+        let kept = stored_null(dir)?;
+        if kept != *null {
+            return Err(Error::Usage(format!(
+                "--checkpoint {}: it holds a fair run against {kept}, not {null}: resume that \
+                 run (dicephys fair --resume {}), or use a new directory",
+                dir.display(),
+                dir.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Keeps `null` in the checkpoint `dir` (the run's, opened by now) for `--resume`.
+fn store_null(dir: &std::path::Path, against: &Null) -> Result<()> {
+    if !dir.join("spec.json").exists() {
+        return Ok(());
+    }
+    let file = dir.join(NULL_FILE);
+    let json = serde_json::to_string(&serde_json::json!({ "null": against }))
+        .map_err(|e| Error::Usage(e.to_string()))?;
+    dicephys::run::io::write_atomic(&file, json.as_bytes())?;
+    Ok(())
+}
+
+/// The null a checkpointed `fair` run keeps (a `roll` checkpoint, which keeps none: uniform).
+fn stored_null(dir: &std::path::Path) -> Result<Null> {
+    let file = dir.join(NULL_FILE);
+    if !file.exists() {
+        return Ok(Null::default());
+    }
+    let text = std::fs::read_to_string(&file)
+        .map_err(|e| Error::Usage(format!("--resume {}: {e}", file.display())))?;
+    #[derive(serde::Deserialize)]
+    struct Kept {
+        null: Null,
+    }
+    serde_json::from_str::<Kept>(&text)
+        .map(|k| k.null)
+        .map_err(|e| Error::Usage(format!("{} is damaged ({e})", file.display())))
+}
+
 /// `--out DIR` made, claimed and held for this `fair` run (another run's directory is refused,
 /// and so is this one's while another process runs it): held while the returned file lives.
 fn claim_out(dir: &std::path::Path, identity: &serde_json::Value) -> Result<std::fs::File> {
@@ -127,16 +210,21 @@ fn claim_out(dir: &std::path::Path, identity: &serde_json::Value) -> Result<std:
 }
 
 /// `fair --counts`: measured counts judged without a simulation.
-fn counted(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, text: &str) -> Result<()> {
+fn counted(
+    a: &FairArgs,
+    spec: &dicephys::run::spec::RunSpec,
+    text: &str,
+    null: &Null,
+) -> Result<()> {
     use dicephys::studies::fair::{assess_counts, parse_counts, write_counted};
     let counts = parse_counts(text)?;
-    let fair = assess_counts(&counts, a.null, &spec.scene, a.roll.layout(spec))?;
+    let fair = assess_counts(&counts, null, &spec.scene, a.roll.layout(spec))?;
     let doc = serde_json::json!({ "fairness": fair });
     let json = dicephys::run::seal::to_string(&doc, true)?;
     if let Some(dir) = &a.out {
         let _held = claim_out(
             dir,
-            &serde_json::json!({ "counts": counts, "null": a.null }),
+            &serde_json::json!({ "counts": counts, "null": (null.spec()) }),
         )?;
         write_counted(dir, &json, &fair)?;
         if !*a.roll.json {
@@ -161,10 +249,10 @@ fn counted(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, text: &str) -> Res
 
 /// `fair --vary`: the die at each value of one feature, judged, as a table (or JSON) and,
 /// with `--out`, the bias figure.
-fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str) -> Result<()> {
+fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str, null: &Null) -> Result<()> {
     use dicephys::studies::fair::{parse_vary, vary, write_bias};
     let (what, values) = parse_vary(v)?;
-    let identity = serde_json::json!({ "spec": spec, "null": a.null, "vary": v });
+    let identity = serde_json::json!({ "spec": spec, "null": (null.spec()), "vary": v });
     let _held = a
         .out
         .as_ref()
@@ -183,14 +271,14 @@ fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str) -> Result<()
     let runner = dicephys::run::runner::Runner::new(threads, super::term::stop().clone());
     let runner = runner.with_progress(&progress);
     let layout = a.roll.layout(spec);
-    let points = vary(spec, layout, what, &values, a.null, &runner);
+    let points = vary(spec, layout, what, &values, null, &runner);
     bar.finish();
     let Some(points) = points? else {
         return Err(Error::Interrupted(dicephys::run::stop::interrupted(
             &dicephys::run::stop::Kept::Nothing(Some("a --vary run does not resume")),
         )));
     };
-    let doc = serde_json::json!({ "vary": what, "null": a.null, "spec": spec, "points": points });
+    let doc = serde_json::json!({ "vary": what, "null": (null.spec()), "spec": spec, "points": points });
     let json = dicephys::run::seal::to_string(&doc, true)?;
     if let Some(dir) = &a.out {
         let die = match &spec.scene.shape {
@@ -202,7 +290,7 @@ fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str) -> Result<()
             spec.engine.name(),
             spec.throws.style,
             spec.rolls,
-            a.null
+            null
         );
         write_bias(dir, what, &title, &points)?;
         dicephys::run::io::write_atomic(&dir.join("bias.json"), json.as_bytes())?;

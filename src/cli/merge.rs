@@ -69,7 +69,7 @@ pub fn run(a: &MergeArgs) -> Result<()> {
     }
     let out = RunSummary::merge(&parts)?;
     if let Some(Some(null)) = nulls.first() {
-        let fair = dicephys::studies::fair::assess(&out, *null)?;
+        let fair = dicephys::studies::fair::assess(&out, null)?;
         let doc = serde_json::json!({ "fairness": fair, "summary": out });
         if *a.json {
             outln!("{}", dicephys::run::seal::to_string(&doc, true)?);

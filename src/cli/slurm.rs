@@ -130,7 +130,7 @@ pub struct SlurmRollArgs {
 pub struct SlurmFairArgs {
     #[command(flatten)]
     pub roll: RollArgs,
-    /// What fair means, as `fair --null` (uniform or quasi-static).
+    /// What fair means, as `fair --null` (uniform, quasi-static, or a target LABEL=P,…).
     #[arg(long, default_value = "uniform", value_parser = super::args::parse_null)]
     pub null: dicephys::studies::fair::Null,
     #[command(flatten)]
@@ -156,7 +156,7 @@ pub fn run(a: &SlurmArgs) -> Result<()> {
             return Ok(());
         }
         SlurmCommand::Roll(r) => (vec![roll("roll", &r.roll, None, &r.job)?], &r.job),
-        SlurmCommand::Fair(f) => (vec![roll("fair", &f.roll, Some(f.null), &f.job)?], &f.job),
+        SlurmCommand::Fair(f) => (vec![roll("fair", &f.roll, Some(f.null.clone()), &f.job)?], &f.job),
         c => {
             let (cfg, threads, json, given, job) = study_of(c)?;
             if let Some(flag) = given {
@@ -314,7 +314,7 @@ fn roll(
     let threads = r.run.threads.max(1);
     super::args::threads(threads)?;
     // `fair` throws in a tumble unless told otherwise, as on one machine.
-    let spec = match fair {
+    let spec = match &fair {
         None => r.spec()?,
         Some(_) => r.spec_or(dicephys::model::throws::ThrowStyle::Tumble)?,
     };

@@ -39,6 +39,10 @@ pub struct FaceVerdict {
 pub struct Fairness {
     /// The null the faces are set against.
     pub null: Null,
+    /// Why the null is not what the die was made for (a uniform null on a die whose faces are
+    /// not alike: `theory::null::unlike`); absent where it is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
     /// Rolls at rest on a face: the denominator.
     pub n: u64,
     /// Each face the die can show (six in 3D, four in 2D), in the order of their numbers.
@@ -90,6 +94,9 @@ impl Fairness {
             );
         }
         out += &format!("  {}\n", self.verdict);
+        if let Some(n) = &self.note {
+            out += &format!("  note: {n}\n");
+        }
         out
     }
 

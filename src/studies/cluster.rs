@@ -319,7 +319,7 @@ pub fn finishing(dir: &Path) -> Result<Finishing> {
             let (json, text) = match fair {
                 None => (crate::run::seal::to_string(&merged, true)?, merged.human()),
                 Some(null) => {
-                    let f = crate::studies::fair::assess(&merged, null)?;
+                    let f = crate::studies::fair::assess(&merged, &null)?;
                     let doc = serde_json::json!({ "fairness": f, "summary": merged });
                     (crate::run::seal::to_string(&doc, true)?, f.text(&merged))
                 }

@@ -28,38 +28,134 @@ fn critical(p: f64, dof: usize) -> f64 {
     ChiSquared::new(dof as f64).map_or(f64::NAN, |d| d.inverse_cdf(1.0 - p))
 }
 
-/// The null's probability for each direction the die can show.
-fn null_probabilities(s: &RunSummary, null: Null) -> Result<Vec<f64>> {
-    if let Some(f) = crate::report::summary::shape_faces(&s.tally, &s.spec.scene) {
-        return match null {
-            Null::Uniform => Ok(vec![1.0 / f.len() as f64; f.len()]),
-            Null::QuasiStatic => theory::quasi_static::outcome_shares(&s.spec.scene)
-                .expect("a die of any shape")
-                .map_err(|e| Error::field(Field::Null, "quasi-static", e)),
-        };
+/// The null's probability for each direction the die can show (a die of any shape: each
+/// label, in `shape_faces`' order), and a note where the null is not what the die was made for
+/// (a uniform null on a die whose faces are not alike).
+fn null_probabilities(s: &RunSummary, null: &Null) -> Result<(Vec<f64>, Option<String>)> {
+    let scene = &s.spec.scene;
+    if let (Some(f), Some(shape)) = (
+        crate::report::summary::shape_faces(&s.tally, scene),
+        scene.shape.as_deref(),
+    ) {
+        let labels: Vec<String> = f.into_iter().map(|(l, _)| l).collect();
+        return shape_null(shape, scene, &labels, null);
     }
     let shown = if s.mode == Mode::ThreeD { 6 } else { 4 };
     match (null, s.mode) {
-        (Null::Uniform, _) => Ok(vec![1.0 / shown as f64; shown]),
-        (Null::QuasiStatic, Mode::ThreeD) if !s.spec.scene.features.plain() => {
+        (Null::Uniform, _) => Ok((vec![1.0 / shown as f64; shown], block_unlike(scene))),
+        (Null::Target(t), _) => {
+            let numbers: Vec<String> = s.layout.numbers()[..shown]
+                .iter()
+                .map(u8::to_string)
+                .collect();
+            let q = theory::null::target_for(t, &numbers)
+                .map_err(|e| Error::field(Field::Null, null.spec(), e))?;
+            Ok((q, None))
+        }
+        (Null::QuasiStatic, Mode::ThreeD) if !scene.features.plain() => {
             // A made die: each face's solid angle from the centre of mass, of the inner box.
-            let die = crate::model::die::DieShape::of(&s.spec.scene);
-            Ok(theory::quasi_static::faces_up(&die).to_vec())
+            let die = crate::model::die::DieShape::of(scene);
+            Ok((theory::quasi_static::faces_up(&die).to_vec(), None))
         }
         (Null::QuasiStatic, Mode::ThreeD) => {
-            let (p, _) = theory::simpson_3d(&s.spec.scene.block);
-            Ok((0..6)
-                .map(|d| match side_of(d) {
-                    crate::model::block::Outcome::Breadth => p.breadth_vertical / 2.0,
-                    crate::model::block::Outcome::Width => p.width_vertical / 2.0,
-                    _ => p.length_vertical / 2.0,
-                })
-                .collect())
+            let (p, _) = theory::simpson_3d(&scene.block);
+            Ok((
+                (0..6)
+                    .map(|d| match side_of(d) {
+                        crate::model::block::Outcome::Breadth => p.breadth_vertical / 2.0,
+                        crate::model::block::Outcome::Width => p.width_vertical / 2.0,
+                        _ => p.length_vertical / 2.0,
+                    })
+                    .collect(),
+                None,
+            ))
         }
         (Null::QuasiStatic, Mode::TwoD) => Err(Error::field(
             Field::Null,
             "quasi-static",
             "the quasi-static theory is 3D; in 2D give uniform",
+        )),
+    }
+}
+
+/// Refused before anything rolls: a null the die of `spec` cannot be judged against (a target
+/// whose labels are not the die's, the quasi-static theory in 2D).
+pub fn check_null(spec: &RunSpec, null: &Null) -> Result<()> {
+    let scene = &spec.scene;
+    match null {
+        Null::Target(t) => {
+            let labels: Vec<String> = match scene.shape.as_deref() {
+                Some(shape) => theory::null::uniform_shares(shape)
+                    .into_iter()
+                    .map(|(l, _)| l)
+                    .collect(),
+                None => {
+                    let shown = if scene.mode == Mode::ThreeD { 6 } else { 4 };
+                    scene.features.layout.numbers()[..shown]
+                        .iter()
+                        .map(u8::to_string)
+                        .collect()
+                }
+            };
+            theory::null::target_for(t, &labels)
+                .map(|_| ())
+                .map_err(|e| Error::field(Field::Null, null.spec(), e))
+        }
+        Null::QuasiStatic if scene.mode == Mode::TwoD => Err(Error::field(
+            Field::Null,
+            "quasi-static",
+            "the quasi-static theory is 3D; in 2D give uniform",
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// A cuboid's faces are alike when it is (nearly) a cube: each face's solid angle from its
+/// centre (`theory::null::unlike`); in 2D, when its breadth and width are.
+fn block_unlike(scene: &crate::model::scene::Scene) -> Option<String> {
+    let b = &scene.block;
+    match scene.mode {
+        Mode::ThreeD => {
+            let (p, _) = theory::simpson_3d(b);
+            theory::null::unlike(&[
+                p.breadth_vertical / 2.0,
+                p.width_vertical / 2.0,
+                p.length_vertical / 2.0,
+            ])
+        }
+        Mode::TwoD => theory::null::unlike(&[b.breadth, b.width]),
+    }
+}
+
+/// A die of any shape's null for each of `labels` (its labels, in `shape_faces`' order), and
+/// the uniform null's note where its faces are not alike.
+fn shape_null(
+    shape: &crate::model::shape::Shape,
+    scene: &crate::model::scene::Scene,
+    labels: &[String],
+    null: &Null,
+) -> Result<(Vec<f64>, Option<String>)> {
+    let by_label = |shares: Vec<(String, f64)>| -> Vec<f64> {
+        labels
+            .iter()
+            .map(|l| shares.iter().find(|(m, _)| m == l).map_or(0.0, |s| s.1))
+            .collect()
+    };
+    match null {
+        Null::Uniform => Ok((
+            by_label(theory::null::uniform_shares(shape)),
+            theory::null::alike(shape),
+        )),
+        Null::QuasiStatic => {
+            let p = theory::quasi_static::outcome_shares(scene)
+                .expect("a die of any shape")
+                .map_err(|e| Error::field(Field::Null, "quasi-static", e))?;
+            Ok((p, None))
+        }
+        Null::Target(t) => Ok((
+            theory::null::target_for(t, labels)
+                .map_err(|e| Error::field(Field::Null, null.spec(), e))?,
+            None,
         )),
     }
 }
@@ -90,8 +186,8 @@ fn face_counts(
 }
 
 /// The faces of the run `s` set against `null`.
-pub fn assess(s: &RunSummary, null: Null) -> Result<Fairness> {
-    let q = null_probabilities(s, null)?;
+pub fn assess(s: &RunSummary, null: &Null) -> Result<Fairness> {
+    let (q, note) = null_probabilities(s, null)?;
     let shape = crate::report::summary::shape_faces(&s.tally, &s.spec.scene);
     if shape.is_none() && !s.tally.faces_complete() {
         return Err(Error::Invalid(
@@ -101,7 +197,9 @@ pub fn assess(s: &RunSummary, null: Null) -> Result<Fairness> {
         ));
     }
     let (numbers, names, counts) = face_counts(s, shape.as_deref(), q.len());
-    judge(&numbers, &names, &counts, &q, null, "rolls at rest")
+    let mut fair = judge(&numbers, &names, &counts, &q, null, "rolls at rest")?;
+    fair.note = note;
+    Ok(fair)
 }
 
 /// Counts a tester measured, `LABEL=N,LABEL=N,…` (`1=170,2=160,…`; a label as the die shows it,
@@ -138,12 +236,28 @@ pub fn parse_counts(text: &str) -> Result<Vec<(String, u64)>> {
 /// the bias as a run's.
 pub fn assess_counts(
     counted: &[(String, u64)],
-    null: Null,
+    null: &Null,
     scene: &crate::model::scene::Scene,
     layout: Layout,
 ) -> Result<Fairness> {
+    let given: Vec<String> = counted.iter().map(|(l, _)| l.clone()).collect();
+    let mut note = None;
     let q = match null {
-        Null::Uniform => vec![1.0 / counted.len() as f64; counted.len()],
+        // The die's own labels: each its facets' share (a die whose labels merge facets);
+        // other labels: 1/N over the faces given.
+        Null::Uniform => match scene.shape.as_deref() {
+            Some(shape) if same_labels(&given, &shape.labels()) => {
+                let shares = theory::null::uniform_shares(shape);
+                note = theory::null::alike(shape);
+                given
+                    .iter()
+                    .map(|l| shares.iter().find(|(m, _)| m == l).map_or(0.0, |s| s.1))
+                    .collect()
+            }
+            _ => vec![1.0 / counted.len() as f64; counted.len()],
+        },
+        Null::Target(t) => theory::null::target_for(t, &given)
+            .map_err(|e| Error::field(Field::Null, null.spec(), e))?,
         Null::QuasiStatic => {
             let shares: Vec<(String, f64)> = match &scene.shape {
                 Some(shape) => {
@@ -210,7 +324,17 @@ pub fn assess_counts(
         .map(|(k, l)| l.parse().unwrap_or(k as u8 + 1))
         .collect();
     let counts: Vec<u64> = counted.iter().map(|(_, c)| *c).collect();
-    judge(&numbers, &names, &counts, &q, null, "throws counted")
+    let mut fair = judge(&numbers, &names, &counts, &q, null, "throws counted")?;
+    fair.note = note;
+    Ok(fair)
+}
+
+/// True if `a` and `b` hold the same labels (each once in `a`).
+fn same_labels(a: &[String], b: &[&str]) -> bool {
+    let mut b: Vec<&str> = b.to_vec();
+    b.sort_unstable();
+    b.dedup();
+    a.len() == b.len() && a.iter().all(|l| b.contains(&l.as_str()))
 }
 
 /// Each face's count set against its null probability `q`: the verdict of [`assess`]; `what`
@@ -220,7 +344,7 @@ fn judge(
     names: &[String],
     counts: &[u64],
     q: &[f64],
-    null: Null,
+    null: &Null,
     what: &str,
 ) -> Result<Fairness> {
     let n: u64 = counts.iter().sum();
@@ -294,7 +418,8 @@ fn judge(
         )
     };
     Ok(Fairness {
-        null,
+        null: null.clone(),
+        note: None,
         n,
         faces,
         chi2,
@@ -506,7 +631,7 @@ pub fn vary(
     layout: Layout,
     what: Varied,
     values: &[f64],
-    null: Null,
+    null: &Null,
     runner: &Runner,
 ) -> Result<Option<Vec<BiasPoint>>> {
     let specs = values
@@ -515,6 +640,11 @@ pub fn vary(
             // The pips already sit by the run's layout (`roll --layout` placed them).
             let mut s = spec.clone();
             s.scene.features = what.set(&spec.scene.features, v)?;
+            // A die of any shape rests on the facets it rests on at this centre of mass.
+            s.scene = s
+                .scene
+                .resting_at_com()
+                .map_err(|e| Error::field(Field::Vary, format!("{what}={v}"), e))?;
             // A value the die cannot take is named as the user wrote it, `--vary NAME=V`, not
             // as the feature's own flag, which they did not give (reliability round 5, G).
             s.validate(false).map_err(|e| match e {
