@@ -399,7 +399,7 @@ def roll(
     floor_thickness: Optional[float] = None,
     linear_damping: float = 0.0,
     angular_damping: float = 0.0,
-    rolling_resistance: float = 0.0,
+    rolling_resistance: Optional[float] = None,
     sleep: bool = True,
     settle: Optional[str] = None,
     flight: str = "fast",
@@ -437,7 +437,8 @@ def roll(
     preset, floor, floor_thickness, linear_damping, angular_damping, sleep: the scene
         (as ``dicephys roll --help`` says).
     rolling_resistance: mm, the lever arm of the floor's push against rolling and turning in
-        place (so that a coin rolling on its rim stops); Bullet only.
+        place (so that a coin rolling on its rim stops); Bullet only; None: 0.05 for a coin
+        on Bullet (a hard table), else 0.
     settle: None (the exact early stop where it is audited exact), "certificate" or
         "dicephys".  flight: "fast" or "stepped".  faithful: DicePhys as the paper ran it.
     com: the centre of mass (x, y, z) in mm from the geometric centre; pips: (diameter,
@@ -517,7 +518,7 @@ def fair(
     floor_thickness: Optional[float] = None,
     linear_damping: float = 0.0,
     angular_damping: float = 0.0,
-    rolling_resistance: float = 0.0,
+    rolling_resistance: Optional[float] = None,
     sleep: bool = True,
     settle: Optional[str] = None,
     flight: str = "fast",

@@ -152,6 +152,15 @@ pub fn run(a: &RollArgs) -> Result<()> {
     } else {
         out!("{}", summary.human());
     }
+    // A die of any shape none of whose rolls came to rest on a face has no shares to give.
+    if let Some(shape) = summary.shape.as_ref().filter(|_| !summary.partial) {
+        if summary.rolls > 0 && shape.faces.iter().all(|f| f.count == 0) {
+            let why = dicephys::report::summary::check_settled(&summary.tally, &spec.scene)
+                .err()
+                .map_or_else(|| "no roll came to rest on a face".into(), |e| e.to_string());
+            return Err(Error::Run(why));
+        }
+    }
     done
 }
 

@@ -213,7 +213,8 @@ pub struct ShapeFace {
     pub p: f64,
     /// The binomial error of `p`.
     pub p_err: f64,
-    /// (p − 1/N) / p_err.
+    /// Its departure from a fair die's share q (its facets' share of all) over that share's
+    /// own error, (p − q)/√(q(1 − q)/n).
     pub z_fair: f64,
     /// The quasi-static theory's probability (`theory::quasi_static::shape`), of the rolls
     /// that end on an outcome; absent where it is not built (a coin loaded off its axis).
@@ -221,39 +222,105 @@ pub struct ShapeFace {
     pub quasi_static: Option<f64>,
 }
 
-/// A die of any shape's outcomes against a fair die's 1/N.
+/// A die of any shape's outcomes against a fair die's (each label its facets' share).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ShapeOutcomes {
     /// The die (`Shape::name`).
     pub shape: String,
     /// Each outcome, in the die's order.
     pub faces: Vec<ShapeFace>,
-    /// Pearson's χ² against 1/N each.
+    /// Pearson's χ² against a fair die's shares.
     pub chi2: f64,
     /// Its degrees of freedom, N − 1.
     pub dof: usize,
     /// Its p-value.
     pub p_value: f64,
+    /// Why a fair die's shares are not what this die was made for (its faces are not
+    /// alike: `theory::null::unlike`); absent where they are.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fair_note: Option<String>,
     /// Pearson's χ² against the quasi-static theory (over the outcomes it gives a share;
     /// degrees of freedom one fewer), its degrees of freedom and p-value: how far the bounce
     /// takes the die from rolling down at rest.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub against_quasi_static: Option<(f64, usize, f64)>,
+    /// Why the quasi-static theory is not beside the counts, where it is not.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quasi_static_missing: Option<String>,
+    /// Rolls that did not come to rest on a face (still moving at the step cap, leaning,
+    /// failed): none of the shares above counts them.
+    #[serde(default)]
+    pub unsettled: u64,
+    /// Why no verdict is drawn from these shares ([`check_settled`]: too many rolls off a
+    /// face); absent where one is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub no_verdict: Option<String>,
+}
+
+/// The share of a run's rolls that may end off a face before its faces' shares, which count
+/// only the rolls at rest on one, are refused a verdict: 1 %. Past it the missing rolls could
+/// move a share by more than a percentage point, and a coin on its rim or a prism still
+/// rolling at the cap is not a random roll to leave out (on its edge, a coin is on its way
+/// to the edge outcome).
+pub const MAX_UNSETTLED_SHARE: f64 = 0.01;
+
+/// Refused, saying why and what to change, when more than [`MAX_UNSETTLED_SHARE`] of the
+/// rolls of `tally` did not come to rest on a face, or none did: a verdict over the settled
+/// rolls alone would be biased.
+pub fn check_settled(tally: &Tally, scene: &crate::model::scene::Scene) -> crate::Result<()> {
+    let faced: u64 = match scene.shape {
+        Some(_) => tally.faces.iter().sum(),
+        None => tally.up.iter().sum(),
+    };
+    let off = tally.rolls.saturating_sub(faced);
+    let lean = tally.counts.unknown;
+    let why = format!(
+        "{} of {} rolls did not come to rest on a face ({} still moving at the step cap, {lean} \
+         leaning, {} failed)",
+        off,
+        tally.rolls,
+        tally.unconverged,
+        tally.failed_total()
+    );
+    let advice = "raise --max-steps, or give --rolling-resistance (0.05 mm: a hard table) so that \
+                  a die rolling on an edge or a rim stops";
+    if tally.rolls > 0 && faced == 0 {
+        return Err(crate::Error::failed(format!("{why}: nothing to count; {advice}")));
+    }
+    if off as f64 > MAX_UNSETTLED_SHARE * tally.rolls as f64 {
+        return Err(crate::Error::failed(format!(
+            "{why}, more than {:.0} %: the faces' shares over the others would be biased; \
+             {advice}",
+            100.0 * MAX_UNSETTLED_SHARE
+        )));
+    }
+    Ok(())
 }
 
 impl ShapeOutcomes {
     /// The outcomes of a die of any shape from its tally; `None` for the cuboid.
     pub fn of(tally: &Tally, scene: &crate::model::scene::Scene) -> Option<ShapeOutcomes> {
+        let shape = scene.shape.as_deref()?;
         let counts = shape_faces(tally, scene)?;
         let n: u64 = counts.iter().map(|(_, c)| c).sum();
         let k = counts.len();
-        let fair = 1.0 / k as f64;
-        let expected = n as f64 * fair;
+        let shares = crate::theory::null::uniform_shares(shape);
+        let fair: Vec<f64> = counts
+            .iter()
+            .map(|(l, _)| shares.iter().find(|(m, _)| m == l).map_or(0.0, |s| s.1))
+            .collect();
+        let nf = n.max(1) as f64;
         let chi2 = counts
             .iter()
-            .map(|(_, c)| (*c as f64 - expected).powi(2) / expected)
+            .zip(&fair)
+            .map(|((_, c), q)| (*c as f64 - nf * q).powi(2) / (nf * q))
             .sum();
-        let theory = crate::theory::quasi_static::outcome_shares(scene)?.ok();
+        let (theory, quasi_static_missing) = match crate::theory::quasi_static::outcome_shares(scene)
+        {
+            Some(Ok(q)) => (Some(q), None),
+            Some(Err(e)) => (None, Some(e)),
+            None => (None, None),
+        };
         let against_quasi_static = theory.as_ref().map(|q| {
             let (mut chi2, mut k) = (0.0, 0usize);
             for ((_, c), q) in counts.iter().zip(q) {
@@ -273,26 +340,33 @@ impl ShapeOutcomes {
             .into_iter()
             .enumerate()
             .map(|(i, (label, count))| {
-                let p = count as f64 / n.max(1) as f64;
-                // The error of a fair die's p at this n, so that a face never seen has one.
-                let p_err = crate::theory::stats::binomial_err(fair, n.max(1));
+                let p = count as f64 / nf;
+                let q = fair[i];
                 ShapeFace {
                     label,
                     count,
                     p,
-                    p_err,
-                    z_fair: (p - fair) / p_err,
-                    quasi_static: theory.as_ref().map(|q| q[i]),
+                    // The face's own binomial error (fair's too).
+                    p_err: crate::theory::stats::binomial_err(p, n.max(1)),
+                    // The departure over the fair share's own error, which a face never seen
+                    // also has.
+                    z_fair: (p - q) / crate::theory::stats::binomial_err(q, n.max(1)),
+                    quasi_static: theory.as_ref().map(|t| t[i]),
                 }
             })
             .collect();
+        let faced: u64 = tally.faces.iter().sum();
         Some(ShapeOutcomes {
-            shape: scene.shape.as_ref()?.name.clone(),
+            shape: shape.name.clone(),
             faces,
             chi2,
             dof: k.saturating_sub(1),
             p_value: crate::theory::stats::chi_square_p_value(chi2, k.saturating_sub(1)),
+            fair_note: crate::theory::null::alike(shape),
             against_quasi_static,
+            quasi_static_missing,
+            unsettled: tally.rolls.saturating_sub(faced),
+            no_verdict: check_settled(tally, scene).err().map(|e| e.to_string()),
         })
     }
 
@@ -312,13 +386,27 @@ impl ShapeOutcomes {
                 .collect();
             s += &format!("  {}\n", each.join("  "));
         }
+        if self.unsettled > 0 {
+            s += &format!(
+                "  {} rolls not at rest on a face: none of these shares counts them\n",
+                self.unsettled
+            );
+        }
+        if let Some(why) = &self.no_verdict {
+            s += &format!("  no verdict: {why}\n");
+            return s;
+        }
         s += &format!(
-            "  against a fair die (1/{} each): χ² {:.1} on {} degrees of freedom, p {:.3}\n",
-            self.faces.len(),
-            self.chi2,
-            self.dof,
-            self.p_value
+            "  against a fair die (each face's share of its facets): χ² {:.1} on {} degrees of \
+             freedom, p {:.3}\n",
+            self.chi2, self.dof, self.p_value
         );
+        if let Some(note) = &self.fair_note {
+            s += &format!("  note: {note}\n");
+        }
+        if let Some(why) = &self.quasi_static_missing {
+            s += &format!("  the quasi-static theory is not beside these counts: {why}\n");
+        }
         if let Some((chi2, dof, p)) = self.against_quasi_static {
             let worst = self
                 .faces

@@ -78,8 +78,9 @@ pub struct SceneRequest {
     pub linear_damping: f64,
     /// Damping rates, 1/s.
     pub angular_damping: f64,
-    /// Rolling resistance's lever arm, mm.
-    pub rolling_resistance_mm: f64,
+    /// Rolling resistance's lever arm, mm (`None`: the die's own default on its engine,
+    /// `Scene::default_rolling_resistance`).
+    pub rolling_resistance_mm: Option<f64>,
     /// Let the engine put the die to sleep.
     pub sleep: bool,
 }
@@ -100,7 +101,7 @@ impl Default for SceneRequest {
             floor_thickness: None,
             linear_damping: paper.linear_damping,
             angular_damping: paper.angular_damping,
-            rolling_resistance_mm: paper.rolling_resistance * 1e3,
+            rolling_resistance_mm: None,
             sleep: paper.sleeping,
         }
     }
@@ -146,7 +147,7 @@ impl SceneRequest {
         scene.preset = self.preset;
         scene.floor = self.floor;
         scene.linear_damping = self.linear_damping;
-        scene.rolling_resistance = self.rolling_resistance_mm / 1000.0;
+        scene.rolling_resistance = self.rolling_resistance_mm.unwrap_or(0.0) / 1000.0;
         scene.angular_damping = self.angular_damping;
         scene.sleeping = self.sleep;
         let (features, density) = Features::described(
@@ -343,7 +344,16 @@ impl RollRequest {
     /// The run, checked, its throws in the style asked, else `default` (a die of any shape: a
     /// tumble).
     pub fn spec_or(&self, default: ThrowStyle) -> Result<RunSpec> {
-        let scene = self.scene.scene()?;
+        let mut scene = self.scene.scene()?;
+        // Unless one is asked: a coin on Bullet rolls against a hard table's resistance (with
+        // none, a coin on its rim rolls to the step cap); every other die against none, as
+        // DicePhys (Rapier has none).
+        if self.scene.rolling_resistance_mm.is_none()
+            && scene.is_coin()
+            && self.engine == EngineKind::Bullet
+        {
+            scene.rolling_resistance = crate::model::scene::COIN_ROLLING_RESISTANCE;
+        }
         let default = match ThrowStyle::default_for(&scene) {
             ThrowStyle::Paper => default,
             other => other,
