@@ -63,15 +63,15 @@ pub fn run(mut a: FairArgs) -> Result<()> {
     if let Some(c) = &a.counts {
         return counted(a, &spec, c);
     }
-    if let Some(v) = &a.vary {
-        return vary(a, &spec, v);
-    }
-    // The null is checked before anything rolls.
+    // The null is checked before anything rolls or is written.
     if a.null == Null::QuasiStatic && spec.scene.mode == dicephys::model::scene::Mode::TwoD {
         return Err(Error::Usage(
             "--null quasi-static (solid-angle): the quasi-static theory is 3D; in 2D give uniform"
                 .into(),
         ));
+    }
+    if let Some(v) = &a.vary {
+        return vary(a, &spec, v);
     }
     let _held = match &a.out {
         Some(dir) => {
@@ -120,7 +120,10 @@ pub fn run(mut a: FairArgs) -> Result<()> {
 
 /// `--out DIR` made, claimed and held for this `fair` run (another run's directory is refused,
 /// and so is this one's while another process runs it): held while the returned file lives.
-fn claim_out(dir: &std::path::Path, identity: &serde_json::Value) -> Result<std::fs::File> {
+fn claim_out(
+    dir: &std::path::Path,
+    identity: &serde_json::Value,
+) -> Result<dicephys::run::lock::Held> {
     std::fs::create_dir_all(dir)
         .map_err(|e| Error::Usage(format!("--out {}: cannot create it ({e})", dir.display())))?;
     Ok(dicephys::studies::fair::claim(dir, identity)?)
@@ -162,8 +165,10 @@ fn counted(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, text: &str) -> Res
 /// `fair --vary`: the die at each value of one feature, judged, as a table (or JSON) and,
 /// with `--out`, the bias figure.
 fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str) -> Result<()> {
-    use dicephys::studies::fair::{parse_vary, vary, write_bias};
+    use dicephys::studies::fair::{parse_vary, varied_specs, vary, write_bias};
     let (what, values) = parse_vary(v)?;
+    // Every value checked before the directory is claimed: a refused one writes nothing.
+    varied_specs(spec, what, &values)?;
     let identity = serde_json::json!({ "spec": spec, "null": a.null, "vary": v });
     let _held = a
         .out

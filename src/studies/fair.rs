@@ -310,7 +310,10 @@ fn judge(
 
 /// Claims `dir` for this `fair` run (`run::owner`) and holds it while the returned file lives:
 /// refused if another command or another run owns it, or another process runs this one there.
-pub fn claim(dir: &std::path::Path, identity: &serde_json::Value) -> Result<std::fs::File> {
+pub fn claim(
+    dir: &std::path::Path,
+    identity: &serde_json::Value,
+) -> Result<crate::run::lock::Held> {
     super::place::claim(dir, "fair", identity, super::place::Claimant::Here)?;
     crate::run::owner::hold(dir)
 }
@@ -509,7 +512,41 @@ pub fn vary(
     null: Null,
     runner: &Runner,
 ) -> Result<Option<Vec<BiasPoint>>> {
-    let specs = values
+    let specs = varied_specs(spec, what, values)?;
+    let mut out = Vec::new();
+    for (i, (s, &value)) in specs.iter().zip(values).enumerate() {
+        let base = i as u64 * spec.rolls;
+        let progress = |n| (runner.progress)(base + n);
+        let summary =
+            crate::studies::outputs::roll(s, None, None, None, &runner.with_progress(&progress))?
+                .with_layout(layout);
+        if summary.partial {
+            return Ok(None);
+        }
+        out.push(BiasPoint {
+            value,
+            fairness: assess(&summary, null)?,
+        });
+    }
+    Ok(Some(out))
+}
+
+/// The run of `spec` at each of `values` of `what`, each checked: what [`vary`] rolls, and
+/// what a front end checks before it claims an output directory, so that a value the die
+/// cannot take is refused with nothing written.
+pub fn varied_specs(spec: &RunSpec, what: Varied, values: &[f64]) -> Result<Vec<RunSpec>> {
+    if let (Varied::PipDepth, Some(shape)) = (what, &spec.scene.shape) {
+        return Err(Error::field(
+            Field::Vary,
+            "pip_depth",
+            format!(
+                "{} has no pips (they are drilled in a cuboid's faces, --block): vary com_x, \
+                 com_y or com_z",
+                shape.name
+            ),
+        ));
+    }
+    values
         .iter()
         .map(|&v| {
             // The pips already sit by the run's layout (`roll --layout` placed them).
@@ -532,23 +569,7 @@ pub fn vary(
             })?;
             Ok(s)
         })
-        .collect::<Result<Vec<_>>>()?;
-    let mut out = Vec::new();
-    for (i, (s, &value)) in specs.iter().zip(values).enumerate() {
-        let base = i as u64 * spec.rolls;
-        let progress = |n| (runner.progress)(base + n);
-        let summary =
-            crate::studies::outputs::roll(s, None, None, None, &runner.with_progress(&progress))?
-                .with_layout(layout);
-        if summary.partial {
-            return Ok(None);
-        }
-        out.push(BiasPoint {
-            value,
-            fairness: assess(&summary, null)?,
-        });
-    }
-    Ok(Some(out))
+        .collect()
 }
 
 /// Writes the bias figure (`bias.svg`, `.png`: each face's probability against the varied
