@@ -59,6 +59,28 @@ pub struct Face {
     pub label: String,
 }
 
+/// A face's label as a die file or `fair --counts` may give it: one that a count can name
+/// (`LABEL=N`, a CSV's `face_<label>` column) and a report can write, so not empty, without
+/// `,` or `=`, and without control characters; else what is wrong with it.
+pub fn check_label(label: &str) -> std::result::Result<(), String> {
+    let shown = label.escape_default();
+    if label.trim().is_empty() {
+        Err(format!("label '{shown}' is empty"))
+    } else if label.chars().any(|c| c == ',' || c == '=') {
+        Err(format!(
+            "label '{shown}' holds ',' or '=', which a count of it (LABEL=N) cannot name"
+        ))
+    } else if label.chars().any(char::is_control) {
+        Err(format!("label '{shown}' holds a control character"))
+    } else if label.trim() != label {
+        Err(format!(
+            "label '{shown}' starts or ends with a space, which a count of it loses"
+        ))
+    } else {
+        Ok(())
+    }
+}
+
 /// A die of any shape.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Shape {

@@ -114,20 +114,26 @@ pub fn parse_counts(text: &str) -> Result<Vec<(String, u64)>> {
             .split_once('=')
             .ok_or_else(|| bad(format!("'{item}': write LABEL=COUNT (e.g. 1=170,2=160,…)")))?;
         let label = label.trim();
-        let n: u64 = n
-            .trim()
-            .parse()
-            .map_err(|_| bad(format!("'{}' is not a count (a whole number)", n.trim())))?;
+        let n = crate::calibration::data::count(n.trim()).map_err(bad)?;
         if label.is_empty() || out.iter().any(|(l, _)| l == label) {
             return Err(bad(format!("face '{label}' is empty or given twice")));
         }
+        crate::model::shape::check_label(label).map_err(bad)?;
         out.push((label.to_string(), n));
     }
     if out.len() < 2 {
         return Err(bad("give at least two faces' counts".into()));
     }
-    if out.iter().map(|(_, n)| n).sum::<u64>() == 0 {
-        return Err(bad("no throws counted".into()));
+    // Each count is at most a fit's row's; their sum is checked too, never wrapped.
+    let max = crate::calibration::data::MAX_ROW_THROWS;
+    match out.iter().try_fold(0u64, |a, (_, n)| a.checked_add(*n)) {
+        Some(0) => return Err(bad("no throws counted".into())),
+        Some(t) if t <= max => {}
+        _ => {
+            return Err(bad(format!(
+                "counts too large: at most {max} throws in all"
+            )))
+        }
     }
     Ok(out)
 }
