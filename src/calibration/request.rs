@@ -143,6 +143,9 @@ impl FitRequest {
         let d = &self.die;
         let shape =
             crate::model::shape::described(d.file.as_deref(), d.shape.as_deref(), d.size, d.scale)?;
+        if let (Some(l), Some(s)) = (d.layout, &shape) {
+            return Err(crate::run::request::layout_beside(l, s));
+        }
         let rows = match &shape {
             Some(s) => data::on_shape(&self.rows, s)
                 .map_err(|e| Error::field(Field::Data, "", e.to_string()))?,

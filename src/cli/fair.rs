@@ -9,6 +9,39 @@ use clap::Args;
 use dicephys::model::throws::ThrowStyle;
 use dicephys::studies::fair::{assess, Null};
 
+/// The flags that say how a die is rolled: refused beside `--counts`, which rolls nothing
+/// (the die's own flags stay: the quasi-static null reads them).
+const SIMULATION: [&str; 28] = [
+    "engine",
+    "dt",
+    "friction",
+    "restitution",
+    "allow_restitution_above_one",
+    "preset",
+    "floor",
+    "floor_thickness",
+    "linear_damping",
+    "angular_damping",
+    "rolling_resistance",
+    "no_sleep",
+    "seed",
+    "source",
+    "velocity",
+    "spin",
+    "drop_height",
+    "style",
+    "kappa",
+    "rolls",
+    "threads",
+    "max_steps",
+    "settle",
+    "margin",
+    "audit",
+    "flight",
+    "faithful",
+    "per_roll",
+];
+
 /// `dicephys fair`'s arguments.
 #[derive(Args, Debug)]
 #[command(mut_arg("precision", |a| a.hide(true)))]
@@ -42,7 +75,7 @@ pub struct FairArgs {
     /// quasi-static: the die --block, --shape or --die describe). No simulation: each face's
     /// p ± σ, the χ², and the throws that would see the bias; with --out, fairness.csv,
     /// fairness.json and the faces figure.
-    #[arg(long, value_name = "LABEL=N,...", conflicts_with_all = ["vary", "checkpoint", "resume", "precision", "within", "per_roll", "shard"])]
+    #[arg(long, value_name = "LABEL=N,...", conflicts_with_all = ["vary", "checkpoint", "resume", "precision", "within", "per_roll", "shard"], conflicts_with_all = SIMULATION)]
     pub counts: Option<String>,
 }
 
@@ -84,6 +117,9 @@ pub fn run(mut a: FairArgs) -> Result<()> {
     };
     if let Some(w) = spec.endless_roll_warning() {
         eprintln!("dicephys: warning: {w}");
+    }
+    if let Some(n) = super::roll::hull_note(&spec).filter(|_| !*a.roll.json) {
+        eprintln!("dicephys: note: {n}");
     }
     if let Some(n) = spec
         .loaded_die_note(&[spec.engine])
