@@ -367,5 +367,24 @@ fn messages_say_what_is_true_in_the_users_terms() {
         out,
     ]);
     refused(&o, 2, "its pip depth 3 mm");
+    // A die of any shape has no pips: the advice is not --pips, which it refuses.
+    let coin = write(
+        &d,
+        "coin.csv",
+        "label,surface,face_heads,face_tails,face_edge\nc,felt,10,12,1\nd,wood,10,12,2\n",
+    );
+    let o = dicephys(&[
+        "fit",
+        "--data",
+        &coin,
+        "--shape",
+        "coin:24,2",
+        "--free",
+        "e,pip_depth",
+        "--out",
+        out,
+    ]);
+    refused(&o, 2, "a die of any shape has no pips");
+    assert!(!stderr(&o).contains("--pips"), "{}", stderr(&o));
     assert!(!d.join("fit-out").exists());
 }
