@@ -224,6 +224,8 @@ pub enum Field {
     Kind,
     /// `ladder`.
     Ladder,
+    /// `layout`.
+    Layout,
     /// `linear_damping`.
     LinearDamping,
     /// `margin`.

@@ -479,8 +479,15 @@ def _roll(
         opts[k] = _pair(k, opts.get(k))
     opts["com"] = _triple("com", opts.get("com"), 3)
     opts["pips"] = _triple("pips", opts.get("pips"), 2)
+    # A bool is an int to Python and a number to the library: size=True would be 1 mm.
+    for k in ("size", "scale", "density", "edge_radius", "kappa", "dt", "restitution", "friction"):
+        if isinstance(opts.get(k), bool):
+            raise ValueError(f"{k}={opts[k]!r}: give a number")
     if opts.get("die") is not None:
-        opts["die"] = os.fspath(opts["die"])
+        try:
+            opts["die"] = os.fspath(opts["die"])
+        except TypeError:
+            raise TypeError(f"die={opts['die']!r}: give a path (a str or an os.PathLike)") from None
     tell, close = _progress(progress, what)
     try:
         text, human, csv_bytes = _native.roll(

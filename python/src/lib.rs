@@ -431,13 +431,21 @@ fn rolled(
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<(dicephys::report::summary::RunSummary, Option<Vec<u8>>)> {
     let threads = threads(threads_)?;
-    if let Some((p, _)) = precision {
+    if let Some((p, target)) = precision {
         if !(p > 0.0 && p < 1.0) {
-            return Err(bad(
-                "precision",
-                p,
-                "a fraction in (0, 1): 0.02 is a relative 2σ of 2 %",
-            ));
+            // fair's target is every face's probability, given as `within`.
+            return Err(match target {
+                Target::Faces => bad(
+                    "within",
+                    p,
+                    "a probability in (0, 1): 0.005 is each face to ±0.005 at 2σ",
+                ),
+                _ => bad(
+                    "precision",
+                    p,
+                    "a fraction in (0, 1): 0.02 is a relative 2σ of 2 %",
+                ),
+            });
         }
     }
     detached(py, progress, None, |session| {

@@ -130,6 +130,9 @@ def test_per_roll_arrays_match_the_cli_s_csv(tmp_path: Path) -> None:
         ({"block": "140x24x20", "progress": 5}, "progress"),
         ({"block": "140x24x20", "progress": "yes"}, "progress"),
         ({"block": "140x24x20", "rolls": True}, "rolls"),
+        # Issue 69, item 14: a bool is no size; an empty die file is no die.
+        ({"shape": "d20", "size": True}, "size=True"),
+        ({"die": "/dev/null"}, "^die=/dev/null: the die file is empty"),
         # Class G: a string where numbers belong is named, not read a character at a time.
         ({"block": "16x16x16", "com": "0,0,-1"}, "com='0,0,-1'"),
         ({"block": "16x16x16", "com": ("a", 0, 0)}, "com="),
@@ -144,6 +147,14 @@ def test_per_roll_arrays_match_the_cli_s_csv(tmp_path: Path) -> None:
 def test_bad_arguments_raise_value_error_naming_them(kwargs: dict, name: str) -> None:
     with pytest.raises(ValueError, match=name):
         dicephys.roll(**{"rolls": 10, **kwargs})
+
+
+def test_a_refusal_names_the_argument_the_caller_gave() -> None:
+    # Issue 69, item 16: fair's target is `within`, and a die that is no path names `die`.
+    with pytest.raises(ValueError, match="^within=2"):
+        dicephys.fair("16x16x16", rolls=10, within=2)
+    with pytest.raises(TypeError, match="^die=3: give a path"):
+        dicephys.roll(rolls=10, die=3)  # type: ignore[arg-type]
 
 
 def test_parameter_names_and_a_contact_are_read_as_the_cli_reads_them() -> None:

@@ -326,8 +326,25 @@ fn columns(have: &[&str], name: &str) -> Result<(Form, bool)> {
     Ok((Form::Block(outcomes, counted), with_thrower))
 }
 
+/// A count as a field (or `fair --counts`'s `LABEL=N`) gives it, a whole number; else what is
+/// wrong with `v`, quoted: not a whole number, or one past [`MAX_ROW_THROWS`].
+pub fn count(v: &str) -> std::result::Result<u64, String> {
+    let too_large = || {
+        format!(
+            "'{}' is too large a count (at most {MAX_ROW_THROWS})",
+            shown(v)
+        )
+    };
+    match v.parse::<u64>() {
+        Ok(n) if n <= MAX_ROW_THROWS => Ok(n),
+        Ok(_) => Err(too_large()),
+        Err(e) if *e.kind() == std::num::IntErrorKind::PosOverflow => Err(too_large()),
+        Err(_) => Err(format!("'{}' is not a count (a whole number)", shown(v))),
+    }
+}
+
 /// A record's counts and which of them are `-` (sides only); a field that is not a count is
-/// the error `(column, its text)`.
+/// the error `(column, what is wrong)`.
 fn counts_of(
     rec: &csv::StringRecord,
     outcomes: Outcomes,
@@ -339,7 +356,15 @@ fn counts_of(
         let c = 6 + k;
         match &rec[c] {
             "-" if outcomes == Outcomes::Sides => dashed[k] = true,
-            v => counts[k] = v.parse().map_err(|_| (c, v.to_string()))?,
+            v => {
+                counts[k] = count(v).map_err(|m| match v.parse::<f64>() {
+                    // A side's count may also be '-' (an equal side's, counted with it).
+                    Err(_) if outcomes == Outcomes::Sides => {
+                        (c, m.replace("(a whole number)", "(a whole number, or '-')"))
+                    }
+                    _ => (c, m),
+                })?
+            }
         }
     }
     Ok((counts, dashed))
@@ -477,12 +502,7 @@ fn shape_row(
     let counts = (0..labels.len())
         .map(|k| {
             let c = 2 + k;
-            rec[c].parse::<u64>().map_err(|_| {
-                (
-                    c,
-                    format!("'{}' is not a count (a whole number)", shown(&rec[c])),
-                )
-            })
+            count(&rec[c]).map_err(|m| (c, m))
         })
         .collect::<std::result::Result<Vec<u64>, _>>()?;
     Ok(DataRow {
@@ -514,12 +534,7 @@ fn block_row(
             "face counts are thrown in 3D (a 2D block shows a side, not a number)".into(),
         ));
     }
-    let (mut counts, mut dashed) = counts_of(rec, outcomes, counted).map_err(|(c, v)| {
-        (
-            c,
-            format!("'{}' is not a count (a whole number, or '-')", shown(&v)),
-        )
-    })?;
+    let (mut counts, mut dashed) = counts_of(rec, outcomes, counted)?;
     // Breadth is the larger side: swap a row given the other way, with its counts.
     if sides[1] < sides[2] {
         if outcomes == Outcomes::Faces {
@@ -827,5 +842,31 @@ mod tests {
         assert_eq!(rows[6].label, "row 7");
         assert_eq!(rows[6].counts, [0, 361, 639]);
         assert_eq!(rows[18].surface, "Tough Carpet");
+    }
+
+    #[test]
+    fn a_quoted_header_is_read_as_csv_and_counts_say_what_is_wrong() {
+        // A header's names are CSV fields: quoted, with a comma or a quote in them.
+        let rows = parse(
+            "label,surface,\"face_a,b\",\"face_say \"\"c\"\"\"\n\"r, 1\",felt,3,4\n",
+            "f.csv",
+        )
+        .unwrap();
+        assert_eq!(rows[0].labels, ["a,b", "say \"c\""]);
+        assert_eq!(rows[0].label, "r, 1");
+        assert_eq!(rows[0].counts, [3, 4]);
+        assert_eq!(count("170"), Ok(170));
+        assert!(count("x")
+            .unwrap_err()
+            .contains("'x' is not a count (a whole number)"));
+        assert!(count("-").unwrap_err().contains("is not a count"));
+        for big in [
+            "1234567890123456789012",
+            "18446744073709551615",
+            "1000000000001",
+        ] {
+            let e = count(big).unwrap_err();
+            assert!(e.contains("too large"), "{e}");
+        }
     }
 }

@@ -119,9 +119,7 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<BlockRow>> {
             [Some(l), Some(b), Some(w)] => {
                 let mut c = [0u64; 3];
                 for (k, &i) in [l, b, w].into_iter().enumerate() {
-                    c[k] = field(i)
-                        .parse()
-                        .map_err(|_| bad(line, format!("'{}' is not a count", shown(&field(i)))))?;
+                    c[k] = super::data::count(&field(i)).map_err(|m| bad(line, m))?;
                 }
                 Some(c)
             }

@@ -85,6 +85,14 @@ impl FitConfig {
             )));
         }
         self.check_shape()?;
+        if self.model.is_free(params::Kind::PipDepth) && self.method.shape.is_some() {
+            return Err(Error::field(
+                Field::Free,
+                "pip_depth",
+                "a die of any shape has no pips (they are drilled in a cuboid's faces): free \
+                 com_x, com_y or com_z",
+            ));
+        }
         if self.model.is_free(params::Kind::PipDepth) && self.method.die.pips.is_none() {
             return Err(Error::field(
                 Field::Free,
@@ -128,7 +136,8 @@ impl FitConfig {
         // box's ends must still fit inside the die).
         let dims = self.model.free.len();
         for r in &self.rows {
-            for u in [0.5, 0.0, 1.0] {
+            // The ends first: a die refused there is named by the range's own numbers.
+            for u in [0.0, 1.0, 0.5] {
                 let v = params::values(&self.model.fixed, &self.model.whole_axes(), &vec![u; dims]);
                 self.method
                     .spec(r.block, r.mode, &v, self.seed, self.design.rolls)
@@ -166,7 +175,7 @@ impl FitConfig {
         Error::field(
             Field::Range,
             boxes.join(","),
-            format!("the die at the box's end, its {what} {value} mm, {why}; narrow the range"),
+            format!("the die at the range's end, its {what} {value} mm, {why}; narrow the range"),
         )
     }
 

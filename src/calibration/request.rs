@@ -143,6 +143,9 @@ impl FitRequest {
         let d = &self.die;
         let shape =
             crate::model::shape::described(d.file.as_deref(), d.shape.as_deref(), d.size, d.scale)?;
+        if let (Some(l), Some(s)) = (d.layout, &shape) {
+            return Err(crate::run::request::layout_beside(l, s));
+        }
         let (mut die, density) = Features::described(
             d.file.as_deref(),
             d.com,

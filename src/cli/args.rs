@@ -177,10 +177,10 @@ pub struct DieArgs {
     pub shape: Option<String>,
     /// A named shape's size, mm, instead of its standard one (see the guide: a d4's edge,
     /// the others' distance between opposite faces).
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     pub size: Option<f64>,
     /// A mesh's lengths times this (e.g. 25.4 for a mesh in inches; default 1: mm).
-    #[arg(long, value_name = "FACTOR")]
+    #[arg(long, value_name = "FACTOR", allow_hyphen_values = true)]
     pub scale: Option<f64>,
 }
 

@@ -100,6 +100,7 @@ pub fn flag(field: Field) -> &'static str {
         Field::Kappa => "--kappa",
         Field::Kind => "--source",
         Field::Ladder => "--ladder",
+        Field::Layout => "--layout",
         Field::LinearDamping => "--linear-damping",
         Field::RollingResistance => "--rolling-resistance",
         Field::Margin => "--margin",

@@ -9,6 +9,39 @@ use clap::Args;
 use dicephys::model::throws::ThrowStyle;
 use dicephys::studies::fair::{assess, Null};
 
+/// The flags that say how a die is rolled: refused beside `--counts`, which rolls nothing
+/// (the die's own flags stay: the quasi-static null reads them).
+const SIMULATION: [&str; 28] = [
+    "engine",
+    "dt",
+    "friction",
+    "restitution",
+    "allow_restitution_above_one",
+    "preset",
+    "floor",
+    "floor_thickness",
+    "linear_damping",
+    "angular_damping",
+    "rolling_resistance",
+    "no_sleep",
+    "seed",
+    "source",
+    "velocity",
+    "spin",
+    "drop_height",
+    "style",
+    "kappa",
+    "rolls",
+    "threads",
+    "max_steps",
+    "settle",
+    "margin",
+    "audit",
+    "flight",
+    "faithful",
+    "per_roll",
+];
+
 /// `dicephys fair`'s arguments.
 #[derive(Args, Debug)]
 #[command(mut_arg("precision", |a| a.hide(true)))]
@@ -45,7 +78,7 @@ pub struct FairArgs {
     /// quasi-static: the die --block, --shape or --die describe). No simulation: each face's
     /// p ± σ, the χ², and the throws that would see the bias; with --out, fairness.csv,
     /// fairness.json and the faces figure.
-    #[arg(long, value_name = "LABEL=N,...", conflicts_with_all = ["vary", "checkpoint", "resume", "precision", "within", "per_roll", "shard"])]
+    #[arg(long, value_name = "LABEL=N,...", conflicts_with_all = ["vary", "checkpoint", "resume", "precision", "within", "per_roll", "shard"], conflicts_with_all = SIMULATION)]
     pub counts: Option<String>,
 }
 
@@ -66,30 +99,28 @@ pub fn run(mut a: FairArgs) -> Result<()> {
     if let Some(c) = &a.counts {
         return counted(a, &spec, c, &a.null.clone().unwrap_or_default());
     }
+    let asked = a.null.clone().unwrap_or_default();
+    // The null is checked before anything rolls or is written.
+    if asked == Null::QuasiStatic && spec.scene.mode == dicephys::model::scene::Mode::TwoD {
+        return Err(Error::Usage(
+            "--null quasi-static (solid-angle): the quasi-static theory is 3D; in 2D give uniform"
+                .into(),
+        ));
+    }
+    dicephys::studies::fair::check_null(&spec, &asked)?;
     if let Some(v) = &a.vary {
-        let null = a.null.clone().unwrap_or_default();
-        dicephys::studies::fair::check_null(&spec, &null)?;
-        return vary(a, &spec, v, &null);
+        return vary(a, &spec, v, &asked);
     }
     // A checkpointed run keeps its null beside its specification, so that --resume judges it
     // as it was asked (the Ctrl-C message gives that command).
     let null = match (&a.roll.resume, &a.roll.checkpoint) {
         (Some(dir), _) => stored_null(dir)?,
         (None, Some(dir)) => {
-            let null = a.null.clone().unwrap_or_default();
-            check_null(dir, &null)?;
-            null
+            check_null(dir, &asked)?;
+            asked
         }
-        (None, None) => a.null.clone().unwrap_or_default(),
+        (None, None) => asked,
     };
-    // The null is checked before anything rolls.
-    if null == Null::QuasiStatic && spec.scene.mode == dicephys::model::scene::Mode::TwoD {
-        return Err(Error::Usage(
-            "--null quasi-static (solid-angle): the quasi-static theory is 3D; in 2D give uniform"
-                .into(),
-        ));
-    }
-    dicephys::studies::fair::check_null(&spec, &null)?;
     let _held = match &a.out {
         Some(dir) => {
             let identity = serde_json::json!({
@@ -101,6 +132,9 @@ pub fn run(mut a: FairArgs) -> Result<()> {
     };
     if let Some(w) = spec.endless_roll_warning() {
         eprintln!("dicephys: warning: {w}");
+    }
+    if let Some(n) = super::roll::hull_note(&spec).filter(|_| !*a.roll.json) {
+        eprintln!("dicephys: note: {n}");
     }
     if let Some(n) = spec
         .loaded_die_note(&[spec.engine])
@@ -203,7 +237,10 @@ fn stored_null(dir: &std::path::Path) -> Result<Null> {
 
 /// `--out DIR` made, claimed and held for this `fair` run (another run's directory is refused,
 /// and so is this one's while another process runs it): held while the returned file lives.
-fn claim_out(dir: &std::path::Path, identity: &serde_json::Value) -> Result<std::fs::File> {
+fn claim_out(
+    dir: &std::path::Path,
+    identity: &serde_json::Value,
+) -> Result<dicephys::run::lock::Held> {
     std::fs::create_dir_all(dir)
         .map_err(|e| Error::Usage(format!("--out {}: cannot create it ({e})", dir.display())))?;
     Ok(dicephys::studies::fair::claim(dir, identity)?)
@@ -250,8 +287,10 @@ fn counted(
 /// `fair --vary`: the die at each value of one feature, judged, as a table (or JSON) and,
 /// with `--out`, the bias figure.
 fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str, null: &Null) -> Result<()> {
-    use dicephys::studies::fair::{parse_vary, vary, write_bias};
+    use dicephys::studies::fair::{parse_vary, varied_specs, vary, write_bias};
     let (what, values) = parse_vary(v)?;
+    // Every value checked before the directory is claimed: a refused one writes nothing.
+    varied_specs(spec, what, &values)?;
     let identity = serde_json::json!({ "spec": spec, "null": (null.spec()), "vary": v });
     let _held = a
         .out

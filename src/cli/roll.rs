@@ -137,6 +137,9 @@ pub fn run(a: &RollArgs) -> Result<()> {
     if let Some(w) = spec.endless_roll_warning() {
         eprintln!("dicephys: warning: {w}");
     }
+    if let Some(n) = hull_note(&spec).filter(|_| !*a.json) {
+        eprintln!("dicephys: note: {n}");
+    }
     if let Some(n) = spec.loaded_die_note(&[spec.engine]).filter(|_| !*a.json) {
         eprintln!("dicephys: note: {n}");
     }
@@ -247,4 +250,9 @@ fn paper_throw_warning(spec: &RunSpec) -> Option<String> {
             b
         )
     })
+}
+
+/// The note for a die of any shape that is not convex (it rolls on its hull), if it is one.
+pub fn hull_note(spec: &RunSpec) -> Option<String> {
+    spec.scene.shape.as_ref().and_then(|s| s.hull_note())
 }

@@ -43,7 +43,39 @@ pub fn read_mesh(bytes: &[u8], name_for_messages: &str) -> Result<Mesh, String> 
     let mesh = parse_mesh(bytes, name_for_messages)?;
     mesh.check()
         .map_err(|e| one_line(&format!("{name_for_messages}: {e}")))?;
+    let bodies = bodies(&mesh);
+    if bodies > 1 {
+        return Err(format!(
+            "{name_for_messages}: the mesh is {bodies} separate bodies (each encloses a volume of \
+             its own); a die is one body"
+        ));
+    }
     Ok(mesh)
+}
+
+/// The separate bodies of a closed mesh: its connected pieces that enclose a volume of their
+/// own (outward, positive). A piece turned inward is a cavity inside one of them, not a body.
+pub fn bodies(mesh: &Mesh) -> usize {
+    let mut parent: Vec<usize> = (0..mesh.vertices.len()).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for t in &mesh.triangles {
+        for k in 1..3 {
+            let (a, b) = (root(&mut parent, t[0]), root(&mut parent, t[k]));
+            parent[a] = b;
+        }
+    }
+    let mut volume: std::collections::HashMap<usize, f64> = Default::default();
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|i| mesh.vertices[i]);
+        *volume.entry(root(&mut parent, t[0])).or_default() += a.dot(&b.cross(&c)) / 6.0;
+    }
+    volume.values().filter(|v| **v > 0.0).count()
 }
 
 /// As [`read_mesh`], without the final check: the triangles as read (polygons triangulated,
@@ -183,6 +215,28 @@ fn read_obj(bytes: &[u8], name: &str) -> Result<Vec<[Vector3<f64>; 3]>, String> 
             e.valid_up_to()
         )
     })?;
+    // A byte-order mark (some Windows editors write one) and comments at the ends of lines
+    // are not OBJ statements: tobj reads neither, so both are taken out, line for line.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let uncommented: String = text
+        .split_inclusive('\n')
+        .map(|l| match l.find('#') {
+            Some(at) => format!("{}{}", &l[..at], if l.ends_with('\n') { "\n" } else { "" }),
+            None => l.to_string(),
+        })
+        .collect();
+    let text = uncommented.as_str();
+    if let Some((i, line)) = text.lines().enumerate().find(|(_, l)| {
+        let mut words = l.split_whitespace();
+        words.next() == Some("f") && words.count() < 3
+    }) {
+        return Err(format!(
+            "{name}: line {}: a face with {} vertices (`{}`): a face needs 3 or more",
+            i + 1,
+            line.split_whitespace().count() - 1,
+            line.trim()
+        ));
+    }
     // `..Default::default()` fills the fields that tobj's optional features (`merging`,
     // `reordering`) add, should another crate of the build turn them on.
     #[allow(clippy::needless_update)]
@@ -646,5 +700,53 @@ f -7 -5 -1 -3
             let n = (square[b] - square[a]).cross(&(square[c] - square[a]));
             assert!((n.z - 1.0).abs() < 1e-15, "{n:?}");
         }
+    }
+
+    #[test]
+    fn two_bodies_are_refused_and_a_cavity_is_not_a_body() {
+        // A second cube, `scale` times the first and moved by `dx`, its faces reversed if
+        // `inward` (a cavity's surface faces into the hollow).
+        let with = |scale: f64, dx: f64, inward: bool| {
+            let mut t = CUBE_OBJ.to_string();
+            for line in CUBE_OBJ.lines().filter(|l| l.starts_with("v ")) {
+                let v: Vec<f64> = line[2..].split(' ').map(|x| x.parse().unwrap()).collect();
+                let _ = writeln!(
+                    t,
+                    "v {} {} {}",
+                    scale * v[0] + dx,
+                    scale * v[1],
+                    scale * v[2]
+                );
+            }
+            for f in [
+                "1 3 4 2", "5 6 8 7", "1 2 6 5", "3 7 8 4", "1 5 7 3", "2 4 8 6",
+            ] {
+                let mut k: Vec<usize> = f
+                    .split(' ')
+                    .map(|i| i.parse::<usize>().unwrap() + 8)
+                    .collect();
+                if inward {
+                    k.reverse();
+                }
+                let k: Vec<String> = k.iter().map(usize::to_string).collect();
+                let _ = writeln!(t, "f {}", k.join(" "));
+            }
+            t
+        };
+        let e = read_mesh(with(1.0, 3.0, false).as_bytes(), "twin.obj").unwrap_err();
+        assert!(e.contains("twin.obj: the mesh is 2 separate bodies"), "{e}");
+        let hollow = read_mesh(with(0.5, 0.0, true).as_bytes(), "hollow.obj").unwrap();
+        assert_eq!(bodies(&hollow), 1);
+        assert!((hollow.mass_properties().volume - 0.875).abs() < 1e-12);
+        // A byte-order mark, comments after statements, and a face of two vertices.
+        let marked = format!("\u{feff}{CUBE_OBJ}");
+        assert!(read_mesh(marked.as_bytes(), "bom.obj").is_ok());
+        let commented: String = CUBE_OBJ.lines().map(|l| format!("{l}  # note\n")).collect();
+        assert!(read_mesh(commented.as_bytes(), "c.obj").is_ok());
+        let e = read_mesh(format!("{CUBE_OBJ}f 1 2\n").as_bytes(), "two.obj").unwrap_err();
+        assert!(
+            e.contains("two.obj: line 19: a face with 2 vertices"),
+            "{e}"
+        );
     }
 }

@@ -682,7 +682,8 @@ pub fn named(name: &str, size: Option<f64>) -> Result<Named, String> {
     }
     let Some(&(_, default, _)) = DEFAULT_SIZES_MM.iter().find(|d| d.0 == key) else {
         return Err(format!(
-            "unknown die \"{name}\": expected d4, d6, d8, d10, d12, d20 or prism:N,D,L"
+            "unknown die \"{name}\": expected d4, d6, d8, d10, d12, d20, coin:D,H or \
+             prism:N,D,L"
         ));
     };
     let size = size.unwrap_or(default);
@@ -942,8 +943,9 @@ fn prism_mesh(n: usize, diameter: f64, length: f64) -> Mesh {
     extrude(&polygon, &cap, -length / 2.0, length / 2.0)
 }
 
-/// The most sides a `prism:N,D,L` may have (a 100 000-gon is a cylinder to 1e-9).
-pub const MAX_PRISM_SIDES: usize = 100_000;
+/// The most sides a `prism:N,D,L` may have: its N sides and two ends are at most the 255
+/// outcomes a die may have (`model::shape::MAX_FACES`).
+pub const MAX_PRISM_SIDES: usize = 253;
 
 /// `prism:N,D,L` (the part after "prism:" in `spec`).
 fn prism_die(spec: &str, name: &str) -> Result<Named, String> {
@@ -959,7 +961,8 @@ fn prism_die(spec: &str, name: &str) -> Result<Named, String> {
         .filter(|n| (3..=MAX_PRISM_SIDES).contains(n))
         .ok_or_else(|| {
             format!(
-                "\"{name}\": N = \"{}\" is not a whole number from 3 to {MAX_PRISM_SIDES}; \
+                "\"{name}\": N = \"{}\" is not a whole number from 3 to {MAX_PRISM_SIDES} \
+                 (its N sides and two ends: a die has at most 255 faces); \
                  {usage}",
                 parts[0]
             )
@@ -974,6 +977,17 @@ fn prism_die(spec: &str, name: &str) -> Result<Named, String> {
     };
     let diameter = length_of(parts[1], "D")?;
     let length = length_of(parts[2], "L")?;
+    // A die's sizes, as a block's (`model::block`): 1 µm to 10 m.
+    let (lo, hi) = (1e-3, 1e4);
+    for (what, v) in [("D", diameter), ("L", length)] {
+        if !(lo..=hi).contains(&v) {
+            return Err(format!(
+                "\"{name}\": {what} = {v} mm is too {} (a die's sizes are from {lo} to {hi} \
+                 mm); {usage}",
+                if v > hi { "long" } else { "short" }
+            ));
+        }
+    }
     let mesh = prism_mesh(n, diameter, length);
     let mut labels: Vec<(Vector3<f64>, String)> = (0..n)
         .map(|k| {

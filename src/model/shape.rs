@@ -69,6 +69,28 @@ pub struct Face {
     pub label: String,
 }
 
+/// A face's label as a die file or `fair --counts` may give it: one that a count can name
+/// (`LABEL=N`, a CSV's `face_<label>` column) and a report can write, so not empty, without
+/// `,` or `=`, and without control characters; else what is wrong with it.
+pub fn check_label(label: &str) -> std::result::Result<(), String> {
+    let shown = label.escape_default();
+    if label.trim().is_empty() {
+        Err(format!("label '{shown}' is empty"))
+    } else if label.chars().any(|c| c == ',' || c == '=') {
+        Err(format!(
+            "label '{shown}' holds ',' or '=', which a count of it (LABEL=N) cannot name"
+        ))
+    } else if label.chars().any(char::is_control) {
+        Err(format!("label '{shown}' holds a control character"))
+    } else if label.trim() != label {
+        Err(format!(
+            "label '{shown}' starts or ends with a space, which a count of it loses"
+        ))
+    } else {
+        Ok(())
+    }
+}
+
 /// A die of any shape.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Shape {
@@ -242,7 +264,7 @@ pub fn from_mesh(
     for (what, v) in [("largest", 2.0 * size), ("smallest", mp.volume.cbrt())] {
         if !(crate::model::block::MIN_SIDE_M..=crate::model::block::MAX_SIDE_M).contains(&v) {
             return Err(format!(
-                "its {what} size, {} mm, is outside [{}, {}] mm (is the mesh in mm? --scale)",
+                "its {what} size, {} mm, is outside [{}, {}] mm",
                 v * 1e3,
                 crate::model::block::MIN_SIDE_M * 1e3,
                 crate::model::block::MAX_SIDE_M * 1e3
@@ -450,6 +472,23 @@ impl Shape {
         (1e-4f64).min(0.01 * inradius)
     }
 
+    /// A note for a die whose solid is not convex (a mesh with a dent or a hollow): what rolls
+    /// is its convex hull, its mass the solid's as given. `None` for a convex one.
+    pub fn hull_note(&self) -> Option<String> {
+        let hull = polytope::hull(&self.points())
+            .ok()?
+            .mass_properties()
+            .volume;
+        (self.volume < hull * (1.0 - 1e-9)).then(|| {
+            format!(
+                "{} is not convex (its volume is {:.1} % of its convex hull's): it rolls on its \
+                 hull, with the mass of the solid as given",
+                self.name,
+                100.0 * self.volume / hull
+            )
+        })
+    }
+
     /// The outcomes' labels, in order.
     pub fn labels(&self) -> Vec<&str> {
         self.faces.iter().map(|f| f.label.as_str()).collect()
@@ -470,22 +509,46 @@ pub fn described(
     size_mm: Option<f64>,
     scale: Option<f64>,
 ) -> Result<Option<Shape>> {
-    use crate::model::mass::{is_mesh, read_die_bytes, DieFile};
+    use crate::model::mass::{is_mesh, DieFile};
     let mesh = match file {
         Some(p) if is_mesh(p) => Some((p.to_path_buf(), DieFile::default())),
         Some(p) => {
             let f = DieFile::read(p)?;
             let dir = p.parent().unwrap_or(std::path::Path::new("."));
+            let bad = |why: &str| Err(Error::field(Field::Die, p.display(), why.to_string()));
+            if f.mesh.is_none() && (f.labels.is_some() || f.reads.is_some() || f.scale.is_some()) {
+                return bad(
+                    "labels, reads and scale describe a mesh: give its mesh (or leave them out)",
+                );
+            }
+            if f.mesh.is_some() && (f.layout.is_some() || f.faces.is_some()) {
+                return bad(
+                    "layout and faces number a cuboid's faces; a mesh's faces show its labels",
+                );
+            }
             f.mesh.clone().map(|m| (dir.join(m), f))
         }
         None => None,
     };
     if let Some(s) = size_mm {
-        if !(s.is_finite() && s > 0.0) || name.is_none() {
+        if name.is_none() {
             return Err(Error::field(
                 Field::Size,
                 s,
-                "must be a positive number of mm, with --shape (a mesh is sized by --scale)",
+                crate::text![
+                    "sizes a named shape: give it with ",
+                    Field::Shape,
+                    " (a mesh is sized by ",
+                    Field::Scale,
+                    ")"
+                ],
+            ));
+        }
+        if !(s.is_finite() && s > 0.0) {
+            return Err(Error::field(
+                Field::Size,
+                s,
+                "must be a positive number of mm",
             ));
         }
     }
@@ -507,45 +570,80 @@ pub fn described(
         (Some(n), None) => named(n, size_mm).map(Some),
         (None, None) => Ok(None),
         (None, Some((path, f))) => {
-            let bytes = read_die_bytes(&path, MAX_MESH_FILE)?;
-            let file_name = path.file_name().map_or_else(
-                || path.display().to_string(),
-                |n| n.to_string_lossy().into(),
-            );
-            let bad = |why: String| Error::field(Field::Die, path.display(), why);
-            let mesh = crate::model::mesh_file::read_mesh(&bytes, &file_name).map_err(bad)?;
-            let k = scale.or(f.scale).unwrap_or(1.0);
-            if !(k.is_finite() && k > 0.0) {
-                return Err(bad(format!("scale {k}: must be a positive factor")));
-            }
-            let labels: Option<Vec<(Vector3<f64>, String)>> = f.labels.as_ref().map(|l| {
-                l.iter()
-                    .map(|d| (Vector3::from(d.normal).normalize(), d.label.clone()))
-                    .collect()
-            });
-            let name = format!(
-                "{file_name}{} fnv1a64:{:016x}",
-                if k == 1.0 {
-                    String::new()
-                } else {
-                    format!(" ×{k}")
-                },
-                fnv64(&bytes)
-            );
-            from_mesh(
-                &mesh.scaled(k),
-                name,
-                labels.as_deref(),
-                f.reads.unwrap_or(if f.labels.is_some() {
-                    Reads::Up
-                } else {
-                    Reads::Down
-                }),
-            )
-            .map(Some)
-            .map_err(bad)
+            // A mesh a die file names is refused naming the die file (the one the user gave).
+            let toml = file.filter(|f| !is_mesh(f));
+            from_mesh_file(&path, &f, toml, scale).map(Some)
         }
     }
+}
+
+/// The die of the mesh at `path`, with a die file's `f` (its scale, reads and labels; from
+/// the file `toml`, if one named the mesh), its lengths times `scale` (else the file's, else
+/// 1). A refusal names `toml` if given, and the mesh.
+fn from_mesh_file(
+    path: &std::path::Path,
+    f: &crate::model::mass::DieFile,
+    toml: Option<&std::path::Path>,
+    scale: Option<f64>,
+) -> Result<Shape> {
+    let bytes = crate::model::mass::read_die_bytes(path, MAX_MESH_FILE)?;
+    let file_name = path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into(),
+    );
+    let bad = |why: String| match toml {
+        Some(toml) if why.starts_with(&file_name) => Error::field(Field::Die, toml.display(), why),
+        Some(toml) => Error::field(Field::Die, toml.display(), format!("{file_name}: {why}")),
+        None => Error::field(Field::Die, path.display(), why),
+    };
+    let mesh = crate::model::mesh_file::read_mesh(&bytes, &file_name).map_err(bad)?;
+    let k = scale.or(f.scale).unwrap_or(1.0);
+    if !(k.is_finite() && k > 0.0) {
+        return Err(bad(format!("scale {k}: must be a positive factor")));
+    }
+    let labels = f.mesh_labels().map_err(bad)?;
+    let name = format!(
+        "{file_name}{} fnv1a64:{:016x}",
+        if k == 1.0 {
+            String::new()
+        } else {
+            format!(" ×{k}")
+        },
+        fnv64(&bytes)
+    );
+    let shape = from_mesh(
+        &mesh.scaled(k),
+        name,
+        labels.as_deref(),
+        f.reads.unwrap_or(if f.labels.is_some() {
+            Reads::Up
+        } else {
+            Reads::Down
+        }),
+    )
+    .map_err(|e| match e.starts_with("its ") && e.contains(" size, ") {
+        true => bad(format!("{e} (is the mesh in mm? --scale)")),
+        false => bad(e),
+    })?;
+    // Every label given names a resting facet: one that names none is a mistake (a
+    // normal mistyped, or a facet the die cannot rest on), not a label to drop.
+    for (n, label) in labels.iter().flatten() {
+        if !shape
+            .faces
+            .iter()
+            .any(|f| Vector3::from(f.normal).dot(n) > 1.0 - 1e-6)
+        {
+            return Err(bad(format!(
+                "label '{label}': its normal ({:.4}, {:.4}, {:.4}) is no resting facet's \
+                 (the die rests on {} facets)",
+                n.x,
+                n.y,
+                n.z,
+                shape.faces.len()
+            )));
+        }
+    }
+    Ok(shape)
 }
 
 /// FNV-1a, 64 bits: a mesh file's fingerprint in the die's name (its geometry itself is in

@@ -103,25 +103,40 @@ impl Fairness {
     /// The faces' table as CSV: one row a face (`face` its number, `label` its direction on a
     /// cube or what a die of any shape shows), the throws to see it empty where unresolved.
     pub fn csv(&self) -> String {
-        let mut out =
-            String::from("face,label,count,p,err,null,departure,z,throws_2sigma,throws_5sigma\n");
+        // Through the CSV writer: a label that holds a comma, a quote or a line end is quoted.
+        let mut w = csv::Writer::from_writer(Vec::new());
         let opt = |v: Option<f64>| v.map_or(String::new(), |t| format!("{t:.0}"));
+        let mut rows = vec![[
+            "face",
+            "label",
+            "count",
+            "p",
+            "err",
+            "null",
+            "departure",
+            "z",
+            "throws_2sigma",
+            "throws_5sigma",
+        ]
+        .map(String::from)];
         for f in &self.faces {
-            out += &format!(
-                "{},{},{},{},{},{},{},{},{},{}\n",
-                f.number,
-                f.direction,
-                f.count,
-                f.p,
-                f.err,
-                f.null,
-                f.departure,
-                f.z,
+            rows.push([
+                f.number.to_string(),
+                f.direction.clone(),
+                f.count.to_string(),
+                f.p.to_string(),
+                f.err.to_string(),
+                f.null.to_string(),
+                f.departure.to_string(),
+                f.z.to_string(),
                 opt(f.throws_2sigma),
-                opt(f.throws_5sigma)
-            );
+                opt(f.throws_5sigma),
+            ]);
         }
-        out
+        for r in &rows {
+            w.write_record(r).expect("a CSV row into memory");
+        }
+        String::from_utf8(w.into_inner().expect("CSV into memory")).expect("UTF-8 fields")
     }
 
     /// The human report.
@@ -144,5 +159,51 @@ impl Fairness {
             out += &format!("  {}\n", r.line());
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_label_with_a_comma_or_a_quote_is_quoted_in_the_csv() {
+        let face = |number: u8, label: &str| FaceVerdict {
+            number,
+            direction: label.into(),
+            count: 5,
+            p: 0.5,
+            err: 0.1,
+            null: 0.5,
+            departure: 0.0,
+            z: 0.0,
+            throws_2sigma: None,
+            throws_5sigma: None,
+        };
+        let fair = Fairness {
+            null: Null::Uniform,
+            note: None,
+            n: 10,
+            faces: vec![face(1, "a,b"), face(2, "say \"c\"")],
+            chi2: 0.0,
+            dof: 1,
+            p_value: 1.0,
+            lambda: 0.0,
+            throws_2sigma: None,
+            throws_5sigma: None,
+            resolved: false,
+            verdict: String::new(),
+        };
+        let text = fair.csv();
+        let mut r = csv::Reader::from_reader(text.as_bytes());
+        let rows: Vec<csv::StringRecord> = r.records().map(|r| r.unwrap()).collect();
+        assert_eq!(rows.len(), 2, "{text}");
+        for (row, label) in rows.iter().zip(["a,b", "say \"c\""]) {
+            assert_eq!(row.len(), 10, "{text}");
+            assert_eq!(&row[1], label, "{text}");
+        }
+        // A plain table is written as before.
+        assert!(text.starts_with("face,label,count,p,err,null,departure,z,throws_2sigma,"));
+        assert!(text.contains("\n1,\"a,b\",5,0.5,0.1,0.5,0,0,,\n"), "{text}");
     }
 }

@@ -17,12 +17,12 @@ pub const FILE: &str = "dicephys-run.json";
 /// The lock a run here holds on its directory while it runs ([`hold`]).
 pub const LOCK: &str = "lock";
 
-/// Holds `dir` for this process while the returned file lives: a second run of the same
+/// Holds `dir` for this process while the returned lock lives (its file removed as it ends): a second run of the same
 /// study there (its claim passes: it is the same run) is refused, naming the first's process,
 /// rather than rolling and writing the same cells and outputs at once. A cluster's tasks,
 /// which share a directory by design, do not take it.
-pub fn hold(dir: &Path) -> Result<std::fs::File> {
-    crate::run::lock::lock(&dir.join(LOCK), &dir.display().to_string())
+pub fn hold(dir: &Path) -> Result<crate::run::lock::Held> {
+    crate::run::lock::lock_removed(&dir.join(LOCK), &dir.display().to_string())
 }
 
 /// A directory's owner.

@@ -136,6 +136,10 @@ impl SceneRequest {
                 ANY_BLOCK
             }
         };
+        // A die of any shape (the default d6 too) shows its labels: no layout numbers it.
+        if let (Some(l), Some(s)) = (d.layout, &shape) {
+            return Err(layout_beside(l, s));
+        }
         let mode = if self.two_d { Mode::TwoD } else { Mode::ThreeD };
         let mut scene = Scene::paper(block, mode);
         if let Some(s) = shape {
@@ -184,6 +188,22 @@ impl SceneRequest {
         })?;
         Ok(scene)
     }
+}
+
+/// A layout given beside a die of any shape (a named one, a mesh, or the default d6): it
+/// numbers a cuboid's faces, and this die shows its own labels.
+pub fn layout_beside(l: Layout, shape: &crate::model::shape::Shape) -> Error {
+    Error::field(
+        Field::Layout,
+        l,
+        crate::text![
+            "numbers a cuboid's faces (",
+            Field::Block,
+            "); ",
+            shape.name.clone(),
+            " shows its own labels"
+        ],
+    )
 }
 
 /// Where the throws come from and how the die is thrown.

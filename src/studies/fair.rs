@@ -212,20 +212,26 @@ pub fn parse_counts(text: &str) -> Result<Vec<(String, u64)>> {
             .split_once('=')
             .ok_or_else(|| bad(format!("'{item}': write LABEL=COUNT (e.g. 1=170,2=160,…)")))?;
         let label = label.trim();
-        let n: u64 = n
-            .trim()
-            .parse()
-            .map_err(|_| bad(format!("'{}' is not a count (a whole number)", n.trim())))?;
+        let n = crate::calibration::data::count(n.trim()).map_err(bad)?;
         if label.is_empty() || out.iter().any(|(l, _)| l == label) {
             return Err(bad(format!("face '{label}' is empty or given twice")));
         }
+        crate::model::shape::check_label(label).map_err(bad)?;
         out.push((label.to_string(), n));
     }
     if out.len() < 2 {
         return Err(bad("give at least two faces' counts".into()));
     }
-    if out.iter().map(|(_, n)| n).sum::<u64>() == 0 {
-        return Err(bad("no throws counted".into()));
+    // Each count is at most a fit's row's; their sum is checked too, never wrapped.
+    let max = crate::calibration::data::MAX_ROW_THROWS;
+    match out.iter().try_fold(0u64, |a, (_, n)| a.checked_add(*n)) {
+        Some(0) => return Err(bad("no throws counted".into())),
+        Some(t) if t <= max => {}
+        _ => {
+            return Err(bad(format!(
+                "counts too large: at most {max} throws in all"
+            )))
+        }
     }
     Ok(out)
 }
@@ -435,7 +441,10 @@ fn judge(
 
 /// Claims `dir` for this `fair` run (`run::owner`) and holds it while the returned file lives:
 /// refused if another command or another run owns it, or another process runs this one there.
-pub fn claim(dir: &std::path::Path, identity: &serde_json::Value) -> Result<std::fs::File> {
+pub fn claim(
+    dir: &std::path::Path,
+    identity: &serde_json::Value,
+) -> Result<crate::run::lock::Held> {
     super::place::claim(dir, "fair", identity, super::place::Claimant::Here)?;
     crate::run::owner::hold(dir)
 }
@@ -634,35 +643,7 @@ pub fn vary(
     null: &Null,
     runner: &Runner,
 ) -> Result<Option<Vec<BiasPoint>>> {
-    let specs = values
-        .iter()
-        .map(|&v| {
-            // The pips already sit by the run's layout (`roll --layout` placed them).
-            let mut s = spec.clone();
-            s.scene.features = what.set(&spec.scene.features, v)?;
-            // A die of any shape rests on the facets it rests on at this centre of mass.
-            s.scene = s
-                .scene
-                .resting_at_com()
-                .map_err(|e| Error::field(Field::Vary, format!("{what}={v}"), e))?;
-            // A value the die cannot take is named as the user wrote it, `--vary NAME=V`, not
-            // as the feature's own flag, which they did not give (reliability round 5, G).
-            s.validate(false).map_err(|e| match e {
-                Error::Field { field, why, .. }
-                    if matches!(
-                        (field, what),
-                        (Field::Com, Varied::ComX | Varied::ComY | Varied::ComZ)
-                            | (Field::PipsDepth, Varied::PipDepth)
-                            | (Field::EdgeRadius, Varied::EdgeRadius)
-                    ) =>
-                {
-                    Error::field(Field::Vary, format!("{what}={v}"), why)
-                }
-                e => e,
-            })?;
-            Ok(s)
-        })
-        .collect::<Result<Vec<_>>>()?;
+    let specs = varied_specs(spec, what, values)?;
     let mut out = Vec::new();
     for (i, (s, &value)) in specs.iter().zip(values).enumerate() {
         let base = i as u64 * spec.rolls;
@@ -679,6 +660,52 @@ pub fn vary(
         });
     }
     Ok(Some(out))
+}
+
+/// The run of `spec` at each of `values` of `what`, each checked: what [`vary`] rolls, and
+/// what a front end checks before it claims an output directory, so that a value the die
+/// cannot take is refused with nothing written.
+pub fn varied_specs(spec: &RunSpec, what: Varied, values: &[f64]) -> Result<Vec<RunSpec>> {
+    if let (Varied::PipDepth, Some(shape)) = (what, &spec.scene.shape) {
+        return Err(Error::field(
+            Field::Vary,
+            "pip_depth",
+            format!(
+                "{} has no pips (they are drilled in a cuboid's faces, --block): vary com_x, \
+                 com_y or com_z",
+                shape.name
+            ),
+        ));
+    }
+    values
+        .iter()
+        .map(|&v| {
+            // The pips already sit by the run's layout (`roll --layout` placed them).
+            let mut s = spec.clone();
+            s.scene.features = what.set(&spec.scene.features, v)?;
+            // A value the die cannot take is named as the user wrote it, `--vary NAME=V`, not
+            // as the feature's own flag, which they did not give (reliability round 5, G).
+            s.validate(false).map_err(|e| match e {
+                Error::Field { field, why, .. }
+                    if matches!(
+                        (field, what),
+                        (Field::Com, Varied::ComX | Varied::ComY | Varied::ComZ)
+                            | (Field::PipsDepth, Varied::PipDepth)
+                            | (Field::EdgeRadius, Varied::EdgeRadius)
+                    ) =>
+                {
+                    Error::field(Field::Vary, format!("{what}={v}"), why)
+                }
+                e => e,
+            })?;
+            // A die of any shape rests on the facets it rests on at this centre of mass.
+            s.scene = s
+                .scene
+                .resting_at_com()
+                .map_err(|e| Error::field(Field::Vary, format!("{what}={v}"), e))?;
+            Ok(s)
+        })
+        .collect()
 }
 
 /// Writes the bias figure (`bias.svg`, `.png`: each face's probability against the varied

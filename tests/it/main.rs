@@ -13,6 +13,7 @@ mod faces;
 mod fit;
 mod fuzz;
 mod impact;
+mod inputs;
 mod io;
 mod made;
 mod paper;

@@ -48,6 +48,9 @@ pub struct DieFile {
     pub labels: Option<Vec<LabelDef>>,
 }
 
+/// A mesh's labels: each facet's outward normal (unit length) and what it shows.
+pub type MeshLabels = Vec<(nalgebra::Vector3<f64>, String)>;
+
 /// One facet's label in a die file.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -86,7 +89,7 @@ impl DieFile {
                 "is not a text file (a die file is TOML; a mesh is .obj or .stl)",
             )
         })?;
-        toml::from_str(&text).map_err(|e| {
+        let file: DieFile = toml::from_str(&text).map_err(|e| {
             let line = e
                 .span()
                 .map(|s| format!(" (line {})", text[..s.start].matches('\n').count() + 1))
@@ -96,7 +99,51 @@ impl DieFile {
                 path.display(),
                 e.message().trim()
             ))
-        })
+        })?;
+        // An empty file (`/dev/null`, a file not yet written) describes nothing: refused,
+        // not rolled as the plain die.
+        if toml::from_str::<toml::Table>(&text).is_ok_and(|t| t.is_empty()) {
+            return Err(Error::field(
+                Field::Die,
+                path.display(),
+                "the die file is empty: give the die's features (com, pips, …) or a mesh",
+            ));
+        }
+        Ok(file)
+    }
+
+    /// A mesh's labels as the file gives them, checked, each normal of unit length: refused
+    /// (the reason) where a label cannot be named or written ([`check_label`]), a normal is
+    /// not a direction (NaN, infinite or zero), or two labels name the same facet.
+    ///
+    /// [`check_label`]: crate::model::shape::check_label
+    pub fn mesh_labels(&self) -> std::result::Result<Option<MeshLabels>, String> {
+        let Some(defs) = &self.labels else {
+            return Ok(None);
+        };
+        let mut out: MeshLabels = Vec::new();
+        for d in defs {
+            crate::model::shape::check_label(&d.label)?;
+            let n = nalgebra::Vector3::from(d.normal);
+            let shown = d.normal.map(|x| x.to_string()).join(", ");
+            if !n.iter().all(|x| x.is_finite()) || n.norm() == 0.0 || !n.norm().is_finite() {
+                return Err(format!(
+                    "label '{}': its normal [{shown}] is not a direction (give three finite \
+                     numbers, not all zero)",
+                    d.label
+                ));
+            }
+            let n = n.normalize();
+            if let Some((_, other)) = out.iter().find(|(m, _)| m.dot(&n) > 1.0 - 1e-6) {
+                return Err(format!(
+                    "labels '{other}' and '{}' have the same normal [{shown}]: a facet has one \
+                     label",
+                    d.label
+                ));
+            }
+            out.push((n, d.label.clone()));
+        }
+        Ok(Some(out))
     }
 
     /// The features it describes, lengths in metres; a face map that is not a permutation of
