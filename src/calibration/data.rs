@@ -331,7 +331,7 @@ fn columns(have: &[&str], name: &str) -> Result<(Form, bool)> {
 pub fn count(v: &str) -> std::result::Result<u64, String> {
     let too_large = || {
         format!(
-            "'{}' is too large a count (at most {MAX_ROW_THROWS})",
+            "'{}' is too large a count (at most {MAX_ROW_THROWS} throws)",
             shown(v)
         )
     };
@@ -574,18 +574,11 @@ fn block_row(
 /// block is the die's bounding box. Rows of a block's sides or a cube's numbers are refused, as
 /// is a die whose faces share a label (its counts could not be told apart).
 pub fn on_shape(rows: &[DataRow], shape: &crate::model::shape::Shape) -> Result<Vec<DataRow>> {
-    let want = shape.labels();
+    // A label on several facets (a mirror pair that shares one printed number) is one
+    // outcome: the rows count it, the fit sums its facets.
+    let labels = shape.outcome_labels();
+    let want: Vec<&str> = labels.iter().map(String::as_str).collect();
     let bad = |m: String| Error::Invalid(m);
-    if let Some(l) = want
-        .iter()
-        .find(|l| want.iter().filter(|m| m == l).count() > 1)
-    {
-        return Err(bad(format!(
-            "{} has more than one face that shows '{l}': its counts cannot be told apart \
-             (give the faces distinct labels)",
-            shape.name
-        )));
-    }
     let [x, y, z] = shape.bounding_box();
     let block = Block {
         breadth: x,

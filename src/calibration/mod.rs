@@ -175,7 +175,7 @@ impl FitConfig {
         Error::field(
             Field::Range,
             boxes.join(","),
-            format!("the die at the range's end, its {what} {value} mm, {why}; narrow the range"),
+            format!("the die at the box's end, its {what} {value} mm, {why}; narrow the range"),
         )
     }
 
@@ -194,7 +194,11 @@ impl FitConfig {
                 None => Ok(()),
             };
         };
-        if let Some(r) = self.rows.iter().find(|r| r.labels != shape.labels()) {
+        if let Some(r) = self
+            .rows
+            .iter()
+            .find(|r| r.labels != shape.outcome_labels())
+        {
             return Err(Error::Invalid(format!(
                 "row '{}' does not count {}'s faces in its order (read the rows with \
                  calibration::data::on_shape)",

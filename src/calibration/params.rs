@@ -544,6 +544,14 @@ impl Method {
         if let Some(d) = self.density {
             scene.density = d;
         }
+        // A die of any shape rests on the facets it rests on at this centre of mass, each
+        // labelled as the rows count it.
+        if let Some(s) = &self.shape {
+            let com = crate::model::mass::MassProps::compute(&scene).com;
+            if let Ok(at) = s.resting_at_keeping(&com) {
+                scene.shape = Some(std::sync::Arc::new(at));
+            }
+        }
         let mut throws = match v.throw {
             FixedThrow::Paper => ThrowSpec::keyed(seed),
             FixedThrow::Hand(k) => ThrowSpec::hand(seed, k),

@@ -181,7 +181,7 @@ impl FitRequest {
         let (degree, max_degree) = DesignSpec::degrees(
             self.degree,
             self.max_degree,
-            shape.as_ref().map_or(6, |s| s.faces.len()),
+            shape.as_ref().map_or(6, |s| s.outcome_labels().len()),
         );
         let cfg = FitConfig {
             rows,

@@ -131,6 +131,14 @@ impl RollArgs {
 /// Runs `dicephys roll`.
 pub fn run(a: &RollArgs) -> Result<()> {
     let spec = a.spec()?;
+    if spec.scene.shape.is_some() && a.run.precision.is_some() {
+        return Err(Error::Usage(
+            "--precision is the ratio's (breadth against width vertical), which a die of any \
+             shape has not: `dicephys fair --within PP` rolls until every face's probability is \
+             known to PP percentage points"
+                .into(),
+        ));
+    }
     if let Some(w) = paper_throw_warning(&spec) {
         eprintln!("{w}");
     }
@@ -160,7 +168,10 @@ pub fn run(a: &RollArgs) -> Result<()> {
         if summary.rolls > 0 && shape.faces.iter().all(|f| f.count == 0) {
             let why = dicephys::report::summary::check_settled(&summary.tally, &spec.scene)
                 .err()
-                .map_or_else(|| "no roll came to rest on a face".into(), |e| e.to_string());
+                .map_or_else(
+                    || "no roll came to rest on a face".into(),
+                    |e| e.to_string(),
+                );
             return Err(Error::Run(why));
         }
     }

@@ -292,7 +292,10 @@ pub fn from_mesh(
         // The facets just found, so that the outcomes are numbered in this hull's order.
         facets: std::sync::OnceLock::from(std::sync::Arc::new(facets)),
     };
-    shape.faces = shape.outcomes_at(&Vector3::zeros())?;
+    shape.faces = shape.outcomes_at(&Vector3::zeros(), false)?;
+    // Found again from the hull's points on first use, as by a run that reads the die back
+    // from its specification: the same die gives the same numbers to the bit, resumed or not.
+    shape.facets = Default::default();
     Ok(shape)
 }
 
@@ -306,14 +309,52 @@ impl Shape {
             return Ok(self.clone());
         }
         let mut s = self.clone();
-        s.faces = self.outcomes_at(com)?;
+        s.faces = self.outcomes_at(com, false)?;
         Ok(s)
+    }
+
+    /// The same die with its centre of mass at `com`, its outcomes labelled as this die's are
+    /// (a fit moving the centre of mass keeps the labels its rows count): a facet it rests on
+    /// there shows its printed label, or, on a die numbered 1…N, the label this die shows on
+    /// it; a facet that rests only there and carries none is no outcome (a roll that ends on it
+    /// is left out, as one that ends on no face).
+    pub fn resting_at_keeping(&self, com: &Vector3<f64>) -> std::result::Result<Shape, String> {
+        if matches!(self.solid, Solid::Cylinder { .. }) {
+            return Ok(self.clone());
+        }
+        let mut keeper = self.clone();
+        if keeper.printed.is_none() {
+            // What each facet shows is its label, read on the facet it rests on.
+            keeper.printed = Some(self.faces.clone());
+            keeper.reads = Reads::Down;
+        }
+        let mut s = self.clone();
+        s.faces = keeper.outcomes_at(com, true)?;
+        Ok(s)
+    }
+
+    /// The distinct labels the die shows, in the order of their first facet: what a count of
+    /// its rolls by label keeps (a label on several facets, a mirror pair that shares one
+    /// printed number, is one outcome).
+    pub fn outcome_labels(&self) -> Vec<String> {
+        let mut out: Vec<String> = Vec::new();
+        for f in &self.faces {
+            if !out.contains(&f.label) {
+                out.push(f.label.clone());
+            }
+        }
+        out
     }
 
     /// The outcomes with the centre of mass at `com`: each facet the die rests on (the foot
     /// of the centre inside it by [`STABLE_MARGIN`] of its size), in the hull's order, with
     /// the label it shows as [`Shape::reads`] says.
-    fn outcomes_at(&self, com: &Vector3<f64>) -> std::result::Result<Vec<Face>, String> {
+    /// `skip_unlabelled`: a resting facet with no label is no outcome, not an error.
+    fn outcomes_at(
+        &self,
+        com: &Vector3<f64>,
+        skip_unlabelled: bool,
+    ) -> std::result::Result<Vec<Face>, String> {
         let facets = self.facets();
         let margin = STABLE_MARGIN * self.circumradius();
         let stable: Vec<&polytope::Facet> = facets
@@ -346,10 +387,7 @@ impl Shape {
             }
         };
         let normal_text = |f: &polytope::Facet| {
-            format!(
-                "({:.4}, {:.4}, {:.4})",
-                f.normal.x, f.normal.y, f.normal.z
-            )
+            format!("({:.4}, {:.4}, {:.4})", f.normal.x, f.normal.y, f.normal.z)
         };
         let labelled: Vec<(&polytope::Facet, String)> = facets
             .iter()
@@ -357,6 +395,7 @@ impl Shape {
             .collect();
         stable
             .iter()
+            .filter(|f| !skip_unlabelled || printed(f).is_some())
             .map(|f| {
                 let own = printed(f).ok_or_else(|| {
                     format!("no label for the facet with normal {}", normal_text(f))
@@ -364,7 +403,11 @@ impl Shape {
                 // The labelled facet facing up, if one is opposite this one.
                 let up = labelled
                     .iter()
-                    .min_by(|a, b| a.0.normal.dot(&f.normal).total_cmp(&b.0.normal.dot(&f.normal)))
+                    .min_by(|a, b| {
+                        a.0.normal
+                            .dot(&f.normal)
+                            .total_cmp(&b.0.normal.dot(&f.normal))
+                    })
                     .filter(|(g, _)| g.normal.dot(&f.normal) < -OPPOSITE_TOLERANCE.cos())
                     .map(|(_, l)| l.clone());
                 let label = match (self.reads, up) {
@@ -790,7 +833,10 @@ mod tests {
         .map(|p| p * 8.0);
         let mesh = polytope::hull(&v).unwrap();
         let e = from_mesh(&mesh, "tetra".into(), None, Reads::Up).unwrap_err();
-        assert!(e.contains("no facet faces up") && e.contains("normal ("), "{e}");
+        assert!(
+            e.contains("no facet faces up") && e.contains("normal ("),
+            "{e}"
+        );
         // Read on the face down it is four outcomes, 1 … 4.
         let down = from_mesh(&mesh, "tetra".into(), None, Reads::Down).unwrap();
         assert_eq!(down.labels(), ["1", "2", "3", "4"]);

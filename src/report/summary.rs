@@ -285,7 +285,9 @@ pub fn check_settled(tally: &Tally, scene: &crate::model::scene::Scene) -> crate
     let advice = "raise --max-steps, or give --rolling-resistance (0.05 mm: a hard table) so that \
                   a die rolling on an edge or a rim stops";
     if tally.rolls > 0 && faced == 0 {
-        return Err(crate::Error::failed(format!("{why}: nothing to count; {advice}")));
+        return Err(crate::Error::failed(format!(
+            "{why}: nothing to count; {advice}"
+        )));
     }
     if off as f64 > MAX_UNSETTLED_SHARE * tally.rolls as f64 {
         return Err(crate::Error::failed(format!(
@@ -315,12 +317,12 @@ impl ShapeOutcomes {
             .zip(&fair)
             .map(|((_, c), q)| (*c as f64 - nf * q).powi(2) / (nf * q))
             .sum();
-        let (theory, quasi_static_missing) = match crate::theory::quasi_static::outcome_shares(scene)
-        {
-            Some(Ok(q)) => (Some(q), None),
-            Some(Err(e)) => (None, Some(e)),
-            None => (None, None),
-        };
+        let (theory, quasi_static_missing) =
+            match crate::theory::quasi_static::outcome_shares(scene) {
+                Some(Ok(q)) => (Some(q), None),
+                Some(Err(e)) => (None, Some(e)),
+                None => (None, None),
+            };
         let against_quasi_static = theory.as_ref().map(|q| {
             let (mut chi2, mut k) = (0.0, 0usize);
             for ((_, c), q) in counts.iter().zip(q) {
@@ -855,7 +857,7 @@ impl Target {
         match self {
             Target::Ratio => ratio_two_sigma(&tally.counts),
             Target::Faces => {
-                let n: u64 = tally.up.iter().sum();
+                let n: u64 = face_counts(tally).iter().sum();
                 let worst = face_variance(tally)?;
                 Some(2.0 * (worst / n as f64).sqrt())
             }
@@ -869,7 +871,7 @@ impl Target {
             // 2σ = 2 √(p(1 − p)/n) ≤ P at the largest p(1 − p): n = 4 p(1 − p)/P², scaled from
             // the faces' rolls to all rolls (some may not settle on a face).
             Target::Faces => {
-                let faced: u64 = tally.up.iter().sum();
+                let faced: u64 = face_counts(tally).iter().sum();
                 let v = face_variance(tally)?;
                 let n = 4.0 * v / (precision * precision) * tally.rolls as f64 / faced as f64;
                 Some(n.ceil() as u64)
@@ -878,12 +880,21 @@ impl Target {
     }
 }
 
+/// The rolls at rest by face a tally counts: a die of any shape's by its resting facet, the
+/// cuboid's by the face up (a shape's `up` stays empty: counting it never ended a run).
+fn face_counts(tally: &Tally) -> &[u64] {
+    if tally.faces.is_empty() {
+        &tally.up
+    } else {
+        &tally.faces
+    }
+}
+
 /// The largest p(1 − p) over the faces a tally counts; `None` before any face.
 fn face_variance(tally: &Tally) -> Option<f64> {
-    let n: u64 = tally.up.iter().sum();
+    let n: u64 = face_counts(tally).iter().sum();
     (n > 0).then(|| {
-        tally
-            .up
+        face_counts(tally)
             .iter()
             .map(|&c| {
                 let p = c as f64 / n as f64;

@@ -107,7 +107,29 @@ impl Default for SceneRequest {
     }
 }
 
+/// The default die where it is made as only a cuboid is: the 16 mm cube (the default d6's).
+pub const DEFAULT_CUBOID: Block = Block {
+    length: 0.016,
+    breadth: 0.016,
+    width: 0.016,
+};
+
 impl SceneRequest {
+    /// True if no die is named but what is asked of it is a cuboid's: pips, rounded edges, an
+    /// insert, an inertia or a numbering of its faces (flags, or a die file with no mesh).
+    fn default_is_cuboid(&self) -> Result<bool> {
+        let d = &self.die;
+        if d.layout.is_some() || d.pips.is_some() || d.edge_radius.is_some() {
+            return Ok(true);
+        }
+        let (f, _) = Features::described(d.file.as_deref(), None, None, None, None, None)?;
+        Ok(f.pips.is_some()
+            || f.edge_radius > 0.0
+            || f.insert.is_some()
+            || f.inertia.is_some()
+            || f.layout != crate::model::faces::Layout::default())
+    }
+
     /// The scene, with every value checked before anything runs.
     pub fn scene(&self) -> Result<Scene> {
         let d = &self.die;
@@ -130,7 +152,10 @@ impl SceneRequest {
             (Some(b), None) => b,
             // The shape's bounding box replaces it (`Scene::with_shape`).
             (None, Some(_)) => ANY_BLOCK,
-            // No die given: a 16 mm d6.
+            // No die given: a 16 mm d6; the 16 mm cube as the cuboid where the die is made
+            // as only a cuboid is (pips, rounded edges, an insert, its inertia, its faces'
+            // numbering), so that what is asked applies to the die rolled.
+            (None, None) if self.default_is_cuboid()? => DEFAULT_CUBOID,
             (None, None) => {
                 shape = crate::model::shape::described(None, Some("d6"), None, None)?;
                 ANY_BLOCK
@@ -177,7 +202,11 @@ impl SceneRequest {
         // A loaded die's outcomes are the facets it rests on at its own centre of mass.
         let scene = scene.resting_at_com().map_err(|e| {
             Error::field(
-                if d.file.is_some() { Field::Die } else { Field::Shape },
+                if d.file.is_some() {
+                    Field::Die
+                } else {
+                    Field::Shape
+                },
                 d.file
                     .as_ref()
                     .map(|p| p.display().to_string())
@@ -365,6 +394,9 @@ impl RollRequest {
     /// tumble).
     pub fn spec_or(&self, default: ThrowStyle) -> Result<RunSpec> {
         let mut scene = self.scene.scene()?;
+        // The default die is thrown in a tumble, as the d6 it stands for (the paper's throw
+        // spins a cube about one axis).
+        let defaulted = self.scene.die.block.is_none() && scene.shape.is_none();
         // Unless one is asked: a coin on Bullet rolls against a hard table's resistance (with
         // none, a coin on its rim rolls to the step cap); every other die against none, as
         // DicePhys (Rapier has none).
@@ -375,6 +407,7 @@ impl RollRequest {
             scene.rolling_resistance = crate::model::scene::COIN_ROLLING_RESISTANCE;
         }
         let default = match ThrowStyle::default_for(&scene) {
+            ThrowStyle::Paper if defaulted => ThrowStyle::Tumble,
             ThrowStyle::Paper => default,
             other => other,
         };

@@ -95,7 +95,9 @@ impl std::str::FromStr for Null {
                 .ok_or_else(|| format!("'{item}': write LABEL=P (e.g. 6=1/4)"))?;
             let label = label.trim();
             if label.is_empty() || out.iter().any(|(l, _)| l == label) {
-                return Err(format!("the target's face '{label}' is empty or given twice"));
+                return Err(format!(
+                    "the target's face '{label}' is empty or given twice"
+                ));
             }
             let p = probability(p).ok_or_else(|| {
                 format!(
@@ -111,9 +113,7 @@ impl std::str::FromStr for Null {
         }
         let sum: f64 = out.iter().map(|(_, p)| p).sum();
         if (sum - 1.0).abs() > SUM_TOLERANCE {
-            return Err(format!(
-                "the target's probabilities sum to {sum:.6}, not 1"
-            ));
+            return Err(format!("the target's probabilities sum to {sum:.6}, not 1"));
         }
         Ok(Null::Target(out))
     }
@@ -189,9 +189,10 @@ pub fn uniform_shares(shape: &Shape) -> Vec<(String, f64)> {
 }
 
 /// How far apart (relative) a die's facets' quasi-static shares may be for its faces to count
-/// as alike: a cube 16 × 16 × 15.8 mm (a die made 1 % thin) is a d6 at 1.9 %, a prism or a
-/// coin whose faces are of two kinds is far outside.
-pub const ALIKE_TOLERANCE: f64 = 0.1;
+/// as alike, so that the die is one meant to be fair, made a little off: a cube 16 × 16 × 15
+/// mm (6 % thin) spans 0.161–0.179 (11 %) and is a d6; a prism or a coin, whose faces are of
+/// two kinds, spans factors of 3 and more.
+pub const ALIKE_TOLERANCE: f64 = 0.25;
 
 /// `None` when the faces of `shares` (each facet's quasi-static share of the uniform solid)
 /// are alike, so that "fair" (each facet 1/N) means what it says; else why not, in words.
@@ -233,7 +234,10 @@ mod tests {
         assert!((v[0].1 - 1.0 / 3.0).abs() < 1e-15);
         let json = serde_json::to_string(&t).unwrap();
         assert_eq!(serde_json::from_str::<Null>(&json).unwrap(), t);
-        assert_eq!(serde_json::to_string(&Null::QuasiStatic).unwrap(), "\"quasi-static\"");
+        assert_eq!(
+            serde_json::to_string(&Null::QuasiStatic).unwrap(),
+            "\"quasi-static\""
+        );
         for bad in [
             "fair",
             "a=0.5,b=0.4",

@@ -507,6 +507,21 @@ fn json_md_lists_the_keys_of_fair() {
         "--json",
     ]);
     c.document("fair", "fair", &v);
+    // The paper's block is no die meant fair: the uniform null is noted.
+    let noted = run(&[
+        "fair",
+        "--block",
+        "140x24x20",
+        "--rolls",
+        "100",
+        "--seed",
+        "1",
+        "--threads",
+        "1",
+        "--json",
+    ]);
+    assert!(noted["fairness"]["note"].is_string());
+    c.document("fair", "fair --block 140x24x20", &noted);
     let vary = run(&[
         "fair",
         "--block",
@@ -609,6 +624,18 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
     ]);
     let none = roll(&["--block", "140x24x20", "--max-steps", "1"]);
     let shaped = roll(&["--shape", "d6", "--rolling-resistance", "0.05"]);
+    // A coin loaded off its axis that rolls on its rim: its faces not alike, no quasi-static
+    // theory, and too many rolls at the cap for a verdict (issue 69).
+    let unsettled = roll(&[
+        "--shape",
+        "coin:24,2",
+        "--com",
+        "1,0,0",
+        "--rolling-resistance",
+        "0",
+        "--max-steps",
+        "3000",
+    ]);
     let broken = roll(&["--block", "140x24x20", "--dt", "1/30"]);
     assert!(broken["warnings"].is_array(), "{}", broken["dipped"]);
     assert!(shaped.get("warnings").is_none());
@@ -671,6 +698,10 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
         ("roll --audit --throw tumble, damped", &odd),
         ("roll --max-steps 1", &none),
         ("roll --shape d6", &shaped),
+        (
+            "roll --shape coin:24,2 --com 1,0,0 --max-steps 3000",
+            &unsettled,
+        ),
         ("roll --dt 1/30", &broken),
         ("roll --precision 60", &precise),
         ("roll --precision 1 --rolls 1000", &short),

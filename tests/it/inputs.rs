@@ -170,7 +170,6 @@ fn what_would_be_ignored_is_refused() {
             ],
             "--layout left",
         ),
-        (vec!["--layout".into(), "left".into()], "--layout left"),
         (
             vec!["--die".into(), write(&d, "labels.toml", "labels = []\n")],
             "give its mesh",

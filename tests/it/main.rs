@@ -7,6 +7,7 @@ mod bench;
 mod bullet;
 mod cli;
 mod coarse;
+mod counting;
 mod crosscheck;
 mod docs;
 mod faces;

@@ -172,7 +172,12 @@ pub fn predict_block(
             ratios.push(c.breadth as f64 / c.width.max(1) as f64);
         }
         if with_faces {
-            let faces = super::simulate::outcome_counts(&done.tally, true, method)?;
+            let faces = super::simulate::outcome_counts(
+                &done.tally,
+                true,
+                method,
+                spec.scene.shape.as_deref(),
+            )?;
             for (k, v) in faces.iter().enumerate() {
                 face_freq[k].push(*v as f64 / settled as f64);
             }
@@ -236,7 +241,7 @@ pub fn predict_block(
 /// none without faces.
 fn face_labels(shape: Option<&crate::model::shape::Shape>, with_faces: bool) -> Vec<String> {
     match shape {
-        Some(s) => s.labels().iter().map(|l| l.to_string()).collect(),
+        Some(s) => s.outcome_labels(),
         None if with_faces => (1..=6).map(|k| k.to_string()).collect(),
         None => Vec::new(),
     }

@@ -130,7 +130,7 @@ pub fn simulate(
             rolls += t.rolls;
             design_points.push(DesignPoint {
                 x: x.clone(),
-                counts: outcome_counts(t, key.faces, plan.method)?,
+                counts: outcome_counts(t, key.faces, plan.method, spec.scene.shape.as_deref())?,
             });
         }
         if runner.share.is_partial() {
@@ -191,22 +191,42 @@ pub fn settled(t: &Tally) -> u64 {
     c.length + c.breadth + c.width + c.face
 }
 
-/// How many faces a fit of faces counts: a die of any shape's, else a cube's six.
+/// How many faces a fit of faces counts: a die of any shape's labels, else a cube's six.
 pub fn face_count(method: &Method) -> usize {
-    method.shape.as_ref().map_or(6, |s| s.faces.len())
+    method
+        .shape
+        .as_ref()
+        .map_or(6, |s| s.outcome_labels().len())
 }
 
 /// A tally's outcomes as a fit counts them: length, breadth and width vertical, or (`faces`)
-/// how often each number 1 to 6 came up on the die's layout, or each face of a die of any
-/// shape in its order.
-pub fn outcome_counts(t: &Tally, faces: bool, method: &Method) -> Result<Vec<u64>> {
+/// how often each number 1 to 6 came up on the die's layout, or each label of a die of any
+/// shape in its order (`Shape::outcome_labels`). `rolled` is the die the tally's rolls were
+/// of (its outcomes at the point's centre of mass), where it is a die of any shape.
+pub fn outcome_counts(
+    t: &Tally,
+    faces: bool,
+    method: &Method,
+    rolled: Option<&crate::model::shape::Shape>,
+) -> Result<Vec<u64>> {
     if !faces {
         return Ok(vec![t.counts.length, t.counts.breadth, t.counts.width]);
     }
-    if method.shape.is_some() {
-        // The tally keeps faces up to the last that came up: the rest are 0.
-        let mut out = t.faces.clone();
-        out.resize(face_count(method), 0);
+    if let Some(shape) = &method.shape {
+        // Each facet's count under its label (the tally keeps faces up to the last that came
+        // up: the rest are 0).
+        let labels = shape.outcome_labels();
+        let rolled = rolled.unwrap_or(shape);
+        let mut out = vec![0; labels.len()];
+        for (k, &n) in t.faces.iter().enumerate() {
+            let at = rolled
+                .faces
+                .get(k)
+                .and_then(|f| labels.iter().position(|l| *l == f.label));
+            if let Some(i) = at {
+                out[i] += n;
+            }
+        }
         return Ok(out);
     }
     if !t.faces_complete() {
