@@ -167,6 +167,12 @@ pub fn run(mut a: FairArgs) -> Result<()> {
         }
     }
     let fair = assess(&summary, &null)?;
+    // Broken physics says so on the terminal too, whatever goes to stdout (as `roll`).
+    if *a.roll.json {
+        for w in &summary.warnings {
+            eprintln!("dicephys: warning: {w}");
+        }
+    }
     let doc = serde_json::json!({ "fairness": fair, "summary": summary });
     let json = dicephys::run::seal::to_string(&doc, true)?;
     if let (Some(dir), false) = (&a.out, summary.partial) {

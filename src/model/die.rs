@@ -23,6 +23,10 @@ pub struct Convex {
     normals: Vec<Vector3<f64>>,
     /// The largest distance from the centre of mass to any point of the die, m.
     pub reach: f64,
+    /// Its least thickness, m (across its facets' planes; a cylinder's height or diameter):
+    /// a centre that sinks deeper than this below the floor's top face has gone into it, not
+    /// dipped (`sim::roll::Dip::through`).
+    pub thickness: f64,
     /// The regions of down directions by the face the downward ray from the centre of mass
     /// leaves through (a hull's facets; a cylinder's caps, then its side).
     regions: Vec<Region>,
@@ -70,6 +74,20 @@ impl Convex {
                 .iter()
                 .map(|p: &Vector3<f64>| p.norm())
                 .fold(0.0, f64::max),
+        };
+        let thickness = match cylinder {
+            Some((r, h)) => (2.0 * r).min(2.0 * h),
+            None => shape
+                .facets()
+                .iter()
+                .map(|f| {
+                    let depth = points
+                        .iter()
+                        .map(|p| f.normal.dot(&(p + com)))
+                        .fold(f64::INFINITY, f64::min);
+                    f.offset - depth
+                })
+                .fold(f64::INFINITY, f64::min),
         };
         let normals: Vec<Vector3<f64>> = shape
             .faces
@@ -138,6 +156,7 @@ impl Convex {
             centroid,
             normals,
             reach,
+            thickness,
             regions,
         }
     }

@@ -158,6 +158,22 @@ impl Fairness {
         if let Some(r) = &s.precision {
             out += &format!("  {}\n", r.line());
         }
+        // What `roll` says of the same run: rolls that failed, and physics that broke.
+        if s.failed_total > 0 {
+            let each: Vec<String> = s
+                .failed
+                .iter()
+                .map(|(f, n)| format!("{} {n}", f.name()))
+                .collect();
+            out += &format!(
+                "  {} rolls failed and are not counted ({})\n",
+                s.failed_total,
+                each.join(", ")
+            );
+        }
+        for w in &s.warnings {
+            out += &format!("  warning: {w}\n");
+        }
         out
     }
 }

@@ -301,3 +301,97 @@ fn fair_within_stops_on_a_shape() {
     let o = dicephys(&["roll", "--shape", "d6", "--precision", "2"]);
     refused(&o, 2, "fair --within");
 }
+
+/// Item 2: a fit takes a die whose labels merge facets (counts per printed number, as users of
+/// mirror-pair dice have them): the cube with A on one face and B on five is fitted on its
+/// two labels, each design point's counts summed over a label's facets (A about a sixth).
+#[test]
+fn a_fit_counts_a_die_by_label() {
+    let d = scratch("counting-fit");
+    write(&d, "cube.obj", CUBE);
+    let labels = "[{ normal = [0, 0, 1], label = \"A\" }, { normal = [0, 0, -1], label = \"B\" }, \
+                  { normal = [1, 0, 0], label = \"B\" }, { normal = [-1, 0, 0], label = \"B\" }, \
+                  { normal = [0, 1, 0], label = \"B\" }, { normal = [0, -1, 0], label = \"B\" }]";
+    let ab = write(
+        &d,
+        "ab.toml",
+        &format!("mesh = \"cube.obj\"\nlabels = {labels}\n"),
+    );
+    let data = write(
+        &d,
+        "ab.csv",
+        "label,surface,face_A,face_B\nab,table,50,250\n",
+    );
+    let out = d.join("out").display().to_string();
+    let doc = json(&dicephys(&[
+        "fit",
+        "--data",
+        &data,
+        "--die",
+        &ab,
+        "--free",
+        "e",
+        "--points",
+        "6",
+        "--degree",
+        "1",
+        "--point-rolls",
+        "200",
+        "--no-refine",
+        "--out",
+        &out,
+        "--json",
+    ]));
+    assert_eq!(
+        doc["config"]["rows"][0]["labels"],
+        serde_json::json!(["A", "B"])
+    );
+    let points = doc["designs"][0]["points"].as_array().unwrap();
+    let (mut a, mut n) = (0u64, 0u64);
+    for p in points {
+        let c: Vec<u64> = p["counts"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_u64().unwrap())
+            .collect();
+        assert_eq!(c.len(), 2, "{p}");
+        assert_eq!(c.iter().sum::<u64>(), 200, "every roll on A or B: {p}");
+        a += c[0];
+        n += 200;
+    }
+    // A is a sixth of the rolls within 4σ (a cube in a tumble).
+    let q = 1.0 / 6.0;
+    let z = (a as f64 - n as f64 * q) / (n as f64 * q * (1.0 - q)).sqrt();
+    assert!(z.abs() < 4.0, "A {a} of {n} (z {z:.1})");
+}
+
+/// Item 3: a die that sinks deeper into the floor than it is thick has gone into it: a 0.1 mm
+/// coin sank 45 times its thickness at 1 ms and was counted (on its edge 3.5 times as often as
+/// the theory). Such rolls are failures (tunnelled), and `fair` says so as `roll` does.
+#[test]
+fn a_die_sunk_deeper_than_it_is_thick_is_a_failure() {
+    let doc = json(&dicephys(&[
+        "roll",
+        "--shape",
+        "coin:24,0.1",
+        "--rolls",
+        "200",
+        "--seed",
+        "1",
+        "--json",
+    ]));
+    let tunnelled = doc["failed"]["tunnelled"].as_u64().unwrap_or(0);
+    assert!(tunnelled > 0, "{}", doc["failed"]);
+    let o = dicephys(&[
+        "fair",
+        "--shape",
+        "coin:24,0.1",
+        "--rolls",
+        "200",
+        "--seed",
+        "1",
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("tunnelled"), "{text}");
+}
