@@ -599,6 +599,19 @@ fn made_die_and_faces() -> (Value, Value) {
     (made, faces)
 }
 
+/// A coin loaded off its axis that rolls on its rim: its faces not alike, no quasi-static
+/// theory, and too many rolls at the cap for a verdict (issue 69).
+const UNSETTLED_COIN: [&str; 8] = [
+    "--shape",
+    "coin:24,2",
+    "--com",
+    "1,0,0",
+    "--rolling-resistance",
+    "0",
+    "--max-steps",
+    "3000",
+];
+
 #[test]
 fn json_md_lists_the_keys_of_roll_and_merge() {
     let mut c = checker();
@@ -624,18 +637,7 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
     ]);
     let none = roll(&["--block", "140x24x20", "--max-steps", "1"]);
     let shaped = roll(&["--shape", "d6", "--rolling-resistance", "0.05"]);
-    // A coin loaded off its axis that rolls on its rim: its faces not alike, no quasi-static
-    // theory, and too many rolls at the cap for a verdict (issue 69).
-    let unsettled = roll(&[
-        "--shape",
-        "coin:24,2",
-        "--com",
-        "1,0,0",
-        "--rolling-resistance",
-        "0",
-        "--max-steps",
-        "3000",
-    ]);
+    let unsettled = roll(&UNSETTLED_COIN);
     let broken = roll(&["--block", "140x24x20", "--dt", "1/30"]);
     assert!(broken["warnings"].is_array(), "{}", broken["dipped"]);
     assert!(shaped.get("warnings").is_none());

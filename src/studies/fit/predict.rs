@@ -172,12 +172,8 @@ pub fn predict_block(
             ratios.push(c.breadth as f64 / c.width.max(1) as f64);
         }
         if with_faces {
-            let faces = super::simulate::outcome_counts(
-                &done.tally,
-                true,
-                method,
-                spec.scene.shape.as_deref(),
-            )?;
+            let rolled = spec.scene.shape.as_deref();
+            let faces = super::simulate::outcome_counts(&done.tally, true, method, rolled)?;
             for (k, v) in faces.iter().enumerate() {
                 face_freq[k].push(*v as f64 / settled as f64);
             }
