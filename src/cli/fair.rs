@@ -317,7 +317,8 @@ fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str, null: &Null)
             &dicephys::run::stop::Kept::Nothing(Some("a --vary run does not resume")),
         )));
     };
-    let doc = serde_json::json!({ "vary": what, "null": (null.spec()), "spec": spec, "points": points });
+    let doc =
+        serde_json::json!({ "vary": what, "null": (null.spec()), "spec": spec, "points": points });
     let json = dicephys::run::seal::to_string(&doc, true)?;
     if let Some(dir) = &a.out {
         let die = match &spec.scene.shape {

@@ -160,7 +160,10 @@ pub fn run(a: &RollArgs) -> Result<()> {
         if summary.rolls > 0 && shape.faces.iter().all(|f| f.count == 0) {
             let why = dicephys::report::summary::check_settled(&summary.tally, &spec.scene)
                 .err()
-                .map_or_else(|| "no roll came to rest on a face".into(), |e| e.to_string());
+                .map_or_else(
+                    || "no roll came to rest on a face".into(),
+                    |e| e.to_string(),
+                );
             return Err(Error::Run(why));
         }
     }

@@ -156,7 +156,10 @@ pub fn run(a: &SlurmArgs) -> Result<()> {
             return Ok(());
         }
         SlurmCommand::Roll(r) => (vec![roll("roll", &r.roll, None, &r.job)?], &r.job),
-        SlurmCommand::Fair(f) => (vec![roll("fair", &f.roll, Some(f.null.clone()), &f.job)?], &f.job),
+        SlurmCommand::Fair(f) => (
+            vec![roll("fair", &f.roll, Some(f.null.clone()), &f.job)?],
+            &f.job,
+        ),
         c => {
             let (cfg, threads, json, given, job) = study_of(c)?;
             if let Some(flag) = given {

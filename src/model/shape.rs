@@ -346,10 +346,7 @@ impl Shape {
             }
         };
         let normal_text = |f: &polytope::Facet| {
-            format!(
-                "({:.4}, {:.4}, {:.4})",
-                f.normal.x, f.normal.y, f.normal.z
-            )
+            format!("({:.4}, {:.4}, {:.4})", f.normal.x, f.normal.y, f.normal.z)
         };
         let labelled: Vec<(&polytope::Facet, String)> = facets
             .iter()
@@ -364,7 +361,11 @@ impl Shape {
                 // The labelled facet facing up, if one is opposite this one.
                 let up = labelled
                     .iter()
-                    .min_by(|a, b| a.0.normal.dot(&f.normal).total_cmp(&b.0.normal.dot(&f.normal)))
+                    .min_by(|a, b| {
+                        a.0.normal
+                            .dot(&f.normal)
+                            .total_cmp(&b.0.normal.dot(&f.normal))
+                    })
                     .filter(|(g, _)| g.normal.dot(&f.normal) < -OPPOSITE_TOLERANCE.cos())
                     .map(|(_, l)| l.clone());
                 let label = match (self.reads, up) {
@@ -790,7 +791,10 @@ mod tests {
         .map(|p| p * 8.0);
         let mesh = polytope::hull(&v).unwrap();
         let e = from_mesh(&mesh, "tetra".into(), None, Reads::Up).unwrap_err();
-        assert!(e.contains("no facet faces up") && e.contains("normal ("), "{e}");
+        assert!(
+            e.contains("no facet faces up") && e.contains("normal ("),
+            "{e}"
+        );
         // Read on the face down it is four outcomes, 1 … 4.
         let down = from_mesh(&mesh, "tetra".into(), None, Reads::Down).unwrap();
         assert_eq!(down.labels(), ["1", "2", "3", "4"]);

@@ -285,7 +285,9 @@ pub fn check_settled(tally: &Tally, scene: &crate::model::scene::Scene) -> crate
     let advice = "raise --max-steps, or give --rolling-resistance (0.05 mm: a hard table) so that \
                   a die rolling on an edge or a rim stops";
     if tally.rolls > 0 && faced == 0 {
-        return Err(crate::Error::failed(format!("{why}: nothing to count; {advice}")));
+        return Err(crate::Error::failed(format!(
+            "{why}: nothing to count; {advice}"
+        )));
     }
     if off as f64 > MAX_UNSETTLED_SHARE * tally.rolls as f64 {
         return Err(crate::Error::failed(format!(
@@ -315,12 +317,12 @@ impl ShapeOutcomes {
             .zip(&fair)
             .map(|((_, c), q)| (*c as f64 - nf * q).powi(2) / (nf * q))
             .sum();
-        let (theory, quasi_static_missing) = match crate::theory::quasi_static::outcome_shares(scene)
-        {
-            Some(Ok(q)) => (Some(q), None),
-            Some(Err(e)) => (None, Some(e)),
-            None => (None, None),
-        };
+        let (theory, quasi_static_missing) =
+            match crate::theory::quasi_static::outcome_shares(scene) {
+                Some(Ok(q)) => (Some(q), None),
+                Some(Err(e)) => (None, Some(e)),
+                None => (None, None),
+            };
         let against_quasi_static = theory.as_ref().map(|q| {
             let (mut chi2, mut k) = (0.0, 0usize);
             for ((_, c), q) in counts.iter().zip(q) {

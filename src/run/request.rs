@@ -177,7 +177,11 @@ impl SceneRequest {
         // A loaded die's outcomes are the facets it rests on at its own centre of mass.
         let scene = scene.resting_at_com().map_err(|e| {
             Error::field(
-                if d.file.is_some() { Field::Die } else { Field::Shape },
+                if d.file.is_some() {
+                    Field::Die
+                } else {
+                    Field::Shape
+                },
                 d.file
                     .as_ref()
                     .map(|p| p.display().to_string())

@@ -95,7 +95,9 @@ impl std::str::FromStr for Null {
                 .ok_or_else(|| format!("'{item}': write LABEL=P (e.g. 6=1/4)"))?;
             let label = label.trim();
             if label.is_empty() || out.iter().any(|(l, _)| l == label) {
-                return Err(format!("the target's face '{label}' is empty or given twice"));
+                return Err(format!(
+                    "the target's face '{label}' is empty or given twice"
+                ));
             }
             let p = probability(p).ok_or_else(|| {
                 format!(
@@ -111,9 +113,7 @@ impl std::str::FromStr for Null {
         }
         let sum: f64 = out.iter().map(|(_, p)| p).sum();
         if (sum - 1.0).abs() > SUM_TOLERANCE {
-            return Err(format!(
-                "the target's probabilities sum to {sum:.6}, not 1"
-            ));
+            return Err(format!("the target's probabilities sum to {sum:.6}, not 1"));
         }
         Ok(Null::Target(out))
     }
@@ -233,7 +233,10 @@ mod tests {
         assert!((v[0].1 - 1.0 / 3.0).abs() < 1e-15);
         let json = serde_json::to_string(&t).unwrap();
         assert_eq!(serde_json::from_str::<Null>(&json).unwrap(), t);
-        assert_eq!(serde_json::to_string(&Null::QuasiStatic).unwrap(), "\"quasi-static\"");
+        assert_eq!(
+            serde_json::to_string(&Null::QuasiStatic).unwrap(),
+            "\"quasi-static\""
+        );
         for bad in [
             "fair",
             "a=0.5,b=0.4",
