@@ -1749,7 +1749,7 @@ mod tests {
         let none = pool.install(|| each_until(1000, &stop, work));
         assert!(none.is_empty());
         assert_eq!(started.load(Ordering::SeqCst), 0);
-        let all = pool.install(|| each_until(1000, &Stop::new(), |b| Some(b)));
+        let all = pool.install(|| each_until(1000, &Stop::new(), Some));
         assert_eq!(all, (0..1000).collect::<Vec<_>>());
     }
 }
