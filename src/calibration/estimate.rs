@@ -938,10 +938,16 @@ fn bootstrap_rows(lik: &Likelihood, x: &[f64], phi: f64, rng: &mut ChaCha8Rng) -
 /// concentration), not the second, which moves the estimate too when the box is not much
 /// wider than the region (a 12-faced synthetic die, 64 points × 500 throws: the truth's
 /// Δ(−2 ln L) averaged 3.6 against χ²₃'s 3; at 100 throws a point 5.2, at 500,000 2.9).
-fn redrawn(designs: &[Design], rng: &mut ChaCha8Rng) -> Vec<Design> {
+///
+/// `None` once a stop is requested (asked before each design's surrogate is fitted again,
+/// and by its fit at every Newton step).
+fn redrawn(designs: &[Design], rng: &mut ChaCha8Rng, stop: &Stop) -> Option<Vec<Design>> {
     designs
         .iter()
         .map(|d| {
+            if stop.requested() {
+                return None;
+            }
             let s = &d.surrogate;
             let pts: Vec<DesignPoint> = d
                 .points
@@ -957,10 +963,11 @@ fn redrawn(designs: &[Design], rng: &mut ChaCha8Rng) -> Vec<Design> {
                     }
                 })
                 .collect();
-            Design {
-                surrogate: Surrogate::fit(&pts, s.dims, s.outcomes, s.degree),
+            let stopped = || stop.requested();
+            Some(Design {
+                surrogate: Surrogate::fit_until(&pts, s.dims, s.outcomes, s.degree, &stopped)?,
                 ..d.clone()
-            }
+            })
         })
         .collect()
 }
@@ -1052,27 +1059,41 @@ fn bootstrap_sets(
     seed: u64,
     phi: f64,
 ) -> Vec<(f64, f64)> {
-    use rayon::prelude::*;
     if dims == 0 || sets == 0 {
         return Vec::new();
     }
-    (0..sets)
+    each_until(sets, &lik.stop, |b| {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        rng.set_stream(b as u64);
+        let designs = redrawn(lik.designs, &mut rng, &lik.stop)?;
+        let rows = bootstrap_rows(lik, x, phi, &mut rng);
+        let free = Likelihood {
+            rows: &rows,
+            designs: &designs,
+            ..lik.holding(Vec::new())
+        };
+        let (best, maxima) = maximise_from(&free, &[x.to_vec(), vec![0.5; dims]]).ok()?;
+        let (boot, (best, _)) = held_again(&free, &best.x, &maxima).ok()?;
+        let chi2 = row_fits(&boot, &best.x).iter().map(|r| r.chi2).sum();
+        Some(((boot.minus_two_ln_l(x) - best.f).max(0.0), chi2))
+    })
+}
+
+/// `work(0)`, …, `work(n − 1)` on the caller's pool, the results kept in order (a `None`
+/// dropped), each unit started only while no stop is requested: once one is, the units under
+/// way finish (each polls the stop itself, or is short) and no other starts. A bootstrap set
+/// is one such unit (its surrogates fitted again, then a search): before, a stop made every
+/// set left redraw its surrogates before its search saw the stop, 1.3–2.5 s of a d20's
+/// likelihood ratio's scale (issue 69.11).
+fn each_until<T: Send>(
+    n: usize,
+    stop: &Stop,
+    work: impl Fn(usize) -> Option<T> + Sync + Send,
+) -> Vec<T> {
+    use rayon::prelude::*;
+    (0..n)
         .into_par_iter()
-        .filter_map(|b| {
-            let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            rng.set_stream(b as u64);
-            let designs = redrawn(lik.designs, &mut rng);
-            let rows = bootstrap_rows(lik, x, phi, &mut rng);
-            let free = Likelihood {
-                rows: &rows,
-                designs: &designs,
-                ..lik.holding(Vec::new())
-            };
-            let (best, maxima) = maximise_from(&free, &[x.to_vec(), vec![0.5; dims]]).ok()?;
-            let (boot, (best, _)) = held_again(&free, &best.x, &maxima).ok()?;
-            let chi2 = row_fits(&boot, &best.x).iter().map(|r| r.chi2).sum();
-            Some(((boot.minus_two_ln_l(x) - best.f).max(0.0), chi2))
-        })
+        .filter_map(|b| if stop.requested() { None } else { work(b) })
         .collect()
 }
 
@@ -1698,5 +1719,37 @@ mod tests {
         assert_eq!(overdispersion(20.0, Some(&boot(0.01)), true), 1.0);
         // A χ² below the bootstrap's mean never narrows.
         assert_eq!(overdispersion(4.0, Some(&boot(0.01)), false), 1.0);
+    }
+
+    /// A stop ends the bootstrap's sets within the sets under way: counted in sets started,
+    /// not seconds, so the test holds on any machine (issue 69.11: a d20's likelihood ratio's
+    /// scale took 1.3–2.5 s to end, every set left redrawing its surrogates). A stop raised
+    /// before starts none; one raised by the 10th set of 1,000 starts at most one more per
+    /// other thread of the pool; none raised, all run, their results in order.
+    #[test]
+    fn a_stop_starts_no_more_bootstrap_sets() {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        let started = AtomicUsize::new(0);
+        let stop = Stop::new();
+        let work = |b: usize| {
+            if started.fetch_add(1, Ordering::SeqCst) + 1 == 10 {
+                stop.request();
+            }
+            Some(b)
+        };
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(4)
+            .build()
+            .unwrap();
+        let done = pool.install(|| each_until(1000, &stop, work));
+        let n = started.load(Ordering::SeqCst);
+        assert!((10..=10 + 3).contains(&n), "{n} sets started");
+        assert!(done.len() == n && done.windows(2).all(|w| w[0] < w[1]));
+        started.store(0, Ordering::SeqCst);
+        let none = pool.install(|| each_until(1000, &stop, work));
+        assert!(none.is_empty());
+        assert_eq!(started.load(Ordering::SeqCst), 0);
+        let all = pool.install(|| each_until(1000, &Stop::new(), Some));
+        assert_eq!(all, (0..1000).collect::<Vec<_>>());
     }
 }

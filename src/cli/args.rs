@@ -79,6 +79,15 @@ impl std::ops::Deref for MaxSteps {
     }
 }
 
+impl MaxSteps {
+    /// The step cap asked, as the library's request: `None` when left at its default, so
+    /// that the library chooses the die's (`EndRequest::cap`: a die of any shape's is
+    /// smaller).
+    pub fn asked(&self) -> Option<u64> {
+        Some(self.max_steps).filter(|&m| m != DEFAULT_MAX_STEPS)
+    }
+}
+
 impl Threads {
     /// The worker threads, checked (0: one per core).
     pub fn checked(&self) -> Result<usize> {
@@ -504,7 +513,7 @@ impl RunArgs {
             fast_flight: self.flight == FlightArg::Fast,
             faithful: self.faithful,
             audit: self.audit,
-            max_steps: Some(*self.max_steps).filter(|&m| m != DEFAULT_MAX_STEPS),
+            max_steps: self.max_steps.asked(),
             margin: self.margin,
         }
     }

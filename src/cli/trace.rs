@@ -8,7 +8,8 @@ use dicephys::engine::{new_engine, EngineKind};
 use dicephys::model::die::DieShape;
 use dicephys::model::state::BodyState;
 use dicephys::report::trace;
-use dicephys::sim::roll::{roll_observed, RollConfig};
+use dicephys::run::request::EndRequest;
+use dicephys::sim::roll::{roll_observed, Fate, RollConfig};
 use std::io::Write;
 
 /// `dicephys trace`'s arguments.
@@ -63,9 +64,18 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     // from its observer); later lines are not attempted.
     let mut failed: Option<std::io::Error> = None;
     let mut last = None;
+    let mut end_state = None;
     let line = |step: u64, s: &BodyState| trace::row(&die, scene.dt, step, s);
+    // The step cap `roll` takes for the same die: a die of any shape's unless asked (a coin
+    // on its edge on a floor without rolling resistance rolls for ever, and traced to
+    // DicePhys's 20,000,000 steps it wrote gigabytes; issue 69.10).
+    let cap = EndRequest {
+        max_steps: a.max_steps.asked(),
+        ..EndRequest::default()
+    }
+    .cap(&scene);
     let settle = RollConfig {
-        max_steps: *a.max_steps,
+        max_steps: cap,
         fast_flight: a.flight == FlightArg::Fast,
         ..RollConfig::default()
     };
@@ -78,6 +88,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
             eprintln!("dicephys: {}", dicephys::run::stop::interrupted(&kept));
             std::process::exit(130);
         }
+        end_state = Some(*s);
         let l = line(step, s);
         if step % a.every == 0 {
             if failed.is_none() {
@@ -96,6 +107,15 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     }
     out.flush()?;
     let labels = scene.shape.as_ref().map(|s| s.labels()).unwrap_or_default();
-    eprintln!("{}", trace::ending(a.index, &throw, &record, &labels));
+    // A die still moving at the cap: the face it was on then, for the ending's line (a
+    // record keeps a face only for a settled roll).
+    let mut ended = record;
+    if let (Fate::Unconverged(_), Some(s)) = (record.fate, end_state) {
+        ended.up = die.outcome(&s).1;
+    }
+    eprintln!("{}", trace::ending(a.index, &throw, &ended, &labels));
+    if let Some(note) = trace::capped(&record, cap, a.max_steps.asked().is_some()) {
+        eprintln!("dicephys: {note}");
+    }
     Ok(())
 }

@@ -49,6 +49,13 @@ pub fn ending(index: u64, throw: &Throw, record: &RollRecord, labels: &[&str]) -
                 .unwrap_or(&"?")
         ),
         Fate::Settled(o) => format!("settled, {} vertical", o.name()),
+        Fate::Unconverged(crate::model::block::Outcome::Face) => format!(
+            "unconverged (showing {} at the cap)",
+            record
+                .up
+                .and_then(|k| labels.get(usize::from(k)))
+                .unwrap_or(&"?")
+        ),
         Fate::Unconverged(o) => format!("unconverged ({} vertical at the cap)", o.name()),
         Fate::Failed(f) => format!("failed: {}", f.name()),
     };
@@ -56,4 +63,23 @@ pub fn ending(index: u64, throw: &Throw, record: &RollRecord, labels: &[&str]) -
         "throw {index}: drop {:.4} m, v {:.4} m/s, spin {:.3} rad/s: {fate} after {} steps",
         throw.drop_height, throw.velocity, throw.spin, record.steps
     )
+}
+
+/// When the step cap ended the trace (the die not at rest after `cap` steps), one line that
+/// says so: the cap, whose it was (`asked`: `--max-steps`, else the die's default) and how to
+/// move it. `None` when the roll ended otherwise.
+pub fn capped(record: &RollRecord, cap: u64, asked: bool) -> Option<String> {
+    if !matches!(record.fate, Fate::Unconverged(_)) {
+        return None;
+    }
+    let whose = if asked {
+        "as asked".to_string()
+    } else if cap == crate::sim::roll::SHAPE_MAX_STEPS {
+        "a die of any shape's default, as `roll`'s; --max-steps sets another".to_string()
+    } else {
+        "DicePhys's default; --max-steps sets another".to_string()
+    };
+    Some(format!(
+        "the step cap ended the trace: the die was not at rest after {cap} steps ({whose})"
+    ))
 }

@@ -12,7 +12,7 @@ use crate::model::mass::Features;
 use crate::model::scene::{Floor, Mode, Preset, Scene};
 use crate::model::throws::{ThrowKind, ThrowRanges, ThrowStyle, DEFAULT_SEED};
 use crate::run::spec::{RunSpec, ThrowSpec};
-use crate::sim::roll::{RollConfig, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS, SHAPE_MAX_STEPS};
+use crate::sim::roll::{default_max_steps, RollConfig, Rule, DEFAULT_MARGIN};
 use std::path::PathBuf;
 
 /// A block where a shape gives the die (its bounding box replaces it: `Scene::with_shape`).
@@ -317,12 +317,13 @@ impl EndRequest {
     /// or for a die of any shape `SHAPE_MAX_STEPS` (a cylinder rolling on its side stops only
     /// by rolling resistance).
     pub fn roll(&self, scene: &Scene) -> Result<RollConfig> {
-        let cap = self.max_steps.unwrap_or(if scene.shape.is_some() {
-            SHAPE_MAX_STEPS
-        } else {
-            DEFAULT_MAX_STEPS
-        });
-        self.roll_at(scene.dt, cap)
+        self.roll_at(scene.dt, self.cap(scene))
+    }
+
+    /// The step cap of each roll of `scene`: the one asked, or the die's default
+    /// ([`default_max_steps`]).
+    pub fn cap(&self, scene: &Scene) -> u64 {
+        self.max_steps.unwrap_or_else(|| default_max_steps(scene))
     }
 
     /// How each roll at time step `dt` is carried out, with the step cap `max_steps`.
@@ -421,5 +422,44 @@ impl RollRequest {
         };
         spec.validate(self.scene.allow_restitution_above_one)?;
         Ok(spec)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::roll::{DEFAULT_MAX_STEPS, SHAPE_MAX_STEPS};
+
+    fn scene_of(die: DieRequest) -> Scene {
+        SceneRequest {
+            die,
+            ..SceneRequest::default()
+        }
+        .scene()
+        .unwrap()
+    }
+
+    #[test]
+    fn the_step_cap_is_the_dies_unless_asked() {
+        // Issue 69.10: `trace` took DicePhys's 20,000,000 for a coin where `roll` took a die
+        // of any shape's 200,000; both now ask `EndRequest::cap`.
+        let coin = scene_of(DieRequest {
+            shape: Some("coin:24,8.5".into()),
+            ..DieRequest::default()
+        });
+        let block = scene_of(DieRequest {
+            block: Some("140x24x20".parse().unwrap()),
+            ..DieRequest::default()
+        });
+        let end = EndRequest::default();
+        assert_eq!(end.cap(&coin), SHAPE_MAX_STEPS);
+        assert_eq!(end.roll(&coin).unwrap().max_steps, SHAPE_MAX_STEPS);
+        assert_eq!(end.cap(&block), DEFAULT_MAX_STEPS);
+        let asked = EndRequest {
+            max_steps: Some(500),
+            ..EndRequest::default()
+        };
+        assert_eq!(asked.cap(&coin), 500);
+        assert_eq!(asked.cap(&block), 500);
     }
 }

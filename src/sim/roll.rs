@@ -24,6 +24,18 @@ pub const DEFAULT_MAX_STEPS: u64 = 20_000_000;
 /// at the cap recorded, in a fraction of a second rather than hours.
 pub const SHAPE_MAX_STEPS: u64 = 200_000;
 
+/// The step cap of a roll of `scene` when none is given: [`SHAPE_MAX_STEPS`] for a die of any
+/// shape, else DicePhys's [`DEFAULT_MAX_STEPS`]. Every command that rolls a die takes its
+/// default cap from here (`roll`, `fair` and `crosscheck` through `EndRequest`, and `trace`),
+/// so that the same die is capped alike.
+pub fn default_max_steps(scene: &Scene) -> u64 {
+    if scene.shape.is_some() {
+        SHAPE_MAX_STEPS
+    } else {
+        DEFAULT_MAX_STEPS
+    }
+}
+
 /// Why a roll failed: the engine's state stopped making sense.
 #[derive(
     Clone,

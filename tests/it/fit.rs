@@ -7,7 +7,9 @@
 //! did not settle is refused. Each of those probes fails against the binary before its fix
 //! (`DICEPHYS_TEST_BIN`, see helpers).
 
-use crate::helpers::{bin, dicephys, json, refused, stderr, timed, wait_at_most, Scratch};
+use crate::helpers::{
+    bin, dicephys, interrupt_after, json, refused, stderr, timed, wait_at_most, Scratch,
+};
 use dicephys::calibration::data::DataRow;
 use dicephys::calibration::design::DesignSpec;
 use dicephys::calibration::estimate::{Identified, Search};
@@ -1181,33 +1183,6 @@ fn ctrl_c_in_the_profiles_of_24_parameters_ends_the_fit_at_once() {
     assert_eq!(code, Some(130), "{seen}");
     assert!(waited < Duration::from_secs(3), "stopped after {waited:?}");
     assert!(!dir.join("out/fit.json").exists());
-}
-
-/// Waits (at most 2 minutes) for a line of `child`'s stderr that contains `stage`, sends it
-/// SIGINT, and returns its exit code, its stderr up to that line and how long it took to end:
-/// a stop signalled after the stage has said it started, so the run is long by construction.
-fn interrupt_after(mut child: std::process::Child, stage: &str) -> (Option<i32>, String, Duration) {
-    use std::io::BufRead;
-    let mut err = std::io::BufReader::new(child.stderr.take().unwrap());
-    let mut seen = String::new();
-    let t = Instant::now();
-    loop {
-        let mut line = String::new();
-        if err.read_line(&mut line).unwrap() == 0 || t.elapsed() > Duration::from_secs(120) {
-            let _ = child.kill();
-            panic!("no line '{stage}' before the run ended: {seen}");
-        }
-        seen.push_str(&line);
-        if line.contains(stage) {
-            break;
-        }
-    }
-    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
-    let stopped = Instant::now();
-    // Drain stderr so that the child never blocks on a full pipe.
-    std::thread::spawn(move || std::io::copy(&mut err, &mut std::io::sink()));
-    let status = child.wait().unwrap();
-    (status.code(), seen, stopped.elapsed())
 }
 
 /// Class 2: a named pipe with no writer as `--data` does not hold off a SIGTERM.

@@ -252,3 +252,33 @@ pub fn has_chunk(dir: &Path) -> bool {
         })
         .unwrap_or(false)
 }
+
+/// Waits (at most 2 minutes) for a line of `child`'s stderr that contains `stage`, sends it
+/// SIGINT, and returns its exit code, its stderr up to that line and how long it took to end:
+/// a stop signalled after the stage has said it started, so the run is long by construction.
+pub fn interrupt_after(
+    mut child: std::process::Child,
+    stage: &str,
+) -> (Option<i32>, String, Duration) {
+    use std::io::BufRead;
+    let mut err = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut seen = String::new();
+    let t = Instant::now();
+    loop {
+        let mut line = String::new();
+        if err.read_line(&mut line).unwrap() == 0 || t.elapsed() > Duration::from_secs(120) {
+            let _ = child.kill();
+            panic!("no line '{stage}' before the run ended: {seen}");
+        }
+        seen.push_str(&line);
+        if line.contains(stage) {
+            break;
+        }
+    }
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let stopped = Instant::now();
+    // Drain stderr so that the child never blocks on a full pipe.
+    std::thread::spawn(move || std::io::copy(&mut err, &mut std::io::sink()));
+    let status = child.wait().unwrap();
+    (status.code(), seen, stopped.elapsed())
+}

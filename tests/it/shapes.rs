@@ -242,6 +242,74 @@ fn a_coin_lands_heads_tails_or_on_its_edge() {
     );
 }
 
+#[test]
+fn trace_stops_at_the_step_cap_roll_takes() {
+    // Issue 69.10: a thick coin on a floor without rolling resistance rolls on its edge for
+    // ever. `roll` caps it at a die of any shape's 200,000 steps; `trace` took DicePhys's
+    // 20,000,000 and wrote 301 MB in 10 s. Throw 0 of seed 1 is such a throw.
+    let coin = [
+        "trace",
+        "--shape",
+        "coin:24,8.5",
+        "--rolling-resistance",
+        "0",
+        "--seed",
+        "1",
+        "--index",
+        "0",
+    ];
+    // Rows: the header, then steps 0 to the cap (the last always printed).
+    let rows = |out: &std::process::Output| {
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        let steps: Vec<u64> = text
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').next().unwrap().parse().unwrap())
+            .collect();
+        assert!(text.starts_with("step,time_s,"), "{text}");
+        steps
+    };
+    // A cap asked: at most cap + 1 rows, the last the cap's, and stderr says the cap ended it.
+    let out = dicephys(&[&coin[..], &["--max-steps", "300"]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let steps = rows(&out);
+    assert!(steps.len() <= 301, "{} rows", steps.len());
+    assert_eq!(steps.last(), Some(&300));
+    assert!(
+        err.contains("the step cap ended the trace: the die was not at rest after 300 steps"),
+        "{err}"
+    );
+    // None asked: `roll`'s cap for the die, 200,000 steps (every 100,000th row printed, so
+    // that the output stays small; the roll takes about a second).
+    let out = dicephys(&[&coin[..], &["--every", "100000"]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert_eq!(rows(&out), [0, 100_000, 200_000], "{err}");
+    assert!(
+        err.contains("not at rest after 200000 steps (a die of any shape's default"),
+        "{err}"
+    );
+    assert!(
+        err.contains("unconverged (showing edge at the cap)"),
+        "{err}"
+    );
+    let roll = json(&dicephys(&[
+        "roll",
+        "--json",
+        "--shape",
+        "coin:24,8.5",
+        "--rolls",
+        "1",
+    ]));
+    assert_eq!(roll["spec"]["roll"]["max_steps"], 200_000);
+    // A die that settles says nothing of the cap.
+    let out = dicephys(&["trace", "--shape", "d20", "--seed", "1", "--every", "100"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("settled"), "{err}");
+    assert!(!err.contains("step cap"), "{err}");
+}
+
 /// One line on stderr, exit 2, containing every one of `says`.
 fn refused(args: &[&str], says: &[&str]) {
     let o = dicephys(args);
