@@ -308,8 +308,31 @@ impl Shape {
         if matches!(self.solid, Solid::Cylinder { .. }) || com.norm() == 0.0 {
             return Ok(self.clone());
         }
+        let faces = if self.printed.is_some() {
+            self.outcomes_at(com, false)?
+        } else {
+            // Numbered 1…N: a facet the uniform die rests on keeps its number, one it rests
+            // on only here is numbered on from N + 1.
+            let mut kept = self.keeper().outcomes_at(com, true)?;
+            let margin = STABLE_MARGIN * self.circumradius();
+            let mut n = self.faces.len();
+            for f in self.facets().iter() {
+                let new = polytope::stable(f, com, margin)
+                    && !kept
+                        .iter()
+                        .any(|k| Vector3::from(k.normal).dot(&f.normal) > 1.0 - 1e-9);
+                if new {
+                    n += 1;
+                    kept.push(Face {
+                        normal: f.normal.into(),
+                        label: n.to_string(),
+                    });
+                }
+            }
+            kept
+        };
         let mut s = self.clone();
-        s.faces = self.outcomes_at(com, false)?;
+        s.faces = self.in_order(faces);
         Ok(s)
     }
 
@@ -322,15 +345,39 @@ impl Shape {
         if matches!(self.solid, Solid::Cylinder { .. }) {
             return Ok(self.clone());
         }
+        let mut s = self.clone();
+        s.faces = self.in_order(self.keeper().outcomes_at(com, true)?);
+        Ok(s)
+    }
+
+    /// This die labelled as it shows its outcomes: its printed labels, or, numbered 1…N,
+    /// each resting facet's label read on the facet itself.
+    fn keeper(&self) -> Shape {
         let mut keeper = self.clone();
         if keeper.printed.is_none() {
-            // What each facet shows is its label, read on the facet it rests on.
             keeper.printed = Some(self.faces.clone());
             keeper.reads = Reads::Down;
         }
-        let mut s = self.clone();
-        s.faces = keeper.outcomes_at(com, true)?;
-        Ok(s)
+        keeper
+    }
+
+    /// `faces` in this die's order of outcomes (those it has, by normal), any other after
+    /// them in the order given: a count by outcome keeps its order when the centre moves.
+    fn in_order(&self, faces: Vec<Face>) -> Vec<Face> {
+        let mut keyed: Vec<(usize, Face)> = faces
+            .into_iter()
+            .enumerate()
+            .map(|(i, f)| {
+                let n = Vector3::from(f.normal);
+                let at = self
+                    .faces
+                    .iter()
+                    .position(|g| Vector3::from(g.normal).dot(&n) > 1.0 - 1e-9);
+                (at.unwrap_or(self.faces.len() + i), f)
+            })
+            .collect();
+        keyed.sort_by_key(|(k, _)| *k);
+        keyed.into_iter().map(|(_, f)| f).collect()
     }
 
     /// The distinct labels the die shows, in the order of their first facet: what a count of
@@ -840,5 +887,30 @@ mod tests {
         // Read on the face down it is four outcomes, 1 … 4.
         let down = from_mesh(&mesh, "tetra".into(), None, Reads::Down).unwrap();
         assert_eq!(down.labels(), ["1", "2", "3", "4"]);
+    }
+
+    #[test]
+    fn a_loaded_die_keeps_its_outcomes_order_and_numbers() {
+        // A d20 loaded 1.5 mm towards −z rests on all its faces, in the same order with the
+        // same labels (a count by outcome keeps its order); a cube numbered 1…N from a mesh
+        // keeps its numbers when its centre moves.
+        let d20 = named("d20", None).unwrap();
+        let loaded = d20.resting_at(&Vector3::new(0.0, 0.0, -0.0015)).unwrap();
+        assert_eq!(loaded.labels(), d20.labels());
+        let v: Vec<Vector3<f64>> = (0..8)
+            .map(|i| {
+                Vector3::new(
+                    if i & 1 == 0 { -8.0 } else { 8.0 },
+                    if i & 2 == 0 { -8.0 } else { 8.0 },
+                    if i & 4 == 0 { -8.0 } else { 8.0 },
+                )
+            })
+            .collect();
+        let mesh = polytope::hull(&v).unwrap();
+        let cube = from_mesh(&mesh, "cube".into(), None, Reads::Down).unwrap();
+        let moved = cube
+            .resting_at(&Vector3::new(0.001, -0.002, 0.0005))
+            .unwrap();
+        assert_eq!(moved.faces, cube.faces);
     }
 }
