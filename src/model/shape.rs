@@ -380,6 +380,23 @@ impl Shape {
         keyed.into_iter().map(|(_, f)| f).collect()
     }
 
+    /// `per_face` (a value for each outcome, in the die's order) summed over the outcomes that
+    /// show the same label, in the order of their first appearance: a count, a share, a
+    /// theory's probability, by label.
+    pub fn by_label<T: Copy + std::ops::AddAssign>(
+        &self,
+        per_face: impl IntoIterator<Item = T>,
+    ) -> Vec<(String, T)> {
+        let mut out: Vec<(String, T)> = Vec::new();
+        for (f, v) in self.faces.iter().zip(per_face) {
+            match out.iter_mut().find(|(l, _)| *l == f.label) {
+                Some((_, m)) => *m += v,
+                None => out.push((f.label.clone(), v)),
+            }
+        }
+        out
+    }
+
     /// The distinct labels the die shows, in the order of their first facet: what a count of
     /// its rolls by label keeps (a label on several facets, a mirror pair that shares one
     /// printed number, is one outcome).

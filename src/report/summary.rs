@@ -190,15 +190,8 @@ pub fn shape_faces(
     scene: &crate::model::scene::Scene,
 ) -> Option<Vec<(String, u64)>> {
     let shape = scene.shape.as_ref()?;
-    let mut out: Vec<(String, u64)> = Vec::new();
-    for (k, f) in shape.faces.iter().enumerate() {
-        let n = tally.faces.get(k).copied().unwrap_or(0);
-        match out.iter_mut().find(|(l, _)| *l == f.label) {
-            Some((_, m)) => *m += n,
-            None => out.push((f.label.clone(), n)),
-        }
-    }
-    Some(out)
+    let counts = (0..shape.faces.len()).map(|k| tally.faces.get(k).copied().unwrap_or(0));
+    Some(shape.by_label(counts))
 }
 
 /// One outcome of a die of any shape: its label, count, probability ± its binomial error, and

@@ -117,17 +117,16 @@ pub const DEFAULT_CUBOID: Block = Block {
 impl SceneRequest {
     /// True if no die is named but what is asked of it is a cuboid's: pips, rounded edges, an
     /// insert, an inertia or a numbering of its faces (flags, or a die file with no mesh).
-    fn default_is_cuboid(&self) -> Result<bool> {
+    fn default_is_cuboid(&self, f: &Features) -> bool {
         let d = &self.die;
-        if d.layout.is_some() || d.pips.is_some() || d.edge_radius.is_some() {
-            return Ok(true);
-        }
-        let (f, _) = Features::described(d.file.as_deref(), None, None, None, None, None)?;
-        Ok(f.pips.is_some()
+        d.layout.is_some()
+            || d.pips.is_some()
+            || d.edge_radius.is_some()
+            || f.pips.is_some()
             || f.edge_radius > 0.0
             || f.insert.is_some()
             || f.inertia.is_some()
-            || f.layout != crate::model::faces::Layout::default())
+            || f.layout != crate::model::faces::Layout::default()
     }
 
     /// The scene, with every value checked before anything runs.
@@ -135,6 +134,14 @@ impl SceneRequest {
         let d = &self.die;
         let mut shape =
             crate::model::shape::described(d.file.as_deref(), d.shape.as_deref(), d.size, d.scale)?;
+        let (features, density) = Features::described(
+            d.file.as_deref(),
+            d.com,
+            d.pips,
+            d.edge_radius,
+            None,
+            d.density,
+        )?;
         let block = match (d.block, &shape) {
             (Some(_), Some(_)) => {
                 return Err(Error::field(
@@ -155,7 +162,7 @@ impl SceneRequest {
             // No die given: a 16 mm d6; the 16 mm cube as the cuboid where the die is made
             // as only a cuboid is (pips, rounded edges, an insert, its inertia, its faces'
             // numbering), so that what is asked applies to the die rolled.
-            (None, None) if self.default_is_cuboid()? => DEFAULT_CUBOID,
+            (None, None) if self.default_is_cuboid(&features) => DEFAULT_CUBOID,
             (None, None) => {
                 shape = crate::model::shape::described(None, Some("d6"), None, None)?;
                 ANY_BLOCK
@@ -179,14 +186,6 @@ impl SceneRequest {
         scene.rolling_resistance = self.rolling_resistance_mm.unwrap_or(0.0) / 1000.0;
         scene.angular_damping = self.angular_damping;
         scene.sleeping = self.sleep;
-        let (features, density) = Features::described(
-            d.file.as_deref(),
-            d.com,
-            d.pips,
-            d.edge_radius,
-            None,
-            d.density,
-        )?;
         scene.features = features;
         if let Some(l) = d.layout {
             // The numbering is the run's (in its specification), pips or none.

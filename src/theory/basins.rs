@@ -637,24 +637,30 @@ mod tests {
 
     /// Uniform directions followed down in 2 mrad steps (`follow`): each face's share within
     /// 4σ of the exact basins, and every face the flow never ends on has no basin.
+    /// A down direction uniform on the sphere (a point in the unit ball, not too near its
+    /// centre; the flow needs only its direction).
+    fn random_direction(rng: &mut impl rand::Rng) -> V3 {
+        loop {
+            let g = V3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            );
+            if g.norm() <= 1.0 && g.norm() > 1e-3 {
+                return g;
+            }
+        }
+    }
+
     fn agrees_with_following(f: &[Facet], com: &V3, seed: u64) {
-        use rand::{Rng, SeedableRng};
+        use rand::SeedableRng;
         let p = facets(f, com).unwrap();
         assert!((p.iter().sum::<f64>() - 1.0).abs() < 1e-12);
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         let n = 3000;
         let mut count = vec![0u32; f.len()];
         for _ in 0..n {
-            let g = loop {
-                let g = V3::new(
-                    rng.random_range(-1.0..1.0),
-                    rng.random_range(-1.0..1.0),
-                    rng.random_range(-1.0..1.0),
-                );
-                if g.norm() <= 1.0 && g.norm() > 1e-3 {
-                    break g;
-                }
-            };
+            let g = random_direction(&mut rng);
             count[follow(f, com, &g, 2e-3)] += 1;
         }
         for (k, &c) in count.iter().enumerate() {
@@ -758,7 +764,7 @@ mod tests {
     /// of its basin, and on no facet without one.
     #[test]
     fn the_designed_hulls_close_and_agree_with_the_flow_followed_step_by_step() {
-        use rand::{Rng, SeedableRng};
+        use rand::SeedableRng;
         let bunny = &include_bytes!("../../tests/data/bunny_d6_hull.obj")[..];
         let kitten = &include_bytes!("../../tests/data/kitten_d3_hull.obj")[..];
         let mut worst = 0.0f64;
@@ -785,16 +791,7 @@ mod tests {
             let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
             let mut count = vec![0u32; f.len()];
             for _ in 0..n {
-                let g = loop {
-                    let g = V3::new(
-                        rng.random_range(-1.0..1.0),
-                        rng.random_range(-1.0..1.0),
-                        rng.random_range(-1.0..1.0),
-                    );
-                    if g.norm() <= 1.0 && g.norm() > 1e-3 {
-                        break g;
-                    }
-                };
+                let g = random_direction(&mut rng);
                 count[settle(&points, &normals, &g)] += 1;
             }
             for (k, &c) in count.iter().enumerate() {

@@ -177,15 +177,8 @@ pub fn target_for(target: &[(String, f64)], labels: &[String]) -> Result<Vec<f64
 /// Each of the die's labels (in the order of their first facet, `Shape::faces`) with the
 /// share a fair die gives it: its resting facets over all of them.
 pub fn uniform_shares(shape: &Shape) -> Vec<(String, f64)> {
-    let n = shape.faces.len() as f64;
-    let mut out: Vec<(String, f64)> = Vec::new();
-    for f in &shape.faces {
-        match out.iter_mut().find(|(l, _)| *l == f.label) {
-            Some((_, q)) => *q += 1.0 / n,
-            None => out.push((f.label.clone(), 1.0 / n)),
-        }
-    }
-    out
+    let n = shape.faces.len();
+    shape.by_label(std::iter::repeat_n(1.0 / n as f64, n))
 }
 
 /// How far apart (relative) a die's facets' quasi-static shares may be for its faces to count

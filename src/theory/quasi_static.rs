@@ -115,15 +115,7 @@ pub fn outcome_shares(scene: &crate::model::scene::Scene) -> Option<Result<Vec<f
 /// [`shape`] summed over the outcomes that show the same label, in the order of their first
 /// appearance (`report::summary::shape_faces`'s).
 pub fn shape_labels(shape_: &Shape, com: &Vector3<f64>) -> Result<Vec<(String, f64)>, String> {
-    let p = shape(shape_, com)?;
-    let mut out: Vec<(String, f64)> = Vec::new();
-    for (f, p) in shape_.faces.iter().zip(p) {
-        match out.iter_mut().find(|(l, _)| *l == f.label) {
-            Some((_, q)) => *q += p,
-            None => out.push((f.label.clone(), p)),
-        }
-    }
-    Ok(out)
+    Ok(shape_.by_label(shape(shape_, com)?))
 }
 
 #[cfg(test)]
