@@ -753,7 +753,7 @@ BulletWorld::BulletWorld(const BulletScene& s)
   // tests give it the whole face's points at once, as the box-box test does the sharp die.
   // A die of any shape (a hull, a cylinder) meets the floor the same way, through GJK, and
   // the same perturbed tests give it a face's points at once, on a box floor or a plane.
-  const bool shaped = !s.hull.empty() || s.cylinder;
+  const bool shaped = s.solid != SolidKind::Box;
   if (s.made && (s.edge_radius > 0 || shaped)) config_->setConvexConvexMultipointIterations();
   if (shaped) config_->setPlaneConvexMultipointIterations();
   dispatcher_ = std::make_unique<btCollisionDispatcher>(config_.get());
@@ -821,7 +821,7 @@ BulletWorld::BulletWorld(const BulletScene& s)
   const double r = s.edge_radius;
   const btQuaternion p(s.principal[0], s.principal[1], s.principal[2], s.principal[3]);
   const btVector3 c = vec(s.com);
-  if (!s.hull.empty()) {
+  if (s.solid == SolidKind::Hull) {
     // A die of any shape: its hull's vertices put straight into the body's frame, Pᵀ(x − c),
     // as the rounded box's balls below. Bullet keeps a convex hull's surface its margin out
     // from the vertices (hull_margin, a hundredth of the die's size at most: Shape::margin).
@@ -857,7 +857,7 @@ BulletWorld::BulletWorld(const BulletScene& s)
   }
   if (!s.offset) {
     // Centred and aligned: the body's frame is the box's (the cylinder's) own.
-    if (s.cylinder) {
+    if (s.solid == SolidKind::Cylinder) {
       die_shape_ = std::make_unique<btCylinderShapeZ>(half);
     } else {
       die_shape_ = std::make_unique<btBoxShape>(half);
@@ -865,7 +865,7 @@ BulletWorld::BulletWorld(const BulletScene& s)
     return;
   }
   // The box (a coin: the cylinder along z) as a compound's child, at Pᵀ(−c), turned by Pᵀ.
-  if (s.cylinder) {
+  if (s.solid == SolidKind::Cylinder) {
     die_solid_ = std::make_unique<btCylinderShapeZ>(half);
   } else {
     die_solid_ = std::make_unique<btBoxShape>(half);

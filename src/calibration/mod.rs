@@ -85,7 +85,13 @@ impl FitConfig {
             )));
         }
         self.check_shape()?;
-        if self.model.is_free(params::Kind::PipDepth) && self.method.shape.is_some() {
+        if self.model.is_free(params::Kind::PipDepth)
+            && self
+                .method
+                .shape
+                .as_deref()
+                .is_some_and(|s| s.as_box().is_none())
+        {
             return Err(Error::field(
                 Field::Free,
                 "pip_depth",

@@ -11,7 +11,6 @@ use super::params::{Fixed, FixedThrow, Kind, Method, ModelSpec};
 use super::FitConfig;
 use crate::engine::EngineKind;
 use crate::error::{Error, Field, Result};
-use crate::model::mass::Features;
 use crate::model::throws::{Range, DEFAULT_SEED};
 use crate::run::request::DieRequest;
 use crate::sim::roll::DEFAULT_MAX_STEPS;
@@ -140,35 +139,22 @@ impl FitRequest {
 
     /// The fit's configuration, checked.
     pub fn config(&self) -> Result<FitConfig> {
-        let d = &self.die;
-        let shape =
-            crate::model::shape::described(d.file.as_deref(), d.shape.as_deref(), d.size, d.scale)?;
-        if let (Some(l), Some(s)) = (d.layout, &shape) {
-            return Err(crate::run::request::layout_beside(l, s));
-        }
-        let (mut die, density) = Features::described(
-            d.file.as_deref(),
-            d.com,
-            d.pips,
-            d.edge_radius,
-            None,
-            d.density,
-        )?;
-        if let Some(layout) = d.layout {
-            die.layout = layout;
-        }
+        let crate::run::request::ResolvedDie {
+            shape,
+            features: mut die,
+            density,
+        } = self.die.resolve()?;
         // A loaded die's outcomes are the facets it rests on at its own centre of mass.
         let shape = match shape {
             Some(s) => {
-                let mut scene = crate::model::scene::Scene::paper(
-                    "16x16x16".parse().expect("a block"),
-                    crate::model::scene::Mode::ThreeD,
-                )
-                .with_shape(s);
+                let mut scene =
+                    crate::model::scene::Scene::paper_shape(s, crate::model::scene::Mode::ThreeD);
                 scene.features = die;
                 let scene = scene.resting_at_com().map_err(|e| {
                     Error::field(Field::Shape, "", format!("at its centre of mass: {e}"))
                 })?;
+                // A box's pips are drilled as its labels number its faces.
+                die = scene.features.clone();
                 scene.shape.map(|s| (*s).clone())
             }
             None => None,

@@ -1,6 +1,7 @@
 //! Bullet (Debian's libbullet, double precision) through the C++ shim in `cpp/`.
 
 use super::{BodyState, Engine};
+use crate::model::collider::Collider;
 use crate::model::mass::{MassProps, Turn};
 use crate::model::scene::{Floor, Mode, Preset, Scene};
 use cxx::UniquePtr;
@@ -8,6 +9,16 @@ use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 #[cxx::bridge(namespace = "dicephys")]
 mod ffi {
+    /// The kind of solid that collides (`model::collider::Collider`'s variants).
+    enum SolidKind {
+        /// A box, `sides` its sides, rounded by `edge_radius`.
+        Box,
+        /// A convex hull, `hull` its vertices.
+        Hull,
+        /// A cylinder along body z (a coin), `sides` its diameter, diameter and height.
+        Cylinder,
+    }
+
     /// Everything the shim needs to build a world; no setting lives only in C++.
     struct BulletScene {
         /// Full side lengths along the body's x, y, z axes, m.
@@ -25,12 +36,11 @@ mod ffi {
         moments: [f64; 3],
         /// Its edges' rounding radius, m.
         edge_radius: f64,
-        /// A die of any shape (`model::shape`): its hull's vertices in body axes from its
-        /// centroid, m, x y z after each other (empty: not a hull).
+        /// What collides (`model::collider::Collider`).
+        solid: SolidKind,
+        /// A hull's vertices in body axes from its centroid, m, x y z after each other
+        /// (empty for a box or a cylinder).
         hull: Vec<f64>,
-        /// A die of any shape that is a cylinder along body z (a coin), `sides` its
-        /// diameter, diameter and height.
-        cylinder: bool,
         /// The hull's collision margin, m (Bullet's convex tests keep the shape this far out).
         hull_margin: f64,
         /// Its centre of mass is off the centre or its principal frame off the body axes:
@@ -187,6 +197,45 @@ pub struct Bullet {
     now: ffi::BodyStateFfi,
 }
 
+/// The die's solid as the shim takes it (`BulletScene`'s fields that say what collides).
+struct BulletSolid {
+    solid: ffi::SolidKind,
+    sides: [f64; 3],
+    edge_radius: f64,
+    hull: Vec<f64>,
+    hull_margin: f64,
+}
+
+/// The die's collider in Bullet's terms: the one place a solid becomes Bullet's.
+fn collider(c: &Collider) -> BulletSolid {
+    match c {
+        Collider::Box { half, radius } => BulletSolid {
+            solid: ffi::SolidKind::Box,
+            sides: (2.0 * half).into(),
+            edge_radius: *radius,
+            hull: Vec::new(),
+            hull_margin: 0.0,
+        },
+        Collider::Hull { points, margin } => BulletSolid {
+            solid: ffi::SolidKind::Hull,
+            sides: [0.0; 3],
+            edge_radius: 0.0,
+            hull: points.iter().flat_map(|v| [v.x, v.y, v.z]).collect(),
+            hull_margin: *margin,
+        },
+        Collider::Cylinder {
+            radius,
+            half_height,
+        } => BulletSolid {
+            solid: ffi::SolidKind::Cylinder,
+            sides: [2.0 * radius, 2.0 * radius, 2.0 * half_height],
+            edge_radius: 0.0,
+            hull: Vec::new(),
+            hull_margin: 0.0,
+        },
+    }
+}
+
 impl Bullet {
     /// A fresh Bullet world for the scene, its solver set by the scene's preset.
     pub fn new(scene: &Scene) -> crate::Result<Bullet> {
@@ -204,28 +253,20 @@ impl Bullet {
     fn build(scene: &Scene, stock_world: bool) -> crate::Result<Bullet> {
         let s = solver(scene.preset);
         let (linear_damping, angular_damping) = scene.bullet_damping();
-        let made = !scene.features.plain() || scene.shape.is_some();
         let mp = MassProps::of(scene)?;
         let p = mp.principal.quaternion();
-        let shape = scene.shape.as_deref();
-        let hull: Vec<f64> = shape.map_or_else(Vec::new, |s| {
-            s.points().iter().flat_map(|v| [v.x, v.y, v.z]).collect()
-        });
-        let cylinder = matches!(
-            shape.map(|s| &s.solid),
-            Some(crate::model::shape::Solid::Cylinder { .. })
-        );
+        let collider = collider(&Collider::of(scene));
         let desc = ffi::BulletScene {
-            sides: scene.body_sides(),
+            sides: collider.sides,
             mass: mp.mass,
-            made,
+            made: Collider::made(scene),
             com: mp.com.into(),
             principal: [p.i, p.j, p.k, p.w],
             moments: mp.moments.into(),
-            edge_radius: scene.features.edge_radius,
-            hull,
-            cylinder,
-            hull_margin: shape.map_or(0.0, |s| s.margin()),
+            edge_radius: collider.edge_radius,
+            solid: collider.solid,
+            hull: collider.hull,
+            hull_margin: collider.hull_margin,
             offset: mp.com != Vector3::zeros() || !mp.aligned(),
             planar: scene.mode == Mode::TwoD,
             die_friction: scene.friction,

@@ -30,6 +30,7 @@
 //! finer). 3D only, a polyhedron only (no rounded edges, no cylinder), no rolling resistance.
 
 use super::{BodyState, Engine};
+use crate::model::collider::Collider;
 use crate::model::mass::MassProps;
 use crate::model::scene::{Mode, Scene};
 use nalgebra::{Matrix3, UnitQuaternion, Vector2, Vector3};
@@ -72,15 +73,12 @@ pub fn models(scene: &Scene) -> crate::Result<()> {
     if scene.mode != Mode::ThreeD {
         return refuse("3D dice only");
     }
-    if scene.features.edge_radius > 0.0 {
-        return refuse("a polyhedron only (no rounded edges)");
-    }
-    if scene
-        .shape
-        .as_deref()
-        .is_some_and(|s| s.points().is_empty())
-    {
-        return refuse("a polyhedron only (no cylinder)");
+    match Collider::of(scene) {
+        Collider::Box { radius, .. } if radius > 0.0 => {
+            return refuse("a polyhedron only (no rounded edges)")
+        }
+        Collider::Cylinder { .. } => return refuse("a polyhedron only (no cylinder)"),
+        _ => {}
     }
     if scene.rolling_resistance > 0.0 {
         return refuse("no rolling resistance");
@@ -88,23 +86,27 @@ pub fn models(scene: &Scene) -> crate::Result<()> {
     Ok(())
 }
 
+/// The die's corners, body axes from its centroid: the one place a solid becomes the
+/// arbiter's (a box's eight, a hull's vertices; `models` refuses the rest).
+fn corners(c: &Collider) -> Vec<Vector3<f64>> {
+    match c {
+        Collider::Box { half, .. } => (0..8)
+            .map(|k| {
+                let sign = |bit: u32| if k & (1 << bit) == 0 { -1.0 } else { 1.0 };
+                Vector3::new(sign(0) * half.x, sign(1) * half.y, sign(2) * half.z)
+            })
+            .collect(),
+        Collider::Hull { points, .. } => points.clone(),
+        Collider::Cylinder { .. } => Vec::new(),
+    }
+}
+
 impl Moreau {
     /// The scene's die on a flat floor; refuses what it does not model (`models`).
     pub fn new(scene: &Scene) -> crate::Result<Moreau> {
         models(scene)?;
         let mp = MassProps::of(scene)?;
-        let points = match scene.shape.as_deref() {
-            Some(s) => s.points(),
-            None => {
-                let [x, y, z] = scene.body_sides().map(|s| 0.5 * s);
-                (0..8)
-                    .map(|k| {
-                        let sign = |bit: u32| if k & (1 << bit) == 0 { -1.0 } else { 1.0 };
-                        Vector3::new(sign(0) * x, sign(1) * y, sign(2) * z)
-                    })
-                    .collect()
-            }
-        };
+        let points = corners(&Collider::of(scene));
         let inv_inertia = mp
             .inertia
             .try_inverse()

@@ -5,6 +5,7 @@
 //! the components across, exactly.
 
 use super::{BodyState, Engine};
+use crate::model::collider::Collider;
 use crate::model::mass::{MassProps, Turn};
 use crate::model::scene::{Floor, Mode, Preset, Scene};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -236,37 +237,20 @@ impl Rapier3d {
             ip.warmstart_coefficient = 0.0;
             ip.num_internal_stabilization_iterations = 3;
         }
-        let [bx, by, bz] = scene.body_sides();
-        let made = !scene.features.plain() || scene.shape.is_some();
+        let made = Collider::made(scene);
         let mp = MassProps::of(scene)?;
         let die_collider = if made {
             // The solid in body axes, centred; the body in its principal frame P at the centre
             // of mass c: the solid sits at Pᵀ(−c), turned by Pᵀ, and weighs nothing itself (the
             // body carries the exact mass properties).
-            let r = scene.features.edge_radius;
-            let (hx, hy, hz) = (0.5 * bx, 0.5 * by, 0.5 * bz);
-            // A parry cylinder's axis is its y: turned onto the die's z.
-            let mut own = Rotation::IDENTITY;
-            let solid = match scene.shape.as_deref().map(|s| (s, &s.solid)) {
-                Some((shape, crate::model::shape::Solid::Hull { .. })) => {
-                    let points: Vec<Vector> = shape.points().iter().map(from_na).collect();
-                    ColliderBuilder::convex_hull(&points).ok_or_else(|| {
-                        crate::Error::Engine("rapier: the die's hull could not be built".into())
-                    })?
-                }
-                Some((_, crate::model::shape::Solid::Cylinder { diameter, height })) => {
-                    own = Rotation::from_rotation_x(std::f64::consts::FRAC_PI_2);
-                    ColliderBuilder::cylinder(0.5 * height, 0.5 * diameter)
-                }
-                None if r > 0.0 => ColliderBuilder::round_cuboid(hx - r, hy - r, hz - r, r),
-                None => ColliderBuilder::cuboid(hx, hy, hz),
-            };
+            let (solid, own) = collider(&Collider::of(scene))?;
             let p = mp.principal.quaternion();
             let turn = Rotation::from_xyzw(p.i, p.j, p.k, p.w).inverse();
             solid
                 .position(Pose::from_parts(turn * -from_na(&mp.com), turn * own))
                 .density(0.0)
         } else {
+            let [bx, by, bz] = scene.body_sides();
             ColliderBuilder::cuboid(0.5 * bx, 0.5 * by, 0.5 * bz)
                 .mass_properties(box_mass_properties(scene.mass(), [bx, by, bz]))
         };
@@ -534,3 +518,37 @@ impl Engine for Rapier3d {
         }
     }
 }
+
+/// The die's collider in Rapier's terms, and the turn from its own axes to the die's (a
+/// parry cylinder's axis is its y, turned onto the die's z): the one place a solid becomes
+/// Rapier's.
+fn collider(c: &Collider) -> crate::Result<(ColliderBuilder, Rotation)> {
+    Ok(match c {
+        Collider::Box { half, radius } if *radius > 0.0 => {
+            let k = half.map(|h| h - radius);
+            (
+                ColliderBuilder::round_cuboid(k.x, k.y, k.z, *radius),
+                Rotation::IDENTITY,
+            )
+        }
+        Collider::Box { half, .. } => (
+            ColliderBuilder::cuboid(half.x, half.y, half.z),
+            Rotation::IDENTITY,
+        ),
+        Collider::Hull { points, .. } => {
+            let points: Vec<Vector> = points.iter().map(from_na).collect();
+            let hull = ColliderBuilder::convex_hull(&points).ok_or_else(|| {
+                crate::Error::Engine("rapier: the die's hull could not be built".into())
+            })?;
+            (hull, Rotation::IDENTITY)
+        }
+        Collider::Cylinder {
+            radius,
+            half_height,
+        } => (
+            ColliderBuilder::cylinder(*half_height, *radius),
+            Rotation::from_rotation_x(std::f64::consts::FRAC_PI_2),
+        ),
+    })
+}
+

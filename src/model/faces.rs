@@ -56,6 +56,22 @@ impl std::fmt::Display for Layout {
 }
 
 impl Layout {
+    /// The layout whose numbers are these (each direction's, in [`DIRECTIONS`]' order): the
+    /// named one where it is one; `None` unless they are 1 to 6, each once.
+    pub fn from_numbers(numbers: [u8; 6]) -> Option<Layout> {
+        let mut sorted = numbers;
+        sorted.sort_unstable();
+        if sorted != [1, 2, 3, 4, 5, 6] {
+            return None;
+        }
+        Some(
+            [Layout::Right, Layout::Left]
+                .into_iter()
+                .find(|l| l.numbers() == numbers)
+                .unwrap_or(Layout::Map(numbers)),
+        )
+    }
+
     /// The number on each direction's face, in [`DIRECTIONS`]' order.
     pub fn numbers(self) -> [u8; 6] {
         match self {

@@ -1,8 +1,9 @@
-//! What is thrown and where: the block and its sides, the die as a rigid body and its six
-//! faces, its state, the
-//! scene (floor, surface, time step), and the throws' initial conditions.
+//! What is thrown and where: the die (the paper's block, a shape, a mesh) and its labelled
+//! faces, what the engines collide, the die as a rigid body, its state, the scene (floor,
+//! surface, time step), and the throws' initial conditions.
 
 pub mod block;
+pub mod collider;
 pub mod die;
 pub mod faces;
 pub mod glibc;

@@ -295,6 +295,15 @@ impl Scene {
                 format!("must be in [0, {}] mm", MAX_ROLLING_RESISTANCE * 1e3),
             );
         }
+        if let (Some(shape), Mode::TwoD) = (&self.shape, self.mode) {
+            // A box-shaped die too: its mass is the box's (`Scene::hull_shape`), its outcomes
+            // its faces in 3D.
+            return Err(Error::field(
+                Field::Shape,
+                &shape.name,
+                "a die of any shape is rolled in 3D only (2D is the paper's block)",
+            ));
+        }
         MassProps::of(self)?;
         Ok(())
     }
@@ -362,21 +371,51 @@ impl Scene {
             plain_mass: self.mass(),
             mode: self.mode,
             features: &self.features,
-            shape: self.shape.as_deref(),
+            shape: self.hull_shape(),
         }
     }
 
-    /// This scene with a die of any shape in place of its block (the block becomes the
-    /// shape's bounding box, for what reads the die's size: the drop, the reports).
-    pub fn with_shape(mut self, shape: Shape) -> Scene {
+    /// The paper's scene (`Scene::paper`) for a die of any shape; its block is the shape's
+    /// bounding box, for what reads the die's size (the drop, the reports).
+    pub fn paper_shape(shape: Shape, mode: Mode) -> Scene {
         let [x, y, z] = shape.bounding_box();
-        self.block = Block {
+        let block = Block {
             breadth: x,
             width: y,
             length: z,
         };
-        self.shape = Some(std::sync::Arc::new(shape));
-        self
+        Scene {
+            shape: Some(std::sync::Arc::new(shape)),
+            ..Scene::paper(block, mode)
+        }
+    }
+
+    /// The die's shape when its solid is not a box (a hull, a cylinder): what the engines,
+    /// the mass and the roll take from a die of any shape. `None` for a box (the cuboid, a d6,
+    /// a box-shaped mesh: `Shape::as_box`), which they all take by the box's closed forms, the
+    /// paper's fast path, whatever its name.
+    pub fn hull_shape(&self) -> Option<&Shape> {
+        self.shape.as_deref().filter(|s| s.as_box().is_none())
+    }
+
+    /// A die of any shape that is a box (`Shape::as_box`): its outcome resting on each face,
+    /// in `faces::DIRECTIONS`' order. `None` for the cuboid and for any other solid.
+    pub fn box_faces(&self) -> Option<[u8; 6]> {
+        self.shape.as_deref().and_then(Shape::as_box).map(|b| b.faces)
+    }
+
+    /// A box-shaped die whose labels are the numbers 1 to 6: the layout they make, which
+    /// places its pips (`model::mass`).
+    pub fn box_layout(&self) -> Option<crate::model::faces::Layout> {
+        let shape = self.shape.as_deref()?;
+        let faces = self.box_faces()?;
+        // A layout numbers the face up: each direction's number is what the die shows
+        // resting on the face opposite.
+        let mut numbers = [0u8; 6];
+        for (d, n) in numbers.iter_mut().enumerate() {
+            *n = shape.faces[usize::from(faces[d ^ 1])].label.parse().ok()?;
+        }
+        crate::model::faces::Layout::from_numbers(numbers)
     }
 
     /// True if the die is a coin (a cylinder), which can roll on its rim for ever.
@@ -390,7 +429,14 @@ impl Scene {
     /// The scene with its die's outcomes at its own centre of mass (`Shape::resting_at`): a
     /// die of any shape loaded off its centroid rests on the facets it rests on there, and a
     /// facet it rolls off is no outcome. Unchanged for the cuboid, a coin, or a centred die.
+    /// A box-shaped die with pips has them drilled as its labels number its faces
+    /// (`Scene::box_layout`).
     pub fn resting_at_com(mut self) -> std::result::Result<Scene, String> {
+        if self.shape.is_some() && self.features.pips.is_some() {
+            self.features.layout = self.box_layout().ok_or_else(|| {
+                "pips are drilled in a box's faces numbered 1 to 6; this die is not one".to_string()
+            })?;
+        }
         if let Some(shape) = &self.shape {
             let com = MassProps::compute(&self).com;
             self.shape = Some(std::sync::Arc::new(shape.resting_at(&com)?));
@@ -400,7 +446,7 @@ impl Scene {
 
     /// The die's mass, multiplied in DicePhys's order so that the numbers agree to the bit.
     pub fn mass(&self) -> f64 {
-        if let Some(s) = &self.shape {
+        if let Some(s) = self.hull_shape() {
             return s.volume * self.density;
         }
         let b = &self.block;

@@ -27,6 +27,21 @@ pub const MAX_FACES: usize = 255;
 /// "opposite" is an edge 60° or more away, is far outside.
 pub const OPPOSITE_TOLERANCE: f64 = 1e-3;
 
+/// How close to a box, as a fraction of its size, a hull must be to be rolled as one
+/// ([`Shape::as_box`]): a mesh's single-precision coordinates (STL) are within 1e-7.
+pub const BOX_TOLERANCE: f64 = 1e-6;
+
+/// A die that is a box (`Shape::as_box`): rolled by the cuboid's closed forms, its outcomes
+/// its own labelled faces.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoxDie {
+    /// Half its sides along body x, y, z, m.
+    pub half: [f64; 3],
+    /// Its outcome (an index of `Shape::faces`) resting on each face (the face on the floor),
+    /// in `faces::DIRECTIONS`' order.
+    pub faces: [u8; 6],
+}
+
 /// Which face's label a die shows.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -503,6 +518,60 @@ impl Shape {
         }
     }
 
+    /// A die that is a uniform box along its body axes (a d6, a box-shaped mesh), as the
+    /// cuboid's closed forms take it: its half sides, m, and its outcome on each face, in
+    /// `faces::DIRECTIONS`' order (+x, −x, +y, −y, +z, −z). `None` for any other solid, for
+    /// a box that is not uniform (a mesh hollow inside: its mass is not the box's), or for one
+    /// with a face that is no outcome. Within [`BOX_TOLERANCE`] of its size.
+    pub fn as_box(&self) -> Option<BoxDie> {
+        let Solid::Hull { points } = &self.solid else {
+            return None;
+        };
+        if points.len() != 8 {
+            return None;
+        }
+        let half: [f64; 3] =
+            std::array::from_fn(|i| points.iter().map(|p| p[i].abs()).fold(0.0, f64::max));
+        let tol = BOX_TOLERANCE * half.iter().fold(0.0f64, |a, &b| a.max(b));
+        // The eight corners (±hx, ±hy, ±hz), each once.
+        let mut seen = [false; 8];
+        for p in points {
+            let mut k = 0;
+            for i in 0..3 {
+                if (p[i].abs() - half[i]).abs() > tol {
+                    return None;
+                }
+                k |= usize::from(p[i] > 0.0) << i;
+            }
+            if std::mem::replace(&mut seen[k], true) {
+                return None;
+            }
+        }
+        // Uniform: the volume and second moments of the solid box.
+        let volume = 8.0 * half[0] * half[1] * half[2];
+        let second = half.map(|h| volume * h * h / 3.0);
+        let near = |a: f64, b: f64| (a - b).abs() <= 1e3 * BOX_TOLERANCE * b.abs();
+        let uniform = near(self.volume, volume)
+            && (0..3).all(|i| near(self.second[i], second[i]))
+            && self.second[3..]
+                .iter()
+                .all(|&x| x.abs() <= 1e3 * BOX_TOLERANCE * second[0].max(second[2]));
+        if !uniform {
+            return None;
+        }
+        let mut faces = [0u8; 6];
+        for (d, face) in faces.iter_mut().enumerate() {
+            let mut n = Vector3::zeros();
+            n[d / 2] = if d % 2 == 0 { 1.0 } else { -1.0 };
+            *face = self
+                .faces
+                .iter()
+                .position(|f| Vector3::from(f.normal).dot(&n) > 1.0 - BOX_TOLERANCE)?
+                as u8;
+        }
+        Some(BoxDie { half, faces })
+    }
+
     /// The largest distance from the centroid to any point of the die, m.
     pub fn circumradius(&self) -> f64 {
         match &self.solid {
@@ -768,11 +837,36 @@ mod tests {
     use crate::model::scene::{Mode, Scene};
 
     fn scene(shape: Shape) -> Scene {
-        Scene::paper("16x16x16".parse().unwrap(), Mode::ThreeD).with_shape(shape)
+        Scene::paper_shape(shape, Mode::ThreeD)
     }
 
     fn close(a: f64, b: f64, tol: f64) -> bool {
         (a - b).abs() <= tol * b.abs().max(1e-30)
+    }
+
+    /// A box is known as one (the d6, a square prism), its faces' outcomes by direction;
+    /// nothing else is, nor a box whose mass is not a uniform box's (a hollow mesh).
+    #[test]
+    fn a_box_is_known_as_one_and_nothing_else_is() {
+        let d6 = named("d6", None).unwrap();
+        let b = d6.as_box().expect("a d6 is a box");
+        assert!(b.half.iter().all(|&h| close(h, 0.008, 1e-12)), "{b:?}");
+        // Resting on −z it shows 1 (+z up), on +x it shows 5: the right-handed layout.
+        assert_eq!(d6.faces[usize::from(b.faces[5])].label, "1");
+        assert_eq!(d6.faces[usize::from(b.faces[0])].label, "5");
+        let s = scene(d6.clone());
+        assert_eq!(s.box_layout(), Some(crate::model::faces::Layout::Right));
+        assert!(s.hull_shape().is_none());
+        let prism = named("prism:4,20,30", None).unwrap();
+        assert!(prism.as_box().is_some());
+        for other in ["d4", "d8", "d20", "prism:6,20,30"] {
+            assert!(named(other, None).unwrap().as_box().is_none(), "{other}");
+        }
+        assert!(coin(24.0, 2.0).unwrap().as_box().is_none());
+        let mut hollow = d6;
+        hollow.volume *= 0.9;
+        assert!(hollow.as_box().is_none());
+        assert!(scene(hollow).hull_shape().is_some());
     }
 
     #[test]

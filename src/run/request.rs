@@ -15,13 +15,6 @@ use crate::run::spec::{RunSpec, ThrowSpec};
 use crate::sim::roll::{default_max_steps, RollConfig, Rule, DEFAULT_MARGIN};
 use std::path::PathBuf;
 
-/// A block where a shape gives the die (its bounding box replaces it: `Scene::with_shape`).
-const ANY_BLOCK: Block = Block {
-    length: 0.001,
-    breadth: 0.001,
-    width: 0.001,
-};
-
 /// Rolls a run takes when none are asked, and the most a run to a precision may take.
 pub const DEFAULT_ROLLS: u64 = 10_000;
 /// The most rolls a run to a precision takes when no cap is asked.
@@ -51,6 +44,53 @@ pub struct DieRequest {
     pub edge_radius: Option<f64>,
     /// Its numbering (the file's, else right-handed).
     pub layout: Option<Layout>,
+}
+
+/// A die as asked, resolved once for every command that takes one (`roll`, `fair`, `fit`):
+/// its shape (`None`: the cuboid, or no die named), what departs from the uniform solid, with
+/// the numbering asked, and its density (`None`: the scene's).
+#[derive(Clone, Debug)]
+pub struct ResolvedDie {
+    /// A named die, a mesh or a die file's mesh.
+    pub shape: Option<crate::model::shape::Shape>,
+    /// Its centre of mass, pips, rounding, insert, inertia and numbering.
+    pub features: Features,
+    /// kg/m³.
+    pub density: Option<f64>,
+}
+
+impl DieRequest {
+    /// The die asked, from its flags and its die file (the flags override the file's
+    /// values), checked; a layout beside a die of any shape is refused (it shows its own
+    /// labels).
+    pub fn resolve(&self) -> Result<ResolvedDie> {
+        let shape = crate::model::shape::described(
+            self.file.as_deref(),
+            self.shape.as_deref(),
+            self.size,
+            self.scale,
+        )?;
+        if let (Some(l), Some(s)) = (self.layout, &shape) {
+            return Err(layout_beside(l, s));
+        }
+        let (mut features, density) = Features::described(
+            self.file.as_deref(),
+            self.com,
+            self.pips,
+            self.edge_radius,
+            None,
+            self.density,
+        )?;
+        if let Some(l) = self.layout {
+            // The numbering is the run's (in its specification), pips or none.
+            features.layout = l;
+        }
+        Ok(ResolvedDie {
+            shape,
+            features,
+            density,
+        })
+    }
 }
 
 /// The scene asked: the die, its surface, its floor, the time step.
@@ -88,7 +128,7 @@ pub struct SceneRequest {
 impl Default for SceneRequest {
     /// The paper's scene (`Scene::paper`): its values are the defaults.
     fn default() -> Self {
-        let paper = Scene::paper(ANY_BLOCK, Mode::ThreeD);
+        let paper = Scene::paper(DEFAULT_CUBOID, Mode::ThreeD);
         SceneRequest {
             die: DieRequest::default(),
             two_d: false,
@@ -132,17 +172,13 @@ impl SceneRequest {
     /// The scene, with every value checked before anything runs.
     pub fn scene(&self) -> Result<Scene> {
         let d = &self.die;
-        let mut shape =
-            crate::model::shape::described(d.file.as_deref(), d.shape.as_deref(), d.size, d.scale)?;
-        let (features, density) = Features::described(
-            d.file.as_deref(),
-            d.com,
-            d.pips,
-            d.edge_radius,
-            None,
-            d.density,
-        )?;
-        let block = match (d.block, &shape) {
+        let ResolvedDie {
+            shape,
+            features,
+            density,
+        } = d.resolve()?;
+        let mode = if self.two_d { Mode::TwoD } else { Mode::ThreeD };
+        let mut scene = match (d.block, shape) {
             (Some(_), Some(_)) => {
                 return Err(Error::field(
                     Field::Block,
@@ -156,27 +192,15 @@ impl SceneRequest {
                     ],
                 ))
             }
-            (Some(b), None) => b,
-            // The shape's bounding box replaces it (`Scene::with_shape`).
-            (None, Some(_)) => ANY_BLOCK,
-            // No die given: a 16 mm d6; the 16 mm cube as the cuboid where the die is made
-            // as only a cuboid is (pips, rounded edges, an insert, its inertia, its faces'
-            // numbering), so that what is asked applies to the die rolled.
-            (None, None) if self.default_is_cuboid(&features) => DEFAULT_CUBOID,
-            (None, None) => {
-                shape = crate::model::shape::described(None, Some("d6"), None, None)?;
-                ANY_BLOCK
-            }
+            (Some(b), None) => Scene::paper(b, mode),
+            (None, Some(s)) => Scene::paper_shape(s, mode),
+            // No die given: a 16 mm d6 (rolled as the box it is); the 16 mm cube as the
+            // cuboid where the die is made as only a cuboid is (pips, rounded edges, an
+            // insert, its inertia, its faces' numbering), so that what is asked applies to
+            // the die rolled as before.
+            (None, None) if self.default_is_cuboid(&features) => Scene::paper(DEFAULT_CUBOID, mode),
+            (None, None) => Scene::paper_shape(crate::model::shape::named("d6", None)?, mode),
         };
-        // A die of any shape (the default d6 too) shows its labels: no layout numbers it.
-        if let (Some(l), Some(s)) = (d.layout, &shape) {
-            return Err(layout_beside(l, s));
-        }
-        let mode = if self.two_d { Mode::TwoD } else { Mode::ThreeD };
-        let mut scene = Scene::paper(block, mode);
-        if let Some(s) = shape {
-            scene = scene.with_shape(s);
-        }
         scene.dt = self.dt;
         scene.friction = self.friction;
         scene.restitution = self.restitution;
@@ -187,10 +211,6 @@ impl SceneRequest {
         scene.angular_damping = self.angular_damping;
         scene.sleeping = self.sleep;
         scene.features = features;
-        if let Some(l) = d.layout {
-            // The numbering is the run's (in its specification), pips or none.
-            scene.features.layout = l;
-        }
         if let Some(density) = density {
             scene.density = density;
         }

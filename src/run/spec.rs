@@ -283,7 +283,7 @@ impl RunSpec {
         }
         let half = s.block.breadth.min(s.block.width).min(s.block.length) / 2.0;
         let flat = half - s.features.edge_radius;
-        (s.shape.is_none() && s.features.edge_radius > 0.0 && flat < 0.1 * half).then(|| {
+        (s.hull_shape().is_none() && s.features.edge_radius > 0.0 && flat < 0.1 * half).then(|| {
             format!(
                 "the die's faces are flat over only {:.3} mm of their {:.1} mm half side \
                  (edge radius {} mm): it rolls like a ball and may reach the step cap ({cap} \

@@ -636,7 +636,11 @@ impl Watch {
         let under = state.position.y < 0.0;
         if self.watch && end.certified.is_none() && !under {
             let certain = match &die.convex {
-                None => self.certificate.certain(die, state).map(|o| (o, None)),
+                // A box: its side, and a box-shaped die of any shape its face (`labelled`).
+                None => self
+                    .certificate
+                    .certain(die, state)
+                    .map(|o| die.certified(o, state)),
                 // A die of any shape: the face of the region it cannot leave.
                 Some(c) => self
                     .certificate

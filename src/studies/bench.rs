@@ -258,7 +258,8 @@ pub fn engine_floor(
 pub const Z_BOUND: f64 = 2.0;
 
 /// Every die `dice_costs` times, as a scene: the made cubes of [`made_dice`], then dice of
-/// other shapes (`--shape`: a d6 on the general hull path beside the cuboid's, a d20, a d4).
+/// other shapes (`--shape`: a d6, which takes the box's path as the cuboid does, with and
+/// without pips; a d20 and a d4 on the general hull path).
 /// Not a coin: a thin one spins like Euler's disk, about 100 ms a roll, and would double the
 /// benchmark's time (its cost is on docs/results/shapes.md).
 pub fn bench_dice() -> crate::Result<Vec<(String, Scene)>> {
@@ -275,9 +276,15 @@ pub fn bench_dice() -> crate::Result<Vec<(String, Scene)>> {
         let shape = crate::model::shape::named(name, None)?;
         out.push((
             format!("--shape {name}"),
-            Scene::paper(block, Mode::ThreeD).with_shape(shape),
+            Scene::paper_shape(shape, Mode::ThreeD),
         ));
     }
+    let mut d6_pips = Scene::paper_shape(crate::model::shape::named("d6", None)?, Mode::ThreeD);
+    d6_pips.features.pips = made_dice()[2].1.pips;
+    let d6_pips = d6_pips
+        .resting_at_com()
+        .map_err(|e| crate::Error::Invalid(format!("the d6 with pips: {e}")))?;
+    out.insert(out.len() - 2, ("--shape d6 --pips 3,1".to_string(), d6_pips));
     Ok(out)
 }
 

@@ -666,7 +666,7 @@ pub fn vary(
 /// what a front end checks before it claims an output directory, so that a value the die
 /// cannot take is refused with nothing written.
 pub fn varied_specs(spec: &RunSpec, what: Varied, values: &[f64]) -> Result<Vec<RunSpec>> {
-    if let (Varied::PipDepth, Some(shape)) = (what, &spec.scene.shape) {
+    if let (Varied::PipDepth, Some(shape)) = (what, spec.scene.hull_shape()) {
         return Err(Error::field(
             Field::Vary,
             "pip_depth",

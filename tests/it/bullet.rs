@@ -297,7 +297,7 @@ fn a_cylinder_rolling_on_its_side_slows_as_rolling_resistance_says() {
     let shape = dicephys::model::shape::coin(30.0, 30.0).unwrap();
     let r = 0.015;
     let decel = |delta: f64| {
-        let mut scene = Scene::paper(block(), Mode::ThreeD).with_shape(shape.clone());
+        let mut scene = Scene::paper_shape(shape.clone(), Mode::ThreeD);
         scene.rolling_resistance = delta;
         scene.sleeping = false;
         let mut e = new_engine(EngineKind::Bullet, &scene).unwrap();

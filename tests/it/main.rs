@@ -17,6 +17,7 @@ mod impact;
 mod inputs;
 mod io;
 mod made;
+mod one_die;
 mod paper;
 mod rapier;
 mod roll;

@@ -87,7 +87,7 @@ fn a_d20_comes_up_fair_on_rapier() {
 
 /// A cube of side `s` mm as an OBJ mesh: eight corners, six quads, counter-clockwise seen
 /// from outside.
-fn cube_obj(s: f64) -> String {
+pub(crate) fn cube_obj(s: f64) -> String {
     let h = s / 2.0;
     let mut t = String::from("# a cube\n");
     for k in 0..8 {
