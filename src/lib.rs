@@ -1,4 +1,5 @@
-//! dicephys: with what probability does a thrown cuboid die land on each face?
+//! dicephys: with what probability does a thrown die — the paper's cuboid, a d4 to d20, a coin,
+//! a printed mesh — land on each face?
 //!
 //! Rigid-body simulation (Bullet through a thin C++ shim, and Rapier) beside the closed-form
 //! theory and measured data of G. A. T. Pender and M. Uhrin, "Predicting Non-Square 2D Dice

@@ -26,7 +26,8 @@ pub mod validate;
 #[command(
     name = "dicephys",
     version,
-    about = "With what probability does a thrown cuboid die land on each face? \
+    about = "With what probability does a thrown die (the paper's cuboid, a d6, any convex \
+             shape) land on each face? \
              Simulation (Bullet, Rapier) beside the theory and data of Pender & Uhrin (2014)."
 )]
 pub struct Cli {
@@ -38,7 +39,7 @@ pub struct Cli {
 pub enum Command {
     /// Reproduce the paper: its table, theory, simulations and figures, into --out.
     Paper(paper::PaperArgs),
-    /// Roll one block many times on one engine: counts, ratio, theory, cost.
+    /// Roll one die many times on one engine: counts, ratio or faces, theory, cost.
     Roll(roll::RollArgs),
     /// Calibrate e, μ and the throw to measured counts (maximum likelihood through a surrogate
     /// of the simulator), or check that a fit recovers known values (--recover).

@@ -2,7 +2,7 @@
 
 use super::{BodyState, Engine};
 use crate::model::collider::Collider;
-use crate::model::mass::{MassProps, Turn};
+use crate::model::mass::{BodyTurn, MassProps};
 use crate::model::scene::{Floor, Mode, Preset, Scene};
 use cxx::UniquePtr;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -192,7 +192,7 @@ pub struct Bullet {
     /// Damping slows the die in flight too, so its flight is not ballistic.
     damped: bool,
     /// How the body is turned from the die's axes (`to_ffi`, `state`).
-    turn: Turn,
+    turn: BodyTurn,
     /// The die's state as the world last reported it (after reset, set_state or a step).
     now: ffi::BodyStateFfi,
 }
@@ -327,7 +327,7 @@ impl Bullet {
 
 /// The engine's state of the body from the die's: the orientation turned by `turn` (the
 /// centre of mass and velocities are the same).
-fn to_ffi(s: &BodyState, turn: &Turn) -> ffi::BodyStateFfi {
+fn to_ffi(s: &BodyState, turn: &BodyTurn) -> ffi::BodyStateFfi {
     let r = turn.to_body(&s.rotation);
     let q = r.quaternion();
     ffi::BodyStateFfi {
@@ -379,7 +379,7 @@ impl Engine for Bullet {
     fn set_body_state(&mut self, now: &BodyState) -> crate::Result<()> {
         self.world
             .pin_mut()
-            .set_state(&to_ffi(now, &Turn::default()))
+            .set_state(&to_ffi(now, &BodyTurn::default()))
             .map_err(|e| crate::Error::Engine(e.to_string()))?;
         self.now = self.world.state();
         Ok(())

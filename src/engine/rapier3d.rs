@@ -6,7 +6,7 @@
 
 use super::{BodyState, Engine};
 use crate::model::collider::Collider;
-use crate::model::mass::{MassProps, Turn};
+use crate::model::mass::{BodyTurn, MassProps};
 use crate::model::scene::{Floor, Mode, Preset, Scene};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use rapier3d_f64::prelude::*;
@@ -40,7 +40,7 @@ pub struct Rapier3d {
     /// collider off it.
     made: bool,
     /// How the body is turned from the die's axes.
-    turn: Turn,
+    turn: BodyTurn,
     /// A made die's mass properties, about the body's frame.
     mass_props: MassProperties,
 }
@@ -551,4 +551,3 @@ fn collider(c: &Collider) -> crate::Result<(ColliderBuilder, Rotation)> {
         ),
     })
 }
-

@@ -1,7 +1,7 @@
 //! The die as a rigid body: its half sides, mass, inertia and barriers, its energies, and
 //! where its lowest point is.
 
-use crate::model::mass::{MassProps, Turn};
+use crate::model::mass::{BodyTurn, MassProps};
 use crate::model::scene::{Mode, Scene};
 pub use crate::model::state::up_in_body;
 use crate::model::state::BodyState;
@@ -247,9 +247,9 @@ impl Convex {
 
     /// The outcome the die rests on given the world's up direction in body axes: the face
     /// whose resting normal points down within DicePhys's vertical tolerance
-    /// (`sim::rest::VERTICAL_TOLERANCE`), else none.
+    /// ([`VERTICAL_TOLERANCE`]), else none.
     pub fn face_down(&self, up: &Vector3<f64>) -> Option<u8> {
-        let tol = crate::sim::rest::VERTICAL_TOLERANCE;
+        let tol = VERTICAL_TOLERANCE;
         let down = -up;
         self.normals
             .iter()
@@ -292,7 +292,7 @@ pub struct DieShape {
     /// The centred sharp block: `lowest_point` and `face_region` take the paper's short forms.
     plain: bool,
     /// How an engine's body is turned from the die's axes (`MassProps::turn`).
-    pub turn: Turn,
+    pub turn: BodyTurn,
     /// Rotation about z only (2D): region and barrier over the x and y axes.
     pub planar: bool,
     /// The centre of mass's height at rest on each face, by the face on the floor:
@@ -408,7 +408,7 @@ impl DieShape {
                 None => (Outcome::Unknown, None),
             };
         }
-        let o = crate::sim::rest::classify(s);
+        let o = classify(s);
         self.labelled(o, s)
     }
 
@@ -431,7 +431,11 @@ impl DieShape {
 
     /// A box's side `o` as the die counts it, at `s`: the cuboid's side and the direction
     /// of its face up (`RollRecord::up`); a box-shaped die of any shape's face (its outcome).
-    pub fn labelled(&self, o: crate::model::block::Outcome, s: &BodyState) -> (crate::model::block::Outcome, Option<u8>) {
+    pub fn labelled(
+        &self,
+        o: crate::model::block::Outcome,
+        s: &BodyState,
+    ) -> (crate::model::block::Outcome, Option<u8>) {
         use crate::model::block::Outcome;
         let up = crate::model::faces::up_direction(&s.rotation, o);
         match (self.box_faces, up) {
@@ -525,4 +529,23 @@ impl DieShape {
 /// about z only, so z adds nothing).
 pub fn lowest_point(half: &Vector3<f64>, s: &BodyState) -> f64 {
     s.position.y - up_in_body(&s.rotation).abs().dot(half)
+}
+
+/// DicePhys's tolerance on a vertical axis: |cos| within 1e-4 of 1.
+pub const VERTICAL_TOLERANCE: f64 = 1e-4;
+
+/// The side standing vertical: the body axis (x = breadth, y = width, z = length, tested in
+/// that order, as DicePhys) whose direction is vertical within the tolerance; else unknown.
+pub fn classify(s: &BodyState) -> crate::model::block::Outcome {
+    use crate::model::block::Outcome;
+    let up = Vector3::y();
+    let sides = [Outcome::Breadth, Outcome::Width, Outcome::Length];
+    for (axis, side) in [Vector3::x(), Vector3::y(), Vector3::z()].iter().zip(sides) {
+        let dir = (s.rotation * axis).normalize();
+        let dot = up.dot(&dir).abs();
+        if dot > 1.0 - VERTICAL_TOLERANCE && dot < 1.0 + VERTICAL_TOLERANCE {
+            return side;
+        }
+    }
+    Outcome::Unknown
 }

@@ -5,7 +5,7 @@
 use crate::error::{Error, Field, Result};
 use crate::model::block::Block;
 pub use crate::model::block::Mode;
-use crate::model::mass::{Features, MassProps, Solid};
+use crate::model::mass::{Composition, Features, MassProps};
 use crate::model::shape::Shape;
 use serde::{Deserialize, Serialize};
 
@@ -364,8 +364,8 @@ impl Scene {
     }
 
     /// What the die's mass properties depend on (`model::mass`).
-    pub fn solid(&self) -> Solid<'_> {
-        Solid {
+    pub fn composition(&self) -> Composition<'_> {
+        Composition {
             sides: self.body_sides(),
             density: self.density,
             plain_mass: self.mass(),
@@ -401,7 +401,10 @@ impl Scene {
     /// A die of any shape that is a box (`Shape::as_box`): its outcome resting on each face,
     /// in `faces::DIRECTIONS`' order. `None` for the cuboid and for any other solid.
     pub fn box_faces(&self) -> Option<[u8; 6]> {
-        self.shape.as_deref().and_then(Shape::as_box).map(|b| b.faces)
+        self.shape
+            .as_deref()
+            .and_then(Shape::as_box)
+            .map(|b| b.faces)
     }
 
     /// A box-shaped die whose labels are the numbers 1 to 6: the layout they make, which
@@ -489,14 +492,14 @@ impl Scene {
 }
 
 impl MassProps {
-    /// The mass properties of the scene's die (`MassProps::of_solid`), checked.
+    /// The mass properties of the scene's die (`MassProps::of_composition`), checked.
     pub fn of(scene: &Scene) -> Result<MassProps> {
-        MassProps::of_solid(&scene.solid())
+        MassProps::of_composition(&scene.composition())
     }
 
     /// `of` for a scene already checked (`Scene::validate` calls `of`).
     pub fn compute(scene: &Scene) -> MassProps {
-        MassProps::compute_solid(&scene.solid())
+        MassProps::compute_composition(&scene.composition())
     }
 }
 

@@ -9,7 +9,7 @@
 //! label the die shows when it rests on that facet.
 
 use crate::error::{Error, Field, Result};
-use crate::model::polytope::{self, Mesh, Reads as PolyReads};
+use crate::model::polytope::{self, Mesh};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -42,19 +42,8 @@ pub struct BoxDie {
     pub faces: [u8; 6],
 }
 
-/// Which face's label a die shows.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Reads {
-    /// The face facing up (most dice).
-    #[default]
-    Up,
-    /// The face on the floor (a d4's point up).
-    Down,
-    /// The face facing up, or, resting on a facet with no facet opposite (an odd prism's
-    /// sides, which rest with an edge up), the facet it lies on.
-    UpOrLying,
-}
+/// Which face's label a die shows (a named die's and a mesh's alike).
+pub use crate::model::polytope::Reads;
 
 /// The body that collides.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -169,11 +158,7 @@ pub fn named(spec: &str, size_mm: Option<f64>) -> Result<Shape> {
         return coin(d, h).map_err(bad);
     }
     let named = polytope::named(spec_t, size_mm).map_err(bad)?;
-    let reads = match named.reads {
-        PolyReads::Up => Reads::Up,
-        PolyReads::Down => Reads::Down,
-        PolyReads::UpOrLying => Reads::UpOrLying,
-    };
+    let reads = named.reads;
     let name = match size_mm {
         Some(s) if !spec_t.contains(':') => format!("{spec_t}@{s}"),
         _ => spec_t.to_string(),
@@ -684,12 +669,13 @@ pub fn described(
     name: Option<&str>,
     size_mm: Option<f64>,
     scale: Option<f64>,
+    read: crate::model::mass::ReadFile,
 ) -> Result<Option<Shape>> {
     use crate::model::mass::{is_mesh, DieFile};
     let mesh = match file {
         Some(p) if is_mesh(p) => Some((p.to_path_buf(), DieFile::default())),
         Some(p) => {
-            let f = DieFile::read(p)?;
+            let f = DieFile::read(p, read)?;
             let dir = p.parent().unwrap_or(std::path::Path::new("."));
             let bad = |why: &str| Err(Error::field(Field::Die, p.display(), why.to_string()));
             if f.mesh.is_none() && (f.labels.is_some() || f.reads.is_some() || f.scale.is_some()) {
@@ -748,7 +734,7 @@ pub fn described(
         (None, Some((path, f))) => {
             // A mesh a die file names is refused naming the die file (the one the user gave).
             let toml = file.filter(|f| !is_mesh(f));
-            from_mesh_file(&path, &f, toml, scale).map(Some)
+            from_mesh_file(&path, &f, toml, scale, read).map(Some)
         }
     }
 }
@@ -761,8 +747,9 @@ fn from_mesh_file(
     f: &crate::model::mass::DieFile,
     toml: Option<&std::path::Path>,
     scale: Option<f64>,
+    read: crate::model::mass::ReadFile,
 ) -> Result<Shape> {
-    let bytes = crate::model::mass::read_die_bytes(path, MAX_MESH_FILE)?;
+    let bytes = read(path, MAX_MESH_FILE)?;
     let file_name = path.file_name().map_or_else(
         || path.display().to_string(),
         |n| n.to_string_lossy().into(),

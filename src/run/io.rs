@@ -18,7 +18,7 @@
 //! killed run left behind is removed by the next run that checks an output, or opens a
 //! checkpoint, in that directory.
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Field, Result};
 use std::ffi::OsStr;
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -348,4 +348,24 @@ pub fn read_capped(path: &Path, max: u64, stop: &crate::run::stop::Stop) -> Resu
         )));
     }
     Ok(bytes)
+}
+
+/// A die file's bytes (a TOML die file, a mesh), at most `max`, through the capped reader;
+/// any failure names `--die`. What the model is given to read a die's files with
+/// (`model::mass::ReadFile`).
+pub fn read_die_bytes(path: &std::path::Path, max: u64) -> Result<Vec<u8>> {
+    if path.is_dir() {
+        return Err(Error::field(Field::Die, path.display(), "is a directory"));
+    }
+    read_capped(path, max, crate::run::stop::Stop::global()).map_err(|e| match e {
+        Error::Stopped => Error::Stopped,
+        Error::Invalid(m) => Error::field(
+            Field::Die,
+            path.display(),
+            m.strip_prefix(&format!("{}: ", path.display()))
+                .unwrap_or(&m)
+                .to_string(),
+        ),
+        e => e,
+    })
 }

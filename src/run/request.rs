@@ -64,11 +64,13 @@ impl DieRequest {
     /// values), checked; a layout beside a die of any shape is refused (it shows its own
     /// labels).
     pub fn resolve(&self) -> Result<ResolvedDie> {
+        let read: crate::model::mass::ReadFile = &crate::run::io::read_die_bytes;
         let shape = crate::model::shape::described(
             self.file.as_deref(),
             self.shape.as_deref(),
             self.size,
             self.scale,
+            read,
         )?;
         if let (Some(l), Some(s)) = (self.layout, &shape) {
             return Err(layout_beside(l, s));
@@ -78,8 +80,8 @@ impl DieRequest {
             self.com,
             self.pips,
             self.edge_radius,
-            None,
             self.density,
+            read,
         )?;
         if let Some(l) = self.layout {
             // The numbering is the run's (in its specification), pips or none.

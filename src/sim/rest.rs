@@ -1,6 +1,5 @@
-//! When a roll is over, and how it came out: DicePhys's at-rest rule and its outcome test.
+//! When a roll is over: DicePhys's at-rest rule (its outcome test, `classify`, is the die's).
 
-use crate::model::block::Outcome;
 use crate::model::state::BodyState;
 use nalgebra::Vector3;
 
@@ -74,20 +73,6 @@ impl RestDetector {
     }
 }
 
-/// DicePhys's tolerance on a vertical axis: |cos| within 1e-4 of 1.
-pub const VERTICAL_TOLERANCE: f64 = 1e-4;
-
-/// The side standing vertical: the body axis (x = breadth, y = width, z = length, tested in
-/// that order, as DicePhys) whose direction is vertical within the tolerance; else unknown.
-pub fn classify(s: &BodyState) -> Outcome {
-    let up = Vector3::y();
-    let sides = [Outcome::Breadth, Outcome::Width, Outcome::Length];
-    for (axis, side) in [Vector3::x(), Vector3::y(), Vector3::z()].iter().zip(sides) {
-        let dir = (s.rotation * axis).normalize();
-        let dot = up.dot(&dir).abs();
-        if dot > 1.0 - VERTICAL_TOLERANCE && dot < 1.0 + VERTICAL_TOLERANCE {
-            return side;
-        }
-    }
-    Outcome::Unknown
-}
+/// DicePhys's outcome test lives with the die (`model::die`): the rest rule here says when a
+/// roll is over, the die how it came out.
+pub use crate::model::die::{classify, VERTICAL_TOLERANCE};

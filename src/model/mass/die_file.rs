@@ -61,6 +61,11 @@ pub struct LabelDef {
     pub label: String,
 }
 
+/// How the model is given a die's files (a die file, the mesh it names): the bytes of the
+/// file at a path, at most so many. The model parses what it is given; reading, its cap and a
+/// stop request while it blocks stay with the other file reading (`run::io::read_die_bytes`).
+pub type ReadFile<'a> = &'a dyn Fn(&std::path::Path, u64) -> Result<Vec<u8>>;
+
 /// The largest die file read (TOML): 1 MiB.
 pub const MAX_DIE_FILE: u64 = 1 << 20;
 
@@ -72,16 +77,16 @@ pub fn is_mesh(path: &std::path::Path) -> bool {
 }
 
 impl DieFile {
-    /// Reads and parses a die file, through the capped reader (`run::io::read_capped`: a
+    /// Reads and parses a die file, its bytes through `read` (`run::io::read_die_bytes`: a
     /// missing file, a directory, a pipe or a file over 1 MiB is refused naming `--die`, and a
     /// stop request is honoured while it blocks): a key it does not know, a value of the
     /// wrong kind, or a file that is not TOML is one line naming it. A mesh (.obj, .stl)
     /// describes no features: its die file is empty.
-    pub fn read(path: &std::path::Path) -> Result<DieFile> {
+    pub fn read(path: &std::path::Path, read: ReadFile) -> Result<DieFile> {
         if is_mesh(path) {
             return Ok(DieFile::default());
         }
-        let bytes = read_die_bytes(path, MAX_DIE_FILE)?;
+        let bytes = read(path, MAX_DIE_FILE)?;
         let text = String::from_utf8(bytes).map_err(|_| {
             Error::field(
                 Field::Die,
@@ -181,46 +186,25 @@ impl DieFile {
     }
 }
 
-/// A die file's bytes, at most `max`, through the capped reader; any failure names `--die`.
-pub fn read_die_bytes(path: &std::path::Path, max: u64) -> Result<Vec<u8>> {
-    if path.is_dir() {
-        return Err(Error::field(Field::Die, path.display(), "is a directory"));
-    }
-    crate::run::io::read_capped(path, max, crate::run::stop::Stop::global()).map_err(|e| match e {
-        Error::Stopped => Error::Stopped,
-        Error::Invalid(m) => Error::field(
-            Field::Die,
-            path.display(),
-            m.strip_prefix(&format!("{}: ", path.display()))
-                .unwrap_or(&m)
-                .to_string(),
-        ),
-        e => e,
-    })
-}
-
 impl Features {
     /// A die as the command line and the Python package describe it: a die file's, if one is
-    /// named, with a centre of mass, pips' diameter and depth and an edge radius given in mm
-    /// laid over it ([`Features::with_mm`]), and a layout over the file's where the die has
-    /// pips for it to place (a plain die's numbers are the summary's business, not its
-    /// mass's). Returns the features and the density given (`density`, else the file's).
+    /// named (its bytes through `read`), with a centre of mass, pips' diameter and depth and
+    /// an edge radius given in mm laid over it ([`Features::with_mm`]). Returns the features
+    /// and the density given (`density`, else the file's). The numbering asked is laid over
+    /// by the caller (`run::request::DieRequest::resolve`).
     pub fn described(
         file: Option<&std::path::Path>,
         com: Option<[f64; 3]>,
         pips: Option<[f64; 2]>,
         edge_radius: Option<f64>,
-        layout: Option<Layout>,
         density: Option<f64>,
+        read: ReadFile,
     ) -> Result<(Features, Option<f64>)> {
         let file = match file {
-            Some(path) => DieFile::read(path)?,
+            Some(path) => DieFile::read(path, read)?,
             None => DieFile::default(),
         };
-        let mut f = file.features()?.with_mm(com, pips, edge_radius);
-        if let (Some(l), Some(_)) = (layout, f.pips) {
-            f.layout = l;
-        }
+        let f = file.features()?.with_mm(com, pips, edge_radius);
         Ok((f, density.or(file.density)))
     }
 }

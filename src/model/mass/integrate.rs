@@ -4,7 +4,7 @@
 use super::features::{Features, Insert};
 use super::moments::Moments;
 use super::pips::{cavity, pip_moments, pip_overlaps, pip_places};
-use super::turn::Turn;
+use super::turn::BodyTurn;
 use crate::error::{Error, Field, Result};
 use crate::model::block::Mode;
 use nalgebra::{Matrix3, Rotation3, SymmetricEigen, UnitQuaternion, Vector3};
@@ -33,8 +33,8 @@ impl MassProps {
     }
 
     /// How an engine's body (the principal frame) is turned from the die's axes.
-    pub fn turn(&self) -> Turn {
-        Turn((!self.aligned()).then_some(self.principal))
+    pub fn turn(&self) -> BodyTurn {
+        BodyTurn((!self.aligned()).then_some(self.principal))
     }
 }
 
@@ -87,9 +87,9 @@ pub fn rounded_box(a: &Vector3<f64>, r: f64) -> (f64, Vector3<f64>) {
 
 /// What a die's mass properties depend on: its body's sides (x, y, z; in 2D the 1 m depth),
 /// its density, its plain mass as the engines multiply it, 2D or 3D, and its features
-/// (`Scene::solid`).
+/// (`Scene::composition`).
 #[derive(Clone, Copy, Debug)]
-pub struct Solid<'a> {
+pub struct Composition<'a> {
     /// The body's sides along x, y, z, m.
     pub sides: [f64; 3],
     /// kg/m³.
@@ -108,7 +108,7 @@ impl MassProps {
     /// The mass properties of a die: a solid of its density, rounded with `edge_radius`, less
     /// its pips (plus their fill), with its centre of mass where `com` puts it if given. The
     /// plain block's are the closed forms the engines use. Checked.
-    pub fn of_solid(s: &Solid) -> Result<MassProps> {
+    pub fn of_composition(s: &Composition) -> Result<MassProps> {
         let [a, b, c] = s.sides;
         match s.shape {
             Some(shape) => s.features.validate_on(shape, s.mode)?,
@@ -116,7 +116,7 @@ impl MassProps {
                 .features
                 .validate(&(Vector3::new(a, b, c) / 2.0), s.mode)?,
         }
-        let m = MassProps::compute_solid(s);
+        let m = MassProps::compute_composition(s);
         let ok = m.moments.iter().all(|&x| x > 0.0)
             && (0..3).all(|i| m.moments[i] <= m.moments[(i + 1) % 3] + m.moments[(i + 2) % 3]);
         if !ok {
@@ -156,8 +156,8 @@ impl MassProps {
         Ok(m)
     }
 
-    /// `of_solid` for a die already checked.
-    pub fn compute_solid(s: &Solid) -> MassProps {
+    /// `of_composition` for a die already checked.
+    pub fn compute_composition(s: &Composition) -> MassProps {
         let f = s.features;
         let [a, b, c] = s.sides;
         let half = Vector3::new(a, b, c) / 2.0;

@@ -23,8 +23,8 @@ mod tests;
 mod turn;
 mod validate;
 
-pub use die_file::{is_mesh, read_die_bytes, DieFile, LabelDef, MAX_DIE_FILE};
+pub use die_file::{is_mesh, DieFile, LabelDef, ReadFile, MAX_DIE_FILE};
 pub use features::{pattern, Features, Insert, PipShape, Pips};
-pub use integrate::{rounded_box, MassProps, Solid};
+pub use integrate::{rounded_box, Composition, MassProps};
 pub use pips::{cavity, pip_places};
-pub use turn::Turn;
+pub use turn::BodyTurn;

@@ -6,9 +6,9 @@ use nalgebra::UnitQuaternion;
 /// is not the body axes, else not at all. Every engine and the free flight turn orientations
 /// through this one pair, so that the die's state is the same number wherever it is read.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Turn(pub(super) Option<UnitQuaternion<f64>>);
+pub struct BodyTurn(pub(super) Option<UnitQuaternion<f64>>);
 
-impl Turn {
+impl BodyTurn {
     /// True if the body is turned off the die's axes.
     pub fn turned(&self) -> bool {
         self.0.is_some()
