@@ -19,3 +19,4 @@ pub mod text;
 pub mod trace;
 pub mod tradeoff;
 pub mod validate;
+pub mod view;
