@@ -177,9 +177,15 @@ pub fn run(mut a: FairArgs) -> Result<()> {
     let json = dicephys::run::seal::to_string(&doc, true)?;
     if let (Some(dir), false) = (&a.out, summary.partial) {
         dicephys::studies::fair::write(dir, &json, &fair, &summary)?;
+        dicephys::report::html::write_text_report(
+            dir,
+            "Is this die fair?",
+            &fair.text(&summary),
+            &["die_map", "faces"],
+        )?;
         if !*a.roll.json {
             eprintln!(
-                "wrote {}/fairness.json and die_map.svg, .png",
+                "wrote {}/fairness.json, report.md, report.html and die_map.svg, .png",
                 dir.display()
             );
         }
@@ -270,9 +276,16 @@ fn counted(
             &serde_json::json!({ "counts": counts, "null": (null.spec()) }),
         )?;
         write_counted(dir, &json, &fair)?;
+        let text = format!(
+            "{} throws counted, against {}\n{}",
+            fair.n,
+            fair.null,
+            fair.table()
+        );
+        dicephys::report::html::write_text_report(dir, "Is this die fair?", &text, &["faces"])?;
         if !*a.roll.json {
             eprintln!(
-                "wrote {}/fairness.json, fairness.csv and faces.svg, .png",
+                "wrote {}/fairness.json, fairness.csv, report.md, report.html and faces.svg, .png",
                 dir.display()
             );
         }

@@ -8,6 +8,7 @@ pub mod crosscheck;
 pub mod fair;
 pub mod figures;
 pub mod fit;
+pub mod html;
 pub mod outcomes;
 pub mod paper;
 pub mod per_roll;

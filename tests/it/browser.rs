@@ -86,7 +86,8 @@ pub fn body_attr(dom: &str, name: &str) -> Option<String> {
     )
 }
 
-/// Every http(s) address in `text` but the XHTML namespace (a name, never fetched).
+/// Every http(s) address in `text` but XML namespaces (XHTML's, SVG's, XLink's: names, never
+/// fetched).
 pub fn addresses(text: &str) -> Vec<String> {
     let mut out = Vec::new();
     for start in ["http://", "https://"] {
@@ -96,7 +97,12 @@ pub fn addresses(text: &str) -> Vec<String> {
                 .find(|c: char| c.is_whitespace() || "\"'()<>`".contains(c))
                 .unwrap_or(rest.len());
             let address = &rest[..end];
-            if address != "http://www.w3.org/1999/xhtml" {
+            let namespaces = [
+                "http://www.w3.org/1999/xhtml",
+                "http://www.w3.org/2000/svg",
+                "http://www.w3.org/1999/xlink",
+            ];
+            if !namespaces.contains(&address) {
                 out.push(address.to_string());
             }
         }
@@ -221,6 +227,94 @@ fn a_screenshot_shows_the_die_where_the_trace_has_it() {
         assert!(
             far < 0.05,
             "{fragment}: {far:.2} of the pixels 150 px from the die are red"
+        );
+    }
+}
+
+/// report.html of `paper`, `fair --out` and `fit`, small runs, each opened offline: no errors
+/// (a figure that does not load is one), every figure report.md names inlined as SVG, every
+/// link to a section leading to one.
+#[test]
+fn the_reports_open_offline_with_their_figures_inline() {
+    let Some(browser) = chromium("the_reports_open_offline_with_their_figures_inline") else {
+        return;
+    };
+    let dir = Scratch::new("browser-reports");
+    let runs: [(&str, &[&str]); 3] = [
+        ("paper", &["paper", "--rolls", "40", "--seed", "3"]),
+        (
+            "fair",
+            &["fair", "--shape", "d6", "--rolls", "300", "--seed", "3"],
+        ),
+        (
+            "fit",
+            &[
+                "fit",
+                "--data",
+                "paper",
+                "--free",
+                "e",
+                "--dt",
+                "1/250",
+                "--no-refine",
+                "--points",
+                "6",
+                "--rolls",
+                "40",
+                "--degree",
+                "1",
+            ],
+        ),
+    ];
+    for (name, args) in runs {
+        let out_dir = dir.join(name);
+        let out = bin()
+            .args(args)
+            .arg("--out")
+            .arg(&out_dir)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let md = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+        let html = std::fs::read_to_string(out_dir.join("report.html")).unwrap();
+        assert_eq!(
+            addresses(&html),
+            Vec::<String>::new(),
+            "{name}: no address to fetch"
+        );
+        let figures = md.matches("![").count();
+        assert!(figures >= 1, "{name}: report.md names no figure");
+        assert_eq!(
+            html.matches("<figure><svg").count(),
+            figures,
+            "{name}: each figure inlined"
+        );
+        for link in html.split("href=\"#").skip(1) {
+            let id = &link[..link.find('"').unwrap()];
+            assert!(
+                html.contains(&format!(" id=\"{id}\"")),
+                "{name}: #{id} leads nowhere"
+            );
+        }
+        let dom = headless(&browser, &out_dir.join("report.html"), "", "--dump-dom");
+        assert_eq!(
+            body_attr(&dom, "data-errors").as_deref(),
+            Some(""),
+            "{name}: errors"
+        );
+        assert_eq!(
+            body_attr(&dom, "data-figures"),
+            Some(figures.to_string()),
+            "{name}: the figures"
+        );
+        assert_eq!(
+            dom.matches("<svg").count(),
+            figures,
+            "{name}: the figures in the page"
         );
     }
 }
