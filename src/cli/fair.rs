@@ -176,13 +176,7 @@ pub fn run(mut a: FairArgs) -> Result<()> {
     let doc = serde_json::json!({ "fairness": fair, "summary": summary });
     let json = dicephys::run::seal::to_string(&doc, true)?;
     if let (Some(dir), false) = (&a.out, summary.partial) {
-        dicephys::studies::fair::write(dir, &json, &fair, &summary)?;
-        dicephys::report::html::write_text_report(
-            dir,
-            "Is this die fair?",
-            &fair.text(&summary),
-            &["die_map", "faces"],
-        )?;
+        write_out(dir, &json, &fair, &summary)?;
         if !*a.roll.json {
             eprintln!(
                 "wrote {}/fairness.json, report.md, report.html and die_map.svg, .png",
@@ -196,6 +190,24 @@ pub fn run(mut a: FairArgs) -> Result<()> {
         out!("{}", fair.text(&summary));
     }
     done
+}
+
+/// A simulated `fair --out`: fairness.json and the figures (`studies::fair::write`), and the
+/// verdict as printed with them as report.md and report.html.
+fn write_out(
+    dir: &std::path::Path,
+    json: &str,
+    fair: &dicephys::report::fair::Fairness,
+    summary: &dicephys::report::summary::RunSummary,
+) -> Result<()> {
+    dicephys::studies::fair::write(dir, json, fair, summary)?;
+    dicephys::report::html::write_text_report(
+        dir,
+        "Is this die fair?",
+        &fair.text(summary),
+        &["die_map", "faces"],
+    )?;
+    Ok(())
 }
 
 /// The file in a `fair` run's checkpoint that keeps its null.
