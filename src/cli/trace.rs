@@ -32,8 +32,9 @@ pub struct TraceArgs {
     /// network) instead of printing the CSV.
     #[arg(long, value_name = "FILE")]
     pub html: Option<std::path::PathBuf>,
-    /// Print every Nth step (the first and the last are always printed).
-    #[arg(long, default_value_t = 1)]
+    /// Print every Nth step (the first and the last are always printed). The CSV's: a page
+    /// (--html) keeps its own frames.
+    #[arg(long, default_value_t = 1, conflicts_with = "html")]
     pub every: u64,
     /// The step cap.
     #[command(flatten)]

@@ -18,6 +18,8 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     if *a.max_steps == 0 {
         return Err(Error::Usage("--max-steps must be at least 1".into()));
     }
+    // Checked before any roll: a page that cannot be written is refused at once.
+    let out = dicephys::run::io::Output::check(path)?;
     let scene = a.scene.scene()?;
     let die = DieShape::of(&scene);
     let throw_spec = a
@@ -76,7 +78,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
         });
     }
     let page = view::page(&DieView::of(&scene, &die), scene.dt, engine_name(a), &views);
-    dicephys::run::io::write_atomic(path, page.as_bytes())?;
+    out.write(page.as_bytes())?;
     Ok(())
 }
 
