@@ -176,10 +176,10 @@ pub fn run(mut a: FairArgs) -> Result<()> {
     let doc = serde_json::json!({ "fairness": fair, "summary": summary });
     let json = dicephys::run::seal::to_string(&doc, true)?;
     if let (Some(dir), false) = (&a.out, summary.partial) {
-        dicephys::studies::fair::write(dir, &json, &fair, &summary)?;
+        write_out(dir, &json, &fair, &summary)?;
         if !*a.roll.json {
             eprintln!(
-                "wrote {}/fairness.json and die_map.svg, .png",
+                "wrote {}/fairness.json, report.md, report.html and die_map.svg, .png",
                 dir.display()
             );
         }
@@ -190,6 +190,24 @@ pub fn run(mut a: FairArgs) -> Result<()> {
         out!("{}", fair.text(&summary));
     }
     done
+}
+
+/// A simulated `fair --out`: fairness.json and the figures (`studies::fair::write`), and the
+/// verdict as printed with them as report.md and report.html.
+fn write_out(
+    dir: &std::path::Path,
+    json: &str,
+    fair: &dicephys::report::fair::Fairness,
+    summary: &dicephys::report::summary::RunSummary,
+) -> Result<()> {
+    dicephys::studies::fair::write(dir, json, fair, summary)?;
+    dicephys::report::html::write_text_report(
+        dir,
+        "Is this die fair?",
+        &fair.text(summary),
+        &["die_map", "faces"],
+    )?;
+    Ok(())
 }
 
 /// The file in a `fair` run's checkpoint that keeps its null.
@@ -270,9 +288,16 @@ fn counted(
             &serde_json::json!({ "counts": counts, "null": (null.spec()) }),
         )?;
         write_counted(dir, &json, &fair)?;
+        let text = format!(
+            "{} throws counted, against {}\n{}",
+            fair.n,
+            fair.null,
+            fair.table()
+        );
+        dicephys::report::html::write_text_report(dir, "Is this die fair?", &text, &["faces"])?;
         if !*a.roll.json {
             eprintln!(
-                "wrote {}/fairness.json, fairness.csv and faces.svg, .png",
+                "wrote {}/fairness.json, fairness.csv, report.md, report.html and faces.svg, .png",
                 dir.display()
             );
         }

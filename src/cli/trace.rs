@@ -1,4 +1,5 @@
-//! `dicephys trace`: one throw's trajectory as CSV, for looking at a single roll.
+//! `dicephys trace`: one throw's trajectory as CSV, for looking at a single roll; or, with
+//! `--html`, a page that plays one or several throws in 3D (`report::view`).
 
 use super::args::MaxSteps;
 use super::args::{parse_engine, FlightArg, SceneArgs, ThrowArgs};
@@ -23,11 +24,17 @@ pub struct TraceArgs {
     pub scene: SceneArgs,
     #[command(flatten)]
     pub throw: ThrowArgs,
-    /// Which throw.
-    #[arg(long, default_value_t = 0)]
-    pub index: u64,
-    /// Print every Nth step (the first and the last are always printed).
-    #[arg(long, default_value_t = 1)]
+    /// Which throw; with --html, also several: A..B, throws A to B, both included (as the
+    /// shell's {A..B}), at most 16.
+    #[arg(long, default_value = "0", value_parser = parse_indices)]
+    pub index: Indices,
+    /// Write a page that plays the throw(s) in 3D (self-contained HTML: opens with no
+    /// network) instead of printing the CSV.
+    #[arg(long, value_name = "FILE")]
+    pub html: Option<std::path::PathBuf>,
+    /// Print every Nth step (the first and the last are always printed). The CSV's: a page
+    /// (--html) keeps its own frames.
+    #[arg(long, default_value_t = 1, conflicts_with = "html")]
     pub every: u64,
     /// The step cap.
     #[command(flatten)]
@@ -39,7 +46,50 @@ pub struct TraceArgs {
     pub flight: FlightArg,
 }
 
+/// The throws `--index` names: `first..=last`.
+#[derive(Clone, Copy, Debug)]
+pub struct Indices {
+    pub first: u64,
+    pub last: u64,
+}
+
+/// The most throws one page plays.
+const MAX_ON_A_PAGE: u64 = 16;
+
+fn parse_indices(s: &str) -> std::result::Result<Indices, String> {
+    let n = |p: &str| {
+        p.trim()
+            .parse::<u64>()
+            .map_err(|_| format!("'{}' is not a throw's index (0, 1, …)", p.trim()))
+    };
+    let (first, last) = match s.split_once("..") {
+        Some((a, b)) => (n(a)?, n(b.strip_prefix('=').unwrap_or(b))?),
+        None => (n(s)?, n(s)?),
+    };
+    if last < first {
+        return Err(format!("{s}: the range runs backwards"));
+    }
+    if last - first >= MAX_ON_A_PAGE {
+        return Err(format!(
+            "{s}: {} throws; a page plays at most {MAX_ON_A_PAGE}",
+            (last - first).saturating_add(1)
+        ));
+    }
+    last.checked_add(1)
+        .ok_or_else(|| format!("{s}: too large"))?;
+    Ok(Indices { first, last })
+}
+
 pub fn run(a: &TraceArgs) -> Result<()> {
+    if a.html.is_some() {
+        return super::trace_html::run(a);
+    }
+    if a.index.first != a.index.last {
+        return Err(Error::Usage(format!(
+            "--index {}..{}: the CSV is one throw's; several are for --html",
+            a.index.first, a.index.last
+        )));
+    }
     let scene = a.scene.scene()?;
     let die = DieShape::of(&scene);
     let throw_spec = a
@@ -50,12 +100,9 @@ pub fn run(a: &TraceArgs) -> Result<()> {
             "--every and --max-steps must be at least 1".into(),
         ));
     }
-    let n = a
-        .index
-        .checked_add(1)
-        .ok_or_else(|| Error::Usage(format!("--index {}: too large", a.index)))?;
-    let throws = throw_spec.source(n);
-    let throw = throws.get(a.index);
+    let index = a.index.first;
+    let throws = throw_spec.source(index + 1);
+    let throw = throws.get(index);
     let mut engine = new_engine(a.engine, &scene)?;
     let out = std::io::stdout();
     let mut out = std::io::BufWriter::new(out.lock());
@@ -113,7 +160,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     if let (Fate::Unconverged(_), Some(s)) = (record.fate, end_state) {
         ended.up = die.outcome(&s).1;
     }
-    eprintln!("{}", trace::ending(a.index, &throw, &ended, &labels));
+    eprintln!("{}", trace::ending(index, &throw, &ended, &labels));
     if let Some(note) = trace::capped(&record, cap, a.max_steps.asked().is_some()) {
         eprintln!("dicephys: {note}");
     }

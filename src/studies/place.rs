@@ -97,8 +97,11 @@ impl Place {
                 format!("cannot create it ({e})"),
             )
         })?;
+        // A report.md is read in a browser too: report.html beside it (`report::html`).
+        let html = files.contains(&"report.md").then_some("report.html");
         files
             .iter()
+            .chain(html.iter())
             .map(|f| Ok((*f, Output::check(&self.out.join(f))?)))
             .collect::<Result<_>>()
             .map(Outputs)
@@ -147,14 +150,25 @@ pub(crate) fn unless_stopped<T>(r: Result<Option<T>>) -> Result<Option<T>> {
 pub(crate) struct Outputs(Vec<(&'static str, Output)>);
 
 impl Outputs {
-    /// Writes `bytes` as the file `name` (one the study declared), whole or not at all.
+    /// Writes `bytes` as the file `name` (one the study declared), whole or not at all; a
+    /// `report.md` also as `report.html`, its figures (written before it) inlined.
     pub(crate) fn write(&self, name: &str, bytes: &[u8]) -> Result<()> {
+        let out = self.output(name)?;
+        out.write(bytes)?;
+        if name == "report.md" {
+            let dir = out.path.parent().unwrap_or(std::path::Path::new("."));
+            let html = crate::report::html::page(&String::from_utf8_lossy(bytes), dir);
+            self.output("report.html")?.write(html.as_bytes())?;
+        }
+        Ok(())
+    }
+
+    fn output(&self, name: &str) -> Result<&Output> {
         self.0
             .iter()
             .find(|(n, _)| *n == name)
-            .ok_or_else(|| Error::failed(format!("{name}: not among the study's outputs")))?
-            .1
-            .write(bytes)
+            .map(|(_, o)| o)
+            .ok_or_else(|| Error::failed(format!("{name}: not among the study's outputs")))
     }
 }
 

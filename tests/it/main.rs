@@ -4,6 +4,7 @@
 mod helpers;
 
 mod bench;
+mod browser;
 mod bullet;
 mod cli;
 mod coarse;

@@ -6,9 +6,10 @@
 //! `dir` (created if missing) and returns an error on failure. Non-finite points are skipped,
 //! never a panic.
 //!
-//! Text is drawn with the DejaVu Sans font embedded by the `dejavu` crate and registered with
-//! plotters' `ab_glyph` renderer: no system fonts or fontconfig are needed. The SVG files name
-//! the family `sans-serif` and leave the glyphs to the viewer.
+//! Each is drawn once, as SVG; the PNG is that SVG rendered by resvg (anti-aliased, text
+//! shaped and kerned) with the DejaVu Sans font embedded by the `dejavu` crate: no system
+//! fonts or fontconfig are needed. The SVG files name the family `sans-serif` and leave the
+//! glyphs to the viewer. Plotters' `ab_glyph` still measures text for its layout.
 
 use std::path::Path;
 use std::sync::OnceLock;
@@ -23,6 +24,9 @@ pub mod paper;
 pub mod sweeps;
 pub mod tradeoff;
 pub mod validate;
+
+#[cfg(test)]
+mod text_test;
 
 /// One plotted value with its one-standard-error bar (`y_err` 0, negative or non-finite: no bar).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -158,21 +162,52 @@ fn write_both(dir: &Path, stem: &str, fig: &impl Figure) -> crate::Result<()> {
             .and_then(|()| root.present().map_err(plot_err))
             .map_err(|e| failed("svg", e))?;
     }
-    let (w, h) = size;
-    let mut rgb = vec![0u8; 3 * w as usize * h as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
-        fig.draw(&root)
-            .and_then(|()| root.present().map_err(plot_err))
-            .map_err(|e| failed("png", e))?;
-    }
+    let png = png_of(&svg, size).map_err(|e| failed("png", e))?;
+    crate::run::io::write_atomic(&dir.join(format!("{stem}.svg")), svg.as_bytes())?;
+    crate::run::io::write_atomic(&dir.join(format!("{stem}.png")), &png)
+}
+
+/// The fonts the PNGs' text is drawn with: the embedded DejaVu Sans (regular and bold), the
+/// SVG's `sans-serif`.
+fn fonts() -> std::sync::Arc<resvg::usvg::fontdb::Database> {
+    static FONTS: OnceLock<std::sync::Arc<resvg::usvg::fontdb::Database>> = OnceLock::new();
+    FONTS
+        .get_or_init(|| {
+            let mut db = resvg::usvg::fontdb::Database::new();
+            db.load_font_data(dejavu::sans::regular().to_vec());
+            db.load_font_data(dejavu::sans::bold().to_vec());
+            db.set_sans_serif_family("DejaVu Sans");
+            std::sync::Arc::new(db)
+        })
+        .clone()
+}
+
+/// The PNG of `svg` (`w` × `h` px) as resvg renders it: anti-aliased, its text shaped (kerned)
+/// in the embedded DejaVu Sans, on white. (Plotters' own bitmap drew the text glyph by glyph
+/// at rounded places, "Probabili ty", and the curves aliased.)
+fn png_of(svg: &str, (w, h): (u32, u32)) -> Result<Vec<u8>, String> {
+    use resvg::tiny_skia;
+    let options = resvg::usvg::Options {
+        font_family: "DejaVu Sans".into(),
+        fontdb: fonts(),
+        ..resvg::usvg::Options::default()
+    };
+    let tree = resvg::usvg::Tree::from_str(svg, &options).map_err(|e| e.to_string())?;
+    let mut pixmap = tiny_skia::Pixmap::new(w, h).ok_or("an empty figure")?;
+    pixmap.fill(tiny_skia::Color::WHITE);
+    resvg::render(&tree, tiny_skia::Transform::default(), &mut pixmap.as_mut());
+    // Opaque on white: the premultiplied RGBA is the RGB.
+    let rgb: Vec<u8> = pixmap
+        .data()
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect();
     use image::ImageEncoder;
     let mut png = Vec::new();
     image::codecs::png::PngEncoder::new(&mut png)
         .write_image(&rgb, w, h, image::ColorType::Rgb8)
-        .map_err(|e| failed("png", e.to_string()))?;
-    crate::run::io::write_atomic(&dir.join(format!("{stem}.svg")), svg.as_bytes())?;
-    crate::run::io::write_atomic(&dir.join(format!("{stem}.png")), &png)
+        .map_err(|e| e.to_string())?;
+    Ok(png)
 }
 
 /// A closed interval grown to hold finite values.
