@@ -32,6 +32,7 @@ pub mod heldout;
 pub mod paper;
 pub mod params;
 pub mod predict;
+pub mod proper;
 pub mod recovery;
 pub mod request;
 pub mod scores;
