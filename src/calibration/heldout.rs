@@ -10,7 +10,8 @@
 //! A counts file (`fit --data`'s format) is read as well: its rows are predicted and tested.
 
 use crate::calibration::data::{self, shown, DataRow};
-use crate::calibration::predict::BlockPrediction;
+use crate::calibration::predict::{BlockPrediction, Predicted};
+use crate::calibration::proper::{self, Score, Scores};
 use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::scene::Mode;
@@ -195,6 +196,10 @@ pub struct PredictedRow {
     pub chi2: Option<f64>,
     /// Its degrees of freedom: the outcomes counted less one.
     pub dof: Option<usize>,
+    /// The proper scores of the prediction against the counts, beside its baselines'
+    /// ([`crate::calibration::proper`]); left out where the row was not measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scores: Option<Scores>,
 }
 
 /// Every block's prediction, with the held-out test over the measured ones.
@@ -208,6 +213,9 @@ pub struct Predictions {
     pub dof: Option<usize>,
     /// P(χ²_dof ≥ χ²).
     pub p_value: Option<f64>,
+    /// The measured rows' proper scores summed, beside the baselines'.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scores: Option<Scores>,
     /// The fit predicted from.
     pub fit: String,
     /// The command line that made it.
@@ -225,6 +233,7 @@ pub fn test(row: &BlockRow, p: BlockPrediction) -> PredictedRow {
             z: None,
             chi2: None,
             dof: None,
+            scores: None,
         };
     };
     let (b, w) = (c[1] as f64, c[2] as f64);
@@ -243,10 +252,11 @@ pub fn test(row: &BlockRow, p: BlockPrediction) -> PredictedRow {
         .zip(p.ratio)
         .map(|(m, r)| stats::z_score(m.value, m.err, r.value, r.err));
     // The outcomes a row counts: a 2D block cannot stand on its end.
-    let live: Vec<usize> = match row.mode {
-        Mode::ThreeD => vec![0, 1, 2],
-        Mode::TwoD => vec![1, 2],
-    };
+    let live = live(row.mode);
+    let scores = Some(Scores {
+        prediction: score_against(row, &p.p, phi),
+        ..Scores::default()
+    });
     let n: f64 = live.iter().map(|&k| c[k] as f64).sum();
     let norm: f64 = live.iter().map(|&k| p.p[k].value).sum();
     let chi2 = (n > 0.0 && norm > 0.0).then(|| {
@@ -271,7 +281,30 @@ pub fn test(row: &BlockRow, p: BlockPrediction) -> PredictedRow {
         z,
         chi2,
         dof: chi2.map(|_| live.len() - 1),
+        scores,
     }
+}
+
+/// The outcomes a block's row counts: a 2D block cannot stand on its end.
+fn live(mode: Mode) -> Vec<usize> {
+    match mode {
+        Mode::ThreeD => vec![0, 1, 2],
+        Mode::TwoD => vec![1, 2],
+    }
+}
+
+/// The proper scores of `p` (length, breadth, width vertical) against `row`'s counts, from a
+/// fit of overdispersion `phi`; `None` where the row was not measured or `p` lacks an outcome.
+pub fn score_against(row: &BlockRow, p: &[Predicted], phi: f64) -> Option<Score> {
+    let c = row.counts?;
+    let live = live(row.mode);
+    let counts: Vec<u64> = live.iter().map(|&k| c[k]).collect();
+    let values: Vec<f64> = live.iter().map(|&k| p.get(k).map_or(f64::NAN, |q| q.value)).collect();
+    let sigma: Vec<f64> = live.iter().map(|&k| p.get(k).map_or(f64::NAN, |q| q.err)).collect();
+    let usable = counts.iter().sum::<u64>() > 0
+        && values.iter().all(|v| v.is_finite())
+        && values.iter().sum::<f64>() > 0.0;
+    usable.then(|| proper::score(&counts, &values, &sigma, phi))
 }
 
 /// The rows' predictions, with the χ² of the measured ones.
@@ -283,11 +316,14 @@ pub fn collect(rows: Vec<PredictedRow>, fit: String, command_line: String) -> Pr
         .zip(dof)
         .filter(|(_, d)| *d > 0)
         .map(|(c, d)| stats::chi_square_p_value(c, d));
+    let scored: Vec<&Scores> = tested.iter().filter_map(|r| r.scores.as_ref()).collect();
+    let scores = (!scored.is_empty()).then(|| Scores::total(&scored));
     Predictions {
         rows,
         chi2,
         dof,
         p_value,
+        scores,
         fit,
         command_line,
     }
@@ -386,6 +422,8 @@ mod tests {
             extrapolation: None,
             overdispersion: 1.0,
             discrepancy: None,
+            other_die: None,
+            tests: Vec::new(),
         };
         let row = BlockRow {
             label: "a".into(),

@@ -284,6 +284,19 @@ impl Scores {
     }
 }
 
+/// A row of counts a prediction was scored against.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CountsTest {
+    /// The row's label.
+    pub label: String,
+    /// The outcomes it counts.
+    pub outcomes: Vec<String>,
+    /// Its counts.
+    pub counts: Vec<u64>,
+    /// The prediction's scores beside the baselines'.
+    pub scores: Scores,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
