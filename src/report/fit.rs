@@ -561,7 +561,7 @@ fn loo_scores_text(res: &FitResult) -> String {
          against the counts' own; with the discrepancy a row's prediction takes from the other \
          rows' misses, and without; beside the uncalibrated default scene (the fit's fixed \
          values, {} rolls a row) and the quasi-static theory where it applies.\n",
-        crate::studies::fit::baseline::LOO_BASELINE_ROLLS
+        res.config.design.rolls * crate::studies::fit::baseline::LOO_BASELINE_POINTS
     );
     for r in &res.loo {
         if let Some(sc) = &r.scores {

@@ -18,8 +18,9 @@ use crate::model::block::Block;
 use crate::model::scene::Mode;
 use crate::run::runner::Runner;
 
-/// Rolls of the default scene for each row a fit's leave-one-out scores.
-pub const LOO_BASELINE_ROLLS: u64 = 8000;
+/// Rolls of the default scene for each row a fit's leave-one-out scores, per roll of one of
+/// the fit's design points: ten points' worth.
+pub const LOO_BASELINE_POINTS: u64 = 10;
 
 /// A seed of the baselines' own, apart from every design's and prediction's.
 const BASELINE_SEED: u64 = 0xba5e_11e;
@@ -121,7 +122,7 @@ fn with_others_discrepancy(loo: &[LooRow], r: usize, phi: f64) -> Option<Vec<Pre
 }
 
 /// Scores every leave-one-out row of a fit of `cfg` in place, beside the baselines (each row's
-/// default scene simulated with [`LOO_BASELINE_ROLLS`]), and returns the total. The rows'
+/// default scene simulated with [`LOO_BASELINE_POINTS`] design points' rolls), and returns the total. The rows'
 /// predictions are the fits without them, on their own errors (φ = 1: the overdispersion of a
 /// fit without the row is not kept); the discrepancy's, one learnt from the other rows' misses
 /// (`phi` the whole fit's, as the fit learns its own). `None` if stopped early.
@@ -147,7 +148,7 @@ pub fn score_loo(
             fixed,
             (row.block, row.mode, faces),
             cfg.seed.wrapping_add(r as u64),
-            LOO_BASELINE_ROLLS,
+            cfg.design.rolls * LOO_BASELINE_POINTS,
             runner,
         )?
         else {
