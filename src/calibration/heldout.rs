@@ -299,8 +299,14 @@ pub fn score_against(row: &BlockRow, p: &[Predicted], phi: f64) -> Option<Score>
     let c = row.counts?;
     let live = live(row.mode);
     let counts: Vec<u64> = live.iter().map(|&k| c[k]).collect();
-    let values: Vec<f64> = live.iter().map(|&k| p.get(k).map_or(f64::NAN, |q| q.value)).collect();
-    let sigma: Vec<f64> = live.iter().map(|&k| p.get(k).map_or(f64::NAN, |q| q.err)).collect();
+    let values: Vec<f64> = live
+        .iter()
+        .map(|&k| p.get(k).map_or(f64::NAN, |q| q.value))
+        .collect();
+    let sigma: Vec<f64> = live
+        .iter()
+        .map(|&k| p.get(k).map_or(f64::NAN, |q| q.err))
+        .collect();
     let usable = counts.iter().sum::<u64>() > 0
         && values.iter().all(|v| v.is_finite())
         && values.iter().sum::<f64>() > 0.0;

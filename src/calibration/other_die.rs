@@ -89,7 +89,10 @@ impl OtherDie {
     /// Refuses a die the fit's throw cannot throw: a die of any shape has no long axis for the
     /// paper's or a hand's throw (a fit of blocks) to spin it about.
     pub fn check(&self, fit: &FitResult) -> Result<()> {
-        let hand = fit.config.model.is_free(crate::calibration::params::Kind::Kappa);
+        let hand = fit
+            .config
+            .model
+            .is_free(crate::calibration::params::Kind::Kappa);
         let throw = fit.config.model.fixed.throw;
         if let (Some(s), true) = (&self.shape, hand || throw != FixedThrow::Tumble) {
             return Err(Error::field(

@@ -325,7 +325,11 @@ mod tests {
         let c = concentration(&[0.5, 0.5], &[0.25, 0.25], 2, 1.0);
         assert!((c - 3.0).abs() < 1e-12, "{c}");
         let s = score(&[1, 1], &[0.5, 0.5], &[0.25, 0.25], 1.0);
-        assert!((s.log_score - 0.375f64.ln()).abs() < 1e-12, "{}", s.log_score);
+        assert!(
+            (s.log_score - 0.375f64.ln()).abs() < 1e-12,
+            "{}",
+            s.log_score
+        );
         // An overdispersion alone widens too: φ = 2, σ = 0, N = 2: 1 + c = 1/(φ − 1) = 1.
         let c = concentration(&[0.5, 0.5], &[0.0, 0.0], 2, 2.0);
         assert!(c.abs() < 1e-5, "{c}");
@@ -335,14 +339,21 @@ mod tests {
     fn the_predictive_distribution_sums_to_one_and_a_vague_prediction_scores_lower() {
         // Every split of N = 6 between two outcomes, at p = 0.3 ± 0.1.
         let total: f64 = (0..=6u64)
-            .map(|k| score(&[k, 6 - k], &[0.3, 0.7], &[0.1, 0.1], 1.0).log_score.exp())
+            .map(|k| {
+                score(&[k, 6 - k], &[0.3, 0.7], &[0.1, 0.1], 1.0)
+                    .log_score
+                    .exp()
+            })
             .sum();
         assert!((total - 1.0).abs() < 1e-12, "{total}");
         // Counts at the prediction: sharp beats vague; the sharpness ratio says by how much.
         let sharp = score(&[300, 700], &[0.3, 0.7], &[0.005, 0.005], 1.0);
         let vague = score(&[300, 700], &[0.3, 0.7], &[0.15, 0.15], 1.0);
         assert!(sharp.log_score > vague.log_score + 1.0);
-        assert!(sharp.sharpness < 0.5 && vague.sharpness > 9.0, "{sharp:?} {vague:?}");
+        assert!(
+            sharp.sharpness < 0.5 && vague.sharpness > 9.0,
+            "{sharp:?} {vague:?}"
+        );
         assert_eq!((vague.within_one_sigma, vague.cells, vague.dof), (2, 2, 1));
     }
 

@@ -338,7 +338,11 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
         return predict_blocks(a, fit, file);
     }
     let other = other_die(a, &fit)?;
-    let block = match (a.block, dicephys::calibration::predict::own_block(&fit), &other) {
+    let block = match (
+        a.block,
+        dicephys::calibration::predict::own_block(&fit),
+        &other,
+    ) {
         (Some(b), _, _) | (None, Some(b), _) => b,
         (None, None, Some(o)) if o.shape.is_some() => o.block(Block::from_mm(16.0, 16.0, 16.0)?),
         (None, None, _) => {
@@ -349,7 +353,12 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
     };
     let block = other.as_ref().map_or(block, |o| o.block(block));
     let counts = match &a.counts {
-        Some(path) => counts_of(path, other.as_ref().map_or(fit.config.method.shape.as_deref(), |o| o.shape.as_deref()))?,
+        Some(path) => counts_of(
+            path,
+            other
+                .as_ref()
+                .map_or(fit.config.method.shape.as_deref(), |o| o.shape.as_deref()),
+        )?,
         None => Vec::new(),
     };
     let cfg = PredictConfig {

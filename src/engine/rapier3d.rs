@@ -551,4 +551,3 @@ fn collider(c: &Collider) -> crate::Result<(ColliderBuilder, Rotation)> {
         ),
     })
 }
-

@@ -2,9 +2,9 @@
 
 use crate::calibration::data::DataRow;
 use crate::calibration::design::point_seed;
+use crate::calibration::heldout;
 use crate::calibration::params::{Kind, Method};
 use crate::calibration::predict::{group, BlockPrediction, PredictConfig, Predicted};
-use crate::calibration::heldout;
 use crate::calibration::FitResult;
 use crate::error::{Error, Field, Result};
 use crate::run::runner::Runner;
@@ -237,36 +237,36 @@ fn fit_prediction(
         })
     });
     Ok(Some(BlockPrediction {
-            block: cfg.block,
-            mode: cfg.mode,
-            shape: shape.map(|s| s.name.clone()),
-            // A surface given by its e and μ is named by them.
-            surface: match cfg.contact {
-                Some([e, mu]) => format!("e {e}, μ {mu}"),
-                None => surface,
-            },
-            thrower,
-            p: freq
-                .iter()
-                .filter(|v| !v.is_empty())
-                .map(|v| combine(v, &binomial))
-                .collect(),
-            ratio,
-            labels: face_labels(shape, with_faces),
-            faces,
-            theory_ratio: shape
-                .is_none()
-                .then(|| crate::theory::ratio_from_r(cfg.block.r())),
-            draws: cfg.draws,
-            rolls: cfg.rolls,
-            unsettled,
-            overdispersion: fit.estimate.overdispersion,
-            discrepancy: None,
-            extrapolation: (shape.is_none() && fit.config.method.shape.is_none())
-                .then(|| extrapolation(fit, &cfg.block))
-                .flatten(),
-            other_die: cfg.other.as_ref().map(|o| o.name(cfg.block)),
-            tests: Vec::new(),
+        block: cfg.block,
+        mode: cfg.mode,
+        shape: shape.map(|s| s.name.clone()),
+        // A surface given by its e and μ is named by them.
+        surface: match cfg.contact {
+            Some([e, mu]) => format!("e {e}, μ {mu}"),
+            None => surface,
+        },
+        thrower,
+        p: freq
+            .iter()
+            .filter(|v| !v.is_empty())
+            .map(|v| combine(v, &binomial))
+            .collect(),
+        ratio,
+        labels: face_labels(shape, with_faces),
+        faces,
+        theory_ratio: shape
+            .is_none()
+            .then(|| crate::theory::ratio_from_r(cfg.block.r())),
+        draws: cfg.draws,
+        rolls: cfg.rolls,
+        unsettled,
+        overdispersion: fit.estimate.overdispersion,
+        discrepancy: None,
+        extrapolation: (shape.is_none() && fit.config.method.shape.is_none())
+            .then(|| extrapolation(fit, &cfg.block))
+            .flatten(),
+        other_die: cfg.other.as_ref().map(|o| o.name(cfg.block)),
+        tests: Vec::new(),
     }))
 }
 
@@ -414,8 +414,8 @@ pub fn predict_blocks(
                     heldout::score_against(r, &own.p, fit.estimate.overdispersion);
             }
             let silent = |_| {};
-            let Some(base) = default_scene(fit, &cfg(r), &runner.with_progress(&silent))
-                .map_err(in_row)?
+            let Some(base) =
+                default_scene(fit, &cfg(r), &runner.with_progress(&silent)).map_err(in_row)?
             else {
                 return Ok(None);
             };
