@@ -202,7 +202,7 @@ pub struct PredictConfig {
     /// Another die than the fit's, thrown by the same hand on the same table; `None`: the
     /// fit's own die (a fit of blocks: `block`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub other: Option<crate::calibration::other_die::OtherDie>,
+    pub other: Option<Box<crate::calibration::other_die::OtherDie>>,
     /// Counts of the die predicted, to score the prediction against (`fit --data`'s rows).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub counts: Vec<crate::calibration::data::DataRow>,

@@ -79,7 +79,7 @@ pub fn concentration(p: &[f64], sigma: &[f64], n: u64, phi: f64) -> f64 {
     let s = sigma.iter().map(|s| s * s).sum::<f64>() / binomial;
     let n1 = n.saturating_sub(1) as f64;
     let a = (phi - 1.0).max(0.0) + n1 * s;
-    if !(a > 0.0) || !s.is_finite() || n1 == 0.0 {
+    if a.is_nan() || a <= 0.0 || !s.is_finite() || n1 == 0.0 {
         return f64::INFINITY;
     }
     // The largest scatter a Dirichlet-multinomial has is c → 0 (every throw the same):

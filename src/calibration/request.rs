@@ -154,7 +154,7 @@ impl FitRequest {
                     Error::field(Field::Shape, "", format!("at its centre of mass: {e}"))
                 })?;
                 // A box's pips are drilled as its labels number its faces.
-                die = scene.features.clone();
+                die = scene.features;
                 scene.shape.map(|s| (*s).clone())
             }
             None => None,

@@ -362,7 +362,7 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
         None => Vec::new(),
     };
     let cfg = PredictConfig {
-        other,
+        other: other.map(Box::new),
         counts,
         block,
         mode: if a.two_d { Mode::TwoD } else { Mode::ThreeD },

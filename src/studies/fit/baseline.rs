@@ -23,7 +23,7 @@ use crate::run::runner::Runner;
 pub const LOO_BASELINE_POINTS: u64 = 10;
 
 /// A seed of the baselines' own, apart from every design's and prediction's.
-const BASELINE_SEED: u64 = 0xba5e_11e;
+const BASELINE_SEED: u64 = 0x0ba5_e11e;
 
 /// `block` in `mode` simulated at `v` with `rolls` throws: each outcome's share of the settled
 /// rolls (length, breadth, width vertical, or, `faces`, each face or label as a fit counts

@@ -439,7 +439,7 @@ pub fn default_scene(
     runner: &Runner,
 ) -> Result<Option<Vec<Predicted>>> {
     let rolls = cfg.rolls * BASELINE_ROLLS_PER_DRAW_ROLLS;
-    let seed = point_seed(cfg.seed ^ 0xba5e_11e, cfg.block, cfg.mode, 0);
+    let seed = point_seed(cfg.seed ^ 0x0ba5_e11e, cfg.block, cfg.mode, 0);
     let spec = fit
         .config
         .method
