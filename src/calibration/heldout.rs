@@ -33,6 +33,10 @@ pub struct BlockRow {
     pub thrower: Option<String>,
     /// Counts of length, breadth and width vertical, if measured.
     pub counts: Option<[u64; 3]>,
+    /// The outcomes a counts file's row counts apart (indices into `counts`; a `-` merges an
+    /// outcome into a congruent one); `None`: every outcome the mode has, apart.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub groups: Option<Vec<Vec<usize>>>,
 }
 
 /// Reliability round 5, class J: a column a blocks file does not know (face counts among
@@ -133,6 +137,7 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<BlockRow>> {
             surface: optional("surface"),
             thrower: optional("thrower"),
             counts,
+            groups: None,
         };
         if row.label.is_empty() || rows.iter().any(|r| r.label == row.label) {
             return Err(bad(
@@ -166,6 +171,7 @@ fn from_counts(r: DataRow, name: &str) -> Result<BlockRow> {
         surface: Some(r.surface),
         thrower: (r.thrower != "all").then_some(r.thrower),
         counts: Some(counts),
+        groups: Some(r.groups),
     })
 }
 
@@ -251,22 +257,22 @@ pub fn test(row: &BlockRow, p: BlockPrediction) -> PredictedRow {
     let z = measured_ratio
         .zip(p.ratio)
         .map(|(m, r)| stats::z_score(m.value, m.err, r.value, r.err));
-    // The outcomes a row counts: a 2D block cannot stand on its end.
-    let live = live(row.mode);
     let scores = Some(Scores {
         prediction: score_against(row, &p.p, phi),
         ..Scores::default()
     });
-    let n: f64 = live.iter().map(|&k| c[k] as f64).sum();
-    let norm: f64 = live.iter().map(|&k| p.p[k].value).sum();
+    let (counts, values, sigma) = cells(row, &p.p).unwrap_or_default();
+    let n: f64 = counts.iter().map(|&k| k as f64).sum();
+    let norm: f64 = values.iter().sum();
     let chi2 = (n > 0.0 && norm > 0.0).then(|| {
-        live.iter()
-            .map(|&k| {
-                let q = p.p[k].value / norm;
-                let s = p.p[k].err / norm;
+        counts
+            .iter()
+            .zip(values.iter().zip(&sigma))
+            .map(|(&k, (&v, &e))| {
+                let (q, s) = (v / norm, e / norm);
                 let var = phi * n * q + n * n * s * s;
                 if var > 0.0 {
-                    (c[k] as f64 - n * q).powi(2) / var
+                    (k as f64 - n * q).powi(2) / var
                 } else {
                     0.0
                 }
@@ -280,7 +286,7 @@ pub fn test(row: &BlockRow, p: BlockPrediction) -> PredictedRow {
         measured_ratio,
         z,
         chi2,
-        dof: chi2.map(|_| live.len() - 1),
+        dof: chi2.map(|_| counts.len() - 1),
         scores,
     }
 }
@@ -293,20 +299,39 @@ fn live(mode: Mode) -> Vec<usize> {
     }
 }
 
+/// The cells a measured row counts apart: its counts, and `p`'s values and errors (length,
+/// breadth, width vertical) summed over each (errors in quadrature): a counts file's groups (a
+/// `-` merges two congruent outcomes), else the mode's outcomes (a 2D block cannot stand on
+/// its end). `None` unmeasured.
+fn cells(row: &BlockRow, p: &[Predicted]) -> Option<Cells> {
+    let c = row.counts?;
+    let groups: Vec<Vec<usize>> = row
+        .groups
+        .clone()
+        .unwrap_or_else(|| live(row.mode).into_iter().map(|k| vec![k]).collect());
+    let of = |g: &Vec<usize>, f: &dyn Fn(&Predicted) -> f64| {
+        g.iter().map(|&k| p.get(k).map_or(f64::NAN, f)).sum::<f64>()
+    };
+    Some((
+        groups
+            .iter()
+            .map(|g| g.iter().map(|&k| c[k]).sum())
+            .collect(),
+        groups.iter().map(|g| of(g, &|q| q.value)).collect(),
+        groups
+            .iter()
+            .map(|g| of(g, &|q| q.err * q.err).sqrt())
+            .collect(),
+    ))
+}
+
+/// A row's cells: counts, predicted values, their errors.
+type Cells = (Vec<u64>, Vec<f64>, Vec<f64>);
+
 /// The proper scores of `p` (length, breadth, width vertical) against `row`'s counts, from a
 /// fit of overdispersion `phi`; `None` where the row was not measured or `p` lacks an outcome.
 pub fn score_against(row: &BlockRow, p: &[Predicted], phi: f64) -> Option<Score> {
-    let c = row.counts?;
-    let live = live(row.mode);
-    let counts: Vec<u64> = live.iter().map(|&k| c[k]).collect();
-    let values: Vec<f64> = live
-        .iter()
-        .map(|&k| p.get(k).map_or(f64::NAN, |q| q.value))
-        .collect();
-    let sigma: Vec<f64> = live
-        .iter()
-        .map(|&k| p.get(k).map_or(f64::NAN, |q| q.err))
-        .collect();
+    let (counts, values, sigma) = cells(row, p)?;
     let usable = counts.iter().sum::<u64>() > 0
         && values.iter().all(|v| v.is_finite())
         && values.iter().sum::<f64>() > 0.0;
@@ -438,6 +463,7 @@ mod tests {
             surface: None,
             thrower: None,
             counts: Some([0, 250, 750]),
+            groups: None,
         };
         let same = test(&row, pred(0.25));
         assert!(same.chi2.unwrap() < 1e-12 && same.z.unwrap().abs() < 1e-12);
