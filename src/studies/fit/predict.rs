@@ -413,13 +413,11 @@ pub fn predict_blocks(
                 scores.without_discrepancy =
                     heldout::score_against(r, &own.p, fit.estimate.overdispersion);
             }
-            let silent = |_| {};
-            let Some(base) =
-                default_scene(fit, &cfg(r), &runner.with_progress(&silent)).map_err(in_row)?
-            else {
+            let Some((scene, theory)) = baselines(fit, &cfg(r), &runner).map_err(in_row)? else {
                 return Ok(None);
             };
-            scores.default_scene = heldout::score_against(r, &base, 1.0);
+            scores.default_scene = heldout::score_against(r, &scene, 1.0);
+            scores.quasi_static = theory.and_then(|q| heldout::score_against(r, &q, 1.0));
         }
         out.push(tested);
     }
@@ -430,34 +428,31 @@ pub fn predict_blocks(
 /// own simulation error is well under the counts'.
 pub const BASELINE_ROLLS_PER_DRAW_ROLLS: u64 = 4;
 
-/// The uncalibrated baseline: `cfg.block` simulated at the fit's fixed values (what `fit` takes
-/// for each parameter it frees when it is not free: the default scene), its error the
-/// simulation's alone. P(length), P(breadth), P(width) vertical; `None` if stopped early.
-pub fn default_scene(
+/// The default scene's shares and the quasi-static theory's, where it applies.
+type Baselines = (Vec<Predicted>, Option<Vec<Predicted>>);
+
+/// The baselines of `cfg`'s block ([`super::baseline`]): the default scene (the fit's fixed
+/// values, its error the simulation's alone) and the quasi-static theory (3D), each as
+/// P(length), P(breadth), P(width) vertical. `None` if stopped early.
+pub fn baselines(
     fit: &FitResult,
     cfg: &PredictConfig,
     runner: &Runner,
-) -> Result<Option<Vec<Predicted>>> {
+) -> Result<Option<Baselines>> {
+    let (method, fixed) = (&fit.config.method, &fit.config.model.fixed);
+    let at = (cfg.block, cfg.mode, false);
     let rolls = cfg.rolls * BASELINE_ROLLS_PER_DRAW_ROLLS;
-    let seed = point_seed(cfg.seed ^ 0x0ba5_e11e, cfg.block, cfg.mode, 0);
-    let spec = fit
-        .config
-        .method
-        .spec(cfg.block, cfg.mode, &fit.config.model.fixed, seed, rolls);
-    spec.validate(false)?;
-    let done = runner.run(&spec, None, &mut |_| Ok(()))?;
-    if !done.complete {
+    let Some((shares, settled)) =
+        super::baseline::shares_at(method, fixed, at, cfg.seed, rolls, runner)?
+    else {
         return Ok(None);
-    }
-    let c = &done.tally.counts;
-    let settled = super::simulate::settled(&done.tally).max(1) as f64;
-    Ok(Some(
-        [c.length, c.breadth, c.width]
-            .iter()
-            .map(|&k| {
-                let q = k as f64 / settled;
-                Predicted::of(&[q], q * (1.0 - q) / settled)
-            })
-            .collect(),
-    ))
+    };
+    let n = settled.max(1) as f64;
+    let scene = shares
+        .iter()
+        .map(|&q| Predicted::of(&[q], q * (1.0 - q) / n))
+        .collect();
+    let theory = super::baseline::quasi_static(method, fixed, at)
+        .map(|q| q.iter().map(|&v| Predicted::of(&[v], 0.0)).collect());
+    Ok(Some((scene, theory)))
 }
