@@ -551,3 +551,4 @@ fn collider(c: &Collider) -> crate::Result<(ColliderBuilder, Rotation)> {
         ),
     })
 }
+

@@ -431,11 +431,7 @@ impl DieShape {
 
     /// A box's side `o` as the die counts it, at `s`: the cuboid's side and the direction
     /// of its face up (`RollRecord::up`); a box-shaped die of any shape's face (its outcome).
-    pub fn labelled(
-        &self,
-        o: crate::model::block::Outcome,
-        s: &BodyState,
-    ) -> (crate::model::block::Outcome, Option<u8>) {
+    pub fn labelled(&self, o: crate::model::block::Outcome, s: &BodyState) -> (crate::model::block::Outcome, Option<u8>) {
         use crate::model::block::Outcome;
         let up = crate::model::faces::up_direction(&s.rotation, o);
         match (self.box_faces, up) {

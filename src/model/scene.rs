@@ -401,10 +401,7 @@ impl Scene {
     /// A die of any shape that is a box (`Shape::as_box`): its outcome resting on each face,
     /// in `faces::DIRECTIONS`' order. `None` for the cuboid and for any other solid.
     pub fn box_faces(&self) -> Option<[u8; 6]> {
-        self.shape
-            .as_deref()
-            .and_then(Shape::as_box)
-            .map(|b| b.faces)
+        self.shape.as_deref().and_then(Shape::as_box).map(|b| b.faces)
     }
 
     /// A box-shaped die whose labels are the numbers 1 to 6: the layout they make, which

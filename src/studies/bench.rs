@@ -284,10 +284,7 @@ pub fn bench_dice() -> crate::Result<Vec<(String, Scene)>> {
     let d6_pips = d6_pips
         .resting_at_com()
         .map_err(|e| crate::Error::Invalid(format!("the d6 with pips: {e}")))?;
-    out.insert(
-        out.len() - 2,
-        ("--shape d6 --pips 3,1".to_string(), d6_pips),
-    );
+    out.insert(out.len() - 2, ("--shape d6 --pips 3,1".to_string(), d6_pips));
     Ok(out)
 }
 

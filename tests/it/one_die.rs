@@ -36,14 +36,7 @@ fn by_number(doc: &serde_json::Value) -> Vec<(String, u64)> {
 
 fn roll(extra: &[&str]) -> serde_json::Value {
     let mut args = vec![
-        "roll",
-        "--rolls",
-        "600",
-        "--seed",
-        "4",
-        "--threads",
-        "2",
-        "--json",
+        "roll", "--rolls", "600", "--seed", "4", "--threads", "2", "--json",
     ];
     args.extend_from_slice(extra);
     json(&dicephys(&args))
@@ -77,10 +70,7 @@ fn a_box_rolls_as_the_cuboid_whatever_its_name() {
         for die in named {
             let doc = roll(&[die, made].concat());
             assert_eq!(by_label(&doc), want, "{die:?} {made:?}");
-            assert_eq!(
-                doc["tally"]["steps"], block["tally"]["steps"],
-                "{die:?} {made:?}"
-            );
+            assert_eq!(doc["tally"]["steps"], block["tally"]["steps"], "{die:?} {made:?}");
         }
     }
     // A cube mesh numbers its faces in its own order: the same counts, sorted.
