@@ -841,6 +841,22 @@ def compare(first: Union[Fit, PathLike], second: Union[Fit, PathLike]) -> Docume
     return Document(_native.compare(texts[0], texts[1], (paths[0], paths[1])))
 
 
+def _other_die(
+    shape: Optional[str],
+    die: Optional[PathLike],
+    size: Optional[float],
+    scale: Optional[float],
+    com: Optional[Sequence[float]],
+    density: Optional[float],
+) -> Optional[Dict[str, Any]]:
+    made = dict(
+        shape=shape, die=None if die is None else os.fspath(die), size=size, scale=scale,
+        com=_triple("com", com, 3), density=density,
+    )
+    given = {k: v for k, v in made.items() if v is not None}
+    return given or None
+
+
 def predict(
     fit: Union[Fit, PathLike],
     block: Optional[str] = None,
@@ -854,6 +870,13 @@ def predict(
     threads: int = 0,
     progress: Progress = None,
     contact: Optional[Tuple[float, float]] = None,
+    shape: Optional[str] = None,
+    die: Optional[PathLike] = None,
+    size: Optional[float] = None,
+    scale: Optional[float] = None,
+    com: Optional[Sequence[float]] = None,
+    density: Optional[float] = None,
+    counts: Any = None,
 ) -> Document:
     """A block the fit did not see, simulated at the fit's posterior draws:
     ``dicephys predict --json`` (docs/json.md, "predict").
@@ -862,6 +885,12 @@ def predict(
     block: the block, "140x24x20" (a fit of a die of any shape predicts that die: None).
     surface, thrower: whose fitted values to use, when the fit has several.
     contact: another surface's (e, μ), where the fit held them fixed.
+    shape, die, size, scale, com, density: another die than the fit's, as ``roll`` takes it,
+        thrown by the same hand on the same table (a block from a fit of a die of any shape
+        is another die too): ``predict --shape``/``--die``.
+    counts: counts of the die predicted (a CSV file or CSV text in ``fit``'s format): the
+        prediction is scored against each row beside the default scene and the quasi-static
+        theory (``doc.tests``; docs/json.md, "Proper scores").
     """
     path = fit.path if isinstance(fit, Fit) else os.fspath(fit)
     with open(path, encoding="utf-8") as f:
@@ -871,7 +900,8 @@ def predict(
         out = _native.predict(
             text, block, mode=mode, surface=surface, thrower=thrower, draws=draws,
             rolls=rolls, seed=seed, threads=threads, progress=tell,
-            contact=_contact(contact),
+            contact=_contact(contact), die=_other_die(shape, die, size, scale, com, density),
+            counts=None if counts is None else _data(counts),
         )
     finally:
         close()

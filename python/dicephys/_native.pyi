@@ -78,4 +78,6 @@ def predict(
     threads: int = ...,
     progress: _Progress = ...,
     contact: Optional[Tuple[float, float]] = ...,
+    die: Optional[Dict[str, Any]] = ...,
+    counts: Optional[str] = ...,
 ) -> str: ...

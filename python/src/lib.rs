@@ -847,10 +847,11 @@ fn compare(first: &str, second: &str, names: [String; 2]) -> PyResult<String> {
 
 #[pyfunction]
 #[pyo3(signature = (fit, block=None, *, mode="3d", surface=None, thrower=None, draws=16,
-    rolls=2000, seed=DEFAULT_SEED, threads=0, progress=None, contact=None))]
+    rolls=2000, seed=DEFAULT_SEED, threads=0, progress=None, contact=None, die=None,
+    counts=None))]
 #[allow(clippy::too_many_arguments)]
-fn predict(
-    py: Python<'_>,
+fn predict<'py>(
+    py: Python<'py>,
     fit: &str,
     block: Option<&str>,
     mode: &str,
@@ -862,15 +863,32 @@ fn predict(
     threads: usize,
     progress: Option<&Bound<'_, PyAny>>,
     contact: Option<[f64; 2]>,
+    die: Option<Bound<'py, PyDict>>,
+    counts: Option<&str>,
 ) -> PyResult<String> {
     let fit = fit_of(fit, "fit")?;
-    // A fit of a die of any shape predicts that die; a fit of blocks needs the block.
-    let block = match (block, calibration::predict::own_block(&fit)) {
-        (Some(b), _) => self::block(b)?,
-        (None, Some(b)) => b,
-        (None, None) => return Err(bad("block", "None", "give the block to predict")),
+    let given = block.map(self::block).transpose()?;
+    let other = other_die(&fit, given, die)?;
+    // A fit of a die of any shape predicts that die; a fit of blocks needs the block; another
+    // die of any shape is its own bounding box.
+    let block = match (given, calibration::predict::own_block(&fit), &other) {
+        (Some(b), _, _) | (None, Some(b), _) => b,
+        (None, None, Some(o)) if o.shape.is_some() => {
+            o.block(Block::from_mm(16.0, 16.0, 16.0).map_err(py_err)?)
+        }
+        (None, None, _) => return Err(bad("block", "None", "give the block to predict")),
+    };
+    let block = other.as_ref().map_or(block, |o| o.block(block));
+    let shape = other
+        .as_ref()
+        .map_or(fit.config.method.shape.as_deref(), |o| o.shape.as_deref());
+    let counts = match counts {
+        Some(c) => counts_of(c, shape)?,
+        None => Vec::new(),
     };
     let cfg = calibration::predict::PredictConfig {
+        other: other.map(Box::new),
+        counts,
         block,
         mode: self::mode(mode)?,
         surface,
@@ -885,6 +903,50 @@ fn predict(
     finished(detached(py, progress, None, |s| {
         s.hooked(|h| cfg.run(&place, h))
     })?)
+}
+
+/// The die `predict` throws in place of the fit's (issue 71.2): `die`'s names as `fit`'s
+/// (shape, die, size, scale, com, pips, edge_radius, density), or a block from a fit of a die
+/// of any shape; `None`: the fit's own.
+fn other_die(
+    fit: &calibration::FitResult,
+    block: Option<Block>,
+    die: Option<Bound<'_, PyDict>>,
+) -> PyResult<Option<calibration::other_die::OtherDie>> {
+    let described = die.as_ref().is_some_and(|d| !d.is_empty());
+    let block_of_shape_fit = block.is_some() && fit.config.method.shape.is_some();
+    if !described && !block_of_shape_fit {
+        return Ok(None);
+    }
+    let request = DieRequest {
+        block,
+        ..fit_die(die)?
+    };
+    calibration::other_die::OtherDie::resolve(&request)
+        .map(Some)
+        .map_err(py_err)
+}
+
+/// `predict`'s counts (a CSV file or CSV text in `fit`'s format), read against the die of any
+/// shape predicted.
+fn counts_of(
+    counts: &str,
+    shape: Option<&dicephys::model::shape::Shape>,
+) -> PyResult<Vec<calibration::data::DataRow>> {
+    let rows = if counts.contains('\n') {
+        calibration::data::parse(counts, "counts")
+    } else {
+        calibration::data::read(std::path::Path::new(counts), &Stop::new())
+    }
+    .map_err(|e| match e {
+        Error::Io { .. } => py_err(e),
+        e => PyValueError::new_err(format!("counts: {}", arguments_in(&e))),
+    })?;
+    match shape {
+        Some(s) => calibration::data::on_shape(&rows, s)
+            .map_err(|e| PyValueError::new_err(format!("counts: {}", arguments_in(&e)))),
+        None => Ok(rows),
+    }
 }
 
 /// The library's version, as `dicephys --version` prints it.

@@ -341,6 +341,14 @@ def test_a_d4_s_weight_fitted_and_predicted_through_python_is_the_cli_s(tmp_path
     assert p.data == cli("predict", "--fit", f.path, "--draws", "3", "--rolls", "100", "--json")
     assert p.data["shape"] == "d4" and len(p.data["faces"]) == 4
     assert sorted(p.data["labels"]) == ["1", "2", "3", "4"]
+    # Issue 71.2: another die from the d4's calibration, scored against its counts, as the CLI.
+    d6 = "label,surface,face_1,face_2,face_3,face_4,face_5,face_6\nd,MDF,9,11,10,10,8,12\n"
+    (tmp_path / "d6.csv").write_text(d6)
+    other = dicephys.predict(f, shape="d6", counts=d6, draws=3, rolls=100)
+    assert other.data == cli("predict", "--fit", f.path, "--shape", "d6", "--counts",
+                             str(tmp_path / "d6.csv"), "--draws", "3", "--rolls", "100", "--json")
+    assert other.data["other_die"] == "d6"
+    assert set(other.data["tests"][0]["scores"]) == {"prediction", "default_scene", "quasi_static"}
 
 
 @pytest.mark.usefixtures("sigint_raises")

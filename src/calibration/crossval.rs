@@ -144,6 +144,7 @@ pub fn score_row(lik: &Likelihood, r: usize, draws: &[Vec<f64>]) -> LooRow {
         end,
         log_score,
         side_log_score,
+        scores: None,
     }
 }
 

@@ -544,6 +544,7 @@ mod tests {
             end: None,
             log_score: 0.0,
             side_log_score: 0.0,
+            scores: None,
         }
     }
 

@@ -10,7 +10,8 @@
 //! A counts file (`fit --data`'s format) is read as well: its rows are predicted and tested.
 
 use crate::calibration::data::{self, shown, DataRow};
-use crate::calibration::predict::BlockPrediction;
+use crate::calibration::predict::{BlockPrediction, Predicted};
+use crate::calibration::proper::{self, Score, Scores};
 use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::scene::Mode;
@@ -32,6 +33,10 @@ pub struct BlockRow {
     pub thrower: Option<String>,
     /// Counts of length, breadth and width vertical, if measured.
     pub counts: Option<[u64; 3]>,
+    /// The outcomes a counts file's row counts apart (indices into `counts`; a `-` merges an
+    /// outcome into a congruent one); `None`: every outcome the mode has, apart.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub groups: Option<Vec<Vec<usize>>>,
 }
 
 /// Reliability round 5, class J: a column a blocks file does not know (face counts among
@@ -132,6 +137,7 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<BlockRow>> {
             surface: optional("surface"),
             thrower: optional("thrower"),
             counts,
+            groups: None,
         };
         if row.label.is_empty() || rows.iter().any(|r| r.label == row.label) {
             return Err(bad(
@@ -165,6 +171,7 @@ fn from_counts(r: DataRow, name: &str) -> Result<BlockRow> {
         surface: Some(r.surface),
         thrower: (r.thrower != "all").then_some(r.thrower),
         counts: Some(counts),
+        groups: Some(r.groups),
     })
 }
 
@@ -195,6 +202,10 @@ pub struct PredictedRow {
     pub chi2: Option<f64>,
     /// Its degrees of freedom: the outcomes counted less one.
     pub dof: Option<usize>,
+    /// The proper scores of the prediction against the counts, beside its baselines'
+    /// ([`crate::calibration::proper`]); left out where the row was not measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scores: Option<Scores>,
 }
 
 /// Every block's prediction, with the held-out test over the measured ones.
@@ -208,6 +219,9 @@ pub struct Predictions {
     pub dof: Option<usize>,
     /// P(χ²_dof ≥ χ²).
     pub p_value: Option<f64>,
+    /// The measured rows' proper scores summed, beside the baselines'.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scores: Option<Scores>,
     /// The fit predicted from.
     pub fit: String,
     /// The command line that made it.
@@ -225,6 +239,7 @@ pub fn test(row: &BlockRow, p: BlockPrediction) -> PredictedRow {
             z: None,
             chi2: None,
             dof: None,
+            scores: None,
         };
     };
     let (b, w) = (c[1] as f64, c[2] as f64);
@@ -242,21 +257,22 @@ pub fn test(row: &BlockRow, p: BlockPrediction) -> PredictedRow {
     let z = measured_ratio
         .zip(p.ratio)
         .map(|(m, r)| stats::z_score(m.value, m.err, r.value, r.err));
-    // The outcomes a row counts: a 2D block cannot stand on its end.
-    let live: Vec<usize> = match row.mode {
-        Mode::ThreeD => vec![0, 1, 2],
-        Mode::TwoD => vec![1, 2],
-    };
-    let n: f64 = live.iter().map(|&k| c[k] as f64).sum();
-    let norm: f64 = live.iter().map(|&k| p.p[k].value).sum();
+    let scores = Some(Scores {
+        prediction: score_against(row, &p.p, phi),
+        ..Scores::default()
+    });
+    let (counts, values, sigma) = cells(row, &p.p).unwrap_or_default();
+    let n: f64 = counts.iter().map(|&k| k as f64).sum();
+    let norm: f64 = values.iter().sum();
     let chi2 = (n > 0.0 && norm > 0.0).then(|| {
-        live.iter()
-            .map(|&k| {
-                let q = p.p[k].value / norm;
-                let s = p.p[k].err / norm;
+        counts
+            .iter()
+            .zip(values.iter().zip(&sigma))
+            .map(|(&k, (&v, &e))| {
+                let (q, s) = (v / norm, e / norm);
                 let var = phi * n * q + n * n * s * s;
                 if var > 0.0 {
-                    (c[k] as f64 - n * q).powi(2) / var
+                    (k as f64 - n * q).powi(2) / var
                 } else {
                     0.0
                 }
@@ -270,8 +286,56 @@ pub fn test(row: &BlockRow, p: BlockPrediction) -> PredictedRow {
         measured_ratio,
         z,
         chi2,
-        dof: chi2.map(|_| live.len() - 1),
+        dof: chi2.map(|_| counts.len() - 1),
+        scores,
     }
+}
+
+/// The outcomes a block's row counts: a 2D block cannot stand on its end.
+fn live(mode: Mode) -> Vec<usize> {
+    match mode {
+        Mode::ThreeD => vec![0, 1, 2],
+        Mode::TwoD => vec![1, 2],
+    }
+}
+
+/// The cells a measured row counts apart: its counts, and `p`'s values and errors (length,
+/// breadth, width vertical) summed over each (errors in quadrature): a counts file's groups (a
+/// `-` merges two congruent outcomes), else the mode's outcomes (a 2D block cannot stand on
+/// its end). `None` unmeasured.
+fn cells(row: &BlockRow, p: &[Predicted]) -> Option<Cells> {
+    let c = row.counts?;
+    let groups: Vec<Vec<usize>> = row
+        .groups
+        .clone()
+        .unwrap_or_else(|| live(row.mode).into_iter().map(|k| vec![k]).collect());
+    let of = |g: &Vec<usize>, f: &dyn Fn(&Predicted) -> f64| {
+        g.iter().map(|&k| p.get(k).map_or(f64::NAN, f)).sum::<f64>()
+    };
+    Some((
+        groups
+            .iter()
+            .map(|g| g.iter().map(|&k| c[k]).sum())
+            .collect(),
+        groups.iter().map(|g| of(g, &|q| q.value)).collect(),
+        groups
+            .iter()
+            .map(|g| of(g, &|q| q.err * q.err).sqrt())
+            .collect(),
+    ))
+}
+
+/// A row's cells: counts, predicted values, their errors.
+type Cells = (Vec<u64>, Vec<f64>, Vec<f64>);
+
+/// The proper scores of `p` (length, breadth, width vertical) against `row`'s counts, from a
+/// fit of overdispersion `phi`; `None` where the row was not measured or `p` lacks an outcome.
+pub fn score_against(row: &BlockRow, p: &[Predicted], phi: f64) -> Option<Score> {
+    let (counts, values, sigma) = cells(row, p)?;
+    let usable = counts.iter().sum::<u64>() > 0
+        && values.iter().all(|v| v.is_finite())
+        && values.iter().sum::<f64>() > 0.0;
+    usable.then(|| proper::score(&counts, &values, &sigma, phi))
 }
 
 /// The rows' predictions, with the χ² of the measured ones.
@@ -283,11 +347,14 @@ pub fn collect(rows: Vec<PredictedRow>, fit: String, command_line: String) -> Pr
         .zip(dof)
         .filter(|(_, d)| *d > 0)
         .map(|(c, d)| stats::chi_square_p_value(c, d));
+    let scored: Vec<&Scores> = tested.iter().filter_map(|r| r.scores.as_ref()).collect();
+    let scores = (!scored.is_empty()).then(|| Scores::total(&scored));
     Predictions {
         rows,
         chi2,
         dof,
         p_value,
+        scores,
         fit,
         command_line,
     }
@@ -386,6 +453,8 @@ mod tests {
             extrapolation: None,
             overdispersion: 1.0,
             discrepancy: None,
+            other_die: None,
+            tests: Vec::new(),
         };
         let row = BlockRow {
             label: "a".into(),
@@ -394,6 +463,7 @@ mod tests {
             surface: None,
             thrower: None,
             counts: Some([0, 250, 750]),
+            groups: None,
         };
         let same = test(&row, pred(0.25));
         assert!(same.chi2.unwrap() < 1e-12 && same.z.unwrap().abs() < 1e-12);

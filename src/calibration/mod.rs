@@ -29,9 +29,11 @@ pub mod design;
 pub mod discrepancy;
 pub mod estimate;
 pub mod heldout;
+pub mod other_die;
 pub mod paper;
 pub mod params;
 pub mod predict;
+pub mod proper;
 pub mod recovery;
 pub mod request;
 pub mod scores;
@@ -284,6 +286,10 @@ pub struct FitResult {
     /// fewer than three rows were scored).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub discrepancy: Option<discrepancy::Discrepancy>,
+    /// The leave-one-out rows' proper scores summed, beside the baselines' (each row's are in
+    /// `loo[].scores`); left out where there are none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub loo_scores: Option<proper::Scores>,
     /// What it cost.
     pub cost: FitCost,
     /// The command line that made it.

@@ -107,6 +107,13 @@ pub struct BlockPrediction {
     /// (each share's `err_model`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub discrepancy: Option<Discrepancy>,
+    /// Another die than the fit's, predicted: what it is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub other_die: Option<String>,
+    /// Each row of counts given (`--counts`), the prediction scored against it beside the
+    /// baselines.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub tests: Vec<crate::calibration::proper::CountsTest>,
 }
 
 impl BlockPrediction {
@@ -192,6 +199,13 @@ pub struct PredictConfig {
     pub rolls: u64,
     /// The throws' seed.
     pub seed: u64,
+    /// Another die than the fit's, thrown by the same hand on the same table; `None`: the
+    /// fit's own die (a fit of blocks: `block`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub other: Option<Box<crate::calibration::other_die::OtherDie>>,
+    /// Counts of the die predicted, to score the prediction against (`fit --data`'s rows).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub counts: Vec<crate::calibration::data::DataRow>,
 }
 
 /// The block a prediction from `fit` simulates where none is given: a fit of a die of any

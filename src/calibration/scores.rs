@@ -113,6 +113,10 @@ pub struct LooRow {
     /// that simulate the row in 2D and in 3D).
     #[serde(deserialize_with = "nan_if_null")]
     pub side_log_score: f64,
+    /// The proper scores of its prediction beside the baselines' ([`crate::calibration::
+    /// proper`]); left out in a fit.json written before them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scores: Option<crate::calibration::proper::Scores>,
 }
 
 /// A number JSON wrote as null (NaN, or an infinity), read back as NaN.

@@ -142,6 +142,17 @@ pub struct PredictArgs {
     /// μ fixed: a die whose weight a fit found on one surface, predicted on another.
     #[arg(long, value_name = "E,MU", conflicts_with_all = ["surface", "blocks"], value_parser = parse_contact)]
     pub contact: Option<[f64; 2]>,
+    /// Another die than the fit's, thrown by the same hand on the same table: --shape NAME or
+    /// --die FILE (a mesh or a die file, as `roll` takes it), or --block from a fit of a die of
+    /// any shape; the fit's surface and throw, the die's own geometry and mass.
+    #[command(flatten)]
+    pub other: super::args::DieArgs,
+    /// Counts of the die predicted (`fit --data`'s format: a block's sides, a cube's faces or a
+    /// die of any shape's face_<label> columns): the prediction is scored against each row
+    /// (log predictive density, Σz² and coverage, sharpness) beside the uncalibrated default
+    /// scene and the quasi-static theory.
+    #[arg(long, value_name = "COUNTS.csv", conflicts_with = "blocks")]
+    pub counts: Option<PathBuf>,
     /// Posterior draws to simulate the block at.
     #[arg(long, default_value_t = dicephys::calibration::predict::DEFAULT_DRAWS)]
     pub draws: usize,
@@ -326,15 +337,33 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
     if let Some(file) = &a.blocks {
         return predict_blocks(a, fit, file);
     }
-    let block = match (a.block, dicephys::calibration::predict::own_block(&fit)) {
-        (Some(b), _) | (None, Some(b)) => b,
-        (None, None) => {
+    let other = other_die(a, &fit)?;
+    let block = match (
+        a.block,
+        dicephys::calibration::predict::own_block(&fit),
+        &other,
+    ) {
+        (Some(b), _, _) | (None, Some(b), _) => b,
+        (None, None, Some(o)) if o.shape.is_some() => o.block(Block::from_mm(16.0, 16.0, 16.0)?),
+        (None, None, _) => {
             return Err(Error::Usage(
                 "give --block (the block to predict) or --blocks-file (a file of them)".into(),
             ))
         }
     };
+    let block = other.as_ref().map_or(block, |o| o.block(block));
+    let counts = match &a.counts {
+        Some(path) => counts_of(
+            path,
+            other
+                .as_ref()
+                .map_or(fit.config.method.shape.as_deref(), |o| o.shape.as_deref()),
+        )?,
+        None => Vec::new(),
+    };
     let cfg = PredictConfig {
+        other: other.map(Box::new),
+        counts,
         block,
         mode: if a.two_d { Mode::TwoD } else { Mode::ThreeD },
         surface: a.surface.clone(),
@@ -355,6 +384,43 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
         command_line: super::term::command_line(),
     };
     super::study::run(&cfg, &place)
+}
+
+/// The die `predict` throws in place of the fit's: --shape or --die (or another flag of the
+/// die), or --block from a fit of a die of any shape; `None`: the fit's own.
+fn other_die(
+    a: &PredictArgs,
+    fit: &FitResult,
+) -> Result<Option<dicephys::calibration::other_die::OtherDie>> {
+    let d = &a.other;
+    let described = d.shape.is_some()
+        || d.die.is_some()
+        || d.com.is_some()
+        || d.pips.is_some()
+        || d.edge_radius.is_some()
+        || d.density.is_some();
+    let block_of_shape_fit = a.block.is_some() && fit.config.method.shape.is_some();
+    if !described && !block_of_shape_fit {
+        return Ok(None);
+    }
+    dicephys::calibration::other_die::OtherDie::resolve(&d.request(a.block, None))
+        .map(Some)
+        .map_err(|e| d.named(e))
+}
+
+/// `--counts`: the rows of a counts file, read against the die of any shape predicted.
+fn counts_of(
+    path: &std::path::Path,
+    shape: Option<&dicephys::model::shape::Shape>,
+) -> Result<Vec<data::DataRow>> {
+    let rows = data::read(path, super::term::stop()).map_err(|e| match e {
+        dicephys::Error::Stopped => Error::Interrupted(nothing_read()),
+        e => Error::Usage(format!("--counts {e}")),
+    })?;
+    match shape {
+        Some(s) => data::on_shape(&rows, s).map_err(|e| Error::Usage(format!("--counts {e}"))),
+        None => Ok(rows),
+    }
 }
 
 /// Runs `dicephys predict --blocks-file`.

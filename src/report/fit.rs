@@ -543,6 +543,32 @@ fn left_out(res: &FitResult) -> String {
                 .into()
         })
     );
+    s += &loo_scores_text(res);
+    s
+}
+
+/// The leave-one-out rows' proper scores, each row's and in total, beside the baselines'.
+fn loo_scores_text(res: &FitResult) -> String {
+    let Some(total) = &res.loo_scores else {
+        return String::new();
+    };
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "\n### Proper scores of the rows predicted without themselves\n\nEach row's log \
+         predictive density (a Dirichlet-multinomial whose mean is the prediction and whose \
+         scatter its error's), Σz² and the outcomes within 1σ and 2σ, and the mean predicted σ \
+         against the counts' own; with the discrepancy a row's prediction takes from the other \
+         rows' misses, and without; beside the uncalibrated default scene (the fit's fixed \
+         values, {} rolls a row) and the quasi-static theory where it applies.\n",
+        res.config.design.rolls * crate::studies::fit::baseline::LOO_BASELINE_POINTS
+    );
+    for r in &res.loo {
+        if let Some(sc) = &r.scores {
+            let _ = writeln!(s, "{}:\n\n{}", r.label, sc.lines("- "));
+        }
+    }
+    let _ = writeln!(s, "All rows:\n\n{}", total.lines("- "));
     s
 }
 
@@ -788,6 +814,28 @@ pub fn prediction_text(p: &BlockPrediction) -> String {
             "  the fit misses rows it did not see beyond their errors: each share moved along \
              its discrepancy's line on the log-odds and widened by it ({})",
             lines.join("; ")
+        );
+    }
+    if let Some(o) = &p.other_die {
+        let _ = writeln!(
+            s,
+            "  another die than the fit's ({o}): the fit's surface and throw, its own geometry and \
+             mass"
+        );
+    }
+    for t in &p.tests {
+        let counts: Vec<String> = t
+            .outcomes
+            .iter()
+            .zip(&t.counts)
+            .map(|(o, c)| format!("{o} {c}"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "  against the counts of {} ({}):\n{}",
+            t.label,
+            counts.join(", "),
+            t.scores.lines("    ")
         );
     }
     s
@@ -1163,6 +1211,7 @@ pub fn predictions_markdown(p: &crate::calibration::heldout::Predictions, stem: 
             p.p_value.map_or(String::new(), |v| format!(", p = {v:.3}"))
         );
     }
+    scores_section(&mut s, p);
     if let Some(phi) = p
         .rows
         .first()
@@ -1200,6 +1249,26 @@ pub fn predictions_markdown(p: &crate::calibration::heldout::Predictions, stem: 
     }
     let _ = writeln!(s, "\n![{stem}]({stem}.svg)");
     s
+}
+
+/// The proper scores of the measured rows, each row's and in total, beside the baselines'
+/// (`calibration::proper`).
+fn scores_section(s: &mut String, p: &crate::calibration::heldout::Predictions) {
+    let Some(total) = &p.scores else { return };
+    let _ = writeln!(
+        s,
+        "\n## Proper scores\n\nThe log predictive density of the counts (a Dirichlet-multinomial \
+         whose mean is the prediction and whose scatter is its error's and the fit's \
+         overdispersion's), Σz² with its degrees of freedom and the outcomes within 1σ and 2σ \
+         (calibration), and the mean predicted σ against the counts' own (sharpness), beside \
+         the uncalibrated default scene and the quasi-static theory where it applies.\n"
+    );
+    for r in &p.rows {
+        if let Some(sc) = &r.scores {
+            let _ = writeln!(s, "{}:\n\n{}", r.label, sc.lines("- "));
+        }
+    }
+    let _ = writeln!(s, "All measured rows:\n\n{}", total.lines("- "));
 }
 
 /// A prediction as a table cell: value ± whole error.

@@ -2,6 +2,7 @@
 //! block simulated over its design, the data simulated at a known truth for the recovery
 //! check, and a new block simulated at the fit's posterior draws.
 
+pub mod baseline;
 pub mod check;
 pub mod outputs;
 pub mod predict;
@@ -136,6 +137,7 @@ pub fn result(f: Fitted, command_line: &str, wall: Instant, cpu: f64) -> FitResu
     FitResult {
         loo: Vec::new(),
         discrepancy: None,
+        loo_scores: None,
         cost: FitCost {
             rolls: f.rolls,
             unsettled: f.unsettled,
@@ -562,14 +564,25 @@ pub fn run(
     let Some(f) = study.fit(runner, dir)? else {
         return Ok(None);
     };
-    let loo = match study.stage {
+    let mut loo = match study.stage {
         Stage::First => Vec::new(),
         _ => rows_without_themselves(&f, runner)?,
     };
     let discrepancy = Discrepancy::estimate(&loo, f.estimate.overdispersion);
+    let phi = f.estimate.overdispersion;
+    // The baselines roll on this process's own cores (a cluster's finishing job included).
+    let loo_scores = if loo.is_empty() {
+        None
+    } else {
+        match baseline::score_loo(&f.config, phi, &mut loo, &own_rolls(runner))? {
+            Some(s) => Some(s),
+            None => return Ok(None),
+        }
+    };
     Ok(Some(FitResult {
         loo,
         discrepancy,
+        loo_scores,
         ..result(f, &command_line, wall, cpu)
     }))
 }

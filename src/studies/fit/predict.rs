@@ -2,7 +2,8 @@
 
 use crate::calibration::data::DataRow;
 use crate::calibration::design::point_seed;
-use crate::calibration::params::Kind;
+use crate::calibration::heldout;
+use crate::calibration::params::{Kind, Method};
 use crate::calibration::predict::{group, BlockPrediction, PredictConfig, Predicted};
 use crate::calibration::FitResult;
 use crate::error::{Error, Field, Result};
@@ -32,7 +33,16 @@ pub fn check(fit: &FitResult, cfg: &PredictConfig) -> Result<()> {
     }
     group(fit, true, &cfg.surface, "surface")?;
     group(fit, false, &cfg.thrower, "thrower")?;
-    if let Some(s) = &fit.config.method.shape {
+    if let Some(other) = &cfg.other {
+        other.check(fit)?;
+        if other.shape.is_some() && cfg.mode != crate::model::scene::Mode::ThreeD {
+            return Err(Error::field(
+                Field::Shape,
+                other.name(cfg.block),
+                "a die of any shape is predicted in 3D",
+            ));
+        }
+    } else if let Some(s) = &fit.config.method.shape {
         let own = fit.config.rows[0].block;
         if cfg.block != own || cfg.mode != crate::model::scene::Mode::ThreeD {
             return Err(Error::field(
@@ -98,17 +108,25 @@ pub fn extrapolation(fit: &FitResult, block: &crate::model::block::Block) -> Opt
 }
 
 /// True if a prediction gives the faces too: of a made die, a fit of faces or a die of any
-/// shape, in 3D.
-fn predicts_faces(fit: &FitResult, cfg: &PredictConfig) -> bool {
-    let method = &fit.config.method;
+/// shape, in 3D (`method` the prediction's: the fit's, or another die's).
+fn predicts_faces(fit: &FitResult, cfg: &PredictConfig, method: &Method) -> bool {
+    let faces_fit = cfg.other.is_none()
+        && fit
+            .config
+            .rows
+            .iter()
+            .any(|r| r.outcomes == crate::calibration::data::Outcomes::Faces);
     cfg.mode == crate::model::scene::Mode::ThreeD
-        && (!method.die.is_default()
-            || method.shape.is_some()
-            || fit
-                .config
-                .rows
-                .iter()
-                .any(|r| r.outcomes == crate::calibration::data::Outcomes::Faces))
+        && (!method.die.is_default() || method.shape.is_some() || faces_fit)
+}
+
+/// How the prediction throws: the fit's method, or the fit's with another die in place of its
+/// own.
+pub fn method_of(fit: &FitResult, cfg: &PredictConfig) -> Method {
+    match &cfg.other {
+        Some(o) => o.method(&fit.config.method),
+        None => fit.config.method.clone(),
+    }
 }
 
 /// Rolls that did not settle, `what` of them, and what to change.
@@ -122,9 +140,30 @@ fn unsettled_error(what: String) -> Error {
     ])
 }
 
-/// Simulates `cfg.block` (or the fit's die of any shape) at posterior draws of `fit`. `None`
-/// if stopped early.
+/// Simulates `cfg.block` (or the fit's die of any shape) at posterior draws of `fit`, with
+/// the fit's discrepancy where it has one. `None` if stopped early.
 pub fn predict_block(
+    fit: &FitResult,
+    cfg: &PredictConfig,
+    runner: &Runner,
+    dir: Option<&Path>,
+) -> Result<Option<BlockPrediction>> {
+    let Some(own) = fit_prediction(fit, cfg, runner, dir)? else {
+        return Ok(None);
+    };
+    let p = own.clone().widened(fit.discrepancy.as_ref());
+    if cfg.counts.is_empty() {
+        return Ok(Some(p));
+    }
+    let method = method_of(fit, cfg);
+    let Some(tests) = super::baseline::test_counts(fit, cfg, &method, (&own, &p), runner)? else {
+        return Ok(None);
+    };
+    Ok(Some(BlockPrediction { tests, ..p }))
+}
+
+/// [`predict_block`] without the fit's discrepancy: the fit's own prediction.
+fn fit_prediction(
     fit: &FitResult,
     cfg: &PredictConfig,
     runner: &Runner,
@@ -133,9 +172,9 @@ pub fn predict_block(
     check(fit, cfg)?;
     let surface = group(fit, true, &cfg.surface, "surface")?;
     let thrower = group(fit, false, &cfg.thrower, "thrower")?;
-    let method = &fit.config.method;
+    let method = &method_of(fit, cfg);
     let shape = method.shape.as_deref();
-    let with_faces = predicts_faces(fit, cfg);
+    let with_faces = predicts_faces(fit, cfg, method);
     let mut freq: [Vec<f64>; 3] = Default::default();
     let mut face_freq: Vec<Vec<f64>> = vec![Vec::new(); super::simulate::face_count(method)];
     let mut ratios = Vec::new();
@@ -197,40 +236,38 @@ pub fn predict_block(
             q * (1.0 - q) / n / (1.0 - q).powi(4)
         })
     });
-    Ok(Some(
-        BlockPrediction {
-            block: cfg.block,
-            mode: cfg.mode,
-            shape: shape.map(|s| s.name.clone()),
-            // A surface given by its e and μ is named by them.
-            surface: match cfg.contact {
-                Some([e, mu]) => format!("e {e}, μ {mu}"),
-                None => surface,
-            },
-            thrower,
-            p: freq
-                .iter()
-                .filter(|v| !v.is_empty())
-                .map(|v| combine(v, &binomial))
-                .collect(),
-            ratio,
-            labels: face_labels(shape, with_faces),
-            faces,
-            theory_ratio: shape
-                .is_none()
-                .then(|| crate::theory::ratio_from_r(cfg.block.r())),
-            draws: cfg.draws,
-            rolls: cfg.rolls,
-            unsettled,
-            overdispersion: fit.estimate.overdispersion,
-            discrepancy: None,
-            extrapolation: shape
-                .is_none()
-                .then(|| extrapolation(fit, &cfg.block))
-                .flatten(),
-        }
-        .widened(fit.discrepancy.as_ref()),
-    ))
+    Ok(Some(BlockPrediction {
+        block: cfg.block,
+        mode: cfg.mode,
+        shape: shape.map(|s| s.name.clone()),
+        // A surface given by its e and μ is named by them.
+        surface: match cfg.contact {
+            Some([e, mu]) => format!("e {e}, μ {mu}"),
+            None => surface,
+        },
+        thrower,
+        p: freq
+            .iter()
+            .filter(|v| !v.is_empty())
+            .map(|v| combine(v, &binomial))
+            .collect(),
+        ratio,
+        labels: face_labels(shape, with_faces),
+        faces,
+        theory_ratio: shape
+            .is_none()
+            .then(|| crate::theory::ratio_from_r(cfg.block.r())),
+        draws: cfg.draws,
+        rolls: cfg.rolls,
+        unsettled,
+        overdispersion: fit.estimate.overdispersion,
+        discrepancy: None,
+        extrapolation: (shape.is_none() && fit.config.method.shape.is_none())
+            .then(|| extrapolation(fit, &cfg.block))
+            .flatten(),
+        other_die: cfg.other.as_ref().map(|o| o.name(cfg.block)),
+        tests: Vec::new(),
+    }))
 }
 
 /// What a prediction's faces show: a die of any shape's labels, 1 to 6 for a cube's faces,
@@ -267,6 +304,7 @@ fn draw_specs(
     let model = &fit.config.model;
     let dims = model.row_dims(&fit.params, &row);
     let axes = model.axes(&fit.params, &dims);
+    let method = method_of(fit, cfg);
     let step = fit.estimate.draws.len() / cfg.draws;
     (0..cfg.draws)
         .map(|m| {
@@ -276,11 +314,11 @@ fn draw_specs(
             if let Some([e, mu]) = cfg.contact {
                 (values.e, values.mu) = (e, mu);
             }
+            if cfg.other.is_some() {
+                values = crate::calibration::other_die::without_die_params(values);
+            }
             let seed = point_seed(cfg.seed, cfg.block, cfg.mode, m);
-            let spec = fit
-                .config
-                .method
-                .spec(cfg.block, cfg.mode, &values, seed, cfg.rolls);
+            let spec = method.spec(cfg.block, cfg.mode, &values, seed, cfg.rolls);
             spec.validate(false)?;
             Ok(spec)
         })
@@ -322,6 +360,8 @@ fn block_config(
         draws,
         rolls,
         seed,
+        other: None,
+        counts: Vec::new(),
     }
 }
 
@@ -358,16 +398,61 @@ pub fn predict_blocks(
     for (i, r) in rows.iter().enumerate() {
         let base = i as u64 * per_row;
         let progress = |n| (runner.progress)(base + n);
-        let Some(p) = predict_block(fit, &cfg(r), &runner.with_progress(&progress), None).map_err(
-            |e| match e {
-                Error::Failed(m) => Error::Failed(m.after(&format!("row '{}': ", r.label))),
-                e => e,
-            },
-        )?
-        else {
+        let in_row = |e| match e {
+            Error::Failed(m) => Error::Failed(m.after(&format!("row '{}': ", r.label))),
+            e => e,
+        };
+        let runner = runner.with_progress(&progress);
+        let Some(own) = fit_prediction(fit, &cfg(r), &runner, None).map_err(in_row)? else {
             return Ok(None);
         };
-        out.push(crate::calibration::heldout::test(r, p));
+        let p = own.clone().widened(fit.discrepancy.as_ref());
+        let mut tested = crate::calibration::heldout::test(r, p);
+        if let Some(scores) = tested.scores.as_mut() {
+            if fit.discrepancy.as_ref().is_some_and(|d| d.any()) {
+                scores.without_discrepancy =
+                    heldout::score_against(r, &own.p, fit.estimate.overdispersion);
+            }
+            let Some((scene, theory)) = baselines(fit, &cfg(r), &runner).map_err(in_row)? else {
+                return Ok(None);
+            };
+            scores.default_scene = heldout::score_against(r, &scene, 1.0);
+            scores.quasi_static = theory.and_then(|q| heldout::score_against(r, &q, 1.0));
+        }
+        out.push(tested);
     }
     Ok(Some(out))
+}
+
+/// Rolls of the uncalibrated default scene, per prediction's roll of one draw: enough that its
+/// own simulation error is well under the counts'.
+pub const BASELINE_ROLLS_PER_DRAW_ROLLS: u64 = 4;
+
+/// The default scene's shares and the quasi-static theory's, where it applies.
+type Baselines = (Vec<Predicted>, Option<Vec<Predicted>>);
+
+/// The baselines of `cfg`'s block ([`super::baseline`]): the default scene (the fit's fixed
+/// values, its error the simulation's alone) and the quasi-static theory (3D), each as
+/// P(length), P(breadth), P(width) vertical. `None` if stopped early.
+pub fn baselines(
+    fit: &FitResult,
+    cfg: &PredictConfig,
+    runner: &Runner,
+) -> Result<Option<Baselines>> {
+    let (method, fixed) = (&fit.config.method, &fit.config.model.fixed);
+    let at = (cfg.block, cfg.mode, false);
+    let rolls = cfg.rolls * BASELINE_ROLLS_PER_DRAW_ROLLS;
+    let Some((shares, settled)) =
+        super::baseline::shares_at(method, fixed, at, cfg.seed, rolls, runner)?
+    else {
+        return Ok(None);
+    };
+    let n = settled.max(1) as f64;
+    let scene = shares
+        .iter()
+        .map(|&q| Predicted::of(&[q], q * (1.0 - q) / n))
+        .collect();
+    let theory = super::baseline::quasi_static(method, fixed, at)
+        .map(|q| q.iter().map(|&v| Predicted::of(&[v], 0.0)).collect());
+    Ok(Some((scene, theory)))
 }
