@@ -22,16 +22,6 @@ use serde::{Deserialize, Serialize};
 
 pub use crate::calibration::scores::{EndCount, LooRow};
 
-fn ln_choose(counts: &[u64]) -> f64 {
-    use statrs::function::gamma::ln_gamma;
-    let n: u64 = counts.iter().sum();
-    ln_gamma(n as f64 + 1.0)
-        - counts
-            .iter()
-            .map(|&k| ln_gamma(k as f64 + 1.0))
-            .sum::<f64>()
-}
-
 fn log_mean_exp(v: &[f64]) -> f64 {
     let m = v.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
     if !m.is_finite() {
@@ -111,7 +101,7 @@ pub fn score_row(lik: &Likelihood, r: usize, draws: &[Vec<f64>]) -> LooRow {
         .iter()
         .map(|pr| ln_dirichlet_multinomial(&counts, &pr.p, pr.c))
         .collect();
-    let log_score = log_mean_exp(&scores) + ln_choose(&counts);
+    let log_score = log_mean_exp(&scores) + crate::calibration::proper::ln_coefficient(&counts);
     let side_log_score = match b.zip(w) {
         Some((b, w)) => {
             let side = [counts[b], counts[w]];
@@ -122,7 +112,7 @@ pub fn score_row(lik: &Likelihood, r: usize, draws: &[Vec<f64>]) -> LooRow {
                     ln_dirichlet_multinomial(&side, &[pr.p[b] / t, pr.p[w] / t], pr.c)
                 })
                 .collect();
-            log_mean_exp(&s) + ln_choose(&side)
+            log_mean_exp(&s) + crate::calibration::proper::ln_coefficient(&side)
         }
         None => f64::NAN,
     };

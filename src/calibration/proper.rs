@@ -61,8 +61,8 @@ pub struct Score {
     pub sharpness: f64,
 }
 
-/// ln Γ(N + 1) − Σ ln Γ(n_k + 1).
-fn ln_coefficient(counts: &[u64]) -> f64 {
+/// ln Γ(N + 1) − Σ ln Γ(n_k + 1): the multinomial coefficient of `counts`, ln.
+pub(crate) fn ln_coefficient(counts: &[u64]) -> f64 {
     let n: u64 = counts.iter().sum();
     ln_gamma(n as f64 + 1.0)
         - counts

@@ -116,16 +116,7 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     // The step cap `roll` takes for the same die: a die of any shape's unless asked (a coin
     // on its edge on a floor without rolling resistance rolls for ever, and traced to
     // DicePhys's 20,000,000 steps it wrote gigabytes; issue 69.10).
-    let cap = EndRequest {
-        max_steps: a.max_steps.asked(),
-        ..EndRequest::default()
-    }
-    .cap(&scene);
-    let settle = RollConfig {
-        max_steps: cap,
-        fast_flight: a.flight == FlightArg::Fast,
-        ..RollConfig::default()
-    };
+    let settle = settle(a, &scene);
     let record = roll_observed(engine.as_mut(), &scene, &throw, &settle, |step, s| {
         // A roll cannot be stopped from its observer: a stop request ends the process here,
         // the rows so far written, as every command stops (exit 130).
@@ -161,8 +152,24 @@ pub fn run(a: &TraceArgs) -> Result<()> {
         ended.up = die.outcome(&s).1;
     }
     eprintln!("{}", trace::ending(index, &throw, &ended, &labels));
-    if let Some(note) = trace::capped(&record, cap, a.max_steps.asked().is_some()) {
+    if let Some(note) = trace::capped(&record, settle.max_steps, a.max_steps.asked().is_some()) {
         eprintln!("dicephys: {note}");
     }
     Ok(())
+}
+
+/// How a traced roll ends: at `roll`'s step cap for the same die unless one is asked (a coin
+/// on its edge on a floor without rolling resistance rolls for ever, and traced to DicePhys's
+/// 20,000,000 steps it wrote gigabytes; issue 69.10), its flight as asked. The HTML page's
+/// trace too (`trace_html`).
+pub fn settle(a: &TraceArgs, scene: &dicephys::model::scene::Scene) -> RollConfig {
+    RollConfig {
+        max_steps: EndRequest {
+            max_steps: a.max_steps.asked(),
+            ..EndRequest::default()
+        }
+        .cap(scene),
+        fast_flight: a.flight == FlightArg::Fast,
+        ..RollConfig::default()
+    }
 }

@@ -2,7 +2,6 @@
 //! (with the early stop audited: when it would have fired, without stopping), written as one
 //! page that plays them (`report::view`). Each throw's ending line goes to stderr as `trace`'s.
 
-use super::args::FlightArg;
 use super::error::{Error, Result};
 use super::trace::TraceArgs;
 use dicephys::engine::new_engine;
@@ -10,7 +9,6 @@ use dicephys::model::block::Outcome;
 use dicephys::model::die::DieShape;
 use dicephys::report::trace;
 use dicephys::report::view::{self, DieView, Recorder, ThrowView};
-use dicephys::run::request::EndRequest;
 use dicephys::sim::roll::{roll_observed, Fate, RollConfig, RollRecord};
 
 pub fn run(a: &TraceArgs) -> Result<()> {
@@ -26,16 +24,9 @@ pub fn run(a: &TraceArgs) -> Result<()> {
         .throw
         .spec_or(dicephys::model::throws::ThrowStyle::default_for(&scene))?;
     let throws = throw_spec.source(a.index.last + 1);
-    let cap = EndRequest {
-        max_steps: a.max_steps.asked(),
-        ..EndRequest::default()
-    }
-    .cap(&scene);
     let settle = RollConfig {
-        max_steps: cap,
-        fast_flight: a.flight == FlightArg::Fast,
         audit: true,
-        ..RollConfig::default()
+        ..super::trace::settle(a, &scene)
     };
     let labels: Vec<String> = scene
         .shape
@@ -66,7 +57,8 @@ pub fn run(a: &TraceArgs) -> Result<()> {
         }
         let ending = trace::ending(index, &throw, &ended, &label_refs);
         eprintln!("{ending}");
-        if let Some(note) = trace::capped(&record, cap, a.max_steps.asked().is_some()) {
+        if let Some(note) = trace::capped(&record, settle.max_steps, a.max_steps.asked().is_some())
+        {
             eprintln!("dicephys: {note}");
         }
         views.push(ThrowView {

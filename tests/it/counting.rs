@@ -25,7 +25,7 @@ fn write(dir: &Path, name: &str, text: &str) -> String {
 }
 
 /// The labels `roll --json` counted, in the die's order, with their counts.
-fn counted(doc: &serde_json::Value) -> Vec<(String, u64)> {
+pub(super) fn counted(doc: &serde_json::Value) -> Vec<(String, u64)> {
     doc["shape"]["faces"]
         .as_array()
         .expect("a die of any shape's faces")

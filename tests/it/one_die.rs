@@ -5,19 +5,9 @@
 
 use super::helpers::{dicephys, json, scratch};
 
-/// The counts by face label of a die of any shape's `roll --json`.
+/// The counts by face label of a die of any shape's `roll --json`, sorted by label.
 fn by_label(doc: &serde_json::Value) -> Vec<(String, u64)> {
-    let mut v: Vec<(String, u64)> = doc["shape"]["faces"]
-        .as_array()
-        .expect("a die of any shape's faces")
-        .iter()
-        .map(|f| {
-            (
-                f["label"].as_str().unwrap().to_string(),
-                f["count"].as_u64().unwrap(),
-            )
-        })
-        .collect();
+    let mut v = super::counting::counted(doc);
     v.sort();
     v
 }
