@@ -87,6 +87,18 @@ impl FitConfig {
             )));
         }
         self.check_shape()?;
+        if self.model.is_free(params::Kind::Rolling)
+            && self.method.engine != crate::engine::EngineKind::Bullet
+        {
+            return Err(Error::field(
+                Field::Free,
+                "rolling",
+                format!(
+                    "{} has no rolling resistance: give --engine bullet",
+                    self.method.engine
+                ),
+            ));
+        }
         if self.model.is_free(params::Kind::PipDepth)
             && self
                 .method

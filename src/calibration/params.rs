@@ -16,7 +16,7 @@ use crate::engine::EngineKind;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::mass::Features;
-use crate::model::scene::{Mode, Scene};
+use crate::model::scene::{Mode, Scene, MAX_ROLLING_RESISTANCE};
 use crate::model::throws::{Range, ThrowRanges, ThrowStyle};
 use crate::run::spec::{RunSpec, ThrowSpec, MAX_KAPPA};
 use crate::sim::roll::{early_stop_exact, RollConfig, Rule};
@@ -46,6 +46,9 @@ pub enum Kind {
     E,
     /// The contact's coefficient of friction μ (per surface).
     Mu,
+    /// The contact's rolling resistance, mm: the lever arm of the floor's push against a die
+    /// rolling or turning on it (`Scene::rolling_resistance`; per surface; Bullet only).
+    Rolling,
     /// The hand's concentration κ (per thrower).
     Kappa,
     /// A factor on the paper's spin range, 31 to 160 rad/s (per thrower).
@@ -69,9 +72,10 @@ pub enum Kind {
 
 impl Kind {
     /// Every kind, in the order a row's coordinates take them.
-    pub const ALL: [Kind; 10] = [
+    pub const ALL: [Kind; 11] = [
         Kind::E,
         Kind::Mu,
+        Kind::Rolling,
         Kind::Kappa,
         Kind::Spin,
         Kind::Height,
@@ -82,16 +86,16 @@ impl Kind {
         Kind::PipDepth,
     ];
 
-    /// "e", "mu", "kappa", "spin", "height", "speed", "com_x", "com_y", "com_z" or
+    /// "e", "mu", "rolling", "kappa", "spin", "height", "speed", "com_x", "com_y", "com_z" or
     /// "pip_depth".
     pub fn name(self) -> &'static str {
         self.into()
     }
 
-    /// True for the surface's parameters (e, μ); false for the throw's (κ, spin, height,
-    /// speed).
+    /// True for the surface's parameters (e, μ, rolling resistance); false for the throw's
+    /// (κ, spin, height, speed).
     pub fn of_surface(self) -> bool {
-        matches!(self, Kind::E | Kind::Mu)
+        matches!(self, Kind::E | Kind::Mu | Kind::Rolling)
     }
 
     /// True for the die's parameters (its centre of mass, its pips' depth): one die, shared by
@@ -100,7 +104,8 @@ impl Kind {
         matches!(self, Kind::ComX | Kind::ComY | Kind::ComZ | Kind::PipDepth)
     }
 
-    /// The widest range accepted: e in [0, 1], μ in [0, 5], κ in [0, 10⁶], spin scale in
+    /// The widest range accepted: e in [0, 1], μ in [0, 5], a rolling resistance in [0, 1]
+    /// mm (`MAX_ROLLING_RESISTANCE`), κ in [0, 10⁶], spin scale in
     /// [0.05, 20], height scale in [0.05, 10] (a drop of 1 to 4 cm up to 2 to 4 m), speed scale
     /// in [0.05, 50] (up to ±10 m/s), a centre of mass within ±1000 mm (the die's own sides bound it further:
     /// checked with the die), a pip depth in [0.001, 100] mm.
@@ -108,6 +113,7 @@ impl Kind {
         match self {
             Kind::E => (0.0, 1.0),
             Kind::Mu => (0.0, 5.0),
+            Kind::Rolling => (0.0, MAX_ROLLING_RESISTANCE * 1e3),
             Kind::Kappa => (0.0, MAX_KAPPA),
             Kind::Spin => (0.05, 20.0),
             Kind::Height => (0.05, 10.0),
@@ -124,6 +130,10 @@ impl Kind {
         match self {
             Kind::E => Range::new(0.05, 0.8),
             Kind::Mu => Range::new(0.1, 1.0),
+            // None (0, the rigid contact of the paper's engines) to 1 mm, a die rolling on
+            // cloth: a rolling-resistance coefficient δ/r of 0.1 for a 16 mm die. A hard die on
+            // a hard table is nearer 0.01 mm (δ/r ≈ 10⁻³, steel on steel).
+            Kind::Rolling => Range::new(0.0, 1.0),
             Kind::Kappa => Range::new(0.0, 1e4),
             // A quarter to three times the paper's spin (31–160 rad/s): a fit of real throws
             // (steel blocks on one table, issue 49) ended on 0.5–2's upper end. Not four: at
@@ -145,7 +155,13 @@ impl Kind {
 
     fn warp(self, v: f64) -> f64 {
         match self {
-            Kind::E | Kind::Mu | Kind::ComX | Kind::ComY | Kind::ComZ | Kind::PipDepth => v,
+            Kind::E
+            | Kind::Mu
+            | Kind::Rolling
+            | Kind::ComX
+            | Kind::ComY
+            | Kind::ComZ
+            | Kind::PipDepth => v,
             Kind::Kappa => (1.0 + v).log10(),
             Kind::Spin | Kind::Height | Kind::Speed => v.ln(),
         }
@@ -153,7 +169,13 @@ impl Kind {
 
     fn unwarp(self, w: f64) -> f64 {
         match self {
-            Kind::E | Kind::Mu | Kind::ComX | Kind::ComY | Kind::ComZ | Kind::PipDepth => w,
+            Kind::E
+            | Kind::Mu
+            | Kind::Rolling
+            | Kind::ComX
+            | Kind::ComY
+            | Kind::ComZ
+            | Kind::PipDepth => w,
             Kind::Kappa => 10f64.powf(w) - 1.0,
             Kind::Spin | Kind::Height | Kind::Speed => w.exp(),
         }
@@ -187,6 +209,9 @@ pub enum FixedThrow {
     /// The tumble: a random orientation and spin axis (the throw of a die of any shape, which
     /// has no long axis for the paper's or a hand's throw to spin it about).
     Tumble,
+    /// A hand's toss (`ThrowStyle::Toss`): the tumble's directions, its magnitudes drawn with
+    /// scales (the spin, height and speed kinds scale them) rather than from uniform ranges.
+    Toss,
 }
 
 /// Values of the parameters that are not free.
@@ -196,6 +221,9 @@ pub struct Fixed {
     pub e: f64,
     /// μ.
     pub mu: f64,
+    /// The rolling resistance, mm (0: none, the paper's).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub rolling: f64,
     /// The throw.
     pub throw: FixedThrow,
     /// The spin scale.
@@ -219,6 +247,10 @@ fn unit() -> f64 {
     1.0
 }
 
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
 fn is_unit(v: &f64) -> bool {
     *v == 1.0
 }
@@ -233,6 +265,7 @@ impl Default for Fixed {
         Fixed {
             e: 0.5,
             mu: 0.29,
+            rolling: 0.0,
             throw: FixedThrow::Paper,
             spin: 1.0,
             height: 1.0,
@@ -279,6 +312,7 @@ pub fn values(fixed: &Fixed, axes: &[(Kind, Range)], x: &[f64]) -> Fixed {
         match kind {
             Kind::E => v.e = value,
             Kind::Mu => v.mu = value,
+            Kind::Rolling => v.rolling = value,
             Kind::Kappa => v.throw = FixedThrow::Hand(value),
             Kind::Spin => v.spin = value,
             Kind::Height => v.height = value,
@@ -357,6 +391,7 @@ impl ModelSpec {
         for (k, v) in [
             (Kind::E, f.e),
             (Kind::Mu, f.mu),
+            (Kind::Rolling, f.rolling),
             (Kind::Spin, f.spin),
             (Kind::Height, f.height),
             (Kind::Speed, f.speed),
@@ -540,6 +575,7 @@ impl Method {
         scene.dt = self.dt;
         scene.restitution = v.e;
         scene.friction = v.mu;
+        scene.rolling_resistance = v.rolling / 1000.0;
         scene.features = self.die_at(v);
         if let Some(d) = self.density {
             scene.density = d;
@@ -556,6 +592,7 @@ impl Method {
             FixedThrow::Paper => ThrowSpec::keyed(seed),
             FixedThrow::Hand(k) => ThrowSpec::hand(seed, k),
             FixedThrow::Tumble => ThrowSpec::keyed_style(seed, ThrowStyle::Tumble),
+            FixedThrow::Toss => ThrowSpec::keyed_style(seed, ThrowStyle::Toss),
         };
         let paper = ThrowRanges::default();
         let scaled = |r: Range, k: f64| Range::new(r.lo * k, r.hi * k);
@@ -618,6 +655,33 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("range of e"));
+    }
+
+    #[test]
+    fn rolling_resistance_is_the_surfaces_and_reaches_the_scene() {
+        // Issue 72: a contact that resists rolling, per surface like e and μ, in mm.
+        let rows = crate::calibration::data::paper_rows().unwrap();
+        let m = ModelSpec::free(&[Kind::E, Kind::Rolling]);
+        m.validate().unwrap();
+        let names: Vec<String> = m.params(&rows).iter().map(Param::name).collect();
+        assert!(names.contains(&"rolling[MDF]".to_string()), "{names:?}");
+        let axes = [(Kind::Rolling, Kind::Rolling.default_range())];
+        let v = values(&Fixed::default(), &axes, &[0.25]);
+        assert_eq!(v.rolling, 0.25);
+        let method = Method {
+            engine: EngineKind::Bullet,
+            dt: 1.0 / 1000.0,
+            max_steps: 1000,
+            die: Features::default(),
+            density: None,
+            shape: None,
+        };
+        let spec = method.spec(rows[0].block, rows[0].mode, &v, 1, 10);
+        assert!((spec.scene.rolling_resistance - 0.25e-3).abs() < 1e-18);
+        // Not free and not given: none, as before (the paper's scenes are unchanged).
+        let plain = method.spec(rows[0].block, rows[0].mode, &Fixed::default(), 1, 10);
+        assert_eq!(plain.scene.rolling_resistance, 0.0);
+        assert!(!serde_json::to_string(&Fixed::default()).unwrap().contains("rolling"));
     }
 
     #[test]

@@ -295,9 +295,12 @@ pub struct ThrowArgs {
     pub drop_height: Range,
     /// How the die is thrown: paper (length along z, spin about it, velocity along x), tumble
     /// (random orientation, spin axis uniform on the sphere, velocity in a random horizontal
-    /// direction; the ranges give the magnitudes), hand (between the two, by --kappa) or rest
+    /// direction; the ranges give the magnitudes), hand (between the two, by --kappa), rest
     /// (released at rest in a random orientation, its lowest corner touching the floor; no
-    /// range is used). [default: paper; `fair`: tumble]
+    /// range is used) or toss (a tumble whose magnitudes have scales, not ranges: the spin an
+    /// isotropic Gaussian of RMS the spin range's middle, the height above touching and the
+    /// speed half-normal, of mean the drop height's middle and RMS the velocity's larger end;
+    /// every range 0 is the rest). [default: paper; `fair`: tumble]
     #[arg(long = "throw", value_parser = parse_throw_style)]
     pub style: Option<ThrowStyle>,
     /// A hand's throw, with this concentration κ >= 0: the paper's throw turned by random

@@ -53,6 +53,12 @@ pub struct FitArgs {
     /// [default: the paper's throw].
     #[arg(long, value_name = "KAPPA", allow_hyphen_values = true)]
     pub kappa: Option<String>,
+    /// The throw where kappa is not free, by its style: paper, tumble or toss (a hand's toss:
+    /// the tumble's directions, its spin, height and speed drawn with scales, which the spin,
+    /// height and speed parameters multiply; `roll --throw toss`) [default: the paper's throw
+    /// for blocks, a tumble for a die of any shape]. A hand's throw is `--kappa K`.
+    #[arg(long, value_name = "STYLE", value_parser = ["paper", "tumble", "toss"])]
+    pub throw: Option<String>,
     /// The spin scale where spin is not free.
     #[arg(long, default_value_t = FitRequest::default().spin_scale, allow_hyphen_values = true)]
     pub spin_scale: f64,
@@ -240,8 +246,19 @@ impl FitArgs {
         })?;
         // `--kappa paper`, the paper's throw, was the spelling before --kappa meant only a
         // hand's κ; it is still read.
-        let throw = match self.kappa.as_deref() {
+        let style = match self.throw.as_deref() {
+            Some("paper") => Some(FixedThrow::Paper),
+            Some("tumble") => Some(FixedThrow::Tumble),
+            Some(_) => Some(FixedThrow::Toss),
             None => None,
+        };
+        let throw = match self.kappa.as_deref() {
+            None => style,
+            Some(k) if style.is_some() => {
+                return Err(Error::Usage(format!(
+                    "--kappa {k} with --throw: a hand's throw has its own style; give one of them"
+                )))
+            }
             Some("paper") => Some(FixedThrow::Paper),
             Some("tumble") => Some(FixedThrow::Tumble),
             Some(k) => Some(FixedThrow::Hand(k.parse().map_err(|_| {

@@ -187,10 +187,19 @@ pub enum ThrowStyle {
     /// Released at rest in a uniformly random orientation (in 2D, angle about z) with its
     /// lowest corner just touching the floor: the quasi-static limit. No range is used.
     Rest,
+    /// A hand's toss: a uniformly random orientation, its lowest point released a height
+    /// above the floor, moving along a random horizontal heading and spinning about a random
+    /// axis, each magnitude drawn from a distribution with a scale rather than from a uniform
+    /// range, so that gentle releases are as possible as hard ones ([`toss_magnitudes`]):
+    /// the spin vector an isotropic Gaussian whose root-mean-square magnitude is the middle of
+    /// the spin range (Maxwell-distributed magnitude); the height and the speed half-normal,
+    /// the height's mean the middle of the drop-height range, the speed's root mean square the
+    /// larger end of the velocity range. Every range 0 is the release at rest, throw for throw.
+    Toss,
 }
 
 impl ThrowStyle {
-    /// "paper", "tumble", "hand" or "rest".
+    /// "paper", "tumble", "hand", "rest" or "toss".
     pub fn name(self) -> &'static str {
         self.into()
     }
@@ -242,6 +251,8 @@ impl Throw {
     ///   (±v, 0, 0) by the sign of cos h, spin (0, 0, ±ω) by the sign of the axis's z.
     /// - Rest: the turn's orientation, at rest, its centre at the height where its lowest
     ///   corner (in 2D, edge) touches the floor's top face.
+    /// - Toss: the turn's orientation, its centre the drop height above where its lowest
+    ///   corner would touch the floor, velocity and spin as a tumble's.
     pub fn start(&self, scene: &Scene) -> BodyState {
         let paper = BodyState {
             position: Vector3::new(0.0, scene.drop_base() + self.drop_height, 0.0),
@@ -271,7 +282,7 @@ impl Throw {
                 angular_velocity: Vector3::new(0.0, 0.0, sign(sz) * self.spin),
                 ..paper
             },
-            (ThrowStyle::Rest, _) => {
+            (ThrowStyle::Rest | ThrowStyle::Toss, _) => {
                 let at_zero = BodyState {
                     position: Vector3::zeros(),
                     rotation,
@@ -282,9 +293,21 @@ impl Throw {
                 // In 2D the rotation is about z only, so the 1 m depth adds nothing here. The
                 // position is the centre of mass's (`DieShape::lowest_point`).
                 let touching = -crate::model::die::DieShape::of(scene).lowest_point(&at_zero);
-                BodyState {
+                let rest = BodyState {
                     position: Vector3::new(0.0, touching, 0.0),
                     ..at_zero
+                };
+                if self.style == ThrowStyle::Rest {
+                    return rest;
+                }
+                let tumble = Throw {
+                    style: ThrowStyle::Tumble,
+                    ..*self
+                }
+                .start(scene);
+                BodyState {
+                    position: Vector3::new(0.0, touching + self.drop_height, 0.0),
+                    ..tumble
                 }
             }
         }
@@ -466,7 +489,51 @@ pub fn keyed_styled(
                 heading: 0.0,
             }),
         },
+        ThrowStyle::Toss => {
+            // The orientation first, as a rest draws it, so that a toss with every scale 0 is
+            // the release at rest throw for throw.
+            let rotation = haar_quaternion(u(), u(), u());
+            let spin_axis = unit_vector(u(), u());
+            let heading = std::f64::consts::TAU * u();
+            let [drop_height, velocity, spin] =
+                toss_magnitudes(ranges, [u(), u(), u(), u(), u(), u()]);
+            Throw {
+                index,
+                drop_height,
+                velocity,
+                spin,
+                style,
+                turn: Some(Turn {
+                    rotation,
+                    spin_axis,
+                    heading,
+                }),
+            }
+        }
     }
+}
+
+/// A toss's height above touching, speed and spin magnitude from six uniform deviates (three
+/// Box–Muller pairs, five standard normals g₁…g₅): the height |g₁| h̄ √(π/2), whose mean is
+/// h̄, the middle of the drop-height range; the speed |g₂| v̄, whose root mean square is v̄, the
+/// larger end of the velocity range in magnitude; the spin ω̄ √((g₃² + g₄² + g₅²)/3), the
+/// magnitude of an isotropic Gaussian vector whose root mean square is ω̄, the middle of the
+/// spin range.
+pub fn toss_magnitudes(ranges: &ThrowRanges, u: [f64; 6]) -> [f64; 3] {
+    // 1 − u lies in (0, 1], so the logarithm is finite.
+    let pair = |a: f64, b: f64| {
+        let r = (-2.0 * (1.0 - a).ln()).sqrt();
+        let (s, c) = (std::f64::consts::TAU * b).sin_cos();
+        [r * c, r * s]
+    };
+    let [g1, g2] = pair(u[0], u[1]);
+    let [g3, g4] = pair(u[2], u[3]);
+    let [g5, _] = pair(u[4], u[5]);
+    let mid = |r: Range| 0.5 * (r.lo + r.hi);
+    let h = g1.abs() * mid(ranges.drop_height) * (std::f64::consts::PI / 2.0).sqrt();
+    let v = g2.abs() * ranges.velocity.lo.abs().max(ranges.velocity.hi.abs());
+    let w = mid(ranges.spin) * ((g3 * g3 + g4 * g4 + g5 * g5) / 3.0).sqrt();
+    [h, v, w]
 }
 
 /// DicePhys's throws 0..n: `srand(seed)`, one discarded draw, then per roll, in this order,
@@ -645,6 +712,56 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_toss_with_every_scale_zero_is_the_rest_throw_for_throw() {
+        let zero = Range::new(0.0, 0.0);
+        let r = ThrowRanges {
+            velocity: zero,
+            spin: zero,
+            drop_height: zero,
+        };
+        for mode in [Mode::ThreeD, Mode::TwoD] {
+            let scene = Scene::paper("40x30x20".parse().unwrap(), mode);
+            for i in 0..100 {
+                let rest = keyed_styled(ThrowStyle::Rest, 0.0, 5, &ThrowRanges::default(), i);
+                let toss = keyed_styled(ThrowStyle::Toss, 0.0, 5, &r, i);
+                assert_eq!(toss.turn.unwrap().rotation, rest.turn.unwrap().rotation);
+                assert_eq!(toss.start(&scene), rest.start(&scene), "throw {i}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_toss_draws_its_magnitudes_with_their_scales() {
+        // The paper's ranges as scales: the height's mean 0.3 m, the speed's RMS 0.2 m/s, the
+        // spin's RMS 95.5 rad/s. 20,000 throws; tolerances 4 standard errors (the height's
+        // σ/mean is √(π/2 − 1) = 0.76, so its mean's relative error is 0.0053; the squared
+        // speed's σ/mean is √2, the squared spin's √(2/3): 0.010 and 0.0058).
+        let (n, r) = (20_000u64, ThrowRanges::default());
+        let scene = Scene::paper("40x30x20".parse().unwrap(), Mode::ThreeD);
+        let half = Vector3::from(scene.body_sides()) / 2.0;
+        let (mut h, mut v2, mut w2) = (0.0, 0.0, 0.0);
+        for i in 0..n {
+            let t = keyed_styled(ThrowStyle::Toss, 0.0, 3, &r, i);
+            let s = t.start(&scene);
+            let above = crate::model::die::lowest_point(&half, &s);
+            assert!((above - t.drop_height).abs() < 1e-12, "{above} {}", t.drop_height);
+            assert!((s.angular_velocity.norm() - t.spin).abs() < 1e-9 * t.spin.max(1.0));
+            assert!((s.linear_velocity.norm() - t.velocity).abs() < 1e-12);
+            assert_eq!(s.linear_velocity.y, 0.0);
+            h += t.drop_height;
+            v2 += t.velocity * t.velocity;
+            w2 += t.spin * t.spin;
+        }
+        let nf = n as f64;
+        let rel = |got: f64, want: f64, se: f64| {
+            assert!((got / want - 1.0).abs() < 4.0 * se, "{got} against {want}");
+        };
+        rel(h / nf, 0.3, 0.76 / nf.sqrt());
+        rel(v2 / nf, 0.04, 2f64.sqrt() / nf.sqrt());
+        rel(w2 / nf, 95.5f64.powi(2), (2.0f64 / 3.0).sqrt() / nf.sqrt());
     }
 
     #[test]

@@ -37,11 +37,15 @@ pub fn fixed_text(res: &FitResult) -> String {
     if !m.is_free(Kind::Mu) {
         parts.push(format!("μ = {}", f.mu));
     }
+    if !m.is_free(Kind::Rolling) && f.rolling > 0.0 {
+        parts.push(format!("rolling resistance {} mm", f.rolling));
+    }
     if !m.is_free(Kind::Kappa) {
         parts.push(match f.throw {
             FixedThrow::Paper => "the paper's throw".into(),
             FixedThrow::Hand(k) => format!("a hand's throw with κ = {k}"),
             FixedThrow::Tumble => "a tumble".into(),
+            FixedThrow::Toss => "a hand's toss".into(),
         });
     }
     if !m.is_free(Kind::Spin) {

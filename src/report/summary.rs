@@ -631,6 +631,7 @@ impl RunSummary {
             ThrowStyle::Tumble => "a tumble",
             ThrowStyle::Hand => "a hand's throw",
             ThrowStyle::Rest => "released at rest",
+            ThrowStyle::Toss => "a hand's toss",
         };
         let source = match self.throws {
             ThrowKind::Keyed => "",

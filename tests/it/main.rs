@@ -21,6 +21,7 @@ mod made;
 mod one_die;
 mod paper;
 mod rapier;
+mod real_throws;
 mod roll;
 mod shape_fit;
 mod shapes;
