@@ -200,8 +200,8 @@ impl FitConfig {
     }
 
     /// A die of any shape and its rows agree: every row counts its faces by label, in its
-    /// order ([`data::on_shape`]), and it is thrown in a tumble (it has no long axis for the
-    /// paper's or a hand's throw, so no κ); without one, no row counts faces by label.
+    /// order ([`data::on_shape`]), and it is thrown in a tumble or a toss (it has no long axis
+    /// for the paper's or a hand's throw, so no κ); without one, no row counts faces by label.
     fn check_shape(&self) -> Result<()> {
         let Some(shape) = &self.method.shape else {
             return match self.rows.iter().find(|r| r.of_shape()) {
@@ -227,14 +227,17 @@ impl FitConfig {
             )));
         }
         let why = format!(
-            "{} is thrown in a tumble: the paper's and a hand's throw spin a die about its long \
-             axis, which it has not",
+            "{} is thrown in a tumble or a toss: the paper's and a hand's throw spin a die about its \
+             long axis, which it has not",
             shape.name
         );
         if self.model.is_free(params::Kind::Kappa) {
             return Err(Error::field(Field::Free, "kappa", why));
         }
-        if self.model.fixed.throw != params::FixedThrow::Tumble {
+        if !matches!(
+            self.model.fixed.throw,
+            params::FixedThrow::Tumble | params::FixedThrow::Toss
+        ) {
             let throw = match self.model.fixed.throw {
                 params::FixedThrow::Hand(k) => k.to_string(),
                 _ => "paper".into(),

@@ -94,7 +94,7 @@ impl OtherDie {
             .model
             .is_free(crate::calibration::params::Kind::Kappa);
         let throw = fit.config.model.fixed.throw;
-        if let (Some(s), true) = (&self.shape, hand || throw != FixedThrow::Tumble) {
+        if let (Some(s), true) = (&self.shape, hand || !matches!(throw, FixedThrow::Tumble | FixedThrow::Toss)) {
             return Err(Error::field(
                 Field::Shape,
                 &s.name,

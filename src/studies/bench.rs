@@ -6,7 +6,7 @@
 use crate::engine::EngineKind;
 use crate::model::faces::Layout;
 use crate::model::scene::{Floor, Mode, Scene};
-use crate::model::throws::{ThrowKind, ThrowRanges, Throws};
+use crate::model::throws::{ThrowKind, ThrowRanges, ThrowStyle, Throws};
 use crate::report::bench::{
     format_row, Bench, BenchRow, DiceCost, DicePhysRun, EngineFloor, FfiCost, Verdict,
 };
@@ -259,24 +259,33 @@ pub const Z_BOUND: f64 = 2.0;
 
 /// Every die `dice_costs` times, as a scene: the made cubes of [`made_dice`], then dice of
 /// other shapes (`--shape`: a d6, which takes the box's path as the cuboid does, with and
-/// without pips; a d20 and a d4 on the general hull path).
+/// without pips; a d20 and a d4 on the general hull path), and the sharp cube under issue 72's
+/// candidates (a hand's toss, rolling resistance). Each with the throw it is thrown in: a
+/// tumble but for the toss.
 /// Not a coin: a thin one spins like Euler's disk, about 100 ms a roll, and would double the
 /// benchmark's time (its cost is on docs/results/shapes.md).
-pub fn bench_dice() -> crate::Result<Vec<(String, Scene)>> {
+pub fn bench_dice() -> crate::Result<Vec<(String, Scene, ThrowStyle)>> {
     let block: crate::model::block::Block = "16x16x16".parse()?;
-    let mut out: Vec<(String, Scene)> = made_dice()
+    let tumble = ThrowStyle::Tumble;
+    let mut out: Vec<(String, Scene, ThrowStyle)> = made_dice()
         .into_iter()
         .map(|(name, features)| {
             let mut scene = Scene::paper(block, Mode::ThreeD);
             scene.features = features;
-            (name.to_string(), scene)
+            (name.to_string(), scene, tumble)
         })
         .collect();
+    let sharp = Scene::paper(block, Mode::ThreeD);
+    out.push(("--throw toss".into(), sharp.clone(), ThrowStyle::Toss));
+    let mut rolling = sharp;
+    rolling.rolling_resistance = 1e-4;
+    out.push(("--rolling-resistance 0.1".into(), rolling, tumble));
     for name in ["d6", "d20", "d4"] {
         let shape = crate::model::shape::named(name, None)?;
         out.push((
             format!("--shape {name}"),
             Scene::paper_shape(shape, Mode::ThreeD),
+            tumble,
         ));
     }
     let mut d6_pips = Scene::paper_shape(crate::model::shape::named("d6", None)?, Mode::ThreeD);
@@ -286,7 +295,7 @@ pub fn bench_dice() -> crate::Result<Vec<(String, Scene)>> {
         .map_err(|e| crate::Error::Invalid(format!("the d6 with pips: {e}")))?;
     out.insert(
         out.len() - 2,
-        ("--shape d6 --pips 3,1".to_string(), d6_pips),
+        ("--shape d6 --pips 3,1".to_string(), d6_pips, tumble),
     );
     Ok(out)
 }
@@ -354,15 +363,16 @@ pub fn dice_costs(
     stop: &crate::run::stop::Stop,
     log: &dyn Fn(&str),
 ) -> crate::Result<Vec<DiceCost>> {
-    use crate::model::throws::ThrowStyle;
-    let throws = Throws::styled(
-        ThrowKind::Keyed,
-        ThrowStyle::Tumble,
-        0.0,
-        seed,
-        ThrowRanges::default(),
-        0,
-    );
+    let throws = |style| {
+        Throws::styled(
+            ThrowKind::Keyed,
+            style,
+            0.0,
+            seed,
+            ThrowRanges::default(),
+            0,
+        )
+    };
     // As `roll` rolls by default at this step: the early stop, free flight flown.
     let cfg = RollConfig {
         rule: Rule::Certificate,
@@ -378,14 +388,16 @@ pub fn dice_costs(
         (EngineKind::Moreau, rolls),
     ] {
         let models = |scene: &Scene| {
-            engine != EngineKind::Moreau || crate::engine::moreau::models(scene).is_ok()
+            (engine != EngineKind::Moreau || crate::engine::moreau::models(scene).is_ok())
+                && (engine == EngineKind::Bullet || scene.rolling_resistance == 0.0)
         };
         let mut best = vec![(f64::INFINITY, Vec::new()); dice.len()];
         for _ in 0..repeat.max(1) {
-            for ((_, scene), best) in dice.iter().zip(best.iter_mut()) {
+            for ((_, scene, style), best) in dice.iter().zip(best.iter_mut()) {
                 if !models(scene) {
                     continue;
                 }
+                let throws = throws(*style);
                 let job = batch::Job {
                     engine,
                     scene,
@@ -405,7 +417,7 @@ pub fn dice_costs(
             }
         }
         let sharp_ms = 1000.0 * best[0].0 / n as f64;
-        for ((name, scene), (cpu_s, recs)) in dice.iter().zip(&best) {
+        for ((name, scene, _), (cpu_s, recs)) in dice.iter().zip(&best) {
             if !models(scene) {
                 continue;
             }
