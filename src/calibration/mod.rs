@@ -87,6 +87,23 @@ impl FitConfig {
             )));
         }
         self.check_shape()?;
+        if self.model.fixed.throw == params::FixedThrow::Rest {
+            if let Some(k) = self.model.free.iter().find(|k| {
+                matches!(
+                    k,
+                    params::Kind::Kappa
+                        | params::Kind::Spin
+                        | params::Kind::Height
+                        | params::Kind::Speed
+                )
+            }) {
+                return Err(Error::field(
+                    Field::Free,
+                    k.name(),
+                    "a die released at rest has no spin, height, speed or κ to fit",
+                ));
+            }
+        }
         if self.model.is_free(params::Kind::Rolling)
             && self.method.engine != crate::engine::EngineKind::Bullet
         {
@@ -236,7 +253,7 @@ impl FitConfig {
         }
         if !matches!(
             self.model.fixed.throw,
-            params::FixedThrow::Tumble | params::FixedThrow::Toss
+            params::FixedThrow::Tumble | params::FixedThrow::Toss | params::FixedThrow::Rest
         ) {
             let throw = match self.model.fixed.throw {
                 params::FixedThrow::Hand(k) => k.to_string(),

@@ -212,6 +212,9 @@ pub enum FixedThrow {
     /// A hand's toss (`ThrowStyle::Toss`): the tumble's directions, its magnitudes drawn with
     /// scales (the spin, height and speed kinds scale them) rather than from uniform ranges.
     Toss,
+    /// Released at rest touching the floor (`ThrowStyle::Rest`): the published predictions'
+    /// drop from rest, no spin, height or speed to scale.
+    Rest,
 }
 
 /// Values of the parameters that are not free.
@@ -593,7 +596,19 @@ impl Method {
             FixedThrow::Hand(k) => ThrowSpec::hand(seed, k),
             FixedThrow::Tumble => ThrowSpec::keyed_style(seed, ThrowStyle::Tumble),
             FixedThrow::Toss => ThrowSpec::keyed_style(seed, ThrowStyle::Toss),
+            FixedThrow::Rest => ThrowSpec::keyed_style(seed, ThrowStyle::Rest),
         };
+        if v.throw == FixedThrow::Rest {
+            // A rest has no ranges to scale (and refuses any but the paper's, unused).
+            return RunSpec {
+                engine: self.engine,
+                scene,
+                throws,
+                roll: self.roll(),
+                rolls,
+                shard: None,
+            };
+        }
         let paper = ThrowRanges::default();
         let scaled = |r: Range, k: f64| Range::new(r.lo * k, r.hi * k);
         throws.ranges.spin = scaled(paper.spin, v.spin);

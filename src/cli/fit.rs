@@ -53,11 +53,12 @@ pub struct FitArgs {
     /// [default: the paper's throw].
     #[arg(long, value_name = "KAPPA", allow_hyphen_values = true)]
     pub kappa: Option<String>,
-    /// The throw where kappa is not free, by its style: paper, tumble or toss (a hand's toss:
+    /// The throw where kappa is not free, by its style: paper, tumble, toss (a hand's toss:
     /// the tumble's directions, its spin, height and speed drawn with scales, which the spin,
-    /// height and speed parameters multiply; `roll --throw toss`) [default: the paper's throw
+    /// height and speed parameters multiply; `roll --throw toss`) or rest (released at rest
+    /// touching the table, `roll --throw rest`; no spin, height or speed) [default: the paper's throw
     /// for blocks, a tumble for a die of any shape]. A hand's throw is `--kappa K`.
-    #[arg(long, value_name = "STYLE", value_parser = ["paper", "tumble", "toss"])]
+    #[arg(long, value_name = "STYLE", value_parser = ["paper", "tumble", "toss", "rest"])]
     pub throw: Option<String>,
     /// The spin scale where spin is not free.
     #[arg(long, default_value_t = FitRequest::default().spin_scale, allow_hyphen_values = true)]
@@ -249,7 +250,8 @@ impl FitArgs {
         let style = match self.throw.as_deref() {
             Some("paper") => Some(FixedThrow::Paper),
             Some("tumble") => Some(FixedThrow::Tumble),
-            Some(_) => Some(FixedThrow::Toss),
+            Some("toss") => Some(FixedThrow::Toss),
+            Some(_) => Some(FixedThrow::Rest),
             None => None,
         };
         let throw = match self.kappa.as_deref() {

@@ -46,6 +46,7 @@ pub fn fixed_text(res: &FitResult) -> String {
             FixedThrow::Hand(k) => format!("a hand's throw with κ = {k}"),
             FixedThrow::Tumble => "a tumble".into(),
             FixedThrow::Toss => "a hand's toss".into(),
+            FixedThrow::Rest => "released at rest".into(),
         });
     }
     if !m.is_free(Kind::Spin) {
