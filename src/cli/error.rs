@@ -134,6 +134,8 @@ pub fn flag(field: Field) -> &'static str {
         Field::Seed => "--seed",
         Field::Settle => "--settle",
         Field::Shape => "--shape",
+        Field::ShellInfill => "--shell infill",
+        Field::ShellWall => "--shell wall",
         Field::Shared => "--shared",
         Field::Size => "--size",
         Field::Spin => "--spin",

@@ -398,6 +398,7 @@ fn other_die(
         || d.com.is_some()
         || d.pips.is_some()
         || d.edge_radius.is_some()
+        || d.shell.is_some()
         || d.density.is_some();
     let block_of_shape_fit = a.block.is_some() && fit.config.method.shape.is_some();
     if !described && !block_of_shape_fit {

@@ -592,7 +592,19 @@ fn made_die_and_faces() -> (Value, Value) {
         weighted.to_str().unwrap(),
     ]);
     assert!(weighted["spec"]["scene"]["features"]["layout"]["map"].is_array());
-    let made = serde_json::json!([made, weighted]);
+    // A die file's printed shell (spec.scene.features.shell).
+    let printed = dir2.join("printed.toml");
+    std::fs::write(&printed, "[shell]\nwall = 1.0\ninfill = 0.2\n").unwrap();
+    let printed = roll(&[
+        "--shape",
+        "d8",
+        "--throw",
+        "tumble",
+        "--die",
+        printed.to_str().unwrap(),
+    ]);
+    assert_eq!(printed["spec"]["scene"]["features"]["shell"]["infill"], 0.2);
+    let made = serde_json::json!([made, weighted, printed]);
     let faces = run(&[
         "fair",
         "--block",

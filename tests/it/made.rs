@@ -526,3 +526,55 @@ fn a_die_file_is_read_capped_and_named() {
     let status = exit_within(&mut child, 5, "a --die pipe held off SIGTERM");
     assert_eq!(status.code(), Some(130));
 }
+
+/// Issue 72: a 3D-printed die, `--shell WALL,INFILL`. The designed die V1 (tests/data) at 24 mm
+/// with a 1 mm wall and a fifth infill rolls on Bullet, every roll counted on one of its
+/// faces; its specification carries the shell (m and a fraction); and a wall as thick as the
+/// die, or an infill past 1, is refused naming the flag, in one line.
+#[test]
+fn a_printed_die_with_a_shell_rolls_on_bullet() {
+    let v1 = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/hendecahedron_v1.obj"
+    );
+    let roll = |shell: &str| {
+        dicephys(&[
+            "roll",
+            "--die",
+            v1,
+            "--scale",
+            "14.821972",
+            "--shell",
+            shell,
+            "--rolls",
+            "50",
+            "--seed",
+            "3",
+            "--threads",
+            "1",
+            "--engine",
+            "bullet",
+            "--json",
+        ])
+    };
+    let v = json(&roll("1,0.2"));
+    let shell = &v["spec"]["scene"]["features"]["shell"];
+    assert_eq!(shell["infill"], 0.2, "{shell}");
+    assert!(
+        (shell["wall"].as_f64().unwrap() - 0.001).abs() < 1e-15,
+        "{shell}"
+    );
+    let counted: u64 = v["shape"]["faces"]
+        .as_array()
+        .expect("the die's faces")
+        .iter()
+        .map(|f| f["count"].as_u64().unwrap())
+        .sum();
+    assert_eq!(counted, 50, "{}", v["shape"]);
+    crate::helpers::refused(&roll("9,0.2"), 2, "--shell wall 9");
+    crate::helpers::refused(&roll("1,1.5"), 2, "--shell infill 1.5");
+    let o = dicephys(&[
+        "roll", "--block", "16x16x16", "--shell", "1,0.2", "--pips", "3,1.2", "--rolls", "1",
+    ]);
+    crate::helpers::refused(&o, 2, "deeper than the shell's wall");
+}
