@@ -120,6 +120,15 @@ impl FitConfig {
                  the other",
             ));
         }
+        if self.model.is_free(params::Kind::Infill) && com_free.clone().count() > 0 {
+            return Err(Error::field(
+                Field::Free,
+                "infill",
+                "and a free centre of mass cannot be told apart: the infill biases a die \
+                 through the centre of mass it moves, and a free centre is given outright; free \
+                 one or the other",
+            ));
+        }
         for kind in com_free {
             let r = self.model.range(kind);
             let axis = kind as usize - params::Kind::ComX as usize;

@@ -293,7 +293,7 @@ mod tests {
                 seen += 1;
             }
         }
-        assert_eq!(seen, 10, "every kind's default range spelt: {spelt}");
+        assert_eq!(seen, 11, "every kind's default range spelt: {spelt}");
     }
 
     #[test]

@@ -287,3 +287,32 @@ fn a_die_without_a_shell_is_written_as_before() {
     assert_eq!(serde_json::from_str::<Features>(&text).unwrap(), f);
     assert!(!f.plain());
 }
+
+#[test]
+fn a_fits_free_infill_fills_the_dies_own_wall_or_a_millimetre() {
+    use crate::calibration::params::{Fixed, Kind, Method};
+    assert!(Kind::Infill.of_die() && Kind::ALL.last() == Some(&Kind::Infill));
+    let method = |die: Features| Method {
+        engine: crate::engine::EngineKind::Bullet,
+        dt: 1e-3,
+        max_steps: 1000,
+        die,
+        density: None,
+        shape: None,
+    };
+    let v = Fixed {
+        infill: Some(0.3),
+        ..Fixed::default()
+    };
+    let plain = method(Features::default()).die_at(&v);
+    assert_eq!(plain.shell, printed(DEFAULT_WALL, 0.3));
+    let own = method(Features {
+        shell: printed(0.0008, 0.1),
+        ..Default::default()
+    })
+    .die_at(&v);
+    assert_eq!(own.shell, printed(0.0008, 0.3));
+    assert!(!serde_json::to_string(&Fixed::default())
+        .unwrap()
+        .contains("infill"));
+}
