@@ -715,6 +715,7 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
     for (what, v) in [
         ("roll --die (every feature)", &made[0]),
         ("roll --die (insert, inertia, face map)", &made[1]),
+        ("roll --shape d8 --die (a printed shell)", &made[2]),
         ("fair --within 10 (its summary)", &faces["summary"]),
         ("roll 3D", &d3),
         ("roll 2D", &d2),

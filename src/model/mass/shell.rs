@@ -53,7 +53,7 @@ pub(super) fn inner_shape(shape: &Shape, wall: f64) -> Option<Moments> {
 /// The corners of the intersection of the half-spaces n·x ≤ d − `wall` (n unit, outward; the
 /// origin inside every one of them, else `None`), as their convex hull.
 pub fn inner_hull(planes: &[(Vector3<f64>, f64)], wall: f64) -> Option<polytope::Mesh> {
-    if planes.iter().any(|(_, d)| !(d - wall > 0.0)) {
+    if !planes.iter().all(|(_, d)| d - wall > 0.0) {
         return None;
     }
     let dual: Vec<Vector3<f64>> = planes.iter().map(|(n, d)| n / (d - wall)).collect();

@@ -316,3 +316,24 @@ fn a_fits_free_infill_fills_the_dies_own_wall_or_a_millimetre() {
         .unwrap()
         .contains("infill"));
 }
+
+#[test]
+fn a_many_faceted_hulls_thin_wall_holds_its_area_times_its_thickness() {
+    // The designed bunny d6's hull (tests/data: 242 triangles, near-coplanar facets, short
+    // edges): the dual finds its inner solid, and a thin wall's volume is its surface's area
+    // times its thickness, to first order in it (V − V(t) = A t − O(t²)).
+    let bytes = include_bytes!("../../../tests/data/bunny_d6_hull.obj");
+    let mesh = crate::model::mesh_file::read_mesh(bytes, "bunny_d6_hull.obj").unwrap();
+    let s = shape::from_mesh(&mesh.scaled(15.0), "bunny".into(), None, Reads::Down).unwrap();
+    let area: f64 = s.facets().iter().map(|f| f.area).sum();
+    let solid = MassProps::of(&on_shape(s.clone())).unwrap();
+    for t in [1e-5, 1e-4] {
+        let wall = MassProps::of(&with_shell(on_shape(s.clone()), printed(t, 0.0))).unwrap();
+        let ratio = wall.mass / (RHO * area * t);
+        assert!(
+            ratio < 1.0 && ratio > 1.0 - 0.1 * t / 1e-4,
+            "t {t}: {ratio}"
+        );
+        assert!(wall.mass < solid.mass);
+    }
+}
