@@ -172,6 +172,18 @@ impl FitConfig {
         let Error::Field { field, value, why } = &e else {
             return e;
         };
+        if *field == Field::ShellWall && self.model.is_free(params::Kind::Infill) {
+            // The wall a free infill fills: the die's own, or one the user never wrote.
+            return Error::field(
+                Field::Free,
+                "infill",
+                format!(
+                    "fills the die's shell wall, {value} mm (its own, else {} mm), which {why}: \
+                     give the die a thinner wall (--shell WALL,INFILL)",
+                    crate::model::mass::DEFAULT_WALL * 1e3
+                ),
+            );
+        }
         let kinds: &[params::Kind] = match field {
             Field::Com => &[params::Kind::ComX, params::Kind::ComY, params::Kind::ComZ],
             Field::PipsDepth => &[params::Kind::PipDepth],

@@ -577,4 +577,32 @@ fn a_printed_die_with_a_shell_rolls_on_bullet() {
         "roll", "--block", "16x16x16", "--shell", "1,0.2", "--pips", "3,1.2", "--rolls", "1",
     ]);
     crate::helpers::refused(&o, 2, "deeper than the shell's wall");
+    // A fit's free infill fills the die's wall, or a 1 mm one: too thick for a 1.5 mm die,
+    // it is refused naming --free, not a --shell the user never gave; and beside a free
+    // centre of mass, which it would only move.
+    let dir = Scratch::new("printed-fit");
+    let csv = dir.join("tiny.csv");
+    std::fs::write(
+        &csv,
+        "label,surface,length_mm,breadth_mm,width_mm,mode,face_1,face_2,face_3,face_4,face_5,\
+         face_6\nd,MDF,1.5,1.5,1.5,3d,30,25,25,25,25,20\n",
+    )
+    .unwrap();
+    let fit = |free: &str| {
+        dicephys(&[
+            "fit",
+            "--data",
+            csv.to_str().unwrap(),
+            "--kappa",
+            "0",
+            "--free",
+            free,
+        ])
+    };
+    crate::helpers::refused(
+        &fit("infill"),
+        2,
+        "--free infill: fills the die's shell wall, 1 mm",
+    );
+    crate::helpers::refused(&fit("infill,com_z"), 2, "cannot be told apart");
 }
