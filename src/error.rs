@@ -296,6 +296,12 @@ pub enum Field {
     Settle,
     /// `shape`.
     Shape,
+    #[strum(serialize = "shell.infill")]
+    /// `shell.infill`.
+    ShellInfill,
+    #[strum(serialize = "shell.wall")]
+    /// `shell.wall`.
+    ShellWall,
     /// `shared`.
     Shared,
     /// `size`.

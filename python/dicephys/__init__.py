@@ -733,7 +733,8 @@ def fit(
         rows), a pandas DataFrame or a list of dicts with the CSV's columns.
     free: the free parameters, among "e", "mu", "kappa", "spin", "height", "speed" (the
         last three factors on the throw's spin, launch height and launch speed); for a die,
-        "com_x", "com_y", "com_z" (its centre of mass, mm) and "pip_depth" (mm).
+        "com_x", "com_y", "com_z" (its centre of mass, mm), "pip_depth" (mm) and "infill" (a
+        printed die's infill fraction, 0 to 1, in its shell's wall or a 1 mm one).
     shared: surface parameters shared by every surface instead of one per surface.
     ranges: a free parameter's box, {"e": (0.05, 0.8)}.
     restitution, friction, kappa, spin_scale: the values where a parameter is not free

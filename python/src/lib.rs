@@ -322,7 +322,7 @@ where
 }
 
 /// The die asked by `roll`'s names (shape, size, scale, die: a file or a mesh, density, com,
-/// pips, edge_radius), with its `block` and the faces' `layout`.
+/// pips, edge_radius, shell), with its `block` and the faces' `layout`.
 fn die_of(o: &Options, block: Option<Block>, layout: Option<Layout>) -> PyResult<DieRequest> {
     Ok(DieRequest {
         block,
@@ -334,6 +334,7 @@ fn die_of(o: &Options, block: Option<Block>, layout: Option<Layout>) -> PyResult
         com: o.maybe("com")?,
         pips: o.maybe("pips")?,
         edge_radius: o.maybe("edge_radius")?,
+        shell: o.maybe("shell")?,
         layout,
     })
 }

@@ -149,6 +149,15 @@ impl FitConfig {
                  the other",
             ));
         }
+        if self.model.is_free(params::Kind::Infill) && com_free.clone().count() > 0 {
+            return Err(Error::field(
+                Field::Free,
+                "infill",
+                "and a free centre of mass cannot be told apart: the infill biases a die \
+                 through the centre of mass it moves, and a free centre is given outright; free \
+                 one or the other",
+            ));
+        }
         for kind in com_free {
             let r = self.model.range(kind);
             let axis = kind as usize - params::Kind::ComX as usize;
@@ -192,6 +201,18 @@ impl FitConfig {
         let Error::Field { field, value, why } = &e else {
             return e;
         };
+        if *field == Field::ShellWall && self.model.is_free(params::Kind::Infill) {
+            // The wall a free infill fills: the die's own, or one the user never wrote.
+            return Error::field(
+                Field::Free,
+                "infill",
+                format!(
+                    "fills the die's shell wall, {value} mm (its own, else {} mm), which {why}: \
+                     give the die a thinner wall (--shell WALL,INFILL)",
+                    crate::model::mass::DEFAULT_WALL * 1e3
+                ),
+            );
+        }
         let kinds: &[params::Kind] = match field {
             Field::Com => &[params::Kind::ComX, params::Kind::ComY, params::Kind::ComZ],
             Field::PipsDepth => &[params::Kind::PipDepth],

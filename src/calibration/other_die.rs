@@ -107,11 +107,12 @@ impl OtherDie {
 }
 
 /// The values `v` for another die: the fitted die's own parameters (its centre of mass, its
-/// pips' depth) dropped, the new die's taken as it is described.
+/// pips' depth, its infill) dropped, the new die's taken as it is described.
 pub fn without_die_params(v: Fixed) -> Fixed {
     Fixed {
         com: [None; 3],
         pip_depth: None,
+        infill: None,
         ..v
     }
 }

@@ -68,11 +68,14 @@ pub enum Kind {
     ComZ,
     /// The depth of the die's pips, mm (its pips' diameter, shape and paint stay the die's).
     PipDepth,
+    /// A printed die's infill fraction, 0 to 1, inside its wall (the die's own shell's, else a
+    /// 1 mm one: `mass::DEFAULT_WALL`).
+    Infill,
 }
 
 impl Kind {
     /// Every kind, in the order a row's coordinates take them.
-    pub const ALL: [Kind; 11] = [
+    pub const ALL: [Kind; 12] = [
         Kind::E,
         Kind::Mu,
         Kind::Rolling,
@@ -84,10 +87,11 @@ impl Kind {
         Kind::ComY,
         Kind::ComZ,
         Kind::PipDepth,
+        Kind::Infill,
     ];
 
-    /// "e", "mu", "rolling", "kappa", "spin", "height", "speed", "com_x", "com_y", "com_z" or
-    /// "pip_depth".
+    /// "e", "mu", "rolling", "kappa", "spin", "height", "speed", "com_x", "com_y", "com_z",
+    /// "pip_depth" or "infill".
     pub fn name(self) -> &'static str {
         self.into()
     }
@@ -98,17 +102,20 @@ impl Kind {
         matches!(self, Kind::E | Kind::Mu | Kind::Rolling)
     }
 
-    /// True for the die's parameters (its centre of mass, its pips' depth): one die, shared by
-    /// every row.
+    /// True for the die's parameters (its centre of mass, its pips' depth, its infill): one
+    /// die, shared by every row.
     pub fn of_die(self) -> bool {
-        matches!(self, Kind::ComX | Kind::ComY | Kind::ComZ | Kind::PipDepth)
+        matches!(
+            self,
+            Kind::ComX | Kind::ComY | Kind::ComZ | Kind::PipDepth | Kind::Infill
+        )
     }
 
     /// The widest range accepted: e in [0, 1], μ in [0, 5], a rolling resistance in [0, 1]
     /// mm (`MAX_ROLLING_RESISTANCE`), κ in [0, 10⁶], spin scale in
     /// [0.05, 20], height scale in [0.05, 10] (a drop of 1 to 4 cm up to 2 to 4 m), speed scale
     /// in [0.05, 50] (up to ±10 m/s), a centre of mass within ±1000 mm (the die's own sides bound it further:
-    /// checked with the die), a pip depth in [0.001, 100] mm.
+    /// checked with the die), a pip depth in [0.001, 100] mm, an infill in [0, 1].
     pub fn limits(self) -> (f64, f64) {
         match self {
             Kind::E => (0.0, 1.0),
@@ -120,6 +127,7 @@ impl Kind {
             Kind::Speed => (0.05, 50.0),
             Kind::ComX | Kind::ComY | Kind::ComZ => (-1000.0, 1000.0),
             Kind::PipDepth => (0.001, 100.0),
+            Kind::Infill => (0.0, 1.0),
         }
     }
 
@@ -150,6 +158,8 @@ impl Kind {
             // millimetre (docs/results/dice.md: 0.25 mm is seen in ~5,000 throws).
             Kind::ComX | Kind::ComY | Kind::ComZ => Range::new(-2.0, 2.0),
             Kind::PipDepth => Range::new(0.2, 1.5),
+            // From a hollow shell to the solid: a slicer's 10 to 30 % lies inside.
+            Kind::Infill => Range::new(0.0, 1.0),
         }
     }
 
@@ -161,7 +171,8 @@ impl Kind {
             | Kind::ComX
             | Kind::ComY
             | Kind::ComZ
-            | Kind::PipDepth => v,
+            | Kind::PipDepth
+            | Kind::Infill => v,
             Kind::Kappa => (1.0 + v).log10(),
             Kind::Spin | Kind::Height | Kind::Speed => v.ln(),
         }
@@ -175,7 +186,8 @@ impl Kind {
             | Kind::ComX
             | Kind::ComY
             | Kind::ComZ
-            | Kind::PipDepth => w,
+            | Kind::PipDepth
+            | Kind::Infill => w,
             Kind::Kappa => 10f64.powf(w) - 1.0,
             Kind::Spin | Kind::Height | Kind::Speed => w.exp(),
         }
@@ -244,6 +256,9 @@ pub struct Fixed {
     /// The die's pips' depth where a fit frees it, mm (`None`: the die's own).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pip_depth: Option<f64>,
+    /// The die's infill fraction where a fit frees it (`None`: the die's own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub infill: Option<f64>,
 }
 
 fn unit() -> f64 {
@@ -275,6 +290,7 @@ impl Default for Fixed {
             speed: 1.0,
             com: [None; 3],
             pip_depth: None,
+            infill: None,
         }
     }
 }
@@ -324,6 +340,7 @@ pub fn values(fixed: &Fixed, axes: &[(Kind, Range)], x: &[f64]) -> Fixed {
             Kind::ComY => v.com[1] = Some(value),
             Kind::ComZ => v.com[2] = Some(value),
             Kind::PipDepth => v.pip_depth = Some(value),
+            Kind::Infill => v.infill = Some(value),
         }
     }
     v
@@ -553,7 +570,8 @@ impl Method {
     }
 
     /// The die at the values `v`: a free centre of mass given outright (its components not
-    /// free from the die's description, else 0), a free pip depth on the die's pips.
+    /// free from the die's description, else 0), a free pip depth on the die's pips, a free
+    /// infill in the die's shell (else a `DEFAULT_WALL` one).
     pub fn die_at(&self, v: &Fixed) -> Features {
         let mut die = self.die;
         for (axis, mm) in v.com.iter().enumerate() {
@@ -563,6 +581,9 @@ impl Method {
         }
         if let Some(h) = v.pip_depth {
             die = die.with_pip_depth(h / 1000.0).unwrap_or(die);
+        }
+        if let Some(f) = v.infill {
+            die = die.with_infill(f);
         }
         die
     }

@@ -171,10 +171,15 @@ pub struct DieArgs {
     /// Round the die's edges and corners with this radius, mm (0, the default: sharp). 3D only.
     #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     pub edge_radius: Option<f64>,
+    /// A 3D-printed die: a solid wall WALL mm thick under every face and a sparse infill of
+    /// volume fraction INFILL (0 to 1) inside it, as a slicer prints it (e.g. 1,0.2): its
+    /// mass, centre of mass and inertia are the wall's and the infill's. 3D only.
+    #[arg(long, value_name = "WALL,INFILL", allow_hyphen_values = true, value_parser = parse_shell)]
+    pub shell: Option<[f64; 2]>,
     /// A die file: a mesh (FILE.obj or FILE.stl, in mm: a die of any shape, rolled on its
     /// convex hull, its mass from the mesh as given), or TOML (lengths in mm): com,
     /// edge_radius, density, [pips] diameter, depth, shape (cap or cylinder), fill_density,
-    /// spacing; or mesh, scale, reads (up or down) and labels for a mesh. Flags given beside
+    /// spacing, [shell] wall, infill; or mesh, scale, reads (up or down) and labels for a mesh. Flags given beside
     /// it override its values.
     #[arg(long, value_name = "FILE")]
     pub die: Option<std::path::PathBuf>,
@@ -207,6 +212,7 @@ impl DieArgs {
             com: self.com,
             pips: self.pips,
             edge_radius: self.edge_radius,
+            shell: self.shell,
             layout,
         }
     }
@@ -231,6 +237,8 @@ impl DieArgs {
             F::InsertCentre => ("insert.centre", false),
             F::InsertDensity => ("insert.density", false),
             F::InsertSize => ("insert.size", false),
+            F::ShellWall => ("shell.wall", self.shell.is_some()),
+            F::ShellInfill => ("shell.infill", self.shell.is_some()),
             _ => return e.into(),
         };
         if flagged || dicephys::model::mass::is_mesh(path) {
@@ -270,6 +278,14 @@ fn parse_com(s: &str) -> std::result::Result<[f64; 3], String> {
 
 fn parse_pips(s: &str) -> std::result::Result<[f64; 2], String> {
     numbers("DIAMETER,DEPTH in mm (e.g. 3,1)", s)
+}
+
+fn parse_shell(s: &str) -> std::result::Result<[f64; 2], String> {
+    numbers(
+        "WALL,INFILL: the wall in mm, the infill a fraction (e.g. 1,0.2)",
+        s,
+    )
+    .map_err(|e| e.replace("a number of mm", "a number"))
 }
 
 /// Where the throws come from.

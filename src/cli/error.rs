@@ -134,6 +134,8 @@ pub fn flag(field: Field) -> &'static str {
         Field::Seed => "--seed",
         Field::Settle => "--settle",
         Field::Shape => "--shape",
+        Field::ShellInfill => "--shell infill",
+        Field::ShellWall => "--shell wall",
         Field::Shared => "--shared",
         Field::Size => "--size",
         Field::Spin => "--spin",
@@ -291,7 +293,7 @@ mod tests {
                 seen += 1;
             }
         }
-        assert_eq!(seen, 10, "every kind's default range spelt: {spelt}");
+        assert_eq!(seen, 11, "every kind's default range spelt: {spelt}");
     }
 
     #[test]

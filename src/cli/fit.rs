@@ -32,7 +32,8 @@ pub struct FitArgs {
     /// The free parameters (comma-separated): e (restitution), mu (friction), kappa (the
     /// throw's concentration, --throw hand), spin, height and speed (factors on the throw's
     /// spin, launch height and launch speed); for a die, com_x, com_y, com_z (its centre of
-    /// mass, mm) and pip_depth (mm).
+    /// mass, mm), pip_depth (mm) and infill (a printed die's infill fraction, in its --shell
+    /// wall or a 1 mm one).
     #[arg(long, value_delimiter = ',', default_value = "e,mu", value_parser = parse_kind)]
     pub free: Vec<Kind>,
     /// Surface parameters shared by every surface instead of one per surface (e, mu).
@@ -40,7 +41,7 @@ pub struct FitArgs {
     pub shared: Vec<Kind>,
     /// A free parameter's range, NAME=LO:HI (repeat for several). Defaults: e=0.05:0.8,
     /// mu=0.1:1, kappa=0:10000, spin=0.25:3, height=0.1:2, speed=0.25:10, com_x|y|z=-2:2,
-    /// pip_depth=0.2:1.5.
+    /// pip_depth=0.2:1.5, infill=0:1.
     #[arg(long = "range", value_name = "NAME=LO:HI")]
     pub ranges: Vec<String>,
     /// e where it is not free.
@@ -417,6 +418,7 @@ fn other_die(
         || d.com.is_some()
         || d.pips.is_some()
         || d.edge_radius.is_some()
+        || d.shell.is_some()
         || d.density.is_some();
     let block_of_shape_fit = a.block.is_some() && fit.config.method.shape.is_some();
     if !described && !block_of_shape_fit {

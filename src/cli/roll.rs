@@ -16,13 +16,14 @@ use std::path::PathBuf;
 use std::sync::atomic::Ordering::Relaxed;
 
 /// The options that define a run: `--resume` takes them from the checkpoint instead.
-const DEFINING: [&str; 32] = [
+const DEFINING: [&str; 33] = [
     "shape",
     "size",
     "scale",
     "com",
     "pips",
     "edge_radius",
+    "shell",
     "die",
     "floor_thickness",
     "engine",

@@ -85,6 +85,20 @@ pub fn fixed_text(res: &FitResult) -> String {
     if die.edge_radius > 0.0 {
         parts.push(format!("edges rounded to {} mm", die.edge_radius * 1000.0));
     }
+    let shell = match (die.shell, m.is_free(Kind::Infill)) {
+        (Some(s), false) => Some((s.wall, format!("{}", s.infill))),
+        (s, true) => Some((
+            s.map_or(crate::model::mass::DEFAULT_WALL, |s| s.wall),
+            "free".into(),
+        )),
+        (None, false) => None,
+    };
+    if let Some((wall, infill)) = shell {
+        parts.push(format!(
+            "printed with a {} mm wall, infill {infill}",
+            wall * 1000.0
+        ));
+    }
     if parts.is_empty() {
         "none".into()
     } else {

@@ -42,6 +42,8 @@ pub struct DieRequest {
     pub pips: Option<[f64; 2]>,
     /// Its edges' and corners' radius, mm.
     pub edge_radius: Option<f64>,
+    /// A printed die's shell: WALL in mm, INFILL a fraction in [0, 1].
+    pub shell: Option<[f64; 2]>,
     /// Its numbering (the file's, else right-handed).
     pub layout: Option<Layout>,
 }
@@ -53,7 +55,7 @@ pub struct DieRequest {
 pub struct ResolvedDie {
     /// A named die, a mesh or a die file's mesh.
     pub shape: Option<crate::model::shape::Shape>,
-    /// Its centre of mass, pips, rounding, insert, inertia and numbering.
+    /// Its centre of mass, pips, rounding, insert, inertia, shell and numbering.
     pub features: Features,
     /// kg/m³.
     pub density: Option<f64>,
@@ -80,6 +82,7 @@ impl DieRequest {
             self.com,
             self.pips,
             self.edge_radius,
+            self.shell,
             self.density,
             read,
         )?;

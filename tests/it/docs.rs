@@ -592,7 +592,19 @@ fn made_die_and_faces() -> (Value, Value) {
         weighted.to_str().unwrap(),
     ]);
     assert!(weighted["spec"]["scene"]["features"]["layout"]["map"].is_array());
-    let made = serde_json::json!([made, weighted]);
+    // A die file's printed shell (spec.scene.features.shell).
+    let printed = dir2.join("printed.toml");
+    std::fs::write(&printed, "[shell]\nwall = 1.0\ninfill = 0.2\n").unwrap();
+    let printed = roll(&[
+        "--shape",
+        "d8",
+        "--throw",
+        "tumble",
+        "--die",
+        printed.to_str().unwrap(),
+    ]);
+    assert_eq!(printed["spec"]["scene"]["features"]["shell"]["infill"], 0.2);
+    let made = serde_json::json!([made, weighted, printed]);
     let faces = run(&[
         "fair",
         "--block",
@@ -703,6 +715,7 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
     for (what, v) in [
         ("roll --die (every feature)", &made[0]),
         ("roll --die (insert, inertia, face map)", &made[1]),
+        ("roll --shape d8 --die (a printed shell)", &made[2]),
         ("fair --within 10 (its summary)", &faces["summary"]),
         ("roll 3D", &d3),
         ("roll 2D", &d2),

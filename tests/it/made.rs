@@ -526,3 +526,83 @@ fn a_die_file_is_read_capped_and_named() {
     let status = exit_within(&mut child, 5, "a --die pipe held off SIGTERM");
     assert_eq!(status.code(), Some(130));
 }
+
+/// Issue 72: a 3D-printed die, `--shell WALL,INFILL`. The designed die V1 (tests/data) at 24 mm
+/// with a 1 mm wall and a fifth infill rolls on Bullet, every roll counted on one of its
+/// faces; its specification carries the shell (m and a fraction); and a wall as thick as the
+/// die, or an infill past 1, is refused naming the flag, in one line.
+#[test]
+fn a_printed_die_with_a_shell_rolls_on_bullet() {
+    let v1 = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/hendecahedron_v1.obj"
+    );
+    let roll = |shell: &str| {
+        dicephys(&[
+            "roll",
+            "--die",
+            v1,
+            "--scale",
+            "14.821972",
+            "--shell",
+            shell,
+            "--rolls",
+            "50",
+            "--seed",
+            "3",
+            "--threads",
+            "1",
+            "--engine",
+            "bullet",
+            "--json",
+        ])
+    };
+    let v = json(&roll("1,0.2"));
+    let shell = &v["spec"]["scene"]["features"]["shell"];
+    assert_eq!(shell["infill"], 0.2, "{shell}");
+    assert!(
+        (shell["wall"].as_f64().unwrap() - 0.001).abs() < 1e-15,
+        "{shell}"
+    );
+    let counted: u64 = v["shape"]["faces"]
+        .as_array()
+        .expect("the die's faces")
+        .iter()
+        .map(|f| f["count"].as_u64().unwrap())
+        .sum();
+    assert_eq!(counted, 50, "{}", v["shape"]);
+    crate::helpers::refused(&roll("9,0.2"), 2, "--shell wall 9");
+    crate::helpers::refused(&roll("1,1.5"), 2, "--shell infill 1.5");
+    let o = dicephys(&[
+        "roll", "--block", "16x16x16", "--shell", "1,0.2", "--pips", "3,1.2", "--rolls", "1",
+    ]);
+    crate::helpers::refused(&o, 2, "deeper than the shell's wall");
+    // A fit's free infill fills the die's wall, or a 1 mm one: too thick for a 1.5 mm die,
+    // it is refused naming --free, not a --shell the user never gave; and beside a free
+    // centre of mass, which it would only move.
+    let dir = Scratch::new("printed-fit");
+    let csv = dir.join("tiny.csv");
+    std::fs::write(
+        &csv,
+        "label,surface,length_mm,breadth_mm,width_mm,mode,face_1,face_2,face_3,face_4,face_5,\
+         face_6\nd,MDF,1.5,1.5,1.5,3d,30,25,25,25,25,20\n",
+    )
+    .unwrap();
+    let fit = |free: &str| {
+        dicephys(&[
+            "fit",
+            "--data",
+            csv.to_str().unwrap(),
+            "--kappa",
+            "0",
+            "--free",
+            free,
+        ])
+    };
+    crate::helpers::refused(
+        &fit("infill"),
+        2,
+        "--free infill: fills the die's shell wall, 1 mm",
+    );
+    crate::helpers::refused(&fit("infill,com_z"), 2, "cannot be told apart");
+}

@@ -1,6 +1,6 @@
 //! Reading a die file (TOML, lengths in mm) and the features it describes.
 
-use super::features::{Features, Insert, Pips};
+use super::features::{Features, Insert, Pips, Shell};
 use crate::error::{Error, Field, Result};
 use crate::model::faces::Layout;
 use serde::Deserialize;
@@ -17,6 +17,9 @@ use serde::Deserialize;
 /// shape = "cap"            # or "cylinder"
 /// fill_density = 1400.0    # paint, kg/m³ (0: empty)
 /// spacing = 0.25           # off-centre pips' distance from the face's centre / its side
+/// [shell]                  # a printed die: a solid wall and a sparse infill inside
+/// wall = 1.0               # the wall's thickness
+/// infill = 0.2             # the infill's volume fraction, 0 to 1
 /// ```
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -37,6 +40,8 @@ pub struct DieFile {
     pub insert: Option<Insert>,
     /// The inertia about the centre of mass, g mm²: xx, yy, zz, xy, xz, yz.
     pub inertia: Option<[f64; 6]>,
+    /// A printed die's wall (mm) and infill (a fraction).
+    pub shell: Option<ShellDef>,
     /// A die of any shape: its mesh (OBJ or STL, in mm; a path from the die file's folder).
     pub mesh: Option<std::path::PathBuf>,
     /// The mesh's lengths times this (e.g. 25.4 for a mesh in inches).
@@ -46,6 +51,16 @@ pub struct DieFile {
     /// The mesh's facets' labels: `{ normal = [0, 0, 1], label = "6" }`, one per resting
     /// facet (matched by its outward normal); none: numbered 1…N.
     pub labels: Option<Vec<LabelDef>>,
+}
+
+/// A printed die's shell in a die file: `[shell]` with `wall` (mm) and `infill` (0 to 1).
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShellDef {
+    /// The wall's thickness, mm.
+    pub wall: f64,
+    /// The infill's volume fraction.
+    pub infill: f64,
 }
 
 /// A mesh's labels: each facet's outward normal (unit length) and what it shows.
@@ -182,21 +197,27 @@ impl DieFile {
             }),
             // g mm² = 10⁻³ kg × 10⁻⁶ m².
             inertia: self.inertia.map(|t| t.map(|x| x * 1e-9)),
+            shell: self.shell.map(|s| Shell {
+                wall: s.wall / 1000.0,
+                infill: s.infill,
+            }),
         })
     }
 }
 
 impl Features {
     /// A die as the command line and the Python package describe it: a die file's, if one is
-    /// named (its bytes through `read`), with a centre of mass, pips' diameter and depth and
-    /// an edge radius given in mm laid over it ([`Features::with_mm`]). Returns the features
-    /// and the density given (`density`, else the file's). The numbering asked is laid over
+    /// named (its bytes through `read`), with a centre of mass, pips' diameter and depth, an
+    /// edge radius and a shell (its wall in mm, its infill a fraction) given laid over it
+    /// ([`Features::with_mm`]). Returns the features and the density given (`density`, else
+    /// the file's). The numbering asked is laid over
     /// by the caller (`run::request::DieRequest::resolve`).
     pub fn described(
         file: Option<&std::path::Path>,
         com: Option<[f64; 3]>,
         pips: Option<[f64; 2]>,
         edge_radius: Option<f64>,
+        shell: Option<[f64; 2]>,
         density: Option<f64>,
         read: ReadFile,
     ) -> Result<(Features, Option<f64>)> {
@@ -204,7 +225,7 @@ impl Features {
             Some(path) => DieFile::read(path, read)?,
             None => DieFile::default(),
         };
-        let f = file.features()?.with_mm(com, pips, edge_radius);
+        let f = file.features()?.with_mm(com, pips, edge_radius, shell);
         Ok((f, density.or(file.density)))
     }
 }

@@ -31,7 +31,28 @@ pub struct Features {
     /// zz, xy, xz, yz), in place of the solid's; its principal frame is found from it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inertia: Option<[f64; 6]>,
+    /// A printed die: a solid outer wall and a sparse infill inside it (`None`: solid
+    /// throughout).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shell: Option<Shell>,
 }
+
+/// A 3D-printed die's build: a solid wall `wall` thick under every face, and inside it an
+/// infill that fills the fraction `infill` of the volume (the slicer's infill density). Its
+/// mass moments are ρ·[M(die) − (1 − infill)·M(inner)], the inner solid the die offset inward
+/// by `wall`: an asymmetric die's centre of mass and inertia move from the uniform solid's.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Shell {
+    /// The wall's thickness, m.
+    pub wall: f64,
+    /// The infill's volume fraction in [0, 1] (1: the uniform solid, 0: a hollow shell).
+    pub infill: f64,
+}
+
+/// The wall a fit's free infill is given on a die that has no shell of its own: 1 mm, a
+/// slicer's usual outer wall (two to three perimeters).
+pub const DEFAULT_WALL: f64 = 0.001;
 
 /// A cuboid of another density inside the die, its edges along the die's axes.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -132,12 +153,13 @@ impl Features {
     /// These features with the ones given in mm (the command line's and the Python
     /// package's units) laid over them: a centre of mass, pips' diameter and depth (on the
     /// pips already here, keeping their shape, paint and spacing, or as empty caps), an edge
-    /// radius.
+    /// radius, a shell (its wall in mm, its infill a fraction).
     pub fn with_mm(
         mut self,
         com: Option<[f64; 3]>,
         pips: Option<[f64; 2]>,
         edge_radius: Option<f64>,
+        shell: Option<[f64; 2]>,
     ) -> Features {
         if let Some(c) = com {
             self.com = Some(c.map(|x| x / 1000.0));
@@ -155,6 +177,12 @@ impl Features {
         }
         if let Some(r) = edge_radius {
             self.edge_radius = r / 1000.0;
+        }
+        if let Some([wall, infill]) = shell {
+            self.shell = Some(Shell {
+                wall: wall / 1000.0,
+                infill,
+            });
         }
         self
     }
@@ -174,6 +202,14 @@ impl Features {
         Some(self)
     }
 
+    /// These features with the infill fraction `f`, in the die's own shell, or in a
+    /// [`DEFAULT_WALL`] one if it has none (a fit's free infill).
+    pub fn with_infill(mut self, f: f64) -> Features {
+        let wall = self.shell.map_or(DEFAULT_WALL, |s| s.wall);
+        self.shell = Some(Shell { wall, infill: f });
+        self
+    }
+
     /// True if nothing is set, not even the layout.
     pub fn is_default(&self) -> bool {
         *self == Features::default()
@@ -186,5 +222,6 @@ impl Features {
             && self.edge_radius == 0.0
             && self.insert.is_none()
             && self.inertia.is_none()
+            && self.shell.is_none()
     }
 }

@@ -4,6 +4,7 @@
 use super::features::{Features, Insert};
 use super::moments::Moments;
 use super::pips::{cavity, pip_moments, pip_overlaps, pip_places};
+use super::shell;
 use super::turn::BodyTurn;
 use crate::error::{Error, Field, Result};
 use crate::model::block::Mode;
@@ -106,7 +107,8 @@ pub struct Composition<'a> {
 
 impl MassProps {
     /// The mass properties of a die: a solid of its density, rounded with `edge_radius`, less
-    /// its pips (plus their fill), with its centre of mass where `com` puts it if given. The
+    /// its pips (plus their fill), printed as a wall and an infill if it has a shell, with its
+    /// centre of mass where `com` puts it if given. The
     /// plain block's are the closed forms the engines use. Checked.
     pub fn of_composition(s: &Composition) -> Result<MassProps> {
         let [a, b, c] = s.sides;
@@ -199,6 +201,19 @@ impl MassProps {
         }
         if let Some(i) = &f.insert {
             total.add(i.density - rho, &i.moments());
+        }
+        if let Some(sh) = &f.shell {
+            // The wall at ρ, the inner solid at ρ·infill: the inner solid's (1 − infill)
+            // taken back. A wall too thick for the die (refused by the checks) leaves none.
+            let inner = match s.shape {
+                Some(shape) => shell::inner_shape(shape, sh.wall),
+                None => {
+                    (sh.wall < half.min()).then(|| shell::inner_box(&half, f.edge_radius, sh.wall))
+                }
+            };
+            if let Some(inner) = inner {
+                total.add(-(1.0 - sh.infill) * rho, &inner);
+            }
         }
         let m = total.mass;
         let com = match f.com {

@@ -1,6 +1,6 @@
-//! The die as it is made: a centre of mass moved off the centre, drilled pips, rounded edges
-//! (`Features`), and the mass properties of the solid that results (`MassProps`): its mass,
-//! centre of mass and inertia tensor, computed exactly.
+//! The die as it is made: a centre of mass moved off the centre, drilled pips, rounded edges,
+//! a printed shell and infill (`Features`), and the mass properties of the solid that results
+//! (`MassProps`): its mass, centre of mass and inertia tensor, computed exactly.
 //!
 //! Every part is a box, a slab, a quarter cylinder, an eighth of a sphere, a spherical cap or a
 //! cylinder, whose mass and first and second moments are closed forms (the cavities' are
@@ -10,21 +10,26 @@
 //! the parallel-axis theorem, and its eigenvectors are the body's principal frame.
 //!
 //! By concern: the description (`features`), its checks (`validate`), the die file
-//! (`die_file`), the pips' geometry (`pips`), a part's moments (`moments`), the mass integration (`integrate`) and the frame
-//! an engine's body is turned by (`turn`).
+//! (`die_file`), the pips' geometry (`pips`), a printed die's inner solid (`shell`), a part's
+//! moments (`moments`), the mass integration (`integrate`) and the frame an engine's body is
+//! turned by (`turn`).
 
 mod die_file;
 mod features;
 mod integrate;
 mod moments;
 mod pips;
+mod shell;
+#[cfg(test)]
+mod shell_tests;
 #[cfg(test)]
 mod tests;
 mod turn;
 mod validate;
 
 pub use die_file::{is_mesh, DieFile, LabelDef, ReadFile, MAX_DIE_FILE};
-pub use features::{pattern, Features, Insert, PipShape, Pips};
+pub use features::{pattern, Features, Insert, PipShape, Pips, Shell, DEFAULT_WALL};
 pub use integrate::{rounded_box, Composition, MassProps};
 pub use pips::{cavity, pip_places};
+pub use shell::{inner_hull, inradius};
 pub use turn::BodyTurn;

@@ -1,7 +1,7 @@
 //! The checks on a die's description: its features against a cuboid's half sides or a die of
 //! any shape, each refusal one line naming the field.
 
-use super::features::{Features, Insert, PipShape, Pips};
+use super::features::{Features, Insert, PipShape, Pips, Shell};
 use super::pips::pip_places;
 use crate::error::{Error, Field, Result};
 use crate::model::block::Mode;
@@ -29,8 +29,8 @@ impl Features {
         }
         if mode == Mode::TwoD {
             return Err(Error::Invalid(
-                "a centre of mass off the centre, pips and rounded edges are modelled in 3D only \
-                 (2D is the paper's ideal block): roll it in 3D"
+                "a centre of mass off the centre, pips, rounded edges and a printed shell are \
+                 modelled in 3D only (2D is the paper's ideal block): roll it in 3D"
                     .into(),
             ));
         }
@@ -72,6 +72,9 @@ impl Features {
         }
         if let Some(t) = self.inertia {
             validate_inertia(t)?;
+        }
+        if let Some(sh) = &self.shell {
+            self.validate_shell(sh, min_half, "half the shortest side")?;
         }
         Ok(())
     }
@@ -137,6 +140,81 @@ impl Features {
         }
         if let Some(t) = self.inertia {
             validate_inertia(t)?;
+        }
+        if let Some(sh) = &self.shell {
+            self.validate_shell_on(sh, shape)?;
+        }
+        Ok(())
+    }
+
+    /// A printed die's shell: a wall thinner than the die's `inradius` (`what` it is), an
+    /// infill fraction in [0, 1], and nothing inside it the model does not combine with it (an
+    /// insert in the infill, a pip deeper than the wall).
+    fn validate_shell(&self, sh: &Shell, inradius: f64, what: &str) -> Result<()> {
+        let mm = shown_mm;
+        if !(sh.wall.is_finite() && sh.wall > 0.0 && sh.wall < inradius) {
+            return Err(Error::field(
+                Field::ShellWall,
+                mm(sh.wall),
+                format!(
+                    "must be positive and under the die's inradius, {} mm ({what})",
+                    mm(inradius)
+                ),
+            ));
+        }
+        if !(sh.infill.is_finite() && (0.0..=1.0).contains(&sh.infill)) {
+            return Err(Error::field(
+                Field::ShellInfill,
+                sh.infill,
+                "must be a fraction in [0, 1] (of the volume inside the wall; 1: solid)",
+            ));
+        }
+        if self.insert.is_some() {
+            return Err(Error::field(
+                Field::InsertCentre,
+                "",
+                "an insert in a printed die's infill is not modelled: give the insert or the \
+                 shell, not both",
+            ));
+        }
+        if let Some(p) = self.pips.filter(|p| p.depth > sh.wall) {
+            return Err(Error::field(
+                Field::PipsDepth,
+                mm(p.depth),
+                format!(
+                    "is deeper than the shell's wall ({} mm): a pip reaching into the infill \
+                     is not modelled",
+                    mm(sh.wall)
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// A shell on a die of any shape: a convex one (a mesh with a dent or a hollow has no
+    /// offset the model takes), its wall under its inradius, an inner solid found.
+    fn validate_shell_on(&self, sh: &Shell, shape: &crate::model::shape::Shape) -> Result<()> {
+        if shape.hull_note().is_some() {
+            return Err(Error::field(
+                Field::ShellWall,
+                shown_mm(sh.wall),
+                format!(
+                    "a shell is modelled on a convex die; {} is not convex",
+                    shape.name
+                ),
+            ));
+        }
+        self.validate_shell(
+            sh,
+            super::shell::inradius(shape),
+            "the nearest facet from its centroid",
+        )?;
+        if super::shell::inner_shape(shape, sh.wall).is_none() {
+            return Err(Error::field(
+                Field::ShellWall,
+                shown_mm(sh.wall),
+                "leaves no inner solid that can be integrated (a thinner wall)",
+            ));
         }
         Ok(())
     }
