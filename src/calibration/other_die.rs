@@ -2,7 +2,9 @@
 //! calibration carried from the die it was fitted on to a die it never saw. The surface's and
 //! the thrower's parameters are the fit's (its posterior draws); the die's geometry, mass and
 //! centre of mass are the new die's own, and a parameter of the fitted die itself (its centre
-//! of mass, its pips' depth) is not carried: it belongs to that die.
+//! of mass, its pips' depth) is not carried: it belongs to that die. A printed die's infill is
+//! carried: it is the printer's setting, not the die's shape (issue 72: calibrate on one print,
+//! predict the next design printed alike).
 
 use crate::calibration::params::{Fixed, FixedThrow, Method};
 use crate::calibration::FitResult;
@@ -107,12 +109,12 @@ impl OtherDie {
 }
 
 /// The values `v` for another die: the fitted die's own parameters (its centre of mass, its
-/// pips' depth, its infill) dropped, the new die's taken as it is described.
+/// pips' depth) dropped, the new die's taken as it is described; a fitted infill kept (the
+/// printer's, in the new die's own shell or a 1 mm one).
 pub fn without_die_params(v: Fixed) -> Fixed {
     Fixed {
         com: [None; 3],
         pip_depth: None,
-        infill: None,
         ..v
     }
 }
