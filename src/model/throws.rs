@@ -267,22 +267,26 @@ impl Throw {
         let rotation = turn.orientation(scene.mode);
         let [sx, sy, sz] = turn.spin_axis;
         let sign = |v: f64| if v < 0.0 { -1.0 } else { 1.0 };
-        match (self.style, scene.mode) {
-            (ThrowStyle::Paper, _) => paper,
-            (ThrowStyle::Tumble | ThrowStyle::Hand, Mode::ThreeD) => BodyState {
+        // A tumble's, a hand's and a toss's motion: along the heading, about the spin axis.
+        let (linear_velocity, angular_velocity) = match scene.mode {
+            Mode::ThreeD => (
+                self.velocity * Vector3::new(turn.heading.cos(), 0.0, turn.heading.sin()),
+                self.spin * Vector3::new(sx, sy, sz),
+            ),
+            Mode::TwoD => (
+                Vector3::new(sign(turn.heading.cos()) * self.velocity, 0.0, 0.0),
+                Vector3::new(0.0, 0.0, sign(sz) * self.spin),
+            ),
+        };
+        match self.style {
+            ThrowStyle::Paper => paper,
+            ThrowStyle::Tumble | ThrowStyle::Hand => BodyState {
                 rotation,
-                linear_velocity: self.velocity
-                    * Vector3::new(turn.heading.cos(), 0.0, turn.heading.sin()),
-                angular_velocity: self.spin * Vector3::new(sx, sy, sz),
+                linear_velocity,
+                angular_velocity,
                 ..paper
             },
-            (ThrowStyle::Tumble | ThrowStyle::Hand, Mode::TwoD) => BodyState {
-                rotation,
-                linear_velocity: Vector3::new(sign(turn.heading.cos()) * self.velocity, 0.0, 0.0),
-                angular_velocity: Vector3::new(0.0, 0.0, sign(sz) * self.spin),
-                ..paper
-            },
-            (ThrowStyle::Rest | ThrowStyle::Toss, _) => {
+            ThrowStyle::Rest | ThrowStyle::Toss => {
                 let at_zero = BodyState {
                     position: Vector3::zeros(),
                     rotation,
@@ -293,21 +297,17 @@ impl Throw {
                 // In 2D the rotation is about z only, so the 1 m depth adds nothing here. The
                 // position is the centre of mass's (`DieShape::lowest_point`).
                 let touching = -crate::model::die::DieShape::of(scene).lowest_point(&at_zero);
-                let rest = BodyState {
-                    position: Vector3::new(0.0, touching, 0.0),
-                    ..at_zero
-                };
                 if self.style == ThrowStyle::Rest {
-                    return rest;
+                    return BodyState {
+                        position: Vector3::new(0.0, touching, 0.0),
+                        ..at_zero
+                    };
                 }
-                let tumble = Throw {
-                    style: ThrowStyle::Tumble,
-                    ..*self
-                }
-                .start(scene);
                 BodyState {
                     position: Vector3::new(0.0, touching + self.drop_height, 0.0),
-                    ..tumble
+                    linear_velocity,
+                    angular_velocity,
+                    ..at_zero
                 }
             }
         }
