@@ -409,6 +409,7 @@ def roll(
     com: Optional[Sequence[float]] = None,
     pips: Optional[Sequence[float]] = None,
     edge_radius: Optional[float] = None,
+    shell: Optional[Sequence[float]] = None,
     die: Optional[PathLike] = None,
     layout: Optional[str] = None,
     threads: int = 0,
@@ -429,7 +430,8 @@ def roll(
     engine: "bullet", "rapier", "rapier-locked" or "moreau" (the arbiter).
     dt: the fixed time step, s.  restitution, friction: the die's e and μ (the floor's are 1).
     density: kg/m³ (default 800, or the ``die`` file's).
-    throw: "paper" (the default), "tumble", "hand" (with ``kappa``) or "rest".
+    throw: "paper" (the default), "tumble", "hand" (with ``kappa``), "rest" or "toss" (a
+        hand's toss: the tumble's directions, its magnitudes drawn with scales).
     kappa: a hand's throw's concentration κ (alone, it asks for ``throw="hand"``).
     source: "keyed" (each throw from (seed, index)) or "dicephys" (DicePhys's rand()).
     velocity, spin, drop_height: the throw's ranges, one number or (low, high)
@@ -442,7 +444,8 @@ def roll(
     settle: None (the exact early stop where it is audited exact), "certificate" or
         "dicephys".  flight: "fast" or "stepped".  faithful: DicePhys as the paper ran it.
     com: the centre of mass (x, y, z) in mm from the geometric centre; pips: (diameter,
-        depth) in mm; edge_radius: mm; die: a die file (TOML) — a die as it is made.
+        depth) in mm; edge_radius: mm; shell: a printed die's (wall mm, infill fraction);
+        die: a die file (TOML) — a die as it is made.
     layout: "right" or "left": how the numbers sit on the faces (default: the ``die``
         file's layout or face map, else "right").
     threads: worker threads (0: one per core).
@@ -459,7 +462,8 @@ def roll(
         angular_damping=angular_damping, rolling_resistance=rolling_resistance, sleep=sleep,
         throw=throw, kappa=kappa, source=source, velocity=velocity, spin=spin,
         drop_height=drop_height, settle=settle, flight=flight, faithful=faithful,
-        max_steps=max_steps, margin=margin, com=com, pips=pips, edge_radius=edge_radius, die=die,
+        max_steps=max_steps, margin=margin, com=com, pips=pips, edge_radius=edge_radius,
+        shell=shell, die=die,
         layout=layout, threads=threads, per_roll=per_roll,
     )
 
@@ -479,6 +483,7 @@ def _roll(
         opts[k] = _pair(k, opts.get(k))
     opts["com"] = _triple("com", opts.get("com"), 3)
     opts["pips"] = _triple("pips", opts.get("pips"), 2)
+    opts["shell"] = _triple("shell", opts.get("shell"), 2)
     # A bool is an int to Python and a number to the library: size=True would be 1 mm.
     for k in ("size", "scale", "density", "edge_radius", "kappa", "dt", "restitution", "friction"):
         if isinstance(opts.get(k), bool):
@@ -535,6 +540,7 @@ def fair(
     com: Optional[Sequence[float]] = None,
     pips: Optional[Sequence[float]] = None,
     edge_radius: Optional[float] = None,
+    shell: Optional[Sequence[float]] = None,
     die: Optional[PathLike] = None,
     layout: Optional[str] = None,
     threads: int = 0,
@@ -570,7 +576,8 @@ def fair(
         angular_damping=angular_damping, rolling_resistance=rolling_resistance, sleep=sleep,
         throw=throw, kappa=kappa, source=source, velocity=velocity, spin=spin,
         drop_height=drop_height, settle=settle, flight=flight, faithful=faithful,
-        max_steps=max_steps, margin=margin, com=com, pips=pips, edge_radius=edge_radius, die=die,
+        max_steps=max_steps, margin=margin, com=com, pips=pips, edge_radius=edge_radius,
+        shell=shell, die=die,
         layout=layout, threads=threads, per_roll=per_roll,
     )
 
@@ -672,6 +679,7 @@ def _fit_config(
     com: Optional[Sequence[float]] = None,
     pips: Optional[Sequence[float]] = None,
     edge_radius: Optional[float] = None,
+    shell: Optional[Sequence[float]] = None,
     die: Optional[PathLike] = None,
     layout: Optional[str] = None,
     density: Optional[float] = None,
@@ -684,6 +692,7 @@ def _fit_config(
     rs = [(k, float(lo), float(hi)) for k, (lo, hi) in (ranges or {}).items()]
     made = dict(
         com=_triple("com", com, 3), pips=_triple("pips", pips, 2), edge_radius=edge_radius,
+        shell=_triple("shell", shell, 2),
         die=None if die is None else os.fspath(die), layout=layout, density=density,
         shape=shape, size=size, scale=scale,
     )
@@ -717,6 +726,7 @@ def fit(
     com: Optional[Sequence[float]] = None,
     pips: Optional[Sequence[float]] = None,
     edge_radius: Optional[float] = None,
+    shell: Optional[Sequence[float]] = None,
     die: Optional[PathLike] = None,
     layout: Optional[str] = None,
     density: Optional[float] = None,
@@ -731,8 +741,9 @@ def fit(
 
     data: the counts — a CSV path (docs/guide.md, "Calibrating"), "paper" (the paper's 19
         rows), a pandas DataFrame or a list of dicts with the CSV's columns.
-    free: the free parameters, among "e", "mu", "kappa", "spin", "height", "speed" (the
-        last three factors on the throw's spin, launch height and launch speed); for a die,
+    free: the free parameters, among "e", "mu", "rolling" (the contact's rolling resistance,
+        mm; Bullet only), "kappa", "spin", "height", "speed" (the last three factors on the
+        throw's spin, launch height and launch speed); for a die,
         "com_x", "com_y", "com_z" (its centre of mass, mm), "pip_depth" (mm) and "infill" (a
         printed die's infill fraction, 0 to 1, in its shell's wall or a 1 mm one).
     shared: surface parameters shared by every surface instead of one per surface.
@@ -742,7 +753,7 @@ def fit(
     points, point_rolls: the design (parameter points per block per pass, rolls at each).
     degree, max_degree: the surrogate's polynomial degree, first and highest (None: 3 and 4;
         2 and 2 for a die of more than six faces).
-    com, pips, edge_radius, die, layout, density: the die thrown, as ``roll`` takes it (one
+    com, pips, edge_radius, shell, die, layout, density: the die thrown, as ``roll`` takes it (one
         die for every row; a counts file with face_1 … face_6 counts its faces).
     shape, size, scale: a die of any shape, as ``roll`` takes it ("d20", "coin:24,8"; or a
         mesh ``die``): the counts are then label, surface and a face_<label> column for each
@@ -753,8 +764,8 @@ def fit(
     config = _fit_config(
         data, free, shared, ranges, restitution, friction, kappa, spin_scale, engine, dt,
         max_steps, points, point_rolls, degree, max_degree, refine, common_throws, seed,
-        com=com, pips=pips, edge_radius=edge_radius, die=die, layout=layout, density=density,
-        shape=shape, size=size, scale=scale,
+        com=com, pips=pips, edge_radius=edge_radius, shell=shell, die=die, layout=layout,
+        density=density, shape=shape, size=size, scale=scale,
     )
     where = _out(out, "fit")
     tell, close = _progress(progress, "fit")
@@ -790,6 +801,7 @@ def recover(
     com: Optional[Sequence[float]] = None,
     pips: Optional[Sequence[float]] = None,
     edge_radius: Optional[float] = None,
+    shell: Optional[Sequence[float]] = None,
     die: Optional[PathLike] = None,
     layout: Optional[str] = None,
     density: Optional[float] = None,
@@ -811,8 +823,8 @@ def recover(
     config = _fit_config(
         data, free, shared, ranges, restitution, friction, kappa, spin_scale, engine, dt,
         max_steps, points, point_rolls, degree, max_degree, refine, common_throws, seed,
-        com=com, pips=pips, edge_radius=edge_radius, die=die, layout=layout, density=density,
-        shape=shape, size=size, scale=scale,
+        com=com, pips=pips, edge_radius=edge_radius, shell=shell, die=die, layout=layout,
+        density=density, shape=shape, size=size, scale=scale,
     )
     where = _out(out, "recover")
     tell, close = _progress(progress, "recover")

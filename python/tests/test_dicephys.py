@@ -51,6 +51,18 @@ def test_counts_equal_the_cli_for_the_same_seed(engine: str, mode: str) -> None:
     assert mine == theirs
 
 
+def test_a_printed_die_in_a_toss_is_the_cli_s() -> None:
+    # Issue 72's candidates through Python: a printed shell and a hand's toss.
+    args = ["roll", "--shape", "d8", "--shell", "1,0.2", "--throw", "toss", "--rolls", "300"]
+    want = cli(*args, "--seed", "2", "--json")
+    got = dicephys.roll(shape="d8", shell=(1, 0.2), throw="toss", rolls=300, seed=2)
+    assert got.faces == want["faces"]
+    assert got.steps_total == want["steps_total"]
+    assert want["spec"]["scene"]["features"]["shell"] == {"wall": 0.001, "infill": 0.2}
+    with pytest.raises(ValueError, match="shell"):
+        dicephys.roll(shape="d8", shell=(1,), rolls=10)
+
+
 def test_a_die_of_any_shape_is_the_cli_s(tmp_path: Path) -> None:
     want = cli("roll", "--shape", "d20", "--rolls", "2000", "--seed", "1", "--json")
     got = dicephys.roll(shape="d20", rolls=2000, seed=1)
