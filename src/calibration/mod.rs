@@ -87,35 +87,7 @@ impl FitConfig {
             )));
         }
         self.check_shape()?;
-        if self.model.fixed.throw == params::FixedThrow::Rest {
-            if let Some(k) = self.model.free.iter().find(|k| {
-                matches!(
-                    k,
-                    params::Kind::Kappa
-                        | params::Kind::Spin
-                        | params::Kind::Height
-                        | params::Kind::Speed
-                )
-            }) {
-                return Err(Error::field(
-                    Field::Free,
-                    k.name(),
-                    "a die released at rest has no spin, height, speed or κ to fit",
-                ));
-            }
-        }
-        if self.model.is_free(params::Kind::Rolling)
-            && self.method.engine != crate::engine::EngineKind::Bullet
-        {
-            return Err(Error::field(
-                Field::Free,
-                "rolling",
-                format!(
-                    "{} has no rolling resistance: give --engine bullet",
-                    self.method.engine
-                ),
-            ));
-        }
+        self.check_candidates()?;
         if self.model.is_free(params::Kind::PipDepth)
             && self
                 .method
@@ -235,6 +207,41 @@ impl FitConfig {
             boxes.join(","),
             format!("the die at the box's end, its {what} {value} mm, {why}; narrow the range"),
         )
+    }
+
+    /// Issue 72's candidates where they cannot run: a release at rest has no spin, height,
+    /// speed or κ to fit; rolling resistance is Bullet's alone.
+    fn check_candidates(&self) -> Result<()> {
+        if self.model.fixed.throw == params::FixedThrow::Rest {
+            if let Some(k) = self.model.free.iter().find(|k| {
+                matches!(
+                    k,
+                    params::Kind::Kappa
+                        | params::Kind::Spin
+                        | params::Kind::Height
+                        | params::Kind::Speed
+                )
+            }) {
+                return Err(Error::field(
+                    Field::Free,
+                    k.name(),
+                    "a die released at rest has no spin, height, speed or κ to fit",
+                ));
+            }
+        }
+        if self.model.is_free(params::Kind::Rolling)
+            && self.method.engine != crate::engine::EngineKind::Bullet
+        {
+            return Err(Error::field(
+                Field::Free,
+                "rolling",
+                format!(
+                    "{} has no rolling resistance: give --engine bullet",
+                    self.method.engine
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// A die of any shape and its rows agree: every row counts its faces by label, in its

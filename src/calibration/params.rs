@@ -717,7 +717,9 @@ mod tests {
         // Not free and not given: none, as before (the paper's scenes are unchanged).
         let plain = method.spec(rows[0].block, rows[0].mode, &Fixed::default(), 1, 10);
         assert_eq!(plain.scene.rolling_resistance, 0.0);
-        assert!(!serde_json::to_string(&Fixed::default()).unwrap().contains("rolling"));
+        assert!(!serde_json::to_string(&Fixed::default())
+            .unwrap()
+            .contains("rolling"));
     }
 
     #[test]

@@ -72,3 +72,27 @@ fn rolling_resistance_is_a_fit_parameter_of_bullets_contact() {
     ]);
     refused(&o, 2, "rolling");
 }
+
+#[test]
+fn a_fit_thrown_at_rest_has_no_throw_to_fit() {
+    // A drop from rest (`fit --throw rest`, the published predictions' throw) has no spin,
+    // height, speed or κ: freeing one is refused in one line, as is a style beside --kappa.
+    let o = dicephys(&[
+        "fit",
+        "--data",
+        "paper",
+        "--throw",
+        "rest",
+        "--free",
+        "e,spin",
+        "--points",
+        "6",
+        "--degree",
+        "1",
+        "--point-rolls",
+        "20",
+    ]);
+    refused(&o, 2, "--free spin: a die released at rest");
+    let o = dicephys(&["fit", "--data", "paper", "--throw", "toss", "--kappa", "3"]);
+    refused(&o, 2, "--kappa 3 with --throw");
+}
