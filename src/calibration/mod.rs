@@ -26,6 +26,7 @@ pub mod compare;
 pub mod crossval;
 pub mod data;
 pub mod design;
+pub mod dice;
 pub mod discrepancy;
 pub mod estimate;
 pub mod heldout;
@@ -116,9 +117,11 @@ impl FitConfig {
                 ),
             ));
         }
+        self.check_dice()?;
+        // One die for every row from here (several are refused its own parameters).
+        let method = self.method.of_row(&self.rows[0]);
         if self.model.is_free(params::Kind::PipDepth)
-            && self
-                .method
+            && method
                 .shape
                 .as_deref()
                 .is_some_and(|s| s.as_box().is_none())
@@ -130,7 +133,7 @@ impl FitConfig {
                  com_x, com_y or com_z",
             ));
         }
-        if self.model.is_free(params::Kind::PipDepth) && self.method.die.pips.is_none() {
+        if self.model.is_free(params::Kind::PipDepth) && method.die.pips.is_none() {
             return Err(Error::field(
                 Field::Free,
                 "pip_depth",
@@ -186,6 +189,7 @@ impl FitConfig {
             for u in [0.0, 1.0, 0.5] {
                 let v = params::values(&self.model.fixed, &self.model.whole_axes(), &vec![u; dims]);
                 self.method
+                    .of_row(r)
                     .spec(r.block, r.mode, &v, self.seed, self.design.rolls)
                     .validate(false)
                     .map_err(|e| self.at_box_end(e))?;
@@ -237,37 +241,84 @@ impl FitConfig {
         )
     }
 
-    /// A die of any shape and its rows agree: every row counts its faces by label, in its
-    /// order ([`data::on_shape`]), and it is thrown in a tumble or a toss (it has no long axis
-    /// for the paper's or a hand's throw, so no κ); without one, no row counts faces by label.
-    fn check_shape(&self) -> Result<()> {
-        let Some(shape) = &self.method.shape else {
-            return match self.rows.iter().find(|r| r.of_shape()) {
-                Some(r) => Err(Error::Invalid(format!(
-                    "row '{}' counts the faces of a die of any shape (face_{}…): give the die \
-                     (--shape, or a mesh --die)",
-                    data::shown(&r.label),
-                    r.labels[0]
-                ))),
-                None => Ok(()),
-            };
-        };
-        if let Some(r) = self
+    /// Several dice (a `die` column naming more than one, or one beside the command line's):
+    /// the surface's and the thrower's parameters are shared across them, but a die's own
+    /// centre of mass or pip depth would belong to one die, and is refused (a free infill is
+    /// the printer's setting, each die's in its own wall, and is kept).
+    fn check_dice(&self) -> Result<()> {
+        let mut dice: Vec<String> = dice::names(&self.rows)
+            .into_iter()
+            .map(String::from)
+            .collect();
+        if let Some(s) = self
             .rows
             .iter()
-            .find(|r| r.labels != shape.outcome_labels())
+            .find(|r| r.die.is_none())
+            .and(self.method.shape.as_ref())
         {
-            return Err(Error::Invalid(format!(
-                "row '{}' does not count {}'s faces in its order (read the rows with \
-                 calibration::data::on_shape)",
-                data::shown(&r.label),
-                shape.name
-            )));
+            dice.push(s.name.clone());
         }
+        if dice.len() < 2 {
+            return Ok(());
+        }
+        let own = [
+            params::Kind::ComX,
+            params::Kind::ComY,
+            params::Kind::ComZ,
+            params::Kind::PipDepth,
+        ];
+        match own.iter().find(|k| self.model.is_free(**k)) {
+            Some(k) => {
+                Err(Error::field(
+                    Field::Free,
+                    k.name(),
+                    format!(
+                    "is one die's own, and the rows name {} dice ({}): free it in a fit of one \
+                     die",
+                    dice.len(),
+                    dice.iter().map(|d| data::shown(d)).collect::<Vec<_>>().join(", ")
+                ),
+                ))
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// Each die of any shape and its rows agree: every row counts its die's faces by label, in
+    /// its order ([`data::on_shape`]), and a die of any shape is thrown in a tumble or a toss
+    /// (it has no long axis for the paper's or a hand's throw, so no κ); a row of no die of any
+    /// shape counts no faces by label.
+    fn check_shape(&self) -> Result<()> {
+        let mut shaped = None;
+        for r in &self.rows {
+            let method = self.method.of_row(r);
+            let Some(shape) = &method.shape else {
+                if r.of_shape() {
+                    return Err(Error::Invalid(format!(
+                        "row '{}' counts the faces of a die of any shape (face_{}…): give the \
+                         die (--shape, a mesh --die, or the row's die column)",
+                        data::shown(&r.label),
+                        r.labels[0]
+                    )));
+                }
+                continue;
+            };
+            if r.labels != shape.outcome_labels() {
+                return Err(Error::Invalid(format!(
+                    "row '{}' does not count {}'s faces in its order (read the rows with \
+                     calibration::data::on_shape)",
+                    data::shown(&r.label),
+                    shape.name
+                )));
+            }
+            shaped.get_or_insert(shape.name.clone());
+        }
+        let Some(name) = shaped else {
+            return Ok(());
+        };
         let why = format!(
-            "{} is thrown in a tumble or a toss: the paper's and a hand's throw spin a die about its \
-             long axis, which it has not",
-            shape.name
+            "{name} is thrown in a tumble or a toss: the paper's and a hand's throw spin a die \
+             about its long axis, which it has not"
         );
         if self.model.is_free(params::Kind::Kappa) {
             return Err(Error::field(Field::Free, "kappa", why));
@@ -745,6 +796,7 @@ mod tests {
             counts: vec![0, 1, 2],
             groups: vec![vec![0], vec![1], vec![2]],
             labels: vec![],
+            die: None,
         };
         let rows = [row];
         let model = ModelSpec::free(&[Kind::E]);

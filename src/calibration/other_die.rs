@@ -96,7 +96,13 @@ impl OtherDie {
             .model
             .is_free(crate::calibration::params::Kind::Kappa);
         let throw = fit.config.model.fixed.throw;
-        if let (Some(s), true) = (&self.shape, hand || !matches!(throw, FixedThrow::Tumble | FixedThrow::Toss | FixedThrow::Rest)) {
+        if let (Some(s), true) = (
+            &self.shape,
+            hand || !matches!(
+                throw,
+                FixedThrow::Tumble | FixedThrow::Toss | FixedThrow::Rest
+            ),
+        ) {
             return Err(Error::field(
                 Field::Shape,
                 &s.name,

@@ -171,6 +171,8 @@ pub fn score_loo(
         let row = &cfg.rows[r];
         let counts = loo[r].counts.clone();
         let faces = row.outcomes == crate::calibration::data::Outcomes::Faces;
+        // The row's own die, where it names one.
+        let method = &*method.of_row(row);
         let Some((shares, settled)) = shares_at(
             method,
             fixed,
@@ -298,6 +300,7 @@ mod tests {
             die: Default::default(),
             density: None,
             shape: None,
+            dice: Vec::new(),
         }
     }
 

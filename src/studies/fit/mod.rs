@@ -369,7 +369,12 @@ fn pooled(cfg: &FitConfig, designs: Vec<Design>, rolled: &mut Vec<Design>) -> Ve
             let all: Vec<_> = d.points.iter().chain(&borrowed).cloned().collect();
             let key = design::Key::of_design(d);
             Design {
-                surrogate: simulate::surrogate(&all, &key, &cfg.method, &cfg.design),
+                surrogate: simulate::surrogate(
+                    &all,
+                    &key,
+                    &cfg.method.for_die(key.die.as_deref()),
+                    &cfg.design,
+                ),
                 borrowed,
                 ..d.clone()
             }

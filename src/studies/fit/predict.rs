@@ -300,6 +300,7 @@ fn draw_specs(
         counts: vec![0, 1, 1],
         groups: vec![vec![1], vec![2]],
         labels: Vec::new(),
+        die: None,
     };
     let model = &fit.config.model;
     let dims = model.row_dims(&fit.params, &row);
