@@ -394,6 +394,10 @@ pub struct FitResult {
     /// `loo[].scores`); left out where there are none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub loo_scores: Option<proper::Scores>,
+    /// Where the rows name their dice: each die's rows, predicted by a fit of the other dice,
+    /// their proper scores summed per die (`loo_scores` sums them all).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub loo_dice: Vec<proper::DieScores>,
     /// What it cost.
     pub cost: FitCost,
     /// The command line that made it.
