@@ -889,6 +889,37 @@ mod tests {
     }
 
     #[test]
+    fn a_die_column_names_each_rows_die_and_its_faces_are_the_cells_it_fills() {
+        let rows = parse(
+            "label,surface,die,face_1,face_2,face_3,face_4,face_5,face_6,face_7,face_8,thrower\n\
+             a,felt,d6,1,2,3,4,5,6,,-,me\n\
+             b,felt,d8,1,2,3,4,5,6,7,8,me\n\
+             c,felt,,1,2,3,4,5,6,,,me\n",
+            "f.csv",
+        )
+        .unwrap();
+        assert_eq!(rows[0].die.as_deref(), Some("d6"));
+        assert_eq!(rows[0].labels, ["1", "2", "3", "4", "5", "6"]);
+        assert_eq!(rows[1].labels.len(), 8);
+        assert_eq!(rows[1].n(), 36);
+        assert_eq!(
+            (rows[2].die.as_deref(), rows[2].thrower.as_str()),
+            (None, "me")
+        );
+        // Read against its die: a d6's row is the d6's, and a face it lacks is refused.
+        let d6 = crate::model::shape::named("d6", None).unwrap();
+        assert_eq!(on_shape(&rows[..1], &d6).unwrap()[0].counts.len(), 6);
+        let e = on_shape(&rows[1..2], &d6).unwrap_err().to_string();
+        assert!(e.contains("not its faces: face_7, face_8"), "{e}");
+        // A cell of a count column still says what is wrong, at its column.
+        let e = parse("label,surface,die,face_1,face_2\na,felt,d6,1,x\n", "f.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("line 2, column 5 (face_2)"), "{e}");
+        assert!(is_die_file("v1.toml") && is_die_file("m/c.OBJ") && !is_die_file("coin:24.5,2"));
+    }
+
+    #[test]
     fn the_papers_rows_are_all_nineteen() {
         let rows = paper_rows().unwrap();
         assert_eq!(rows.len(), 19);

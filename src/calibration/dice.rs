@@ -94,7 +94,13 @@ pub fn resolve_rows(rows: &[DataRow]) -> Result<Vec<RowDie>> {
                 format!(
                     "row '{}': its die '{}': {why}",
                     data::shown(&r.label),
-                    data::shown(name)
+                    // Whole (a path is long), its control characters escaped.
+                    name.chars()
+                        .flat_map(|c| match c.is_control() {
+                            true => c.escape_default().collect::<Vec<_>>(),
+                            false => vec![c],
+                        })
+                        .collect::<String>()
                 ),
             )
         })?;

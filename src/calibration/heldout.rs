@@ -446,7 +446,6 @@ mod tests {
             faces: None,
             labels: Vec::new(),
             shape: None,
-            dice: Vec::new(),
             theory_ratio: Some(0.5),
             draws: 2,
             rolls: 10,
