@@ -118,49 +118,10 @@ impl FitConfig {
             ));
         }
         self.check_dice()?;
-        // One die for every row from here (several are refused its own parameters).
-        let method = self.method.of_row(&self.rows[0]);
-        if self.model.is_free(params::Kind::PipDepth)
-            && method
-                .shape
-                .as_deref()
-                .is_some_and(|s| s.as_box().is_none())
-        {
-            return Err(Error::field(
-                Field::Free,
-                "pip_depth",
-                "a die of any shape has no pips (they are drilled in a cuboid's faces): free \
-                 com_x, com_y or com_z",
-            ));
-        }
-        if self.model.is_free(params::Kind::PipDepth) && method.die.pips.is_none() {
-            return Err(Error::field(
-                Field::Free,
-                "pip_depth",
-                "the die has no pips to vary: give them (--pips D,H or a die file's [pips])",
-            ));
-        }
+        self.check_pips()?;
         let com_free = [params::Kind::ComX, params::Kind::ComY, params::Kind::ComZ]
             .into_iter()
             .filter(|&k| self.model.is_free(k));
-        if self.model.is_free(params::Kind::PipDepth) && com_free.clone().count() > 0 {
-            return Err(Error::field(
-                Field::Free,
-                "pip_depth",
-                "and a free centre of mass cannot be told apart: pips bias a die through the \
-                 centre of mass they move, and a free centre is given outright; free one or \
-                 the other",
-            ));
-        }
-        if self.model.is_free(params::Kind::Infill) && com_free.clone().count() > 0 {
-            return Err(Error::field(
-                Field::Free,
-                "infill",
-                "and a free centre of mass cannot be told apart: the infill biases a die \
-                 through the centre of mass it moves, and a free centre is given outright; free \
-                 one or the other",
-            ));
-        }
         for kind in com_free {
             let r = self.model.range(kind);
             let axis = kind as usize - params::Kind::ComX as usize;
@@ -239,6 +200,55 @@ impl FitConfig {
             boxes.join(","),
             format!("the die at the box's end, its {what} {value} mm, {why}; narrow the range"),
         )
+    }
+
+    /// A free pip depth needs a die with pips, a cuboid's (one die for every row by now:
+    /// several dice are refused it, [`FitConfig::check_dice`]); a free pip depth or infill
+    /// cannot be told from a free centre of mass.
+    fn check_pips(&self) -> Result<()> {
+        let method = self.method.of_row(&self.rows[0]);
+        if self.model.is_free(params::Kind::PipDepth)
+            && method
+                .shape
+                .as_deref()
+                .is_some_and(|s| s.as_box().is_none())
+        {
+            return Err(Error::field(
+                Field::Free,
+                "pip_depth",
+                "a die of any shape has no pips (they are drilled in a cuboid's faces): free \
+                 com_x, com_y or com_z",
+            ));
+        }
+        if self.model.is_free(params::Kind::PipDepth) && method.die.pips.is_none() {
+            return Err(Error::field(
+                Field::Free,
+                "pip_depth",
+                "the die has no pips to vary: give them (--pips D,H or a die file's [pips])",
+            ));
+        }
+        let com_free = [params::Kind::ComX, params::Kind::ComY, params::Kind::ComZ]
+            .into_iter()
+            .filter(|&k| self.model.is_free(k));
+        if self.model.is_free(params::Kind::PipDepth) && com_free.clone().count() > 0 {
+            return Err(Error::field(
+                Field::Free,
+                "pip_depth",
+                "and a free centre of mass cannot be told apart: pips bias a die through the \
+                 centre of mass they move, and a free centre is given outright; free one or \
+                 the other",
+            ));
+        }
+        if self.model.is_free(params::Kind::Infill) && com_free.clone().count() > 0 {
+            return Err(Error::field(
+                Field::Free,
+                "infill",
+                "and a free centre of mass cannot be told apart: the infill biases a die \
+                 through the centre of mass it moves, and a free centre is given outright; free \
+                 one or the other",
+            ));
+        }
+        Ok(())
     }
 
     /// Several dice (a `die` column naming more than one, or one beside the command line's):
