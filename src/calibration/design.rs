@@ -277,12 +277,16 @@ impl Key {
         let axes: Vec<String> = self.axes.iter().map(|(k, r)| format!("{k}={r}")).collect();
         let h = fnv(&axes.join(","));
         let faces = if self.faces { "-faces" } else { "" };
-        // A row's own die: its name's hash too (two dice may share a bounding box); a fit of
-        // one die keeps the tags, and so the seeds and checkpoints, it had.
-        let die = self
-            .die
-            .as_ref()
-            .map_or(String::new(), |d| format!("-die{:08x}", fnv(d) >> 32));
+        // A row's own die: its name's hash too (two dice may share a bounding box), a die
+        // file's by its file name, so that its seeds do not move with the folder the command
+        // runs in; a fit of one die keeps the tags, and so the seeds and checkpoints, it had.
+        let die = self.die.as_ref().map_or(String::new(), |d| {
+            let name = std::path::Path::new(d)
+                .file_name()
+                .and_then(|n| n.to_str())
+                .unwrap_or(d);
+            format!("-die{:08x}", fnv(name) >> 32)
+        });
         format!(
             "{}-{}{faces}{die}-{:08x}",
             self.block,
