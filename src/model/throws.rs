@@ -747,11 +747,7 @@ mod tests {
             let t = keyed_styled(ThrowStyle::Toss, 0.0, 3, &r, i);
             let s = t.start(&scene);
             let above = crate::model::die::lowest_point(&half, &s);
-            assert!(
-                (above - t.drop_height).abs() < 1e-12,
-                "{above} {}",
-                t.drop_height
-            );
+            assert!((above - t.drop_height).abs() < 1e-12, "{above} {}", t.drop_height);
             assert!((s.angular_velocity.norm() - t.spin).abs() < 1e-9 * t.spin.max(1.0));
             assert!((s.linear_velocity.norm() - t.velocity).abs() < 1e-12);
             assert_eq!(s.linear_velocity.y, 0.0);
