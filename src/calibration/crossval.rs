@@ -30,10 +30,28 @@ fn log_mean_exp(v: &[f64]) -> f64 {
     m + (v.iter().map(|x| (x - m).exp()).sum::<f64>() / v.len() as f64).ln()
 }
 
+/// The rows a leave-one-out leaves out together, in first-seen order: all the rows of one die
+/// (a `die` column's), and every other row alone; each group's rows in the file's order.
+pub fn held_out_groups(rows: &[DataRow]) -> Vec<Vec<usize>> {
+    let mut out: Vec<Vec<usize>> = Vec::new();
+    for (i, r) in rows.iter().enumerate() {
+        let die = r.die.as_ref();
+        match out
+            .iter_mut()
+            .find(|g| die.is_some() && rows[g[0]].die.as_ref() == die)
+        {
+            Some(g) => g.push(i),
+            None => out.push(vec![i]),
+        }
+    }
+    out
+}
+
 /// Every row of `rows` predicted by the fit of the others (in parallel over rows), starting
 /// each fit's search from the whole fit's maximum, its islands and the centre; its draws come
 /// from every maximum within the whole fit's joint 2σ threshold of its best, as the whole
-/// fit's do.
+/// fit's do. The rows of one die (a `die` column's) are left out together, and each predicted
+/// by the fit of the other dice ([`held_out_groups`]): with every die one row, the same.
 pub fn leave_one_out(
     rows: &[DataRow],
     designs: &[Design],
@@ -44,15 +62,26 @@ pub fn leave_one_out(
     watch: &crate::run::stop::Watch,
 ) -> Result<Vec<LooRow>> {
     use rayon::prelude::*;
-    (watch.say)(&format!(
-        "fit: each of {} rows predicted by a fit without it",
-        rows.len()
-    ));
-    let out = (0..rows.len())
+    let groups = held_out_groups(rows);
+    (watch.say)(&if groups.len() == rows.len() {
+        format!(
+            "fit: each of {} rows predicted by a fit without it",
+            rows.len()
+        )
+    } else {
+        format!(
+            "fit: the rows of each of {} dice predicted by a fit without that die",
+            groups.len()
+        )
+    });
+    let out: Result<Vec<Vec<(usize, LooRow)>>> = groups
         .into_par_iter()
-        .map(|r| {
+        .map(|g| {
+            let r = g[0];
             let mut lik = Likelihood::new(rows, designs, model, params).stopped_by(watch.stop);
-            lik.include[r] = false;
+            for &i in &g {
+                lik.include[i] = false;
+            }
             let mut from = whole.starts();
             from.push(vec![0.5; params.len()]);
             let (best, maxima) = maximise_from(&lik, &from)?;
@@ -68,11 +97,13 @@ pub fn leave_one_out(
                 search.draws.max(50),
                 search.seed.wrapping_add(r as u64),
             );
-            Ok(score_row(&lik, r, &draws))
+            Ok(g.iter().map(|&i| (i, score_row(&lik, i, &draws))).collect())
         })
         .collect();
     watch.check()?;
-    out
+    let mut out: Vec<(usize, LooRow)> = out?.into_iter().flatten().collect();
+    out.sort_by_key(|(i, _)| *i);
+    Ok(out.into_iter().map(|(_, row)| row).collect())
 }
 
 /// Row `r` of `lik` predicted at the posterior `draws` and scored.
@@ -118,6 +149,7 @@ pub fn score_row(lik: &Likelihood, r: usize, draws: &[Vec<f64>]) -> LooRow {
     };
     LooRow {
         label: row.label.clone(),
+        die: row.die.clone(),
         surface: row.surface.clone(),
         alone: lik
             .rows()

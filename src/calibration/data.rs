@@ -24,6 +24,18 @@
 //! thick coin,felt,412,398,190
 //! ```
 //!
+//! Several dice in one file: a `die` column after the surface names each row's die, a shape
+//! name as `--shape` takes it (`d8`, `coin:24,2`) or a die file as `--die` takes it (a TOML or
+//! a mesh, by its extension), a path relative to the file's folder ([`read`] joins it). Each
+//! row fills its own die's `face_<label>` columns and leaves the others empty (or `-`); a row
+//! whose die cell is empty is the command line's die's (`--shape`/`--die`):
+//!
+//! ```text
+//! label,surface,die,face_1,face_2,face_3,face_4,face_5,face_6,face_7,face_8
+//! cube,felt,d6,170,162,171,165,168,164,,
+//! octahedron,felt,d8,126,118,131,122,125,127,120,131
+//! ```
+//!
 //! - `mode`: how the row is simulated, `3d` (a free body) or `2d` (DicePhys's plane-locked
 //!   block). A 2D block cannot land on its end: a `2d` row is fitted on its two side outcomes,
 //!   and its length-vertical count is kept but set aside.
@@ -105,6 +117,11 @@ pub struct DataRow {
     /// faces' order once [`on_shape`] has read the row against it). Empty for a block's rows.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub labels: Vec<String>,
+    /// The row's own die, as its `die` column names it (a shape name, or a die file's path
+    /// joined to the counts file's folder); `None`: the fit's die (`--shape`/`--die`), or a
+    /// block.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub die: Option<String>,
 }
 
 impl DataRow {
@@ -114,16 +131,6 @@ impl DataRow {
             .iter()
             .map(|g| g.iter().map(|&k| self.counts[k]).sum())
             .collect()
-    }
-
-    /// The file's column of the first count (0-based): after the sides and mode, or (a die of
-    /// any shape) after the label and surface.
-    fn first_count_column(&self) -> usize {
-        if self.labels.is_empty() {
-            6
-        } else {
-            2
-        }
     }
 
     /// True if the row counts the faces of a die of any shape (`face_<label>` columns).
@@ -218,7 +225,25 @@ pub fn read(path: &std::path::Path, stop: &crate::run::stop::Stop) -> Result<Vec
             "{name}: line {line}, byte {col}: not UTF-8 (save the file as UTF-8 text)"
         ))
     })?;
-    parse(text, &name)
+    let mut rows = parse(text, &name)?;
+    // A row's die file is found beside the counts file, wherever the command runs.
+    let dir = path.parent().unwrap_or(std::path::Path::new(""));
+    for r in &mut rows {
+        if let Some(d) = r.die.as_mut().filter(|d| is_die_file(d)) {
+            *d = dir.join(&*d).display().to_string();
+        }
+    }
+    Ok(rows)
+}
+
+/// True if a `die` cell names a die file (a TOML or a mesh, by its extension) rather than a
+/// shape (`d8`, `coin:24.5,2`).
+pub fn is_die_file(die: &str) -> bool {
+    let p = std::path::Path::new(die);
+    crate::model::mass::is_mesh(p)
+        || p.extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
 }
 
 /// The 1-based line and column (in bytes) of byte `at`.
@@ -282,27 +307,40 @@ fn line_counter(text: &str) -> impl FnMut(usize) -> usize + '_ {
 enum Form {
     /// Sides or a cube's six faces, with this many count columns.
     Block(Outcomes, usize),
-    /// A die of any shape, by these labels (the header's `face_<label>`, in its order).
-    Shape(Vec<String>),
+    /// A die of any shape, by these labels (the header's `face_<label>`, in its order), and
+    /// whether a `die` column names each row's die (before the labels).
+    Shape(Vec<String>, bool),
+}
+
+impl Form {
+    /// The file's column of the first count (0-based).
+    fn first_count_column(&self) -> usize {
+        match self {
+            Form::Block(..) => 6,
+            Form::Shape(_, with_die) => 2 + usize::from(*with_die),
+        }
+    }
 }
 
 /// What a header says (sides, a cube's faces or a shape's, and whether a `thrower` column ends
 /// it); a header that is none of the forms is refused.
 fn columns(have: &[&str], name: &str) -> Result<(Form, bool)> {
     let with_thrower = have.last() == Some(&"thrower");
-    if have.len() > 2 && have[..2] == COLUMNS[..2] && have[2].starts_with("face_") {
-        let faces = &have[2..have.len() - usize::from(with_thrower)];
+    let with_die = have.get(2) == Some(&"die");
+    let first = 2 + usize::from(with_die);
+    if have.len() > first && have[..2] == COLUMNS[..2] && have[first].starts_with("face_") {
+        let faces = &have[first..have.len() - usize::from(with_thrower)];
         let labels: Vec<String> = faces
             .iter()
             .map(|c| c.strip_prefix("face_").unwrap_or("").to_string())
             .collect();
         if labels.len() < 2 || labels.iter().any(String::is_empty) {
             return Err(Error::Invalid(format!(
-                "{name}: line 1: a die of any shape is counted as label,surface,face_<label>,…                  (a column for each face, at least two)[,thrower], got {}",
+                "{name}: line 1: a die of any shape is counted as label,surface[,die],face_<label>,… (a column for each face, at least two)[,thrower], got {}",
                 shown(&have.join(","))
             )));
         }
-        return Ok((Form::Shape(labels), with_thrower));
+        return Ok((Form::Shape(labels, with_die), with_thrower));
     }
     let (outcomes, counted) = if have.get(6) == Some(&FACE_COLUMNS[0]) {
         (Outcomes::Faces, 6)
@@ -472,7 +510,7 @@ fn row_of(
     };
     let row = match form {
         Form::Block(outcomes, counted) => block_row(rec, *outcomes, *counted)?,
-        Form::Shape(labels) => shape_row(rec, labels)?,
+        Form::Shape(labels, with_die) => shape_row(rec, labels, *with_die)?,
     };
     let row = DataRow {
         label,
@@ -483,28 +521,48 @@ fn row_of(
     let total = row.counts.iter().try_fold(0u64, |a, &c| a.checked_add(c));
     if total.is_none_or(|t| t > MAX_ROW_THROWS) {
         return Err((
-            row.first_count_column(),
+            form.first_count_column(),
             format!("counts too large: at most {MAX_ROW_THROWS} throws a row"),
         ));
     }
     if row.n() == 0 {
-        return Err((row.first_count_column(), "no throws counted".into()));
+        return Err((form.first_count_column(), "no throws counted".into()));
     }
     Ok(row)
 }
 
-/// A record's counts of a die of any shape, one a label, from column 3 (its block is a
-/// placeholder until [`on_shape`] reads the row against the die).
+/// A record's counts of a die of any shape, one a label, from column 3 (or 4 after a `die`
+/// column, `with_die`: then a column left empty or `-` is another die's, and the row has no
+/// such face); its block is a placeholder until [`on_shape`] reads the row against the die.
 fn shape_row(
     rec: &csv::StringRecord,
     labels: &[String],
+    with_die: bool,
 ) -> std::result::Result<DataRow, (usize, String)> {
-    let counts = (0..labels.len())
-        .map(|k| {
-            let c = 2 + k;
-            count(&rec[c]).map_err(|m| (c, m))
-        })
-        .collect::<std::result::Result<Vec<u64>, _>>()?;
+    let first = 2 + usize::from(with_die);
+    let die = (with_die && !matches!(&rec[2], "" | "-")).then(|| rec[2].to_string());
+    if let Some(d) = &die {
+        if d.chars().any(char::is_control) {
+            return Err((2, format!("'{}' holds a control character", shown(d))));
+        }
+    }
+    let mut counts = Vec::new();
+    let mut kept = Vec::new();
+    for (k, label) in labels.iter().enumerate() {
+        let c = first + k;
+        if with_die && matches!(&rec[c], "" | "-") {
+            continue;
+        }
+        counts.push(count(&rec[c]).map_err(|m| (c, m))?);
+        kept.push(label.clone());
+    }
+    if kept.len() < 2 {
+        return Err((
+            first,
+            "a die's row counts at least two of its faces (the other dice's columns left empty)"
+                .into(),
+        ));
+    }
     Ok(DataRow {
         label: String::new(),
         surface: String::new(),
@@ -514,7 +572,8 @@ fn shape_row(
         outcomes: Outcomes::Faces,
         groups: (0..counts.len()).map(|k| vec![k]).collect(),
         counts,
-        labels: labels.to_vec(),
+        labels: kept,
+        die,
     })
 }
 
@@ -566,6 +625,7 @@ fn block_row(
         counts,
         groups,
         labels: Vec::new(),
+        die: None,
     })
 }
 
@@ -826,6 +886,37 @@ mod tests {
             &format!("{HEAD}a,MDF,140,24,20,3d,0,361,639\n"),
             "row 'a': coin:24,8 is counted by its faces",
         );
+    }
+
+    #[test]
+    fn a_die_column_names_each_rows_die_and_its_faces_are_the_cells_it_fills() {
+        let rows = parse(
+            "label,surface,die,face_1,face_2,face_3,face_4,face_5,face_6,face_7,face_8,thrower\n\
+             a,felt,d6,1,2,3,4,5,6,,-,me\n\
+             b,felt,d8,1,2,3,4,5,6,7,8,me\n\
+             c,felt,,1,2,3,4,5,6,,,me\n",
+            "f.csv",
+        )
+        .unwrap();
+        assert_eq!(rows[0].die.as_deref(), Some("d6"));
+        assert_eq!(rows[0].labels, ["1", "2", "3", "4", "5", "6"]);
+        assert_eq!(rows[1].labels.len(), 8);
+        assert_eq!(rows[1].n(), 36);
+        assert_eq!(
+            (rows[2].die.as_deref(), rows[2].thrower.as_str()),
+            (None, "me")
+        );
+        // Read against its die: a d6's row is the d6's, and a face it lacks is refused.
+        let d6 = crate::model::shape::named("d6", None).unwrap();
+        assert_eq!(on_shape(&rows[..1], &d6).unwrap()[0].counts.len(), 6);
+        let e = on_shape(&rows[1..2], &d6).unwrap_err().to_string();
+        assert!(e.contains("not its faces: face_7, face_8"), "{e}");
+        // A cell of a count column still says what is wrong, at its column.
+        let e = parse("label,surface,die,face_1,face_2\na,felt,d6,1,x\n", "f.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("line 2, column 5 (face_2)"), "{e}");
+        assert!(is_die_file("v1.toml") && is_die_file("m/c.OBJ") && !is_die_file("coin:24.5,2"));
     }
 
     #[test]

@@ -182,6 +182,9 @@ pub struct Design {
     /// True if its outcomes are the die's six faces (numbers 1 to 6), not the three sides.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub faces: bool,
+    /// The rows' own die it was rolled as (a `die` column's), where not the fit's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub die: Option<String>,
     /// Each point and its counts of length, breadth and width vertical (or of faces 1 to 6).
     pub points: Vec<DesignPoint>,
     /// The points of earlier passes' designs of the same block that lie inside this one's box,
@@ -197,9 +200,12 @@ pub struct Design {
 }
 
 impl Design {
-    /// "140x24x20 3d".
+    /// "140x24x20 3d", or its die's name ("d8 3d").
     pub fn name(&self) -> String {
-        format!("{} {}", self.block, self.mode.name())
+        match &self.die {
+            Some(d) => format!("{d} {}", self.mode.name()),
+            None => format!("{} {}", self.block, self.mode.name()),
+        }
     }
 }
 
@@ -216,7 +222,7 @@ pub fn borrowed(d: &Design, earlier: &[Design]) -> Vec<DesignPoint> {
     let mut seen: Vec<&Axes> = vec![&d.axes];
     let mut out = Vec::new();
     for e in earlier {
-        let same = e.block == d.block && e.mode == d.mode && e.faces == d.faces;
+        let same = e.block == d.block && e.mode == d.mode && e.faces == d.faces && e.die == d.die;
         if !same || !same_kinds(e) || seen.contains(&&e.axes) {
             continue;
         }
@@ -250,6 +256,8 @@ pub struct Key {
     pub axes: Axes,
     /// True if it counts faces, not sides.
     pub faces: bool,
+    /// The row's own die, where a `die` column names one.
+    pub die: Option<String>,
 }
 
 impl Key {
@@ -260,6 +268,7 @@ impl Key {
             mode: row.mode,
             axes: model.axes(params, &model.row_dims(params, row)),
             faces: row.outcomes == crate::calibration::data::Outcomes::Faces,
+            die: row.die.clone(),
         }
     }
 
@@ -268,7 +277,22 @@ impl Key {
         let axes: Vec<String> = self.axes.iter().map(|(k, r)| format!("{k}={r}")).collect();
         let h = fnv(&axes.join(","));
         let faces = if self.faces { "-faces" } else { "" };
-        format!("{}-{}{faces}-{:08x}", self.block, self.mode.name(), h >> 32)
+        // A row's own die: its name's hash too (two dice may share a bounding box), a die
+        // file's by its file name, so that its seeds do not move with the folder the command
+        // runs in; a fit of one die keeps the tags, and so the seeds and checkpoints, it had.
+        let die = self.die.as_ref().map_or(String::new(), |d| {
+            let name = std::path::Path::new(d)
+                .file_name()
+                .and_then(|n| n.to_str())
+                .unwrap_or(d);
+            format!("-die{:08x}", fnv(name) >> 32)
+        });
+        format!(
+            "{}-{}{faces}{die}-{:08x}",
+            self.block,
+            self.mode.name(),
+            h >> 32
+        )
     }
 
     /// The seed of point `point`'s throws.
@@ -283,12 +307,17 @@ impl Key {
             mode: d.mode,
             axes: d.axes.clone(),
             faces: d.faces,
+            die: d.die.clone(),
         }
     }
 
     /// True if `d` is this key's design.
     pub fn is(&self, d: &Design) -> bool {
-        d.block == self.block && d.mode == self.mode && d.axes == self.axes && d.faces == self.faces
+        d.block == self.block
+            && d.mode == self.mode
+            && d.axes == self.axes
+            && d.faces == self.faces
+            && d.die == self.die
     }
 }
 
@@ -392,6 +421,7 @@ mod tests {
                 (Kind::Kappa, Range::new(kappa.0, kappa.1)),
             ],
             faces: false,
+            die: None,
             surrogate: Surrogate::fit(&points, 2, 3, 1),
             points,
             borrowed: vec![],

@@ -533,6 +533,7 @@ mod tests {
         };
         LooRow {
             label: "r".into(),
+            die: None,
             surface: "s".into(),
             alone: false,
             outcomes: vec!["a".into(), "b".into()],

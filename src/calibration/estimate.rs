@@ -1283,6 +1283,7 @@ mod tests {
             counts: vec![c[0], c[1], c[2]],
             groups: vec![vec![0], vec![1], vec![2]],
             labels: Vec::new(),
+            die: None,
         }];
         let pts: Vec<DesignPoint> = points(1, 24)
             .into_iter()
@@ -1295,6 +1296,7 @@ mod tests {
             block,
             mode: crate::model::scene::Mode::ThreeD,
             faces: false,
+            die: None,
             axes: vec![(Kind::E, Kind::E.default_range())],
             surrogate: Surrogate::fit_best(&pts, 1, 3, 4, 6),
             points: pts,
@@ -1348,6 +1350,7 @@ mod tests {
             block,
             mode: crate::model::scene::Mode::ThreeD,
             faces,
+            die: None,
             axes: [Kind::E, Kind::Mu, Kind::Kappa]
                 .iter()
                 .map(|k| (*k, k.default_range()))
@@ -1400,6 +1403,7 @@ mod tests {
                 counts: vec![c[0], c[1], c[2]],
                 groups: vec![vec![0], vec![1], vec![2]],
                 labels: Vec::new(),
+                die: None,
             });
             let pts: Vec<DesignPoint> = points(3, 64)
                 .into_iter()
@@ -1465,6 +1469,7 @@ mod tests {
             counts: multinomial(6000, &faces(k, truth), &mut rng),
             groups: (0..k).map(|i| vec![i]).collect(),
             labels: Vec::new(),
+            die: None,
         }];
         let pts: Vec<DesignPoint> = points(3, 64)
             .into_iter()
@@ -1656,6 +1661,7 @@ mod tests {
                     counts: multinomial(2000, &law(&truth), &mut rng),
                     groups: vec![vec![0], vec![1], vec![2]],
                     labels: Vec::new(),
+                    die: None,
                 }];
                 let pts: Vec<DesignPoint> = points(3, 64)
                     .into_iter()

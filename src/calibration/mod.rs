@@ -26,6 +26,7 @@ pub mod compare;
 pub mod crossval;
 pub mod data;
 pub mod design;
+pub mod dice;
 pub mod discrepancy;
 pub mod estimate;
 pub mod heldout;
@@ -87,49 +88,40 @@ impl FitConfig {
             )));
         }
         self.check_shape()?;
-        self.check_candidates()?;
-        if self.model.is_free(params::Kind::PipDepth)
-            && self
-                .method
-                .shape
-                .as_deref()
-                .is_some_and(|s| s.as_box().is_none())
+        if self.model.fixed.throw == params::FixedThrow::Rest {
+            if let Some(k) = self.model.free.iter().find(|k| {
+                matches!(
+                    k,
+                    params::Kind::Kappa
+                        | params::Kind::Spin
+                        | params::Kind::Height
+                        | params::Kind::Speed
+                )
+            }) {
+                return Err(Error::field(
+                    Field::Free,
+                    k.name(),
+                    "a die released at rest has no spin, height, speed or κ to fit",
+                ));
+            }
+        }
+        if self.model.is_free(params::Kind::Rolling)
+            && self.method.engine != crate::engine::EngineKind::Bullet
         {
             return Err(Error::field(
                 Field::Free,
-                "pip_depth",
-                "a die of any shape has no pips (they are drilled in a cuboid's faces): free \
-                 com_x, com_y or com_z",
+                "rolling",
+                format!(
+                    "{} has no rolling resistance: give --engine bullet",
+                    self.method.engine
+                ),
             ));
         }
-        if self.model.is_free(params::Kind::PipDepth) && self.method.die.pips.is_none() {
-            return Err(Error::field(
-                Field::Free,
-                "pip_depth",
-                "the die has no pips to vary: give them (--pips D,H or a die file's [pips])",
-            ));
-        }
+        self.check_dice()?;
+        self.check_pips()?;
         let com_free = [params::Kind::ComX, params::Kind::ComY, params::Kind::ComZ]
             .into_iter()
             .filter(|&k| self.model.is_free(k));
-        if self.model.is_free(params::Kind::PipDepth) && com_free.clone().count() > 0 {
-            return Err(Error::field(
-                Field::Free,
-                "pip_depth",
-                "and a free centre of mass cannot be told apart: pips bias a die through the \
-                 centre of mass they move, and a free centre is given outright; free one or \
-                 the other",
-            ));
-        }
-        if self.model.is_free(params::Kind::Infill) && com_free.clone().count() > 0 {
-            return Err(Error::field(
-                Field::Free,
-                "infill",
-                "and a free centre of mass cannot be told apart: the infill biases a die \
-                 through the centre of mass it moves, and a free centre is given outright; free \
-                 one or the other",
-            ));
-        }
         for kind in com_free {
             let r = self.model.range(kind);
             let axis = kind as usize - params::Kind::ComX as usize;
@@ -158,6 +150,7 @@ impl FitConfig {
             for u in [0.0, 1.0, 0.5] {
                 let v = params::values(&self.model.fixed, &self.model.whole_axes(), &vec![u; dims]);
                 self.method
+                    .of_row(r)
                     .spec(r.block, r.mode, &v, self.seed, self.design.rolls)
                     .validate(false)
                     .map_err(|e| self.at_box_end(e))?;
@@ -209,72 +202,133 @@ impl FitConfig {
         )
     }
 
-    /// Issue 72's candidates where they cannot run: a release at rest has no spin, height,
-    /// speed or κ to fit; rolling resistance is Bullet's alone.
-    fn check_candidates(&self) -> Result<()> {
-        if self.model.fixed.throw == params::FixedThrow::Rest {
-            if let Some(k) = self.model.free.iter().find(|k| {
-                matches!(
-                    k,
-                    params::Kind::Kappa
-                        | params::Kind::Spin
-                        | params::Kind::Height
-                        | params::Kind::Speed
-                )
-            }) {
-                return Err(Error::field(
-                    Field::Free,
-                    k.name(),
-                    "a die released at rest has no spin, height, speed or κ to fit",
-                ));
-            }
-        }
-        if self.model.is_free(params::Kind::Rolling)
-            && self.method.engine != crate::engine::EngineKind::Bullet
+    /// A free pip depth needs a die with pips, a cuboid's (one die for every row by now:
+    /// several dice are refused it, [`FitConfig::check_dice`]); a free pip depth or infill
+    /// cannot be told from a free centre of mass.
+    fn check_pips(&self) -> Result<()> {
+        let method = self.method.of_row(&self.rows[0]);
+        if self.model.is_free(params::Kind::PipDepth)
+            && method
+                .shape
+                .as_deref()
+                .is_some_and(|s| s.as_box().is_none())
         {
             return Err(Error::field(
                 Field::Free,
-                "rolling",
-                format!(
-                    "{} has no rolling resistance: give --engine bullet",
-                    self.method.engine
-                ),
+                "pip_depth",
+                "a die of any shape has no pips (they are drilled in a cuboid's faces): free \
+                 com_x, com_y or com_z",
+            ));
+        }
+        if self.model.is_free(params::Kind::PipDepth) && method.die.pips.is_none() {
+            return Err(Error::field(
+                Field::Free,
+                "pip_depth",
+                "the die has no pips to vary: give them (--pips D,H or a die file's [pips])",
+            ));
+        }
+        let com_free = [params::Kind::ComX, params::Kind::ComY, params::Kind::ComZ]
+            .into_iter()
+            .filter(|&k| self.model.is_free(k));
+        if self.model.is_free(params::Kind::PipDepth) && com_free.clone().count() > 0 {
+            return Err(Error::field(
+                Field::Free,
+                "pip_depth",
+                "and a free centre of mass cannot be told apart: pips bias a die through the \
+                 centre of mass they move, and a free centre is given outright; free one or \
+                 the other",
+            ));
+        }
+        if self.model.is_free(params::Kind::Infill) && com_free.clone().count() > 0 {
+            return Err(Error::field(
+                Field::Free,
+                "infill",
+                "and a free centre of mass cannot be told apart: the infill biases a die \
+                 through the centre of mass it moves, and a free centre is given outright; free \
+                 one or the other",
             ));
         }
         Ok(())
     }
 
-    /// A die of any shape and its rows agree: every row counts its faces by label, in its
-    /// order ([`data::on_shape`]), and it is thrown in a tumble or a toss (it has no long axis
-    /// for the paper's or a hand's throw, so no κ); without one, no row counts faces by label.
-    fn check_shape(&self) -> Result<()> {
-        let Some(shape) = &self.method.shape else {
-            return match self.rows.iter().find(|r| r.of_shape()) {
-                Some(r) => Err(Error::Invalid(format!(
-                    "row '{}' counts the faces of a die of any shape (face_{}…): give the die \
-                     (--shape, or a mesh --die)",
-                    data::shown(&r.label),
-                    r.labels[0]
-                ))),
-                None => Ok(()),
-            };
-        };
-        if let Some(r) = self
+    /// Several dice (a `die` column naming more than one, or one beside the command line's):
+    /// the surface's and the thrower's parameters are shared across them, but a die's own
+    /// centre of mass or pip depth would belong to one die, and is refused (a free infill is
+    /// the printer's setting, each die's in its own wall, and is kept).
+    fn check_dice(&self) -> Result<()> {
+        let mut dice: Vec<String> = dice::names(&self.rows)
+            .into_iter()
+            .map(String::from)
+            .collect();
+        if let Some(s) = self
             .rows
             .iter()
-            .find(|r| r.labels != shape.outcome_labels())
+            .find(|r| r.die.is_none())
+            .and(self.method.shape.as_ref())
         {
-            return Err(Error::Invalid(format!(
-                "row '{}' does not count {}'s faces in its order (read the rows with \
-                 calibration::data::on_shape)",
-                data::shown(&r.label),
-                shape.name
-            )));
+            dice.push(s.name.clone());
         }
+        if dice.len() < 2 {
+            return Ok(());
+        }
+        let own = [
+            params::Kind::ComX,
+            params::Kind::ComY,
+            params::Kind::ComZ,
+            params::Kind::PipDepth,
+        ];
+        match own.iter().find(|k| self.model.is_free(**k)) {
+            Some(k) => {
+                Err(Error::field(
+                    Field::Free,
+                    k.name(),
+                    format!(
+                    "is one die's own, and the rows name {} dice ({}): free it in a fit of one \
+                     die",
+                    dice.len(),
+                    dice.iter().map(|d| data::shown(d)).collect::<Vec<_>>().join(", ")
+                ),
+                ))
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// Each die of any shape and its rows agree: every row counts its die's faces by label, in
+    /// its order ([`data::on_shape`]), and a die of any shape is thrown in a tumble or a toss
+    /// (it has no long axis for the paper's or a hand's throw, so no κ); a row of no die of any
+    /// shape counts no faces by label.
+    fn check_shape(&self) -> Result<()> {
+        let mut shaped = None;
+        for r in &self.rows {
+            let method = self.method.of_row(r);
+            let Some(shape) = &method.shape else {
+                if r.of_shape() {
+                    return Err(Error::Invalid(format!(
+                        "row '{}' counts the faces of a die of any shape (face_{}…): give the \
+                         die (--shape, a mesh --die, or the row's die column)",
+                        data::shown(&r.label),
+                        r.labels[0]
+                    )));
+                }
+                continue;
+            };
+            if r.labels != shape.outcome_labels() {
+                return Err(Error::Invalid(format!(
+                    "row '{}' does not count {}'s faces in its order (read the rows with \
+                     calibration::data::on_shape)",
+                    data::shown(&r.label),
+                    shape.name
+                )));
+            }
+            shaped.get_or_insert(shape.name.clone());
+        }
+        let Some(name) = shaped else {
+            return Ok(());
+        };
         let why = format!(
-            "{} is thrown in a tumble or a toss: the paper's and a hand's throw spin a die about its \
-             long axis, which it has not",
-            shape.name
+            "{name} is thrown in a tumble or a toss: the paper's and a hand's throw spin a die \
+             about its long axis, which it has not"
         );
         if self.model.is_free(params::Kind::Kappa) {
             return Err(Error::field(Field::Free, "kappa", why));
@@ -350,6 +404,10 @@ pub struct FitResult {
     /// `loo[].scores`); left out where there are none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub loo_scores: Option<proper::Scores>,
+    /// Where the rows name their dice: each die's rows, predicted by a fit of the other dice,
+    /// their proper scores summed per die (`loo_scores` sums them all).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub loo_dice: Vec<proper::DieScores>,
     /// What it cost.
     pub cost: FitCost,
     /// The command line that made it.
@@ -752,6 +810,7 @@ mod tests {
             counts: vec![0, 1, 2],
             groups: vec![vec![0], vec![1], vec![2]],
             labels: vec![],
+            die: None,
         };
         let rows = [row];
         let model = ModelSpec::free(&[Kind::E]);

@@ -552,6 +552,10 @@ pub struct Method {
     /// faces by label ([`crate::calibration::data::on_shape`]), thrown in a tumble.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shape: Option<std::sync::Arc<crate::model::shape::Shape>>,
+    /// The rows' own dice, where a `die` column names them (`calibration::dice`): a row is
+    /// simulated as its die (`Method::for_die`), the rest as above.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub dice: Vec<crate::calibration::dice::RowDie>,
 }
 
 impl Method {
@@ -711,6 +715,7 @@ mod tests {
             die: Features::default(),
             density: None,
             shape: None,
+            dice: vec![],
         };
         let spec = method.spec(rows[0].block, rows[0].mode, &v, 1, 10);
         assert!((spec.scene.rolling_resistance - 0.25e-3).abs() < 1e-18);
@@ -747,6 +752,7 @@ mod tests {
             die: Default::default(),
             density: None,
             shape: None,
+            dice: vec![],
         };
         let block = Block::from_mm(140.0, 24.0, 20.0).unwrap();
         let spec = method.spec(block, Mode::ThreeD, &v, 1, 10);

@@ -209,13 +209,16 @@ pub struct PredictConfig {
 }
 
 /// The block a prediction from `fit` simulates where none is given: a fit of a die of any
-/// shape predicts that die (its rows' block is its bounding box); a fit of blocks needs one.
+/// shape predicts that die (its rows' block is its bounding box); a fit of blocks needs one,
+/// and so does a fit whose rows all name their own dice (which of them?).
 pub fn own_block(fit: &FitResult) -> Option<Block> {
+    fit.config.method.shape.as_ref()?;
+    // A row of the fit's own die, not one that names another (a `die` column's).
     fit.config
-        .method
-        .shape
-        .as_ref()
-        .map(|_| fit.config.rows[0].block)
+        .rows
+        .iter()
+        .find(|r| r.die.is_none())
+        .map(|r| r.block)
 }
 
 /// Which group a new row takes from the fit: the named one, or the only one there is.

@@ -284,6 +284,18 @@ impl Scores {
     }
 }
 
+/// One die's rows of a fit's leave-one-out (a `die` column's), predicted by a fit of the other
+/// dice: their scores summed.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DieScores {
+    /// The die, as the rows name it.
+    pub die: String,
+    /// Its rows' labels.
+    pub rows: Vec<String>,
+    /// Their scores summed, beside the baselines'.
+    pub scores: Scores,
+}
+
 /// A row of counts a prediction was scored against.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CountsTest {

@@ -147,31 +147,39 @@ impl FitRequest {
         // A loaded die's outcomes are the facets it rests on at its own centre of mass.
         let shape = match shape {
             Some(s) => {
-                let mut scene =
-                    crate::model::scene::Scene::paper_shape(s, crate::model::scene::Mode::ThreeD);
-                scene.features = die;
-                let scene = scene.resting_at_com().map_err(|e| {
+                let (s, features) = super::dice::resting(s, die).map_err(|e| {
                     Error::field(Field::Shape, "", format!("at its centre of mass: {e}"))
                 })?;
                 // A box's pips are drilled as its labels number its faces.
-                die = scene.features;
-                scene.shape.map(|s| (*s).clone())
+                die = features;
+                Some(s)
             }
             None => None,
         };
-        let rows = match &shape {
-            Some(s) => data::on_shape(&self.rows, s)
-                .map_err(|e| Error::field(Field::Data, "", e.to_string()))?,
-            None => self.rows.clone(),
-        };
-        let (degree, max_degree) = DesignSpec::degrees(
-            self.degree,
-            self.max_degree,
-            shape.as_ref().map_or(6, |s| s.outcome_labels().len()),
-        );
+        // The rows' own dice (a `die` column): each row read against its die, the rest
+        // against the command line's.
+        let dice = super::dice::resolve_rows(&self.rows)?;
+        let own = |r: &DataRow| dice.iter().find(|d| Some(&d.name) == r.die.as_ref());
+        let mut rows = Vec::with_capacity(self.rows.len());
+        for r in &self.rows {
+            let read = match (own(r), &shape) {
+                (Some(d), _) => data::on_shape(std::slice::from_ref(r), &d.shape),
+                (None, Some(s)) => data::on_shape(std::slice::from_ref(r), s),
+                (None, None) => Ok(vec![r.clone()]),
+            };
+            rows.extend(read.map_err(|e| Error::field(Field::Data, "", e.to_string()))?);
+        }
+        // The surrogate's degree for the die of most outcomes.
+        let outcomes = dice
+            .iter()
+            .map(|d| d.shape.outcome_labels().len())
+            .chain(shape.as_ref().map(|s| s.outcome_labels().len()))
+            .max()
+            .unwrap_or(6);
+        let (degree, max_degree) = DesignSpec::degrees(self.degree, self.max_degree, outcomes);
         let cfg = FitConfig {
             rows,
-            model: self.model(shape.is_some())?,
+            model: self.model(shape.is_some() || !dice.is_empty())?,
             method: Method {
                 engine: self.engine,
                 dt: self.dt,
@@ -179,6 +187,7 @@ impl FitRequest {
                 die,
                 density,
                 shape: shape.map(std::sync::Arc::new),
+                dice,
             },
             design: DesignSpec {
                 points: self.points,

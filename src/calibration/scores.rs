@@ -87,6 +87,10 @@ pub struct EndCount {
 pub struct LooRow {
     /// The row's label.
     pub label: String,
+    /// Its die, where a `die` column names one: its rows were left out together, and predicted
+    /// by a fit of the other dice.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub die: Option<String>,
     /// Its surface.
     pub surface: String,
     /// The only row on its surface: without it the data say nothing of that surface's e and μ.

@@ -90,6 +90,7 @@ impl PaperArgs {
         dicephys::studies::calibrated::CalibratedConfig {
             method: Method {
                 shape: None,
+                dice: Vec::new(),
                 engine: EngineKind::Bullet,
                 dt: a.dt,
                 max_steps: *a.max_steps,

@@ -511,15 +511,29 @@ fn left_out(res: &FitResult) -> String {
         &res.loo,
     );
     let _ = writeln!(s, "\n## Each row predicted without itself\n");
+    let dice = crate::calibration::dice::names(&res.config.rows).len();
     let _ = writeln!(
         s,
-        "Every row predicted by a fit of the other {} (leave one out), at that fit's posterior \
-         draws: its ratio N(breadth)/N(width) and its end count (length vertical), each with the \
+        "{}, at that fit's posterior draws: its ratio N(breadth)/N(width) and its end count (length vertical), each with the \
          prediction's error (parameters and simulation) combined with the measurement's. Ratios \
          within 1σ: {} of {}, within 2σ: {} (a Gaussian error puts 68 % and 95 % there). \
          Summed log predictive probability of the rows' counts: {:.1} — what `dicephys compare` \
          sets this fit beside another model's fit of the same counts by.\n",
-        res.loo.len() - 1,
+        if dice > 0 {
+            format!(
+                "Each die's rows predicted together by a fit of the other {} (leave one die out)",
+                if dice == 2 {
+                    "die".to_string()
+                } else {
+                    format!("{} dice", dice - 1)
+                }
+            )
+        } else {
+            format!(
+                "Every row predicted by a fit of the other {} (leave one out)",
+                res.loo.len() - 1
+            )
+        },
         score.within_one_sigma,
         score.rows_scored,
         score.within_two_sigma,
@@ -534,8 +548,9 @@ fn left_out(res: &FitResult) -> String {
     for r in &res.loo {
         let _ = writeln!(
             s,
-            "| {} | {}{} | {} | {} | {} | {} | {} | {} | {:.2} |",
+            "| {}{} | {}{} | {} | {} | {} | {} | {} | {} | {:.2} |",
             r.label,
+            r.die.as_ref().map_or(String::new(), |d| format!(" ({d})")),
             r.surface,
             if r.alone { " (alone)" } else { "" },
             cell(
@@ -584,7 +599,20 @@ fn loo_scores_text(res: &FitResult) -> String {
     );
     for r in &res.loo {
         if let Some(sc) = &r.scores {
-            let _ = writeln!(s, "{}:\n\n{}", r.label, sc.lines("- "));
+            let die = r.die.as_ref().map_or(String::new(), |d| format!(" ({d})"));
+            let _ = writeln!(s, "{}{die}:\n\n{}", r.label, sc.lines("- "));
+        }
+    }
+    // Each die's rows together, where there is a die of several rows to sum.
+    if res.loo_dice.iter().any(|d| d.rows.len() > 1) {
+        for d in &res.loo_dice {
+            let _ = writeln!(
+                s,
+                "Die {} ({} rows, predicted by a fit of the other dice):\n\n{}",
+                d.die,
+                d.rows.len(),
+                d.scores.lines("- ")
+            );
         }
     }
     let _ = writeln!(s, "All rows:\n\n{}", total.lines("- "));

@@ -1072,6 +1072,41 @@ d,MDF,9,11,10,10,8,12
     c.document("predict", "predict another die against its counts", &p);
 }
 
+/// Two dice in one fit, by a `die` column (issue 71.1), each left out in turn (71.4).
+fn document_several_dice(c: &mut Checker, dir: &Scratch) {
+    let csv = dir.join("dice.csv");
+    std::fs::write(
+        &csv,
+        "label,surface,die,face_1,face_2,face_3,face_4,face_5,face_6\n\
+         a,MDF,d4,30,25,25,20,,\n\
+         b,MDF,d6,9,11,10,10,8,12\n",
+    )
+    .unwrap();
+    let v = run(&[
+        "fit",
+        "--data",
+        csv.to_str().unwrap(),
+        "--free",
+        "e",
+        "--points",
+        "8",
+        "--point-rolls",
+        "60",
+        "--degree",
+        "1",
+        "--no-refine",
+        "--dt",
+        "1/250",
+        "--threads",
+        "1",
+        "--out",
+        dir.join("dice").to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(v["loo_dice"].as_array().map(Vec::len), Some(2), "{v}");
+    c.document("fit", "fit of two dice", &v);
+}
+
 /// A made die's face counts fitted, its centre of mass free, and a prediction of its faces.
 fn document_a_die_fit(c: &mut Checker, dir: &Scratch) {
     let d = dir.to_str().unwrap();
@@ -1222,6 +1257,7 @@ fn json_md_lists_the_keys_of_fit_recover_and_predict() {
     c.document("fit", "fit (nothing to narrow)", &fit);
     document_fit_passes(&mut c, &dir);
     document_a_die_fit(&mut c, &dir);
+    document_several_dice(&mut c, &dir);
     let file: Value = serde_json::from_str(&read(&dir.join("fit/fit.json"))).unwrap();
     c.document("fit", "fit.json", &file);
     let one = run_owned(fit_args(&["--no-refine", "--out", &format!("{d}/one")]));

@@ -405,6 +405,7 @@ fn counted_at_e_03(runner: &Runner) -> FitConfig {
         counts: vec![0, 0, n],
         groups: vec![vec![1], vec![2]],
         labels: Vec::new(),
+        die: None,
     };
     let shape = vec![
         row("a1", "A", "140x30x10", 4000),
@@ -421,6 +422,7 @@ fn counted_at_e_03(runner: &Runner) -> FitConfig {
             die: Default::default(),
             density: None,
             shape: None,
+            dice: Vec::new(),
         },
         design: DesignSpec {
             points: POINTS,

@@ -400,6 +400,7 @@ fn a_fit_simulates_a_die_of_any_shape_as_roll_does_throw_for_throw() {
         die: Default::default(),
         density: None,
         shape: Some(std::sync::Arc::new(shape)),
+        dice: Vec::new(),
     };
     let values = Fixed {
         throw: FixedThrow::Tumble,

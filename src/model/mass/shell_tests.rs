@@ -299,6 +299,7 @@ fn a_fits_free_infill_fills_the_dies_own_wall_or_a_millimetre() {
         die,
         density: None,
         shape: None,
+        dice: Vec::new(),
     };
     let v = Fixed {
         infill: Some(0.3),

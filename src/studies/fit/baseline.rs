@@ -11,7 +11,7 @@ use crate::calibration::discrepancy::{self, Discrepancy};
 use crate::calibration::params::{Fixed, Method};
 use crate::calibration::predict::Predicted;
 use crate::calibration::predict::{BlockPrediction, PredictConfig};
-use crate::calibration::proper::{self, CountsTest, Score, Scores};
+use crate::calibration::proper::{self, CountsTest, DieScores, Score, Scores};
 use crate::calibration::{FitConfig, FitResult};
 use crate::error::{Error, Result};
 use crate::model::block::Block;
@@ -126,13 +126,15 @@ pub fn score_of(counts: &[u64], p: &[Predicted], phi: f64) -> Score {
     proper::score(counts, &values, &sigma, phi)
 }
 
-/// Row `r` of `loo` as a discrepancy learnt from the other rows (not from itself) leaves it:
-/// `None` where they ask for none.
+/// Row `r` of `loo` as a discrepancy learnt from the other rows (not from itself, nor from
+/// its die's other rows where a `die` column names it) leaves it: `None` where they ask for
+/// none.
 fn with_others_discrepancy(loo: &[LooRow], r: usize, phi: f64) -> Option<Vec<Predicted>> {
+    let own = |i: usize| i == r || loo[r].die.is_some() && loo[i].die == loo[r].die;
     let others: Vec<LooRow> = loo
         .iter()
         .enumerate()
-        .filter(|(i, _)| *i != r)
+        .filter(|(i, _)| !own(*i))
         .map(|(_, row)| row.clone())
         .collect();
     let d = Discrepancy::estimate(&others, phi).filter(Discrepancy::any)?;
@@ -171,6 +173,8 @@ pub fn score_loo(
         let row = &cfg.rows[r];
         let counts = loo[r].counts.clone();
         let faces = row.outcomes == crate::calibration::data::Outcomes::Faces;
+        // The row's own die, where it names one.
+        let method = &*method.of_row(row);
         let Some((shares, settled)) = shares_at(
             method,
             fixed,
@@ -199,6 +203,34 @@ pub fn score_loo(
     }
     let refs: Vec<&Scores> = all.iter().collect();
     Ok(Some(Scores::total(&refs)))
+}
+
+/// The leave-one-out rows' scores summed per die, where a `die` column names them (each die's
+/// rows were predicted together by a fit of the other dice); none for rows of no die.
+pub fn by_die(loo: &[LooRow]) -> Vec<DieScores> {
+    let mut out: Vec<DieScores> = Vec::new();
+    let mut dice: Vec<&str> = Vec::new();
+    for d in loo.iter().filter_map(|r| r.die.as_deref()) {
+        if !dice.contains(&d) {
+            dice.push(d);
+        }
+    }
+    for die in dice {
+        let rows: Vec<&LooRow> = loo
+            .iter()
+            .filter(|r| r.die.as_deref() == Some(die))
+            .collect();
+        let scores: Vec<&Scores> = rows.iter().filter_map(|r| r.scores.as_ref()).collect();
+        if scores.len() != rows.len() {
+            continue;
+        }
+        out.push(DieScores {
+            die: die.to_string(),
+            rows: rows.iter().map(|r| r.label.clone()).collect(),
+            scores: Scores::total(&scores),
+        });
+    }
+    out
 }
 
 /// Each group of `row`'s outcomes predicted: `p` (in the row's counts' order) summed over the
@@ -298,6 +330,7 @@ mod tests {
             die: Default::default(),
             density: None,
             shape: None,
+            dice: Vec::new(),
         }
     }
 

@@ -138,6 +138,7 @@ pub fn result(f: Fitted, command_line: &str, wall: Instant, cpu: f64) -> FitResu
         loo: Vec::new(),
         discrepancy: None,
         loo_scores: None,
+        loo_dice: Vec::new(),
         cost: FitCost {
             rolls: f.rolls,
             unsettled: f.unsettled,
@@ -369,7 +370,12 @@ fn pooled(cfg: &FitConfig, designs: Vec<Design>, rolled: &mut Vec<Design>) -> Ve
             let all: Vec<_> = d.points.iter().chain(&borrowed).cloned().collect();
             let key = design::Key::of_design(d);
             Design {
-                surrogate: simulate::surrogate(&all, &key, &cfg.method, &cfg.design),
+                surrogate: simulate::surrogate(
+                    &all,
+                    &key,
+                    &cfg.method.for_die(key.die.as_deref()),
+                    &cfg.design,
+                ),
                 borrowed,
                 ..d.clone()
             }
@@ -579,10 +585,12 @@ pub fn run(
             None => return Ok(None),
         }
     };
+    let loo_dice = baseline::by_die(&loo);
     Ok(Some(FitResult {
         loo,
         discrepancy,
         loo_scores,
+        loo_dice,
         ..result(f, &command_line, wall, cpu)
     }))
 }
@@ -592,9 +600,17 @@ pub fn run(
 const LOO_ROWS: usize = 3;
 
 /// Every row of `f` predicted by a fit of the others, as the calibrated paper scores its
-/// models (no rolls: the surrogates are `f`'s); none for a fit of fewer than [`LOO_ROWS`].
+/// models (no rolls: the surrogates are `f`'s); none for a fit of fewer than [`LOO_ROWS`]. A
+/// fit whose rows name their dice leaves each die out (its rows together), and does so from
+/// two dice up: one die predicted from a fit of another is the question a die's designer asks.
 fn rows_without_themselves(f: &Fitted, runner: &Runner) -> Result<Vec<LooRow>> {
-    if f.config.rows.len() < LOO_ROWS {
+    let rows = &f.config.rows;
+    let enough = if rows.iter().any(|r| r.die.is_some()) {
+        crate::calibration::crossval::held_out_groups(rows).len() >= 2
+    } else {
+        rows.len() >= LOO_ROWS
+    };
+    if !enough {
         return Ok(Vec::new());
     }
     leave_one_out(

@@ -42,8 +42,10 @@ pub fn check(fit: &FitResult, cfg: &PredictConfig) -> Result<()> {
                 "a die of any shape is predicted in 3D",
             ));
         }
-    } else if let Some(s) = &fit.config.method.shape {
-        let own = fit.config.rows[0].block;
+    } else if let (Some(s), Some(own)) = (
+        &fit.config.method.shape,
+        crate::calibration::predict::own_block(fit),
+    ) {
         if cfg.block != own || cfg.mode != crate::model::scene::Mode::ThreeD {
             return Err(Error::field(
                 Field::Block,
@@ -300,6 +302,7 @@ fn draw_specs(
         counts: vec![0, 1, 1],
         groups: vec![vec![1], vec![2]],
         labels: Vec::new(),
+        die: None,
     };
     let model = &fit.config.model;
     let dims = model.row_dims(&fit.params, &row);

@@ -25,7 +25,9 @@ pub fn simulate_data(
     let mut before = 0;
     for (i, row) in cfg.rows.iter().enumerate() {
         let n = row.counts.iter().sum::<u64>();
-        let spec = cfg.method.spec(
+        // The row's own die, where it names one.
+        let method = cfg.method.of_row(row);
+        let spec = method.spec(
             row.block,
             row.mode,
             truth,
@@ -42,7 +44,7 @@ pub fn simulate_data(
             return Ok(None);
         }
         let faces = row.outcomes == Outcomes::Faces;
-        let counts = outcome_counts(&done.tally, faces, &cfg.method, spec.scene.shape.as_deref())?;
+        let counts = outcome_counts(&done.tally, faces, &method, spec.scene.shape.as_deref())?;
         // Merged groups keep their count in the first member, as the data file does.
         let grouped: Vec<u64> = row
             .groups

@@ -95,15 +95,15 @@ pub fn simulate(
             continue;
         }
         let (block, mode) = (key.block, key.mode);
+        // The key's own die, where a row names one.
+        let method = plan.method.for_die(key.die.as_deref());
         let mut design_points = Vec::new();
         let (mut unsettled, mut rolls) = (0u64, 0u64);
         for (g, x) in xs.iter().enumerate() {
             let values = params::values(&plan.model.fixed, &key.axes, x);
             // Common random numbers: every point the throws of the first.
             let seed = key.seed(plan.seed, if plan.design.common { 0 } else { g });
-            let spec = plan
-                .method
-                .spec(block, mode, &values, seed, plan.design.rolls);
+            let spec = method.spec(block, mode, &values, seed, plan.design.rolls);
             spec.validate(false)?;
             let ck = match dir {
                 Some(d) => Some(
@@ -130,18 +130,19 @@ pub fn simulate(
             rolls += t.rolls;
             design_points.push(DesignPoint {
                 x: x.clone(),
-                counts: outcome_counts(t, key.faces, plan.method, spec.scene.shape.as_deref())?,
+                counts: outcome_counts(t, key.faces, &method, spec.scene.shape.as_deref())?,
             });
         }
         if runner.share.is_partial() {
             continue;
         }
-        let surrogate = surrogate(&design_points, key, plan.method, plan.design);
+        let surrogate = surrogate(&design_points, key, &method, plan.design);
         let design = Design {
             block,
             mode,
             axes: key.axes.clone(),
             faces: key.faces,
+            die: key.die.clone(),
             points: design_points,
             borrowed: vec![],
             unsettled,
