@@ -26,7 +26,9 @@ use std::path::PathBuf;
 pub struct FitArgs {
     /// The measured counts: a CSV with the columns label, surface, length_mm, breadth_mm,
     /// width_mm, mode (2d or 3d), length_vertical, breadth_vertical, width_vertical and
-    /// optionally thrower (docs/guide.md, "Calibrating"); or "paper", the paper's 19 rows.
+    /// optionally thrower (docs/guide.md, "Calibrating"); or label, surface, die (a shape name
+    /// or a die file beside the CSV) and face_<label> counts, several dice in one fit; or
+    /// "paper", the paper's 19 rows.
     #[arg(long, value_name = "COUNTS.csv")]
     pub data: PathBuf,
     /// The free parameters (comma-separated): e (restitution), mu (friction), kappa (the
