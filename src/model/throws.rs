@@ -460,11 +460,7 @@ pub fn keyed_styled(
             let velocity = ranges.velocity.draw(u());
             let spin = ranges.spin.draw(u());
             let turn = match style {
-                ThrowStyle::Tumble => Some(Turn {
-                    rotation: haar_quaternion(u(), u(), u()),
-                    spin_axis: unit_vector(u(), u()),
-                    heading: std::f64::consts::TAU * u(),
-                }),
+                ThrowStyle::Tumble => Some(tumble_turn([u(), u(), u(), u(), u(), u()])),
                 ThrowStyle::Hand => Some(hand_turn(kappa, [u(), u(), u(), u(), u(), u()])),
                 _ => None,
             };
@@ -492,9 +488,7 @@ pub fn keyed_styled(
         ThrowStyle::Toss => {
             // The orientation first, as a rest draws it, so that a toss with every scale 0 is
             // the release at rest throw for throw.
-            let rotation = haar_quaternion(u(), u(), u());
-            let spin_axis = unit_vector(u(), u());
-            let heading = std::f64::consts::TAU * u();
+            let turn = tumble_turn([u(), u(), u(), u(), u(), u()]);
             let [drop_height, velocity, spin] =
                 toss_magnitudes(ranges, [u(), u(), u(), u(), u(), u()]);
             Throw {
@@ -503,13 +497,20 @@ pub fn keyed_styled(
                 velocity,
                 spin,
                 style,
-                turn: Some(Turn {
-                    rotation,
-                    spin_axis,
-                    heading,
-                }),
+                turn: Some(turn),
             }
         }
+    }
+}
+
+/// A tumble's directions from six uniform deviates: a uniformly random orientation (three),
+/// a spin axis uniform on the sphere (two) and a horizontal heading (one). A toss draws the
+/// same.
+fn tumble_turn(u: [f64; 6]) -> Turn {
+    Turn {
+        rotation: haar_quaternion(u[0], u[1], u[2]),
+        spin_axis: unit_vector(u[3], u[4]),
+        heading: std::f64::consts::TAU * u[5],
     }
 }
 
