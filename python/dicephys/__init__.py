@@ -890,6 +890,7 @@ def predict(
     com: Optional[Sequence[float]] = None,
     density: Optional[float] = None,
     counts: Any = None,
+    discrepancy: str = "auto",
 ) -> Document:
     """A block the fit did not see, simulated at the fit's posterior draws:
     ``dicephys predict --json`` (docs/json.md, "predict").
@@ -904,6 +905,8 @@ def predict(
     counts: counts of the die predicted (a CSV file or CSV text in ``fit``'s format): the
         prediction is scored against each row beside the default scene and the quasi-static
         theory (``doc.tests``; docs/json.md, "Proper scores").
+    discrepancy: the fit's discrepancy applied where it improved the fit's held-out log score
+        ("auto"), always ("on") or never ("off"): ``predict --discrepancy``.
     """
     path = fit.path if isinstance(fit, Fit) else os.fspath(fit)
     with open(path, encoding="utf-8") as f:
@@ -914,7 +917,7 @@ def predict(
             text, block, mode=mode, surface=surface, thrower=thrower, draws=draws,
             rolls=rolls, seed=seed, threads=threads, progress=tell,
             contact=_contact(contact), die=_other_die(shape, die, size, scale, com, density),
-            counts=None if counts is None else _data(counts),
+            counts=None if counts is None else _data(counts), discrepancy=discrepancy,
         )
     finally:
         close()

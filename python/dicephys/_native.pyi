@@ -80,4 +80,5 @@ def predict(
     contact: Optional[Tuple[float, float]] = ...,
     die: Optional[Dict[str, Any]] = ...,
     counts: Optional[str] = ...,
+    discrepancy: str = ...,
 ) -> str: ...

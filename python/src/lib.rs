@@ -849,7 +849,7 @@ fn compare(first: &str, second: &str, names: [String; 2]) -> PyResult<String> {
 #[pyfunction]
 #[pyo3(signature = (fit, block=None, *, mode="3d", surface=None, thrower=None, draws=16,
     rolls=2000, seed=DEFAULT_SEED, threads=0, progress=None, contact=None, die=None,
-    counts=None))]
+    counts=None, discrepancy="auto"))]
 #[allow(clippy::too_many_arguments)]
 fn predict<'py>(
     py: Python<'py>,
@@ -866,8 +866,19 @@ fn predict<'py>(
     contact: Option<[f64; 2]>,
     die: Option<Bound<'py, PyDict>>,
     counts: Option<&str>,
+    discrepancy: &str,
 ) -> PyResult<String> {
-    let fit = fit_of(fit, "fit")?;
+    let mut fit = fit_of(fit, "fit")?;
+    let discrepancy: calibration::discrepancy::Use = discrepancy.parse().map_err(|_: String| {
+        bad(
+            "discrepancy",
+            format!("'{discrepancy}'"),
+            "give auto, on or off",
+        )
+    })?;
+    if let Some(d) = fit.discrepancy.as_mut() {
+        d.set_use(discrepancy);
+    }
     let given = block.map(self::block).transpose()?;
     let other = other_die(&fit, given, die)?;
     // A fit of a die of any shape predicts that die; a fit of blocks needs the block; another

@@ -170,6 +170,44 @@ impl OutcomeDiscrepancy {
 pub struct Discrepancy {
     /// Each outcome, in the rows' order.
     pub outcomes: Vec<OutcomeDiscrepancy>,
+    /// Whether predictions take it: only where it improved the held-out log score of the
+    /// fit's rows predicted without themselves (each row's discrepancy learnt from the other
+    /// rows' misses), or where `predict --discrepancy on` asks. A fit.json from before this
+    /// was judged reads as applied, as it was.
+    #[serde(default = "applied")]
+    pub applied: bool,
+    /// What it did to that held-out log score, in nats (with it minus without it, summed over
+    /// the rows); `None` where not judged.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub held_out_gain: Option<f64>,
+}
+
+fn applied() -> bool {
+    true
+}
+
+/// Whether a prediction takes its fit's discrepancy (`predict --discrepancy`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Use {
+    /// As the fit judged it: where it improved the held-out log score.
+    #[default]
+    Auto,
+    /// Always.
+    On,
+    /// Never.
+    Off,
+}
+
+impl std::str::FromStr for Use {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Use, String> {
+        match s {
+            "auto" => Ok(Use::Auto),
+            "on" => Ok(Use::On),
+            "off" => Ok(Use::Off),
+            _ => Err(format!("'{s}' is not auto, on or off")),
+        }
+    }
 }
 
 /// One share as the discrepancy leaves it: its value, the factor its value and errors were
@@ -208,7 +246,54 @@ impl Discrepancy {
                 outcome(name, &cells, phi.max(1.0))
             })
             .collect();
-        Some(Discrepancy { outcomes })
+        Some(Discrepancy {
+            outcomes,
+            applied: true,
+            held_out_gain: None,
+        })
+    }
+
+    /// Judged by the held-out log score of the fit's rows predicted without themselves: a
+    /// discrepancy widens predictions only as far as it improved that score, so one that did
+    /// not (a tie included) is kept in the fit for the reader and not applied. A choice of
+    /// one bit made on the held-out rows: their score of the choice made is a little
+    /// optimistic.
+    pub fn judge(&mut self, loo: &crate::calibration::proper::Scores) {
+        let (Some(with), Some(without)) = (loo.prediction, loo.without_discrepancy) else {
+            return;
+        };
+        let gain = with.log_score - without.log_score;
+        self.held_out_gain = Some(gain);
+        self.applied = gain > 0.0;
+    }
+
+    /// Applied as `u` asks: as judged (auto), always (on) or never (off).
+    pub fn set_use(&mut self, u: Use) {
+        match u {
+            Use::Auto => {}
+            Use::On => self.applied = true,
+            Use::Off => self.applied = false,
+        }
+    }
+
+    /// Whether it moves and widens a prediction: applied, with an outcome that asked.
+    pub fn in_force(&self) -> bool {
+        self.applied && self.any()
+    }
+
+    /// Why it is not applied, in a sentence, where it asked and is not.
+    pub fn not_applied(&self) -> Option<String> {
+        if self.applied || !self.any() {
+            return None;
+        }
+        Some(match self.held_out_gain.filter(|&g| g <= 0.0) {
+            Some(g) => format!(
+                "the fit's discrepancy is not applied: with it, the fit's rows predicted \
+                 without themselves score {g:+.2} nats of log score over without it \
+                 (`predict --discrepancy on` applies it)"
+            ),
+            None => "the fit's discrepancy is not applied (`--discrepancy off`)".into(),
+        })
     }
 
     /// `name`'s discrepancy, where the rows asked for one.
@@ -559,6 +644,58 @@ mod tests {
                 row(c, n, logistic(eta), 0.0)
             })
             .collect()
+    }
+
+    #[test]
+    fn a_discrepancy_is_applied_only_where_it_improved_the_held_out_score() {
+        use crate::calibration::proper::{score, Scores};
+        // Rows whose log-odds miss by N(0, 1²): a discrepancy is asked for.
+        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+        let mut d = Discrepancy::estimate(&rows(&mut rng, 8, 2_000, 1.0), 1.0).unwrap();
+        assert!(d.any() && d.applied && d.held_out_gain.is_none());
+        let (better, worse) = (
+            score(&[50, 50], &[0.5, 0.5], &[0.0; 2], 1.0),
+            score(&[50, 50], &[0.2, 0.8], &[0.0; 2], 1.0),
+        );
+        let judged = |with, without| Scores {
+            prediction: Some(with),
+            without_discrepancy: Some(without),
+            ..Scores::default()
+        };
+        d.judge(&judged(better, worse));
+        let gain = better.log_score - worse.log_score;
+        assert!(gain > 0.0 && d.in_force() && d.held_out_gain == Some(gain));
+        d.judge(&judged(worse, better));
+        assert!(!d.in_force() && d.held_out_gain == Some(-gain));
+        assert!(d
+            .not_applied()
+            .unwrap()
+            .contains(&format!("{:+.2} nats", -gain)));
+        // A tie is not an improvement.
+        d.judge(&judged(better, better));
+        assert!(!d.applied);
+        // Nothing to judge by: as it was.
+        d.judge(&Scores::default());
+        assert!(!d.applied && d.held_out_gain == Some(0.0));
+        // What a prediction asks overrides the judgement; auto keeps it.
+        d.set_use(Use::On);
+        assert!(d.in_force());
+        d.set_use(Use::Auto);
+        assert!(d.in_force());
+        d.set_use(Use::Off);
+        assert!(!d.in_force() && d.not_applied().is_some());
+        assert_eq!("off".parse::<Use>(), Ok(Use::Off));
+        assert!("maybe"
+            .parse::<Use>()
+            .unwrap_err()
+            .contains("auto, on or off"));
+        // A fit.json written before the judgement reads as applied, as it predicted then.
+        let mut v = serde_json::to_value(&d).unwrap();
+        let o = v.as_object_mut().unwrap();
+        o.remove("applied");
+        o.remove("held_out_gain");
+        let old: Discrepancy = serde_json::from_value(v).unwrap();
+        assert!(old.in_force() && old.held_out_gain.is_none());
     }
 
     #[test]

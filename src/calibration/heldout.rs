@@ -219,13 +219,28 @@ pub struct Predictions {
     pub dof: Option<usize>,
     /// P(χ²_dof ≥ χ²).
     pub p_value: Option<f64>,
-    /// The measured rows' proper scores summed, beside the baselines'.
+    /// The measured rows' proper scores summed (the dice's included), beside the baselines'.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scores: Option<Scores>,
+    /// Each die of any shape a `die` column named, in the file's order: its prediction (its
+    /// `tests` the row's scores).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub dice: Vec<PredictedDie>,
     /// The fit predicted from.
     pub fit: String,
     /// The command line that made it.
     pub command_line: String,
+}
+
+/// A die of any shape's row of a counts file, predicted.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PredictedDie {
+    /// The row's name.
+    pub label: String,
+    /// Its die, as the `die` column names it.
+    pub die: String,
+    /// The prediction, scored against the row's counts (its `tests`).
+    pub prediction: BlockPrediction,
 }
 
 /// `row`'s prediction `p`, tested against its counts if it has them.
@@ -339,7 +354,12 @@ pub fn score_against(row: &BlockRow, p: &[Predicted], phi: f64) -> Option<Score>
 }
 
 /// The rows' predictions, with the χ² of the measured ones.
-pub fn collect(rows: Vec<PredictedRow>, fit: String, command_line: String) -> Predictions {
+pub fn collect(
+    rows: Vec<PredictedRow>,
+    dice: Vec<PredictedDie>,
+    fit: String,
+    command_line: String,
+) -> Predictions {
     let tested: Vec<&PredictedRow> = rows.iter().filter(|r| r.chi2.is_some()).collect();
     let chi2 = (!tested.is_empty()).then(|| tested.iter().filter_map(|r| r.chi2).sum::<f64>());
     let dof = (!tested.is_empty()).then(|| tested.iter().filter_map(|r| r.dof).sum::<usize>());
@@ -347,7 +367,15 @@ pub fn collect(rows: Vec<PredictedRow>, fit: String, command_line: String) -> Pr
         .zip(dof)
         .filter(|(_, d)| *d > 0)
         .map(|(c, d)| stats::chi_square_p_value(c, d));
-    let scored: Vec<&Scores> = tested.iter().filter_map(|r| r.scores.as_ref()).collect();
+    let scored: Vec<&Scores> = tested
+        .iter()
+        .filter_map(|r| r.scores.as_ref())
+        .chain(
+            dice.iter()
+                .flat_map(|d| &d.prediction.tests)
+                .map(|t| &t.scores),
+        )
+        .collect();
     let scores = (!scored.is_empty()).then(|| Scores::total(&scored));
     Predictions {
         rows,
@@ -355,6 +383,7 @@ pub fn collect(rows: Vec<PredictedRow>, fit: String, command_line: String) -> Pr
         dof,
         p_value,
         scores,
+        dice,
         fit,
         command_line,
     }
@@ -484,7 +513,7 @@ mod tests {
         );
         assert!((widened.chi2.unwrap() - want / 4.0).abs() < 1e-9);
         assert!((widened.z.unwrap() - far.z.unwrap() / 2.0).abs() < 1e-9);
-        let all = collect(vec![same, far], "f".into(), "c".into());
+        let all = collect(vec![same, far], Vec::new(), "f".into(), "c".into());
         assert_eq!(all.dof, Some(2));
         assert!(all.p_value.unwrap() < 1e-6);
     }

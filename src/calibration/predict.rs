@@ -121,10 +121,18 @@ impl BlockPrediction {
     /// each share moved along its outcome's line and widened by its spread, each face by its
     /// label's, the others scaled so that they still sum to 1, and the ratio moved and widened
     /// with breadth's and width's.
+    /// A discrepancy not applied (it did not improve the fit's held-out score) leaves the
+    /// prediction as it was and is carried beside it, for the reader.
     pub fn widened(self, d: Option<&Discrepancy>) -> BlockPrediction {
         let Some(d) = d.filter(|d| d.any()) else {
             return self;
         };
+        if !d.in_force() {
+            return BlockPrediction {
+                discrepancy: Some(d.clone()),
+                ..self
+            };
+        }
         const SIDES: [&str; 3] = ["length", "breadth", "width"];
         let shares = |ps: &[Predicted], names: &[&str]| -> (Vec<Predicted>, Vec<Corrected>) {
             let values: Vec<f64> = ps.iter().map(|q| q.value).collect();

@@ -305,6 +305,10 @@ pub struct CountsTest {
     pub outcomes: Vec<String>,
     /// Its counts.
     pub counts: Vec<u64>,
+    /// The prediction of each outcome counted (a group of faces the counts merge summed, its
+    /// errors in quadrature), as scored.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub predicted: Vec<crate::calibration::predict::Predicted>,
     /// The prediction's scores beside the baselines'.
     pub scores: Scores,
 }

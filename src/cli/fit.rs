@@ -163,6 +163,10 @@ pub struct PredictArgs {
     /// scene and the quasi-static theory.
     #[arg(long, value_name = "COUNTS.csv", conflicts_with = "blocks")]
     pub counts: Option<PathBuf>,
+    /// The fit's discrepancy (how far it missed rows it did not see): applied where it
+    /// improved the fit's held-out log score (auto), always (on) or never (off).
+    #[arg(long, value_name = "auto|on|off", default_value = "auto")]
+    pub discrepancy: dicephys::calibration::discrepancy::Use,
     /// Posterior draws to simulate the block at.
     #[arg(long, default_value_t = dicephys::calibration::predict::DEFAULT_DRAWS)]
     pub draws: usize,
@@ -351,11 +355,14 @@ fn truth_values(cfg: &FitConfig, truth: &str) -> Result<Vec<f64>> {
 
 /// Runs `dicephys predict`.
 pub fn predict(a: &PredictArgs) -> Result<()> {
-    let fit: FitResult =
+    let mut fit: FitResult =
         dicephys::calibration::read_fit(&a.fit, super::term::stop()).map_err(|e| match e {
             dicephys::Error::Stopped => Error::Interrupted(nothing_read()),
             e => Error::Usage(format!("--fit {e}")),
         })?;
+    if let Some(d) = fit.discrepancy.as_mut() {
+        d.set_use(a.discrepancy);
+    }
     if let Some(file) = &a.blocks {
         return predict_blocks(a, fit, file);
     }
@@ -456,10 +463,24 @@ fn predict_blocks(a: &PredictArgs, fit: FitResult, file: &std::path::Path) -> Re
         })?;
     let text = std::str::from_utf8(&bytes)
         .map_err(|_| Error::Usage(format!("--blocks-file {}: not UTF-8", file.display())))?;
-    let rows = heldout::parse(text, &file.display().to_string())
-        .map_err(|e| Error::Usage(format!("--blocks-file {e}")))?;
+    let usage = |e: dicephys::Error| Error::Usage(format!("--blocks-file {e}"));
+    // A counts file whose rows name their dice (a `die` column) predicts each of them.
+    let names_dice = text
+        .lines()
+        .find(|l| !l.starts_with('#'))
+        .is_some_and(|h| h.split(',').any(|c| c.trim() == "die"));
+    let (rows, dice) = if names_dice {
+        let rows = data::read(file, super::term::stop()).map_err(usage)?;
+        let dice = dicephys::studies::fit::predict::die_configs(rows, a.draws, a.rolls, *a.seed)
+            .map_err(usage)?;
+        (Vec::new(), dice)
+    } else {
+        let rows = heldout::parse(text, &file.display().to_string()).map_err(usage)?;
+        (rows, Vec::new())
+    };
     let config = BlocksConfig {
         rows,
+        dice,
         draws: a.draws,
         rolls: a.rolls,
         seed: *a.seed,

@@ -639,13 +639,26 @@ pub fn discrepancy_text(d: Option<&Discrepancy>) -> Option<String> {
             )
         })
         .collect();
+    let judged = match (d.applied, d.held_out_gain) {
+        (true, Some(g)) => format!(
+            " Applied: with it, the rows predicted without themselves (each taking the line the \
+             other rows' misses draw) score {g:+.2} nats of log score over without it."
+        ),
+        (true, None) => " Applied, not judged: too few rows to learn it without each.".into(),
+        (false, Some(g)) if g <= 0.0 => format!(
+            " **Not applied**: with it, the rows predicted without themselves score {g:+.2} nats \
+             of log score over without it (`predict --discrepancy on` applies it)."
+        ),
+        (false, _) => " **Not applied** (`predict --discrepancy off`).".into(),
+    };
     Some(format!(
         "**The model misses rows it did not see beyond their errors**, in {}: the rows \
          predicted without themselves say how far a block's log-odds are missed, as a line in \
-         the predicted log-odds η with a spread τ about it beyond the counts' noise, and every \
+         the predicted log-odds η with a spread τ about it beyond the counts' noise, and a \
          prediction of a block this fit did not see is moved along that line and widened by \
-         the line's error there and τ (`err_model`). A bias that differs from block to block \
-         is not extra scatter in the counts: it does not shrink with the throws counted.",
+         the line's error there and τ (`err_model`) where that improved the rows' held-out \
+         log score. A bias that differs from block to block is not extra scatter in the \
+         counts: it does not shrink with the throws counted.{judged}",
         asked.join("; ")
     ))
 }
@@ -849,7 +862,10 @@ pub fn prediction_text(p: &BlockPrediction) -> String {
             p.overdispersion
         );
     }
-    if let Some(d) = p.discrepancy.as_ref().filter(|d| d.any()) {
+    if let Some(why) = p.discrepancy.as_ref().and_then(|d| d.not_applied()) {
+        let _ = writeln!(s, "  {why}");
+    }
+    if let Some(d) = p.discrepancy.as_ref().filter(|d| d.in_force()) {
         let lines: Vec<String> = d
             .outcomes
             .iter()
@@ -1225,11 +1241,13 @@ pub fn predictions_markdown(p: &crate::calibration::heldout::Predictions, stem: 
     let mut s = String::new();
     let _ = writeln!(s, "# Predictions from {}\n", p.fit);
     let _ = writeln!(s, "`{}`\n", p.command_line);
-    let _ = writeln!(
-        s,
-        "| row | block | surface | P(length) | P(breadth) | P(width) | ratio | theory | measured | z |"
-    );
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---:|---|---:|");
+    if !p.rows.is_empty() {
+        let _ = writeln!(
+            s,
+            "| row | block | surface | P(length) | P(breadth) | P(width) | ratio | theory | measured | z |"
+        );
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---:|---|---:|");
+    }
     for r in &p.rows {
         let q = &r.prediction;
         let _ = writeln!(
@@ -1258,24 +1276,29 @@ pub fn predictions_markdown(p: &crate::calibration::heldout::Predictions, stem: 
             p.p_value.map_or(String::new(), |v| format!(", p = {v:.3}"))
         );
     }
+    for d in &p.dice {
+        let _ = writeln!(
+            s,
+            "\n## {} ({})\n\n```text\n{}```",
+            d.label,
+            d.die,
+            prediction_text(&d.prediction)
+        );
+    }
     scores_section(&mut s, p);
-    if let Some(phi) = p
+    let first = p
         .rows
         .first()
-        .map(|r| r.prediction.overdispersion)
-        .filter(|&v| v > 1.0)
-    {
+        .map(|r| &r.prediction)
+        .or(p.dice.first().map(|d| &d.prediction));
+    if let Some(phi) = first.map(|q| q.overdispersion).filter(|&v| v > 1.0) {
         let _ = writeln!(
             s,
             "\nThe fit misfits: its overdispersion φ = {phi:.2} widens every prediction above, and \
              each measured count's variance is taken φ times the multinomial's."
         );
     }
-    if let Some(t) = discrepancy_text(
-        p.rows
-            .first()
-            .and_then(|r| r.prediction.discrepancy.as_ref()),
-    ) {
+    if let Some(t) = discrepancy_text(first.and_then(|q| q.discrepancy.as_ref())) {
         let _ = writeln!(s, "\n{t}");
     }
     let far: Vec<String> = p
@@ -1294,7 +1317,9 @@ pub fn predictions_markdown(p: &crate::calibration::heldout::Predictions, stem: 
             let _ = writeln!(s, "- {f}");
         }
     }
-    let _ = writeln!(s, "\n![{stem}]({stem}.svg)");
+    if !p.rows.is_empty() {
+        let _ = writeln!(s, "\n![{stem}]({stem}.svg)");
+    }
     s
 }
 
@@ -1315,12 +1340,46 @@ fn scores_section(s: &mut String, p: &crate::calibration::heldout::Predictions) 
             let _ = writeln!(s, "{}:\n\n{}", r.label, sc.lines("- "));
         }
     }
+    for d in &p.dice {
+        for t in &d.prediction.tests {
+            let _ = writeln!(s, "{} ({}):\n\n{}", t.label, d.die, t.scores.lines("- "));
+        }
+    }
     let _ = writeln!(s, "All measured rows:\n\n{}", total.lines("- "));
 }
 
 /// A prediction as a table cell: value ± whole error.
 fn short(p: &Predicted) -> String {
     format!("{:.4} ± {:.4}", p.value, p.err)
+}
+
+/// `predict --blocks-file`'s dice (a `die` column's) as CSV: one line an outcome of a row,
+/// its predicted share and error beside its count.
+pub fn dice_csv(p: &crate::calibration::heldout::Predictions) -> String {
+    let mut s = String::from("label,die,outcome,p,p_err,count\n");
+    let quote = |v: &str| {
+        if v.contains([',', '"', '\n']) {
+            format!("\"{}\"", v.replace('"', "\"\""))
+        } else {
+            v.to_string()
+        }
+    };
+    for d in &p.dice {
+        for t in &d.prediction.tests {
+            for ((name, q), c) in t.outcomes.iter().zip(&t.predicted).zip(&t.counts) {
+                let _ = writeln!(
+                    s,
+                    "{},{},{},{},{},{c}",
+                    quote(&t.label),
+                    quote(&d.die),
+                    quote(name),
+                    q.value,
+                    q.err
+                );
+            }
+        }
+    }
+    s
 }
 
 /// `predict --blocks`'s table as CSV: one row a block.

@@ -196,3 +196,117 @@ fn what_a_rows_die_cannot_be_is_refused_in_one_line() {
         refused(&fit(&csv, free, &out, &[]), 2, says);
     }
 }
+
+/// `predict --blocks-file` with a `die` column (issue 71.2): each row's die predicted from the
+/// fit as `predict --shape/--die … --counts` predicts it alone, with the same numbers at the
+/// same seed; a row of no die, or a die that cannot be had, refused in one line naming it.
+#[test]
+fn a_file_of_dice_is_predicted_row_by_row_as_each_die_alone() {
+    let dir = Scratch::new("dice-predict");
+    let csv = dir.join("cube.csv");
+    std::fs::write(
+        &csv,
+        format!("{HEAD}\ncube,felt,d6,170,162,171,165,168,164,,\n"),
+    )
+    .unwrap();
+    let out = Scratch::absent("dice-predict-fit");
+    json(&fit(&csv, "e", &out, &[]));
+    let fit_json = out.join("fit.json");
+    let fit_json = fit_json.to_str().unwrap();
+    let dice = dir.join("dice.csv");
+    std::fs::write(
+        &dice,
+        format!("{HEAD}\noctahedron,felt,d8,26,18,31,22,25,27,20,31\ncube2,felt,d6,30,32,29,35,31,33,,\n"),
+    )
+    .unwrap();
+    let few = ["--draws", "2", "--rolls", "40", "--threads", "1", "--json"];
+    let pred = dir.join("pred");
+    let mut a = vec![
+        "predict",
+        "--fit",
+        fit_json,
+        "--blocks-file",
+        dice.to_str().unwrap(),
+        "--out",
+        pred.to_str().unwrap(),
+    ];
+    a.extend(few);
+    let v = json(&dicephys(&a));
+    let rows = v["dice"].as_array().unwrap();
+    assert_eq!(rows.len(), 2, "{v}");
+    assert_eq!(
+        (rows[0]["label"].as_str(), rows[0]["die"].as_str()),
+        (Some("octahedron"), Some("d8"))
+    );
+    assert!(
+        v["rows"].as_array().is_none_or(Vec::is_empty),
+        "no blocks: {v}"
+    );
+    // The octahedron alone, as `predict --shape d8 --counts` predicts it.
+    let alone_csv = dir.join("d8.csv");
+    std::fs::write(
+        &alone_csv,
+        "label,surface,face_1,face_2,face_3,face_4,face_5,face_6,face_7,face_8\n\
+         octahedron,felt,26,18,31,22,25,27,20,31\n",
+    )
+    .unwrap();
+    let mut a = vec![
+        "predict",
+        "--fit",
+        fit_json,
+        "--shape",
+        "d8",
+        "--counts",
+        alone_csv.to_str().unwrap(),
+    ];
+    a.extend(few);
+    let alone = json(&dicephys(&a));
+    let test = &rows[0]["prediction"]["tests"][0];
+    for kind in ["prediction", "default_scene", "quasi_static"] {
+        let (x, y) = (
+            test["scores"][kind]["log_score"].as_f64().unwrap(),
+            alone["tests"][0]["scores"][kind]["log_score"]
+                .as_f64()
+                .unwrap(),
+        );
+        assert!((x - y).abs() < 1e-9, "{kind}: {x} in the file, {y} alone");
+    }
+    assert_eq!(test["predicted"].as_array().unwrap().len(), 8);
+    // The total sums both dice's rows.
+    let total = v["scores"]["prediction"]["log_score"].as_f64().unwrap();
+    let sum: f64 = rows
+        .iter()
+        .map(|r| {
+            r["prediction"]["tests"][0]["scores"]["prediction"]["log_score"]
+                .as_f64()
+                .unwrap()
+        })
+        .sum();
+    assert!((total - sum).abs() < 1e-9, "{total} {sum}");
+    let table = std::fs::read_to_string(pred.join("dice.csv")).unwrap();
+    assert_eq!(table.lines().count(), 1 + 8 + 6, "{table}");
+    assert!(
+        table.starts_with("label,die,outcome,p,p_err,count\noctahedron,d8,face 1,"),
+        "{table}"
+    );
+    let report = std::fs::read_to_string(pred.join("report.md")).unwrap();
+    assert!(report.contains("## octahedron (d8)"), "{report}");
+    // A row that names no die, and a die that is not one.
+    for (row, says) in [
+        ("a,felt,,1,2,3,4,5,6,,", "row 'a': names no die"),
+        ("a,felt,d7,1,2,3,4,5,6,7,8", "row 'a': die 'd7'"),
+    ] {
+        std::fs::write(&dice, format!("{HEAD}\n{row}\n")).unwrap();
+        let mut a = vec![
+            "predict",
+            "--fit",
+            fit_json,
+            "--blocks-file",
+            dice.to_str().unwrap(),
+            "--out",
+            pred.to_str().unwrap(),
+        ];
+        a.extend(few);
+        refused(&dicephys(&a), 2, says);
+    }
+}

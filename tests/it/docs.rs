@@ -309,6 +309,7 @@ const REFS: &[(&str, &str, &str)] = &[
     ("predict", "tests[].scores", "scores"),
     ("predict-blocks", "rows[].scores", "scores"),
     ("predict-blocks", "scores", "scores"),
+    ("predict-blocks", "dice[].prediction", "predict"),
     ("scores", "prediction", "score"),
     ("scores", "without_discrepancy", "score"),
     ("scores", "default_scene", "score"),
@@ -1070,6 +1071,34 @@ d,MDF,9,11,10,10,8,12
     ]);
     assert!(p["tests"][0]["scores"]["quasi_static"].is_object(), "{p}");
     c.document("predict", "predict another die against its counts", &p);
+    // The same die in a file of dice (a `die` column): `predict --blocks-file`'s `dice[]`.
+    let dice_csv = dir.join("dice.csv");
+    std::fs::write(
+        &dice_csv,
+        "label,surface,die,face_1,face_2,face_3,face_4,face_5,face_6
+d,MDF,d6,9,11,10,10,8,12
+",
+    )
+    .unwrap();
+    let out = dir.join("dice-out");
+    let many = run(&[
+        "predict",
+        "--fit",
+        &format!("{d4_fit}/fit.json"),
+        "--blocks-file",
+        dice_csv.to_str().unwrap(),
+        "--draws",
+        "3",
+        "--rolls",
+        "50",
+        "--threads",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(many["dice"][0]["die"], "d6", "{many}");
+    c.document("predict-blocks", "predict --blocks-file (dice)", &many);
 }
 
 /// Two dice in one fit, by a `die` column (issue 71.1), each left out in turn (71.4).

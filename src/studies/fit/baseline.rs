@@ -279,7 +279,7 @@ pub fn test_counts(
     };
     let theory = quasi_static(method, &fixed, at);
     let phi = fit.estimate.overdispersion;
-    let has_d = fit.discrepancy.as_ref().is_some_and(Discrepancy::any);
+    let has_d = fit.discrepancy.as_ref().is_some_and(Discrepancy::in_force);
     let of = |b: &BlockPrediction, row: &DataRow| {
         by_group(
             row,
@@ -295,8 +295,9 @@ pub fn test_counts(
         .iter()
         .map(|row| {
             let counts = row.grouped();
+            let predicted = of(p, row);
             let scores = Scores {
-                prediction: Some(score_of(&counts, &of(p, row), phi)),
+                prediction: Some(score_of(&counts, &predicted, phi)),
                 without_discrepancy: has_d.then(|| score_of(&counts, &of(own, row), phi)),
                 default_scene: Some(score_of(
                     &counts,
@@ -311,6 +312,7 @@ pub fn test_counts(
                 label: row.label.clone(),
                 outcomes: row.group_names(),
                 counts,
+                predicted,
                 scores,
             }
         })

@@ -464,6 +464,10 @@ pub struct BlocksStudy {
 pub struct BlocksConfig {
     /// The blocks, with their counts where measured.
     pub rows: Vec<crate::calibration::heldout::BlockRow>,
+    /// Dice of any shape (a counts file's `die` column): each its own prediction, another die
+    /// than the fit's, scored against its row's counts.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub dice: Vec<crate::calibration::predict::PredictConfig>,
     /// Posterior draws a block.
     pub draws: usize,
     /// Rolls a draw.
@@ -574,7 +578,7 @@ pub fn run(
         Stage::First => Vec::new(),
         _ => rows_without_themselves(&f, runner)?,
     };
-    let discrepancy = Discrepancy::estimate(&loo, f.estimate.overdispersion);
+    let mut discrepancy = Discrepancy::estimate(&loo, f.estimate.overdispersion);
     let phi = f.estimate.overdispersion;
     // The baselines roll on this process's own cores (a cluster's finishing job included).
     let loo_scores = if loo.is_empty() {
@@ -585,6 +589,9 @@ pub fn run(
             None => return Ok(None),
         }
     };
+    if let (Some(d), Some(s)) = (discrepancy.as_mut(), loo_scores.as_ref()) {
+        d.judge(s);
+    }
     let loo_dice = baseline::by_die(&loo);
     Ok(Some(FitResult {
         loo,

@@ -3,6 +3,7 @@
 //! whole (as [`crate::studies::outputs`] does for the other studies).
 
 use super::{BlocksStudy, FitStudy, PredictStudy, RecoverStudy, Stage, FIRST_PASS};
+use crate::error::Error;
 use crate::error::Result;
 use crate::report::fit as report;
 use crate::report::progress::Unit;
@@ -79,7 +80,13 @@ impl Kind for BlocksStudy {
     }
     fn validate(&self) -> Result<()> {
         let c = &self.config;
-        super::predict::check_blocks(&self.fit, &c.rows, c.draws, c.rolls, c.seed)
+        super::predict::check_blocks(&self.fit, &c.rows, c.draws, c.rolls, c.seed)?;
+        for d in &c.dice {
+            let label = d.counts.first().map_or("", |r| r.label.as_str());
+            super::predict::check(&self.fit, d)
+                .map_err(|e| Error::Invalid(format!("row '{label}': {e}")))?;
+        }
+        Ok(())
     }
     fn unit(&self) -> Unit {
         Unit::Rolls {
@@ -201,12 +208,17 @@ fn predict(study: &PredictStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
 /// `predictions` in `place.out` (claimed as a study's); the table printed.
 fn predict_blocks(study: &BlocksStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
     let (fit, cfg) = (&study.fit, &study.config);
-    let (stem, files) = (
-        "predictions",
-        ["predictions.json", "predictions.csv", "report.md"],
-    );
+    let stem = "predictions";
+    let mut files = vec!["predictions.json", "report.md"];
+    if !cfg.rows.is_empty() {
+        files.push("predictions.csv");
+    }
+    if !cfg.dice.is_empty() {
+        files.push("dice.csv");
+    }
     let outputs = place.outputs(&files)?;
-    let total = (cfg.rows.len() as u64 * cfg.draws as u64 * cfg.rolls) as f64;
+    let per_row = cfg.draws as u64 * cfg.rolls;
+    let total = ((cfg.rows.len() + cfg.dice.len()) as u64 * per_row) as f64;
     let progress = |n: u64| (hooks.progress)(n as f64, total);
     let study = place.study(&hooks.stop, &progress);
     let runner = &study.runner;
@@ -216,19 +228,62 @@ fn predict_blocks(study: &BlocksStudy, place: &Place, hooks: &Hooks) -> Result<D
     let Some(rows) = rows else {
         return Ok(interrupted(None));
     };
-    let res =
-        crate::calibration::heldout::collect(rows, cfg.fit.clone(), place.command_line.clone());
-    report::predictions_figure(&place.out, stem, &res)?;
+    let mut dice = Vec::new();
+    for (i, d) in cfg.dice.iter().enumerate() {
+        let base = ((cfg.rows.len() + i) as u64 * per_row) as f64;
+        let progress = |n: u64| (hooks.progress)(base + n as f64, total);
+        let runner = runner.with_progress(&progress);
+        let label = d.counts.first().map_or("", |r| r.label.as_str());
+        let in_row = |e| match e {
+            Error::Failed(m) => Error::Failed(m.after(&format!("row '{label}': "))),
+            e => e,
+        };
+        let predicted =
+            unless_stopped(runner.install(|| {
+                super::predict::predict_block(fit, d, &runner, None).map_err(in_row)
+            })?)?;
+        let Some(prediction) = predicted else {
+            return Ok(interrupted(None));
+        };
+        dice.push(crate::calibration::heldout::PredictedDie {
+            label: label.to_string(),
+            die: d
+                .counts
+                .first()
+                .and_then(|r| r.die.clone())
+                .unwrap_or_default(),
+            prediction,
+        });
+    }
+    let res = crate::calibration::heldout::collect(
+        rows,
+        dice,
+        cfg.fit.clone(),
+        place.command_line.clone(),
+    );
+    if !res.rows.is_empty() {
+        report::predictions_figure(&place.out, stem, &res)?;
+    }
+    if !res.dice.is_empty() {
+        outputs.write("dice.csv", report::dice_csv(&res).as_bytes())?;
+    }
     let md = report::predictions_markdown(&res, stem);
     let json = to_json(&res)?;
     outputs.write("predictions.json", json.as_bytes())?;
-    outputs.write("predictions.csv", report::predictions_csv(&res).as_bytes())?;
+    if !res.rows.is_empty() {
+        outputs.write("predictions.csv", report::predictions_csv(&res).as_bytes())?;
+    }
     outputs.write("report.md", md.as_bytes())?;
     let mut done = place.done(&json, &md, "predictions.json");
     done.note = done.note.map(|_| {
         format!(
-            "wrote {}/predictions.json, predictions.csv, report.md and the figure",
-            place.out.display()
+            "wrote {}/{}",
+            place.out.display(),
+            match (res.rows.is_empty(), res.dice.is_empty()) {
+                (false, true) => "predictions.json, predictions.csv, report.md and the figure",
+                (true, false) => "predictions.json, dice.csv and report.md",
+                _ => "predictions.json, predictions.csv, dice.csv, report.md and the figure",
+            }
         )
         .into()
     });

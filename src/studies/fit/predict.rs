@@ -368,6 +368,59 @@ fn block_config(
     }
 }
 
+/// Each row of a counts file that names its die (its `die` column: a shape or a die file) as
+/// a prediction of that die, another than the fit's, scored against the row's counts
+/// (`draws` posterior draws × `rolls` throws a die, every die at `seed`). A row that names
+/// none, or a die that cannot be had, is refused in one line naming the row.
+pub fn die_configs(
+    rows: Vec<crate::calibration::data::DataRow>,
+    draws: usize,
+    rolls: u64,
+    seed: u64,
+) -> Result<Vec<PredictConfig>> {
+    use crate::calibration::other_die::OtherDie;
+    let mut dice: Vec<(String, OtherDie)> = Vec::new();
+    rows.into_iter()
+        .map(|row| {
+            let at = |e: Error| Error::Invalid(format!("row '{}': {e}", row.label));
+            let Some(name) = row.die.clone() else {
+                return Err(at(Error::Invalid(
+                    "names no die (a file of dice gives each row's in its die column)".into(),
+                )));
+            };
+            let die = match dice.iter().find(|(n, _)| *n == name) {
+                Some((_, d)) => d.clone(),
+                None => {
+                    let r = crate::calibration::dice::RowDie::resolve(&name)
+                        .map_err(|e| at(Error::Invalid(format!("die '{name}': {e}"))))?;
+                    let d = OtherDie {
+                        shape: Some(r.shape),
+                        features: r.die,
+                        density: r.density,
+                    };
+                    dice.push((name, d.clone()));
+                    d
+                }
+            };
+            let shape = die.shape.as_deref().expect("a die of any shape");
+            let counts = crate::calibration::data::on_shape(std::slice::from_ref(&row), shape)
+                .map_err(at)?;
+            Ok(PredictConfig {
+                block: die.block(row.block),
+                mode: crate::model::scene::Mode::ThreeD,
+                surface: Some(row.surface.clone()),
+                thrower: (row.thrower != "all").then(|| row.thrower.clone()),
+                contact: None,
+                draws,
+                rolls,
+                seed,
+                other: Some(Box::new(die)),
+                counts,
+            })
+        })
+        .collect()
+}
+
 /// Checks every row of a blocks file ([`check`]) before anything is written or rolled.
 pub fn check_blocks(
     fit: &FitResult,
@@ -412,7 +465,7 @@ pub fn predict_blocks(
         let p = own.clone().widened(fit.discrepancy.as_ref());
         let mut tested = crate::calibration::heldout::test(r, p);
         if let Some(scores) = tested.scores.as_mut() {
-            if fit.discrepancy.as_ref().is_some_and(|d| d.any()) {
+            if fit.discrepancy.as_ref().is_some_and(|d| d.in_force()) {
                 scores.without_discrepancy =
                     heldout::score_against(r, &own.p, fit.estimate.overdispersion);
             }
