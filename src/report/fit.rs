@@ -512,61 +512,85 @@ fn left_out(res: &FitResult) -> String {
     );
     let _ = writeln!(s, "\n## Each row predicted without itself\n");
     let dice = crate::calibration::dice::names(&res.config.rows).len();
-    let _ = writeln!(
-        s,
-        "{}, at that fit's posterior draws: its ratio N(breadth)/N(width) and its end count (length vertical), each with the \
-         prediction's error (parameters and simulation) combined with the measurement's. Ratios \
-         within 1σ: {} of {}, within 2σ: {} (a Gaussian error puts 68 % and 95 % there). \
-         Summed log predictive probability of the rows' counts: {:.1} — what `dicephys compare` \
-         sets this fit beside another model's fit of the same counts by.\n",
-        if dice > 0 {
-            format!(
-                "Each die's rows predicted together by a fit of the other {} (leave one die out)",
-                if dice == 2 {
-                    "die".to_string()
-                } else {
-                    format!("{} dice", dice - 1)
-                }
-            )
-        } else {
-            format!(
-                "Every row predicted by a fit of the other {} (leave one out)",
-                res.loo.len() - 1
-            )
-        },
-        score.within_one_sigma,
-        score.rows_scored,
-        score.within_two_sigma,
-        score.loo_log_score
-    );
-    let _ = writeln!(
-        s,
-        "| row | surface | measured ratio | predicted | z | ends: counted | predicted P(length) | z | log score |"
-    );
-    let _ = writeln!(s, "|---|---|---|---|---:|---|---|---:|---:|");
+    let who = if dice > 0 {
+        format!(
+            "Each die's rows predicted together by a fit of the other {} (leave one die out)",
+            if dice == 2 {
+                "die".to_string()
+            } else {
+                format!("{} dice", dice - 1)
+            }
+        )
+    } else {
+        format!(
+            "Every row predicted by a fit of the other {} (leave one out)",
+            res.loo.len() - 1
+        )
+    };
     let cell = |v: Option<String>| v.unwrap_or_else(|| "–".into());
-    for r in &res.loo {
+    // Rows that count faces have no ratio and no end count: their scores say it all.
+    if res.loo.iter().all(|r| r.ratio.is_none() && r.end.is_none()) {
         let _ = writeln!(
             s,
-            "| {}{} | {}{} | {} | {} | {} | {} | {} | {} | {:.2} |",
-            r.label,
-            r.die.as_ref().map_or(String::new(), |d| format!(" ({d})")),
-            r.surface,
-            if r.alone { " (alone)" } else { "" },
-            cell(
-                r.measured_ratio
-                    .map(|m| format!("{:.3} ± {:.3}", m.value, m.err))
-            ),
-            cell(r.ratio.map(|p| format!("{:.3} ± {:.3}", p.value, p.err))),
-            cell(r.z.map(|z| format!("{z:+.2}"))),
-            cell(r.end.map(|e| format!("{} / {}", e.counted, e.throws))),
-            cell(
-                r.end
-                    .map(|e| format!("{:.4} ± {:.4}", e.predicted.value, e.predicted.err))
-            ),
-            cell(r.end.map(|e| format!("{:+.2}", e.z))),
-            r.log_score
+            "{who}, at that fit's posterior draws; the rows count faces (no ratio, no end count), \
+             so each is judged by its proper scores (below). Summed log predictive probability \
+             of the rows' counts: {:.1} — what `dicephys compare` sets this fit beside another \
+             model's fit of the same counts by.\n",
+            score.loo_log_score
         );
+        let _ = writeln!(s, "| row | surface | outcomes | log score |");
+        let _ = writeln!(s, "|---|---|---:|---:|");
+        for r in &res.loo {
+            let _ = writeln!(
+                s,
+                "| {}{} | {}{} | {} | {:.2} |",
+                r.label,
+                r.die.as_ref().map_or(String::new(), |d| format!(" ({d})")),
+                r.surface,
+                if r.alone { " (alone)" } else { "" },
+                r.outcomes.len(),
+                r.log_score
+            );
+        }
+    } else {
+        let _ = writeln!(
+            s,
+            "{who}, at that fit's posterior draws: its ratio N(breadth)/N(width) and its end \
+             count (length vertical), each with the prediction's error (parameters and \
+             simulation) combined with the measurement's. Ratios within 1σ: {} of {}, within \
+             2σ: {} (a Gaussian error puts 68 % and 95 % there). Summed log predictive \
+             probability of the rows' counts: {:.1} — what `dicephys compare` sets this fit \
+             beside another model's fit of the same counts by.\n",
+            score.within_one_sigma, score.rows_scored, score.within_two_sigma, score.loo_log_score
+        );
+        let _ = writeln!(
+            s,
+            "| row | surface | measured ratio | predicted | z | ends: counted | predicted P(length) | z | log score |"
+        );
+        let _ = writeln!(s, "|---|---|---|---|---:|---|---|---:|---:|");
+        for r in &res.loo {
+            let _ = writeln!(
+                s,
+                "| {}{} | {}{} | {} | {} | {} | {} | {} | {} | {:.2} |",
+                r.label,
+                r.die.as_ref().map_or(String::new(), |d| format!(" ({d})")),
+                r.surface,
+                if r.alone { " (alone)" } else { "" },
+                cell(
+                    r.measured_ratio
+                        .map(|m| format!("{:.3} ± {:.3}", m.value, m.err))
+                ),
+                cell(r.ratio.map(|p| format!("{:.3} ± {:.3}", p.value, p.err))),
+                cell(r.z.map(|z| format!("{z:+.2}"))),
+                cell(r.end.map(|e| format!("{} / {}", e.counted, e.throws))),
+                cell(
+                    r.end
+                        .map(|e| format!("{:.4} ± {:.4}", e.predicted.value, e.predicted.err))
+                ),
+                cell(r.end.map(|e| format!("{:+.2}", e.z))),
+                r.log_score
+            );
+        }
     }
     let _ = write!(
         s,

@@ -104,6 +104,12 @@ fn a_d6_and_a_d8_share_the_surface_and_each_is_predicted_from_the_other() {
     assert!((total - sum).abs() < 1e-9, "{total} {sum}");
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("leave one die out"), "{report}");
+    // Faces have no ratio: no "Ratios within 1σ: 0 of 0".
+    assert!(!report.contains("Ratios within"), "{report}");
+    assert!(
+        report.contains("| row | surface | outcomes | log score |"),
+        "{report}"
+    );
 }
 
 /// A cube as a mesh: its facets numbered 1 to 6 by their order.
