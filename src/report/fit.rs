@@ -496,6 +496,24 @@ fn goodness_of_fit(e: &Estimate) -> String {
     s
 }
 
+/// The rows of faces predicted without themselves: each row's outcomes and log score.
+fn faces_table(s: &mut String, loo: &[crate::calibration::scores::LooRow]) {
+    let _ = writeln!(s, "| row | surface | outcomes | log score |");
+    let _ = writeln!(s, "|---|---|---:|---:|");
+    for r in loo {
+        let _ = writeln!(
+            s,
+            "| {}{} | {}{} | {} | {:.2} |",
+            r.label,
+            r.die.as_ref().map_or(String::new(), |d| format!(" ({d})")),
+            r.surface,
+            if r.alone { " (alone)" } else { "" },
+            r.outcomes.len(),
+            r.log_score
+        );
+    }
+}
+
 /// The report's rows each predicted by a fit of the others (none for a fit of fewer than
 /// three rows).
 fn left_out(res: &FitResult) -> String {
@@ -538,20 +556,7 @@ fn left_out(res: &FitResult) -> String {
              model's fit of the same counts by.\n",
             score.loo_log_score
         );
-        let _ = writeln!(s, "| row | surface | outcomes | log score |");
-        let _ = writeln!(s, "|---|---|---:|---:|");
-        for r in &res.loo {
-            let _ = writeln!(
-                s,
-                "| {}{} | {}{} | {} | {:.2} |",
-                r.label,
-                r.die.as_ref().map_or(String::new(), |d| format!(" ({d})")),
-                r.surface,
-                if r.alone { " (alone)" } else { "" },
-                r.outcomes.len(),
-                r.log_score
-            );
-        }
+        faces_table(&mut s, &res.loo);
     } else {
         let _ = writeln!(
             s,

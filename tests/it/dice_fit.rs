@@ -225,19 +225,16 @@ fn a_file_of_dice_is_predicted_row_by_row_as_each_die_alone() {
         format!("{HEAD}\noctahedron,felt,d8,26,18,31,22,25,27,20,31\ncube2,felt,d6,30,32,29,35,31,33,,\n"),
     )
     .unwrap();
-    let few = ["--draws", "2", "--rolls", "40", "--threads", "1", "--json"];
     let pred = dir.join("pred");
-    let mut a = vec![
-        "predict",
-        "--fit",
+    let v = json(&predict(
         fit_json,
-        "--blocks-file",
-        dice.to_str().unwrap(),
-        "--out",
-        pred.to_str().unwrap(),
-    ];
-    a.extend(few);
-    let v = json(&dicephys(&a));
+        &[
+            "--blocks-file",
+            dice.to_str().unwrap(),
+            "--out",
+            pred.to_str().unwrap(),
+        ],
+    ));
     let rows = v["dice"].as_array().unwrap();
     assert_eq!(rows.len(), 2, "{v}");
     assert_eq!(
@@ -256,17 +253,10 @@ fn a_file_of_dice_is_predicted_row_by_row_as_each_die_alone() {
          octahedron,felt,26,18,31,22,25,27,20,31\n",
     )
     .unwrap();
-    let mut a = vec![
-        "predict",
-        "--fit",
+    let alone = json(&predict(
         fit_json,
-        "--shape",
-        "d8",
-        "--counts",
-        alone_csv.to_str().unwrap(),
-    ];
-    a.extend(few);
-    let alone = json(&dicephys(&a));
+        &["--shape", "d8", "--counts", alone_csv.to_str().unwrap()],
+    ));
     let test = &rows[0]["prediction"]["tests"][0];
     for kind in ["prediction", "default_scene", "quasi_static"] {
         let (x, y) = (
@@ -303,16 +293,20 @@ fn a_file_of_dice_is_predicted_row_by_row_as_each_die_alone() {
         ("a,felt,d7,1,2,3,4,5,6,7,8", "row 'a': die 'd7'"),
     ] {
         std::fs::write(&dice, format!("{HEAD}\n{row}\n")).unwrap();
-        let mut a = vec![
-            "predict",
-            "--fit",
-            fit_json,
+        let args = [
             "--blocks-file",
             dice.to_str().unwrap(),
             "--out",
             pred.to_str().unwrap(),
         ];
-        a.extend(few);
-        refused(&dicephys(&a), 2, says);
+        refused(&predict(fit_json, &args), 2, says);
     }
+}
+
+/// `predict --fit FIT` with `extra`, two draws of 40 rolls on one thread, as JSON.
+fn predict(fit: &str, extra: &[&str]) -> std::process::Output {
+    let mut a = vec!["predict", "--fit", fit];
+    a.extend(extra);
+    a.extend(["--draws", "2", "--rolls", "40", "--threads", "1", "--json"]);
+    dicephys(&a)
 }
