@@ -603,6 +603,17 @@ fn fair_tells_each_face_apart_by_the_normal_and_the_area_it_rests_on() {
         first[2].as_f64().unwrap()
     );
     assert!(row("1").contains(&shown) && row("1").contains("12.50 %"), "{text}");
+    // roll says the same of each face, in its JSON and its text.
+    let rolled = ["roll", "--shape", "d8", "--rolls", "20", "--seed", "1"];
+    let r = json(&dicephys(&[&rolled[..], &["--json"]].concat()));
+    assert_eq!(r["shape"]["faces"][0]["label"], faces[0]["direction"]);
+    assert_eq!(r["shape"]["faces"][0]["normal"], faces[0]["normal"]);
+    assert_eq!(r["shape"]["faces"][0]["area_share"], faces[0]["area_share"]);
+    let said = String::from_utf8(dicephys(&rolled).stdout).unwrap();
+    assert!(
+        said.contains("rests on the facet of outward normal") && said.contains(&shown),
+        "{said}"
+    );
 
     // A coin's measured counts: the caps and the edge of a 24 × 2 mm cylinder.
     let coin = json(&dicephys(&[
