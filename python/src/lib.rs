@@ -521,7 +521,11 @@ fn roll<'py>(
                 .map_err(py_err)?;
         let json = dicephys::run::seal::to_string(&serde_json::json!({ "fairness": fair }), true)
             .map_err(py_err)?;
-        return Ok((json, format!("Is this die fair? {}", fair.counted_text()), None));
+        return Ok((
+            json,
+            format!("Is this die fair? {}", fair.counted_text()),
+            None,
+        ));
     }
     if null == Some(dicephys::studies::fair::Null::QuasiStatic) && spec.scene.mode == Mode::TwoD {
         return Err(bad(

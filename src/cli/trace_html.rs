@@ -3,9 +3,9 @@
 //! page that plays them (`report::trace::page`). Each throw's ending line goes to stderr as
 //! `trace`'s.
 
+use super::args::FlightArg;
 use super::error::{Error, Result};
 use super::trace::TraceArgs;
-use super::args::FlightArg;
 
 pub fn run(a: &TraceArgs) -> Result<()> {
     let path = a.html.as_ref().expect("called with --html");

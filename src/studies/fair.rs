@@ -358,7 +358,11 @@ fn place_faces(fair: &mut Fairness, scene: &crate::model::scene::Scene, counted:
         (None, Mode::ThreeD) => {
             let b = &scene.block;
             // Body x is the breadth, y the width, z the length.
-            let side = [b.width * b.length, b.breadth * b.length, b.breadth * b.width];
+            let side = [
+                b.width * b.length,
+                b.breadth * b.length,
+                b.breadth * b.width,
+            ];
             let total = 2.0 * side.iter().sum::<f64>();
             DIRECTIONS
                 .iter()

@@ -602,7 +602,10 @@ fn fair_tells_each_face_apart_by_the_normal_and_the_area_it_rests_on() {
         first[1].as_f64().unwrap(),
         first[2].as_f64().unwrap()
     );
-    assert!(row("1").contains(&shown) && row("1").contains("12.50 %"), "{text}");
+    assert!(
+        row("1").contains(&shown) && row("1").contains("12.50 %"),
+        "{text}"
+    );
     // roll says the same of each face, in its JSON and its text.
     let rolled = ["roll", "--shape", "d8", "--rolls", "20", "--seed", "1"];
     let r = json(&dicephys(&[&rolled[..], &["--json"]].concat()));
