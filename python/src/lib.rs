@@ -615,8 +615,9 @@ fn counts_given(c: &Bound<'_, PyAny>, spec: &RunSpec) -> PyResult<Vec<(String, u
         return Err(bad(
             "counts",
             &shown,
-            "give a mapping label → count ({'1': 170, '2': 160, …}), counts in the die's \
-             order, or the command line's text '1=170,2=160,…'",
+            "give whole numbers of throws, 0 or more: a mapping label → count ({'1': 170, \
+             '2': 160, …}), counts in the faces' order, or the command line's text \
+             '1=170,2=160,…'",
         ));
     };
     check_counts(pairs, &shown).map_err(py_err)

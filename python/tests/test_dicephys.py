@@ -279,10 +279,10 @@ def test_fair_counts_judges_measured_counts_as_the_cli_does() -> None:
             dicephys.fair(counts=MEASURED, **kwargs)  # type: ignore[arg-type]
     for counts, says in [
         ({"1": 5}, "at least two"),
-        ({"1": 5, "2": -1}, "counts"),
+        ({"1": 5, "2": -1}, "whole numbers of throws, 0 or more"),
         ([5, 5, 5], "the die has 20 faces"),
         ("1=5,x", "LABEL=COUNT"),
-        (3.5, "give a mapping"),
+        (3.5, "a mapping label → count"),
     ]:
         with pytest.raises(ValueError, match=says):
             dicephys.fair(counts=counts, shape="d20" if isinstance(counts, list) else None)  # type: ignore[arg-type]
