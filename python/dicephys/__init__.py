@@ -32,6 +32,9 @@ __all__ = [
     "Document",
     "Fit",
     "Roll",
+    "Sweep",
+    "Trace",
+    "TracedThrow",
     "Value",
     "compare",
     "fair",
@@ -43,6 +46,8 @@ __all__ = [
     "roll",
     "study",
     "theory",
+    "trace",
+    "trace_dtype",
     "__version__",
 ]
 
@@ -192,6 +197,8 @@ class Roll(Document):
         die = shape["name"] if shape else "x".join(f"{v:g}" for v in r.get("block_mm", []))
         engine = r.get("spec", {}).get("engine", "?")
         head = f"{type(self).__name__}({die}, {engine}, {r.get('rolls', 0):,} rolls"
+        if "summary" not in self.data and "fairness" in self.data:
+            head = f"{type(self).__name__}(counted, {self.data['fairness']['n']:,} throws"
         faces = self.faces
         if 0 < len(faces) <= 12:
             head += ": faces " + " ".join(f"{k}:{v}" for k, v in faces.items())
@@ -239,7 +246,10 @@ class Roll(Document):
 
     @property
     def faces(self) -> Dict[str, int]:
-        """Rolls by the number up, ``"1"``…``"6"`` (in 2D the four sides' numbers)."""
+        """Rolls by the number up, ``"1"``…``"6"`` (in 2D the four sides' numbers); for
+        ``fair(counts=…)`` the counts judged, by label."""
+        if "summary" not in self.data and "fairness" in self.data:
+            return {str(f["direction"]): int(f["count"]) for f in self.data["fairness"]["faces"]}
         return dict(self.result.get("faces", {}))
 
     @property
@@ -251,6 +261,47 @@ class Roll(Document):
     def theory_ratio(self) -> float:
         """The paper's 2D theory of the ratio for this block (its eq. MasterEqu)."""
         return float(self.result["theory_ratio"])
+
+
+class Sweep(Document):
+    """``fair(vary=…)``'s result: ``dicephys fair --vary --json``'s document (docs/json.md,
+    "fair --vary"): ``vary`` (the feature), ``null``, ``spec`` (the run at each value) and
+    ``points``, each value's ``value`` (mm) and ``fairness``. ``summary()`` is the table the
+    command line prints, ``table()`` the points as NumPy columns."""
+
+    def __init__(self, text: str, human: str) -> None:
+        super().__init__(text)
+        self._human = human
+
+    def summary(self) -> str:
+        """What ``dicephys fair --vary`` prints for this sweep, as text."""
+        return self._human
+
+    def table(self) -> Dict[str, Any]:
+        """``value`` (mm, one a point), ``label`` (one a face), and ``p``, ``err`` and ``z``
+        (a row a point, a column a face, in the faces' order), and each point's χ² ``p_value``."""
+        import numpy as np
+
+        points = self.data["points"]
+        faces = [f["faces"] for f in (p["fairness"] for p in points)]
+
+        def col(key: str) -> Any:
+            return np.array([[np.nan if x[key] is None else x[key] for x in row] for row in faces], dtype=np.float64)
+
+        return {
+            "value": np.array([p["value"] for p in points], dtype=np.float64),
+            "label": np.array([str(f.get("label", f["number"])) for f in faces[0]] if faces else []),
+            "p": col("p"),
+            "err": col("err"),
+            "z": col("z"),
+            "p_value": np.array([p["fairness"]["p_value"] for p in points], dtype=np.float64),
+        }
+
+    def __repr__(self) -> str:
+        points = self.data.get("points", [])
+        values = [p["value"] for p in points]
+        span = f"{min(values):g}…{max(values):g} mm" if values else "no values"
+        return f"Sweep({self.data.get('vary')} {span}, {len(points)} values; null {self.data.get('null')})"
 
 
 class Fit(Document):
@@ -477,6 +528,20 @@ def _roll(
     **opts: Any,
 ) -> Roll:
     """``roll``'s and ``fair``'s one call into the library, the arguments converted."""
+    text, human, csv_bytes = _call(block, what, progress, null, precision, **opts)
+    return Roll(text, human, csv_bytes)
+
+
+def _call(
+    block: Optional[str],
+    what: str,
+    progress: Progress,
+    null: Optional[str],
+    precision: Optional[float],
+    **opts: Any,
+) -> Tuple[str, str, Optional[bytes]]:
+    """The library's run for ``roll`` and ``fair``: its document, its text and its per-roll
+    CSV, the arguments converted."""
     if isinstance(opts.get("rolls"), bool):
         raise ValueError(f"rolls={opts['rolls']!r}: give a number of rolls")
     for k in ("velocity", "spin", "drop_height"):
@@ -500,7 +565,7 @@ def _roll(
         )
     finally:
         close()
-    return Roll(text, human, None if csv_bytes is None else bytes(csv_bytes))
+    return text, human, None if csv_bytes is None else bytes(csv_bytes)
 
 
 def fair(
@@ -508,6 +573,8 @@ def fair(
     *,
     null: str = "uniform",
     within: Optional[float] = None,
+    counts: Union[None, str, Mapping[str, int], Sequence[int]] = None,
+    vary: Union[None, str, Tuple[str, float, float, int]] = None,
     shape: Optional[str] = None,
     size: Optional[float] = None,
     scale: Optional[float] = None,
@@ -547,7 +614,7 @@ def fair(
     per_roll: bool = False,
     progress: Progress = None,
     precision: Optional[float] = None,
-) -> Roll:
+) -> Union[Roll, Sweep]:
     """Is this die fair, face by face: ``dicephys fair --json``.
 
     Rolls the die as ``roll`` does (the same arguments, with the same meanings; thrown in a
@@ -560,6 +627,19 @@ def fair(
         each face to ±0.005; the command line's ``--within 0.5``, in percentage points).
     precision: the old name of ``within`` (deprecated: in ``roll`` it is the ratio's relative
         error).
+    counts: judge counts you measured instead of rolling (``fair --counts``): a mapping
+        label → count (``{"1": 170, "2": 160, …}``, ``{"heads": 48, "tails": 51}``), counts in
+        the faces' order (a numbered die's 1 … N; other labels in the die's own order, a
+        coin's heads, tails, edge), or the
+        command line's text ``"1=170,2=160,…"``; against ``null`` (uniform: 1/N over the faces
+        given; quasi-static: the die ``block``, ``shape`` or ``die`` describe). Nothing is
+        rolled: the arguments that say how a die is rolled are refused beside it. Returns a
+        ``Roll`` whose ``fairness`` is the verdict (``faces`` the counts).
+    vary: how a feature of the die biases it (``fair --vary``): ``"NAME=LO:HI:N"`` or
+        ``(NAME, LO, HI, N)``, the die rolled at N values of NAME from LO to HI mm (NAME
+        ``com_x``, ``com_y``, ``com_z``, ``pip_depth`` or ``edge_radius``), the same throws at
+        each, each judged against ``null``. Returns a ``Sweep`` (``fair --vary --json``'s
+        document: ``points``, each value's ``fairness``).
     """
     if precision is not None:
         if within is not None:
@@ -568,8 +648,21 @@ def fair(
 
         warnings.warn("fair(precision=) is now fair(within=)", DeprecationWarning, stacklevel=2)
         within = precision
-    return _roll(
-        block, "fair", progress, null, within,
+    if counts is not None or vary is not None:
+        _refuse_beside(counts, vary, locals())
+    given: Any = counts
+    if isinstance(counts, Mapping):
+        given = [(str(k), v) for k, v in counts.items()]
+    elif isinstance(counts, Iterable) and not isinstance(counts, (str, bytes)):
+        given = list(counts)
+    if isinstance(vary, tuple):
+        try:
+            name, lo, hi, n = vary
+            vary = f"{name}={float(lo)!r}:{float(hi)!r}:{int(n)}"
+        except (TypeError, ValueError):
+            raise ValueError(f"vary={vary!r}: give 'NAME=LO:HI:N' or (NAME, LO, HI, N)") from None
+    text, human, csv_bytes = _call(
+        block, "fair", progress, null, within, counts=given, vary=vary,
         shape=shape, size=size, scale=scale, rolls=rolls, seed=seed, mode=mode, engine=engine,
         dt=dt, restitution=restitution, friction=friction, density=density, preset=preset,
         floor=floor, floor_thickness=floor_thickness, linear_damping=linear_damping,
@@ -580,6 +673,40 @@ def fair(
         shell=shell, die=die,
         layout=layout, threads=threads, per_roll=per_roll,
     )
+    if vary is not None:
+        return Sweep(text, human)
+    return Roll(text, human, csv_bytes)
+
+
+# What says how a die is rolled, with each default: refused beside fair(counts=), which rolls
+# nothing (the die's own arguments stay: the quasi-static null reads them), as the command
+# line refuses its flags beside --counts.
+_SIMULATION: Dict[str, Any] = dict(
+    rolls=None, seed=DEFAULT_SEED, engine="bullet", dt=DEFAULT_DT,
+    restitution=DEFAULT_RESTITUTION, friction=DEFAULT_FRICTION, throw="tumble", kappa=None,
+    source="keyed", velocity=None, spin=None, drop_height=None, preset="dicephys281",
+    floor="box", floor_thickness=None, linear_damping=0.0, angular_damping=0.0,
+    rolling_resistance=None, sleep=True, settle=None, flight="fast", faithful=False,
+    max_steps=None, margin=DEFAULT_MARGIN, threads=0, per_roll=False, within=None,
+)
+# Refused beside fair(vary=), as beside --vary: a sweep rolls ``rolls`` at each value.
+_NOT_WITH_VARY = ("within", "per_roll")
+
+
+def _refuse_beside(counts: Any, vary: Any, given: Mapping[str, Any]) -> None:
+    """A ValueError naming what ``fair(counts=)`` or ``fair(vary=)`` cannot be given with."""
+    if counts is not None and vary is not None:
+        raise ValueError("counts= and vary= cannot be used together: counts judges measured "
+                         "throws, vary rolls the die at each value")
+    if counts is not None:
+        names = [k for k, v in _SIMULATION.items() if given[k] != v]
+        why = "counts= judges measured throws and rolls nothing"
+    else:
+        names = [k for k in _NOT_WITH_VARY if given[k] not in (None, False)]
+        why = "vary= rolls the die `rolls` times at each value"
+    if names:
+        shown = ", ".join(f"{k}={given[k]!r}" for k in names)
+        raise ValueError(f"{'counts' if counts is not None else 'vary'}=: cannot be used with {shown} ({why})")
 
 
 def theory(block: Optional[str] = None, *, tolerance: float = 0.1) -> Document:
@@ -922,3 +1049,170 @@ def predict(
     finally:
         close()
     return Document(out)
+
+
+def trace_dtype() -> Any:
+    """The NumPy dtype of a traced throw's rows: ``dicephys trace``'s CSV columns (step, time,
+    the centre's position, m, its orientation as a quaternion, its velocities, m/s and rad/s,
+    kinetic, potential and total energy, J, and whether the engine had put it to sleep)."""
+    import numpy as np
+
+    names = "step,time_s,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,kinetic_j,potential_j,total_j,sleeping"
+    kind = {"step": np.uint64, "sleeping": np.uint8}
+    return np.dtype([(n, kind.get(n, np.float64)) for n in names.split(",")])
+
+
+def _trace_rows(csv_text: str) -> Any:
+    """A traced throw's CSV as a NumPy structured array (``trace_dtype``)."""
+    import numpy as np
+
+    dtype = trace_dtype()
+    header, _, body = csv_text.partition("\n")
+    if tuple(header.split(",")) != dtype.names:
+        raise RuntimeError(f"trace columns {header} are not {dtype.names}")
+    values = np.loadtxt(io.StringIO(body), delimiter=",", dtype=np.float64, ndmin=2)
+    rows = np.zeros(len(values), dtype=dtype)
+    for k, name in enumerate(dtype.names):
+        rows[name] = values[:, k]
+    return rows
+
+
+class TracedThrow(NamedTuple):
+    """One throw of a ``Trace``: ``throw``, its index in the seed's sequence; its rows (``trace_dtype``),
+    ``dicephys trace``'s CSV text, the line that says how it ended (what ``trace`` prints on
+    standard error) and, where the step cap ended it, the note that says so."""
+
+    throw: int
+    rows: Any
+    csv: str
+    ending: str
+    note: Optional[str]
+
+
+class Trace:
+    """``trace()``'s result: each throw's trajectory (``throws``, as ``dicephys trace`` prints
+    it) and the page ``trace --html`` writes for them (``page``, self-contained HTML that plays
+    the throws in 3D; ``path`` where it was written, if asked). ``rows``, ``csv`` and
+    ``ending`` are the throw's when there is one. In Jupyter the page shows inline."""
+
+    def __init__(self, throws: List[TracedThrow], page: str, path: Optional[str]) -> None:
+        self.throws = throws
+        self.page = page
+        self.path = path
+
+    def _one(self) -> TracedThrow:
+        if len(self.throws) != 1:
+            raise ValueError(f"{len(self.throws)} throws traced: take one from .throws")
+        return self.throws[0]
+
+    @property
+    def rows(self) -> Any:
+        """The throw's rows, a NumPy structured array (``trace_dtype()``)."""
+        return self._one().rows
+
+    @property
+    def csv(self) -> str:
+        """The throw's CSV, as ``dicephys trace`` prints it."""
+        return self._one().csv
+
+    @property
+    def ending(self) -> str:
+        """How the throw ended, the line ``dicephys trace`` prints on standard error."""
+        return self._one().ending
+
+    def _repr_html_(self) -> str:
+        """The page inline (Jupyter): in an iframe of its own, so that its scripts and styles
+        keep to themselves."""
+        import html
+
+        return (
+            '<iframe style="width:100%;height:720px;border:0" title="dicephys trace" srcdoc="'
+            + html.escape(self.page, quote=True)
+            + '"></iframe>'
+        )
+
+    def __repr__(self) -> str:
+        shown = "; ".join(t.ending for t in self.throws[:3])
+        more = f"; … {len(self.throws) - 3} more" if len(self.throws) > 3 else ""
+        return f"Trace({shown}{more})"
+
+
+def trace(
+    block: Optional[str] = None,
+    *,
+    index: Union[int, str, range] = 0,
+    shape: Optional[str] = None,
+    size: Optional[float] = None,
+    scale: Optional[float] = None,
+    die: Optional[PathLike] = None,
+    seed: int = DEFAULT_SEED,
+    mode: str = "3d",
+    engine: str = "bullet",
+    dt: float = DEFAULT_DT,
+    restitution: float = DEFAULT_RESTITUTION,
+    friction: float = DEFAULT_FRICTION,
+    density: Optional[float] = None,
+    throw: Optional[str] = None,
+    kappa: Optional[float] = None,
+    source: str = "keyed",
+    velocity: RangeArg = None,
+    spin: RangeArg = None,
+    drop_height: RangeArg = None,
+    preset: str = "dicephys281",
+    floor: str = "box",
+    floor_thickness: Optional[float] = None,
+    linear_damping: float = 0.0,
+    angular_damping: float = 0.0,
+    rolling_resistance: Optional[float] = None,
+    sleep: bool = True,
+    com: Optional[Sequence[float]] = None,
+    pips: Optional[Sequence[float]] = None,
+    edge_radius: Optional[float] = None,
+    shell: Optional[Sequence[float]] = None,
+    max_steps: Optional[int] = None,
+    flight: str = "fast",
+    every: int = 1,
+    html: Optional[PathLike] = None,
+) -> Trace:
+    """One throw's trajectory, step by step: ``dicephys trace`` (and ``--html``).
+
+    The die, the scene and the throws as ``roll`` takes them (the same names and meanings);
+    ``index`` the throw in the seed's sequence, or several: ``range(0, 10)`` or ``"0..9"``
+    (both ends included, as ``--index 0..9``), at most 16.
+    max_steps: the step cap (default: ``roll``'s for the die).
+    flight: "fast" (in closed form where it is ballistic, as ``roll`` flies it) or "stepped".
+    every: keep every Nth step's row (the first and the last always).
+    html: also write the page ``trace --html`` writes here: self-contained HTML that plays the
+        throws in 3D beside their heights and energies, the early stop and the outcome.
+
+    Returns a ``Trace``: ``rows`` (a NumPy structured array of the CSV's columns,
+    ``trace_dtype()``), ``csv``, ``ending``, and ``throws`` for several; ``page`` the HTML,
+    which Jupyter shows inline.
+    """
+    if isinstance(index, bool):
+        raise ValueError(f"index={index!r}: give a throw's index, a range or 'A..B'")
+    if isinstance(index, range):
+        if index.step != 1 or len(index) == 0:
+            raise ValueError(f"index={index!r}: give a range of consecutive throws, range(A, B + 1)")
+        index = f"{index.start}..{index[-1]}"
+    for k, x in (("size", size), ("scale", scale), ("density", density), ("edge_radius", edge_radius),
+                 ("kappa", kappa), ("dt", dt), ("restitution", restitution), ("friction", friction)):
+        if isinstance(x, bool):
+            raise ValueError(f"{k}={x!r}: give a number")
+    throws, page = _native.trace(
+        block, index=str(index), shape=shape, size=size, scale=scale,
+        die=None if die is None else os.fspath(die), seed=seed, mode=mode, engine=engine, dt=dt,
+        restitution=restitution, friction=friction, density=density, throw=throw, kappa=kappa,
+        source=source, velocity=_pair("velocity", velocity), spin=_pair("spin", spin),
+        drop_height=_pair("drop_height", drop_height), preset=preset, floor=floor,
+        floor_thickness=floor_thickness, linear_damping=linear_damping,
+        angular_damping=angular_damping, rolling_resistance=rolling_resistance, sleep=sleep,
+        com=_triple("com", com, 3), pips=_triple("pips", pips, 2), edge_radius=edge_radius,
+        shell=_triple("shell", shell, 2), max_steps=max_steps, flight=flight, every=every,
+        html=None if html is None else os.fspath(html),
+    )
+    return Trace(
+        [TracedThrow(i, _trace_rows(text), text, ending, note) for i, text, ending, note in throws],
+        page,
+        None if html is None else os.fspath(html),
+    )

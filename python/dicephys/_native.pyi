@@ -25,8 +25,16 @@ _Log = Optional[Callable[[str], Any]]
 
 def version() -> str: ...
 def roll(block: Optional[str] = None, **options: Any) -> Tuple[str, str, Optional[bytes]]:
-    """``dicephys.roll``'s options by name (``fair``: a null, for ``dicephys.fair``): the
-    JSON document, the command line's text, the per-roll CSV."""
+    """``dicephys.roll``'s options by name (``fair``: a null, for ``dicephys.fair``, with
+    ``counts`` or ``vary`` as ``fair --counts``/``--vary``): the JSON document, the command
+    line's text, the per-roll CSV."""
+    ...
+
+def trace(
+    block: Optional[str] = None, **options: Any
+) -> Tuple[List[Tuple[int, str, str, Optional[str]]], str]:
+    """``dicephys.trace``'s options by name: each throw's (index, CSV, ending line, the cap's
+    note) and the page ``trace --html`` writes."""
     ...
 
 def theory(block: Optional[str] = ..., tolerance: float = ...) -> str: ...

@@ -496,6 +496,8 @@ fn roll<'py>(
         .map(|l| named::<Layout>("layout", "layout", &l))
         .transpose()?;
     let null_given = o.maybe::<String>("fair")?;
+    let counts = o.object("counts")?;
+    let vary = o.maybe::<String>("vary")?;
     let null = null_given
         .as_deref()
         .map(|n| {
@@ -511,12 +513,30 @@ fn roll<'py>(
     // The numbers: the layout given, else the die's own (a die file's map), else right.
     let layout = layout.unwrap_or(spec.scene.features.layout);
     o.finish()?;
+    let null_or_uniform = null.clone().unwrap_or_default();
+    if let Some(c) = counts {
+        let counts = counts_given(&c, &spec)?;
+        let fair =
+            dicephys::studies::fair::assess_counts(&counts, &null_or_uniform, &spec.scene, layout)
+                .map_err(py_err)?;
+        let json = dicephys::run::seal::to_string(&serde_json::json!({ "fairness": fair }), true)
+            .map_err(py_err)?;
+        return Ok((
+            json,
+            format!("Is this die fair? {}", fair.counted_text()),
+            None,
+        ));
+    }
     if null == Some(dicephys::studies::fair::Null::QuasiStatic) && spec.scene.mode == Mode::TwoD {
         return Err(bad(
             "null",
             format!("'{}'", null_given.as_deref().unwrap_or_default()),
             "the quasi-static theory is 3D; in 2D give 'uniform'",
         ));
+    }
+    if let Some(v) = vary {
+        let (json, text) = varied(py, &spec, layout, &v, &null_or_uniform, threads, progress)?;
+        return Ok((json, text, None));
     }
     let target = if null.is_some() {
         Target::Faces
@@ -553,6 +573,177 @@ fn roll<'py>(
         text,
         csv.map(|b| PyBytes::new(py, &b)),
     ))
+}
+
+/// `fair`'s measured counts as Python gives them: the command line's text (`1=170,2=160,…`),
+/// (label, count) pairs (a mapping's items), or counts in the faces' order (a numbered die's
+/// 1 … N, other labels in the die's own order: a coin's heads, tails, edge); checked by the
+/// library.
+fn counts_given(c: &Bound<'_, PyAny>, spec: &RunSpec) -> PyResult<Vec<(String, u64)>> {
+    use dicephys::studies::fair::{check_counts, parse_counts};
+    let shown = c.repr().map_or("?".into(), |r| r.to_string());
+    let pairs = if let Ok(text) = c.extract::<String>() {
+        return parse_counts(&text).map_err(py_err);
+    } else if let Ok(pairs) = c.extract::<Vec<(String, u64)>>() {
+        pairs
+    } else if let Ok(counts) = c.extract::<Vec<u64>>() {
+        let labels: Vec<String> = match &spec.scene.shape {
+            Some(shape) => {
+                // Numbers in their order (a d6's 1 … 6, whatever its facets' order), other
+                // labels in the die's (a coin's heads, tails, edge).
+                let mut l = shape.outcome_labels();
+                l.sort_by_key(|x| x.parse::<u32>().unwrap_or(u32::MAX));
+                l
+            }
+            None => (1..=counts.len()).map(|k| k.to_string()).collect(),
+        };
+        if labels.len() != counts.len() {
+            return Err(bad(
+                "counts",
+                &shown,
+                format!(
+                    "{} counts; the die has {} faces ({}): give one a face, in its order, or a \
+                     mapping label → count",
+                    counts.len(),
+                    labels.len(),
+                    labels.join(", ")
+                ),
+            ));
+        }
+        labels.into_iter().zip(counts).collect()
+    } else {
+        return Err(bad(
+            "counts",
+            &shown,
+            "give whole numbers of throws, 0 or more: a mapping label → count ({'1': 170, \
+             '2': 160, …}), counts in the faces' order, or the command line's text \
+             '1=170,2=160,…'",
+        ));
+    };
+    check_counts(pairs, &shown).map_err(py_err)
+}
+
+/// `fair --vary`: the die of `spec` at each value `vary` names (`NAME=LO:HI:N`), each judged
+/// against `null` (`studies::fair::vary`): `fair --vary --json`'s document and its table.
+fn varied(
+    py: Python<'_>,
+    spec: &RunSpec,
+    layout: Layout,
+    vary: &str,
+    null: &dicephys::studies::fair::Null,
+    threads_: usize,
+    progress: Option<Bound<'_, PyAny>>,
+) -> PyResult<(String, String)> {
+    use dicephys::studies::fair::{bias_document, bias_table, check_null, parse_vary};
+    check_null(spec, null).map_err(py_err)?;
+    let (what, values) = parse_vary(vary).map_err(py_err)?;
+    dicephys::studies::fair::varied_specs(spec, what, &values).map_err(py_err)?;
+    let threads = threads(threads_)?;
+    let points = detached(py, progress.as_ref(), None, |session| {
+        let total = (spec.rolls * values.len() as u64) as f64;
+        let tell = |n: u64| session.set(n as f64, total);
+        let runner = Runner::new(threads, session.stop.clone());
+        let runner = runner.with_progress(&tell);
+        dicephys::studies::fair::vary(spec, layout, what, &values, null, &runner)?
+            .ok_or(Error::Stopped)
+    })?;
+    let json = dicephys::run::seal::to_string(&bias_document(spec, what, null, &points), true)
+        .map_err(py_err)?;
+    Ok((json, bias_table(what, &points)))
+}
+
+/// One throw traced: its index, `trace`'s CSV (header and rows), its ending line and the
+/// cap's note where the cap ended it.
+type Traced = (u64, String, String, Option<String>);
+
+/// `dicephys trace`: throws `index` (`I` or `A..B`, as `--index`) of the scene and throws
+/// `roll`'s options describe (and `engine`, `max_steps`, `flight`), each as `trace` prints it
+/// (every `every`th row), and the page `trace --html` writes for them, also written to `html`
+/// if given.
+#[pyfunction]
+#[pyo3(signature = (block=None, **options))]
+fn trace<'py>(
+    py: Python<'py>,
+    block: Option<&str>,
+    options: Option<Bound<'py, PyDict>>,
+) -> PyResult<(Vec<Traced>, String)> {
+    use dicephys::report::trace;
+    let o = Options {
+        given: options.map(|d| d.copy()).transpose()?,
+    };
+    let index = o.get("index", "0".to_string())?;
+    let (first, last) = trace::indices(&index).map_err(|e| bad("index", &index, e))?;
+    let every = o.get("every", 1u64)?;
+    if every == 0 {
+        return Err(bad("every", every, "at least 1"));
+    }
+    let max_steps = o.maybe::<u64>("max_steps")?;
+    if max_steps == Some(0) {
+        return Err(bad("max_steps", 0, "at least 1"));
+    }
+    let fast_flight = match o.maybe::<String>("flight")?.as_deref() {
+        None | Some("fast") => true,
+        Some("stepped") => false,
+        Some(s) => return Err(bad("flight", format!("'{s}'"), "give 'fast' or 'stepped'")),
+    };
+    let engine = match o.maybe::<String>("engine")? {
+        Some(e) => named::<EngineKind>("engine", "engine", &e)?,
+        None => EngineKind::Bullet,
+    };
+    let html = o.maybe::<PathBuf>("html")?;
+    let scene = scene_of(block, &o, None)?.scene().map_err(py_err)?;
+    let throws = throws_of(&o)?
+        .spec_or(ThrowStyle::default_for(&scene))
+        .map_err(py_err)?;
+    o.finish()?;
+    // Checked before any roll: a page that cannot be written is refused at once.
+    let out = html
+        .map(|p| dicephys::run::io::Output::check(&p))
+        .transpose()
+        .map_err(py_err)?;
+    let source = throws.source(last + 1);
+    let labels = scene.shape.as_ref().map(|s| s.labels()).unwrap_or_default();
+    let (traced, page) = detached(py, None, None, |session| {
+        let settle = trace::config(&scene, max_steps, fast_flight, false);
+        let mut traced = Vec::new();
+        for index in first..=last {
+            let throw = source.get(index);
+            let mut csv = format!("{}\n", trace::HEADER);
+            let record = trace::rows(
+                engine,
+                &scene,
+                &throw,
+                &settle,
+                every,
+                |l| {
+                    csv.push_str(l);
+                    csv.push('\n');
+                },
+                |_| {},
+            )?;
+            if session.stop.requested() {
+                return Err(Error::Stopped);
+            }
+            let ending = trace::ending(index, &throw, &record, &labels);
+            let note = trace::capped(&record, settle.max_steps, max_steps.is_some());
+            traced.push((index, csv, ending, note));
+        }
+        let page = trace::page(
+            engine,
+            &scene,
+            &source,
+            first..=last,
+            max_steps,
+            fast_flight,
+            |_, _| {},
+            |_| {},
+        )?;
+        Ok((traced, page))
+    })?;
+    if let Some(out) = out {
+        out.write(page.as_bytes()).map_err(py_err)?;
+    }
+    Ok((traced, page))
 }
 
 /// `dicephys theory --block … --json` (or `--table --json` without a block).
@@ -971,6 +1162,7 @@ fn version() -> &'static str {
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(roll, m)?)?;
     m.add_function(wrap_pyfunction!(theory, m)?)?;
+    m.add_function(wrap_pyfunction!(trace, m)?)?;
     m.add_function(wrap_pyfunction!(study, m)?)?;
     m.add_function(wrap_pyfunction!(paper_config, m)?)?;
     m.add_function(wrap_pyfunction!(fit_config, m)?)?;

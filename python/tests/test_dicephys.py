@@ -246,6 +246,125 @@ def test_a_result_reads_at_a_glance_and_as_arrays() -> None:
     assert repr(d20).startswith("Roll(d20, bullet, 300 rolls: 20 faces") and "ratio" not in repr(d20)
 
 
+MEASURED = {"1": 170, "2": 160, "3": 165, "4": 180, "5": 170, "6": 178}
+
+
+def test_fair_counts_judges_measured_counts_as_the_cli_does() -> None:
+    # Issue 74.5: fair --counts from Python, as a mapping, in the die's order, or as the text.
+    text = ",".join(f"{k}={v}" for k, v in MEASURED.items())
+    want = cli("fair", "--counts", text, "--json")
+    for counts in (MEASURED, list(MEASURED.values()), text):
+        got = dicephys.fair(counts=counts)
+        assert isinstance(got, dicephys.Roll)
+        assert got.data == want, counts
+    assert got.summary().startswith("Is this die fair? 1023 throws counted, against uniform")
+    assert got.face_table()["count"].tolist() == list(MEASURED.values())
+    assert got.faces == MEASURED
+    assert repr(got).startswith("Roll(counted, 1,023 throws: faces 1:170 2:160")
+    # A coin's labels, against its own shape: the quasi-static null reads the die.
+    coin = {"heads": 48, "tails": 51, "edge": 1}
+    want = cli("fair", "--counts", "heads=48,tails=51,edge=1", "--shape", "coin:24,8",
+               "--null", "quasi-static", "--json")
+    assert dicephys.fair(counts=coin, shape="coin:24,8", null="quasi-static").data == want
+    assert dicephys.fair(counts=[48, 51, 1], shape="coin:24,8", null="quasi-static").data == want
+    # What the command line refuses beside --counts, refused here, naming it.
+    for kwargs, says in [
+        (dict(rolls=100), "rolls=100"),
+        (dict(seed=3), "seed=3"),
+        (dict(engine="rapier"), "engine='rapier'"),
+        (dict(vary="com_z=0:1:2"), "counts= and vary="),
+        (dict(within=0.01), "within"),
+    ]:
+        with pytest.raises(ValueError, match=says):
+            dicephys.fair(counts=MEASURED, **kwargs)  # type: ignore[arg-type]
+    for counts, says in [
+        ({"1": 5}, "at least two"),
+        ({"1": 5, "2": -1}, "whole numbers of throws, 0 or more"),
+        ([5, 5, 5], "the die has 20 faces"),
+        ("1=5,x", "LABEL=COUNT"),
+        (3.5, "a mapping label → count"),
+    ]:
+        with pytest.raises(ValueError, match=says):
+            dicephys.fair(counts=counts, shape="d20" if isinstance(counts, list) else None)  # type: ignore[arg-type]
+
+
+def test_fair_vary_is_the_cli_s_sweep() -> None:
+    want = cli("fair", "--block", "16x16x16", "--vary", "com_z=0:1:2", "--rolls", "200",
+               "--seed", "4", "--json")
+    got = dicephys.fair("16x16x16", vary="com_z=0:1:2", rolls=200, seed=4, threads=2)
+    assert isinstance(got, dicephys.Sweep)
+    assert got.data == want
+    assert dicephys.fair("16x16x16", vary=("com_z", 0, 1, 2), rolls=200, seed=4).data == want
+    table = got.table()
+    assert table["value"].tolist() == [0.0, 1.0]
+    assert table["p"].shape == (2, 6)
+    assert table["p"][1].tolist() == [f["p"] for f in want["points"][1]["fairness"]["faces"]]
+    text = subprocess.run(
+        [BIN, "fair", "--block", "16x16x16", "--vary", "com_z=0:1:2", "--rolls", "200", "--seed", "4"],
+        check=True, capture_output=True, text=True,
+    ).stdout
+    assert got.summary() == text
+    for kwargs, says in [
+        (dict(within=0.01), "within"),
+        (dict(per_roll=True), "per_roll"),
+        (dict(vary="com_q=0:1:2"), "com_q"),
+        (dict(vary="com_z=1:0:2"), "LO <= HI"),
+        (dict(vary="pip_depth=0:1:2"), "no pips"),
+    ]:
+        opts: Dict[str, Any] = dict(vary="com_z=0:1:2", rolls=10)
+        opts.update(kwargs)
+        with pytest.raises(ValueError, match=says):
+            dicephys.fair("16x16x16", **opts)
+
+
+def test_trace_is_the_cli_s_and_its_page_too(tmp_path: Path) -> None:
+    # Issue 74.5: dicephys trace from Python: the CSV's rows and ending, and the page.
+    args = ["trace", "--shape", "d20", "--seed", "1", "--index", "2"]
+    done = subprocess.run([BIN, *args], check=True, capture_output=True, text=True)
+    t = dicephys.trace(shape="d20", seed=1, index=2)
+    assert t.csv == done.stdout
+    assert t.ending == done.stderr.strip()
+    rows = t.rows
+    assert rows.dtype == dicephys.trace_dtype()
+    lines = done.stdout.splitlines()
+    assert len(rows) == len(lines) - 1
+    last = lines[-1].split(",")
+    assert rows["step"][-1] == int(last[0]) and rows["z"][-1] == float(last[4])
+    assert rows["total_j"][0] > rows["total_j"][-1]
+    # Every 10th step, as --every 10.
+    every = subprocess.run([BIN, *args, "--every", "10"], check=True, capture_output=True, text=True)
+    assert dicephys.trace(shape="d20", seed=1, index=2, every=10).csv == every.stdout
+    # Several throws and their page, as trace --index 0..2 --html writes it.
+    page = tmp_path / "cli.html"
+    subprocess.run([BIN, "trace", "--shape", "d20", "--seed", "1", "--index", "0..2", "--html", str(page)],
+                   check=True, capture_output=True)
+    mine = tmp_path / "py.html"
+    several = dicephys.trace(shape="d20", seed=1, index=range(0, 3), html=mine)
+    assert [s.throw for s in several.throws] == [0, 1, 2]
+    assert mine.read_bytes() == page.read_bytes()
+    assert several.page == page.read_text(encoding="utf-8")
+    assert dicephys.trace(shape="d20", seed=1, index="0..2").page == several.page
+    with pytest.raises(ValueError, match="3 throws"):
+        several.rows
+    # In a notebook: the page inline, in an iframe of its own.
+    import html
+
+    shown = several._repr_html_()
+    assert shown.startswith("<iframe") and html.escape(several.page, quote=True) in shown
+    assert html.unescape(shown.split('srcdoc="', 1)[1].rsplit('"', 1)[0]) == several.page
+    for kwargs, says in [
+        (dict(index="0..20"), "at most 16"),
+        (dict(index="3..1"), "backwards"),
+        (dict(index=range(0, 6, 2)), "consecutive"),
+        (dict(every=0), "every"),
+        (dict(max_steps=0), "max_steps"),
+        (dict(flight="slow"), "flight"),
+        (dict(html=tmp_path / "no" / "such" / "dir" / "t.html"), "t.html"),
+    ]:
+        with pytest.raises((ValueError, OSError), match=says):
+            dicephys.trace(shape="d20", **kwargs)  # type: ignore[arg-type]
+
+
 def test_fair_within_is_every_face_s_2_sigma_as_a_probability() -> None:
     # within=0.02 is the command line's --within 2 (percentage points); precision= its old name.
     want = cli("fair", "--block", "16x16x16", "--within", "2", "--seed", "3", "--json")

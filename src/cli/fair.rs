@@ -288,13 +288,12 @@ fn counted(
             &serde_json::json!({ "counts": counts, "null": (null.spec()) }),
         )?;
         write_counted(dir, &json, &fair)?;
-        let text = format!(
-            "{} throws counted, against {}\n{}",
-            fair.n,
-            fair.null,
-            fair.table()
-        );
-        dicephys::report::html::write_text_report(dir, "Is this die fair?", &text, &["faces"])?;
+        dicephys::report::html::write_text_report(
+            dir,
+            "Is this die fair?",
+            &fair.counted_text(),
+            &["faces"],
+        )?;
         if !*a.roll.json {
             eprintln!(
                 "wrote {}/fairness.json, fairness.csv, report.md, report.html and faces.svg, .png",
@@ -305,12 +304,7 @@ fn counted(
     if *a.roll.json {
         outln!("{}", json);
     } else {
-        out!(
-            "Is this die fair? {} throws counted, against {}\n{}",
-            fair.n,
-            fair.null,
-            fair.table()
-        );
+        out!("Is this die fair? {}", fair.counted_text());
     }
     Ok(())
 }
@@ -348,9 +342,10 @@ fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str, null: &Null)
             &dicephys::run::stop::Kept::Nothing(Some("a --vary run does not resume")),
         )));
     };
-    let doc =
-        serde_json::json!({ "vary": what, "null": (null.spec()), "spec": spec, "points": points });
-    let json = dicephys::run::seal::to_string(&doc, true)?;
+    let json = dicephys::run::seal::to_string(
+        &dicephys::studies::fair::bias_document(spec, what, null, &points),
+        true,
+    )?;
     if let Some(dir) = &a.out {
         let die = match &spec.scene.shape {
             Some(shape) => shape.name.clone(),
@@ -373,36 +368,6 @@ fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str, null: &Null)
         outln!("{}", json);
         return Ok(());
     }
-    // Each face in the order the rows give them (a cube's 1 … 6, a shape's labels).
-    let names: Vec<String> = points.first().map_or_else(Vec::new, |b| {
-        b.fairness
-            .faces
-            .iter()
-            .map(|f| f.number.to_string())
-            .collect()
-    });
-    let mut t = format!(
-        "{what} (mm) | P({}), each ± its error | χ² p | throws to see it at 2σ\n",
-        match names.len() {
-            0..=6 => names.join(", "),
-            n => format!("{} … {}, {n} faces", names[0], names[n - 1]),
-        }
-    );
-    for b in &points {
-        let f = &b.fairness;
-        let ps: Vec<String> = f
-            .faces
-            .iter()
-            .map(|x| format!("{:.4}±{:.4}", x.p, x.err))
-            .collect();
-        t += &format!(
-            "{:>8.3} | {} | {:.2e} | {}\n",
-            b.value,
-            ps.join(" "),
-            f.p_value,
-            f.throws_2sigma.map_or("-".into(), |n| format!("{n:.0}"))
-        );
-    }
-    out!("{}", t);
+    out!("{}", dicephys::studies::fair::bias_table(what, &points));
     Ok(())
 }

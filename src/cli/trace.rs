@@ -5,12 +5,9 @@ use super::args::MaxSteps;
 use super::args::{parse_engine, FlightArg, SceneArgs, ThrowArgs};
 use super::error::{Error, Result};
 use clap::Args;
-use dicephys::engine::{new_engine, EngineKind};
-use dicephys::model::die::DieShape;
-use dicephys::model::state::BodyState;
+use dicephys::engine::EngineKind;
 use dicephys::report::trace;
-use dicephys::run::request::EndRequest;
-use dicephys::sim::roll::{roll_observed, Fate, RollConfig};
+use dicephys::sim::roll::RollConfig;
 use std::io::Write;
 
 /// `dicephys trace`'s arguments.
@@ -53,30 +50,8 @@ pub struct Indices {
     pub last: u64,
 }
 
-/// The most throws one page plays.
-const MAX_ON_A_PAGE: u64 = 16;
-
 fn parse_indices(s: &str) -> std::result::Result<Indices, String> {
-    let n = |p: &str| {
-        p.trim()
-            .parse::<u64>()
-            .map_err(|_| format!("'{}' is not a throw's index (0, 1, …)", p.trim()))
-    };
-    let (first, last) = match s.split_once("..") {
-        Some((a, b)) => (n(a)?, n(b.strip_prefix('=').unwrap_or(b))?),
-        None => (n(s)?, n(s)?),
-    };
-    if last < first {
-        return Err(format!("{s}: the range runs backwards"));
-    }
-    if last - first >= MAX_ON_A_PAGE {
-        return Err(format!(
-            "{s}: {} throws; a page plays at most {MAX_ON_A_PAGE}",
-            (last - first).saturating_add(1)
-        ));
-    }
-    last.checked_add(1)
-        .ok_or_else(|| format!("{s}: too large"))?;
+    let (first, last) = trace::indices(s)?;
     Ok(Indices { first, last })
 }
 
@@ -91,7 +66,6 @@ pub fn run(a: &TraceArgs) -> Result<()> {
         )));
     }
     let scene = a.scene.scene()?;
-    let die = DieShape::of(&scene);
     let throw_spec = a
         .throw
         .spec_or(dicephys::model::throws::ThrowStyle::default_for(&scene))?;
@@ -103,73 +77,55 @@ pub fn run(a: &TraceArgs) -> Result<()> {
     let index = a.index.first;
     let throws = throw_spec.source(index + 1);
     let throw = throws.get(index);
-    let mut engine = new_engine(a.engine, &scene)?;
     let out = std::io::stdout();
-    let mut out = std::io::BufWriter::new(out.lock());
-    writeln!(out, "{}", trace::HEADER)?;
+    // Both the rows and a stop request write to it (a stop flushes the rows so far).
+    let out = std::cell::RefCell::new(std::io::BufWriter::new(out.lock()));
+    writeln!(out.borrow_mut(), "{}", trace::HEADER)?;
     // The first failed write is kept and returned after the roll (a roll cannot be stopped
     // from its observer); later lines are not attempted.
     let mut failed: Option<std::io::Error> = None;
-    let mut last = None;
-    let mut end_state = None;
-    let line = |step: u64, s: &BodyState| trace::row(&die, scene.dt, step, s);
-    // The step cap `roll` takes for the same die: a die of any shape's unless asked (a coin
-    // on its edge on a floor without rolling resistance rolls for ever, and traced to
-    // DicePhys's 20,000,000 steps it wrote gigabytes; issue 69.10).
     let settle = settle(a, &scene);
-    let record = roll_observed(engine.as_mut(), &scene, &throw, &settle, |step, s| {
-        // A roll cannot be stopped from its observer: a stop request ends the process here,
-        // the rows so far written, as every command stops (exit 130).
-        if step.is_multiple_of(1024) && super::term::stop().requested() {
-            let _ = out.flush();
-            let kept = dicephys::run::stop::Kept::Steps(step);
-            eprintln!("dicephys: {}", dicephys::run::stop::interrupted(&kept));
-            std::process::exit(130);
-        }
-        end_state = Some(*s);
-        let l = line(step, s);
-        if step % a.every == 0 {
+    let record = trace::rows(
+        a.engine,
+        &scene,
+        &throw,
+        &settle,
+        a.every,
+        |l| {
             if failed.is_none() {
-                failed = writeln!(out, "{l}").err();
+                failed = writeln!(out.borrow_mut(), "{l}").err();
             }
-            last = None;
-        } else {
-            last = Some(l);
-        }
-    });
+        },
+        |step| {
+            // A roll cannot be stopped from its observer: a stop request ends the process here,
+            // the rows so far written, as every command stops (exit 130).
+            if step.is_multiple_of(1024) && super::term::stop().requested() {
+                let _ = out.borrow_mut().flush();
+                let kept = dicephys::run::stop::Kept::Steps(step);
+                eprintln!("dicephys: {}", dicephys::run::stop::interrupted(&kept));
+                std::process::exit(130);
+            }
+        },
+    )?;
     if let Some(e) = failed {
         return Err(e.into());
     }
-    if let Some(l) = last {
-        writeln!(out, "{l}")?;
-    }
-    out.flush()?;
+    out.borrow_mut().flush()?;
     let labels = scene.shape.as_ref().map(|s| s.labels()).unwrap_or_default();
-    // A die still moving at the cap: the face it was on then, for the ending's line (a
-    // record keeps a face only for a settled roll).
-    let mut ended = record;
-    if let (Fate::Unconverged(_), Some(s)) = (record.fate, end_state) {
-        ended.up = die.outcome(&s).1;
-    }
-    eprintln!("{}", trace::ending(index, &throw, &ended, &labels));
+    eprintln!("{}", trace::ending(index, &throw, &record, &labels));
     if let Some(note) = trace::capped(&record, settle.max_steps, a.max_steps.asked().is_some()) {
         eprintln!("dicephys: {note}");
     }
     Ok(())
 }
 
-/// How a traced roll ends: at `roll`'s step cap for the same die unless one is asked (a coin
-/// on its edge on a floor without rolling resistance rolls for ever, and traced to DicePhys's
-/// 20,000,000 steps it wrote gigabytes; issue 69.10), its flight as asked. The HTML page's
-/// trace too (`trace_html`).
-pub fn settle(a: &TraceArgs, scene: &dicephys::model::scene::Scene) -> RollConfig {
-    RollConfig {
-        max_steps: EndRequest {
-            max_steps: a.max_steps.asked(),
-            ..EndRequest::default()
-        }
-        .cap(scene),
-        fast_flight: a.flight == FlightArg::Fast,
-        ..RollConfig::default()
-    }
+/// How a traced roll ends (`report::trace::config`): at `roll`'s step cap for the same die
+/// unless one is asked, its flight as asked, the early stop taken.
+fn settle(a: &TraceArgs, scene: &dicephys::model::scene::Scene) -> RollConfig {
+    trace::config(
+        scene,
+        a.max_steps.asked(),
+        a.flight == FlightArg::Fast,
+        false,
+    )
 }

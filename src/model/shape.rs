@@ -650,6 +650,56 @@ impl Shape {
         })
     }
 
+    /// Each outcome as the text tells it apart (issue 74.3), by label in
+    /// [`Shape::outcome_labels`]' order: the outward normal (body axes, unit) of the facet the
+    /// die rests on to show it, the one the die map draws it on (`None` for a coin's edge,
+    /// which has no one normal, and for a label several facets show), and that facet's (those
+    /// facets') share of the die's surface area.
+    pub fn outcome_geometry(&self) -> Vec<(String, Option<[f64; 3]>, f64)> {
+        let facets = self.facets();
+        let (areas, total): (Vec<f64>, f64) = match &self.solid {
+            Solid::Cylinder { diameter, height } => {
+                let cap = std::f64::consts::PI * 0.25 * diameter * diameter;
+                let side = std::f64::consts::PI * diameter * height;
+                let each = self
+                    .faces
+                    .iter()
+                    .map(|f| if f.normal == [0.0; 3] { side } else { cap })
+                    .collect();
+                (each, 2.0 * cap + side)
+            }
+            Solid::Hull { .. } => {
+                let each = self
+                    .faces
+                    .iter()
+                    .map(|f| {
+                        let n = Vector3::from(f.normal);
+                        facets
+                            .iter()
+                            .filter(|g| (g.normal - n).norm() < 1e-6)
+                            .map(|g| g.area)
+                            .sum()
+                    })
+                    .collect();
+                (each, facets.iter().map(|g| g.area).sum())
+            }
+        };
+        self.outcome_labels()
+            .into_iter()
+            .map(|label| {
+                let on: Vec<usize> = (0..self.faces.len())
+                    .filter(|&k| self.faces[k].label == label)
+                    .collect();
+                let normal = match on[..] {
+                    [k] if self.faces[k].normal != [0.0; 3] => Some(self.faces[k].normal),
+                    _ => None,
+                };
+                let share = on.iter().map(|&k| areas[k]).sum::<f64>() / total.max(1e-300);
+                (label, normal, share)
+            })
+            .collect()
+    }
+
     /// The outcomes' labels, in order.
     pub fn labels(&self) -> Vec<&str> {
         self.faces.iter().map(|f| f.label.as_str()).collect()

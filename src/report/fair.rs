@@ -26,6 +26,16 @@ pub struct FaceVerdict {
     pub departure: f64,
     /// The departure over the null's own error √(q(1 − q)/n).
     pub z: f64,
+    /// The outward normal (body axes, unit) of the facet the die rests on when it shows this
+    /// face, the one the die map draws it on (a cube's: opposite `direction`); absent where
+    /// there is none (a coin's edge, a label several facets show, 2D, counts by labels that
+    /// are not the die's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<[f64; 3]>,
+    /// That facet's share of the die's surface area (a label several facets show: theirs);
+    /// absent where the die is not known (2D, counts by labels that are not the die's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub area_share: Option<f64>,
     /// The throws at which a tester counting this face alone sees its departure at 2σ
     /// (z² q(1 − q)/departure²); `None` where the simulation does not resolve the departure
     /// itself (|departure| < 2 err).
@@ -83,21 +93,52 @@ impl Fairness {
             "  face  up  count      p        ± 1σ     null     departure      z   throws to see \
              it (2σ / 5σ)\n",
         );
+        let shaped = self.faces.iter().any(|f| f.area_share.is_some());
+        if shaped {
+            // The faces told apart without the picture: where each lies, and how large it is.
+            let head = format!("   {:<26}  {:>7}", "rests on (normal x, y, z)", "area");
+            out.insert_str(out.len() - 1, &head);
+        }
         for f in &self.faces {
             let see = match (f.throws_2sigma, f.throws_5sigma) {
                 (Some(a), Some(b)) => format!("{a:.0} / {b:.0}"),
                 _ => "unresolved".into(),
             };
             out += &format!(
-                "  {:>4}  {:<2} {:>7}  {:.5}  {:.5}  {:.5}  {:+.5}  {:+6.2}   {see}\n",
+                "  {:>4}  {:<2} {:>7}  {:.5}  {:.5}  {:.5}  {:+.5}  {:+6.2}   {see}",
                 f.number, f.direction, f.count, f.p, f.err, f.null, f.departure, f.z
             );
+            if shaped {
+                // Rounded first, so that no -0.000 shows.
+                let c = |v: f64| (v * 1000.0).round() / 1000.0 + 0.0;
+                let normal = f.normal.map_or("-".to_string(), |[x, y, z]| {
+                    format!("({:+.3}, {:+.3}, {:+.3})", c(x), c(y), c(z))
+                });
+                let area = f
+                    .area_share
+                    .map_or("-".to_string(), |a| format!("{:.2} %", 100.0 * a));
+                // Under the header's columns: "throws to see it (2σ / 5σ)" is 26 wide.
+                let pad = 26usize.saturating_sub(see.chars().count());
+                out += &format!("{:pad$}   {normal:<26}  {area:>7}", "");
+            }
+            out += "\n";
         }
         out += &format!("  {}\n", self.verdict);
         if let Some(n) = &self.note {
             out += &format!("  note: {n}\n");
         }
         out
+    }
+
+    /// Measured counts' verdict (`studies::fair::assess_counts`), as `fair --counts` prints
+    /// it after "Is this die fair? ": the throws, the null and the table.
+    pub fn counted_text(&self) -> String {
+        format!(
+            "{} throws counted, against {}\n{}",
+            self.n,
+            self.null,
+            self.table()
+        )
     }
 
     /// The faces' table as CSV: one row a face (`face` its number, `label` its direction on a
@@ -193,6 +234,8 @@ mod tests {
             null: 0.5,
             departure: 0.0,
             z: 0.0,
+            normal: None,
+            area_share: None,
             throws_2sigma: None,
             throws_5sigma: None,
         };

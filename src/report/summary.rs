@@ -213,6 +213,14 @@ pub struct ShapeFace {
     /// that end on an outcome; absent where it is not built (a coin loaded off its axis).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub quasi_static: Option<f64>,
+    /// The outward normal (body axes, unit) of the facet the die rests on to show it, the one
+    /// the die map draws it on; absent for a coin's edge and a label several facets show
+    /// (`Shape::outcome_geometry`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<[f64; 3]>,
+    /// That facet's (those facets') share of the die's surface area.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub area_share: Option<f64>,
 }
 
 /// A die of any shape's outcomes against a fair die's (each label its facets' share).
@@ -331,13 +339,17 @@ impl ShapeOutcomes {
                 crate::theory::stats::chi_square_p_value(chi2, dof),
             )
         });
+        let places = shape.outcome_geometry();
         let faces = counts
             .into_iter()
             .enumerate()
             .map(|(i, (label, count))| {
                 let p = count as f64 / nf;
                 let q = fair[i];
+                let place = places.iter().find(|(l, _, _)| *l == label);
                 ShapeFace {
+                    normal: place.and_then(|p| p.1),
+                    area_share: place.map(|p| p.2),
                     label,
                     count,
                     p,
@@ -380,6 +392,27 @@ impl ShapeOutcomes {
                 })
                 .collect();
             s += &format!("  {}\n", each.join("  "));
+        }
+        // The faces told apart without the die map (issue 74.3).
+        if self.faces.iter().any(|f| f.area_share.is_some()) {
+            s += "  each face rests on the facet of outward normal (x, y, z), body axes; its \
+                  share of the surface:\n";
+            let c = |v: f64| (v * 1000.0).round() / 1000.0 + 0.0;
+            for chunk in self.faces.chunks(3) {
+                let each: Vec<String> = chunk
+                    .iter()
+                    .map(|f| {
+                        let normal = f.normal.map_or("-".to_string(), |[x, y, z]| {
+                            format!("({:+.3}, {:+.3}, {:+.3})", c(x), c(y), c(z))
+                        });
+                        let area = f
+                            .area_share
+                            .map_or("-".to_string(), |a| format!("{:.2} %", 100.0 * a));
+                        format!("{:>5} {normal:<24} {area:>7}", f.label)
+                    })
+                    .collect();
+                s += &format!("  {}\n", each.join("   "));
+            }
         }
         if self.unsettled > 0 {
             s += &format!(

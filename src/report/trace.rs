@@ -83,3 +83,165 @@ pub fn capped(record: &RollRecord, cap: u64, asked: bool) -> Option<String> {
         "the step cap ended the trace: the die was not at rest after {cap} steps ({whose})"
     ))
 }
+
+/// How a traced roll ends: at `roll`'s step cap for the same die unless `max_steps` asks
+/// another (a coin on its edge on a floor without rolling resistance rolls for ever, and traced
+/// to DicePhys's 20,000,000 steps it wrote gigabytes; issue 69.10), its flight fast (in closed
+/// form where it is ballistic, as `roll` flies it) or stepped; `audit`: the early stop noted
+/// where it would fire, the roll carried on to rest (the page's), else taken (the CSV's).
+pub fn config(
+    scene: &crate::model::scene::Scene,
+    max_steps: Option<u64>,
+    fast_flight: bool,
+    audit: bool,
+) -> crate::sim::roll::RollConfig {
+    crate::sim::roll::RollConfig {
+        max_steps: crate::run::request::EndRequest {
+            max_steps,
+            ..crate::run::request::EndRequest::default()
+        }
+        .cap(scene),
+        fast_flight,
+        audit,
+        ..crate::sim::roll::RollConfig::default()
+    }
+}
+
+/// `throw` rolled on a new engine of `kind` as `trace` rolls it, each step's state passed to
+/// `observe`: its record, where a die still moving at the cap keeps the face it was on then
+/// (a record keeps a face only for a settled roll), for the ending's line.
+pub fn roll(
+    kind: crate::engine::EngineKind,
+    scene: &crate::model::scene::Scene,
+    throw: &Throw,
+    settle: &crate::sim::roll::RollConfig,
+    mut observe: impl FnMut(u64, &BodyState),
+) -> crate::Result<RollRecord> {
+    let die = DieShape::of(scene);
+    let mut engine = crate::engine::new_engine(kind, scene)?;
+    let mut end_state = None;
+    let record =
+        crate::sim::roll::roll_observed(engine.as_mut(), scene, throw, settle, |step, s| {
+            end_state = Some(*s);
+            observe(step, s);
+        });
+    let mut ended = record;
+    if let (Fate::Unconverged(_), Some(s)) = (record.fate, end_state) {
+        ended.up = die.outcome(&s).1;
+    }
+    Ok(ended)
+}
+
+/// The CSV's rows of `throw` (`trace`'s, without the header), each passed to `line`: every
+/// `every`th step's, and the last's; `tick` is called at every step (a front end's stop).
+/// Its record (`roll`).
+#[allow(clippy::too_many_arguments)]
+pub fn rows(
+    kind: crate::engine::EngineKind,
+    scene: &crate::model::scene::Scene,
+    throw: &Throw,
+    settle: &crate::sim::roll::RollConfig,
+    every: u64,
+    mut line: impl FnMut(&str),
+    mut tick: impl FnMut(u64),
+) -> crate::Result<RollRecord> {
+    let die = DieShape::of(scene);
+    let mut last = None;
+    let record = roll(kind, scene, throw, settle, |step, s| {
+        tick(step);
+        let l = row(&die, scene.dt, step, s);
+        if step % every == 0 {
+            line(&l);
+            last = None;
+        } else {
+            last = Some(l);
+        }
+    })?;
+    if let Some(l) = last {
+        line(&l);
+    }
+    Ok(record)
+}
+
+/// The page (`report::view`) that plays throws `indices` of `throws` of `scene` on `kind`,
+/// each rolled as `trace --html` rolls it (the early stop audited: noted where it would have
+/// fired, the roll carried on to rest); each throw's ending line, with the cap's note where
+/// the cap ended it (`capped`), passed to `say`; `tick` is called at every step (a front end's stop).
+#[allow(clippy::too_many_arguments)]
+pub fn page(
+    kind: crate::engine::EngineKind,
+    scene: &crate::model::scene::Scene,
+    throws: &crate::model::throws::Throws,
+    indices: std::ops::RangeInclusive<u64>,
+    max_steps: Option<u64>,
+    fast_flight: bool,
+    mut say: impl FnMut(&str, Option<&str>),
+    mut tick: impl FnMut(u64),
+) -> crate::Result<String> {
+    use crate::report::view::{self, DieView, Recorder, ThrowView};
+    let die = DieShape::of(scene);
+    let settle = config(scene, max_steps, fast_flight, true);
+    let labels: Vec<String> = scene
+        .shape
+        .as_ref()
+        .map(|s| s.labels().into_iter().map(String::from).collect())
+        .unwrap_or_default();
+    let label_refs: Vec<&str> = labels.iter().map(String::as_str).collect();
+    let mut views = Vec::new();
+    for index in indices {
+        let throw = throws.get(index);
+        let mut rec = Recorder::new(scene.dt);
+        let record = roll(kind, scene, &throw, &settle, |step, s| {
+            tick(step);
+            rec.push(&die, step, s);
+        })?;
+        let ending = ending(index, &throw, &record, &label_refs);
+        say(
+            &ending,
+            capped(&record, settle.max_steps, max_steps.is_some()).as_deref(),
+        );
+        views.push(ThrowView::of(
+            index,
+            ending,
+            &record,
+            scene.dt,
+            &labels,
+            rec.finish(&die),
+        ));
+    }
+    Ok(view::page(
+        &DieView::of(scene, &die),
+        scene.dt,
+        kind.into(),
+        &views,
+    ))
+}
+
+/// The most throws one page plays.
+pub const MAX_ON_A_PAGE: u64 = 16;
+
+/// The throws `trace --index` names, (first, last): `I`, or `A..B` (both included, as the
+/// shell's {A..B}; also `A..=B`), at most [`MAX_ON_A_PAGE`]; else why not.
+pub fn indices(s: &str) -> std::result::Result<(u64, u64), String> {
+    let n = |p: &str| {
+        p.trim()
+            .parse::<u64>()
+            .map_err(|_| format!("'{}' is not a throw's index (0, 1, …)", p.trim()))
+    };
+    let (first, last) = match s.split_once("..") {
+        Some((a, b)) => (n(a)?, n(b.strip_prefix('=').unwrap_or(b))?),
+        None => (n(s)?, n(s)?),
+    };
+    if last < first {
+        return Err(format!("{s}: the range runs backwards"));
+    }
+    if last - first >= MAX_ON_A_PAGE {
+        return Err(format!(
+            "{s}: {} throws; a page plays at most {MAX_ON_A_PAGE}",
+            (last - first).saturating_add(1)
+        ));
+    }
+    last.checked_add(1)
+        .ok_or_else(|| format!("{s}: too large"))?;
+    Ok((first, last))
+}

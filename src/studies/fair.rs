@@ -198,6 +198,7 @@ pub fn assess(s: &RunSummary, null: &Null) -> Result<Fairness> {
     }
     let (numbers, names, counts) = face_counts(s, shape.as_deref(), q.len());
     let mut fair = judge(&numbers, &names, &counts, &q, null, "rolls at rest")?;
+    place_faces(&mut fair, &s.spec.scene, None);
     fair.note = note;
     Ok(fair)
 }
@@ -211,20 +212,29 @@ pub fn parse_counts(text: &str) -> Result<Vec<(String, u64)>> {
         let (label, n) = item
             .split_once('=')
             .ok_or_else(|| bad(format!("'{item}': write LABEL=COUNT (e.g. 1=170,2=160,…)")))?;
-        let label = label.trim();
         let n = crate::calibration::data::count(n.trim()).map_err(bad)?;
-        if label.is_empty() || out.iter().any(|(l, _)| l == label) {
+        out.push((label.trim().to_string(), n));
+    }
+    check_counts(out, text)
+}
+
+/// Counts a tester measured, (label, count) in the order given (`parse_counts`' or a front
+/// end's own), checked: each label once and one a count can name, at least two, some throws
+/// and not too many; `given` is how they were written, for the error.
+pub fn check_counts(counts: Vec<(String, u64)>, given: &str) -> Result<Vec<(String, u64)>> {
+    let bad = |why: String| Error::field(Field::Counts, given, why);
+    for (k, (label, _)) in counts.iter().enumerate() {
+        if label.is_empty() || counts[..k].iter().any(|(l, _)| l == label) {
             return Err(bad(format!("face '{label}' is empty or given twice")));
         }
         crate::model::shape::check_label(label).map_err(bad)?;
-        out.push((label.to_string(), n));
     }
-    if out.len() < 2 {
+    if counts.len() < 2 {
         return Err(bad("give at least two faces' counts".into()));
     }
     // Each count is at most a fit's row's; their sum is checked too, never wrapped.
     let max = crate::calibration::data::MAX_ROW_THROWS;
-    match out.iter().try_fold(0u64, |a, (_, n)| a.checked_add(*n)) {
+    match counts.iter().try_fold(0u64, |a, (_, n)| a.checked_add(*n)) {
         Some(0) => return Err(bad("no throws counted".into())),
         Some(t) if t <= max => {}
         _ => {
@@ -233,7 +243,7 @@ pub fn parse_counts(text: &str) -> Result<Vec<(String, u64)>> {
             )))
         }
     }
-    Ok(out)
+    Ok(counts)
 }
 
 /// Measured counts (`parse_counts`) set against `null`: uniform (each of the faces given 1/N),
@@ -332,7 +342,50 @@ pub fn assess_counts(
     let counts: Vec<u64> = counted.iter().map(|(_, c)| *c).collect();
     let mut fair = judge(&numbers, &names, &counts, &q, null, "throws counted")?;
     fair.note = note;
+    place_faces(&mut fair, scene, Some(layout));
     Ok(fair)
+}
+
+/// Each face of `fair` told apart without the die map (issue 74.3): the outward normal of the
+/// facet the die rests on to show it and that facet's share of the die's surface, for a die of
+/// any shape by its label (`Shape::outcome_geometry`), for a cuboid in 3D by its direction
+/// (`counted` by its layout: counts give the numbers, not the directions); nothing in 2D or
+/// for a label the die has not.
+fn place_faces(fair: &mut Fairness, scene: &crate::model::scene::Scene, counted: Option<Layout>) {
+    let places: Vec<(String, Option<[f64; 3]>, f64)> = match (&scene.shape, scene.mode) {
+        (Some(shape), _) => shape.outcome_geometry(),
+        (None, Mode::TwoD) => return,
+        (None, Mode::ThreeD) => {
+            let b = &scene.block;
+            // Body x is the breadth, y the width, z the length.
+            let side = [
+                b.width * b.length,
+                b.breadth * b.length,
+                b.breadth * b.width,
+            ];
+            let total = 2.0 * side.iter().sum::<f64>();
+            DIRECTIONS
+                .iter()
+                .enumerate()
+                .map(|(d, name)| {
+                    let key = match counted {
+                        Some(layout) => layout.numbers()[d].to_string(),
+                        None => name.to_string(),
+                    };
+                    // The face up is `name`; the die rests on the one opposite.
+                    let mut normal = [0.0; 3];
+                    normal[d / 2] = if d % 2 == 0 { -1.0 } else { 1.0 };
+                    (key, Some(normal), side[d / 2] / total)
+                })
+                .collect()
+        }
+    };
+    for f in &mut fair.faces {
+        if let Some((_, normal, share)) = places.iter().find(|(k, _, _)| *k == f.direction) {
+            f.normal = *normal;
+            f.area_share = Some(*share);
+        }
+    }
 }
 
 /// True if `a` and `b` hold the same labels (each once in `a`).
@@ -378,6 +431,8 @@ fn judge(
                 null: q,
                 departure,
                 z: departure / (q * (1.0 - q) / nf).sqrt(),
+                normal: None,
+                area_share: None,
                 throws_2sigma: resolved.then(|| see(2.0, q, departure)),
                 throws_5sigma: resolved.then(|| see(5.0, q, departure)),
             }
@@ -706,6 +761,53 @@ pub fn varied_specs(spec: &RunSpec, what: Varied, values: &[f64]) -> Result<Vec<
             Ok(s)
         })
         .collect()
+}
+
+/// `fair --vary --json`'s document (bias.json): the feature, the null, the run and each
+/// value's verdict.
+pub fn bias_document(
+    spec: &RunSpec,
+    what: Varied,
+    null: &Null,
+    points: &[BiasPoint],
+) -> serde_json::Value {
+    serde_json::json!({ "vary": what, "null": (null.spec()), "spec": spec, "points": points })
+}
+
+/// `fair --vary`'s table, as the terminal shows it: a row a value of `what`, each face's
+/// probability with its error, χ²'s p and the throws to see the bias.
+pub fn bias_table(what: Varied, points: &[BiasPoint]) -> String {
+    // Each face in the order the rows give them (a cube's 1 … 6, a shape's labels).
+    let names: Vec<String> = points.first().map_or_else(Vec::new, |b| {
+        b.fairness
+            .faces
+            .iter()
+            .map(|f| f.number.to_string())
+            .collect()
+    });
+    let mut t = format!(
+        "{what} (mm) | P({}), each ± its error | χ² p | throws to see it at 2σ\n",
+        match names.len() {
+            0..=6 => names.join(", "),
+            n => format!("{} … {}, {n} faces", names[0], names[n - 1]),
+        }
+    );
+    for b in points {
+        let f = &b.fairness;
+        let ps: Vec<String> = f
+            .faces
+            .iter()
+            .map(|x| format!("{:.4}±{:.4}", x.p, x.err))
+            .collect();
+        t += &format!(
+            "{:>8.3} | {} | {:.2e} | {}\n",
+            b.value,
+            ps.join(" "),
+            f.p_value,
+            f.throws_2sigma.map_or("-".into(), |n| format!("{n:.0}"))
+        );
+    }
+    t
 }
 
 /// Writes the bias figure (`bias.svg`, `.png`: each face's probability against the varied

@@ -563,3 +563,88 @@ fn broken_physics_says_so_and_the_defaults_do_not() {
     assert!(v.get("warnings").is_none(), "{}", v["warnings"]);
     assert!(!e.contains("warning"), "{e}");
 }
+
+/// Issue 74.3: each face told apart without the die map, in the text and the JSON: the
+/// outward normal of the facet the die rests on to show it, and that facet's share of the
+/// surface. A d8's eight facets are the eight (±1, ±1, ±1)/√3, each an eighth of the surface;
+/// a coin's caps rest on ∓z, its edge on no one facet, and their shares are the cylinder's
+/// areas; a 16x16x15 block's face 3 (+y up) rests on −y, a 16 × 16 face of 1472 mm² in all.
+#[test]
+fn fair_tells_each_face_apart_by_the_normal_and_the_area_it_rests_on() {
+    let args = ["fair", "--shape", "d8", "--rolls", "200", "--seed", "1"];
+    let v = json(&dicephys(&[&args[..], &["--json"]].concat()));
+    let faces = v["fairness"]["faces"].as_array().unwrap();
+    assert_eq!(faces.len(), 8);
+    let mut normals: Vec<[i64; 3]> = Vec::new();
+    for f in faces {
+        let n: Vec<f64> = serde_json::from_value(f["normal"].clone()).unwrap();
+        let third = 1.0 / 3f64.sqrt();
+        assert!(n.iter().all(|x| (x.abs() - third).abs() < 1e-9), "{n:?}");
+        normals.push([0, 1, 2].map(|k| n[k].signum() as i64));
+        let share = f["area_share"].as_f64().unwrap();
+        assert!((share - 0.125).abs() < 1e-9, "{share}");
+    }
+    normals.sort_unstable();
+    normals.dedup();
+    assert_eq!(normals.len(), 8, "each face its own facet");
+    let text = String::from_utf8(dicephys(&args).stdout).unwrap();
+    assert!(text.contains("rests on (normal x, y, z)"), "{text}");
+    let row = |label: &str| {
+        text.lines()
+            .find(|l| l.split_whitespace().nth(1) == Some(label))
+            .unwrap_or_else(|| panic!("no row {label}: {text}"))
+            .to_string()
+    };
+    let first = &faces[0]["normal"];
+    let shown = format!(
+        "({:+.3}, {:+.3}, {:+.3})",
+        first[0].as_f64().unwrap(),
+        first[1].as_f64().unwrap(),
+        first[2].as_f64().unwrap()
+    );
+    assert!(
+        row("1").contains(&shown) && row("1").contains("12.50 %"),
+        "{text}"
+    );
+    // roll says the same of each face, in its JSON and its text.
+    let rolled = ["roll", "--shape", "d8", "--rolls", "20", "--seed", "1"];
+    let r = json(&dicephys(&[&rolled[..], &["--json"]].concat()));
+    assert_eq!(r["shape"]["faces"][0]["label"], faces[0]["direction"]);
+    assert_eq!(r["shape"]["faces"][0]["normal"], faces[0]["normal"]);
+    assert_eq!(r["shape"]["faces"][0]["area_share"], faces[0]["area_share"]);
+    let said = String::from_utf8(dicephys(&rolled).stdout).unwrap();
+    assert!(
+        said.contains("rests on the facet of outward normal") && said.contains(&shown),
+        "{said}"
+    );
+
+    // A coin's measured counts: the caps and the edge of a 24 × 2 mm cylinder.
+    let coin = json(&dicephys(&[
+        "fair",
+        "--counts",
+        "heads=48,tails=51,edge=1",
+        "--shape",
+        "coin:24,2",
+        "--json",
+    ]));
+    let (cap, side) = (std::f64::consts::PI * 144.0, std::f64::consts::PI * 48.0);
+    for (f, (z, share)) in coin["fairness"]["faces"].as_array().unwrap().iter().zip([
+        (Some(-1.0), cap),
+        (Some(1.0), cap),
+        (None, side),
+    ]) {
+        assert_eq!(f["normal"][2].as_f64(), z, "{f}");
+        let got = f["area_share"].as_f64().unwrap();
+        assert!((got - share / (2.0 * cap + side)).abs() < 1e-12, "{f}");
+    }
+
+    // A cuboid, by its direction: face 3 shows +y and rests on −y.
+    let block = json(&dicephys(&[
+        "fair", "--block", "16x16x15", "--rolls", "60", "--seed", "1", "--json",
+    ]));
+    let three = &block["fairness"]["faces"][2];
+    assert_eq!(three["direction"], "+y");
+    assert_eq!(three["normal"], serde_json::json!([0.0, -1.0, 0.0]));
+    let share = three["area_share"].as_f64().unwrap();
+    assert!((share - 256.0 / 1472.0).abs() < 1e-12, "{share}");
+}

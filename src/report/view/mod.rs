@@ -5,8 +5,10 @@
 
 pub mod die;
 
+use crate::model::block::Outcome;
 use crate::model::die::DieShape;
 use crate::model::state::BodyState;
+use crate::sim::roll::{Fate, RollRecord};
 use serde::Serialize;
 
 pub use die::DieView;
@@ -146,6 +148,44 @@ pub struct ThrowView {
     pub early_stop: Option<(f64, String)>,
     /// Its frames.
     pub frames: Frames,
+}
+
+impl ThrowView {
+    /// Throw `index`, ended by `record` (`report::trace::roll`'s) as `ending` says, rolled
+    /// at `dt`, a die of any shape's outcomes named by `labels`.
+    pub fn of(
+        index: u64,
+        ending: String,
+        record: &RollRecord,
+        dt: f64,
+        labels: &[String],
+        frames: Frames,
+    ) -> ThrowView {
+        let outcome = match record.fate {
+            Fate::Settled(o) | Fate::Unconverged(o) => named(o, record.up, labels),
+            Fate::Failed(_) => None,
+        };
+        let early_stop = record.certified.and_then(|(step, o)| {
+            Some((step as f64 * dt, named(o, record.certified_face, labels)?))
+        });
+        ThrowView {
+            index,
+            ending,
+            outcome,
+            early_stop,
+            frames,
+        }
+    }
+}
+
+/// The outcome `o` (a die of any shape's `face`, named by `labels`) as the page's die names
+/// its outcomes: a label, or "breadth vertical".
+fn named(o: Outcome, face: Option<u8>, labels: &[String]) -> Option<String> {
+    match o {
+        Outcome::Face => face.and_then(|k| labels.get(usize::from(k)).cloned()),
+        Outcome::Unknown => None,
+        o => Some(format!("{} vertical", o.name())),
+    }
 }
 
 /// The page's data.
