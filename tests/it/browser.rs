@@ -318,3 +318,89 @@ fn the_reports_open_offline_with_their_figures_inline() {
         );
     }
 }
+
+/// A box with pips and rounded edges (issue 74: "the die as it is"): its page opens offline in
+/// both renderers with no error, ends on the side `trace` names, and shows the die (its red)
+/// where the page puts its centre; the pips and the rounding's geometry are checked against
+/// their closed forms in `report::view::die`'s tests.
+#[test]
+fn a_box_with_pips_and_rounded_edges_opens_and_ends_on_its_side() {
+    let Some(browser) = chromium("a_box_with_pips_and_rounded_edges_opens_and_ends_on_its_side")
+    else {
+        return;
+    };
+    let dir = Scratch::new("browser-box");
+    let page = dir.join("box.html");
+    let out = bin()
+        .args([
+            "trace",
+            "--block",
+            "16x16x16",
+            "--pips",
+            "3,0.5",
+            "--edge-radius",
+            "1",
+            "--seed",
+            "1",
+            "--index",
+            "0",
+            "--html",
+        ])
+        .arg(&page)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(out.status.success(), "trace --html failed: {err}");
+    // trace's line: "throw 0: … settled, breadth vertical after N steps".
+    let side = err
+        .split("settled, ")
+        .nth(1)
+        .and_then(|s| s.split(" after").next())
+        .unwrap_or_else(|| panic!("no side in trace's line: {err}"));
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(
+        html.contains("\"pip_radius\":0.0015"),
+        "the page has the pips"
+    );
+    for fragment in ["t=end", "t=end&2d"] {
+        let dom = headless(&browser, &page, fragment, "--dump-dom");
+        assert_eq!(
+            body_attr(&dom, "data-ready").as_deref(),
+            Some("1"),
+            "{fragment}: {dom:.2000}"
+        );
+        assert_eq!(
+            body_attr(&dom, "data-errors").as_deref(),
+            Some(""),
+            "{fragment}: errors"
+        );
+        assert_eq!(
+            body_attr(&dom, "data-final-face").as_deref(),
+            Some(side),
+            "{fragment}"
+        );
+        let centre = body_attr(&dom, "data-centre").expect("the page gives the die's centre");
+        let (x, y) = centre.split_once(',').expect("x,y");
+        let (x, y): (f64, f64) = (x.parse().unwrap(), y.parse().unwrap());
+        let shot = dir.join(format!("{}.png", fragment.replace(['=', '&'], "-")));
+        headless(
+            &browser,
+            &page,
+            fragment,
+            &format!("--screenshot={}", shot.display()),
+        );
+        // The pips (white) cover part of the faces about the centre: a lower share than a
+        // plain die's 0.35, still far above the floor's none.
+        let near = red_share(&shot, (x, y), 12.0);
+        let far = red_share(&shot, (x + 150.0, y), 12.0);
+        eprintln!("{fragment}: red at the die's centre {near:.2}, 150 px away {far:.2}");
+        assert!(
+            near > 0.2,
+            "{fragment}: {near:.2} of the pixels at the die's centre are its red"
+        );
+        assert!(
+            far < 0.05,
+            "{fragment}: {far:.2} of the pixels 150 px away are red"
+        );
+    }
+}

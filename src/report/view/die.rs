@@ -20,6 +20,9 @@ pub struct Poly {
     /// The label printed on it, if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub label: Option<String>,
+    /// The pips drilled in it (a box with pips: they show its number), their centres on it, m.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub pips: Vec<[f64; 3]>,
 }
 
 /// One outcome: the die resting on the face with this outward normal (body axes; a
@@ -43,7 +46,18 @@ pub struct DieView {
     pub outcomes: Vec<Resting>,
     /// The farthest any point of it is from its centre of mass, m (the camera's scale).
     pub reach: f64,
+    /// A pip's radius on its face, m (0: no pips).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub pip_radius: f64,
 }
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+/// Each rounded edge's quarter circle is drawn in this many flat strips (its two halves on the
+/// two faces' sides).
+const ROUND_STEPS: usize = 4;
 
 /// Rounds to 0.1 µm: the page's coordinates.
 fn round(v: &Vector3<f64>) -> [f64; 3] {
@@ -61,14 +75,23 @@ impl DieView {
 }
 
 /// The cuboid: its six faces about its geometric centre (at −com from the centre of mass),
-/// each with the number its layout puts there (`faces::DIRECTIONS`' order); resting on a ±x face is "breadth vertical".
-/// In 2D its 1 m depth is drawn as deep as its breadth.
+/// each with the number its layout puts there (`faces::DIRECTIONS`' order); resting on a ±x
+/// face is "breadth vertical". Its pips are drawn where `pip_places` drills them, and rounded
+/// edges ([`rounded_face`]) as the box swept by a sphere of the edge radius: each face's flat
+/// middle carries its number, its rim the quarter circles of its edges and corners. In 2D its
+/// 1 m depth is drawn as deep as its breadth.
 fn block(scene: &Scene, die: &DieShape) -> DieView {
     let mut half = die.half;
     if scene.mode == Mode::TwoD {
         half.z = half.x.max(half.y);
     }
-    let numbers = scene.features.layout.numbers();
+    let f = &scene.features;
+    let r = f.edge_radius.clamp(0.0, half.min());
+    let numbers = f.layout.numbers();
+    let places = f
+        .pips
+        .map(|p| crate::model::mass::pip_places(&half, &p, f.layout))
+        .unwrap_or_default();
     let mut polys = Vec::new();
     let mut outcomes = Vec::new();
     for (k, number) in numbers.iter().enumerate() {
@@ -76,26 +99,23 @@ fn block(scene: &Scene, die: &DieShape) -> DieView {
         let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
         let mut n = Vector3::zeros();
         n[axis] = sign;
-        let corner = |a: f64, b: f64| {
-            let mut p = n * half[axis];
-            p[u] = a * half[u];
-            p[v] = b * half[v];
-            round(&(p - die.com))
-        };
-        // u × v = the axis: counter-clockwise about +n seen from outside, reversed for −n.
-        let mut corners = vec![
-            corner(-1.0, -1.0),
-            corner(1.0, -1.0),
-            corner(1.0, 1.0),
-            corner(-1.0, 1.0),
-        ];
-        if sign < 0.0 {
-            corners.reverse();
+        let pips: Vec<[f64; 3]> = places
+            .iter()
+            .filter(|&&(i, s, _, _)| i == axis && s == sign)
+            .map(|&(_, _, pu, pv)| {
+                let mut c = n * half[axis];
+                c[u] = pu;
+                c[v] = pv;
+                round(&(c - die.com))
+            })
+            .collect();
+        for (corners, middle) in rounded_face(&half, r, axis, sign) {
+            polys.push(Poly {
+                corners: corners.iter().map(|c| round(&(c - die.com))).collect(),
+                label: middle.then(|| number.to_string()),
+                pips: if middle { pips.clone() } else { Vec::new() },
+            });
         }
-        polys.push(Poly {
-            corners,
-            label: Some(number.to_string()),
-        });
         let vertical = [Outcome::Breadth, Outcome::Width, Outcome::Length][axis];
         outcomes.push(Resting {
             normal: n.into(),
@@ -114,7 +134,75 @@ fn block(scene: &Scene, die: &DieShape) -> DieView {
         polys,
         outcomes,
         reach,
+        pip_radius: f.pips.map_or(0.0, |p| 0.5 * p.diameter),
     }
+}
+
+/// The face of the box of half sides `half` on `axis` at `sign`, its edges rounded with radius
+/// `r`: quads about the geometric centre, counter-clockwise seen from outside, each marked
+/// whether it is the face's flat middle. A point p of the face's grid is moved to q + r (p −
+/// q)/|p − q|, q being p clamped to the inner box (the box less r on every side): the flat
+/// middle stays, the rim's points go onto the quarter circles, half of each edge's on either
+/// face. Sharp (r 0): the one quad.
+fn rounded_face(
+    half: &Vector3<f64>,
+    r: f64,
+    axis: usize,
+    sign: f64,
+) -> Vec<(Vec<Vector3<f64>>, bool)> {
+    let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+    let ticks = |h: f64| -> Vec<f64> {
+        if r <= 0.0 {
+            return vec![-h, h];
+        }
+        let band = |s: f64| {
+            (0..=ROUND_STEPS).map(move |i| s * (h - r + r * i as f64 / ROUND_STEPS as f64))
+        };
+        let mut t: Vec<f64> = band(-1.0).collect();
+        t.reverse();
+        t.extend(band(1.0));
+        t.dedup_by(|a, b| (*a - *b).abs() < 1e-15);
+        t
+    };
+    let inner = half.map(|h| (h - r).max(0.0));
+    let on_surface = |a: f64, b: f64| {
+        let mut p = Vector3::zeros();
+        p[axis] = sign * half[axis];
+        p[u] = a;
+        p[v] = b;
+        if r <= 0.0 {
+            return p;
+        }
+        let q = Vector3::new(
+            p.x.clamp(-inner.x, inner.x),
+            p.y.clamp(-inner.y, inner.y),
+            p.z.clamp(-inner.z, inner.z),
+        );
+        let d = p - q;
+        q + d * (r / d.norm())
+    };
+    let (tu, tv) = (ticks(half[u]), ticks(half[v]));
+    let mut out = Vec::new();
+    for i in 0..tu.len() - 1 {
+        for j in 0..tv.len() - 1 {
+            let (a0, a1, b0, b1) = (tu[i], tu[i + 1], tv[j], tv[j + 1]);
+            // u × v = the axis: counter-clockwise about +n seen from outside, reversed for −n.
+            let mut corners = vec![
+                on_surface(a0, b0),
+                on_surface(a1, b0),
+                on_surface(a1, b1),
+                on_surface(a0, b1),
+            ];
+            if sign < 0.0 {
+                corners.reverse();
+            }
+            let middle = r <= 0.0
+                || (a0 >= -inner[u] - 1e-15 && a1 <= inner[u] + 1e-15)
+                    && (b0 >= -inner[v] - 1e-15 && b1 <= inner[v] + 1e-15);
+            out.push((corners, middle));
+        }
+    }
+    out
 }
 
 /// A die of any shape: its hull's facets (or a cylinder's caps and rim), each labelled as the
@@ -137,6 +225,7 @@ fn shaped(shape: &Shape, com: &Vector3<f64>) -> DieView {
             .map(|f| Poly {
                 corners: f.polygon.iter().map(|p| round(&(p - com))).collect(),
                 label: printed(&f.normal),
+                pips: Vec::new(),
             })
             .collect(),
         Solid::Cylinder { diameter, height } => cylinder(0.5 * diameter, 0.5 * height, com)
@@ -144,6 +233,7 @@ fn shaped(shape: &Shape, com: &Vector3<f64>) -> DieView {
             .map(|(corners, n)| Poly {
                 corners,
                 label: n.and_then(|n| printed(&n)),
+                pips: Vec::new(),
             })
             .collect(),
     };
@@ -157,6 +247,7 @@ fn shaped(shape: &Shape, com: &Vector3<f64>) -> DieView {
         polys,
         outcomes,
         reach,
+        pip_radius: 0.0,
     }
 }
 
@@ -222,6 +313,69 @@ mod tests {
             .collect();
         labels.sort();
         assert_eq!(labels, (1..=20).collect::<Vec<_>>());
+    }
+
+    /// A 16 × 16 × 16 mm box with 3 mm pips 0.5 mm deep and edges rounded `r` mm, as drawn.
+    fn box_view(r: f64) -> (DieView, Vector3<f64>) {
+        use crate::model::block::Block;
+        let mut scene = Scene::paper(Block::from_mm(16.0, 16.0, 16.0).unwrap(), Mode::ThreeD);
+        scene.features.pips = Some(crate::model::mass::Pips::caps(3e-3, 0.5e-3));
+        scene.features.edge_radius = r * 1e-3;
+        let die = DieShape::of(&scene);
+        (block(&scene, &die), die.com)
+    }
+
+    #[test]
+    fn a_box_shows_its_pips_and_its_rounded_edges_where_they_are() {
+        let h = 8e-3;
+        for r in [0.0, 2.0] {
+            let (v, com) = box_view(r);
+            assert!((v.pip_radius - 1.5e-3).abs() < 1e-12);
+            // Six labelled middles, each with as many pips as its number, on its face's plane.
+            let faces: Vec<&Poly> = v.polys.iter().filter(|p| p.label.is_some()).collect();
+            assert_eq!(faces.len(), 6, "r {r}");
+            for f in &faces {
+                let n: usize = f.label.as_ref().unwrap().parse().unwrap();
+                assert_eq!(f.pips.len(), n, "face {n}, r {r}");
+                let on = |c: &[f64; 3]| Vector3::from(*c) + com;
+                let centre: Vector3<f64> = f.corners.iter().map(on).sum::<Vector3<f64>>() / 4.0;
+                let axis = centre.iamax();
+                for p in &f.pips {
+                    assert!((on(p)[axis].abs() - h).abs() < 1e-6, "face {n}: {p:?}");
+                }
+            }
+            assert_eq!(faces.iter().map(|f| f.pips.len()).sum::<usize>(), 21);
+            // Every corner lies on the box swept by a sphere of radius r: at r from the inner
+            // box (the box less r); its area is the swept box's, 2(AB + BC + CA) + 2πr(A + B +
+            // C) + 4πr² for the inner sides A, B, C, within the quarter circles' chords (1 %).
+            let (r, inner) = (r * 1e-3, h - r * 1e-3);
+            let mut area = 0.0;
+            for p in &v.polys {
+                let c: Vec<Vector3<f64>> =
+                    p.corners.iter().map(|c| Vector3::from(*c) + com).collect();
+                for x in &c {
+                    let d = x.map(|t| (t.abs() - inner).max(0.0)).norm();
+                    assert!(
+                        (d - r).abs() < 1e-6,
+                        "{x:?} is {d} from the inner box, not {r}"
+                    );
+                }
+                area += 0.5
+                    * ((c[1] - c[0]).cross(&(c[2] - c[0])).norm()
+                        + (c[2] - c[0]).cross(&(c[3] - c[0])).norm());
+            }
+            let a = 2.0 * inner;
+            let want = 6.0 * a * a
+                + 2.0 * std::f64::consts::PI * r * 3.0 * a
+                + 4.0 * std::f64::consts::PI * r * r;
+            assert!(
+                (area / want - 1.0).abs() < 0.01,
+                "r {r}: area {area} against {want}"
+            );
+            assert!(area <= want * (1.0 + 1e-9), "chords lie inside the arcs");
+        }
+        // Sharp: the six quads alone.
+        assert_eq!(box_view(0.0).0.polys.len(), 6);
     }
 
     #[test]

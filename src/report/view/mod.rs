@@ -285,6 +285,7 @@ mod tests {
             polys: vec![],
             outcomes: vec![],
             reach: 0.01,
+            pip_radius: 0.0,
         };
         let page = page(&die, 0.001, "bullet", &[]);
         assert_eq!(page.matches("</script>").count(), 4);

@@ -108,7 +108,8 @@ function facetFrame(corners) {
   for (let i = 0; i < c.length; i++) n.add(new THREE.Vector3().crossVectors(c[i], c[(i + 1) % c.length]));
   return { c, centroid, normal: n.normalize() };
 }
-const FACETS = D.die.polys.map((p) => ({ ...facetFrame(p.corners), label: p.label }));
+const FACETS = D.die.polys.map((p) => ({ ...facetFrame(p.corners), label: p.label, pips: (p.pips || []).map((v) => new THREE.Vector3(...v)) }));
+const PIP_RADIUS = D.die.pip_radius || 0;
 
 function webgl() {
   const probe = document.createElement("canvas");
@@ -153,18 +154,24 @@ function webgl() {
   };
 }
 
-/// A label on the die's colour, as a texture.
-function labelTexture(label, colour) {
+/// A label on the die's colour, as a texture: its pips where it has them (`pips`, each at its
+/// texture coordinates [u, v], `r` their radius in the same units), else its text.
+function labelTexture(label, colour, pips, r) {
   const c = document.createElement("canvas");
   c.width = c.height = 128;
   const g = c.getContext("2d");
   g.fillStyle = colour;
   g.fillRect(0, 0, 128, 128);
   g.fillStyle = "#fff";
-  g.font = "bold " + (label.length > 2 ? 30 : 44) + "px DejaVu Sans, sans-serif";
-  g.textAlign = "center";
-  g.textBaseline = "middle";
-  g.fillText(label, 64, 66);
+  if (pips.length) {
+    // The texture's v runs up; the canvas's y down.
+    for (const [u, v] of pips) { g.beginPath(); g.arc(u * 128, (1 - v) * 128, r * 128, 0, 2 * Math.PI); g.fill(); }
+  } else {
+    g.font = "bold " + (label.length > 2 ? 30 : 44) + "px DejaVu Sans, sans-serif";
+    g.textAlign = "center";
+    g.textBaseline = "middle";
+    g.fillText(label, 64, 66);
+  }
   const tex = new THREE.CanvasTexture(c);
   tex.colorSpace = THREE.SRGBColorSpace;
   return tex;
@@ -180,14 +187,16 @@ function dieMesh(colour) {
     const e1 = f.c[0].clone().sub(f.centroid).normalize();
     const e2 = new THREE.Vector3().crossVectors(f.normal, e1);
     const size = Math.max(...f.c.map((p) => p.distanceTo(f.centroid)));
-    const uv = f.c.map((p) => { const d = p.clone().sub(f.centroid); return [0.5 + d.dot(e1) / (2 * size), 0.5 + d.dot(e2) / (2 * size)]; });
+    const uvOf = (p) => { const d = p.clone().sub(f.centroid); return [0.5 + d.dot(e1) / (2 * size), 0.5 + d.dot(e2) / (2 * size)]; };
+    const uv = f.c.map(uvOf);
     const pos = [], uvs = [];
     for (let i = 1; i + 1 < f.c.length; i++) for (const j of [0, i, i + 1]) { pos.push(f.c[j].x, f.c[j].y, f.c[j].z); uvs.push(...uv[j]); }
     const geo = new THREE.BufferGeometry();
     geo.setAttribute("position", new THREE.Float32BufferAttribute(pos, 3));
     geo.setAttribute("uv", new THREE.Float32BufferAttribute(uvs, 2));
     geo.computeVertexNormals();
-    group.add(new THREE.Mesh(geo, new THREE.MeshLambertMaterial({ map: labelTexture(f.label, colour) })));
+    const tex = labelTexture(f.label, colour, f.pips.map(uvOf), PIP_RADIUS / (2 * size));
+    group.add(new THREE.Mesh(geo, new THREE.MeshLambertMaterial({ map: tex })));
   }
   if (rest.length) {
     const geo = new THREE.BufferGeometry().setFromPoints(rest);
@@ -229,7 +238,8 @@ function flat() {
           const c = f.centroid.clone().applyQuaternion(q).add(p);
           if (n.dot(camera.position.clone().sub(c)) <= 0) continue;
           const pts = f.c.map((v) => toScreen(v.clone().applyQuaternion(q).add(p), w, h));
-          polys.push({ pts, depth: c.distanceTo(camera.position), shade: 0.45 + 0.55 * Math.max(0, n.dot(light)), colour: th.colour, label: f.label, at: toScreen(c, w, h) });
+          const pips = f.pips.map((v) => toScreen(v.clone().applyQuaternion(q).add(p), w, h));
+          polys.push({ pts, depth: c.distanceTo(camera.position), shade: 0.45 + 0.55 * Math.max(0, n.dot(light)), colour: th.colour, label: f.label, pips, pipR: f.pips.length ? PIP_RADIUS / f.c[0].distanceTo(f.centroid) : 0, at: toScreen(c, w, h) });
         }
       });
       polys.sort((a, b) => b.depth - a.depth);
@@ -278,10 +288,19 @@ function flatFacet(g, p) {
   g.strokeStyle = "#222"; g.lineWidth = 0.8;
   g.beginPath();
   p.pts.forEach(([x, y], i) => (i ? g.lineTo(x, y) : g.moveTo(x, y)));
-  g.closePath(); g.fill(); g.stroke();
+  g.closePath(); g.fill();
+  // A finely divided surface (a rounded box's rims, a fine mesh) is drawn without its seams.
+  if (FACETS.length < 60 || p.label) g.stroke();
   if (!p.label) return;
   const size = Math.min(...p.pts.map(([x, y]) => Math.hypot(x - p.at[0], y - p.at[1])));
   if (size < 5) return;
+  if (p.pips.length) {
+    // A pip's radius on screen: scaled as the face's first half diagonal is.
+    const r = Math.max(1, p.pipR * Math.hypot(p.pts[0][0] - p.at[0], p.pts[0][1] - p.at[1]));
+    g.fillStyle = "#fff";
+    for (const [x, y] of p.pips) { g.beginPath(); g.arc(x, y, r, 0, 2 * Math.PI); g.fill(); }
+    return;
+  }
   g.fillStyle = "#fff"; g.font = "bold " + Math.round(size * 0.8) + "px DejaVu Sans, sans-serif";
   g.textAlign = "center"; g.textBaseline = "middle";
   g.fillText(p.label, p.at[0], p.at[1]);
