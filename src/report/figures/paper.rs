@@ -100,8 +100,15 @@ impl Figure for MasterGraph<'_> {
         )?;
         // The simulations first, so that the measurements, drawn last, are never hidden
         // under their markers (the MDF points at R = 0.833 were).
+        // The series share their blocks' R: each drawn a little to the side of the others
+        // (DODGE apart in R, centred on the true R), so that no marker hides another.
+        let n = self.sims.len() + sets.len();
+        let dodge = |k: usize, pts: &[Point]| -> Vec<Point> {
+            let dx = DODGE * (k as f64 - 0.5 * (n as f64 - 1.0));
+            pts.iter().map(|p| Point { x: p.x + dx, ..*p }).collect()
+        };
         let (mut n2, mut n3) = (0, 0);
-        for s in self.sims {
+        for (k, s) in self.sims.iter().enumerate() {
             let (color, marker) = if s.two_d {
                 n2 += 1;
                 (SIM_2D[(n2 - 1) % SIM_2D.len()], Marker::Circle)
@@ -109,13 +116,20 @@ impl Figure for MasterGraph<'_> {
                 n3 += 1;
                 (SIM_3D[(n3 - 1) % SIM_3D.len()], Marker::Triangle)
             };
-            points(&mut chart, &s.points, color, marker, s.two_d, &s.label)?;
+            points(
+                &mut chart,
+                &dodge(k, &s.points),
+                color,
+                marker,
+                s.two_d,
+                &s.label,
+            )?;
         }
-        for set in &sets {
+        for (k, set) in sets.iter().enumerate() {
             let (label, color) = set_style(set);
             points(
                 &mut chart,
-                &exp_points(set),
+                &dodge(self.sims.len() + k, &exp_points(set)),
                 color,
                 Marker::Circle,
                 false,
@@ -126,11 +140,15 @@ impl Figure for MasterGraph<'_> {
     }
 }
 
+/// How far apart in R the master graph draws its series at one R (about a marker's width).
+const DODGE: f64 = 0.005;
+
 /// Figure MasterGraph2: the ratio P(breadth vertical)/P(width vertical) against R over (0, 1]
 /// (wider if points lie beyond): the theory (MasterEqu) as a solid dark blue line, the no-bounce
 /// ratio (InElasK) dashed in lighter blue, the measured points with their error bars coloured by
 /// set (pine sienna, MDF red, carpet green) drawn above each 2D simulation (connected circles)
-/// and each 3D simulation (separate triangles), every error bar ±1σ as the title says. Every
+/// and each 3D simulation (separate triangles), every error bar ±1σ as the title says; the
+/// series at one R side by side, [`DODGE`] apart, centred on it. Every
 /// series is named in the legend in words (the paper's equation by its number).
 pub fn master_graph(
     dir: &Path,
