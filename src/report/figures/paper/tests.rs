@@ -155,6 +155,46 @@ fn master_graph_writes_both_files_with_every_series() {
 }
 
 #[test]
+fn master_graph_draws_the_series_at_one_r_side_by_side() {
+    // Two 2D simulations and one measurement at the same R and ratio: three circles, none on
+    // another (before, all three at one x).
+    let dir = TempDir::new("master-dodge");
+    let at = |label: &str| SimSeries {
+        label: label.into(),
+        two_d: true,
+        points: vec![Point {
+            x: 0.5,
+            y: 0.3,
+            y_err: 0.0,
+        }],
+    };
+    let exp = [ExpPoint {
+        r: 0.5,
+        ratio: 0.3,
+        err: 0.0,
+        set: "mdf".into(),
+    }];
+    master_graph(&dir.0, "dodge", &exp, &[at("a"), at("b")]).unwrap();
+    let svg = check_files(&dir.0, "dodge");
+    let mut xs: Vec<i64> = svg
+        .split("<circle cx=\"")
+        .skip(1)
+        .filter_map(|c| {
+            let (x, rest) = c.split_once('"')?;
+            // The plotted markers, not the legend's (drawn in its box at the left).
+            let y: i64 = rest.split_once("cy=\"")?.1.split_once('"')?.0.parse().ok()?;
+            (y > 300).then(|| x.parse().ok()).flatten()
+        })
+        .collect();
+    xs.sort_unstable();
+    assert_eq!(xs.len(), 3, "{xs:?}");
+    for w in xs.windows(2) {
+        assert!(w[1] - w[0] >= 4, "markers {xs:?} px: one hides another");
+    }
+    assert!((xs[0] + xs[2] - 2 * xs[1]).abs() <= 1, "centred on the R: {xs:?}");
+}
+
+#[test]
 fn master_graph_survives_bad_and_empty_input() {
     let dir = TempDir::new("master-nan");
     let nan = f64::NAN;
