@@ -312,6 +312,8 @@ pub enum Field {
     Starts,
     /// `style`.
     Style,
+    /// `target`.
+    Target,
     /// `tasks`.
     Tasks,
     /// `threads`.

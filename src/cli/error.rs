@@ -146,6 +146,7 @@ pub fn flag(field: Field) -> &'static str {
         Field::Time => "--time",
         Field::Trend => "--trend",
         Field::TrendRolls => "--trend-rolls",
+        Field::Target => "--target",
         Field::Vary => "--vary",
         Field::Velocity => "--velocity",
     }

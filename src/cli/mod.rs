@@ -8,6 +8,7 @@ pub mod args;
 pub mod bench;
 pub mod compare;
 pub mod crosscheck;
+pub mod design;
 pub mod error;
 pub mod fair;
 pub mod fit;
@@ -54,6 +55,10 @@ pub enum Command {
     /// Is this die fair? Roll it (thrown in a tumble by default) and set each face against a
     /// fair die's: its probability and departure in σ, χ², and the throws a tester would need.
     Fair(fair::FairArgs),
+    /// Design a die for its throws: the value of one feature (a coin's thickness, a block's
+    /// length, the centre of mass, the pips' depth, the edges' radius) that gives the
+    /// probabilities you want, found by rolling it and checked at a fresh seed.
+    Design(design::DesignArgs),
     /// The paper's closed-form theory for a block, or its whole experimental table.
     Theory(theory::TheoryArgs),
     /// The same throws on several engines: counts, ratios, σ apart, per-throw agreement, cost.
@@ -124,6 +129,7 @@ pub fn dispatch(command: Command) -> error::Result<()> {
         Command::Compare(a) => compare::run(&a),
         Command::Predict(a) => fit::predict(&a),
         Command::Fair(a) => fair::run(a),
+        Command::Design(a) => design::run(&a),
         Command::Merge(a) => merge::run(&a),
         Command::Paper(a) => paper::run(&a),
         Command::Theory(a) => theory::run(&a),

@@ -621,13 +621,61 @@ pub enum Varied {
     PipDepth,
     /// The edges' and corners' radius, mm.
     EdgeRadius,
+    /// A coin's (a cylinder's) thickness, mm, its diameter kept (`--shape coin:D,H`).
+    Thickness,
+    /// A block's length, mm, its breadth and width kept (`--block`).
+    Length,
 }
 
 impl Varied {
-    /// `features` with this feature at `mm`.
+    /// `scene` with this feature at `mm`: the die's shape or block for a coin's thickness or
+    /// a block's length, else its features.
+    pub fn apply(
+        self,
+        scene: &crate::model::scene::Scene,
+        mm: f64,
+    ) -> Result<crate::model::scene::Scene> {
+        use crate::model::shape::Solid;
+        let at = |why: &str| Error::field(Field::Vary, format!("{self}={mm}"), why.to_string());
+        let mut s = scene.clone();
+        match self {
+            Varied::Thickness => {
+                let Some(Solid::Cylinder { diameter, .. }) =
+                    scene.shape.as_deref().map(|x| &x.solid)
+                else {
+                    return Err(at("the die is not a coin: give --shape coin:D,H"));
+                };
+                let coin =
+                    crate::model::shape::named(&format!("coin:{},{mm}", diameter * 1e3), None)
+                        .map_err(|e| at(&e.to_string()))?;
+                s.shape = Some(std::sync::Arc::new(coin));
+            }
+            Varied::Length => {
+                if scene.shape.is_some() {
+                    return Err(at("the die is not a block: give --block LxBxW"));
+                }
+                s.block = crate::model::block::Block::from_mm(
+                    mm,
+                    scene.block.breadth * 1e3,
+                    scene.block.width * 1e3,
+                )
+                .map_err(|e| at(&e.to_string()))?;
+            }
+            _ => s.features = self.set(&scene.features, mm)?,
+        }
+        Ok(s)
+    }
+
+    /// `features` with this feature at `mm` (the features alone: not a coin's thickness or a
+    /// block's length, which are the die's shape, [`Varied::apply`]).
     pub fn set(self, features: &Features, mm: f64) -> Result<Features> {
         let m = mm / 1000.0;
         match self {
+            Varied::Thickness | Varied::Length => Err(Error::field(
+                Field::Vary,
+                self.to_string(),
+                "is the die's shape, not a feature",
+            )),
             Varied::ComX | Varied::ComY | Varied::ComZ => {
                 Ok(features.with_com_on(self as usize, m))
             }
@@ -737,7 +785,7 @@ pub fn varied_specs(spec: &RunSpec, what: Varied, values: &[f64]) -> Result<Vec<
         .map(|&v| {
             // The pips already sit by the run's layout (`roll --layout` placed them).
             let mut s = spec.clone();
-            s.scene.features = what.set(&spec.scene.features, v)?;
+            s.scene = what.apply(&spec.scene, v)?;
             // A value the die cannot take is named as the user wrote it, `--vary NAME=V`, not
             // as the feature's own flag, which they did not give (reliability round 5, G).
             s.validate(false).map_err(|e| match e {

@@ -11,6 +11,7 @@ pub mod cluster;
 pub mod converge;
 pub mod crosscheck;
 pub mod departure;
+pub mod design;
 pub mod fair;
 pub mod fit;
 pub mod kind;

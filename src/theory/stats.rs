@@ -183,6 +183,21 @@ pub fn chi_square(rows: &[Comparison]) -> ChiSquare {
     ChiSquare { chi2, dof, skipped }
 }
 
+/// The χ² value with `dof` degrees of freedom below which a share `level` of the
+/// distribution lies (0.95: the 95 % point), by bisection on [`chi_square_p_value`].
+pub fn chi_square_quantile(level: f64, dof: usize) -> f64 {
+    let (mut lo, mut hi) = (0.0, 10.0 + 10.0 * dof as f64);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if 1.0 - chi_square_p_value(mid, dof) < level {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
 /// The upper tail P(χ²_dof ≥ chi2) (`statrs`'s χ² distribution). dof = 0, a negative or NaN
 /// χ² give NaN.
 pub fn chi_square_p_value(chi2: f64, dof: usize) -> f64 {
@@ -325,6 +340,17 @@ mod tests {
             1e-13
         ));
         assert!(chi_square_p_value(1.0, 0).is_nan());
+        // The quantiles the p-values above name.
+        assert!(close(
+            chi_square_quantile(0.95, 1),
+            3.841_458_820_694_124,
+            1e-9
+        ));
+        assert!(close(
+            chi_square_quantile(0.95, 5),
+            11.070_497_693_516_351,
+            1e-9
+        ));
         assert!(chi_square_p_value(-1.0, 2).is_nan());
         assert_eq!(chi_square_p_value(f64::INFINITY, 2), 0.0);
     }

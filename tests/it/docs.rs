@@ -545,7 +545,28 @@ fn json_md_lists_the_keys_of_fair() {
         "--json",
     ]);
     c.document("fair-vary", "fair --vary", &vary);
-    c.finish(&["fair", "fair-vary"]);
+    let design = run(&[
+        "design",
+        "--shape",
+        "coin:24,10",
+        "--free",
+        "thickness",
+        "--range",
+        "thickness=6:14",
+        "--target",
+        "heads=1/3,tails=1/3,edge=1/3",
+        "--rolls",
+        "60",
+        "--points",
+        "3",
+        "--check-rolls",
+        "100",
+        "--threads",
+        "1",
+        "--json",
+    ]);
+    c.document("design", "design", &design);
+    c.finish(&["fair", "fair-vary", "design"]);
 }
 
 /// A made die, every feature (its spec carries them), rolled; and fair's precision of the

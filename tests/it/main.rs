@@ -10,6 +10,7 @@ mod cli;
 mod coarse;
 mod counting;
 mod crosscheck;
+mod design;
 mod dice_fit;
 mod docs;
 mod faces;

@@ -100,13 +100,8 @@ impl Figure for MasterGraph<'_> {
         )?;
         // The simulations first, so that the measurements, drawn last, are never hidden
         // under their markers (the MDF points at R = 0.833 were).
-        // The series share their blocks' R: each drawn a little to the side of the others
-        // (DODGE apart in R, centred on the true R), so that no marker hides another.
         let n = self.sims.len() + sets.len();
-        let dodge = |k: usize, pts: &[Point]| -> Vec<Point> {
-            let dx = DODGE * (k as f64 - 0.5 * (n as f64 - 1.0));
-            pts.iter().map(|p| Point { x: p.x + dx, ..*p }).collect()
-        };
+        let dodge = |k: usize, pts: &[Point]| dodged(k, n, pts);
         let (mut n2, mut n3) = (0, 0);
         for (k, s) in self.sims.iter().enumerate() {
             let (color, marker) = if s.two_d {
@@ -142,6 +137,13 @@ impl Figure for MasterGraph<'_> {
 
 /// How far apart in R the master graph draws its series at one R (about a marker's width).
 const DODGE: f64 = 0.005;
+
+/// Series `k` of `n` that share their blocks' R, each drawn a little to the side of the
+/// others ([`DODGE`] apart, centred on the true R), so that no marker hides another.
+fn dodged(k: usize, n: usize, pts: &[Point]) -> Vec<Point> {
+    let dx = DODGE * (k as f64 - 0.5 * (n as f64 - 1.0));
+    pts.iter().map(|p| Point { x: p.x + dx, ..*p }).collect()
+}
 
 /// Figure MasterGraph2: the ratio P(breadth vertical)/P(width vertical) against R over (0, 1]
 /// (wider if points lie beyond): the theory (MasterEqu) as a solid dark blue line, the no-bounce

@@ -182,7 +182,13 @@ fn master_graph_draws_the_series_at_one_r_side_by_side() {
         .filter_map(|c| {
             let (x, rest) = c.split_once('"')?;
             // The plotted markers, not the legend's (drawn in its box at the left).
-            let y: i64 = rest.split_once("cy=\"")?.1.split_once('"')?.0.parse().ok()?;
+            let y: i64 = rest
+                .split_once("cy=\"")?
+                .1
+                .split_once('"')?
+                .0
+                .parse()
+                .ok()?;
             (y > 300).then(|| x.parse().ok()).flatten()
         })
         .collect();
@@ -191,7 +197,10 @@ fn master_graph_draws_the_series_at_one_r_side_by_side() {
     for w in xs.windows(2) {
         assert!(w[1] - w[0] >= 4, "markers {xs:?} px: one hides another");
     }
-    assert!((xs[0] + xs[2] - 2 * xs[1]).abs() <= 1, "centred on the R: {xs:?}");
+    assert!(
+        (xs[0] + xs[2] - 2 * xs[1]).abs() <= 1,
+        "centred on the R: {xs:?}"
+    );
 }
 
 #[test]

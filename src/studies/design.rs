@@ -1,0 +1,629 @@
+//! `dicephys design` (issue 73): the value of one feature of a die — a coin's thickness, a
+//! block's length, its centre of mass along an axis, its pips' depth, its edges' radius — that
+//! gives the face probabilities a target asks for, thrown as the scene throws it (not only at
+//! rest). Designed through the dynamics and checked by them:
+//!
+//! 1. **A scan**: the die rolled at `points` values over the range, the same keyed throws at
+//!    every value (so that the curves' steps are the feature's, not the throws'), as `fair
+//!    --vary` rolls it.
+//! 2. **Curves**: each target outcome's share against the value, a polynomial (degree 3, or
+//!    fewer points less one) fitted by weighted least squares; the design is the value on the
+//!    curves nearest the target, D(x) = Σ (p(x) − t)²/t (Pearson's distance: χ² per throw).
+//! 3. **Its interval**: the scan's counts drawn again from their own shares (a parametric
+//!    bootstrap, [`BOOTSTRAP`] sets), the curves fitted and the nearest value found each time:
+//!    the central 95 % of those values, the designs the target allows within the simulation's
+//!    error. The same keyed throws at every value correlate the points, which the bootstrap
+//!    (drawing each point apart) ignores: it errs wide.
+//! 4. **A second scan** over three times the interval about the design (within the range), at
+//!    throws of its own, fitted the same way: the design and its interval.
+//! 5. **The check**: the design rolled at a fresh seed with `check_rolls` throws, its counts
+//!    against the target (Pearson's χ² on outcomes − 1); the same design's quasi-static shares
+//!    beside them. A target the curves cannot reach anywhere in the range (their nearest point's
+//!    χ² at the check's throws beyond χ²'s 95 % point) is an answer, not an error:
+//!    "unreachable in this family".
+
+use crate::error::{Error, Field, Result};
+use crate::model::faces::Layout;
+use crate::run::runner::Runner;
+use crate::run::spec::RunSpec;
+use crate::studies::fair::{assess, Null, Varied};
+use crate::theory::stats;
+use serde::Serialize;
+
+/// Bootstrap sets the interval is drawn from.
+pub const BOOTSTRAP: usize = 200;
+
+/// Values a curve is searched at, across a scan's range.
+const GRID: usize = 2001;
+
+/// The check's seed, apart from the scans'.
+const CHECK_SEED: u64 = 0xc4ec_0000_0073;
+
+/// What `design` asks for.
+#[derive(Clone, Debug, Serialize)]
+pub struct DesignConfig {
+    /// The die, its scene and throws; its `rolls` the throws at each scan's value.
+    pub spec: RunSpec,
+    /// How its numbers sit on its faces.
+    pub layout: Layout,
+    /// The feature designed.
+    pub what: Varied,
+    /// Its range, mm, fixed before the search: a design at its end is a finding.
+    pub range: [f64; 2],
+    /// The target: each outcome's label (a die's label, or `rest`: every label not named) and
+    /// probability, summing to 1.
+    pub target: Vec<(String, f64)>,
+    /// Values a scan rolls.
+    pub points: usize,
+    /// Throws of the check.
+    pub check_rolls: u64,
+}
+
+/// One scan: the values rolled and each target outcome's count there.
+#[derive(Clone, Debug, Serialize)]
+pub struct Scan {
+    /// The values, mm.
+    pub values: Vec<f64>,
+    /// Each value's counts, one per target outcome (rolls at rest on one of them).
+    pub counts: Vec<Vec<u64>>,
+    /// Its throws' seed.
+    pub seed: u64,
+    /// The design it found and its interval, mm.
+    pub value: f64,
+    /// The central 95 % of the bootstrap's designs, mm.
+    pub interval: [f64; 2],
+}
+
+/// The design rolled at a fresh seed.
+#[derive(Clone, Debug, Serialize)]
+pub struct Check {
+    /// Its seed.
+    pub seed: u64,
+    /// Rolls at rest on a target outcome.
+    pub n: u64,
+    /// Each target outcome's count.
+    pub counts: Vec<u64>,
+    /// Its share, count / n.
+    pub p: Vec<f64>,
+    /// Its binomial error.
+    pub err: Vec<f64>,
+    /// (share − target) / the target's binomial error.
+    pub z: Vec<f64>,
+    /// Pearson's χ² of the counts against the target.
+    pub chi2: f64,
+    /// Outcomes − 1.
+    pub dof: usize,
+    /// P(χ²_dof ≥ chi2).
+    pub p_value: f64,
+}
+
+/// `design`'s answer.
+#[derive(Clone, Debug, Serialize)]
+pub struct Design {
+    /// The feature, its range and the target.
+    pub config: DesignConfig,
+    /// The target's outcomes, in order.
+    pub outcomes: Vec<String>,
+    /// The scans, first and second.
+    pub scans: Vec<Scan>,
+    /// The design: the feature's value, mm.
+    pub value: f64,
+    /// The designs the target allows within the simulation's error (the second scan's
+    /// bootstrap), mm.
+    pub interval: [f64; 2],
+    /// The design lies at its range's end (within 1 % of the range): the target asks for a
+    /// value beyond it, or the curves' nearest point is there.
+    pub at_range_end: bool,
+    /// The curves' shares at the design.
+    pub curve: Vec<f64>,
+    /// The design rolled at a fresh seed.
+    pub check: Check,
+    /// The same design's quasi-static shares (released at rest, rolling without a bounce),
+    /// per outcome; `None` in 2D.
+    pub quasi_static: Option<Vec<f64>>,
+    /// The curves reach the target within the range: their nearest point's χ² at the check's
+    /// throws is within χ²'s 95 % point.
+    pub reachable: bool,
+    /// The verdict, in a sentence.
+    pub verdict: String,
+}
+
+/// The die's labels a target outcome gathers: each named label its own, `rest` every label
+/// not named. Refused in one line where a label is not the die's, one of the die's is left
+/// out (with no `rest`), or `rest` gathers none.
+pub fn groups(target: &[(String, f64)], labels: &[String]) -> Result<Vec<Vec<usize>>> {
+    let bad = |why: String| Error::field(Field::Target, spec_of(target), why);
+    let named: Vec<&str> = target
+        .iter()
+        .map(|(l, _)| l.as_str())
+        .filter(|l| *l != "rest")
+        .collect();
+    let unknown: Vec<&str> = named
+        .iter()
+        .copied()
+        .filter(|l| !labels.iter().any(|m| m == l))
+        .collect();
+    if !unknown.is_empty() {
+        return Err(bad(format!(
+            "the die has no face {} (its faces: {})",
+            unknown.join(", "),
+            labels.join(", ")
+        )));
+    }
+    let rest: Vec<usize> = (0..labels.len())
+        .filter(|&k| !named.contains(&labels[k].as_str()))
+        .collect();
+    target
+        .iter()
+        .map(|(l, _)| {
+            if l == "rest" {
+                if rest.is_empty() {
+                    return Err(bad("rest: every face is named already".into()));
+                }
+                Ok(rest.clone())
+            } else {
+                Ok(vec![labels.iter().position(|m| m == l).expect("known")])
+            }
+        })
+        .collect::<Result<Vec<_>>>()
+        .and_then(|g| {
+            if !rest.is_empty() && !target.iter().any(|(l, _)| l == "rest") {
+                let left: Vec<&str> = rest.iter().map(|&k| labels[k].as_str()).collect();
+                return Err(bad(format!(
+                    "the target leaves out {} (name them, or give rest=P)",
+                    left.join(", ")
+                )));
+            }
+            Ok(g)
+        })
+}
+
+fn spec_of(target: &[(String, f64)]) -> String {
+    target
+        .iter()
+        .map(|(l, p)| format!("{l}={p}"))
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+/// The run of `spec`'s die at `value`, judged by its faces: each face's label and count.
+fn faces_at(
+    spec: &RunSpec,
+    layout: Layout,
+    runner: &Runner,
+) -> Result<Option<(Vec<String>, Vec<u64>)>> {
+    let summary =
+        crate::studies::outputs::roll(spec, None, None, None, runner)?.with_layout(layout);
+    if summary.partial {
+        return Ok(None);
+    }
+    let f = assess(&summary, &Null::Uniform)?;
+    let shape = spec.scene.shape.is_some();
+    Ok(Some((
+        f.faces.iter().map(|v| face_label(v, shape)).collect(),
+        f.faces.iter().map(|v| v.count).collect(),
+    )))
+}
+
+/// A face's label: a die of any shape's (fair's `direction`), else its number.
+fn face_label(v: &crate::report::fair::FaceVerdict, shape: bool) -> String {
+    if shape {
+        v.direction.clone()
+    } else {
+        v.number.to_string()
+    }
+}
+
+/// The die's labels, as [`faces_at`] names them: a die of any shape's, else its numbers.
+pub fn labels(spec: &RunSpec, layout: Layout) -> Vec<String> {
+    match spec.scene.shape.as_deref() {
+        Some(shape) => crate::theory::null::uniform_shares(shape)
+            .into_iter()
+            .map(|(l, _)| l)
+            .collect(),
+        None => {
+            let shown = if spec.scene.mode == crate::model::scene::Mode::ThreeD {
+                6
+            } else {
+                4
+            };
+            layout.numbers()[..shown]
+                .iter()
+                .map(u8::to_string)
+                .collect()
+        }
+    }
+}
+
+/// Each target outcome's count (or share) from the faces' (`labels`, `counts`), by name: a
+/// named label's own, `rest` every face not named.
+fn gathered<T: Copy + std::iter::Sum<T>>(
+    labels: &[String],
+    counts: &[T],
+    target: &[(String, f64)],
+) -> Vec<T> {
+    let named = |l: &str| target.iter().any(|(t, _)| t == l);
+    target
+        .iter()
+        .map(|(t, _)| {
+            labels
+                .iter()
+                .zip(counts)
+                .filter(|(l, _)| if t == "rest" { !named(l) } else { *l == t })
+                .map(|(_, c)| *c)
+                .sum()
+        })
+        .collect()
+}
+
+/// Checks `cfg` before anything rolls: the range, the target's labels, every scan value the
+/// die can take. Returns the target's groups.
+pub fn check(cfg: &DesignConfig) -> Result<Vec<Vec<usize>>> {
+    let [lo, hi] = cfg.range;
+    if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+        return Err(Error::field(
+            Field::Range,
+            format!("{}={lo}:{hi}", cfg.what),
+            "LO and HI must be numbers of mm, LO < HI",
+        ));
+    }
+    if !(3..=50).contains(&cfg.points) {
+        return Err(Error::field(Field::Points, cfg.points, "from 3 to 50"));
+    }
+    if cfg.check_rolls == 0 || cfg.check_rolls > crate::run::spec::MAX_ROLLS {
+        return Err(Error::field(
+            Field::CheckRolls,
+            cfg.check_rolls,
+            format!(
+                "the check's throws: from 1 to {}",
+                crate::run::spec::MAX_ROLLS
+            ),
+        ));
+    }
+    // A value the die cannot take is named as the range gave it, not as `fair --vary`.
+    crate::studies::fair::varied_specs(&cfg.spec, cfg.what, &[lo, hi]).map_err(|e| match e {
+        Error::Field {
+            field: Field::Vary,
+            value,
+            why,
+        } => Error::field(Field::Range, value, why),
+        e => e,
+    })?;
+    groups(&cfg.target, &labels(&cfg.spec, cfg.layout))
+}
+
+/// Runs the design. `None` if a stop request ended it.
+pub fn run(cfg: &DesignConfig, runner: &Runner) -> Result<Option<Design>> {
+    check(cfg)?;
+    let t: Vec<f64> = cfg.target.iter().map(|(_, p)| *p).collect();
+    let [lo, hi] = cfg.range;
+    let per_scan = cfg.spec.rolls * cfg.points as u64;
+    let mut scans = Vec::new();
+    let mut span = [lo, hi];
+    for stage in 0..2u64 {
+        let values = spread(span, cfg.points);
+        let mut spec = cfg.spec.clone();
+        spec.throws.seed = cfg.spec.throws.seed.wrapping_add(stage);
+        let specs = crate::studies::fair::varied_specs(&spec, cfg.what, &values)?;
+        let mut counts = Vec::new();
+        for (i, s) in specs.iter().enumerate() {
+            let base = stage * per_scan + i as u64 * cfg.spec.rolls;
+            let progress = |n| (runner.progress)(base + n);
+            let Some((l, c)) = faces_at(s, cfg.layout, &runner.with_progress(&progress))? else {
+                return Ok(None);
+            };
+            counts.push(gathered(&l, &c, &cfg.target));
+        }
+        let (value, interval) = estimate(&values, &counts, &t, span, spec.throws.seed);
+        scans.push(Scan {
+            values,
+            counts,
+            seed: spec.throws.seed,
+            value,
+            interval,
+        });
+        // The second scan: three times the interval about the design, within the range (and
+        // no narrower than a twentieth of it).
+        let h = (1.5 * (interval[1] - interval[0])).max((hi - lo) / 40.0);
+        span = [(value - h).max(lo), (value + h).min(hi)];
+    }
+    let last = scans.last().expect("two scans");
+    let (value, interval) = (last.value, last.interval);
+    let curve = curves(&last.values, &last.counts, span_of(&last.values))
+        .iter()
+        .map(|c| c.at(value))
+        .collect::<Vec<f64>>();
+    // The check: the design at a fresh seed.
+    let mut spec = cfg.spec.clone();
+    spec.throws.seed = cfg.spec.throws.seed ^ CHECK_SEED;
+    spec.rolls = cfg.check_rolls;
+    let spec = crate::studies::fair::varied_specs(&spec, cfg.what, &[value])?
+        .pop()
+        .expect("one");
+    let base = 2 * per_scan;
+    let progress = |n| (runner.progress)(base + n);
+    let runner = runner.with_progress(&progress);
+    let summary =
+        crate::studies::outputs::roll(&spec, None, None, None, &runner)?.with_layout(cfg.layout);
+    if summary.partial {
+        return Ok(None);
+    }
+    let shape = spec.scene.shape.is_some();
+    let label = |v: &crate::report::fair::FaceVerdict| face_label(v, shape);
+    let f = assess(&summary, &Null::Uniform)?;
+    let names: Vec<String> = f.faces.iter().map(label).collect();
+    let faces: Vec<u64> = f.faces.iter().map(|v| v.count).collect();
+    let check = judge(spec.throws.seed, &gathered(&names, &faces, &cfg.target), &t);
+    // The quasi-static shares, gathered as the counts are (each face's null, by its label).
+    let quasi_static = (spec.scene.mode == crate::model::scene::Mode::ThreeD)
+        .then(|| assess(&summary, &Null::QuasiStatic).ok())
+        .flatten()
+        .map(|q| {
+            let names: Vec<String> = q.faces.iter().map(label).collect();
+            let shares: Vec<f64> = q.faces.iter().map(|v| v.null).collect();
+            gathered(&names, &shares, &cfg.target)
+        });
+    let near: f64 = curve
+        .iter()
+        .zip(&t)
+        .map(|(p, t)| (p - t).powi(2) / t)
+        .sum::<f64>()
+        * check.n as f64;
+    let reachable = near <= stats::chi_square_quantile(0.95, check.dof);
+    let at_range_end = (value - lo).min(hi - value) <= 0.01 * (hi - lo);
+    let verdict = verdict(cfg, value, interval, &check, reachable, at_range_end);
+    Ok(Some(Design {
+        config: cfg.clone(),
+        outcomes: cfg.target.iter().map(|(l, _)| l.clone()).collect(),
+        scans,
+        value,
+        interval,
+        at_range_end,
+        curve,
+        check,
+        quasi_static,
+        reachable,
+        verdict,
+    }))
+}
+
+fn verdict(
+    cfg: &DesignConfig,
+    value: f64,
+    [a, b]: [f64; 2],
+    c: &Check,
+    reachable: bool,
+    at_end: bool,
+) -> String {
+    let what = cfg.what;
+    let at = format!(
+        "χ² {:.2} on {} (p {:.3}) at {} fresh throws",
+        c.chi2, c.dof, c.p_value, c.n
+    );
+    if !reachable {
+        return format!(
+            "unreachable in this family: the closest design is {what} = {value:.3} mm with {at}{}",
+            if at_end { ", at its range's end" } else { "" }
+        );
+    }
+    let end = if at_end {
+        " (at its range's end: a finding, not a reason to widen it)"
+    } else {
+        ""
+    };
+    if c.p_value >= 0.05 {
+        format!("{what} = {value:.3} mm (95 %: {a:.3} to {b:.3}){end} hits the target: {at}")
+    } else {
+        format!(
+            "{what} = {value:.3} mm (95 %: {a:.3} to {b:.3}){end} misses the target at the check \
+             ({at}), though the scan's curves reach it: more throws a value (--rolls) narrow it"
+        )
+    }
+}
+
+/// The check's counts against the target.
+fn judge(seed: u64, counts: &[u64], t: &[f64]) -> Check {
+    let n: u64 = counts.iter().sum();
+    let nf = n.max(1) as f64;
+    let p: Vec<f64> = counts.iter().map(|&c| c as f64 / nf).collect();
+    let err = p.iter().map(|q| (q * (1.0 - q) / nf).sqrt()).collect();
+    let z = p
+        .iter()
+        .zip(t)
+        .map(|(q, t)| (q - t) / (t * (1.0 - t) / nf).sqrt())
+        .collect();
+    let chi2 = counts
+        .iter()
+        .zip(t)
+        .map(|(&c, t)| (c as f64 - nf * t).powi(2) / (nf * t))
+        .sum();
+    let dof = counts.len() - 1;
+    Check {
+        seed,
+        n,
+        counts: counts.to_vec(),
+        p,
+        err,
+        z,
+        chi2,
+        dof,
+        p_value: stats::chi_square_p_value(chi2, dof),
+    }
+}
+
+/// `n` values evenly over `[lo, hi]`.
+fn spread([lo, hi]: [f64; 2], n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
+        .collect()
+}
+
+fn span_of(values: &[f64]) -> [f64; 2] {
+    [values[0], values[values.len() - 1]]
+}
+
+/// One outcome's share against the value: a polynomial in x = (value − centre)/half.
+struct Curve {
+    coef: Vec<f64>,
+    centre: f64,
+    half: f64,
+}
+
+impl Curve {
+    fn at(&self, v: f64) -> f64 {
+        let x = (v - self.centre) / self.half;
+        self.coef.iter().rev().fold(0.0, |acc, c| acc * x + c)
+    }
+}
+
+/// Each outcome's curve through a scan's counts: weighted least squares of its share on a
+/// polynomial of degree min(3, points − 1), each share's weight its binomial variance's
+/// inverse (a count of 0 or all taken as half a throw's).
+fn curves(values: &[f64], counts: &[Vec<u64>], [lo, hi]: [f64; 2]) -> Vec<Curve> {
+    let k = counts.first().map_or(0, Vec::len);
+    let degree = 3.min(values.len() - 1);
+    let (centre, half) = (0.5 * (lo + hi), (0.5 * (hi - lo)).max(f64::MIN_POSITIVE));
+    (0..k)
+        .map(|j| {
+            let m = degree + 1;
+            let mut a = nalgebra::DMatrix::<f64>::zeros(m, m);
+            let mut b = nalgebra::DVector::<f64>::zeros(m);
+            for (v, c) in values.iter().zip(counts) {
+                let n = c.iter().sum::<u64>().max(1) as f64;
+                let p = c[j] as f64 / n;
+                let q = p.clamp(0.5 / n, 1.0 - 0.5 / n);
+                let w = n / (q * (1.0 - q));
+                let x = (v - centre) / half;
+                let powers: Vec<f64> = (0..m).map(|e| x.powi(e as i32)).collect();
+                for r in 0..m {
+                    b[r] += w * powers[r] * p;
+                    for s in 0..m {
+                        a[(r, s)] += w * powers[r] * powers[s];
+                    }
+                }
+            }
+            let coef = a
+                .lu()
+                .solve(&b)
+                .map_or_else(|| vec![0.0; m], |c| c.iter().copied().collect());
+            Curve { coef, centre, half }
+        })
+        .collect()
+}
+
+/// The value in `span` nearest the target on the curves: the least D = Σ (p − t)²/t.
+fn nearest(curves: &[Curve], t: &[f64], [lo, hi]: [f64; 2]) -> f64 {
+    (0..GRID)
+        .map(|i| lo + (hi - lo) * i as f64 / (GRID - 1) as f64)
+        .map(|v| {
+            let d: f64 = curves
+                .iter()
+                .zip(t)
+                .map(|(c, t)| (c.at(v) - t).powi(2) / t)
+                .sum();
+            (v, d)
+        })
+        .fold(
+            (lo, f64::INFINITY),
+            |best, (v, d)| if d < best.1 { (v, d) } else { best },
+        )
+        .0
+}
+
+/// A scan's design and its 95 % interval: the value nearest the target on its curves, and
+/// the central 95 % of the same found on [`BOOTSTRAP`] sets of counts drawn from each value's
+/// own shares.
+fn estimate(
+    values: &[f64],
+    counts: &[Vec<u64>],
+    t: &[f64],
+    span: [f64; 2],
+    seed: u64,
+) -> (f64, [f64; 2]) {
+    use rand::SeedableRng;
+    use rand_distr::{Binomial, Distribution};
+    let value = nearest(&curves(values, counts, span), t, span);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed ^ 0xb007_5742);
+    let mut found: Vec<f64> = (0..BOOTSTRAP)
+        .map(|_| {
+            let drawn: Vec<Vec<u64>> = counts
+                .iter()
+                .map(|c| {
+                    // A multinomial draw, outcome by outcome.
+                    let mut left = c.iter().sum::<u64>();
+                    let mut mass = 1.0;
+                    let n = left.max(1) as f64;
+                    c.iter()
+                        .map(|&k| {
+                            let p = k as f64 / n;
+                            let q = if mass > 0.0 {
+                                (p / mass).clamp(0.0, 1.0)
+                            } else {
+                                0.0
+                            };
+                            let x = Binomial::new(left, q).map_or(0, |b| b.sample(&mut rng));
+                            left -= x;
+                            mass -= p;
+                            x
+                        })
+                        .collect()
+                })
+                .collect();
+            nearest(&curves(values, &drawn, span), t, span)
+        })
+        .collect();
+    found.sort_by(f64::total_cmp);
+    let q = |f: f64| found[((f * (BOOTSTRAP - 1) as f64).round() as usize).min(BOOTSTRAP - 1)];
+    (value, [q(0.025), q(0.975)])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_curves_find_a_known_crossing_and_its_interval_holds_it() {
+        // Shares p(v) = 0.2 + 0.05 v of one outcome (the rest the other), 20,000 throws at
+        // each of nine values from 0 to 8: the target 0.45 is met at v = 5. Drawn counts, the
+        // curves' design within 0.1 of it, the interval around it and narrower than 1.
+        use rand::SeedableRng;
+        use rand_distr::{Binomial, Distribution};
+        let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+        let values = spread([0.0, 8.0], 9);
+        let n = 20_000;
+        let counts: Vec<Vec<u64>> = values
+            .iter()
+            .map(|v| {
+                let k = Binomial::new(n, 0.2 + 0.05 * v).unwrap().sample(&mut rng);
+                vec![k, n - k]
+            })
+            .collect();
+        let (v, [a, b]) = estimate(&values, &counts, &[0.45, 0.55], [0.0, 8.0], 1);
+        assert!((v - 5.0).abs() < 0.1, "{v}");
+        assert!(a <= 5.0 && 5.0 <= b && b - a < 1.0, "[{a}, {b}]");
+    }
+
+    #[test]
+    fn a_target_names_the_dies_labels_or_gathers_the_rest() {
+        let labels: Vec<String> = ["1", "2", "3", "4", "5", "6"].map(String::from).to_vec();
+        let t = |s: &[(&str, f64)]| -> Vec<(String, f64)> {
+            s.iter().map(|(l, p)| (l.to_string(), *p)).collect()
+        };
+        assert_eq!(
+            groups(&t(&[("6", 0.25), ("rest", 0.75)]), &labels).unwrap(),
+            vec![vec![5], vec![0, 1, 2, 3, 4]]
+        );
+        let e = groups(&t(&[("7", 0.25), ("rest", 0.75)]), &labels).unwrap_err();
+        assert!(e.to_string().contains("no face 7"), "{e}");
+        let e = groups(&t(&[("6", 0.25), ("1", 0.75)]), &labels).unwrap_err();
+        assert!(e.to_string().contains("leaves out 2, 3, 4, 5"), "{e}");
+    }
+
+    #[test]
+    fn the_check_is_pearsons_chi_square_against_the_target() {
+        let c = judge(1, &[30, 70], &[0.25, 0.75]);
+        let want = 5.0f64.powi(2) / 25.0 + 5.0f64.powi(2) / 75.0;
+        assert!((c.chi2 - want).abs() < 1e-12 && c.dof == 1);
+        assert!((c.p_value - stats::chi_square_p_value(want, 1)).abs() < 1e-15);
+    }
+}
