@@ -150,19 +150,20 @@ fn text(d: &Design) -> String {
     );
     let _ = writeln!(
         s,
-        "  {:<10} {:>8} {:>8} {:>17} {:>7} {:>13}",
-        "outcome", "target", "curve", "check", "z", "quasi-static"
+        "  {:<10} {:>8} {:>8} {:>17} {:>8} {:>7} {:>13}",
+        "outcome", "target", "curve", "check", "design ±", "z", "quasi-static"
     );
     for (k, o) in d.outcomes.iter().enumerate() {
         let ch = &d.check;
         let _ = writeln!(
             s,
-            "  {:<10} {:>8.4} {:>8.4} {:>8.4} ± {:.4} {:>+7.2} {:>13}",
+            "  {:<10} {:>8.4} {:>8.4} {:>8.4} ± {:.4} {:>8.4} {:>+7.2} {:>13}",
             o,
             c.target[k].1,
             d.curve[k],
             ch.p[k],
             ch.err[k],
+            ch.design_err[k],
             ch.z[k],
             d.quasi_static
                 .as_ref()

@@ -87,9 +87,14 @@ pub struct Check {
     pub p: Vec<f64>,
     /// Its binomial error.
     pub err: Vec<f64>,
-    /// (share − target) / the target's binomial error.
+    /// The design's own error in each share: the curves' spread across the design's 95 %
+    /// interval, (max − min)/3.92 (as a 1σ).
+    pub design_err: Vec<f64>,
+    /// (share − target) / √(the target's binomial variance + design_err²).
     pub z: Vec<f64>,
-    /// Pearson's χ² of the counts against the target.
+    /// The χ² of the counts against the target: their departure on all outcomes but one
+    /// against the multinomial's covariance plus the design's own (N² design_err² on the
+    /// diagonal); Pearson's χ² where the design has no error.
     pub chi2: f64,
     /// Outcomes − 1.
     pub dof: usize,
@@ -329,10 +334,19 @@ pub fn run(cfg: &DesignConfig, runner: &Runner) -> Result<Option<Design>> {
     }
     let last = scans.last().expect("two scans");
     let (value, interval) = (last.value, last.interval);
-    let curve = curves(&last.values, &last.counts, span_of(&last.values))
+    let fitted = curves(&last.values, &last.counts, span_of(&last.values));
+    let curve: Vec<f64> = fitted.iter().map(|c| c.at(value)).collect();
+    // The design's own error in each share: the curves' spread across its interval.
+    let design_err: Vec<f64> = fitted
         .iter()
-        .map(|c| c.at(value))
-        .collect::<Vec<f64>>();
+        .map(|c| {
+            let along = spread(interval, 101).into_iter().map(|v| c.at(v));
+            let (lo, hi) = along.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                (a.min(p), b.max(p))
+            });
+            (hi - lo) / 3.92
+        })
+        .collect();
     // The check: the design at a fresh seed.
     let mut spec = cfg.spec.clone();
     spec.throws.seed = cfg.spec.throws.seed ^ CHECK_SEED;
@@ -353,7 +367,8 @@ pub fn run(cfg: &DesignConfig, runner: &Runner) -> Result<Option<Design>> {
     let f = assess(&summary, &Null::Uniform)?;
     let names: Vec<String> = f.faces.iter().map(label).collect();
     let faces: Vec<u64> = f.faces.iter().map(|v| v.count).collect();
-    let check = judge(spec.throws.seed, &gathered(&names, &faces, &cfg.target), &t);
+    let counts = gathered(&names, &faces, &cfg.target);
+    let check = judge(spec.throws.seed, &counts, &t, &design_err);
     // The quasi-static shares, gathered as the counts are (each face's null, by its label).
     let quasi_static = (spec.scene.mode == crate::model::scene::Mode::ThreeD)
         .then(|| assess(&summary, &Null::QuasiStatic).ok())
@@ -397,7 +412,7 @@ fn verdict(
 ) -> String {
     let what = cfg.what;
     let at = format!(
-        "χ² {:.2} on {} (p {:.3}) at {} fresh throws",
+        "χ² {:.2} on {} (p {:.3}) at {} fresh throws, the design's own error included",
         c.chi2, c.dof, c.p_value, c.n
     );
     if !reachable {
@@ -422,7 +437,7 @@ fn verdict(
 }
 
 /// The check's counts against the target.
-fn judge(seed: u64, counts: &[u64], t: &[f64]) -> Check {
+fn judge(seed: u64, counts: &[u64], t: &[f64], design_err: &[f64]) -> Check {
     let n: u64 = counts.iter().sum();
     let nf = n.max(1) as f64;
     let p: Vec<f64> = counts.iter().map(|&c| c as f64 / nf).collect();
@@ -430,13 +445,23 @@ fn judge(seed: u64, counts: &[u64], t: &[f64]) -> Check {
     let z = p
         .iter()
         .zip(t)
-        .map(|(q, t)| (q - t) / (t * (1.0 - t) / nf).sqrt())
+        .zip(design_err)
+        .map(|((q, t), d)| (q - t) / (t * (1.0 - t) / nf + d * d).sqrt())
         .collect();
-    let chi2 = counts
-        .iter()
-        .zip(t)
-        .map(|(&c, t)| (c as f64 - nf * t).powi(2) / (nf * t))
-        .sum();
+    // The counts' departure from N t on all outcomes but the last (they sum to n), against
+    // its covariance: the multinomial's N (diag t − t tᵀ) and the design's own N² d² on the
+    // diagonal. With no design error this is Pearson's χ².
+    let m = counts.len().saturating_sub(1);
+    let dev = nalgebra::DVector::from_fn(m, |i, _| counts[i] as f64 - nf * t[i]);
+    let cov = nalgebra::DMatrix::from_fn(m, m, |i, j| {
+        let own = if i == j {
+            t[i] + nf * design_err[i] * design_err[i]
+        } else {
+            0.0
+        };
+        nf * (own - t[i] * t[j])
+    });
+    let chi2 = cov.cholesky().map_or(f64::NAN, |c| dev.dot(&c.solve(&dev)));
     let dof = counts.len() - 1;
     Check {
         seed,
@@ -444,6 +469,7 @@ fn judge(seed: u64, counts: &[u64], t: &[f64]) -> Check {
         counts: counts.to_vec(),
         p,
         err,
+        design_err: design_err.to_vec(),
         z,
         chi2,
         dof,
@@ -621,9 +647,19 @@ mod tests {
 
     #[test]
     fn the_check_is_pearsons_chi_square_against_the_target() {
-        let c = judge(1, &[30, 70], &[0.25, 0.75]);
+        let c = judge(1, &[30, 70], &[0.25, 0.75], &[0.0, 0.0]);
         let want = 5.0f64.powi(2) / 25.0 + 5.0f64.powi(2) / 75.0;
         assert!((c.chi2 - want).abs() < 1e-12 && c.dof == 1);
         assert!((c.p_value - stats::chi_square_p_value(want, 1)).abs() < 1e-15);
+        // The design's own error widens the variance: N t (1 − t) + N² d²; with two outcomes
+        // the χ² is z².
+        let c = judge(1, &[30, 70], &[0.25, 0.75], &[0.05, 0.05]);
+        let z = 0.05 / (0.1875f64 / 100.0 + 0.0025).sqrt();
+        assert!((c.z[0] - z).abs() < 1e-12);
+        assert!((c.chi2 - z * z).abs() < 1e-12, "{} {}", c.chi2, z * z);
+        // Three outcomes, no design error: Pearson's χ².
+        let c = judge(1, &[30, 30, 40], &[0.25, 0.25, 0.5], &[0.0; 3]);
+        let want = 25.0 / 25.0 + 25.0 / 25.0 + 100.0 / 50.0;
+        assert!((c.chi2 - want).abs() < 1e-9, "{}", c.chi2);
     }
 }
