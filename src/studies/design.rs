@@ -126,8 +126,9 @@ pub struct Design {
     /// The same design's quasi-static shares (released at rest, rolling without a bounce),
     /// per outcome; `None` in 2D.
     pub quasi_static: Option<Vec<f64>>,
-    /// The curves reach the target within the range: their nearest point's χ² at the check's
-    /// throws is within χ²'s 95 % point.
+    /// The target is within reach in the range: the check hit it (p ≥ 0.05), or the curves'
+    /// nearest point's χ² at the check's throws, their own error counted, is within χ²'s 95 %
+    /// point.
     pub reachable: bool,
     /// The verdict, in a sentence.
     pub verdict: String,
@@ -378,13 +379,17 @@ pub fn run(cfg: &DesignConfig, runner: &Runner) -> Result<Option<Design>> {
             let shares: Vec<f64> = q.faces.iter().map(|v| v.null).collect();
             gathered(&names, &shares, &cfg.target)
         });
-    let near: f64 = curve
+    // Reachable: the check hit the target, or the curves come within χ²'s 95 % point of it at
+    // the check's throws, their own error counted (the design's, and a scan's: a polynomial
+    // of degree + 1 parameters through points × rolls throws).
+    let per_fit = (cfg.points as f64 * cfg.spec.rolls as f64) / (degree(cfg.points) + 1) as f64;
+    let curve_err: Vec<f64> = t
         .iter()
-        .zip(&t)
-        .map(|(p, t)| (p - t).powi(2) / t)
-        .sum::<f64>()
-        * check.n as f64;
-    let reachable = near <= stats::chi_square_quantile(0.95, check.dof);
+        .zip(&design_err)
+        .map(|(t, d)| (d * d + t * (1.0 - t) / per_fit).sqrt())
+        .collect();
+    let near = chi_square(&curve, &t, check.n as f64, &curve_err);
+    let reachable = check.p_value >= 0.05 || near <= stats::chi_square_quantile(0.95, check.dof);
     let at_range_end = (value - lo).min(hi - value) <= 0.01 * (hi - lo);
     let verdict = verdict(cfg, value, interval, &check, reachable, at_range_end);
     Ok(Some(Design {
@@ -448,20 +453,7 @@ fn judge(seed: u64, counts: &[u64], t: &[f64], design_err: &[f64]) -> Check {
         .zip(design_err)
         .map(|((q, t), d)| (q - t) / (t * (1.0 - t) / nf + d * d).sqrt())
         .collect();
-    // The counts' departure from N t on all outcomes but the last (they sum to n), against
-    // its covariance: the multinomial's N (diag t − t tᵀ) and the design's own N² d² on the
-    // diagonal. With no design error this is Pearson's χ².
-    let m = counts.len().saturating_sub(1);
-    let dev = nalgebra::DVector::from_fn(m, |i, _| counts[i] as f64 - nf * t[i]);
-    let cov = nalgebra::DMatrix::from_fn(m, m, |i, j| {
-        let own = if i == j {
-            t[i] + nf * design_err[i] * design_err[i]
-        } else {
-            0.0
-        };
-        nf * (own - t[i] * t[j])
-    });
-    let chi2 = cov.cholesky().map_or(f64::NAN, |c| dev.dot(&c.solve(&dev)));
+    let chi2 = chi_square(&p, t, nf, design_err);
     let dof = counts.len() - 1;
     Check {
         seed,
@@ -477,6 +469,24 @@ fn judge(seed: u64, counts: &[u64], t: &[f64], design_err: &[f64]) -> Check {
     }
 }
 
+/// The χ² of shares `p` of `n` throws against the target `t`: their departure n (p − t) on all
+/// outcomes but the last (they sum to n) against its covariance, the multinomial's n (diag t −
+/// t tᵀ) and n² `extra`² on the diagonal (an error of the shares' own). With no extra error
+/// this is Pearson's χ².
+fn chi_square(p: &[f64], t: &[f64], n: f64, extra: &[f64]) -> f64 {
+    let m = p.len().saturating_sub(1);
+    let dev = nalgebra::DVector::from_fn(m, |i, _| n * (p[i] - t[i]));
+    let cov = nalgebra::DMatrix::from_fn(m, m, |i, j| {
+        let own = if i == j {
+            t[i] + n * extra[i] * extra[i]
+        } else {
+            0.0
+        };
+        n * (own - t[i] * t[j])
+    });
+    cov.cholesky().map_or(f64::NAN, |c| dev.dot(&c.solve(&dev)))
+}
+
 /// `n` values evenly over `[lo, hi]`.
 fn spread([lo, hi]: [f64; 2], n: usize) -> Vec<f64> {
     (0..n)
@@ -486,6 +496,11 @@ fn spread([lo, hi]: [f64; 2], n: usize) -> Vec<f64> {
 
 fn span_of(values: &[f64]) -> [f64; 2] {
     [values[0], values[values.len() - 1]]
+}
+
+/// The curves' degree through `points` values: 3, or fewer points less one.
+fn degree(points: usize) -> usize {
+    3.min(points - 1)
 }
 
 /// One outcome's share against the value: a polynomial in x = (value − centre)/half.
@@ -507,7 +522,7 @@ impl Curve {
 /// inverse (a count of 0 or all taken as half a throw's).
 fn curves(values: &[f64], counts: &[Vec<u64>], [lo, hi]: [f64; 2]) -> Vec<Curve> {
     let k = counts.first().map_or(0, Vec::len);
-    let degree = 3.min(values.len() - 1);
+    let degree = degree(values.len());
     let (centre, half) = (0.5 * (lo + hi), (0.5 * (hi - lo)).max(f64::MIN_POSITIVE));
     (0..k)
         .map(|j| {
