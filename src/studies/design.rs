@@ -220,27 +220,6 @@ fn face_label(v: &crate::report::fair::FaceVerdict, shape: bool) -> String {
     }
 }
 
-/// The die's labels, as [`faces_at`] names them: a die of any shape's, else its numbers.
-pub fn labels(spec: &RunSpec, layout: Layout) -> Vec<String> {
-    match spec.scene.shape.as_deref() {
-        Some(shape) => crate::theory::null::uniform_shares(shape)
-            .into_iter()
-            .map(|(l, _)| l)
-            .collect(),
-        None => {
-            let shown = if spec.scene.mode == crate::model::scene::Mode::ThreeD {
-                6
-            } else {
-                4
-            };
-            layout.numbers()[..shown]
-                .iter()
-                .map(u8::to_string)
-                .collect()
-        }
-    }
-}
-
 /// Each target outcome's count (or share) from the faces' (`labels`, `counts`), by name: a
 /// named label's own, `rest` every face not named.
 fn gathered<T: Copy + std::iter::Sum<T>>(
@@ -295,7 +274,10 @@ pub fn check(cfg: &DesignConfig) -> Result<Vec<Vec<usize>>> {
         } => Error::field(Field::Range, value, why),
         e => e,
     })?;
-    groups(&cfg.target, &labels(&cfg.spec, cfg.layout))
+    groups(
+        &cfg.target,
+        &crate::studies::fair::die_labels(&cfg.spec.scene, cfg.layout),
+    )
 }
 
 /// Runs the design. `None` if a stop request ended it.

@@ -84,19 +84,7 @@ pub fn check_null(spec: &RunSpec, null: &Null) -> Result<()> {
     let scene = &spec.scene;
     match null {
         Null::Target(t) => {
-            let labels: Vec<String> = match scene.shape.as_deref() {
-                Some(shape) => theory::null::uniform_shares(shape)
-                    .into_iter()
-                    .map(|(l, _)| l)
-                    .collect(),
-                None => {
-                    let shown = if scene.mode == Mode::ThreeD { 6 } else { 4 };
-                    scene.features.layout.numbers()[..shown]
-                        .iter()
-                        .map(u8::to_string)
-                        .collect()
-                }
-            };
+            let labels = die_labels(scene, scene.features.layout);
             theory::null::target_for(t, &labels)
                 .map(|_| ())
                 .map_err(|e| Error::field(Field::Null, null.spec(), e))
@@ -107,6 +95,24 @@ pub fn check_null(spec: &RunSpec, null: &Null) -> Result<()> {
             "the quasi-static theory is 3D; in 2D give uniform",
         )),
         _ => Ok(()),
+    }
+}
+
+/// The labels a die shows: a die of any shape's (in its faces' order), else the numbers on a
+/// block's faces under `layout` (four in 2D).
+pub fn die_labels(scene: &crate::model::scene::Scene, layout: Layout) -> Vec<String> {
+    match scene.shape.as_deref() {
+        Some(shape) => theory::null::uniform_shares(shape)
+            .into_iter()
+            .map(|(l, _)| l)
+            .collect(),
+        None => {
+            let shown = if scene.mode == Mode::ThreeD { 6 } else { 4 };
+            layout.numbers()[..shown]
+                .iter()
+                .map(u8::to_string)
+                .collect()
+        }
     }
 }
 

@@ -194,6 +194,31 @@ fn red_share(png: &Path, (x, y): (f64, f64), radius: f64) -> f64 {
     f64::from(red) / f64::from(all.max(1))
 }
 
+/// A screenshot of `page` at `fragment` (its DOM `dom`, dumped): the die's centre on screen as
+/// the page gives it, and the share of its red within 12 px of it and 150 px to its right.
+fn red_about_the_die(
+    browser: &Path,
+    page: &Path,
+    dir: &Path,
+    fragment: &str,
+    dom: &str,
+) -> ((f64, f64), f64, f64) {
+    let centre = body_attr(dom, "data-centre").expect("the page gives the die's centre");
+    let (x, y) = centre.split_once(',').expect("x,y");
+    let (x, y): (f64, f64) = (x.parse().unwrap(), y.parse().unwrap());
+    let shot = dir.join(format!("{}.png", fragment.replace(['=', '&'], "-")));
+    headless(
+        browser,
+        page,
+        fragment,
+        &format!("--screenshot={}", shot.display()),
+    );
+    let near = red_share(&shot, (x, y), 12.0);
+    let far = red_share(&shot, (x + 150.0, y), 12.0);
+    eprintln!("{fragment}: red at the die's centre {near:.2}, 150 px away {far:.2}");
+    ((x, y), near, far)
+}
+
 #[test]
 fn a_screenshot_shows_the_die_where_the_trace_has_it() {
     let Some(browser) = chromium("a_screenshot_shows_the_die_where_the_trace_has_it") else {
@@ -203,23 +228,11 @@ fn a_screenshot_shows_the_die_where_the_trace_has_it() {
     let (page, _) = d20_page(&dir);
     for fragment in ["t=0.25", "t=end", "t=0.25&2d"] {
         let dom = headless(&browser, &page, fragment, "--dump-dom");
-        let centre = body_attr(&dom, "data-centre").expect("the page gives the die's centre");
-        let (x, y) = centre.split_once(',').expect("x,y");
-        let (x, y): (f64, f64) = (x.parse().unwrap(), y.parse().unwrap());
+        let ((x, y), near, far) = red_about_the_die(&browser, &page, &dir, fragment, &dom);
         assert!(
             (0.0..f64::from(WINDOW.0)).contains(&x) && (0.0..f64::from(WINDOW.1)).contains(&y),
             "{fragment}: the die's centre ({x}, {y}) is off the screen"
         );
-        let shot = dir.join(format!("{}.png", fragment.replace(['=', '&'], "-")));
-        headless(
-            &browser,
-            &page,
-            fragment,
-            &format!("--screenshot={}", shot.display()),
-        );
-        let near = red_share(&shot, (x, y), 12.0);
-        let far = red_share(&shot, (x + 150.0, y), 12.0);
-        eprintln!("{fragment}: red at the die's centre {near:.2}, 150 px away {far:.2}");
         assert!(
             near > 0.35,
             "{fragment}: {near:.2} of the pixels at the die's centre ({x}, {y}) are its red"
@@ -379,21 +392,9 @@ fn a_box_with_pips_and_rounded_edges_opens_and_ends_on_its_side() {
             Some(side),
             "{fragment}"
         );
-        let centre = body_attr(&dom, "data-centre").expect("the page gives the die's centre");
-        let (x, y) = centre.split_once(',').expect("x,y");
-        let (x, y): (f64, f64) = (x.parse().unwrap(), y.parse().unwrap());
-        let shot = dir.join(format!("{}.png", fragment.replace(['=', '&'], "-")));
-        headless(
-            &browser,
-            &page,
-            fragment,
-            &format!("--screenshot={}", shot.display()),
-        );
         // The pips (white) cover part of the faces about the centre: a lower share than a
         // plain die's 0.35, still far above the floor's none.
-        let near = red_share(&shot, (x, y), 12.0);
-        let far = red_share(&shot, (x + 150.0, y), 12.0);
-        eprintln!("{fragment}: red at the die's centre {near:.2}, 150 px away {far:.2}");
+        let (_, near, far) = red_about_the_die(&browser, &page, &dir, fragment, &dom);
         assert!(
             near > 0.2,
             "{fragment}: {near:.2} of the pixels at the die's centre are its red"
