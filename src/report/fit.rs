@@ -40,6 +40,9 @@ pub fn fixed_text(res: &FitResult) -> String {
     if !m.is_free(Kind::Rolling) && f.rolling > 0.0 {
         parts.push(format!("rolling resistance {} mm", f.rolling));
     }
+    if !m.is_free(Kind::Bounce) && f.bounce > 0.0 {
+        parts.push(format!("bounce threshold {} m/s", f.bounce));
+    }
     if !m.is_free(Kind::Kappa) {
         parts.push(match f.throw {
             FixedThrow::Paper => "the paper's throw".into(),
@@ -47,7 +50,11 @@ pub fn fixed_text(res: &FitResult) -> String {
             FixedThrow::Tumble => "a tumble".into(),
             FixedThrow::Toss => "a hand's toss".into(),
             FixedThrow::Rest => "released at rest".into(),
+            FixedThrow::HandToss(k) => format!("a hand's toss in a hand's directions, κ = {k}"),
+            FixedThrow::Flip => "a flip".into(),
         });
+    } else if matches!(f.throw, FixedThrow::Toss | FixedThrow::HandToss(_)) {
+        parts.push("a hand's toss in a hand's directions (κ free)".into());
     }
     if !m.is_free(Kind::Spin) {
         parts.push(format!("spin scale {}", f.spin));
@@ -418,6 +425,9 @@ pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
     s += &parameters(res);
     s += &passes(res);
     s += &goodness_of_fit(e);
+    if let Some(r) = &res.rolled {
+        s += &rolled_line(r, e.overdispersion);
+    }
     s += &left_out(res);
     let _ = writeln!(s, "\n## Surrogates\n");
     let _ = writeln!(
@@ -454,6 +464,34 @@ pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
         for f in figures {
             let _ = writeln!(s, "![{f}]({f}.png)");
         }
+    }
+    s
+}
+
+/// The fit's estimate rolled: the model's own Pearson χ² at its values, beside the surrogate's.
+fn rolled_line(r: &crate::calibration::rolled::Rolled, phi: f64) -> String {
+    let p = match r.p_value {
+        Some(p) => format!("p = {p:.3}"),
+        None => "no degrees of freedom left".into(),
+    };
+    let mut s = format!(
+        "\nRolled at the estimate ({} fresh throws a row): Pearson's χ² = {:.2} on {} degrees \
+         of freedom, {p}, each count against the rolled share with the binomial error of the \
+         counts and of the rolls, unwidened. The χ² above is the surrogate's, its errors widened \
+         by the overdispersion φ = {phi:.2}: where the two part, the model misses by this one.\n\n",
+        r.rolls, r.chi2, r.dof
+    );
+    s += "| row | outcomes counted | rolled shares | χ² |\n|---|---|---|---:|\n";
+    for row in &r.rows {
+        let shares: Vec<String> = row.shares.iter().map(|q| format!("{q:.3}")).collect();
+        let counts: Vec<String> = row.counts.iter().map(u64::to_string).collect();
+        s += &format!(
+            "| {} | {} | {} | {:.2} |\n",
+            row.label,
+            counts.join(", "),
+            shares.join(", "),
+            row.chi2
+        );
     }
     s
 }

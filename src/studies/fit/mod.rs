@@ -7,6 +7,7 @@ pub mod check;
 pub mod outputs;
 pub mod predict;
 pub mod recovery;
+pub mod rolled;
 pub mod simulate;
 
 use crate::calibration::crossval::{leave_one_out, LooRow};
@@ -139,6 +140,7 @@ pub fn result(f: Fitted, command_line: &str, wall: Instant, cpu: f64) -> FitResu
         discrepancy: None,
         loo_scores: None,
         loo_dice: Vec::new(),
+        rolled: None,
         cost: FitCost {
             rolls: f.rolls,
             unsettled: f.unsettled,
@@ -593,13 +595,24 @@ pub fn run(
         d.judge(s);
     }
     let loo_dice = baseline::by_die(&loo);
-    Ok(Some(FitResult {
+    // The estimate rolled: every row at the fitted values, on throws of its own.
+    let mut res = FitResult {
         loo,
         discrepancy,
         loo_scores,
         loo_dice,
         ..result(f, &command_line, wall, cpu)
-    }))
+    };
+    if study.stage != Stage::First {
+        match rolled::roll(&res, &own_rolls(runner))? {
+            Some(r) => res.rolled = Some(r),
+            None => return Ok(None),
+        }
+        // Its rolls are the fit's cost too.
+        res.cost.wall_s = wall.elapsed().as_secs_f64();
+        res.cost.cpu_s = process_cpu_seconds() - cpu;
+    }
+    Ok(Some(res))
 }
 
 /// The fewest rows a fit scores by leaving each out: with two, each row's prediction is a fit
