@@ -27,6 +27,14 @@ pub const MAX_FACES: usize = 255;
 /// "opposite" is an edge 60° or more away, is far outside.
 pub const OPPOSITE_TOLERANCE: f64 = 1e-3;
 
+/// A facet of the hull within this angle (rad, 5°) of a printed side's normal is part of that
+/// side and shows its label. A designed mesh splits a side into nearly coplanar triangles (the
+/// 2d6 hendecahedron V1's 7: two, 2.84° apart; its other sides' pairs within 0.73°), and which
+/// of them the die rests on can change as its centre of mass moves: the side is still the
+/// one printed. A labelled facet keeps its own label (the nearest printed normal is its own);
+/// the development dice's distinct sides are 12° or more apart.
+pub const SIDE_ANGLE: f64 = 5.0 * std::f64::consts::PI / 180.0;
+
 /// How close to a box, as a fraction of its size, a hull must be to be rolled as one
 /// ([`Shape::as_box`]): a mesh's single-precision coordinates (STL) are within 1e-7.
 pub const BOX_TOLERANCE: f64 = 1e-6;
@@ -434,15 +442,15 @@ impl Shape {
                 stable.len()
             ));
         }
-        // The label printed on a facet: the given one whose normal is nearest, or 1…N over
-        // the resting facets in order.
+        // The label printed on a facet: the given one whose normal is nearest, within a side's
+        // angle, or 1…N over the resting facets in order.
         let printed = |f: &polytope::Facet| -> Option<String> {
             match &self.printed {
                 Some(l) => l
                     .iter()
                     .map(|p| (Vector3::from(p.normal), &p.label))
                     .max_by(|a, b| f.normal.dot(&a.0).total_cmp(&f.normal.dot(&b.0)))
-                    .filter(|(n, _)| f.normal.dot(n) > 1.0 - 1e-6)
+                    .filter(|(n, _)| f.normal.dot(n) > SIDE_ANGLE.cos())
                     .map(|(_, s)| s.clone()),
                 None => stable
                     .iter()
