@@ -272,6 +272,8 @@ pub enum Field {
     Recover,
     /// `rolling_resistance`.
     RollingResistance,
+    /// `bounce_threshold`.
+    BounceThreshold,
     /// `reference_budget_s`.
     ReferenceBudgetS,
     /// `reference_dt`.

@@ -359,6 +359,7 @@ fn scene_of(block_: Option<&str>, o: &Options, layout: Option<Layout>) -> PyResu
         linear_damping: o.get("linear_damping", d.linear_damping)?,
         angular_damping: o.get("angular_damping", d.angular_damping)?,
         rolling_resistance_mm: o.maybe("rolling_resistance")?,
+        bounce_threshold: o.get("bounce_threshold", d.bounce_threshold)?,
         sleep: o.get("sleep", d.sleep)?,
     })
 }

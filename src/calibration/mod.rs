@@ -37,6 +37,7 @@ pub mod predict;
 pub mod proper;
 pub mod recovery;
 pub mod request;
+pub mod rolled;
 pub mod scores;
 
 use crate::error::{Error, Field, Result};
@@ -105,17 +106,26 @@ impl FitConfig {
                 ));
             }
         }
-        if self.model.is_free(params::Kind::Rolling)
-            && self.method.engine != crate::engine::EngineKind::Bullet
+        if self.model.fixed.throw == params::FixedThrow::Flip
+            && self.model.is_free(params::Kind::Kappa)
         {
             return Err(Error::field(
                 Field::Free,
-                "rolling",
-                format!(
-                    "{} has no rolling resistance: give --engine bullet",
-                    self.method.engine
-                ),
+                "kappa",
+                "a flip spins the die about a diameter, not near its long axis: it has no κ",
             ));
+        }
+        for (kind, what) in [
+            (params::Kind::Rolling, "rolling resistance"),
+            (params::Kind::Bounce, "bounce threshold"),
+        ] {
+            if self.model.is_free(kind) && self.method.engine != crate::engine::EngineKind::Bullet {
+                return Err(Error::field(
+                    Field::Free,
+                    kind.name(),
+                    format!("{} has no {what}: give --engine bullet", self.method.engine),
+                ));
+            }
         }
         self.check_dice()?;
         self.check_pips()?;
@@ -335,10 +345,13 @@ impl FitConfig {
         }
         if !matches!(
             self.model.fixed.throw,
-            params::FixedThrow::Tumble | params::FixedThrow::Toss | params::FixedThrow::Rest
+            params::FixedThrow::Tumble
+                | params::FixedThrow::Toss
+                | params::FixedThrow::Rest
+                | params::FixedThrow::Flip
         ) {
             let throw = match self.model.fixed.throw {
-                params::FixedThrow::Hand(k) => k.to_string(),
+                params::FixedThrow::Hand(k) | params::FixedThrow::HandToss(k) => k.to_string(),
                 _ => "paper".into(),
             };
             return Err(Error::field(Field::Kappa, throw, why));
@@ -408,6 +421,11 @@ pub struct FitResult {
     /// their proper scores summed per die (`loo_scores` sums them all).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub loo_dice: Vec<proper::DieScores>,
+    /// Every row rolled afresh at the estimate, its counts' Pearson χ² against those shares:
+    /// the model's goodness of fit at its estimate, not the surrogate's (none for a first
+    /// pass, or a fit written before 2026-12-03).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rolled: Option<rolled::Rolled>,
     /// What it cost.
     pub cost: FitCost,
     /// The command line that made it.

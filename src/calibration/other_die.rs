@@ -100,7 +100,7 @@ impl OtherDie {
             &self.shape,
             hand || !matches!(
                 throw,
-                FixedThrow::Tumble | FixedThrow::Toss | FixedThrow::Rest
+                FixedThrow::Tumble | FixedThrow::Toss | FixedThrow::Rest | FixedThrow::Flip
             ),
         ) {
             return Err(Error::field(

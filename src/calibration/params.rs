@@ -71,11 +71,14 @@ pub enum Kind {
     /// A printed die's infill fraction, 0 to 1, inside its wall (the die's own shell's, else a
     /// 1 mm one: `mass::DEFAULT_WALL`).
     Infill,
+    /// The contact's bounce threshold, m/s: slower impacts do not bounce
+    /// (`Scene::bounce_threshold`; per surface; Bullet only).
+    Bounce,
 }
 
 impl Kind {
     /// Every kind, in the order a row's coordinates take them.
-    pub const ALL: [Kind; 12] = [
+    pub const ALL: [Kind; 13] = [
         Kind::E,
         Kind::Mu,
         Kind::Rolling,
@@ -88,10 +91,11 @@ impl Kind {
         Kind::ComZ,
         Kind::PipDepth,
         Kind::Infill,
+        Kind::Bounce,
     ];
 
     /// "e", "mu", "rolling", "kappa", "spin", "height", "speed", "com_x", "com_y", "com_z",
-    /// "pip_depth" or "infill".
+    /// "pip_depth", "infill" or "bounce".
     pub fn name(self) -> &'static str {
         self.into()
     }
@@ -99,7 +103,7 @@ impl Kind {
     /// True for the surface's parameters (e, μ, rolling resistance); false for the throw's
     /// (κ, spin, height, speed).
     pub fn of_surface(self) -> bool {
-        matches!(self, Kind::E | Kind::Mu | Kind::Rolling)
+        matches!(self, Kind::E | Kind::Mu | Kind::Rolling | Kind::Bounce)
     }
 
     /// True for the die's parameters (its centre of mass, its pips' depth, its infill): one
@@ -121,6 +125,7 @@ impl Kind {
             Kind::E => (0.0, 1.0),
             Kind::Mu => (0.0, 5.0),
             Kind::Rolling => (0.0, MAX_ROLLING_RESISTANCE * 1e3),
+            Kind::Bounce => (0.0, crate::model::scene::MAX_BOUNCE_THRESHOLD),
             Kind::Kappa => (0.0, MAX_KAPPA),
             Kind::Spin => (0.05, 20.0),
             Kind::Height => (0.05, 10.0),
@@ -160,6 +165,9 @@ impl Kind {
             Kind::PipDepth => Range::new(0.2, 1.5),
             // From a hollow shell to the solid: a slicer's 10 to 30 % lies inside.
             Kind::Infill => Range::new(0.0, 1.0),
+            // None (every impact bounces, the paper's engines) to 1 m/s, half a throw's first
+            // impact (a drop of 20 cm lands at 2 m/s): the settling bounces, not the landing.
+            Kind::Bounce => Range::new(0.0, 1.0),
         }
     }
 
@@ -172,7 +180,8 @@ impl Kind {
             | Kind::ComY
             | Kind::ComZ
             | Kind::PipDepth
-            | Kind::Infill => v,
+            | Kind::Infill
+            | Kind::Bounce => v,
             Kind::Kappa => (1.0 + v).log10(),
             Kind::Spin | Kind::Height | Kind::Speed => v.ln(),
         }
@@ -187,7 +196,8 @@ impl Kind {
             | Kind::ComY
             | Kind::ComZ
             | Kind::PipDepth
-            | Kind::Infill => w,
+            | Kind::Infill
+            | Kind::Bounce => w,
             Kind::Kappa => 10f64.powf(w) - 1.0,
             Kind::Spin | Kind::Height | Kind::Speed => w.exp(),
         }
@@ -227,6 +237,12 @@ pub enum FixedThrow {
     /// Released at rest touching the floor (`ThrowStyle::Rest`): the published predictions'
     /// drop from rest, no spin, height or speed to scale.
     Rest,
+    /// A hand's toss in a hand's directions with this κ: the toss's magnitudes, the hand's
+    /// turn of the paper's throw (`ThrowStyle::Toss` with κ). A toss whose κ is free is this.
+    HandToss(f64),
+    /// A flip (`ThrowStyle::Flip`): a spin about one of the die's diameters, the toss's
+    /// magnitudes.
+    Flip,
 }
 
 /// Values of the parameters that are not free.
@@ -239,6 +255,9 @@ pub struct Fixed {
     /// The rolling resistance, mm (0: none, the paper's).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub rolling: f64,
+    /// The bounce threshold, m/s (0: none, the paper's).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub bounce: f64,
     /// The throw.
     pub throw: FixedThrow,
     /// The spin scale.
@@ -284,6 +303,7 @@ impl Default for Fixed {
             e: 0.5,
             mu: 0.29,
             rolling: 0.0,
+            bounce: 0.0,
             throw: FixedThrow::Paper,
             spin: 1.0,
             height: 1.0,
@@ -332,7 +352,14 @@ pub fn values(fixed: &Fixed, axes: &[(Kind, Range)], x: &[f64]) -> Fixed {
             Kind::E => v.e = value,
             Kind::Mu => v.mu = value,
             Kind::Rolling => v.rolling = value,
-            Kind::Kappa => v.throw = FixedThrow::Hand(value),
+            Kind::Bounce => v.bounce = value,
+            // A toss's κ turns its directions a hand's way; any other throw's makes it a hand's.
+            Kind::Kappa => {
+                v.throw = match v.throw {
+                    FixedThrow::Toss | FixedThrow::HandToss(_) => FixedThrow::HandToss(value),
+                    _ => FixedThrow::Hand(value),
+                }
+            }
             Kind::Spin => v.spin = value,
             Kind::Height => v.height = value,
             Kind::Speed => v.speed = value,
@@ -412,6 +439,7 @@ impl ModelSpec {
             (Kind::E, f.e),
             (Kind::Mu, f.mu),
             (Kind::Rolling, f.rolling),
+            (Kind::Bounce, f.bounce),
             (Kind::Spin, f.spin),
             (Kind::Height, f.height),
             (Kind::Speed, f.speed),
@@ -421,7 +449,7 @@ impl ModelSpec {
                 return bad(format!("{k} {v}: must be in [{lo}, {hi}]"));
             }
         }
-        if let FixedThrow::Hand(k) = f.throw {
+        if let FixedThrow::Hand(k) | FixedThrow::HandToss(k) = f.throw {
             if !(0.0..=MAX_KAPPA).contains(&k) {
                 return bad(format!("kappa {k}: must be in [0, {MAX_KAPPA:e}]"));
             }
@@ -604,6 +632,7 @@ impl Method {
         scene.restitution = v.e;
         scene.friction = v.mu;
         scene.rolling_resistance = v.rolling / 1000.0;
+        scene.bounce_threshold = v.bounce;
         scene.features = self.die_at(v);
         if let Some(d) = self.density {
             scene.density = d;
@@ -621,6 +650,11 @@ impl Method {
             FixedThrow::Hand(k) => ThrowSpec::hand(seed, k),
             FixedThrow::Tumble => ThrowSpec::keyed_style(seed, ThrowStyle::Tumble),
             FixedThrow::Toss => ThrowSpec::keyed_style(seed, ThrowStyle::Toss),
+            FixedThrow::HandToss(k) => ThrowSpec {
+                kappa: Some(k),
+                ..ThrowSpec::keyed_style(seed, ThrowStyle::Toss)
+            },
+            FixedThrow::Flip => ThrowSpec::keyed_style(seed, ThrowStyle::Flip),
             FixedThrow::Rest => ThrowSpec::keyed_style(seed, ThrowStyle::Rest),
         };
         if v.throw == FixedThrow::Rest {

@@ -143,6 +143,15 @@ pub struct SceneArgs {
     /// [default: 0.05 for a coin on Bullet, else 0].
     #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     pub rolling_resistance: Option<f64>,
+    /// Bounce threshold, m/s: an impact slower than this along the contact's normal does not
+    /// bounce, a faster one bounces with --restitution (0 to 2; DicePhys: 0). Bullet only.
+    #[arg(
+        long,
+        value_name = "M/S",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    pub bounce_threshold: f64,
     /// Never let the engine put the die to sleep (for slow, over-damped rolls, which it would
     /// freeze mid-fall).
     #[arg(long)]
@@ -316,12 +325,14 @@ pub struct ThrowArgs {
     /// range is used) or toss (a tumble whose magnitudes have scales, not ranges: the spin an
     /// isotropic Gaussian of RMS the spin range's middle, the height above touching and the
     /// speed half-normal, of mean the drop height's middle and RMS the velocity's larger end;
-    /// every range 0 is the rest). [default: paper; `fair`: tumble]
+    /// every range 0 is the rest; with --kappa, in a hand's directions) or flip (a spin about
+    /// one of the die's diameters, square to its z axis, which starts upright; the toss's
+    /// magnitudes). [default: paper; `fair`: tumble]
     #[arg(long = "throw", value_parser = parse_throw_style)]
     pub style: Option<ThrowStyle>,
     /// A hand's throw, with this concentration κ >= 0: the paper's throw turned by random
     /// angles whose mean cosine is coth κ − 1/κ (0: the tumble's spread; large: the paper's
-    /// throw). Implies --throw hand.
+    /// throw). Implies --throw hand; with --throw toss, the toss's directions a hand's.
     #[arg(long, value_name = "KAPPA", allow_hyphen_values = true)]
     pub kappa: Option<f64>,
 }
@@ -480,6 +491,7 @@ impl SceneArgs {
             linear_damping: self.linear_damping,
             angular_damping: self.angular_damping,
             rolling_resistance_mm: self.rolling_resistance,
+            bounce_threshold: self.bounce_threshold,
             sleep: !self.no_sleep,
         }
     }

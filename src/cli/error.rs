@@ -103,6 +103,7 @@ pub fn flag(field: Field) -> &'static str {
         Field::Layout => "--layout",
         Field::LinearDamping => "--linear-damping",
         Field::RollingResistance => "--rolling-resistance",
+        Field::BounceThreshold => "--bounce-threshold",
         Field::Margin => "--margin",
         Field::MaxSteps => "--max-steps",
         Field::Modes => "--modes",

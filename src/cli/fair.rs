@@ -11,7 +11,7 @@ use dicephys::studies::fair::{assess, Null};
 
 /// The flags that say how a die is rolled: refused beside `--counts`, which rolls nothing
 /// (the die's own flags stay: the quasi-static null reads them).
-const SIMULATION: [&str; 28] = [
+const SIMULATION: [&str; 29] = [
     "engine",
     "dt",
     "friction",
@@ -23,6 +23,7 @@ const SIMULATION: [&str; 28] = [
     "linear_damping",
     "angular_damping",
     "rolling_resistance",
+    "bounce_threshold",
     "no_sleep",
     "seed",
     "source",

@@ -58,10 +58,12 @@ pub struct FitArgs {
     pub kappa: Option<String>,
     /// The throw where kappa is not free, by its style: paper, tumble, toss (a hand's toss:
     /// the tumble's directions, its spin, height and speed drawn with scales, which the spin,
-    /// height and speed parameters multiply; `roll --throw toss`) or rest (released at rest
-    /// touching the table, `roll --throw rest`; no spin, height or speed) [default: the paper's throw
-    /// for blocks, a tumble for a die of any shape]. A hand's throw is `--kappa K`.
-    #[arg(long, value_name = "STYLE", value_parser = ["paper", "tumble", "toss", "rest"])]
+    /// height and speed parameters multiply; `roll --throw toss`; with --free kappa, in a
+    /// hand's directions, `roll --throw toss --kappa K`), flip (a spin about a diameter, the toss's magnitudes;
+    /// `roll --throw flip`) or rest (released at rest touching the table, `roll --throw rest`;
+    /// no spin, height or speed) [default: the paper's throw for blocks, a tumble for a die of
+    /// any shape]. A hand's throw is `--kappa K`.
+    #[arg(long, value_name = "STYLE", value_parser = ["paper", "tumble", "toss", "flip", "rest"])]
     pub throw: Option<String>,
     /// The spin scale where spin is not free.
     #[arg(long, default_value_t = FitRequest::default().spin_scale, allow_hyphen_values = true)]
@@ -258,14 +260,17 @@ impl FitArgs {
             Some("paper") => Some(FixedThrow::Paper),
             Some("tumble") => Some(FixedThrow::Tumble),
             Some("toss") => Some(FixedThrow::Toss),
+            Some("flip") => Some(FixedThrow::Flip),
             Some(_) => Some(FixedThrow::Rest),
             None => None,
         };
         let throw = match self.kappa.as_deref() {
             None => style,
+
             Some(k) if style.is_some() => {
                 return Err(Error::Usage(format!(
-                    "--kappa {k} with --throw: a hand's throw has its own style; give one of them"
+                    "--kappa {k} with --throw: a hand's throw has its own style; give one of them \
+                     (--throw toss --free kappa fits a toss in a hand's directions)"
                 )))
             }
             Some("paper") => Some(FixedThrow::Paper),

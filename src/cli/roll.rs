@@ -16,7 +16,7 @@ use std::path::PathBuf;
 use std::sync::atomic::Ordering::Relaxed;
 
 /// The options that define a run: `--resume` takes them from the checkpoint instead.
-const DEFINING: [&str; 33] = [
+const DEFINING: [&str; 34] = [
     "shape",
     "size",
     "scale",
@@ -48,6 +48,7 @@ const DEFINING: [&str; 33] = [
     "linear_damping",
     "angular_damping",
     "rolling_resistance",
+    "bounce_threshold",
     "no_sleep",
     "style",
 ];

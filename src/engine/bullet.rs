@@ -279,7 +279,9 @@ impl Bullet {
             dt: scene.dt,
             gyroscopic_implicit: s.gyroscopic_implicit,
             gyroscopic_scaled: s.gyroscopic_scaled,
-            restitution_velocity_threshold: s.restitution_velocity_threshold,
+            restitution_velocity_threshold: s
+                .restitution_velocity_threshold
+                .max(scene.bounce_threshold),
             split_impulse: true,
             split_every_depth: s.split_every_depth,
             two_friction_directions: s.two_friction_directions,

@@ -83,6 +83,9 @@ pub fn models(scene: &Scene) -> crate::Result<()> {
     if scene.rolling_resistance > 0.0 {
         return refuse("no rolling resistance");
     }
+    if scene.bounce_threshold > 0.0 {
+        return refuse("no bounce threshold");
+    }
     Ok(())
 }
 

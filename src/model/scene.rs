@@ -136,6 +136,14 @@ pub struct Scene {
     /// rim never stops. Bullet only. Written into a specification only when not 0.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub rolling_resistance: f64,
+    /// The bounce threshold, m/s: a contact met slower than this along its normal does not
+    /// bounce (restitution 0), a faster one bounces with e, as Bullet 3 drops restitution below
+    /// its `m_restitutionVelocityThreshold` (the preset `bullet3`'s own is 0.2 m/s; the larger
+    /// of the two holds). A real die's slow impacts lose what a fast one keeps (a plastic or
+    /// sticky contact), which one e cannot say. DicePhys: 0, every impact bounces. Bullet only.
+    /// Written into a specification only when not 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub bounce_threshold: f64,
     /// The engine may put a die that has slowed down to sleep (Bullet's deactivation after
     /// 2 s under 0.8 m/s and 1 rad/s, Rapier's after 0.5 s under its thresholds), as DicePhys
     /// let Bullet do. False: never, for a die that moves slowly for long (an over-damped roll,
@@ -180,6 +188,10 @@ pub const MAX_FRICTION: f64 = 10.0;
 /// The largest rolling resistance accepted, m: 1 mm, already the lever arm of soft felt
 /// under a heavy die (hard surfaces are near 0.01 mm).
 pub const MAX_ROLLING_RESISTANCE: f64 = 1e-3;
+
+/// The largest bounce threshold a scene takes, m/s: a die dropped from 20 cm meets the table at
+/// 2 m/s, so every impact of a throw is below it.
+pub const MAX_BOUNCE_THRESHOLD: f64 = 2.0;
 
 /// The finest time step accepted, s: 1 µs. A roll at rest by DicePhys's rule takes about a
 /// second of simulated time, a million steps here; finer steps only multiply the work (a
@@ -295,6 +307,15 @@ impl Scene {
                 format!("must be in [0, {}] mm", MAX_ROLLING_RESISTANCE * 1e3),
             );
         }
+        if !(self.bounce_threshold.is_finite()
+            && (0.0..=MAX_BOUNCE_THRESHOLD).contains(&self.bounce_threshold))
+        {
+            return bad(
+                Field::BounceThreshold,
+                self.bounce_threshold,
+                format!("must be in [0, {MAX_BOUNCE_THRESHOLD}] m/s"),
+            );
+        }
         if let (Some(shape), Mode::TwoD) = (&self.shape, self.mode) {
             // A box-shaped die too: its mass is the box's (`Scene::hull_shape`), its outcomes
             // its faces in 3D.
@@ -326,6 +347,7 @@ impl Scene {
             linear_damping: 0.0,
             angular_damping: 0.0,
             rolling_resistance: 0.0,
+            bounce_threshold: 0.0,
             sleeping: true,
             features: Features::default(),
             shape: None,

@@ -195,11 +195,20 @@ pub enum ThrowStyle {
     /// the spin range (Maxwell-distributed magnitude); the height and the speed half-normal,
     /// the height's mean the middle of the drop-height range, the speed's root mean square the
     /// larger end of the velocity range. Every range 0 is the release at rest, throw for throw.
+    /// Given a concentration κ, a hand's toss: the toss's magnitudes in a hand's directions
+    /// ([`hand_turn`]: the paper's throw turned by angles that κ spreads), so that the spin keeps
+    /// near the die's long axis as a hand's does.
     Toss,
+    /// A flip: a spin about one of the die's diameters (an axis through it across its z axis:
+    /// a coin's diameter, a long block end over end), the toss's magnitudes. The spin axis is
+    /// horizontal, its azimuth uniform; the die's z axis starts vertical, turned about the spin
+    /// axis by a uniform phase and about itself by a uniform angle; the heading uniform
+    /// ([`flip_turn`]). In 2D the spin is about z, as every 2D throw's.
+    Flip,
 }
 
 impl ThrowStyle {
-    /// "paper", "tumble", "hand", "rest" or "toss".
+    /// "paper", "tumble", "hand", "rest", "toss" or "flip".
     pub fn name(self) -> &'static str {
         self.into()
     }
@@ -251,8 +260,8 @@ impl Throw {
     ///   (±v, 0, 0) by the sign of cos h, spin (0, 0, ±ω) by the sign of the axis's z.
     /// - Rest: the turn's orientation, at rest, its centre at the height where its lowest
     ///   corner (in 2D, edge) touches the floor's top face.
-    /// - Toss: the turn's orientation, its centre the drop height above where its lowest
-    ///   corner would touch the floor, velocity and spin as a tumble's.
+    /// - Toss and flip: the turn's orientation, its centre the drop height above where its
+    ///   lowest corner would touch the floor, velocity and spin as a tumble's.
     pub fn start(&self, scene: &Scene) -> BodyState {
         let paper = BodyState {
             position: Vector3::new(0.0, scene.drop_base() + self.drop_height, 0.0),
@@ -286,7 +295,7 @@ impl Throw {
                 angular_velocity,
                 ..paper
             },
-            ThrowStyle::Rest | ThrowStyle::Toss => {
+            ThrowStyle::Rest | ThrowStyle::Toss | ThrowStyle::Flip => {
                 let at_zero = BodyState {
                     position: Vector3::zeros(),
                     rotation,
@@ -356,8 +365,8 @@ pub enum Throws {
         ranges: ThrowRanges,
         /// How each die is thrown.
         style: ThrowStyle,
-        /// The hand's concentration κ (used by [`ThrowStyle::Hand`] only).
-        kappa: f64,
+        /// The hand's concentration κ (a hand's throw's, or a toss's where it is a hand's).
+        kappa: Option<f64>,
     },
     /// DicePhys's sequence. It is sequential, so the generator's state is kept at every
     /// `DICEPHYS_MARK`-th throw (drawn up front, 152 bytes each: 15 MB for 10⁸ throws) and a
@@ -376,16 +385,16 @@ pub const DICEPHYS_MARK: u64 = 1024;
 impl Throws {
     /// A throw source of the paper's throws that can give throws `0..n`.
     pub fn new(kind: ThrowKind, seed: u64, ranges: ThrowRanges, n: u64) -> Throws {
-        Throws::styled(kind, ThrowStyle::Paper, 0.0, seed, ranges, n)
+        Throws::styled(kind, ThrowStyle::Paper, None, seed, ranges, n)
     }
 
-    /// A throw source that can give throws `0..n` thrown in `style` (a hand's with
-    /// concentration `kappa`). DicePhys's sequence has the paper's throw only
+    /// A throw source that can give throws `0..n` thrown in `style` (a hand's, or a hand's
+    /// toss, with concentration `kappa`). DicePhys's sequence has the paper's throw only
     /// (`ThrowSpec::validate` refuses another style with it).
     pub fn styled(
         kind: ThrowKind,
         style: ThrowStyle,
-        kappa: f64,
+        kappa: Option<f64>,
         seed: u64,
         ranges: ThrowRanges,
         n: u64,
@@ -436,17 +445,19 @@ impl Throws {
 /// Throw `index` of the keyed source, the paper's throw: ChaCha8 seeded by `seed`, on stream
 /// `index`.
 pub fn keyed(seed: u64, ranges: &ThrowRanges, index: u64) -> Throw {
-    keyed_styled(ThrowStyle::Paper, 0.0, seed, ranges, index)
+    keyed_styled(ThrowStyle::Paper, None, seed, ranges, index)
 }
 
-/// Throw `index` of the keyed source in `style` (a hand's with concentration `kappa`):
-/// ChaCha8 seeded by `seed`, on stream `index`. The paper's throw draws drop height, velocity
-/// and spin, in that order; a tumble draws the same three, then its orientation (three
-/// deviates), spin axis (two) and heading (one); a hand's throw draws the same three, then six
-/// deviates for its turn ([`hand_turn`]); a rest draws only its orientation.
+/// Throw `index` of the keyed source in `style` (a hand's, or a hand's toss, with
+/// concentration `kappa`): ChaCha8 seeded by `seed`, on stream `index`. The paper's throw draws
+/// drop height, velocity and spin, in that order; a tumble draws the same three, then its
+/// orientation (three deviates), spin axis (two) and heading (one); a hand's throw draws the
+/// same three, then six deviates for its turn ([`hand_turn`]); a rest draws only its
+/// orientation; a toss and a flip draw six deviates for their directions, then six for their
+/// magnitudes. A hand's throw without κ is a tumble's (κ = 0 is its distribution).
 pub fn keyed_styled(
     style: ThrowStyle,
-    kappa: f64,
+    kappa: Option<f64>,
     seed: u64,
     ranges: &ThrowRanges,
     index: u64,
@@ -461,7 +472,10 @@ pub fn keyed_styled(
             let spin = ranges.spin.draw(u());
             let turn = match style {
                 ThrowStyle::Tumble => Some(tumble_turn([u(), u(), u(), u(), u(), u()])),
-                ThrowStyle::Hand => Some(hand_turn(kappa, [u(), u(), u(), u(), u(), u()])),
+                ThrowStyle::Hand => Some(hand_turn(
+                    kappa.unwrap_or(0.0),
+                    [u(), u(), u(), u(), u(), u()],
+                )),
                 _ => None,
             };
             Throw {
@@ -485,10 +499,15 @@ pub fn keyed_styled(
                 heading: 0.0,
             }),
         },
-        ThrowStyle::Toss => {
+        ThrowStyle::Toss | ThrowStyle::Flip => {
             // The orientation first, as a rest draws it, so that a toss with every scale 0 is
             // the release at rest throw for throw.
-            let turn = tumble_turn([u(), u(), u(), u(), u(), u()]);
+            let d = [u(), u(), u(), u(), u(), u()];
+            let turn = match (style, kappa) {
+                (ThrowStyle::Flip, _) => flip_turn(d),
+                (_, Some(k)) => hand_turn(k, d),
+                _ => tumble_turn(d),
+            };
             let [drop_height, velocity, spin] =
                 toss_magnitudes(ranges, [u(), u(), u(), u(), u(), u()]);
             Throw {
@@ -511,6 +530,26 @@ fn tumble_turn(u: [f64; 6]) -> Turn {
         rotation: haar_quaternion(u[0], u[1], u[2]),
         spin_axis: unit_vector(u[3], u[4]),
         heading: std::f64::consts::TAU * u[5],
+    }
+}
+
+/// A flip's directions from six uniform deviates (the last unused): the spin axis horizontal
+/// at azimuth 2πu₀; the die's z axis turned to the vertical, then about the spin axis by the
+/// phase 2πu₁, after a turn about itself by 2πu₂; the heading 2πu₃. So the spin axis is always
+/// a diameter of the die (square to its z axis), and the phase makes which face is up when it
+/// leaves the hand uniform over the flip's circle.
+pub fn flip_turn(u: [f64; 6]) -> Turn {
+    use std::f64::consts::{FRAC_PI_2, TAU};
+    let (s, c) = (TAU * u[0]).sin_cos();
+    let axis = Vector3::new(c, 0.0, s);
+    let q = UnitQuaternion::from_axis_angle(&nalgebra::Unit::new_unchecked(axis), TAU * u[1])
+        * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), -FRAC_PI_2)
+        * UnitQuaternion::from_axis_angle(&Vector3::z_axis(), TAU * u[2]);
+    let qq = q.quaternion();
+    Turn {
+        rotation: [qq.w, qq.i, qq.j, qq.k],
+        spin_axis: [axis.x, axis.y, axis.z],
+        heading: TAU * u[3],
     }
 }
 
@@ -627,17 +666,17 @@ mod tests {
         // The paper's throw draws exactly what it drew before the styles: three deviates.
         let r = ThrowRanges::default();
         let t = keyed(7, &r, 3);
-        assert_eq!(t, keyed_styled(ThrowStyle::Paper, 0.0, 7, &r, 3));
+        assert_eq!(t, keyed_styled(ThrowStyle::Paper, None, 7, &r, 3));
         assert!(t.turn.is_none());
         let json = serde_json::to_string(&t).unwrap();
         assert!(!json.contains("style") && !json.contains("turn"), "{json}");
         // A tumble shares the paper's first three numbers, then draws its directions.
-        let u = keyed_styled(ThrowStyle::Tumble, 0.0, 7, &r, 3);
+        let u = keyed_styled(ThrowStyle::Tumble, None, 7, &r, 3);
         assert_eq!(
             (u.drop_height, u.velocity, u.spin),
             (t.drop_height, t.velocity, t.spin)
         );
-        assert_eq!(u, keyed_styled(ThrowStyle::Tumble, 0.0, 7, &r, 3));
+        assert_eq!(u, keyed_styled(ThrowStyle::Tumble, None, 7, &r, 3));
         let back: Throw = serde_json::from_str(&serde_json::to_string(&u).unwrap()).unwrap();
         assert_eq!(back, u);
     }
@@ -651,7 +690,7 @@ mod tests {
         let r = ThrowRanges::default();
         let (mut sq, mut cos, mut w2) = (Vector3::zeros(), 0.0, 0.0);
         for i in 0..n {
-            let t = keyed_styled(ThrowStyle::Rest, 0.0, 11, &r, i);
+            let t = keyed_styled(ThrowStyle::Rest, None, 11, &r, i);
             let turn = t.turn.unwrap();
             let q = turn.orientation(Mode::ThreeD);
             let x = q * Vector3::x();
@@ -679,7 +718,7 @@ mod tests {
             let scene = Scene::paper("40x30x20".parse().unwrap(), mode);
             let half = Vector3::from(scene.body_sides()) / 2.0;
             for i in 0..100 {
-                let t = keyed_styled(ThrowStyle::Rest, 0.0, 5, &ThrowRanges::default(), i);
+                let t = keyed_styled(ThrowStyle::Rest, None, 5, &ThrowRanges::default(), i);
                 let s = t.start(&scene);
                 assert!(crate::model::die::lowest_point(&half, &s).abs() < 1e-15);
                 assert_eq!(s.linear_velocity, Vector3::zeros());
@@ -699,7 +738,7 @@ mod tests {
             let scene = Scene::paper("140x24x20".parse().unwrap(), mode);
             let half = Vector3::from(scene.body_sides()) / 2.0;
             for i in 0..200 {
-                let t = keyed_styled(ThrowStyle::Tumble, 0.0, 9, &r, i);
+                let t = keyed_styled(ThrowStyle::Tumble, None, 9, &r, i);
                 let s = t.start(&scene);
                 assert!(crate::model::die::lowest_point(&half, &s) > 0.0);
                 assert!((s.angular_velocity.norm() - t.spin).abs() < 1e-9 * t.spin);
@@ -726,8 +765,8 @@ mod tests {
         for mode in [Mode::ThreeD, Mode::TwoD] {
             let scene = Scene::paper("40x30x20".parse().unwrap(), mode);
             for i in 0..100 {
-                let rest = keyed_styled(ThrowStyle::Rest, 0.0, 5, &ThrowRanges::default(), i);
-                let toss = keyed_styled(ThrowStyle::Toss, 0.0, 5, &r, i);
+                let rest = keyed_styled(ThrowStyle::Rest, None, 5, &ThrowRanges::default(), i);
+                let toss = keyed_styled(ThrowStyle::Toss, None, 5, &r, i);
                 assert_eq!(toss.turn.unwrap().rotation, rest.turn.unwrap().rotation);
                 assert_eq!(toss.start(&scene), rest.start(&scene), "throw {i}");
             }
@@ -745,7 +784,7 @@ mod tests {
         let half = Vector3::from(scene.body_sides()) / 2.0;
         let (mut h, mut v2, mut w2) = (0.0, 0.0, 0.0);
         for i in 0..n {
-            let t = keyed_styled(ThrowStyle::Toss, 0.0, 3, &r, i);
+            let t = keyed_styled(ThrowStyle::Toss, None, 3, &r, i);
             let s = t.start(&scene);
             let above = crate::model::die::lowest_point(&half, &s);
             assert!(
@@ -791,7 +830,7 @@ mod tests {
         let (r, kappa, n) = (ThrowRanges::default(), 2.0, 20_000u64);
         let (mut tilt, mut spin, mut heading) = (0.0, 0.0, 0.0);
         for i in 0..n {
-            let t = keyed_styled(ThrowStyle::Hand, kappa, 4, &r, i);
+            let t = keyed_styled(ThrowStyle::Hand, Some(kappa), 4, &r, i);
             let turn = t.turn.unwrap();
             let q = turn.orientation(Mode::ThreeD);
             let long = q * Vector3::z();
@@ -814,7 +853,7 @@ mod tests {
         let n = 20_000;
         let (mut sq, mut cos, mut axis) = (Vector3::zeros(), 0.0, Vector3::zeros());
         for i in 0..n {
-            let turn = keyed_styled(ThrowStyle::Hand, 0.0, 6, &r, i).turn.unwrap();
+            let turn = keyed_styled(ThrowStyle::Hand, None, 6, &r, i).turn.unwrap();
             let q = turn.orientation(Mode::ThreeD);
             let x = q * Vector3::x();
             sq += x.component_mul(&x);
@@ -833,7 +872,7 @@ mod tests {
         for mode in [Mode::ThreeD, Mode::TwoD] {
             let scene = Scene::paper("140x24x20".parse().unwrap(), mode);
             for i in 0..50 {
-                let hand = keyed_styled(ThrowStyle::Hand, 1e8, 8, &r, i).start(&scene);
+                let hand = keyed_styled(ThrowStyle::Hand, Some(1e8), 8, &r, i).start(&scene);
                 let paper = keyed(8, &r, i).start(&scene);
                 assert_eq!(hand.position, paper.position);
                 assert!(hand.rotation.angle_to(&paper.rotation) < 1e-2);
@@ -850,9 +889,94 @@ mod tests {
         let r = ThrowRanges::default();
         let scene = Scene::paper("140x24x20".parse().unwrap(), Mode::ThreeD);
         for i in 0..200 {
-            let a = keyed_styled(ThrowStyle::Hand, 5.0, 2, &r, i).start(&scene);
-            let b = keyed_styled(ThrowStyle::Hand, 5.05, 2, &r, i).start(&scene);
+            let a = keyed_styled(ThrowStyle::Hand, Some(5.0), 2, &r, i).start(&scene);
+            let b = keyed_styled(ThrowStyle::Hand, Some(5.05), 2, &r, i).start(&scene);
             assert!(a.rotation.angle_to(&b.rotation) < 0.05, "throw {i}");
         }
+    }
+
+    #[test]
+    fn a_hands_toss_is_the_tosss_magnitudes_in_a_hands_directions() {
+        // The same deviates: the first six turn the throw as a hand's with κ, the next six are
+        // the toss's magnitudes, exactly. κ at its largest is the paper's directions (the die
+        // upright, spinning about its long axis, moving along x); κ = 0 spreads the spin axis
+        // as the tumble's (its cosine to the long axis uniform: mean 0, mean square 1/3, each
+        // within 4 standard errors of 20,000 throws: 0.0041 and 0.0021).
+        let r = ThrowRanges::default();
+        let scene = Scene::paper("16x16x16".parse().unwrap(), Mode::ThreeD);
+        for i in 0..200 {
+            let toss = keyed_styled(ThrowStyle::Toss, None, 4, &r, i);
+            let hand = keyed_styled(ThrowStyle::Toss, Some(3.0), 4, &r, i);
+            assert_eq!(
+                (hand.drop_height, hand.velocity, hand.spin),
+                (toss.drop_height, toss.velocity, toss.spin)
+            );
+            let mut rng = ChaCha8Rng::seed_from_u64(4);
+            rng.set_stream(i);
+            let d: [f64; 6] = std::array::from_fn(|_| rng.random::<f64>());
+            assert_eq!(hand.turn.unwrap(), hand_turn(3.0, d));
+            let paper = keyed_styled(ThrowStyle::Toss, Some(MAX_KAPPA_TEST), 4, &r, i);
+            let s = paper.start(&scene);
+            let z = s.rotation * Vector3::z();
+            assert!(z.z > 1.0 - 1e-4, "throw {i}: {z}");
+            assert!(s.angular_velocity.normalize().z > 1.0 - 1e-4, "throw {i}");
+        }
+        let n = 20_000u64;
+        let (mut c, mut c2) = (0.0, 0.0);
+        for i in 0..n {
+            let s = keyed_styled(ThrowStyle::Toss, Some(0.0), 5, &r, i).start(&scene);
+            let cos = (s.rotation * Vector3::z()).dot(&s.angular_velocity.normalize());
+            c += cos;
+            c2 += cos * cos;
+        }
+        let nf = n as f64;
+        assert!(
+            (c / nf).abs() < 4.0 * (1.0f64 / 3.0).sqrt() / nf.sqrt(),
+            "{}",
+            c / nf
+        );
+        let se2 = (1.0f64 / 5.0 - 1.0 / 9.0).sqrt() / nf.sqrt();
+        assert!((c2 / nf - 1.0 / 3.0).abs() < 4.0 * se2, "{}", c2 / nf);
+    }
+
+    /// The largest κ `ThrowSpec` takes (`run::spec::MAX_KAPPA`, a layer above).
+    const MAX_KAPPA_TEST: f64 = 1e6;
+
+    #[test]
+    fn a_flip_spins_the_die_about_a_diameter_at_a_uniform_phase() {
+        // Every flip's spin axis is horizontal and square to the die's z axis (a coin's
+        // diameter) exactly; the phase is uniform, so the z axis's cosine to the vertical has
+        // mean 0 and mean square 1/2 (standard errors √(1/2)/√n and √(1/8)/√n: 4 of them, 20,000
+        // throws); the toss's magnitudes are the toss's, throw for throw.
+        let r = ThrowRanges::default();
+        let scene = Scene::paper_shape(
+            crate::model::shape::named("coin:24,2", None).unwrap(),
+            Mode::ThreeD,
+        );
+        let n = 20_000u64;
+        let (mut c, mut c2) = (0.0, 0.0);
+        for i in 0..n {
+            let t = keyed_styled(ThrowStyle::Flip, None, 6, &r, i);
+            let toss = keyed_styled(ThrowStyle::Toss, None, 6, &r, i);
+            assert_eq!((t.drop_height, t.spin), (toss.drop_height, toss.spin));
+            let s = t.start(&scene);
+            let axis = s.angular_velocity / t.spin;
+            let z = s.rotation * Vector3::z();
+            assert!(axis.y.abs() < 1e-12 && (axis.norm() - 1.0).abs() < 1e-12);
+            assert!(z.dot(&axis).abs() < 1e-12, "throw {i}: {z} {axis}");
+            c += z.y;
+            c2 += z.y * z.y;
+        }
+        let nf = n as f64;
+        assert!(
+            (c / nf).abs() < 4.0 * 0.5f64.sqrt() / nf.sqrt(),
+            "{}",
+            c / nf
+        );
+        assert!(
+            (c2 / nf - 0.5).abs() < 4.0 * 0.125f64.sqrt() / nf.sqrt(),
+            "{}",
+            c2 / nf
+        );
     }
 }

@@ -659,13 +659,7 @@ impl RunSummary {
         };
         // The throw is always named: a fair cube under the paper's throw shows 1 and 6 less
         // often, and a reader must see which throw made the counts.
-        let throw = match self.spec.throws.style {
-            ThrowStyle::Paper => "the paper's throw",
-            ThrowStyle::Tumble => "a tumble",
-            ThrowStyle::Hand => "a hand's throw",
-            ThrowStyle::Rest => "released at rest",
-            ThrowStyle::Toss => "a hand's toss",
-        };
+        let throw = throw_name(&self.spec.throws);
         let source = match self.throws {
             ThrowKind::Keyed => "",
             ThrowKind::Dicephys => " from DicePhys's rand()",
@@ -1023,5 +1017,18 @@ impl Reached {
                 .then(|| target.rolls_for(tally, precision))
                 .flatten(),
         }
+    }
+}
+
+/// A run's throw, named for its summary line.
+fn throw_name(t: &crate::run::spec::ThrowSpec) -> String {
+    match (t.style, t.kappa) {
+        (ThrowStyle::Paper, _) => "the paper's throw".into(),
+        (ThrowStyle::Tumble, _) => "a tumble".into(),
+        (ThrowStyle::Hand, _) => "a hand's throw".into(),
+        (ThrowStyle::Rest, _) => "released at rest".into(),
+        (ThrowStyle::Toss, None) => "a hand's toss".into(),
+        (ThrowStyle::Toss, Some(k)) => format!("a hand's toss in a hand's directions (κ {k})"),
+        (ThrowStyle::Flip, _) => "a flip".into(),
     }
 }

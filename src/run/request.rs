@@ -126,6 +126,8 @@ pub struct SceneRequest {
     /// Rolling resistance's lever arm, mm (`None`: the die's own default on its engine,
     /// `Scene::default_rolling_resistance`).
     pub rolling_resistance_mm: Option<f64>,
+    /// The bounce threshold, m/s (0: none).
+    pub bounce_threshold: f64,
     /// Let the engine put the die to sleep.
     pub sleep: bool,
 }
@@ -147,6 +149,7 @@ impl Default for SceneRequest {
             linear_damping: paper.linear_damping,
             angular_damping: paper.angular_damping,
             rolling_resistance_mm: None,
+            bounce_threshold: 0.0,
             sleep: paper.sleeping,
         }
     }
@@ -213,6 +216,7 @@ impl SceneRequest {
         scene.floor = self.floor;
         scene.linear_damping = self.linear_damping;
         scene.rolling_resistance = self.rolling_resistance_mm.unwrap_or(0.0) / 1000.0;
+        scene.bounce_threshold = self.bounce_threshold;
         scene.angular_damping = self.angular_damping;
         scene.sleeping = self.sleep;
         scene.features = features;

@@ -26,7 +26,8 @@ pub struct ThrowSpec {
     /// specification and its key are as before), a tumble, or at rest.
     #[serde(default, skip_serializing_if = "ThrowStyle::is_paper")]
     pub style: ThrowStyle,
-    /// A hand's throw's concentration κ (`ThrowStyle::Hand` only; left out otherwise).
+    /// A hand's throw's concentration κ (`ThrowStyle::Hand`, or a toss thrown in a hand's
+    /// directions; left out otherwise).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kappa: Option<f64>,
 }
@@ -80,7 +81,7 @@ impl ThrowSpec {
                     ],
                 ))
             }
-            (ThrowStyle::Hand, Some(k)) if !(0.0..=MAX_KAPPA).contains(&k) => {
+            (ThrowStyle::Hand | ThrowStyle::Toss, Some(k)) if !(0.0..=MAX_KAPPA).contains(&k) => {
                 return Err(Error::field(
                     Field::Kappa,
                     k,
@@ -91,7 +92,7 @@ impl ThrowSpec {
                     ],
                 ))
             }
-            (ThrowStyle::Hand, Some(_)) | (_, None) => {}
+            (ThrowStyle::Hand | ThrowStyle::Toss, Some(_)) | (_, None) => {}
             (s, Some(_)) => {
                 return Err(Error::field(
                     Field::Kappa,
@@ -99,7 +100,7 @@ impl ThrowSpec {
                     crate::text![
                         "only ",
                         Field::Style,
-                        " hand takes a concentration, not ",
+                        " hand (and toss, a hand's toss) takes a concentration, not ",
                         Field::Style,
                         format!(" {s}")
                     ],
@@ -152,8 +153,7 @@ impl ThrowSpec {
 
     /// The throw source, able to give throws `0..n`.
     pub fn source(&self, n: u64) -> Throws {
-        let kappa = self.kappa.unwrap_or(0.0);
-        Throws::styled(self.kind, self.style, kappa, self.seed, self.ranges, n)
+        Throws::styled(self.kind, self.style, self.kappa, self.seed, self.ranges, n)
     }
 }
 
@@ -227,15 +227,26 @@ impl RunSpec {
                 ),
             ));
         }
+        if self.scene.bounce_threshold > 0.0 && self.engine != EngineKind::Bullet {
+            return Err(Error::field(
+                Field::BounceThreshold,
+                self.scene.bounce_threshold,
+                format!(
+                    "{} has no bounce threshold; give --engine bullet",
+                    self.engine.name()
+                ),
+            ));
+        }
         if let Some(shape) = &self.scene.shape {
             use crate::model::throws::ThrowStyle;
-            if matches!(self.throws.style, ThrowStyle::Paper | ThrowStyle::Hand) {
+            let hands = self.throws.style == ThrowStyle::Toss && self.throws.kappa.is_some();
+            if hands || matches!(self.throws.style, ThrowStyle::Paper | ThrowStyle::Hand) {
                 return Err(Error::field(
                     Field::Style,
                     self.throws.style.name(),
                     format!(
                         "the paper's throw and a hand's spin a die about its long axis, which \
-                         {} has not: use tumble or rest",
+                         {} has not: use tumble, toss (without kappa), flip or rest",
                         shape.name
                     ),
                 ));

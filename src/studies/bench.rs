@@ -260,8 +260,8 @@ pub const Z_BOUND: f64 = 2.0;
 /// Every die `dice_costs` times, as a scene: the made cubes of [`made_dice`], then dice of
 /// other shapes (`--shape`: a d6, which takes the box's path as the cuboid does, with and
 /// without pips; a d20 and a d4 on the general hull path), and the sharp cube under issue 72's
-/// candidates (a hand's toss, a printed shell and infill, rolling resistance). Each with the throw it is thrown in: a
-/// tumble but for the toss.
+/// candidates (a hand's toss, a flip, a printed shell and infill, rolling resistance). Each
+/// with the throw it is thrown in: a tumble but for the toss and the flip.
 /// Not a coin: a thin one spins like Euler's disk, about 100 ms a roll, and would double the
 /// benchmark's time (its cost is on docs/results/shapes.md).
 pub fn bench_dice() -> crate::Result<Vec<(String, Scene, ThrowStyle)>> {
@@ -277,6 +277,7 @@ pub fn bench_dice() -> crate::Result<Vec<(String, Scene, ThrowStyle)>> {
         .collect();
     let sharp = Scene::paper(block, Mode::ThreeD);
     out.push(("--throw toss".into(), sharp.clone(), ThrowStyle::Toss));
+    out.push(("--throw flip".into(), sharp.clone(), ThrowStyle::Flip));
     let mut printed = sharp.clone();
     printed.features.shell = Some(crate::model::mass::Shell {
         wall: 0.001,
@@ -373,7 +374,7 @@ pub fn dice_costs(
         Throws::styled(
             ThrowKind::Keyed,
             style,
-            0.0,
+            None,
             seed,
             ThrowRanges::default(),
             0,

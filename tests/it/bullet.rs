@@ -252,7 +252,14 @@ fn the_shims_shortcuts_leave_every_state_as_bullets_own_world_has_it() {
         let mut scene = Scene::paper(block(), mode);
         (scene.floor, scene.dt, scene.preset) = (floor, dt, preset);
         (scene.linear_damping, scene.angular_damping) = (damping, damping);
-        let throws = Throws::styled(ThrowKind::Keyed, style, 0.0, 11, ThrowRanges::default(), 40);
+        let throws = Throws::styled(
+            ThrowKind::Keyed,
+            style,
+            None,
+            11,
+            ThrowRanges::default(),
+            40,
+        );
         let mut ours = Bullet::new(&scene).unwrap();
         let mut stock = Bullet::stock(&scene).unwrap();
         for index in 0..40 {

@@ -655,6 +655,33 @@ const UNSETTLED_COIN: [&str; 8] = [
     "3000",
 ];
 
+/// An odd roll: audited, tumbled, damped, never asleep.
+const ODD: [&str; 10] = [
+    "--block",
+    "30x20x10",
+    "--audit",
+    "--throw",
+    "tumble",
+    "--linear-damping",
+    "1",
+    "--angular-damping",
+    "1",
+    "--no-sleep",
+];
+
+/// A toss in a hand's directions beside a bounce threshold: `spec.throws.kappa` and
+/// `spec.scene.bounce_threshold`.
+const TOSSED: [&str; 8] = [
+    "--block",
+    "16x16x16",
+    "--throw",
+    "toss",
+    "--kappa",
+    "5",
+    "--bounce-threshold",
+    "0.1",
+];
+
 #[test]
 fn json_md_lists_the_keys_of_roll_and_merge() {
     let mut c = checker();
@@ -666,20 +693,10 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
     };
     let d3 = roll(&["--block", "140x24x20"]);
     let d2 = roll(&["--block", "140x24x20", "--2d"]);
-    let odd = roll(&[
-        "--block",
-        "30x20x10",
-        "--audit",
-        "--throw",
-        "tumble",
-        "--linear-damping",
-        "1",
-        "--angular-damping",
-        "1",
-        "--no-sleep",
-    ]);
+    let odd = roll(&ODD);
     let none = roll(&["--block", "140x24x20", "--max-steps", "1"]);
     let shaped = roll(&["--shape", "d6", "--rolling-resistance", "0.05"]);
+    let tossed = roll(&TOSSED);
     let unsettled = roll(&UNSETTLED_COIN);
     let broken = roll(&["--block", "140x24x20", "--dt", "1/30"]);
     assert!(broken["warnings"].is_array(), "{}", broken["dipped"]);
@@ -744,6 +761,10 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
         ("roll --audit --throw tumble, damped", &odd),
         ("roll --max-steps 1", &none),
         ("roll --shape d6", &shaped),
+        (
+            "roll --throw toss --kappa 5 --bounce-threshold 0.1",
+            &tossed,
+        ),
         (
             "roll --shape coin:24,2 --com 1,0,0 --max-steps 3000",
             &unsettled,
