@@ -706,7 +706,7 @@ fn die_name(spec: &RunSpec) -> String {
 fn scene_words(c: &DesignConfig) -> String {
     let sc = &c.spec.scene;
     let table = format!(
-        "e {}, μ {}, rolling resistance {} mm",
+        "e {:.3}, μ {:.3}, rolling resistance {:.3} mm",
         sc.restitution,
         sc.friction,
         sc.rolling_resistance * 1000.0
