@@ -29,6 +29,7 @@ from typing import Any, Callable, Dict, Iterable, List, Mapping, NamedTuple, Opt
 from . import _native
 
 __all__ = [
+    "Design",
     "Document",
     "Fit",
     "Roll",
@@ -37,6 +38,7 @@ __all__ = [
     "TracedThrow",
     "Value",
     "compare",
+    "design",
     "fair",
     "fit",
     "paper",
@@ -72,6 +74,9 @@ DEFAULT_REPEATS: int = _native.DEFAULT_REPEATS
 DEFAULT_DRAWS: int = _native.DEFAULT_DRAWS
 DEFAULT_PREDICT_ROLLS: int = _native.DEFAULT_PREDICT_ROLLS
 DEFAULT_ENGINES: Tuple[str, ...] = tuple(_native.DEFAULT_ENGINES)
+DEFAULT_DESIGN_ROLLS: int = _native.DEFAULT_DESIGN_ROLLS
+DEFAULT_DESIGN_POINTS: int = _native.DEFAULT_DESIGN_POINTS
+DEFAULT_CHECK_ROLLS: int = _native.DEFAULT_CHECK_ROLLS
 
 
 class Value(NamedTuple):
@@ -1049,6 +1054,97 @@ def predict(
     finally:
         close()
     return Document(out)
+
+
+class Design(Document):
+    """``design``'s result: ``dicephys design --json``'s document (docs/json.md, "design
+    --json"): ``value`` and ``interval`` (mm), ``outcomes``, ``check`` (the design rolled at a
+    fresh seed), ``quasi_static``, ``reachable``, ``verdict``; ``config.named_target`` and
+    ``config.calibration`` where a named target or a fit was given. ``summary()`` is the text
+    the command line prints."""
+
+    def __init__(self, text: str, human: str) -> None:
+        super().__init__(text)
+        self._human = human
+
+    def summary(self) -> str:
+        """What ``dicephys design`` prints for this design, as text."""
+        return self._human
+
+    def __repr__(self) -> str:
+        d = self.data
+        lo, hi = d["interval"]
+        what = d["config"]["what"]
+        return f"Design({what} = {d['value']:.3f} mm (95 %: {lo:.3f} to {hi:.3f}); {d['verdict']})"
+
+
+def design(
+    block: Optional[str] = None,
+    *,
+    free: str,
+    range: Tuple[float, float],
+    target: Union[str, Mapping[str, float]],
+    points: int = DEFAULT_DESIGN_POINTS,
+    check_rolls: int = DEFAULT_CHECK_ROLLS,
+    rolls: int = DEFAULT_DESIGN_ROLLS,
+    fit: Union[None, Fit, PathLike] = None,
+    surface: Optional[str] = None,
+    thrower: Optional[str] = None,
+    out: Optional[PathLike] = None,
+    threads: int = 0,
+    progress: Progress = None,
+    **options: Any,
+) -> Design:
+    """Design a die for its throws: ``dicephys design --json``.
+
+    The value of one feature of the die that gives ``target``'s probabilities thrown, with its
+    95 % interval, checked by rolling it ``check_rolls`` times at a fresh seed, the same
+    design's quasi-static shares beside (docs/guide.md, "Design a die for its throws").
+
+    block: the die as ``roll`` takes it, with ``roll``'s options by name in ``options``
+        (``shape``, ``die``, ``com``, ``seed``, ``engine``, ``throw`` …; thrown in a tumble
+        unless ``throw`` says otherwise).
+    free: the feature: ``thickness`` (a coin's), ``length`` (a block's), ``com_x``, ``com_y``,
+        ``com_z``, ``pip_depth`` or ``edge_radius``; mm.
+    range: its (LO, HI), mm, fixed before the search.
+    target: ``"LABEL=P,…"`` or a mapping label → probability, summing to 1 (``rest`` gathers
+        every label not named); or a named law over a die whose labels are its numbers,
+        ``"2d6"`` or ``"binomial:N"``.
+    rolls, points: throws at each value of a scan, and values each of the two scans rolls.
+    fit: design under a fit's calibration (a ``Fit`` or its fit.json's path): its e, μ,
+        rolling resistance and throw at its maximum, the die this one; ``surface`` and
+        ``thrower`` pick its values where it has several. The scene and throw options are then
+        the fit's and refused.
+    out: also write design.json, report.md, report.html and the figure design.svg, .png.
+    """
+    if isinstance(target, Mapping):
+        target = ",".join(f"{k}={float(v)!r}" for k, v in target.items())
+    lo_hi = tuple(range)
+    if len(lo_hi) != 2:
+        raise ValueError(f"range={range!r}: give (LO, HI), mm")
+    for k in ("com", "pips", "shell"):
+        options[k] = _triple(k, options.get(k), 3 if k == "com" else 2)
+    for k in ("velocity", "spin", "drop_height"):
+        if k in options:
+            options[k] = _pair(k, options[k])
+    if options.get("die") is not None:
+        options["die"] = os.fspath(options["die"])
+    fit_text = fit_name = None
+    if fit is not None:
+        fit_name = fit.path if isinstance(fit, Fit) else os.fspath(fit)
+        with open(fit_name, encoding="utf-8") as f:
+            fit_text = f.read()
+    tell, close = _progress(progress, "design")
+    try:
+        text, human = _native.design(
+            block, free=free, range=lo_hi, target=target, points=points,
+            check_rolls=check_rolls, rolls=rolls, fit=fit_text, fit_name=fit_name,
+            surface=surface, thrower=thrower, out=None if out is None else os.fspath(out),
+            threads=threads, progress=tell, **options,
+        )
+    finally:
+        close()
+    return Design(text, human)
 
 
 def trace_dtype() -> Any:

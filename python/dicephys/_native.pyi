@@ -19,6 +19,9 @@ DEFAULT_REPEATS: int
 DEFAULT_DRAWS: int
 DEFAULT_PREDICT_ROLLS: int
 DEFAULT_ENGINES: List[str]
+DEFAULT_DESIGN_ROLLS: int
+DEFAULT_DESIGN_POINTS: int
+DEFAULT_CHECK_ROLLS: int
 
 _Progress = Optional[Callable[[float, float], Any]]
 _Log = Optional[Callable[[str], Any]]
@@ -90,3 +93,7 @@ def predict(
     counts: Optional[str] = ...,
     discrepancy: str = ...,
 ) -> str: ...
+def design(block: Optional[str] = None, **options: Any) -> Tuple[str, str]:
+    """``dicephys.design``'s options by name: ``design --json``'s document and the text
+    ``design`` prints."""
+    ...

@@ -39,6 +39,8 @@ use std::path::PathBuf;
 use std::sync::{Condvar, Mutex};
 use std::time::Duration;
 
+mod design;
+
 /// The Python argument that sets a field of the library's configurations: most are the
 /// field's own name (a die's `pips.depth` is `pips`); these are spelt otherwise.
 fn argument(field: Field) -> &'static str {
@@ -1171,6 +1173,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(recover, m)?)?;
     m.add_function(wrap_pyfunction!(predict, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
+    m.add_function(wrap_pyfunction!(design::design, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     m.add("DEFAULT_MAX_STEPS", DEFAULT_MAX_STEPS)?;
     m.add("DEFAULT_SEED", DEFAULT_SEED)?;
@@ -1190,6 +1193,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_REPEATS", calibration::recovery::DEFAULT_REPEATS)?;
     m.add("DEFAULT_DRAWS", calibration::predict::DEFAULT_DRAWS)?;
     m.add("DEFAULT_PREDICT_ROLLS", calibration::predict::DEFAULT_ROLLS)?;
+    use dicephys::studies::design as design_;
+    m.add("DEFAULT_DESIGN_ROLLS", design_::DEFAULT_ROLLS)?;
+    m.add("DEFAULT_DESIGN_POINTS", design_::DEFAULT_POINTS)?;
+    m.add("DEFAULT_CHECK_ROLLS", design_::DEFAULT_CHECK_ROLLS)?;
     let engines: Vec<String> = dicephys::studies::paper::DEFAULT_ENGINES
         .iter()
         .map(|e| e.to_string())

@@ -508,3 +508,40 @@ def test_paper_is_the_cli_s_and_a_stopped_one_writes_nothing(tmp_path: Path) -> 
 def test_an_unknown_option_is_a_type_error() -> None:
     with pytest.raises(TypeError, match="colour"):
         dicephys.fair("16x16x16", rolls=10, colour="red")
+
+
+# A design of the loaded d6's weight (P(1) = 1/4), small: three values a scan, 100 throws each.
+DESIGN_ARGS = ("--block", "16x16x16", "--free", "com_z", "--range", "com_z=-3:0",
+               "--rolls", "100", "--points", "3", "--check-rolls", "200", "--seed", "1")
+
+
+def test_design_is_the_cli_s_design_with_a_named_target_and_a_fit(tmp_path: Path) -> None:
+    # Issue 73: dicephys.design() returns design --json's document, the same numbers.
+    want = cli("design", *DESIGN_ARGS, "--target", "1=1/4,rest=3/4", "--json")
+    kw: Dict[str, Any] = dict(free="com_z", range=(-3, 0), rolls=100, points=3, check_rolls=200, seed=1)
+    got = dicephys.design("16x16x16", target={"1": 0.25, "rest": 0.75}, threads=2, **kw)
+    assert isinstance(got, dicephys.Design)
+    assert got.data == want
+    assert got.summary().startswith("design: com_z of 16x16x16 mm")
+    assert repr(got).startswith("Design(com_z = ")
+    # Under a fit's calibration (a cube's faces, μ free, e held at 0.9), written with --out.
+    csv = tmp_path / "cube.csv"
+    csv.write_text("label,surface,length_mm,breadth_mm,width_mm,mode,face_1,face_2,face_3,"
+                   "face_4,face_5,face_6\nd,felt,16,16,16,3d,170,160,170,165,170,165\n")
+    subprocess.run([BIN, "fit", "--data", str(csv), "--free", "mu", "--restitution", "0.9",
+                    "--points", "6", "--rolls", "100", "--degree", "1", "--no-refine", "--dt",
+                    "1/250", "--seed", "1", "--out", str(tmp_path / "fit")],
+                   check=True, capture_output=True)
+    fit = str(tmp_path / "fit" / "fit.json")
+    want = cli("design", *DESIGN_ARGS, "--target", "1=1/4,rest=3/4", "--fit", fit, "--json")
+    got = dicephys.design("16x16x16", target="1=1/4,rest=3/4", fit=fit, out=tmp_path / "d", **kw)
+    assert got.data == want
+    assert got.config["calibration"]["values"]["e"] == 0.9
+    assert json.loads((tmp_path / "d" / "design.json").read_text()) == want
+    assert (tmp_path / "d" / "design.svg").is_file() and (tmp_path / "d" / "design.png").is_file()
+    # A named target is refused where the die's labels are not its numbers; a scene option
+    # beside a fit, which sets the scene.
+    with pytest.raises(ValueError, match="'1' is not among them"):
+        dicephys.design("16x16x16", target="2d6", **kw)
+    with pytest.raises(ValueError, match="friction"):
+        dicephys.design("16x16x16", target="1=1/4,rest=3/4", fit=fit, friction=0.3, **kw)

@@ -545,6 +545,13 @@ fn json_md_lists_the_keys_of_fair() {
         "--json",
     ]);
     c.document("fair-vary", "fair --vary", &vary);
+    document_designs(&mut c);
+    c.finish(&["fair", "fair-vary", "design"]);
+}
+
+/// `design`'s documents: a coin's thickness for a target by label, a named target over a die
+/// file's classes, and a design under a fit's calibration.
+fn document_designs(c: &mut Checker) {
     let design = run(&[
         "design",
         "--shape",
@@ -566,7 +573,55 @@ fn json_md_lists_the_keys_of_fair() {
         "--json",
     ]);
     c.document("design", "design", &design);
-    c.finish(&["fair", "fair-vary", "design"]);
+    // A named target over a die file's classes, and a design under a fit's calibration.
+    let dir = crate::helpers::Scratch::new("docs-design");
+    let die = crate::design::v1_classes(&dir);
+    let small = [
+        "--rolls",
+        "60",
+        "--points",
+        "3",
+        "--check-rolls",
+        "100",
+        "--threads",
+        "1",
+        "--json",
+    ];
+    let named = run(&[
+        &[
+            "design",
+            "--die",
+            &die,
+            "--free",
+            "com_z",
+            "--range",
+            "com_z=-1:1",
+            "--target",
+            "2d6",
+        ][..],
+        &small,
+    ]
+    .concat());
+    c.document("design", "design --target 2d6", &named);
+    let fit = crate::design::cube_fit(&dir);
+    let calibrated = run(&[
+        &[
+            "design",
+            "--block",
+            "16x16x16",
+            "--free",
+            "com_z",
+            "--range",
+            "com_z=-3:0",
+            "--target",
+            "1=1/4,rest=3/4",
+            "--fit",
+            &fit,
+        ][..],
+        &small,
+    ]
+    .concat());
+    c.document("design", "design --fit", &calibrated);
 }
 
 /// A made die, every feature (its spec carries them), rolled; and fair's precision of the

@@ -18,6 +18,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+pub mod design;
 pub mod die;
 pub mod fit;
 pub mod paper;

@@ -21,6 +21,12 @@
 //!    beside them. A target the curves cannot reach anywhere in the range (their nearest point's
 //!    χ² at the check's throws beyond χ²'s 95 % point) is an answer, not an error:
 //!    "unreachable in this family".
+//!
+//! The target may be named ([`named`]: `2d6`, `binomial:N`), and the scene and throw a fit's
+//! calibration ([`calibrated`]: `--fit`).
+
+pub mod calibrated;
+pub mod named;
 
 use crate::error::{Error, Field, Result};
 use crate::model::faces::Layout;
@@ -38,6 +44,13 @@ const GRID: usize = 2001;
 
 /// The check's seed, apart from the scans'.
 const CHECK_SEED: u64 = 0xc4ec_0000_0073;
+
+/// Throws a scan rolls at each value unless asked otherwise.
+pub const DEFAULT_ROLLS: u64 = 2_000;
+/// Values each scan rolls unless asked otherwise.
+pub const DEFAULT_POINTS: usize = 9;
+/// Throws of the check unless asked otherwise.
+pub const DEFAULT_CHECK_ROLLS: u64 = 20_000;
 
 /// What `design` asks for.
 #[derive(Clone, Debug, Serialize)]
@@ -57,6 +70,12 @@ pub struct DesignConfig {
     pub points: usize,
     /// Throws of the check.
     pub check_rolls: u64,
+    /// The named target `target` was made from (`2d6`, `binomial:N`), where one was given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub named_target: Option<named::Named>,
+    /// The fit whose calibrated scene and throw `spec` is (`--fit`), where one was given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub calibration: Option<calibrated::Calibration>,
 }
 
 /// One scan: the values rolled and each target outcome's count there.
@@ -598,6 +617,138 @@ fn estimate(
     found.sort_by(f64::total_cmp);
     let q = |f: f64| found[((f * (BOOTSTRAP - 1) as f64).round() as usize).min(BOOTSTRAP - 1)];
     (value, [q(0.025), q(0.975)])
+}
+
+impl Design {
+    /// The design as the terminal shows it (and `report.md` holds it).
+    pub fn text(&self) -> String {
+        use std::fmt::Write;
+        let c = &self.config;
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "design: {} of {} ({}, {}), range {}–{} mm; two scans of {} values × {} throws, the \
+             check {} throws at a fresh seed",
+            c.what,
+            die_name(&c.spec),
+            c.spec.engine.name(),
+            c.spec.throws.style,
+            c.range[0],
+            c.range[1],
+            c.points,
+            c.spec.rolls,
+            c.check_rolls
+        );
+        if let Some(n) = c.named_target {
+            let _ = writeln!(s, "target: {n}, over the die's labels");
+        }
+        let _ = writeln!(s, "scene and throw: {}", scene_words(c));
+        let _ = writeln!(
+            s,
+            "\n  {} = {:.3} mm   (95 %: {:.3} to {:.3}; the designs the target allows within the \
+             simulation's error)\n",
+            c.what, self.value, self.interval[0], self.interval[1]
+        );
+        let _ = writeln!(
+            s,
+            "  {:<10} {:>8} {:>8} {:>17} {:>8} {:>7} {:>13}",
+            "outcome", "target", "curve", "check", "design ±", "z", "quasi-static"
+        );
+        for (k, o) in self.outcomes.iter().enumerate() {
+            let ch = &self.check;
+            let _ = writeln!(
+                s,
+                "  {:<10} {:>8.4} {:>8.4} {:>8.4} ± {:.4} {:>8.4} {:>+7.2} {:>13}",
+                o,
+                c.target[k].1,
+                self.curve[k],
+                ch.p[k],
+                ch.err[k],
+                ch.design_err[k],
+                ch.z[k],
+                self.quasi_static
+                    .as_ref()
+                    .map_or("–".into(), |q| format!("{:.4}", q[k]))
+            );
+        }
+        let _ = writeln!(s, "\n{}", self.verdict);
+        s
+    }
+
+    /// The design figure's bars: per outcome, the target, the check's share with its error
+    /// (binomial and the design's own together) and the quasi-static share.
+    pub fn bars(&self) -> Vec<crate::report::figures::design::DesignBar> {
+        let ch = &self.check;
+        self.outcomes
+            .iter()
+            .enumerate()
+            .map(|(k, o)| crate::report::figures::design::DesignBar {
+                label: o.clone(),
+                target: self.config.target[k].1,
+                p: ch.p[k],
+                err: ch.err[k].hypot(ch.design_err[k]),
+                quasi_static: self.quasi_static.as_ref().map(|q| q[k]),
+            })
+            .collect()
+    }
+}
+
+/// The die, in a few words.
+fn die_name(spec: &RunSpec) -> String {
+    match &spec.scene.shape {
+        Some(shape) => shape.name.clone(),
+        None => format!("{} mm", spec.scene.block),
+    }
+}
+
+/// The scene and throw a design was made under: a fit's calibration, named with its values,
+/// or the scene as given.
+fn scene_words(c: &DesignConfig) -> String {
+    let sc = &c.spec.scene;
+    let table = format!(
+        "e {:.3}, μ {:.3}, rolling resistance {:.3} mm",
+        sc.restitution,
+        sc.friction,
+        sc.rolling_resistance * 1000.0
+    );
+    match &c.calibration {
+        Some(k) => format!(
+            "the calibration of {} (surface {}, thrower {}; at its maximum): {table}, throw {}",
+            k.fit, k.surface, k.thrower, c.spec.throws.style
+        ),
+        None => format!("as given: {table}, throw {}", c.spec.throws.style),
+    }
+}
+
+/// `design --out`'s files in `dir` (claimed by then): `design.json` (the document `json`,
+/// as `--json` prints it), `report.md` and `report.html` (the text), and the figure
+/// `design.svg`, `.png`, each whole or not at all.
+pub fn write(dir: &std::path::Path, json: &str, d: &Design) -> Result<()> {
+    let c = &d.config;
+    let title = format!(
+        "{} = {:.3} mm of {}, {}, {}{}: {} fresh throws",
+        c.what,
+        d.value,
+        die_name(&c.spec),
+        c.spec.engine.name(),
+        c.spec.throws.style,
+        if c.calibration.is_some() {
+            ", calibrated"
+        } else {
+            ""
+        },
+        d.check.n
+    );
+    crate::report::figures::design::design(dir, "design", &title, &d.bars())?;
+    crate::run::io::write_atomic(&dir.join("design.json"), json.as_bytes())?;
+    crate::report::html::write_text_report(dir, "Design", &d.text(), &["design"])
+}
+
+/// Claims `dir` for this design (`run::owner`) and holds it while the returned file lives:
+/// refused if another command or another run owns it.
+pub fn claim(dir: &std::path::Path, cfg: &DesignConfig) -> Result<crate::run::lock::Held> {
+    super::place::claim(dir, "design", cfg, super::place::Claimant::Here)?;
+    crate::run::owner::hold(dir)
 }
 
 #[cfg(test)]
