@@ -471,7 +471,8 @@ pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
 /// The fit's estimate rolled: the model's own Pearson χ² at its values, beside the surrogate's.
 fn rolled_line(r: &crate::calibration::rolled::Rolled, phi: f64) -> String {
     let p = match r.p_value {
-        Some(p) => format!("p = {p:.3}"),
+        Some(p) if p >= 1e-3 => format!("p = {p:.3}"),
+        Some(p) => format!("p = {p:.1e}"),
         None => "no degrees of freedom left".into(),
     };
     let mut s = format!(
