@@ -49,6 +49,9 @@ pub enum Kind {
     /// The contact's rolling resistance, mm: the lever arm of the floor's push against a die
     /// rolling or turning on it (`Scene::rolling_resistance`; per surface; Bullet only).
     Rolling,
+    /// The contact's bounce threshold, m/s: slower impacts do not bounce
+    /// (`Scene::bounce_threshold`; per surface; Bullet only).
+    Bounce,
     /// The hand's concentration κ (per thrower).
     Kappa,
     /// A factor on the paper's spin range, 31 to 160 rad/s (per thrower).
@@ -71,9 +74,6 @@ pub enum Kind {
     /// A printed die's infill fraction, 0 to 1, inside its wall (the die's own shell's, else a
     /// 1 mm one: `mass::DEFAULT_WALL`).
     Infill,
-    /// The contact's bounce threshold, m/s: slower impacts do not bounce
-    /// (`Scene::bounce_threshold`; per surface; Bullet only).
-    Bounce,
 }
 
 impl Kind {
@@ -82,6 +82,7 @@ impl Kind {
         Kind::E,
         Kind::Mu,
         Kind::Rolling,
+        Kind::Bounce,
         Kind::Kappa,
         Kind::Spin,
         Kind::Height,
@@ -91,11 +92,10 @@ impl Kind {
         Kind::ComZ,
         Kind::PipDepth,
         Kind::Infill,
-        Kind::Bounce,
     ];
 
-    /// "e", "mu", "rolling", "kappa", "spin", "height", "speed", "com_x", "com_y", "com_z",
-    /// "pip_depth", "infill" or "bounce".
+    /// "e", "mu", "rolling", "bounce", "kappa", "spin", "height", "speed", "com_x", "com_y",
+    /// "com_z", "pip_depth" or "infill".
     pub fn name(self) -> &'static str {
         self.into()
     }
