@@ -267,6 +267,15 @@ impl Discrepancy {
         self.applied = gain > 0.0;
     }
 
+    /// Judged where every row could have learnt a discrepancy from the others (enough rows
+    /// without it) and none did: the held-out rows gain nothing from it, a tie, so it is not
+    /// applied (a discrepancy only the whole fit's rows together ask for is not carried to a
+    /// row it has not seen).
+    pub fn judge_none_learnt(&mut self) {
+        self.held_out_gain = Some(0.0);
+        self.applied = false;
+    }
+
     /// Applied as `u` asks: as judged (auto), always (on) or never (off).
     pub fn set_use(&mut self, u: Use) {
         match u {
@@ -696,6 +705,16 @@ mod tests {
         o.remove("held_out_gain");
         let old: Discrepancy = serde_json::from_value(v).unwrap();
         assert!(old.in_force() && old.held_out_gain.is_none());
+    }
+
+    #[test]
+    fn a_discrepancy_no_row_learnt_from_the_others_is_a_tie_and_not_applied() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+        let mut d = Discrepancy::estimate(&rows(&mut rng, 8, 2_000, 1.0), 1.0).unwrap();
+        assert!(d.in_force());
+        d.judge_none_learnt();
+        assert!(!d.in_force() && d.held_out_gain == Some(0.0));
+        assert!(d.not_applied().unwrap().contains("+0.00 nats"));
     }
 
     #[test]

@@ -479,7 +479,8 @@ fn rolled_line(r: &crate::calibration::rolled::Rolled, phi: f64) -> String {
         "\nRolled at the estimate ({} fresh throws a row): Pearson's χ² = {:.2} on {} degrees \
          of freedom, {p}, each count against the rolled share with the binomial error of the \
          counts and of the rolls, unwidened. The χ² above is the surrogate's, its errors widened \
-         by the overdispersion φ = {phi:.2}: where the two part, the model misses by this one.\n\n",
+         by the overdispersion φ = {phi:.2}: where the two part, the model at this estimate misses by \
+         this one (the surrogate's own error may have moved the estimate, or hidden the miss).\n\n",
         r.rolls, r.chi2, r.dof
     );
     s += "| row | outcomes counted | rolled shares | χ² |\n|---|---|---|---:|\n";
