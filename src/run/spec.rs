@@ -100,7 +100,9 @@ impl ThrowSpec {
                     crate::text![
                         "only ",
                         Field::Style,
-                        " hand (and toss, a hand's toss) takes a concentration, not ",
+                        " hand takes a concentration (and ",
+                        Field::Style,
+                        " toss, turned a hand's way), not ",
                         Field::Style,
                         format!(" {s}")
                     ],
