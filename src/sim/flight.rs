@@ -93,6 +93,7 @@ impl Flight {
     }
 
     /// The die's state from a flown body state (the engine's `state` from its `body_state`).
+    #[inline]
     pub fn to_die(&self, body: &BodyState) -> BodyState {
         if !self.die.turn.turned() {
             return *body;
