@@ -725,6 +725,38 @@ pub fn read_fit(path: &std::path::Path, stop: &crate::run::stop::Stop) -> Result
 }
 
 impl FitResult {
+    /// Every parameter's value at the unit coordinates `x` (the maximum, a posterior draw) for
+    /// `row`'s surface and thrower, the rest as the model fixes them.
+    pub fn values_at(&self, row: &DataRow, x: &[f64]) -> params::Fixed {
+        let model = &self.config.model;
+        let dims = model.row_dims(&self.params, row);
+        let axes = model.axes(&self.params, &dims);
+        let local: Vec<f64> = dims.iter().map(|&d| x[d]).collect();
+        params::values(&model.fixed, &axes, &local)
+    }
+
+    /// A row of no counts at `block` in `mode` on `surface`, thrown by `thrower`: where a new
+    /// block's or die's parameters are read (`values_at`).
+    pub fn new_row(
+        surface: &str,
+        thrower: &str,
+        block: crate::model::block::Block,
+        mode: crate::model::scene::Mode,
+    ) -> DataRow {
+        DataRow {
+            label: "predicted".into(),
+            surface: surface.into(),
+            thrower: thrower.into(),
+            block,
+            mode,
+            outcomes: Default::default(),
+            counts: vec![0, 1, 1],
+            groups: vec![vec![1], vec![2]],
+            labels: Vec::new(),
+            die: None,
+        }
+    }
+
     /// Checks that the fit is whole: its configuration valid, its parameters those of its
     /// model, its posterior draws there and inside the unit box.
     pub fn check(&self) -> Result<()> {

@@ -165,44 +165,20 @@ struct Faces<'a> {
 
 impl Figure for Faces<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let n = self.bars.len();
         let mut ys = Span::new(f64::INFINITY, f64::NEG_INFINITY);
         for b in self.bars {
             ys.add(b.p - 2.0 * bar(b.err));
             ys.add(b.p + 2.0 * bar(b.err));
             ys.add(b.null);
         }
-        root.fill(&WHITE).map_err(plot_err)?;
         let labels: Vec<String> = self.bars.iter().map(|b| b.label.clone()).collect();
-        let name = move |v: &f64| {
-            let k = v.round();
-            if (v - k).abs() < 1e-6 && k >= 1.0 && k as usize <= labels.len() {
-                labels[k as usize - 1].clone()
-            } else {
-                String::new()
-            }
-        };
-        let mut chart = ChartBuilder::on(root)
-            .caption(self.title, (FONT, 22))
-            .margin(20)
-            .x_label_area_size(55)
-            .y_label_area_size(80)
-            .build_cartesian_2d(0.4..n as f64 + 0.6, ys.padded(0.1, 0.3))
-            .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .x_desc("face (the label it shows)")
-            .y_desc("P(face), with its 2σ interval")
-            .axis_desc_style((FONT, 20))
-            .label_style((FONT, 16))
-            .x_labels(n + 1)
-            .x_label_formatter(&name)
-            .y_label_formatter(&tick)
-            .disable_x_mesh()
-            .light_line_style(RGBColor(243, 243, 243))
-            .bold_line_style(RGBColor(210, 210, 210))
-            .draw()
-            .map_err(plot_err)?;
+        let mut chart = labelled_chart(
+            root,
+            (self.title, 22),
+            labels,
+            ys.padded(0.1, 0.3),
+            ("face (the label it shows)", "P(face), with its 2σ interval"),
+        )?;
         // The null: a short grey bar across each face's place.
         let grey = RGBColor(90, 90, 90).stroke_width(3);
         chart

@@ -323,6 +323,49 @@ fn chart<'a, DB: DrawingBackend>(
     Ok(chart)
 }
 
+/// White background, caption (its text and size), and axes for one bar a label at x = 1 … n,
+/// each label written under its place, y over `y`: the die's faces and a design's outcomes.
+fn labelled_chart<'a, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
+    (title, size): (&str, u32),
+    labels: Vec<String>,
+    y: std::ops::Range<f64>,
+    (x_desc, y_desc): (&str, &str),
+) -> Result<Chart<'a, DB>, String> {
+    let n = labels.len();
+    root.fill(&WHITE).map_err(plot_err)?;
+    let name = move |v: &f64| {
+        let k = v.round();
+        if (v - k).abs() < 1e-6 && k >= 1.0 && k as usize <= labels.len() {
+            labels[k as usize - 1].clone()
+        } else {
+            String::new()
+        }
+    };
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, (FONT, size))
+        .margin(20)
+        .x_label_area_size(55)
+        .y_label_area_size(80)
+        .build_cartesian_2d(0.4..n as f64 + 0.6, y)
+        .map_err(plot_err)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .axis_desc_style((FONT, 20))
+        .label_style((FONT, 16))
+        .x_labels(n + 1)
+        .x_label_formatter(&name)
+        .y_label_formatter(&tick)
+        .disable_x_mesh()
+        .light_line_style(RGBColor(243, 243, 243))
+        .bold_line_style(RGBColor(210, 210, 210))
+        .draw()
+        .map_err(plot_err)?;
+    Ok(chart)
+}
+
 /// A solid line with its legend entry.
 fn solid<'a, DB: DrawingBackend + 'a>(
     chart: &mut Chart<'a, DB>,

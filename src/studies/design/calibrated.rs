@@ -7,9 +7,8 @@
 //! design's interval is the simulation's error at those values, and the calibration's own
 //! uncertainty is not carried into it (`predict` carries it, for one die).
 
-use crate::calibration::data::DataRow;
 use crate::calibration::other_die::{without_die_params, OtherDie};
-use crate::calibration::params::{self, Fixed};
+use crate::calibration::params::Fixed;
 use crate::calibration::predict::group;
 use crate::calibration::FitResult;
 use crate::error::Result;
@@ -53,23 +52,8 @@ pub fn calibrated(
     die.check(fit)?;
     // A new row's coordinates, as `predict` builds them: the fit's parameters of this surface
     // and thrower, at the fit's maximum.
-    let row = DataRow {
-        label: "designed".into(),
-        surface: surface.clone(),
-        thrower: thrower.clone(),
-        block: spec.scene.block,
-        mode: spec.scene.mode,
-        outcomes: Default::default(),
-        counts: vec![0, 1, 1],
-        groups: vec![vec![1], vec![2]],
-        labels: Vec::new(),
-        die: None,
-    };
-    let model = &fit.config.model;
-    let dims = model.row_dims(&fit.params, &row);
-    let axes = model.axes(&fit.params, &dims);
-    let best: Vec<f64> = dims.iter().map(|&d| fit.estimate.x[d]).collect();
-    let values = without_die_params(params::values(&model.fixed, &axes, &best));
+    let row = FitResult::new_row(&surface, &thrower, spec.scene.block, spec.scene.mode);
+    let values = without_die_params(fit.values_at(&row, &fit.estimate.x));
     let method = die.method(&fit.config.method);
     let out = method.spec(
         spec.scene.block,

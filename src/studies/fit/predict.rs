@@ -1,6 +1,5 @@
 //! `dicephys predict`: a block the fit did not see, simulated at the fit's posterior draws.
 
-use crate::calibration::data::DataRow;
 use crate::calibration::design::point_seed;
 use crate::calibration::heldout;
 use crate::calibration::params::{Kind, Method};
@@ -292,28 +291,12 @@ fn draw_specs(
     thrower: &str,
 ) -> Result<Vec<crate::run::spec::RunSpec>> {
     // The new row's coordinates: the fit's parameters of its surface and thrower.
-    let row = DataRow {
-        label: "predicted".into(),
-        surface: surface.into(),
-        thrower: thrower.into(),
-        block: cfg.block,
-        mode: cfg.mode,
-        outcomes: Default::default(),
-        counts: vec![0, 1, 1],
-        groups: vec![vec![1], vec![2]],
-        labels: Vec::new(),
-        die: None,
-    };
-    let model = &fit.config.model;
-    let dims = model.row_dims(&fit.params, &row);
-    let axes = model.axes(&fit.params, &dims);
+    let row = FitResult::new_row(surface, thrower, cfg.block, cfg.mode);
     let method = method_of(fit, cfg);
     let step = fit.estimate.draws.len() / cfg.draws;
     (0..cfg.draws)
         .map(|m| {
-            let x = &fit.estimate.draws[m * step];
-            let local: Vec<f64> = dims.iter().map(|&d| x[d]).collect();
-            let mut values = crate::calibration::params::values(&model.fixed, &axes, &local);
+            let mut values = fit.values_at(&row, &fit.estimate.draws[m * step]);
             if let Some([e, mu]) = cfg.contact {
                 (values.e, values.mu) = (e, mu);
             }

@@ -3,7 +3,6 @@
 
 use super::baseline::{grouped, shares_at};
 use crate::calibration::data::Outcomes;
-use crate::calibration::params;
 use crate::calibration::rolled::{Rolled, RolledRow};
 use crate::calibration::FitResult;
 use crate::error::Result;
@@ -21,14 +20,10 @@ const ROLLED_SEED: u64 = 0x0e57_1a7e;
 /// row. `None` if stopped early.
 pub fn roll(fit: &FitResult, runner: &Runner) -> Result<Option<Rolled>> {
     let cfg = &fit.config;
-    let model = &cfg.model;
     let rolls = cfg.design.rolls * ROLLED_POINTS;
     let mut rows = Vec::new();
     for (r, row) in cfg.rows.iter().enumerate() {
-        let dims = model.row_dims(&fit.params, row);
-        let axes = model.axes(&fit.params, &dims);
-        let x: Vec<f64> = dims.iter().map(|&d| fit.estimate.x[d]).collect();
-        let values = params::values(&model.fixed, &axes, &x);
+        let values = fit.values_at(row, &fit.estimate.x);
         let method = &*cfg.method.of_row(row);
         let faces = row.outcomes == Outcomes::Faces;
         let Some((shares, settled)) = shares_at(
