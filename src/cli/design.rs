@@ -6,6 +6,7 @@ use super::roll::RollArgs;
 use super::term::{out, outln};
 use clap::Args;
 use dicephys::model::throws::ThrowStyle;
+use dicephys::studies::design::mesh::{self, MeshConfig};
 use dicephys::studies::design::named::Named;
 use dicephys::studies::design::{DesignConfig, DEFAULT_CHECK_ROLLS, DEFAULT_POINTS, DEFAULT_ROLLS};
 use dicephys::studies::fair::{Null, Varied};
@@ -37,11 +38,15 @@ pub struct DesignArgs {
     #[command(flatten)]
     pub roll: RollArgs,
     /// The feature to design: thickness (a coin's, --shape coin:D,H), length (a block's,
-    /// --block), com_x, com_y, com_z (the centre of mass), pip_depth or edge_radius; mm.
+    /// --block), com_x, com_y, com_z (the centre of mass), pip_depth or edge_radius; mm. Or
+    /// facets: a convex die's shape (--die FILE, --mesh or a named polyhedron), each facet's
+    /// plane moved and tilted within --range of its start's, a mirror symmetry about x = 0
+    /// kept.
     #[arg(long, value_name = "NAME")]
     pub free: String,
     /// Its range, mm, fixed before the search (a design at its end is reported as such):
-    /// NAME=LO:HI.
+    /// NAME=LO:HI (facets=-2:2: each facet's offset and its rim's tilts within 2 mm of the
+    /// start's).
     #[arg(long, value_name = "NAME=LO:HI")]
     pub range: String,
     /// The probabilities wanted: LABEL=P,… summing to 1 (edge=1/3,heads=1/3,tails=1/3);
@@ -50,12 +55,16 @@ pub struct DesignArgs {
     /// fair dice, 2 to 12) or binomial:N (heads in N fair tosses, 0 to N).
     #[arg(long, value_name = "LABEL=P,...|2d6|binomial:N", value_parser = parse_target)]
     pub target: TargetArg,
-    /// Values each of the two scans rolls.
-    #[arg(long, default_value_t = DEFAULT_POINTS)]
-    pub points: usize,
+    /// Values each of the two scans rolls [default: 9].
+    #[arg(long)]
+    pub points: Option<usize>,
     /// Throws of the check: the design rolled at a fresh seed.
     #[arg(long, default_value_t = DEFAULT_CHECK_ROLLS)]
     pub check_rolls: u64,
+    /// With --free facets: rounds of throws, each correcting the quasi-static design by
+    /// what the throws show (--rolls throws a round [default: 20,000]) [default: 5].
+    #[arg(long)]
+    pub rounds: Option<usize>,
     /// Design under a fit's calibration (its fit.json): the fit's e, μ, rolling resistance
     /// and throw at its maximum, on its engine and step, with this die in place of the fit's
     /// (as `predict --die`); the scene and throw flags are the fit's, not given.
@@ -100,9 +109,25 @@ const FIT_SETS: [&str; 22] = [
     "faithful",
 ];
 
+/// What `design` designs: one feature, or a convex die's facets.
+enum Config {
+    Feature(DesignConfig),
+    Mesh(MeshConfig),
+}
+
+/// What every design shares: the die and its scene (calibrated where `--fit` is given), its
+/// numbering, the target over its labels.
+struct Common {
+    spec: dicephys::run::spec::RunSpec,
+    layout: dicephys::model::faces::Layout,
+    calibration: Option<dicephys::studies::design::calibrated::Calibration>,
+    target: Vec<(String, f64)>,
+    named_target: Option<Named>,
+}
+
 /// The design `a` asks for, every value checked (the fit read, the named target set over the
 /// die's labels) before anything rolls or is written.
-fn config_of(a: &DesignArgs) -> Result<DesignConfig> {
+fn config_of(a: &DesignArgs) -> Result<Config> {
     let r = &a.roll;
     for (given, flag) in [
         (r.checkpoint.is_some(), "--checkpoint"),
@@ -116,10 +141,56 @@ fn config_of(a: &DesignArgs) -> Result<DesignConfig> {
             )));
         }
     }
+    if a.free.trim() == mesh::FACETS {
+        if a.points.is_some() {
+            return Err(Error::Usage(
+                "--points: a design of the facets rolls rounds (--rounds), not scans".into(),
+            ));
+        }
+        let range = range_of(&a.range, mesh::FACETS)?;
+        let c = common(a, r.run.rolls.unwrap_or(mesh::DEFAULT_ROLLS))?;
+        let cfg = MeshConfig {
+            spec: c.spec,
+            layout: c.layout,
+            range,
+            target: c.target,
+            rounds: a.rounds.unwrap_or(mesh::DEFAULT_ROUNDS),
+            check_rolls: a.check_rolls,
+            named_target: c.named_target,
+            calibration: c.calibration,
+        };
+        mesh::check(&cfg)?;
+        return Ok(Config::Mesh(cfg));
+    }
     let what: Varied = dicephys::error::parse_name("feature", a.free.trim())?;
-    let range = range_of(&a.range, what)?;
+    if a.rounds.is_some() {
+        return Err(Error::Usage(format!(
+            "--rounds: only --free {} rolls rounds; a feature's design scans (--points)",
+            mesh::FACETS
+        )));
+    }
+    let range = range_of(&a.range, &what.to_string())?;
+    let c = common(a, r.run.rolls.unwrap_or(DEFAULT_ROLLS))?;
+    let cfg = DesignConfig {
+        layout: c.layout,
+        spec: c.spec,
+        what,
+        range,
+        target: c.target,
+        points: a.points.unwrap_or(DEFAULT_POINTS),
+        check_rolls: a.check_rolls,
+        named_target: c.named_target,
+        calibration: c.calibration,
+    };
+    dicephys::studies::design::check(&cfg)?;
+    Ok(Config::Feature(cfg))
+}
+
+/// The die, scene, calibration and target `a` gives, `rolls` throws a run.
+fn common(a: &DesignArgs, rolls: u64) -> Result<Common> {
+    let r = &a.roll;
     let mut spec = r.spec_or(ThrowStyle::Tumble)?;
-    spec.rolls = r.run.rolls.unwrap_or(DEFAULT_ROLLS);
+    spec.rolls = rolls;
     let layout = r.layout(&spec);
     let calibration = match &a.fit {
         Some(path) => {
@@ -161,19 +232,13 @@ fn config_of(a: &DesignArgs) -> Result<DesignConfig> {
             (t, Some(n))
         }
     };
-    let cfg = DesignConfig {
-        layout,
+    Ok(Common {
         spec,
-        what,
-        range,
-        target,
-        points: a.points,
-        check_rolls: a.check_rolls,
-        named_target,
+        layout,
         calibration,
-    };
-    dicephys::studies::design::check(&cfg)?;
-    Ok(cfg)
+        target,
+        named_target,
+    })
 }
 
 /// Runs `dicephys design`.
@@ -186,12 +251,18 @@ pub fn run(a: &DesignArgs) -> Result<()> {
             std::fs::create_dir_all(dir).map_err(|e| {
                 Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
             })?;
-            Some(dicephys::studies::design::claim(dir, &cfg)?)
+            Some(match &cfg {
+                Config::Feature(c) => dicephys::studies::design::claim(dir, c)?,
+                Config::Mesh(c) => mesh::claim(dir, c)?,
+            })
         }
         None => None,
     };
     let threads = r.run.threads()?;
-    let total = (cfg.spec.rolls * 2 * cfg.points as u64 + cfg.check_rolls) as f64;
+    let total = match &cfg {
+        Config::Feature(c) => c.spec.rolls * 2 * c.points as u64 + c.check_rolls,
+        Config::Mesh(c) => c.spec.rolls * (c.rounds as u64 + 1) + 2 * c.check_rolls,
+    } as f64;
     let bar = dicephys::report::progress::Progress::new(
         "design",
         dicephys::report::progress::Unit::Rolls { per_cell: 0 },
@@ -202,38 +273,64 @@ pub fn run(a: &DesignArgs) -> Result<()> {
     let progress = |n: u64| bar.set(n as f64, total);
     let runner = dicephys::run::runner::Runner::new(threads, super::term::stop().clone());
     let runner = runner.with_progress(&progress);
-    let design = dicephys::studies::design::run(&cfg, &runner);
+    let done = match &cfg {
+        Config::Feature(c) => dicephys::studies::design::run(c, &runner).map(|d| {
+            d.map(|d| {
+                let json = dicephys::run::seal::to_string(&d, true);
+                (json, d.text(), Done::Feature(Box::new(d)))
+            })
+        }),
+        Config::Mesh(c) => mesh::run(c, &runner).map(|d| {
+            d.map(|d| {
+                let json = dicephys::run::seal::to_string(&d, true);
+                (json, d.text(), Done::Mesh(Box::new(d)))
+            })
+        }),
+    };
     bar.finish();
-    let Some(design) = design? else {
+    let Some((json, text, design)) = done? else {
         return Err(Error::Interrupted(dicephys::run::stop::interrupted(
             &dicephys::run::stop::Kept::Nothing(Some("a design does not resume")),
         )));
     };
-    let json = dicephys::run::seal::to_string(&design, true)?;
+    let json = json?;
     if let Some(dir) = &a.out {
-        dicephys::studies::design::write(dir, &json, &design)?;
+        match &design {
+            Done::Feature(d) => dicephys::studies::design::write(dir, &json, d)?,
+            Done::Mesh(d) => mesh::write(dir, &json, d)?,
+        }
     }
     if *r.json {
         outln!("{}", json);
     } else {
-        out!("{}", design.text());
+        out!("{}", text);
     }
     if let (Some(dir), false) = (&a.out, *r.json) {
+        let die = match design {
+            Done::Feature(_) => "",
+            Done::Mesh(_) => ", the die design.obj and its die file design.toml",
+        };
         eprintln!(
-            "wrote {}/design.json, report.md, report.html and design.svg, .png",
+            "wrote {}/design.json, report.md, report.html and design.svg, .png{die}",
             dir.display()
         );
     }
     Ok(())
 }
 
+/// A design made.
+enum Done {
+    Feature(Box<dicephys::studies::design::Design>),
+    Mesh(Box<mesh::MeshDesign>),
+}
+
 /// `--range NAME=LO:HI`, for the feature `--free` names.
-fn range_of(s: &str, what: Varied) -> Result<[f64; 2]> {
+fn range_of(s: &str, what: &str) -> Result<[f64; 2]> {
     let bad = |why: &str| Error::Usage(format!("--range '{s}': {why}"));
     let (name, span) = s
         .split_once('=')
         .ok_or_else(|| bad("write NAME=LO:HI, e.g. thickness=6:14"))?;
-    if name.trim() != what.to_string() {
+    if name.trim() != what {
         return Err(bad(&format!("the range is --free's, {what}")));
     }
     let (lo, hi) = span

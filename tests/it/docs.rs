@@ -546,7 +546,7 @@ fn json_md_lists_the_keys_of_fair() {
     ]);
     c.document("fair-vary", "fair --vary", &vary);
     document_designs(&mut c);
-    c.finish(&["fair", "fair-vary", "design"]);
+    c.finish(&["fair", "fair-vary", "design", "design-facets"]);
 }
 
 /// `design`'s documents: a coin's thickness for a target by label, a named target over a die
@@ -622,6 +622,29 @@ fn document_designs(c: &mut Checker) {
     ]
     .concat());
     c.document("design", "design --fit", &calibrated);
+    // A die's facets designed for 2d6, in one tiny round.
+    let die = crate::design::v1_numbers(&dir);
+    let facets = run(&[
+        "design",
+        "--die",
+        &die,
+        "--free",
+        "facets",
+        "--range",
+        "facets=-1:1",
+        "--target",
+        "2d6",
+        "--rolls",
+        "40",
+        "--rounds",
+        "1",
+        "--check-rolls",
+        "40",
+        "--threads",
+        "1",
+        "--json",
+    ]);
+    c.document("design-facets", "design --free facets", &facets);
 }
 
 /// A made die, every feature (its spec carries them), rolled; and fair's precision of the

@@ -26,6 +26,7 @@
 //! calibration ([`calibrated`]: `--fit`).
 
 pub mod calibrated;
+pub mod mesh;
 pub mod named;
 
 use crate::error::{Error, Field, Result};
