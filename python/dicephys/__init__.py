@@ -77,6 +77,8 @@ DEFAULT_ENGINES: Tuple[str, ...] = tuple(_native.DEFAULT_ENGINES)
 DEFAULT_DESIGN_ROLLS: int = _native.DEFAULT_DESIGN_ROLLS
 DEFAULT_DESIGN_POINTS: int = _native.DEFAULT_DESIGN_POINTS
 DEFAULT_CHECK_ROLLS: int = _native.DEFAULT_CHECK_ROLLS
+DEFAULT_FACETS_ROLLS: int = _native.DEFAULT_FACETS_ROLLS
+DEFAULT_FACETS_ROUNDS: int = _native.DEFAULT_FACETS_ROUNDS
 
 
 class Value(NamedTuple):
@@ -1060,8 +1062,11 @@ class Design(Document):
     """``design``'s result: ``dicephys design --json``'s document (docs/json.md, "design
     --json"): ``value`` and ``interval`` (mm), ``outcomes``, ``check`` (the design rolled at a
     fresh seed), ``quasi_static``, ``reachable``, ``verdict``; ``config.named_target`` and
-    ``config.calibration`` where a named target or a fit was given. ``summary()`` is the text
-    the command line prints."""
+    ``config.calibration`` where a named target or a fit was given. A design of a die's facets
+    (``free="facets"``, "design --free facets --json") has ``rounds``, the mesh
+    (``vertices``, ``triangles``, ``faces``), ``check`` and ``start_check`` (and ``by_class``
+    for 2d6) in place of ``value`` and ``interval``. ``summary()`` is the text the command line
+    prints."""
 
     def __init__(self, text: str, human: str) -> None:
         super().__init__(text)
@@ -1073,6 +1078,8 @@ class Design(Document):
 
     def __repr__(self) -> str:
         d = self.data
+        if "interval" not in d:
+            return f"Design(facets moved up to {d['largest_move']:.3f} mm; {d['verdict']})"
         lo, hi = d["interval"]
         what = d["config"]["what"]
         return f"Design({what} = {d['value']:.3f} mm (95 %: {lo:.3f} to {hi:.3f}); {d['verdict']})"
@@ -1084,9 +1091,10 @@ def design(
     free: str,
     range: Tuple[float, float],
     target: Union[str, Mapping[str, float]],
-    points: int = DEFAULT_DESIGN_POINTS,
+    points: Optional[int] = None,
     check_rolls: int = DEFAULT_CHECK_ROLLS,
-    rolls: int = DEFAULT_DESIGN_ROLLS,
+    rolls: Optional[int] = None,
+    rounds: Optional[int] = None,
     fit: Union[None, Fit, PathLike] = None,
     surface: Optional[str] = None,
     thrower: Optional[str] = None,
@@ -1105,12 +1113,18 @@ def design(
         (``shape``, ``die``, ``com``, ``seed``, ``engine``, ``throw`` …; thrown in a tumble
         unless ``throw`` says otherwise).
     free: the feature: ``thickness`` (a coin's), ``length`` (a block's), ``com_x``, ``com_y``,
-        ``com_z``, ``pip_depth`` or ``edge_radius``; mm.
+        ``com_z``, ``pip_depth`` or ``edge_radius``; mm. Or ``facets``: a convex die's shape
+        (``die=`` a die file, or a named polyhedron), each facet moved and tilted within
+        ``range`` of its start; the result then has no ``value`` but the design's mesh
+        (``vertices``, ``triangles``, ``faces``) and the rounds of throws that made it.
     range: its (LO, HI), mm, fixed before the search.
     target: ``"LABEL=P,…"`` or a mapping label → probability, summing to 1 (``rest`` gathers
         every label not named); or a named law over a die whose labels are its numbers,
         ``"2d6"`` or ``"binomial:N"``.
-    rolls, points: throws at each value of a scan, and values each of the two scans rolls.
+    rolls, points: throws at each value of a scan (default ``DEFAULT_DESIGN_ROLLS``), and
+        values each of the two scans rolls (``DEFAULT_DESIGN_POINTS``); with ``facets``,
+        ``rolls`` is the throws of each of ``rounds`` rounds (``DEFAULT_FACETS_ROLLS``,
+        ``DEFAULT_FACETS_ROUNDS``).
     fit: design under a fit's calibration (a ``Fit`` or its fit.json's path): its e, μ,
         rolling resistance and throw at its maximum, the die this one; ``surface`` and
         ``thrower`` pick its values where it has several. The scene and throw options are then
@@ -1138,7 +1152,8 @@ def design(
     try:
         text, human = _native.design(
             block, free=free, range=lo_hi, target=target, points=points,
-            check_rolls=check_rolls, rolls=rolls, fit=fit_text, fit_name=fit_name,
+            check_rolls=check_rolls, rolls=rolls, rounds=rounds, fit=fit_text,
+            fit_name=fit_name,
             surface=surface, thrower=thrower, out=None if out is None else os.fspath(out),
             threads=threads, progress=tell, **options,
         )

@@ -22,6 +22,8 @@ DEFAULT_ENGINES: List[str]
 DEFAULT_DESIGN_ROLLS: int
 DEFAULT_DESIGN_POINTS: int
 DEFAULT_CHECK_ROLLS: int
+DEFAULT_FACETS_ROLLS: int
+DEFAULT_FACETS_ROUNDS: int
 
 _Progress = Optional[Callable[[float, float], Any]]
 _Log = Optional[Callable[[str], Any]]

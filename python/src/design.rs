@@ -7,6 +7,7 @@ use dicephys::model::faces::Layout;
 use dicephys::model::throws::ThrowStyle;
 use dicephys::run::request::RollRequest;
 use dicephys::run::runner::Runner;
+use dicephys::studies::design::mesh::{self, MeshConfig};
 use dicephys::studies::design::named::Named;
 use dicephys::studies::design::{self as design_, DesignConfig};
 use dicephys::studies::fair::{Null, Varied};
@@ -82,7 +83,11 @@ pub fn design<'py>(
     let progress = o.object("progress")?;
     let cfg = config(block, o)?;
     // The range is `range` here (a fit's are `ranges`).
-    design_::check(&cfg).map_err(|e| match e {
+    let checked = match &cfg {
+        Config::Feature(c) => design_::check(c).map(|_| ()),
+        Config::Facets(c) => mesh::check(c),
+    };
+    checked.map_err(|e| match e {
         Error::Field {
             field: dicephys::error::Field::Range,
             value,
@@ -94,37 +99,91 @@ pub fn design<'py>(
         let _held = match &out {
             Some(dir) => {
                 std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-                Some(design_::claim(dir, &cfg)?)
+                Some(match &cfg {
+                    Config::Feature(c) => design_::claim(dir, c)?,
+                    Config::Facets(c) => mesh::claim(dir, c)?,
+                })
             }
             None => None,
         };
-        let total = (cfg.spec.rolls * 2 * cfg.points as u64 + cfg.check_rolls) as f64;
+        let total = match &cfg {
+            Config::Feature(c) => c.spec.rolls * 2 * c.points as u64 + c.check_rolls,
+            Config::Facets(c) => c.spec.rolls * (c.rounds as u64 + 1) + 2 * c.check_rolls,
+        } as f64;
         let tell = |n: u64| session.set(n as f64, total);
         let runner = Runner::new(threads, session.stop.clone());
         let runner = runner.with_progress(&tell);
-        let d = design_::run(&cfg, &runner)?.ok_or(Error::Stopped)?;
-        let json = dicephys::run::seal::to_string(&d, true)?;
-        if let Some(dir) = &out {
-            design_::write(dir, &json, &d)?;
+        match &cfg {
+            Config::Feature(c) => {
+                let d = design_::run(c, &runner)?.ok_or(Error::Stopped)?;
+                let json = dicephys::run::seal::to_string(&d, true)?;
+                if let Some(dir) = &out {
+                    design_::write(dir, &json, &d)?;
+                }
+                Ok((json, d.text()))
+            }
+            Config::Facets(c) => {
+                let d = mesh::run(c, &runner)?.ok_or(Error::Stopped)?;
+                let json = dicephys::run::seal::to_string(&d, true)?;
+                if let Some(dir) = &out {
+                    mesh::write(dir, &json, &d)?;
+                }
+                Ok((json, d.text()))
+            }
         }
-        Ok((json, d.text()))
     })
+}
+
+/// Refuses `points` beside the facets (they roll rounds) and `rounds` beside a feature (it
+/// scans).
+fn scans_or_rounds(facets: bool, points: Option<usize>, rounds: Option<usize>) -> PyResult<()> {
+    match (facets, points, rounds) {
+        (true, Some(_), _) => Err(bad(
+            "points",
+            "…",
+            "a design of the facets rolls rounds (rounds), not scans",
+        )),
+        (false, _, Some(_)) => Err(bad(
+            "rounds",
+            "…",
+            "only free='facets' rolls rounds; a feature's design scans (points)",
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// What a design designs: one feature, or a convex die's facets.
+enum Config {
+    Feature(DesignConfig),
+    Facets(MeshConfig),
 }
 
 /// The design the options ask for (every one read: any other is refused): the die and its
 /// scene by `roll`'s names, or in a fit's calibration; the target set over its labels.
-fn config(block: Option<&str>, o: Options) -> PyResult<DesignConfig> {
+fn config(block: Option<&str>, o: Options) -> PyResult<Config> {
     let free = o
         .maybe::<String>("free")?
         .ok_or_else(|| bad("free", "None", "name the feature to design"))?;
-    let what: Varied = named("free", "feature", &free)?;
+    let facets = free.trim() == mesh::FACETS;
+    let what: Option<Varied> = if facets {
+        None
+    } else {
+        Some(named("free", "feature", &free)?)
+    };
     let range = o
         .maybe::<(f64, f64)>("range")?
         .ok_or_else(|| bad("range", "None", "give (LO, HI), mm"))?;
     let target = o
         .maybe::<String>("target")?
         .ok_or_else(|| bad("target", "None", "give the probabilities wanted"))?;
-    let points = o.get("points", design_::DEFAULT_POINTS)?;
+    let points = o.maybe::<usize>("points")?;
+    let rounds = o.maybe::<usize>("rounds")?;
+    scans_or_rounds(facets, points, rounds)?;
+    let default_rolls = if facets {
+        mesh::DEFAULT_ROLLS
+    } else {
+        design_::DEFAULT_ROLLS
+    };
     let check_rolls = o.get("check_rolls", design_::DEFAULT_CHECK_ROLLS)?;
     let fit = o.maybe::<String>("fit")?;
     let fit_name = o.get("fit_name", "fit".to_string())?;
@@ -153,7 +212,7 @@ fn config(block: Option<&str>, o: Options) -> PyResult<DesignConfig> {
             Some(e) => named::<EngineKind>("engine", "engine", &e)?,
             None => RollRequest::default().engine,
         },
-        rolls: Some(o.get("rolls", design_::DEFAULT_ROLLS)?),
+        rolls: Some(o.maybe::<u64>("rolls")?.unwrap_or(default_rolls)),
         to_precision: false,
         shard: None,
     };
@@ -172,15 +231,27 @@ fn config(block: Option<&str>, o: Options) -> PyResult<DesignConfig> {
         None => None,
     };
     let (target, named_target) = target_of(&target, &spec, layout)?;
-    Ok(DesignConfig {
-        layout,
-        spec,
-        what,
-        range: [range.0, range.1],
-        target,
-        points,
-        check_rolls,
-        named_target,
-        calibration,
+    Ok(match what {
+        Some(what) => Config::Feature(DesignConfig {
+            layout,
+            spec,
+            what,
+            range: [range.0, range.1],
+            target,
+            points: points.unwrap_or(design_::DEFAULT_POINTS),
+            check_rolls,
+            named_target,
+            calibration,
+        }),
+        None => Config::Facets(MeshConfig {
+            layout,
+            spec,
+            range: [range.0, range.1],
+            target,
+            rounds: rounds.unwrap_or(mesh::DEFAULT_ROUNDS),
+            check_rolls,
+            named_target,
+            calibration,
+        }),
     })
 }

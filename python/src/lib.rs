@@ -1197,6 +1197,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_DESIGN_ROLLS", design_::DEFAULT_ROLLS)?;
     m.add("DEFAULT_DESIGN_POINTS", design_::DEFAULT_POINTS)?;
     m.add("DEFAULT_CHECK_ROLLS", design_::DEFAULT_CHECK_ROLLS)?;
+    m.add("DEFAULT_FACETS_ROLLS", design_::mesh::DEFAULT_ROLLS)?;
+    m.add("DEFAULT_FACETS_ROUNDS", design_::mesh::DEFAULT_ROUNDS)?;
     let engines: Vec<String> = dicephys::studies::paper::DEFAULT_ENGINES
         .iter()
         .map(|e| e.to_string())

@@ -545,3 +545,25 @@ def test_design_is_the_cli_s_design_with_a_named_target_and_a_fit(tmp_path: Path
         dicephys.design("16x16x16", target="2d6", **kw)
     with pytest.raises(ValueError, match="friction"):
         dicephys.design("16x16x16", target="1=1/4,rest=3/4", fit=fit, friction=0.3, **kw)
+
+
+def test_a_design_of_a_dies_facets_is_the_cli_s(tmp_path: Path) -> None:
+    # Issue 73, the mesh family: V1 numbered (tests/data's mesh), its facets designed for 2d6
+    # in one small round; the same document as the command line's, its die file written.
+    root = Path(__file__).resolve().parents[2]
+    text = (root / "docs/results/real-dice/v1-numbers.toml").read_text()
+    mesh = root / "tests/data/hendecahedron_v1.obj"
+    die = tmp_path / "v1.toml"
+    die.write_text("\n".join(f'mesh = "{mesh}"' if line.startswith("mesh = ") else line
+                             for line in text.splitlines()))
+    args = ("--die", str(die), "--free", "facets", "--range", "facets=-2:2", "--target", "2d6",
+            "--rolls", "100", "--rounds", "1", "--check-rolls", "100", "--seed", "1")
+    want = cli("design", *args, "--json")
+    got = dicephys.design(die=die, free="facets", range=(-2, 2), target="2d6", rolls=100,
+                          rounds=1, check_rolls=100, seed=1, threads=2, out=tmp_path / "d")
+    assert got.data == want
+    assert repr(got).startswith("Design(facets moved up to ")
+    assert len(got.data["faces"]) == 11 and got.data["by_class"]["check"]["dof"] == 5
+    assert (tmp_path / "d" / "design.toml").is_file() and (tmp_path / "d" / "design.obj").is_file()
+    with pytest.raises(ValueError, match="not scans"):
+        dicephys.design(die=die, free="facets", range=(-2, 2), target="2d6", points=3)
