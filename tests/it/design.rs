@@ -683,3 +683,75 @@ fn what_a_facets_design_cannot_be_is_refused_in_one_line() {
         "only --free facets rolls rounds",
     );
 }
+
+/// A coin designed under a fit that measured no rolling resistance (a cube's, thrown in a
+/// tumble) keeps the coin's own, 0.05 mm on Bullet: with the fit's 0, a coin rolling on its
+/// rim never stops and every such roll runs to the step cap (a design of hours, not seconds).
+#[test]
+fn a_coin_under_a_fit_without_rolling_resistance_keeps_its_own() {
+    let dir = Scratch::new("design-coin-fit");
+    let csv = dir.join("cube.csv");
+    std::fs::write(
+        &csv,
+        "label,surface,length_mm,breadth_mm,width_mm,mode,face_1,face_2,face_3,face_4,face_5,\
+         face_6\nd,felt,16,16,16,3d,170,160,170,165,170,165\n",
+    )
+    .unwrap();
+    let out = dir.join("fit");
+    let fit = dicephys(&[
+        "fit",
+        "--data",
+        csv.to_str().unwrap(),
+        "--free",
+        "mu",
+        "--restitution",
+        "0.9",
+        "--points",
+        "6",
+        "--rolls",
+        "100",
+        "--degree",
+        "1",
+        "--no-refine",
+        "--dt",
+        "1/250",
+        "--throw",
+        "tumble",
+        "--seed",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(fit.status.success(), "{}", stderr(&fit));
+    let fit_json = out.join("fit.json");
+    let v = json(&dicephys(&[
+        "design",
+        "--shape",
+        "coin:24,10",
+        "--free",
+        "thickness",
+        "--range",
+        "thickness=6:14",
+        "--target",
+        "heads=1/3,tails=1/3,edge=1/3",
+        "--fit",
+        fit_json.to_str().unwrap(),
+        "--rolls",
+        "100",
+        "--points",
+        "3",
+        "--check-rolls",
+        "200",
+        "--threads",
+        "2",
+        "--seed",
+        "1",
+        "--json",
+    ]));
+    assert_eq!(v["config"]["calibration"]["values"]["rolling"], 0.05);
+    assert_eq!(v["config"]["spec"]["scene"]["rolling_resistance"], 5e-5);
+    assert_eq!(
+        v["check"]["n"], 200,
+        "every check roll at rest on a face or the edge"
+    );
+}

@@ -3,6 +3,8 @@
 //! the fit's, as `predict --die` carries a calibration to a die it never saw
 //! (`calibration::other_die`).
 //!
+//! A coin keeps its own rolling resistance (0.05 mm on Bullet) where the fit measured none.
+//!
 //! The design takes the fit at its maximum (its best values), not at its posterior draws: the
 //! design's interval is the simulation's error at those values, and the calibration's own
 //! uncertainty is not carried into it (`predict` carries it, for one die).
@@ -53,7 +55,21 @@ pub fn calibrated(
     // A new row's coordinates, as `predict` builds them: the fit's parameters of this surface
     // and thrower, at the fit's maximum.
     let row = FitResult::new_row(&surface, &thrower, spec.scene.block, spec.scene.mode);
-    let values = without_die_params(fit.values_at(&row, &fit.estimate.x));
+    let mut values = without_die_params(fit.values_at(&row, &fit.estimate.x));
+    // A coin keeps its own rolling resistance where the fit measured none (not free, and 0:
+    // its dice's default, not a finding): with none, a coin rolling on its rim never stops,
+    // and every roll that ends there runs to the step cap.
+    let coin_engine = fit.config.method.engine == crate::engine::EngineKind::Bullet;
+    if spec.scene.is_coin()
+        && coin_engine
+        && values.rolling == 0.0
+        && !fit
+            .config
+            .model
+            .is_free(crate::calibration::params::Kind::Rolling)
+    {
+        values.rolling = crate::model::scene::COIN_ROLLING_RESISTANCE * 1e3;
+    }
     let method = die.method(&fit.config.method);
     let out = method.spec(
         spec.scene.block,
