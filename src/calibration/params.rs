@@ -632,6 +632,11 @@ impl Method {
         scene.restitution = v.e;
         scene.friction = v.mu;
         scene.rolling_resistance = v.rolling / 1000.0;
+        // A coin on Bullet at 0 takes its own default, as `roll` gives it one: with none, a
+        // coin rolling on its rim never stops (a fit's 0 is no rolling resistance measured).
+        if v.rolling == 0.0 && scene.is_coin() && self.engine == crate::engine::EngineKind::Bullet {
+            scene.rolling_resistance = crate::model::scene::COIN_ROLLING_RESISTANCE;
+        }
         scene.bounce_threshold = v.bounce;
         scene.features = self.die_at(v);
         if let Some(d) = self.density {

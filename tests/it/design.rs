@@ -685,8 +685,9 @@ fn what_a_facets_design_cannot_be_is_refused_in_one_line() {
 }
 
 /// A coin designed under a fit that measured no rolling resistance (a cube's, thrown in a
-/// tumble) keeps the coin's own, 0.05 mm on Bullet: with the fit's 0, a coin rolling on its
-/// rim never stops and every such roll runs to the step cap (a design of hours, not seconds).
+/// tumble) keeps the coin's own, 0.05 mm on Bullet, and so does a prediction for it: with the
+/// fit's 0, a coin rolling on its rim never stops and every such roll runs to the step cap
+/// (unsettled; a design of hours, not seconds).
 #[test]
 fn a_coin_under_a_fit_without_rolling_resistance_keeps_its_own() {
     let dir = Scratch::new("design-coin-fit");
@@ -754,4 +755,22 @@ fn a_coin_under_a_fit_without_rolling_resistance_keeps_its_own() {
         v["check"]["n"], 200,
         "every check roll at rest on a face or the edge"
     );
+    // `predict` carries the same fit to the coin the same way: every roll comes to rest.
+    let p = json(&dicephys(&[
+        "predict",
+        "--fit",
+        fit_json.to_str().unwrap(),
+        "--shape",
+        "coin:24,10",
+        "--draws",
+        "2",
+        "--rolls",
+        "50",
+        "--threads",
+        "1",
+        "--seed",
+        "1",
+        "--json",
+    ]));
+    assert_eq!(p["unsettled"], 0);
 }
