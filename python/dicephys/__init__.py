@@ -1112,7 +1112,8 @@ def design(
     block: the die as ``roll`` takes it, with ``roll``'s options by name in ``options``
         (``shape``, ``die``, ``com``, ``seed``, ``engine``, ``throw`` …; thrown in a tumble
         unless ``throw`` says otherwise).
-    free: the feature: ``thickness`` (a coin's), ``length`` (a block's), ``com_x``, ``com_y``,
+    free: the feature: ``thickness`` (a coin's), ``length`` (a block's or a prism's),
+        ``breadth``, ``width`` (a block's), ``com_x``, ``com_y``,
         ``com_z``, ``pip_depth`` or ``edge_radius``; mm. Or ``facets``: a convex die's shape
         (``die=`` a die file, or a named polyhedron), each facet moved and tilted within
         ``range`` of its start; the result then has no ``value`` but the design's mesh

@@ -38,7 +38,8 @@ pub struct DesignArgs {
     #[command(flatten)]
     pub roll: RollArgs,
     /// The feature to design: thickness (a coin's, --shape coin:D,H), length (a block's,
-    /// --block), com_x, com_y, com_z (the centre of mass), pip_depth or edge_radius; mm. Or
+    /// --block, or a prism's, --shape prism:N,D,L), breadth or width (a block's), com_x,
+    /// com_y, com_z (the centre of mass), pip_depth or edge_radius; mm. Or
     /// facets: a convex die's shape (--die FILE, --mesh or a named polyhedron), each facet's
     /// plane moved and tilted within --range of its start's, a mirror symmetry about x = 0
     /// kept.

@@ -69,8 +69,8 @@ pub struct FairArgs {
     #[arg(long, value_name = "DIR")]
     pub out: Option<std::path::PathBuf>,
     /// How a feature of the die biases it: the die rolled at N values of NAME from LO to HI
-    /// (mm; NAME com_x, com_y, com_z, pip_depth, edge_radius, thickness (a coin) or length (a
-    /// block)), the same throws at each,
+    /// (mm; NAME com_x, com_y, com_z, pip_depth, edge_radius, thickness (a coin), length (a
+    /// block or a prism), breadth or width (a block)), the same throws at each,
     /// each judged; with --out, the figure bias.svg, .png (each face's probability against
     /// the value, the null beside it) and bias.json.
     #[arg(long, value_name = "NAME=LO:HI:N", conflicts_with_all = ["checkpoint", "resume", "precision", "within", "per_roll", "shard"])]

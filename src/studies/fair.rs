@@ -629,8 +629,13 @@ pub enum Varied {
     EdgeRadius,
     /// A coin's (a cylinder's) thickness, mm, its diameter kept (`--shape coin:D,H`).
     Thickness,
-    /// A block's length, mm, its breadth and width kept (`--block`).
+    /// A block's length, mm, its breadth and width kept (`--block`); or a prism's length, its
+    /// sides and breadth kept (`--shape prism:N,D,L`).
     Length,
+    /// A block's breadth, mm, its length and width kept.
+    Breadth,
+    /// A block's width, mm, its length and breadth kept.
+    Width,
 }
 
 impl Varied {
@@ -656,17 +661,32 @@ impl Varied {
                         .map_err(|e| at(&e.to_string()))?;
                 s.shape = Some(std::sync::Arc::new(coin));
             }
-            Varied::Length => {
-                if scene.shape.is_some() {
-                    return Err(at("the die is not a block: give --block LxBxW"));
+            Varied::Length | Varied::Breadth | Varied::Width => match scene.shape.as_deref() {
+                None => {
+                    let b = &scene.block;
+                    let mut sides = [b.length, b.breadth, b.width].map(|v| v * 1e3);
+                    sides[self as usize - Varied::Length as usize] = mm;
+                    s.block = crate::model::block::Block::from_mm(sides[0], sides[1], sides[2])
+                        .map_err(|e| at(&e.to_string()))?;
                 }
-                s.block = crate::model::block::Block::from_mm(
-                    mm,
-                    scene.block.breadth * 1e3,
-                    scene.block.width * 1e3,
-                )
-                .map_err(|e| at(&e.to_string()))?;
-            }
+                Some(shape) if self == Varied::Length && shape.name.starts_with("prism:") => {
+                    // prism:N,D,L: its sides and breadth kept, its length this.
+                    let args: Vec<&str> = shape.name["prism:".len()..].split(',').collect();
+                    let prism = crate::model::shape::named(
+                        &format!("prism:{},{},{mm}", args[0], args[1]),
+                        None,
+                    )
+                    .map_err(|e| at(&e.to_string()))?;
+                    s.shape = Some(std::sync::Arc::new(prism));
+                }
+                Some(_) if self == Varied::Length => {
+                    return Err(at(
+                        "the die is not a block or a prism: give --block LxBxW or --shape \
+                         prism:N,D,L",
+                    ))
+                }
+                Some(_) => return Err(at("the die is not a block: give --block LxBxW")),
+            },
             _ => s.features = self.set(&scene.features, mm)?,
         }
         Ok(s)
@@ -677,11 +697,13 @@ impl Varied {
     pub fn set(self, features: &Features, mm: f64) -> Result<Features> {
         let m = mm / 1000.0;
         match self {
-            Varied::Thickness | Varied::Length => Err(Error::field(
-                Field::Vary,
-                self.to_string(),
-                "is the die's shape, not a feature",
-            )),
+            Varied::Thickness | Varied::Length | Varied::Breadth | Varied::Width => {
+                Err(Error::field(
+                    Field::Vary,
+                    self.to_string(),
+                    "is the die's shape, not a feature",
+                ))
+            }
             Varied::ComX | Varied::ComY | Varied::ComZ => {
                 Ok(features.with_com_on(self as usize, m))
             }

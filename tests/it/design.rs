@@ -774,3 +774,78 @@ fn a_coin_under_a_fit_without_rolling_resistance_keeps_its_own() {
     ]));
     assert_eq!(p["unsettled"], 0);
 }
+
+/// A block's breadth and width and a prism's length are families too (issue 73's list): a
+/// 16 mm cube's width set so that its ±y faces come up 1/2 of the time (a flatter block; the
+/// width lands below 16 mm), and a hexagonal prism's length so that its ends come up 1/4 of the
+/// time, each found inside its range; a breadth asked of a prism is refused in one line.
+#[test]
+fn a_blocks_breadth_and_width_and_a_prisms_length_are_designed() {
+    let small = [
+        "--rolls",
+        "300",
+        "--points",
+        "4",
+        "--check-rolls",
+        "400",
+        "--threads",
+        "2",
+        "--seed",
+        "1",
+        "--json",
+    ];
+    let width = json(&dicephys(
+        &[
+            &[
+                "design",
+                "--block",
+                "16x16x16",
+                "--free",
+                "width",
+                "--range",
+                "width=8:16",
+                "--target",
+                "3=1/4,4=1/4,rest=1/2",
+            ][..],
+            &small,
+        ]
+        .concat(),
+    ));
+    let w = width["value"].as_f64().unwrap();
+    assert!(w > 8.0 && w < 16.0, "{w}");
+    assert_eq!(width["config"]["what"], "width");
+    let prism = json(&dicephys(
+        &[
+            &[
+                "design",
+                "--shape",
+                "prism:6,16,20",
+                "--free",
+                "length",
+                "--range",
+                "length=8:40",
+                "--target",
+                "top=1/8,bottom=1/8,rest=3/4",
+            ][..],
+            &small,
+        ]
+        .concat(),
+    ));
+    let l = prism["value"].as_f64().unwrap();
+    assert!(l > 8.0 && l < 40.0, "{l}");
+    refused(
+        &dicephys(&[
+            "design",
+            "--shape",
+            "prism:6,16,20",
+            "--free",
+            "breadth",
+            "--range",
+            "breadth=8:20",
+            "--target",
+            "top=1/8,bottom=1/8,rest=3/4",
+        ]),
+        2,
+        "the die is not a block",
+    );
+}
