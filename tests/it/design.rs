@@ -191,7 +191,13 @@ pub fn v1_classes(dir: &Scratch) -> String {
         ([0.571414, 0.023049, 0.820338], "2|12"),
         ([-0.571414, 0.023049, 0.820338], "2|12"),
     ];
-    let labels: Vec<String> = classes
+    v1_labelled(dir, "v1.toml", &classes)
+}
+
+/// V1 (tests/data) at 24 mm, read down, its resting facets labelled by `labels` (outward
+/// normal, label): a die file `name` written into `dir`.
+fn v1_labelled(dir: &Scratch, name: &str, labels: &[([f64; 3], &str)]) -> String {
+    let labels: Vec<String> = labels
         .iter()
         .map(|(n, l)| {
             format!(
@@ -200,7 +206,7 @@ pub fn v1_classes(dir: &Scratch) -> String {
             )
         })
         .collect();
-    let path = dir.join("v1.toml");
+    let path = dir.join(name);
     std::fs::write(
         &path,
         format!(
@@ -217,6 +223,11 @@ pub fn v1_classes(dir: &Scratch) -> String {
 /// A fit of a 16 mm cube's faces on felt (1,000 throws, near fair), its μ free and e held at
 /// 0.9 (far from the default scene's 0.5), one small pass at dt = 1/250: its fit.json.
 pub fn cube_fit(dir: &Scratch) -> String {
+    cube_fit_with(dir, &[])
+}
+
+/// `cube_fit` with `extra` flags (`--throw tumble`).
+fn cube_fit_with(dir: &Scratch, extra: &[&str]) -> String {
     let csv = dir.join("cube.csv");
     std::fs::write(
         &csv,
@@ -225,31 +236,37 @@ pub fn cube_fit(dir: &Scratch) -> String {
     )
     .unwrap();
     let out = dir.join("fit");
-    json(&dicephys(&[
-        "fit",
-        "--data",
-        csv.to_str().unwrap(),
-        "--free",
-        "mu",
-        "--restitution",
-        "0.9",
-        "--points",
-        "6",
-        "--rolls",
-        "100",
-        "--degree",
-        "1",
-        "--no-refine",
-        "--dt",
-        "1/250",
-        "--seed",
-        "1",
-        "--threads",
-        "1",
-        "--out",
-        out.to_str().unwrap(),
-        "--json",
-    ]));
+    json(&dicephys(
+        &[
+            "fit",
+            "--data",
+            csv.to_str().unwrap(),
+            "--free",
+            "mu",
+            "--restitution",
+            "0.9",
+            "--points",
+            "6",
+            "--rolls",
+            "100",
+            "--degree",
+            "1",
+            "--no-refine",
+            "--dt",
+            "1/250",
+            "--seed",
+            "1",
+            "--threads",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+            "--json",
+        ]
+        .iter()
+        .chain(extra)
+        .copied()
+        .collect::<Vec<_>>(),
+    ));
     out.join("fit.json").display().to_string()
 }
 
@@ -497,27 +514,7 @@ pub fn v1_numbers(dir: &Scratch) -> String {
         ([-0.571414, 0.023049, 0.820338], "2"),
         ([0.571414, 0.023049, 0.820338], "12"),
     ];
-    let labels: Vec<String> = numbers
-        .iter()
-        .map(|(n, l)| {
-            format!(
-                "  {{ normal = [{}, {}, {}], label = \"{l}\" }},",
-                n[0], n[1], n[2]
-            )
-        })
-        .collect();
-    let path = dir.join("v1-numbers.toml");
-    std::fs::write(
-        &path,
-        format!(
-            "mesh = \"{}/tests/data/hendecahedron_v1.obj\"\nscale = 14.821972\nreads = \"down\"\n\
-             labels = [\n{}\n]\n",
-            env!("CARGO_MANIFEST_DIR"),
-            labels.join("\n")
-        ),
-    )
-    .unwrap();
-    path.display().to_string()
+    v1_labelled(dir, "v1-numbers.toml", &numbers)
 }
 
 /// A design of V1's facets for 2d6, in one small round (300 throws a round and a check): the
@@ -691,40 +688,7 @@ fn what_a_facets_design_cannot_be_is_refused_in_one_line() {
 #[test]
 fn a_coin_under_a_fit_without_rolling_resistance_keeps_its_own() {
     let dir = Scratch::new("design-coin-fit");
-    let csv = dir.join("cube.csv");
-    std::fs::write(
-        &csv,
-        "label,surface,length_mm,breadth_mm,width_mm,mode,face_1,face_2,face_3,face_4,face_5,\
-         face_6\nd,felt,16,16,16,3d,170,160,170,165,170,165\n",
-    )
-    .unwrap();
-    let out = dir.join("fit");
-    let fit = dicephys(&[
-        "fit",
-        "--data",
-        csv.to_str().unwrap(),
-        "--free",
-        "mu",
-        "--restitution",
-        "0.9",
-        "--points",
-        "6",
-        "--rolls",
-        "100",
-        "--degree",
-        "1",
-        "--no-refine",
-        "--dt",
-        "1/250",
-        "--throw",
-        "tumble",
-        "--seed",
-        "1",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(fit.status.success(), "{}", stderr(&fit));
-    let fit_json = out.join("fit.json");
+    let fit_json = std::path::PathBuf::from(cube_fit_with(&dir, &["--throw", "tumble"]));
     let v = json(&dicephys(&[
         "design",
         "--shape",

@@ -71,6 +71,17 @@ pub struct MeshConfig {
     pub calibration: Option<Calibration>,
 }
 
+impl MeshConfig {
+    /// The start die's name.
+    fn die_name(&self) -> &str {
+        self.spec
+            .scene
+            .shape
+            .as_ref()
+            .map_or("the die", |s| s.name.as_str())
+    }
+}
+
 /// One shape thrown: its quasi-static shares and its throws' per target outcome.
 #[derive(Clone, Debug, Serialize)]
 pub struct Round {
@@ -700,11 +711,7 @@ impl MeshDesign {
             s,
             "design: the facets of {} ({}, {}), each moved and tilted {}–{} mm{}; {} rounds of \
              {} throws, the check {} throws at a fresh seed",
-            c.spec
-                .scene
-                .shape
-                .as_ref()
-                .map_or("the die", |s| s.name.as_str()),
+            c.die_name(),
             c.spec.engine.name(),
             c.spec.throws.style,
             c.range[0],
@@ -773,18 +780,12 @@ impl MeshDesign {
 
     /// The design figure's bars, as a feature's.
     pub fn bars(&self) -> Vec<crate::report::figures::design::DesignBar> {
-        let ch = &self.check;
-        self.outcomes
-            .iter()
-            .enumerate()
-            .map(|(k, o)| crate::report::figures::design::DesignBar {
-                label: o.clone(),
-                target: self.config.target[k].1,
-                p: ch.p[k],
-                err: ch.err[k].hypot(ch.design_err[k]),
-                quasi_static: Some(self.quasi_static[k]),
-            })
-            .collect()
+        super::bars(
+            &self.outcomes,
+            &self.config.target,
+            &self.check,
+            Some(&self.quasi_static),
+        )
     }
 
     /// The design's mesh as OBJ, mm.
@@ -840,11 +841,7 @@ pub fn write(dir: &std::path::Path, json: &str, d: &MeshDesign) -> Result<()> {
     let c = &d.config;
     let title = format!(
         "the facets of {}, {}, {}: {} fresh throws",
-        c.spec
-            .scene
-            .shape
-            .as_ref()
-            .map_or("the die", |s| s.name.as_str()),
+        c.die_name(),
         c.spec.engine.name(),
         c.spec.throws.style,
         d.check.n

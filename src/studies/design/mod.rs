@@ -679,19 +679,34 @@ impl Design {
     /// The design figure's bars: per outcome, the target, the check's share with its error
     /// (binomial and the design's own together) and the quasi-static share.
     pub fn bars(&self) -> Vec<crate::report::figures::design::DesignBar> {
-        let ch = &self.check;
-        self.outcomes
-            .iter()
-            .enumerate()
-            .map(|(k, o)| crate::report::figures::design::DesignBar {
-                label: o.clone(),
-                target: self.config.target[k].1,
-                p: ch.p[k],
-                err: ch.err[k].hypot(ch.design_err[k]),
-                quasi_static: self.quasi_static.as_ref().map(|q| q[k]),
-            })
-            .collect()
+        bars(
+            &self.outcomes,
+            &self.config.target,
+            &self.check,
+            self.quasi_static.as_deref(),
+        )
     }
+}
+
+/// The design figure's bars of `outcomes`: per outcome the target, the check's share with its
+/// error (binomial and the design's own together) and the quasi-static share, if any.
+fn bars(
+    outcomes: &[String],
+    target: &[(String, f64)],
+    ch: &Check,
+    quasi_static: Option<&[f64]>,
+) -> Vec<crate::report::figures::design::DesignBar> {
+    outcomes
+        .iter()
+        .enumerate()
+        .map(|(k, o)| crate::report::figures::design::DesignBar {
+            label: o.clone(),
+            target: target[k].1,
+            p: ch.p[k],
+            err: ch.err[k].hypot(ch.design_err[k]),
+            quasi_static: quasi_static.map(|q| q[k]),
+        })
+        .collect()
 }
 
 /// The die, in a few words.
