@@ -709,13 +709,15 @@ fn the_same_counts_from_three_first_boxes_at_three_seeds_give_one_estimate() {
 }
 
 /// Issue 49's held-out check: blocks counted at a known e and μ (the paper's throw, 2D, 2,000
-/// throws each), three fitted and three others predicted by `predict --blocks-file`, 24 times
-/// over (seeds 1–24, each its own counts, designs and predictions). A prediction's error holds
+/// throws each), three fitted and three others predicted by `predict --blocks-file`, 16 times
+/// over (seeds 1–16, each its own counts, designs and predictions). A prediction's error holds
 /// the fit's uncertainty and the simulation's, so each held-out χ² (on 3) should fall inside
 /// χ²₃'s two-sided 95 % band (p in 0.025–0.975) 95 % of the time, and their mean near 3.
-/// Measured: 22 of 24, mean 2.77 (40 repetitions: 38, mean 2.37). At 20 of 24 the binomial's
+/// Measured: 22 of 24, mean 2.77 (40 repetitions: 38, mean 2.37). At 13 of 16 the binomial's
 /// chance of failing a right error is 0.7 %; errors 1.5 times too small put about one χ² in
-/// five outside the band and the mean near 6.7.
+/// five outside the band (failing it 40 % of the time) and the mean near 6.7, which fails the
+/// mean's bound (3 ± 0.61 for 16: 4.5 is 2.5σ). It was 24 times over (20 of 24: 0.6 % and
+/// 54 %), the suite's second-longest test; 16 keep its power in the mean.
 #[test]
 fn held_out_blocks_fall_in_their_chi2_band_at_the_stated_rate() {
     let dir = Scratch::new("fit-held-out");
@@ -723,7 +725,7 @@ fn held_out_blocks_fall_in_their_chi2_band_at_the_stated_rate() {
     let held = ["140x27x13", "140x26x12", "140x35x20"];
     let mut inside = 0;
     let mut chi2 = Vec::new();
-    for seed in 1..=24 {
+    for seed in 1..=16 {
         let seed = seed.to_string();
         let mut fit_csv = HEAD.to_string();
         let mut held_csv =
@@ -774,10 +776,10 @@ fn held_out_blocks_fall_in_their_chi2_band_at_the_stated_rate() {
     }
     let mean = chi2.iter().sum::<f64>() / chi2.len() as f64;
     assert!(
-        inside >= 20,
-        "{inside} of 24 inside χ²₃'s 95 % band: {chi2:?}"
+        inside >= 13,
+        "{inside} of 16 inside χ²₃'s 95 % band: {chi2:?}"
     );
-    // The mean of 24 χ²₃ is 3 ± 0.5: within 3 of its σ.
+    // The mean of 16 χ²₃ is 3 ± 0.61: within 2.5 of its σ.
     assert!(
         (1.5..=4.5).contains(&mean),
         "mean held-out χ² {mean:.2}: {chi2:?}"

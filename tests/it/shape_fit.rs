@@ -55,11 +55,14 @@ const SMALL: [&str; 12] = [
 
 #[test]
 fn a_loaded_d20s_centre_of_mass_is_recovered_from_its_faces_with_the_stated_coverage() {
-    // 10 fixed-seed repetitions: 4,000 throws of a d20 whose centre of mass is 0.5, −0.3,
+    // 6 fixed-seed repetitions: 4,000 throws of a d20 whose centre of mass is 0.5, −0.3,
     // −1.0 mm off centre, counted by face and fitted back with their own simulations. The joint
-    // 2σ region is stated to hold the truth 95.45 % of the time: the test asks 8 of 10 (below 8
-    // has probability 1 % if the statement is true). Measured: 10 of 10, the truth's
-    // Δ(−2 ln L) averaging 3.9 (χ²₃'s mean is 3); each component's 2σ interval 9 of 10.
+    // 2σ region is stated to hold the truth 95.45 % of the time: the test asks 5 of 6 (below 5
+    // has probability 2.7 % if the statement is true; a region that held it 70 % of the time
+    // fails 58 % of the time). Measured at 10 repetitions: 10 of 10, the truth's Δ(−2 ln L)
+    // averaging 3.9 (χ²₃'s mean is 3); each component's 2σ interval 9 of 10. It was 10 (8 of
+    // 10: 0.9 % and 62 %), the suite's longest test: 6 keep its power. The mean of 6 Δ is
+    // 3 ± 1 where the statement holds: below 6 is 3σ.
     let dir = Scratch::new("shape-fit-recover");
     let labels = d20_labels();
     let csv = counts_file(&dir, &labels, &[200; 20]);
@@ -73,7 +76,7 @@ fn a_loaded_d20s_centre_of_mass_is_recovered_from_its_faces_with_the_stated_cove
                 "--recover",
                 "com_x=0.5,com_y=-0.3,com_z=-1",
                 "--repeats",
-                "10",
+                "6",
                 "--seed",
                 "11",
                 "--out",
@@ -85,14 +88,14 @@ fn a_loaded_d20s_centre_of_mass_is_recovered_from_its_faces_with_the_stated_cove
     );
     let r = json(&out);
     let reps = r["repetitions"].as_array().unwrap();
-    assert_eq!(reps.len(), 10);
+    assert_eq!(reps.len(), 6);
     let covered = reps.iter().filter(|x| x["covered"] == true).count();
-    assert!(covered >= 8, "{covered} of 10 covered: {r}");
+    assert!(covered >= 5, "{covered} of 6 covered: {r}");
     let mean: f64 = reps
         .iter()
         .map(|x| x["truth_delta"].as_f64().unwrap())
         .sum::<f64>()
-        / 10.0;
+        / 6.0;
     assert!(mean < 6.0, "the truth's mean Δ {mean}");
     assert_eq!(r["names"][2], "com_z[die]");
 }
