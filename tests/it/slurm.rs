@@ -455,7 +455,7 @@ fn a_tradeoff_rolled_ahead_by_tasks_finishes_as_on_one_machine() {
     let d = dir.to_str().unwrap();
     let study = [
         "--precision",
-        "20",
+        "30",
         "--dts",
         "1/250",
         "--rapier-dts",
@@ -474,7 +474,7 @@ fn a_tradeoff_rolled_ahead_by_tasks_finishes_as_on_one_machine() {
     let ahead = [
         &["tradeoff"],
         &study[..],
-        &["--preroll", "2000", "--tasks", "2", "--dir", d],
+        &["--preroll", "1000", "--tasks", "2", "--dir", d],
     ];
     assert!(slurm(&ahead.concat()).status.success());
     for k in ["0", "1"] {
