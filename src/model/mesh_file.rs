@@ -237,12 +237,11 @@ fn read_obj(bytes: &[u8], name: &str) -> Result<Vec<[Vector3<f64>; 3]>, String> 
             line.trim()
         ));
     }
-    // `..Default::default()` fills the fields that tobj's optional features (`merging`,
-    // `reordering`) add, should another crate of the build turn them on.
-    #[allow(clippy::needless_update)]
+    // tobj's defaults (derived: every option off) keep the faces as written, with no single
+    // index and no triangulation; points and lines are skipped. `..Default::default()` also
+    // fills the fields that tobj's optional features (`merging`, `reordering`) add, should
+    // another crate of the build turn them on.
     let options = tobj::LoadOptions {
-        single_index: false,
-        triangulate: false,
         ignore_points: true,
         ignore_lines: true,
         ..Default::default()

@@ -135,7 +135,6 @@ pub fn roll(
 /// The CSV's rows of `throw` (`trace`'s, without the header), each passed to `line`: every
 /// `every`th step's, and the last's; `tick` is called at every step (a front end's stop).
 /// Its record (`roll`).
-#[allow(clippy::too_many_arguments)]
 pub fn rows(
     kind: crate::engine::EngineKind,
     scene: &crate::model::scene::Scene,
