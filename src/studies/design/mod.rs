@@ -231,17 +231,22 @@ fn faces_at(
     if summary.partial {
         return Ok(None);
     }
-    let f = assess(&summary, &Null::Uniform)?;
-    let shape = spec.scene.shape.is_some();
-    Ok(Some((
+    faces_of(&summary).map(Some)
+}
+
+/// A run's faces: each face's label and count, as `fair` counts them.
+fn faces_of(summary: &crate::report::summary::RunSummary) -> Result<(Vec<String>, Vec<u64>)> {
+    let f = assess(summary, &Null::Uniform)?;
+    let shape = summary.spec.scene.shape.is_some();
+    Ok((
         f.faces.iter().map(|v| face_label(v, shape)).collect(),
         f.faces.iter().map(|v| v.count).collect(),
-    )))
+    ))
 }
 
 /// The run of `spec`'s die, each target outcome's count in [`BATCHES`] batches of its throws
 /// by index (throw i in batch i · batches / rolls): what the bootstrap draws. Their sum is
-/// checked against the run's own counts ([`faces_at`], the tally's), so a roll counted one
+/// checked against the run's own counts ([`faces_of`], the tally's), so a roll counted one
 /// way and not the other is an error, not a skewed interval.
 fn batched_at(
     spec: &RunSpec,
@@ -285,10 +290,7 @@ fn batched_at(
     if summary.partial {
         return Ok(None);
     }
-    let f = assess(&summary, &Null::Uniform)?;
-    let shape = spec.scene.shape.is_some();
-    let names: Vec<String> = f.faces.iter().map(|v| face_label(v, shape)).collect();
-    let faces: Vec<u64> = f.faces.iter().map(|v| v.count).collect();
+    let (names, faces) = faces_of(&summary)?;
     let counted = gathered(&names, &faces, target);
     if summed(&batches, None) != counted {
         return Err(Error::Mismatch(format!(
@@ -449,9 +451,7 @@ pub fn run(cfg: &DesignConfig, runner: &Runner) -> Result<Option<Design>> {
     }
     let shape = spec.scene.shape.is_some();
     let label = |v: &crate::report::fair::FaceVerdict| face_label(v, shape);
-    let f = assess(&summary, &Null::Uniform)?;
-    let names: Vec<String> = f.faces.iter().map(label).collect();
-    let faces: Vec<u64> = f.faces.iter().map(|v| v.count).collect();
+    let (names, faces) = faces_of(&summary)?;
     let counts = gathered(&names, &faces, &cfg.target);
     let check = judge(spec.throws.seed, &counts, &t, &design_err);
     // The quasi-static shares, gathered as the counts are (each face's null, by its label).
