@@ -746,7 +746,9 @@ BulletWorld::BulletWorld(const BulletScene& s)
       deactivation_(s.deactivation),
       linear_damping_(s.linear_damping),
       angular_damping_(s.angular_damping),
-      rolling_friction_(s.rolling_friction) {
+      rolling_friction_(s.rolling_friction),
+      contact_stiffness_(s.contact_stiffness),
+      contact_damping_(s.contact_damping) {
   config_ = std::make_unique<btDefaultCollisionConfiguration>();
   // A rounded die meets the floor through the convex-convex test (GJK), one point per step:
   // resting on a face it would rock and slide until its manifold held enough. Perturbed
@@ -809,6 +811,10 @@ BulletWorld::BulletWorld(const BulletScene& s)
   floor_info.m_friction = s.floor_friction;
   floor_info.m_restitution = s.floor_restitution;
   floor_ = std::make_unique<btRigidBody>(floor_info);
+  // A soft contact: Bullet combines two bodies' stiffnesses as springs in series and sums
+  // their dampings, so the floor's are an infinite stiffness and no damping (its defaults
+  // would add 0.1 N s/m) and the contact's are the die's own (reset).
+  if (contact_stiffness_ > 0) floor_->setContactStiffnessAndDamping(BT_LARGE_FLOAT, 0);
   world_->addRigidBody(floor_.get());
 
   const btVector3 half(0.5 * s.sides[0], 0.5 * s.sides[1], 0.5 * s.sides[2]);
@@ -926,6 +932,12 @@ void BulletWorld::reset(const BodyStateFfi& start) {
   if (rolling_friction_ > 0) {
     die_->setRollingFriction(rolling_friction_);
     die_->setSpinningFriction(rolling_friction_);
+  }
+  // A soft contact (model/compliance.rs): each point a spring and a dashpot, which Bullet's
+  // solver applies implicitly (ERP = h k/(h k + c), CFM = 1/(h k + c)); its contacts too go
+  // through Bullet's own solver (`DieSolver` declines them).
+  if (contact_stiffness_ > 0) {
+    die_->setContactStiffnessAndDamping(contact_stiffness_, contact_damping_);
   }
   world_->addRigidBody(die_.get());
 }

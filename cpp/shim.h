@@ -62,6 +62,8 @@ class BulletWorld {
   double linear_damping_;
   double angular_damping_;
   double rolling_friction_;
+  double contact_stiffness_;
+  double contact_damping_;
 };
 
 std::unique_ptr<BulletWorld> new_world(const BulletScene& scene);

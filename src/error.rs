@@ -274,6 +274,8 @@ pub enum Field {
     RollingResistance,
     /// `bounce_threshold`.
     BounceThreshold,
+    /// `contact_time`.
+    ContactTime,
     /// `reference_budget_s`.
     ReferenceBudgetS,
     /// `reference_dt`.

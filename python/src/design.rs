@@ -17,7 +17,7 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 
 /// What a fit's calibration sets: refused beside `fit`, as the command line refuses its flags.
-const FIT_SETS: [&str; 21] = [
+const FIT_SETS: [&str; 23] = [
     "engine",
     "mode",
     "dt",
@@ -29,6 +29,8 @@ const FIT_SETS: [&str; 21] = [
     "linear_damping",
     "angular_damping",
     "rolling_resistance",
+    "bounce_threshold",
+    "contact_time",
     "sleep",
     "source",
     "velocity",

@@ -362,6 +362,7 @@ fn scene_of(block_: Option<&str>, o: &Options, layout: Option<Layout>) -> PyResu
         angular_damping: o.get("angular_damping", d.angular_damping)?,
         rolling_resistance_mm: o.maybe("rolling_resistance")?,
         bounce_threshold: o.get("bounce_threshold", d.bounce_threshold)?,
+        contact_time_ms: o.get("contact_time", d.contact_time_ms)?,
         sleep: o.get("sleep", d.sleep)?,
     })
 }

@@ -118,6 +118,7 @@ impl FitConfig {
         for (kind, what) in [
             (params::Kind::Rolling, "rolling resistance"),
             (params::Kind::Bounce, "bounce threshold"),
+            (params::Kind::ContactTime, "soft contact"),
         ] {
             if self.model.is_free(kind) && self.method.engine != crate::engine::EngineKind::Bullet {
                 return Err(Error::field(

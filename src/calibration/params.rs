@@ -52,6 +52,9 @@ pub enum Kind {
     /// The contact's bounce threshold, m/s: slower impacts do not bounce
     /// (`Scene::bounce_threshold`; per surface; Bullet only).
     Bounce,
+    /// The contact time, ms: a soft table whose flat landing lasts this long
+    /// (`Scene::contact_time`, `model::compliance`; per surface; Bullet only).
+    ContactTime,
     /// The hand's concentration κ (per thrower).
     Kappa,
     /// A factor on the paper's spin range, 31 to 160 rad/s (per thrower).
@@ -78,11 +81,12 @@ pub enum Kind {
 
 impl Kind {
     /// Every kind, in the order a row's coordinates take them.
-    pub const ALL: [Kind; 13] = [
+    pub const ALL: [Kind; 14] = [
         Kind::E,
         Kind::Mu,
         Kind::Rolling,
         Kind::Bounce,
+        Kind::ContactTime,
         Kind::Kappa,
         Kind::Spin,
         Kind::Height,
@@ -94,7 +98,7 @@ impl Kind {
         Kind::Infill,
     ];
 
-    /// "e", "mu", "rolling", "bounce", "kappa", "spin", "height", "speed", "com_x", "com_y",
+    /// "e", "mu", "rolling", "bounce", "contact_time", "kappa", "spin", "height", "speed", "com_x", "com_y",
     /// "com_z", "pip_depth" or "infill".
     pub fn name(self) -> &'static str {
         self.into()
@@ -103,7 +107,10 @@ impl Kind {
     /// True for the surface's parameters (e, μ, rolling resistance); false for the throw's
     /// (κ, spin, height, speed).
     pub fn of_surface(self) -> bool {
-        matches!(self, Kind::E | Kind::Mu | Kind::Rolling | Kind::Bounce)
+        matches!(
+            self,
+            Kind::E | Kind::Mu | Kind::Rolling | Kind::Bounce | Kind::ContactTime
+        )
     }
 
     /// True for the die's parameters (its centre of mass, its pips' depth, its infill): one
@@ -126,6 +133,7 @@ impl Kind {
             Kind::Mu => (0.0, 5.0),
             Kind::Rolling => (0.0, MAX_ROLLING_RESISTANCE * 1e3),
             Kind::Bounce => (0.0, crate::model::scene::MAX_BOUNCE_THRESHOLD),
+            Kind::ContactTime => (0.0, crate::model::scene::MAX_CONTACT_TIME * 1e3),
             Kind::Kappa => (0.0, MAX_KAPPA),
             Kind::Spin => (0.05, 20.0),
             Kind::Height => (0.05, 10.0),
@@ -168,6 +176,10 @@ impl Kind {
             // None (every impact bounces, the paper's engines) to 1 m/s, half a throw's first
             // impact (a drop of 20 cm lands at 2 m/s): the settling bounces, not the landing.
             Kind::Bounce => Range::new(0.0, 1.0),
+            // Two steps of the fits' 1 ms (a shorter contact is not resolved, and 0, the rigid
+            // contact, is not its limit: backward Euler's damping takes the bounce first) to
+            // 10 ms, a die landing on thick felt or cloth; a hard table's 0.1 ms lies below.
+            Kind::ContactTime => Range::new(2.0, 10.0),
         }
     }
 
@@ -181,7 +193,8 @@ impl Kind {
             | Kind::ComZ
             | Kind::PipDepth
             | Kind::Infill
-            | Kind::Bounce => v,
+            | Kind::Bounce
+            | Kind::ContactTime => v,
             Kind::Kappa => (1.0 + v).log10(),
             Kind::Spin | Kind::Height | Kind::Speed => v.ln(),
         }
@@ -197,7 +210,8 @@ impl Kind {
             | Kind::ComZ
             | Kind::PipDepth
             | Kind::Infill
-            | Kind::Bounce => w,
+            | Kind::Bounce
+            | Kind::ContactTime => w,
             Kind::Kappa => 10f64.powf(w) - 1.0,
             Kind::Spin | Kind::Height | Kind::Speed => w.exp(),
         }
@@ -258,6 +272,9 @@ pub struct Fixed {
     /// The bounce threshold, m/s (0: none, the paper's).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub bounce: f64,
+    /// The contact time, ms (0: the rigid contact, the paper's).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub contact_time: f64,
     /// The throw.
     pub throw: FixedThrow,
     /// The spin scale.
@@ -304,6 +321,7 @@ impl Default for Fixed {
             mu: 0.29,
             rolling: 0.0,
             bounce: 0.0,
+            contact_time: 0.0,
             throw: FixedThrow::Paper,
             spin: 1.0,
             height: 1.0,
@@ -353,6 +371,7 @@ pub fn values(fixed: &Fixed, axes: &[(Kind, Range)], x: &[f64]) -> Fixed {
             Kind::Mu => v.mu = value,
             Kind::Rolling => v.rolling = value,
             Kind::Bounce => v.bounce = value,
+            Kind::ContactTime => v.contact_time = value,
             // A toss's κ turns its directions a hand's way; any other throw's makes it a hand's.
             Kind::Kappa => {
                 v.throw = match v.throw {
@@ -440,6 +459,7 @@ impl ModelSpec {
             (Kind::Mu, f.mu),
             (Kind::Rolling, f.rolling),
             (Kind::Bounce, f.bounce),
+            (Kind::ContactTime, f.contact_time),
             (Kind::Spin, f.spin),
             (Kind::Height, f.height),
             (Kind::Speed, f.speed),
@@ -638,6 +658,7 @@ impl Method {
             scene.rolling_resistance = crate::model::scene::COIN_ROLLING_RESISTANCE;
         }
         scene.bounce_threshold = v.bounce;
+        scene.contact_time = v.contact_time / 1000.0;
         scene.features = self.die_at(v);
         if let Some(d) = self.density {
             scene.density = d;
@@ -764,6 +785,41 @@ mod tests {
         assert!(!serde_json::to_string(&Fixed::default())
             .unwrap()
             .contains("rolling"));
+    }
+
+    #[test]
+    fn the_contact_time_is_the_surfaces_and_reaches_the_scene() {
+        // Issue 72: a soft table, per surface like e and μ, in ms; its range (fixed before
+        // any fit) from two of the fits' 1 ms steps to 10 ms.
+        let rows = crate::calibration::data::paper_rows().unwrap();
+        let m = ModelSpec::free(&[Kind::E, Kind::ContactTime]);
+        m.validate().unwrap();
+        let names: Vec<String> = m.params(&rows).iter().map(Param::name).collect();
+        assert!(
+            names.contains(&"contact_time[MDF]".to_string()),
+            "{names:?}"
+        );
+        assert_eq!(Kind::ContactTime.default_range(), Range::new(2.0, 10.0));
+        let axes = [(Kind::ContactTime, Kind::ContactTime.default_range())];
+        let v = values(&Fixed::default(), &axes, &[0.5]);
+        assert_eq!(v.contact_time, 6.0);
+        let method = Method {
+            engine: EngineKind::Bullet,
+            dt: 1.0 / 1000.0,
+            max_steps: 1000,
+            die: Features::default(),
+            density: None,
+            shape: None,
+            dice: vec![],
+        };
+        let spec = method.spec(rows[0].block, rows[0].mode, &v, 1, 10);
+        assert!((spec.scene.contact_time - 6e-3).abs() < 1e-18);
+        spec.validate(false).unwrap();
+        let plain = method.spec(rows[0].block, rows[0].mode, &Fixed::default(), 1, 10);
+        assert_eq!(plain.scene.contact_time, 0.0);
+        assert!(!serde_json::to_string(&Fixed::default())
+            .unwrap()
+            .contains("contact"));
     }
 
     #[test]

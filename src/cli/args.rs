@@ -152,6 +152,17 @@ pub struct SceneArgs {
         allow_hyphen_values = true
     )]
     pub bounce_threshold: f64,
+    /// Contact time, ms: a soft table, each impact a spring and a dashpot whose flat landing
+    /// lasts this long and leaves at --restitution times its speed (0: the rigid contact,
+    /// DicePhys's; else at least two steps of --dt, up to 50; felt or cloth a few ms, a hard
+    /// table about 0.1). Bullet only.
+    #[arg(
+        long,
+        value_name = "MS",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    pub contact_time: f64,
     /// Never let the engine put the die to sleep (for slow, over-damped rolls, which it would
     /// freeze mid-fall).
     #[arg(long)]
@@ -492,6 +503,7 @@ impl SceneArgs {
             angular_damping: self.angular_damping,
             rolling_resistance_mm: self.rolling_resistance,
             bounce_threshold: self.bounce_threshold,
+            contact_time_ms: self.contact_time,
             sleep: !self.no_sleep,
         }
     }

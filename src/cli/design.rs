@@ -85,7 +85,7 @@ pub struct DesignArgs {
 }
 
 /// What a fit's calibration sets: refused beside --fit.
-const FIT_SETS: [&str; 22] = [
+const FIT_SETS: [&str; 24] = [
     "engine",
     "two_d",
     "dt",
@@ -98,6 +98,8 @@ const FIT_SETS: [&str; 22] = [
     "linear_damping",
     "angular_damping",
     "rolling_resistance",
+    "bounce_threshold",
+    "contact_time",
     "no_sleep",
     "source",
     "velocity",

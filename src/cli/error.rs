@@ -104,6 +104,7 @@ pub fn flag(field: Field) -> &'static str {
         Field::LinearDamping => "--linear-damping",
         Field::RollingResistance => "--rolling-resistance",
         Field::BounceThreshold => "--bounce-threshold",
+        Field::ContactTime => "--contact-time",
         Field::Margin => "--margin",
         Field::MaxSteps => "--max-steps",
         Field::Modes => "--modes",

@@ -11,7 +11,7 @@ use dicephys::studies::fair::{assess, Null};
 
 /// The flags that say how a die is rolled: refused beside `--counts`, which rolls nothing
 /// (the die's own flags stay: the quasi-static null reads them).
-const SIMULATION: [&str; 29] = [
+const SIMULATION: [&str; 30] = [
     "engine",
     "dt",
     "friction",
@@ -24,6 +24,7 @@ const SIMULATION: [&str; 29] = [
     "angular_damping",
     "rolling_resistance",
     "bounce_threshold",
+    "contact_time",
     "no_sleep",
     "seed",
     "source",

@@ -16,7 +16,7 @@ use std::path::PathBuf;
 use std::sync::atomic::Ordering::Relaxed;
 
 /// The options that define a run: `--resume` takes them from the checkpoint instead.
-const DEFINING: [&str; 34] = [
+const DEFINING: [&str; 35] = [
     "shape",
     "size",
     "scale",
@@ -49,6 +49,7 @@ const DEFINING: [&str; 34] = [
     "angular_damping",
     "rolling_resistance",
     "bounce_threshold",
+    "contact_time",
     "no_sleep",
     "style",
 ];

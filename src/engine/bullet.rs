@@ -85,6 +85,11 @@ mod ffi {
         /// The die's rolling and spinning friction (`Scene::rolling_resistance` over the
         /// floor's friction, which Bullet multiplies them by); 0: none, as DicePhys.
         rolling_friction: f64,
+        /// A soft contact (`model::compliance`): each contact point's stiffness, N/m, and
+        /// damping, N s/m, set on the die (the floor's stiffness infinite, its damping 0, so
+        /// the contact's are the die's); 0: the rigid contact, as DicePhys.
+        contact_stiffness: f64,
+        contact_damping: f64,
         /// Bullet's own world and solver, every part of a step as Bullet does it, without the
         /// shim's shortcuts (`DiceWorld`, `DieSolver` in cpp/shim.cc): for the check that
         /// they change nothing.
@@ -256,6 +261,12 @@ impl Bullet {
         let mp = MassProps::of(scene)?;
         let p = mp.principal.quaternion();
         let collider = collider(&Collider::of(scene));
+        let soft = scene.contact_time > 0.0;
+        let (contact_stiffness, contact_damping) = if soft {
+            crate::model::compliance::per_point(mp.mass, scene.restitution, scene.contact_time)
+        } else {
+            (0.0, 0.0)
+        };
         let desc = ffi::BulletScene {
             sides: collider.sides,
             mass: mp.mass,
@@ -270,7 +281,8 @@ impl Bullet {
             offset: mp.com != Vector3::zeros() || !mp.aligned(),
             planar: scene.mode == Mode::TwoD,
             die_friction: scene.friction,
-            die_restitution: scene.restitution,
+            // A soft contact bounces by its spring: no restitution on top of it.
+            die_restitution: if soft { 0.0 } else { scene.restitution },
             floor_friction: scene.floor_friction,
             floor_restitution: scene.floor_restitution,
             plane_floor: scene.floor == Floor::Plane,
@@ -283,7 +295,9 @@ impl Bullet {
                 .restitution_velocity_threshold
                 .max(scene.bounce_threshold),
             split_impulse: true,
-            split_every_depth: s.split_every_depth,
+            // A soft contact's spring acts through the penetration in the velocity solve;
+            // split off, it would only push the die out, never throw it back.
+            split_every_depth: s.split_every_depth && !soft,
             two_friction_directions: s.two_friction_directions,
             solver_iterations: 10,
             deactivation: scene.sleeping,
@@ -294,6 +308,8 @@ impl Bullet {
             } else {
                 0.0
             },
+            contact_stiffness,
+            contact_damping,
             stock_world,
         };
         let world =

@@ -86,6 +86,9 @@ pub fn models(scene: &Scene) -> crate::Result<()> {
     if scene.bounce_threshold > 0.0 {
         return refuse("no bounce threshold");
     }
+    if scene.contact_time > 0.0 {
+        return refuse("no soft contact");
+    }
     Ok(())
 }
 

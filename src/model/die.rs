@@ -307,6 +307,9 @@ pub struct DieShape {
     /// A die of any shape that is a box (a d6, a box-shaped mesh): its outcome resting on
     /// each face, in `faces::DIRECTIONS`' order (`Scene::box_faces`); `None` for the cuboid.
     pub box_faces: Option<[u8; 6]>,
+    /// A soft contact's stiffness for a flat landing, N/m: m ω₀², the four points' together
+    /// (`model::compliance`); 0 for the rigid contact.
+    pub spring: f64,
 }
 
 impl DieShape {
@@ -380,7 +383,22 @@ impl DieShape {
             barrier,
             convex,
             box_faces: scene.box_faces(),
+            spring: if scene.contact_time > 0.0 {
+                let (w0, _) =
+                    crate::model::compliance::solve(scene.restitution, scene.contact_time);
+                mp.mass * w0 * w0
+            } else {
+                0.0
+            },
         }
+    }
+
+    /// At most the energy a soft contact's springs hold with the die's lowest point `sunk`
+    /// below the floor: ½ K sunk², as if every point of the contact (four at most) were as
+    /// deep (0 for the rigid contact).
+    #[inline]
+    pub fn elastic_at_most(&self, sunk: f64) -> f64 {
+        0.5 * self.spring * sunk * sunk
     }
 
     /// The largest distance from the centre of mass to any point of the die, m; in 2D (turning

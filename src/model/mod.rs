@@ -4,6 +4,7 @@
 
 pub mod block;
 pub mod collider;
+pub mod compliance;
 pub mod die;
 pub mod faces;
 pub mod glibc;

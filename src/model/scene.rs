@@ -144,6 +144,12 @@ pub struct Scene {
     /// Written into a specification only when not 0.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub bounce_threshold: f64,
+    /// The contact time, s: a soft table (`model::compliance`), each impact a spring and a
+    /// dashpot whose flat landing lasts this long and leaves at `restitution` times its
+    /// speed. 0: the rigid contact (DicePhys's), an impulse in one step. Bullet only; at
+    /// least two steps. Written into a specification only when not 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub contact_time: f64,
     /// The engine may put a die that has slowed down to sleep (Bullet's deactivation after
     /// 2 s under 0.8 m/s and 1 rad/s, Rapier's after 0.5 s under its thresholds), as DicePhys
     /// let Bullet do. False: never, for a die that moves slowly for long (an over-damped roll,
@@ -192,6 +198,13 @@ pub const MAX_ROLLING_RESISTANCE: f64 = 1e-3;
 /// The largest bounce threshold a scene takes, m/s: a die dropped from 20 cm meets the table at
 /// 2 m/s, so every impact of a throw is below it.
 pub const MAX_BOUNCE_THRESHOLD: f64 = 2.0;
+
+/// The longest contact time a scene takes, s: 50 ms, a die sinking into a cushion.
+pub const MAX_CONTACT_TIME: f64 = 0.05;
+
+/// The fewest steps a soft contact may last: a shorter one is not resolved (its spring acts
+/// within a step, and backward Euler's own damping takes the bounce).
+pub const MIN_CONTACT_STEPS: f64 = 2.0;
 
 /// The finest time step accepted, s: 1 µs. A roll at rest by DicePhys's rule takes about a
 /// second of simulated time, a million steps here; finer steps only multiply the work (a
@@ -316,6 +329,7 @@ impl Scene {
                 format!("must be in [0, {MAX_BOUNCE_THRESHOLD}] m/s"),
             );
         }
+        self.check_contact()?;
         if let (Some(shape), Mode::TwoD) = (&self.shape, self.mode) {
             // A box-shaped die too: its mass is the box's (`Scene::hull_shape`), its outcomes
             // its faces in 3D.
@@ -326,6 +340,54 @@ impl Scene {
             ));
         }
         MassProps::of(self)?;
+        Ok(())
+    }
+
+    /// A soft contact's time within what the step resolves, its restitution one a dashpot
+    /// gives, and no bounce threshold beside it (its spring, not a restitution, bounces).
+    fn check_contact(&self) -> Result<()> {
+        let bad = |field, v: f64, why: String| Err(Error::field(field, v, why));
+        if self.contact_time == 0.0 {
+            return Ok(());
+        }
+        let lo = MIN_CONTACT_STEPS * self.dt;
+        if !(self.contact_time.is_finite() && (lo..=MAX_CONTACT_TIME).contains(&self.contact_time))
+        {
+            return Err(Error::field(
+                Field::ContactTime,
+                self.contact_time * 1e3,
+                crate::text![
+                    format!(
+                        "must be 0 (a rigid contact) or in [{}, {}] ms: at least \
+                         {MIN_CONTACT_STEPS} steps of ",
+                        lo * 1e3,
+                        MAX_CONTACT_TIME * 1e3
+                    ),
+                    Field::Dt
+                ],
+            ));
+        }
+        if !(self.restitution > 0.0 && self.restitution <= 1.0) {
+            return bad(
+                Field::Restitution,
+                self.restitution,
+                "a soft contact's restitution must be in (0, 1]: its dashpot cannot stop a \
+                 landing dead nor give back more than it took"
+                    .into(),
+            );
+        }
+        if self.bounce_threshold > 0.0 {
+            return Err(Error::field(
+                Field::BounceThreshold,
+                self.bounce_threshold,
+                crate::text![
+                    "a soft contact bounces by its spring, not by a restitution: give one of ",
+                    Field::ContactTime,
+                    " and ",
+                    Field::BounceThreshold
+                ],
+            ));
+        }
         Ok(())
     }
 
@@ -348,6 +410,7 @@ impl Scene {
             angular_damping: 0.0,
             rolling_resistance: 0.0,
             bounce_threshold: 0.0,
+            contact_time: 0.0,
             sleeping: true,
             features: Features::default(),
             shape: None,

@@ -43,6 +43,9 @@ pub fn fixed_text(res: &FitResult) -> String {
     if !m.is_free(Kind::Bounce) && f.bounce > 0.0 {
         parts.push(format!("bounce threshold {} m/s", f.bounce));
     }
+    if !m.is_free(Kind::ContactTime) && f.contact_time > 0.0 {
+        parts.push(format!("contact time {} ms", f.contact_time));
+    }
     if !m.is_free(Kind::Kappa) {
         parts.push(match f.throw {
             FixedThrow::Paper => "the paper's throw".into(),

@@ -128,6 +128,8 @@ pub struct SceneRequest {
     pub rolling_resistance_mm: Option<f64>,
     /// The bounce threshold, m/s (0: none).
     pub bounce_threshold: f64,
+    /// The contact time, ms (0: the rigid contact).
+    pub contact_time_ms: f64,
     /// Let the engine put the die to sleep.
     pub sleep: bool,
 }
@@ -150,6 +152,7 @@ impl Default for SceneRequest {
             angular_damping: paper.angular_damping,
             rolling_resistance_mm: None,
             bounce_threshold: 0.0,
+            contact_time_ms: 0.0,
             sleep: paper.sleeping,
         }
     }
@@ -217,6 +220,7 @@ impl SceneRequest {
         scene.linear_damping = self.linear_damping;
         scene.rolling_resistance = self.rolling_resistance_mm.unwrap_or(0.0) / 1000.0;
         scene.bounce_threshold = self.bounce_threshold;
+        scene.contact_time = self.contact_time_ms / 1000.0;
         scene.angular_damping = self.angular_damping;
         scene.sleeping = self.sleep;
         scene.features = features;

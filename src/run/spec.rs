@@ -239,6 +239,16 @@ impl RunSpec {
                 ),
             ));
         }
+        if self.scene.contact_time > 0.0 && self.engine != EngineKind::Bullet {
+            return Err(Error::field(
+                Field::ContactTime,
+                self.scene.contact_time * 1e3,
+                format!(
+                    "{} has no soft contact; give --engine bullet",
+                    self.engine.name()
+                ),
+            ));
+        }
         if let Some(shape) = &self.scene.shape {
             use crate::model::throws::ThrowStyle;
             let hands = self.throws.style == ThrowStyle::Toss && self.throws.kappa.is_some();

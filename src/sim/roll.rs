@@ -413,8 +413,13 @@ impl EnergyWatch {
         }
     }
 
-    /// Takes one state's energy: flags a gain, keeps the lowest value so far.
+    /// Takes one state's energy: flags a gain, keeps the lowest value so far. On a soft table
+    /// a die pressed into it holds energy in its springs that kinetic plus potential leave
+    /// out, and gets it back: only states clear of the table are compared.
     pub fn push(&mut self, die: &DieShape, s: &BodyState) {
+        if die.spring > 0.0 && die.lowest_point(s) < 0.0 {
+            return;
+        }
         let e = die.energy(s);
         if e > self.lowest + self.allowance {
             self.gained = true;

@@ -260,8 +260,8 @@ pub const Z_BOUND: f64 = 2.0;
 /// Every die `dice_costs` times, as a scene: the made cubes of [`made_dice`], then dice of
 /// other shapes (`--shape`: a d6, which takes the box's path as the cuboid does, with and
 /// without pips; a d20 and a d4 on the general hull path), and the sharp cube under issue 72's
-/// candidates (a hand's toss, a flip, a printed shell and infill, rolling resistance). Each
-/// with the throw it is thrown in: a tumble but for the toss and the flip.
+/// candidates (a hand's toss, a flip, a printed shell and infill, rolling resistance, a soft
+/// contact). Each with the throw it is thrown in: a tumble but for the toss and the flip.
 /// Not a coin: a thin one spins like Euler's disk, about 100 ms a roll, and would double the
 /// benchmark's time (its cost is on docs/results/shapes.md).
 pub fn bench_dice() -> crate::Result<Vec<(String, Scene, ThrowStyle)>> {
@@ -284,9 +284,12 @@ pub fn bench_dice() -> crate::Result<Vec<(String, Scene, ThrowStyle)>> {
         infill: 0.2,
     });
     out.push(("--shell 1,0.2".into(), printed, tumble));
-    let mut rolling = sharp;
+    let mut rolling = sharp.clone();
     rolling.rolling_resistance = 1e-4;
     out.push(("--rolling-resistance 0.1".into(), rolling, tumble));
+    let mut soft = sharp;
+    soft.contact_time = 0.005;
+    out.push(("--contact-time 5".into(), soft, tumble));
     for name in ["d6", "d20", "d4"] {
         let shape = crate::model::shape::named(name, None)?;
         out.push((
@@ -396,7 +399,8 @@ pub fn dice_costs(
     ] {
         let models = |scene: &Scene| {
             (engine != EngineKind::Moreau || crate::engine::moreau::models(scene).is_ok())
-                && (engine == EngineKind::Bullet || scene.rolling_resistance == 0.0)
+                && (engine == EngineKind::Bullet
+                    || (scene.rolling_resistance == 0.0 && scene.contact_time == 0.0))
         };
         let mut best = vec![(f64::INFINITY, Vec::new()); dice.len()];
         for _ in 0..repeat.max(1) {

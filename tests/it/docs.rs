@@ -773,7 +773,14 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
     let d2 = roll(&["--block", "140x24x20", "--2d"]);
     let odd = roll(&ODD);
     let none = roll(&["--block", "140x24x20", "--max-steps", "1"]);
-    let shaped = roll(&["--shape", "d6", "--rolling-resistance", "0.05"]);
+    let shaped = roll(&[
+        "--shape",
+        "d6",
+        "--rolling-resistance",
+        "0.05",
+        "--contact-time",
+        "5",
+    ]);
     let tossed = roll(&TOSSED);
     let unsettled = roll(&UNSETTLED_COIN);
     let broken = roll(&["--block", "140x24x20", "--dt", "1/30"]);
