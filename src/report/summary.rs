@@ -601,6 +601,18 @@ impl RunSummary {
         if !scene.sleeping {
             extra.push("never asleep".into());
         }
+        if scene.rolling_resistance > 0.0 {
+            extra.push(format!(
+                "rolling resistance {} mm",
+                scene.rolling_resistance * 1e3
+            ));
+        }
+        if scene.bounce_threshold > 0.0 {
+            extra.push(format!("bounce threshold {} m/s", scene.bounce_threshold));
+        }
+        if scene.contact_time > 0.0 {
+            extra.push(format!("a soft contact of {} ms", scene.contact_time * 1e3));
+        }
         if extra.is_empty() {
             String::new()
         } else {
