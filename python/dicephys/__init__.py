@@ -458,6 +458,8 @@ def roll(
     linear_damping: float = 0.0,
     angular_damping: float = 0.0,
     rolling_resistance: Optional[float] = None,
+    bounce_threshold: float = 0.0,
+    contact_time: float = 0.0,
     sleep: bool = True,
     settle: Optional[str] = None,
     flight: str = "fast",
@@ -499,6 +501,10 @@ def roll(
     rolling_resistance: mm, the lever arm of the floor's push against rolling and turning in
         place (so that a coin rolling on its rim stops); Bullet only; None: 0.05 for a coin
         on Bullet (a hard table), else 0.
+    bounce_threshold: m/s, impacts slower than this do not bounce (0: every one does);
+        contact_time: ms, a soft table whose flat landing lasts this long and leaves at
+        ``restitution`` times its speed (0: the rigid contact; else at least two steps of
+        ``dt``). Both Bullet only.
     settle: None (the exact early stop where it is audited exact), "certificate" or
         "dicephys".  flight: "fast" or "stepped".  faithful: DicePhys as the paper ran it.
     com: the centre of mass (x, y, z) in mm from the geometric centre; pips: (diameter,
@@ -518,6 +524,7 @@ def roll(
         dt=dt, restitution=restitution, friction=friction, density=density, preset=preset,
         floor=floor, floor_thickness=floor_thickness, linear_damping=linear_damping,
         angular_damping=angular_damping, rolling_resistance=rolling_resistance, sleep=sleep,
+        bounce_threshold=bounce_threshold, contact_time=contact_time,
         throw=throw, kappa=kappa, source=source, velocity=velocity, spin=spin,
         drop_height=drop_height, settle=settle, flight=flight, faithful=faithful,
         max_steps=max_steps, margin=margin, com=com, pips=pips, edge_radius=edge_radius,
@@ -605,6 +612,8 @@ def fair(
     linear_damping: float = 0.0,
     angular_damping: float = 0.0,
     rolling_resistance: Optional[float] = None,
+    bounce_threshold: float = 0.0,
+    contact_time: float = 0.0,
     sleep: bool = True,
     settle: Optional[str] = None,
     flight: str = "fast",
@@ -674,6 +683,7 @@ def fair(
         dt=dt, restitution=restitution, friction=friction, density=density, preset=preset,
         floor=floor, floor_thickness=floor_thickness, linear_damping=linear_damping,
         angular_damping=angular_damping, rolling_resistance=rolling_resistance, sleep=sleep,
+        bounce_threshold=bounce_threshold, contact_time=contact_time,
         throw=throw, kappa=kappa, source=source, velocity=velocity, spin=spin,
         drop_height=drop_height, settle=settle, flight=flight, faithful=faithful,
         max_steps=max_steps, margin=margin, com=com, pips=pips, edge_radius=edge_radius,
@@ -693,8 +703,9 @@ _SIMULATION: Dict[str, Any] = dict(
     restitution=DEFAULT_RESTITUTION, friction=DEFAULT_FRICTION, throw="tumble", kappa=None,
     source="keyed", velocity=None, spin=None, drop_height=None, preset="dicephys281",
     floor="box", floor_thickness=None, linear_damping=0.0, angular_damping=0.0,
-    rolling_resistance=None, sleep=True, settle=None, flight="fast", faithful=False,
-    max_steps=None, margin=DEFAULT_MARGIN, threads=0, per_roll=False, within=None,
+    rolling_resistance=None, bounce_threshold=0.0, contact_time=0.0, sleep=True, settle=None,
+    flight="fast", faithful=False, max_steps=None, margin=DEFAULT_MARGIN, threads=0,
+    per_roll=False, within=None,
 )
 # Refused beside fair(vary=), as beside --vary: a sweep rolls ``rolls`` at each value.
 _NOT_WITH_VARY = ("within", "per_roll")
@@ -1276,6 +1287,8 @@ def trace(
     linear_damping: float = 0.0,
     angular_damping: float = 0.0,
     rolling_resistance: Optional[float] = None,
+    bounce_threshold: float = 0.0,
+    contact_time: float = 0.0,
     sleep: bool = True,
     com: Optional[Sequence[float]] = None,
     pips: Optional[Sequence[float]] = None,
@@ -1319,6 +1332,7 @@ def trace(
         drop_height=_pair("drop_height", drop_height), preset=preset, floor=floor,
         floor_thickness=floor_thickness, linear_damping=linear_damping,
         angular_damping=angular_damping, rolling_resistance=rolling_resistance, sleep=sleep,
+        bounce_threshold=bounce_threshold, contact_time=contact_time,
         com=_triple("com", com, 3), pips=_triple("pips", pips, 2), edge_radius=edge_radius,
         shell=_triple("shell", shell, 2), max_steps=max_steps, flight=flight, every=every,
         html=None if html is None else os.fspath(html),

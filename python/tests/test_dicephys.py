@@ -93,6 +93,14 @@ def test_a_die_of_any_shape_is_the_cli_s(tmp_path: Path) -> None:
     assert d6.result["spec"]["throws"]["style"] == "tumble"
     with pytest.raises(ValueError, match="shape"):
         dicephys.roll(shape="d7")
+    # A soft table (issue 72): the CLI's counts throw for throw; too short for the step, refused.
+    soft = ["--rolls", "60", "--seed", "4", "--contact-time", "5", "--restitution", "0.3"]
+    want = cli("roll", *soft, "--json")
+    got = dicephys.roll(rolls=60, seed=4, contact_time=5, restitution=0.3)
+    assert got.faces == want["faces"]
+    assert got.result["spec"]["scene"]["contact_time"] == 0.005
+    with pytest.raises(ValueError, match="contact_time"):
+        dicephys.roll(rolls=10, contact_time=1)
 
 
 def test_the_issue_s_example() -> None:
