@@ -737,8 +737,10 @@ fn trace<'py>(
             &scene,
             &source,
             first..=last,
-            max_steps,
-            fast_flight,
+            trace::Stepping {
+                max_steps,
+                fast_flight,
+            },
             |_, _| {},
             |_| {},
         )?;

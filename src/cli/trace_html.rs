@@ -23,8 +23,10 @@ pub fn run(a: &TraceArgs) -> Result<()> {
         &scene,
         &throw_spec.source(a.index.last + 1),
         a.index.first..=a.index.last,
-        a.max_steps.asked(),
-        a.flight == FlightArg::Fast,
+        dicephys::report::trace::Stepping {
+            max_steps: a.max_steps.asked(),
+            fast_flight: a.flight == FlightArg::Fast,
+        },
         |ending, note| {
             eprintln!("{ending}");
             if let Some(note) = note {

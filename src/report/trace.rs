@@ -162,22 +162,34 @@ pub fn rows(
     Ok(record)
 }
 
+/// How `trace` steps its throws: the step cap asked (`None`: the scene's own) and whether free
+/// flight is flown in closed form (fast) or stepped.
+#[derive(Clone, Copy, Debug)]
+pub struct Stepping {
+    /// The step cap asked.
+    pub max_steps: Option<u64>,
+    /// Free flight flown in closed form.
+    pub fast_flight: bool,
+}
+
 /// The page (`report::view`) that plays throws `indices` of `throws` of `scene` on `kind`,
 /// each rolled as `trace --html` rolls it (the early stop audited: noted where it would have
 /// fired, the roll carried on to rest); each throw's ending line, with the cap's note where
 /// the cap ended it (`capped`), passed to `say`; `tick` is called at every step (a front end's stop).
-#[allow(clippy::too_many_arguments)]
 pub fn page(
     kind: crate::engine::EngineKind,
     scene: &crate::model::scene::Scene,
     throws: &crate::model::throws::Throws,
     indices: std::ops::RangeInclusive<u64>,
-    max_steps: Option<u64>,
-    fast_flight: bool,
+    stepping: Stepping,
     mut say: impl FnMut(&str, Option<&str>),
     mut tick: impl FnMut(u64),
 ) -> crate::Result<String> {
     use crate::report::view::{self, DieView, Recorder, ThrowView};
+    let Stepping {
+        max_steps,
+        fast_flight,
+    } = stepping;
     let die = DieShape::of(scene);
     let settle = config(scene, max_steps, fast_flight, true);
     let labels: Vec<String> = scene
