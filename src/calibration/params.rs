@@ -757,6 +757,19 @@ mod tests {
             .contains("range of e"));
     }
 
+    /// Bullet at the fits' 1 ms step, the plain die, 1,000 steps a roll.
+    fn bullet_at_1ms() -> Method {
+        Method {
+            engine: EngineKind::Bullet,
+            dt: 1e-3,
+            max_steps: 1000,
+            die: Features::default(),
+            density: None,
+            shape: None,
+            dice: vec![],
+        }
+    }
+
     #[test]
     fn rolling_resistance_is_the_surfaces_and_reaches_the_scene() {
         // Issue 72: a contact that resists rolling, per surface like e and μ, in mm.
@@ -768,15 +781,7 @@ mod tests {
         let axes = [(Kind::Rolling, Kind::Rolling.default_range())];
         let v = values(&Fixed::default(), &axes, &[0.25]);
         assert_eq!(v.rolling, 0.25);
-        let method = Method {
-            engine: EngineKind::Bullet,
-            dt: 1.0 / 1000.0,
-            max_steps: 1000,
-            die: Features::default(),
-            density: None,
-            shape: None,
-            dice: vec![],
-        };
+        let method = bullet_at_1ms();
         let spec = method.spec(rows[0].block, rows[0].mode, &v, 1, 10);
         assert!((spec.scene.rolling_resistance - 0.25e-3).abs() < 1e-18);
         // Not free and not given: none, as before (the paper's scenes are unchanged).
@@ -803,15 +808,7 @@ mod tests {
         let axes = [(Kind::ContactTime, Kind::ContactTime.default_range())];
         let v = values(&Fixed::default(), &axes, &[0.5]);
         assert_eq!(v.contact_time, 6.0);
-        let method = Method {
-            engine: EngineKind::Bullet,
-            dt: 1.0 / 1000.0,
-            max_steps: 1000,
-            die: Features::default(),
-            density: None,
-            shape: None,
-            dice: vec![],
-        };
+        let method = bullet_at_1ms();
         let spec = method.spec(rows[0].block, rows[0].mode, &v, 1, 10);
         assert!((spec.scene.contact_time - 6e-3).abs() < 1e-18);
         spec.validate(false).unwrap();
@@ -840,15 +837,7 @@ mod tests {
         ];
         let v = values(&Fixed::default(), &axes, &[0.0, 1.0]);
         assert!((v.height - 0.1).abs() < 1e-15 && v.speed == 10.0, "{v:?}");
-        let method = Method {
-            engine: EngineKind::Bullet,
-            dt: 1e-3,
-            max_steps: 1000,
-            die: Default::default(),
-            density: None,
-            shape: None,
-            dice: vec![],
-        };
+        let method = bullet_at_1ms();
         let block = Block::from_mm(140.0, 24.0, 20.0).unwrap();
         let spec = method.spec(block, Mode::ThreeD, &v, 1, 10);
         let (h, u) = (spec.throws.ranges.drop_height, spec.throws.ranges.velocity);
