@@ -115,19 +115,7 @@ impl FitConfig {
                 "a flip spins the die about a diameter, not near its long axis: it has no κ",
             ));
         }
-        for (kind, what) in [
-            (params::Kind::Rolling, "rolling resistance"),
-            (params::Kind::Bounce, "bounce threshold"),
-            (params::Kind::ContactTime, "soft contact"),
-        ] {
-            if self.model.is_free(kind) && self.method.engine != crate::engine::EngineKind::Bullet {
-                return Err(Error::field(
-                    Field::Free,
-                    kind.name(),
-                    format!("{} has no {what}: give --engine bullet", self.method.engine),
-                ));
-            }
-        }
+        self.check_contact_laws()?;
         self.check_dice()?;
         self.check_pips()?;
         let com_free = [params::Kind::ComX, params::Kind::ComY, params::Kind::ComZ]
@@ -258,6 +246,42 @@ impl FitConfig {
                  through the centre of mass it moves, and a free centre is given outright; free \
                  one or the other",
             ));
+        }
+        Ok(())
+    }
+
+    /// The contact's own laws (rolling resistance, a bounce threshold, a soft table) are
+    /// Bullet's; a soft table's range must last two steps of the fit's.
+    fn check_contact_laws(&self) -> Result<()> {
+        for (kind, what) in [
+            (params::Kind::Rolling, "rolling resistance"),
+            (params::Kind::Bounce, "bounce threshold"),
+            (params::Kind::ContactTime, "soft contact"),
+        ] {
+            if self.model.is_free(kind) && self.method.engine != crate::engine::EngineKind::Bullet {
+                return Err(Error::field(
+                    Field::Free,
+                    kind.name(),
+                    format!("{} has no {what}: give --engine bullet", self.method.engine),
+                ));
+            }
+        }
+        if self.model.is_free(params::Kind::ContactTime) {
+            // A soft contact shorter than two steps is not resolved: the scene refuses it at
+            // every design point below, so the range is checked against the step here.
+            let lo = self.model.range(params::Kind::ContactTime).lo;
+            let least = crate::model::scene::MIN_CONTACT_STEPS * self.method.dt * 1e3;
+            if lo < least {
+                return Err(Error::field(
+                    Field::Range,
+                    format!("contact_time={lo}"),
+                    format!(
+                        "a soft contact must last at least two steps: from {least} ms at a step \
+                         of {} s",
+                        self.method.dt
+                    ),
+                ));
+            }
         }
         Ok(())
     }

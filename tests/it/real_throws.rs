@@ -89,6 +89,25 @@ fn rolling_resistance_is_a_fit_parameter_of_bullets_contact() {
         "20",
     ]);
     refused(&o, 2, "rolling");
+    // A soft table's contact time likewise on Rapier, and, on Bullet, a range that starts
+    // below two of the fit's steps (2 ms at a 5 ms step): refused before anything runs.
+    for extra in [&["--engine", "rapier"][..], &["--dt", "0.005"][..]] {
+        let mut args = vec![
+            "fit",
+            "--data",
+            "paper",
+            "--free",
+            "e,contact_time",
+            "--points",
+            "6",
+            "--degree",
+            "1",
+            "--point-rolls",
+            "20",
+        ];
+        args.extend(extra);
+        refused(&dicephys(&args), 2, "contact_time");
+    }
 }
 
 #[test]
