@@ -219,35 +219,35 @@ impl RunSpec {
         self.scene.validate(allow_restitution_above_one)?;
         self.throws.validate()?;
         self.roll.validate()?;
-        if self.scene.rolling_resistance > 0.0 && self.engine != EngineKind::Bullet {
-            return Err(Error::field(
+        // The contact laws Bullet alone has: each refused on another engine, by its flag.
+        let s = &self.scene;
+        for (on, field, shown, what) in [
+            (
+                s.rolling_resistance > 0.0,
                 Field::RollingResistance,
-                self.scene.rolling_resistance * 1e3,
-                format!(
-                    "{} has no rolling resistance; give --engine bullet",
-                    self.engine.name()
-                ),
-            ));
-        }
-        if self.scene.bounce_threshold > 0.0 && self.engine != EngineKind::Bullet {
-            return Err(Error::field(
+                s.rolling_resistance * 1e3,
+                "rolling resistance",
+            ),
+            (
+                s.bounce_threshold > 0.0,
                 Field::BounceThreshold,
-                self.scene.bounce_threshold,
-                format!(
-                    "{} has no bounce threshold; give --engine bullet",
-                    self.engine.name()
-                ),
-            ));
-        }
-        if self.scene.contact_time > 0.0 && self.engine != EngineKind::Bullet {
-            return Err(Error::field(
+                s.bounce_threshold,
+                "bounce threshold",
+            ),
+            (
+                s.contact_time > 0.0,
                 Field::ContactTime,
-                self.scene.contact_time * 1e3,
-                format!(
-                    "{} has no soft contact; give --engine bullet",
-                    self.engine.name()
-                ),
-            ));
+                s.contact_time * 1e3,
+                "soft contact",
+            ),
+        ] {
+            if on && self.engine != EngineKind::Bullet {
+                return Err(Error::field(
+                    field,
+                    shown,
+                    format!("{} has no {what}; give --engine bullet", self.engine.name()),
+                ));
+            }
         }
         if let Some(shape) = &self.scene.shape {
             use crate::model::throws::ThrowStyle;

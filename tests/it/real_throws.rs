@@ -72,32 +72,20 @@ fn a_toss_with_every_scale_zero_is_the_release_at_rest() {
 
 #[test]
 fn rolling_resistance_is_a_fit_parameter_of_bullets_contact() {
-    // Free on Rapier, which has none, it is refused in one line before anything runs.
-    let o = dicephys(&[
-        "fit",
-        "--data",
-        "paper",
-        "--free",
-        "e,rolling",
-        "--engine",
-        "rapier",
-        "--points",
-        "6",
-        "--degree",
-        "1",
-        "--point-rolls",
-        "20",
-    ]);
-    refused(&o, 2, "rolling");
-    // A soft table's contact time likewise on Rapier, and, on Bullet, a range that starts
-    // below two of the fit's steps (2 ms at a 5 ms step): refused before anything runs.
-    for extra in [&["--engine", "rapier"][..], &["--dt", "0.005"][..]] {
+    // Free on Rapier, which has none, it is refused in one line before anything runs; a soft
+    // table's contact time likewise, and, on Bullet, a range that starts below two of the
+    // fit's steps (2 ms at a 5 ms step).
+    for (free, extra, says) in [
+        ("e,rolling", ["--engine", "rapier"], "rolling"),
+        ("e,contact_time", ["--engine", "rapier"], "contact_time"),
+        ("e,contact_time", ["--dt", "0.005"], "contact_time"),
+    ] {
         let mut args = vec![
             "fit",
             "--data",
             "paper",
             "--free",
-            "e,contact_time",
+            free,
             "--points",
             "6",
             "--degree",
@@ -106,7 +94,7 @@ fn rolling_resistance_is_a_fit_parameter_of_bullets_contact() {
             "20",
         ];
         args.extend(extra);
-        refused(&dicephys(&args), 2, "contact_time");
+        refused(&dicephys(&args), 2, says);
     }
 }
 
