@@ -118,6 +118,7 @@ impl FitConfig {
         self.check_contact_laws()?;
         self.check_dice()?;
         self.check_pips()?;
+        self.check_rounding()?;
         let com_free = [params::Kind::ComX, params::Kind::ComY, params::Kind::ComZ]
             .into_iter()
             .filter(|&k| self.model.is_free(k));
@@ -246,6 +247,43 @@ impl FitConfig {
                  through the centre of mass it moves, and a free centre is given outright; free \
                  one or the other",
             ));
+        }
+        Ok(())
+    }
+
+    /// A free rounding: on a box its closed forms take any radius below its half sides (the
+    /// scene's checks, at the box's ends below); any other convex die must take the range's
+    /// largest radius in its hull and be a die its rounding has not been given already.
+    fn check_rounding(&self) -> Result<()> {
+        if !self.model.is_free(params::Kind::EdgeRadius) {
+            return Ok(());
+        }
+        let hi = self.model.range(params::Kind::EdgeRadius).hi;
+        for row in &self.rows {
+            let method = self.method.of_row(row);
+            let Some(shape) = method.shape.as_deref().filter(|s| s.as_box().is_none()) else {
+                continue;
+            };
+            let why = if shape.radius > 0.0 {
+                Some(format!(
+                    "{} is rounded already ({} mm, --edge-radius): leave its rounding to the \
+                     fit",
+                    shape.name,
+                    shape.radius * 1e3
+                ))
+            } else {
+                shape
+                    .rounded(hi / 1000.0)
+                    .err()
+                    .map(|why| format!("{}: {why}", shape.name))
+            };
+            if let Some(why) = why {
+                return Err(Error::field(
+                    Field::Range,
+                    format!("edge_radius={}", self.model.range(params::Kind::EdgeRadius)),
+                    why,
+                ));
+            }
         }
         Ok(())
     }

@@ -74,6 +74,9 @@ pub enum Kind {
     ComZ,
     /// The depth of the die's pips, mm (its pips' diameter, shape and paint stay the die's).
     PipDepth,
+    /// The die's edges' and corners' rounding, mm (a box's, `Features::edge_radius`; any other
+    /// convex die's, `Shape::rounded`): one for every row.
+    EdgeRadius,
     /// A printed die's infill fraction, 0 to 1, inside its wall (the die's own shell's, else a
     /// 1 mm one: `mass::DEFAULT_WALL`).
     Infill,
@@ -81,7 +84,7 @@ pub enum Kind {
 
 impl Kind {
     /// Every kind, in the order a row's coordinates take them.
-    pub const ALL: [Kind; 14] = [
+    pub const ALL: [Kind; 15] = [
         Kind::E,
         Kind::Mu,
         Kind::Rolling,
@@ -95,11 +98,12 @@ impl Kind {
         Kind::ComY,
         Kind::ComZ,
         Kind::PipDepth,
+        Kind::EdgeRadius,
         Kind::Infill,
     ];
 
     /// "e", "mu", "rolling", "bounce", "contact_time", "kappa", "spin", "height", "speed", "com_x", "com_y",
-    /// "com_z", "pip_depth" or "infill".
+    /// "com_z", "pip_depth", "edge_radius" or "infill".
     pub fn name(self) -> &'static str {
         self.into()
     }
@@ -113,12 +117,12 @@ impl Kind {
         )
     }
 
-    /// True for the die's parameters (its centre of mass, its pips' depth, its infill): one
-    /// die, shared by every row.
+    /// True for the die's parameters (its centre of mass, its pips' depth, its rounding, its
+    /// infill): one die, shared by every row.
     pub fn of_die(self) -> bool {
         matches!(
             self,
-            Kind::ComX | Kind::ComY | Kind::ComZ | Kind::PipDepth | Kind::Infill
+            Kind::ComX | Kind::ComY | Kind::ComZ | Kind::PipDepth | Kind::EdgeRadius | Kind::Infill
         )
     }
 
@@ -140,6 +144,7 @@ impl Kind {
             Kind::Speed => (0.05, 50.0),
             Kind::ComX | Kind::ComY | Kind::ComZ => (-1000.0, 1000.0),
             Kind::PipDepth => (0.001, 100.0),
+            Kind::EdgeRadius => (0.0, 100.0),
             Kind::Infill => (0.0, 1.0),
         }
     }
@@ -171,6 +176,10 @@ impl Kind {
             // millimetre (docs/results/dice.md: 0.25 mm is seen in ~5,000 throws).
             Kind::ComX | Kind::ComY | Kind::ComZ => Range::new(-2.0, 2.0),
             Kind::PipDepth => Range::new(0.2, 1.5),
+            // Sharp (a machined or printed edge, 0) to 2 mm: a casino die's edges are nearly
+            // sharp, a mass-made 16 mm d6's rounded by 1 to 2 mm; past 2 mm a 16 mm die turns
+            // into a pebble. Fixed before the first fit (issue 72's fifth round).
+            Kind::EdgeRadius => Range::new(0.0, 2.0),
             // From a hollow shell to the solid: a slicer's 10 to 30 % lies inside.
             Kind::Infill => Range::new(0.0, 1.0),
             // None (every impact bounces, the paper's engines) to 1 m/s, half a throw's first
@@ -192,6 +201,7 @@ impl Kind {
             | Kind::ComY
             | Kind::ComZ
             | Kind::PipDepth
+            | Kind::EdgeRadius
             | Kind::Infill
             | Kind::Bounce
             | Kind::ContactTime => v,
@@ -209,6 +219,7 @@ impl Kind {
             | Kind::ComY
             | Kind::ComZ
             | Kind::PipDepth
+            | Kind::EdgeRadius
             | Kind::Infill
             | Kind::Bounce
             | Kind::ContactTime => w,
@@ -295,6 +306,9 @@ pub struct Fixed {
     /// The die's infill fraction where a fit frees it (`None`: the die's own).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub infill: Option<f64>,
+    /// The die's edges' rounding where a fit frees it, mm (`None`: the die's own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub edge_radius: Option<f64>,
 }
 
 fn unit() -> f64 {
@@ -329,6 +343,7 @@ impl Default for Fixed {
             com: [None; 3],
             pip_depth: None,
             infill: None,
+            edge_radius: None,
         }
     }
 }
@@ -387,6 +402,7 @@ pub fn values(fixed: &Fixed, axes: &[(Kind, Range)], x: &[f64]) -> Fixed {
             Kind::ComZ => v.com[2] = Some(value),
             Kind::PipDepth => v.pip_depth = Some(value),
             Kind::Infill => v.infill = Some(value),
+            Kind::EdgeRadius => v.edge_radius = Some(value),
         }
     }
     v
@@ -637,6 +653,9 @@ impl Method {
         if let Some(f) = v.infill {
             die = die.with_infill(f);
         }
+        if let Some(r) = v.edge_radius {
+            die.edge_radius = r / 1000.0;
+        }
         die
     }
 
@@ -663,11 +682,21 @@ impl Method {
         if let Some(d) = self.density {
             scene.density = d;
         }
-        // A die of any shape rests on the facets it rests on at this centre of mass, each
-        // labelled as the rows count it.
+        // A die of any shape but a box takes its rounding in its hull (`Shape::rounded`; a
+        // rounding it cannot take stays in the features, which the scene's checks refuse),
+        // and rests on the facets it rests on at this centre of mass, each labelled as the
+        // rows count it.
         if let Some(s) = &self.shape {
+            let mut base = s.clone();
+            if scene.features.edge_radius > 0.0 && s.as_box().is_none() {
+                if let Ok(r) = s.rounded(scene.features.edge_radius) {
+                    base = std::sync::Arc::new(r);
+                    scene.features.edge_radius = 0.0;
+                    scene.shape = Some(base.clone());
+                }
+            }
             let com = crate::model::mass::MassProps::compute(&scene).com;
-            if let Ok(at) = s.resting_at_keeping(&com) {
+            if let Ok(at) = base.resting_at_keeping(&com) {
                 scene.shape = Some(std::sync::Arc::new(at));
             }
         }

@@ -221,7 +221,7 @@ fn collider(c: &Collider) -> BulletSolid {
             hull: Vec::new(),
             hull_margin: 0.0,
         },
-        Collider::Hull { points, margin } => BulletSolid {
+        Collider::Hull { points, margin, .. } => BulletSolid {
             solid: ffi::SolidKind::Hull,
             sides: [0.0; 3],
             edge_radius: 0.0,

@@ -74,7 +74,7 @@ pub fn models(scene: &Scene) -> crate::Result<()> {
         return refuse("3D dice only");
     }
     match Collider::of(scene) {
-        Collider::Box { radius, .. } if radius > 0.0 => {
+        Collider::Box { radius, .. } | Collider::Hull { radius, .. } if radius > 0.0 => {
             return refuse("a polyhedron only (no rounded edges)")
         }
         Collider::Cylinder { .. } => return refuse("a polyhedron only (no cylinder)"),

@@ -535,9 +535,15 @@ fn collider(c: &Collider) -> crate::Result<(ColliderBuilder, Rotation)> {
             ColliderBuilder::cuboid(half.x, half.y, half.z),
             Rotation::IDENTITY,
         ),
-        Collider::Hull { points, .. } => {
+        Collider::Hull { points, radius, .. } => {
             let points: Vec<Vector> = points.iter().map(from_na).collect();
-            let hull = ColliderBuilder::convex_hull(&points).ok_or_else(|| {
+            // A rounded die: the inner body's hull with a border of its radius.
+            let hull = if *radius > 0.0 {
+                ColliderBuilder::round_convex_hull(&points, *radius)
+            } else {
+                ColliderBuilder::convex_hull(&points)
+            };
+            let hull = hull.ok_or_else(|| {
                 crate::Error::Engine("rapier: the die's hull could not be built".into())
             })?;
             (hull, Rotation::IDENTITY)

@@ -18,12 +18,15 @@ pub enum Collider {
         radius: f64,
     },
     /// A convex polyhedron: its vertices, m, and the margin Bullet keeps its surface out
-    /// from them (`Shape::margin`).
+    /// from them (`Shape::margin`); rounded by `radius` (0: sharp), the vertices' hull swept
+    /// by a ball of it (`Shape::rounded`: the inner body's vertices, the margin the radius).
     Hull {
         /// The vertices.
         points: Vec<Vector3<f64>>,
         /// m.
         margin: f64,
+        /// m.
+        radius: f64,
     },
     /// A cylinder along body z (a coin).
     Cylinder {
@@ -48,6 +51,7 @@ impl Collider {
             Some((s, Solid::Hull { .. })) => Collider::Hull {
                 points: s.points(),
                 margin: s.margin(),
+                radius: s.radius,
             },
             Some((_, Solid::Cylinder { diameter, height })) => Collider::Cylinder {
                 radius: 0.5 * diameter,

@@ -30,6 +30,9 @@ pub struct Convex {
     /// The regions of down directions by the face the downward ray from the centre of mass
     /// leaves through (a hull's facets; a cylinder's caps, then its side).
     regions: Vec<Region>,
+    /// A rounded die's rounding (`Shape::radius`), m: every support, rest height and barrier
+    /// of its inner body (`points`, the facets) plus this.
+    radius: f64,
 }
 
 /// The down directions g (body axes) whose ray from the centre of mass c leaves the die
@@ -62,6 +65,7 @@ impl Convex {
     fn of(shape: &crate::model::shape::Shape, com: &Vector3<f64>) -> Convex {
         use crate::model::shape::Solid;
         let centroid = -com;
+        let radius = shape.radius;
         let (points, cylinder) = match &shape.solid {
             Solid::Hull { .. } => (shape.points().iter().map(|p| p - com).collect(), None),
             Solid::Cylinder { diameter, height } => {
@@ -70,10 +74,13 @@ impl Convex {
         };
         let reach = match cylinder {
             Some((r, h)) => centroid.norm() + r.hypot(h),
-            None => points
-                .iter()
-                .map(|p: &Vector3<f64>| p.norm())
-                .fold(0.0, f64::max),
+            None => {
+                points
+                    .iter()
+                    .map(|p: &Vector3<f64>| p.norm())
+                    .fold(0.0, f64::max)
+                    + radius
+            }
         };
         let thickness = match cylinder {
             Some((r, h)) => (2.0 * r).min(2.0 * h),
@@ -85,7 +92,7 @@ impl Convex {
                         .iter()
                         .map(|p| f.normal.dot(&(p + com)))
                         .fold(f64::INFINITY, f64::min);
-                    f.offset - depth
+                    f.offset - depth + 2.0 * radius
                 })
                 .fold(f64::INFINITY, f64::min),
         };
@@ -140,10 +147,11 @@ impl Convex {
                         .map(|i| {
                             line_distance(&(f.polygon[i] - com), &(f.polygon[(i + 1) % m] - com))
                         })
-                        .fold(f64::INFINITY, f64::min);
+                        .fold(f64::INFINITY, f64::min)
+                        + radius;
                     Region {
                         normal: n,
-                        rest: f.offset - n.dot(com),
+                        rest: f.offset - n.dot(com) + radius,
                         barrier,
                         outcome: outcome(&n),
                     }
@@ -158,6 +166,7 @@ impl Convex {
             reach,
             thickness,
             regions,
+            radius,
         }
     }
 
@@ -237,11 +246,13 @@ impl Convex {
     fn depth(&self, down: &Vector3<f64>) -> f64 {
         match self.cylinder {
             Some((r, h)) => self.centroid.dot(down) + h * down.z.abs() + r * down.x.hypot(down.y),
-            None => self
-                .points
-                .iter()
-                .map(|p| p.dot(down))
-                .fold(f64::NEG_INFINITY, f64::max),
+            None => {
+                self.points
+                    .iter()
+                    .map(|p| p.dot(down))
+                    .fold(f64::NEG_INFINITY, f64::max)
+                    + self.radius
+            }
         }
     }
 

@@ -126,6 +126,10 @@ pub struct Shape {
     /// Which face's label it shows.
     #[serde(default, skip_serializing_if = "is_up")]
     pub reads: Reads,
+    /// Its edges' and corners' rounding, m (0: sharp): the hull of `solid`'s points swept by
+    /// a ball of this radius ([`Shape::rounded`]), its volume and moments the rounded body's.
+    #[serde(default, skip_serializing_if = "is_sharp")]
+    pub radius: f64,
     /// The hull's facets, found once on first use (`Shape::facets`): every roll's die asks
     /// for them.
     #[serde(skip)]
@@ -134,6 +138,10 @@ pub struct Shape {
 
 fn is_up(r: &Reads) -> bool {
     *r == Reads::Up
+}
+
+fn is_sharp(r: &f64) -> bool {
+    *r == 0.0
 }
 
 impl PartialEq for Shape {
@@ -146,6 +154,7 @@ impl PartialEq for Shape {
             && self.faces == o.faces
             && self.printed == o.printed
             && self.reads == o.reads
+            && self.radius == o.radius
     }
 }
 
@@ -217,6 +226,7 @@ pub fn coin(d: f64, h: f64) -> std::result::Result<Shape, String> {
         facets: Default::default(),
         printed: None,
         reads: Reads::Up,
+        radius: 0.0,
         faces: vec![
             Face {
                 normal: [0.0, 0.0, -1.0],
@@ -297,6 +307,7 @@ pub fn from_mesh(
                 .collect()
         }),
         reads,
+        radius: 0.0,
         // The facets just found, so that the outcomes are numbered in this hull's order.
         facets: std::sync::OnceLock::from(std::sync::Arc::new(facets)),
     };
@@ -355,6 +366,75 @@ impl Shape {
         }
         let mut s = self.clone();
         s.faces = self.in_order(self.keeper().outcomes_at(com, true)?);
+        Ok(s)
+    }
+
+    /// The same die with its edges and corners rounded by `radius`, m: its facets moved in by
+    /// the radius and the inner body swept by a ball of it (`mass::rounded_hull`), its outer
+    /// faces where they were. Its mass properties are the rounded body's, about its own
+    /// centroid (this die's points move by the few µm the centroid does); its outcomes are the
+    /// same facets with the same labels, and a rounding that leaves a labelled face no facet
+    /// to rest on is refused. Only a convex hull is rounded here (a coin's or a non-convex
+    /// mesh's edges are rounded in the mesh itself). 0: this die.
+    pub fn rounded(&self, radius: f64) -> std::result::Result<Shape, String> {
+        if radius == 0.0 {
+            return Ok(self.clone());
+        }
+        if matches!(self.solid, Solid::Cylinder { .. }) {
+            return Err("a coin's edge is its own (round a coin's rim in a mesh)".into());
+        }
+        if self.radius > 0.0 {
+            return Err(format!(
+                "its edges are rounded already ({} mm)",
+                self.radius * 1e3
+            ));
+        }
+        if self.hull_note().is_some() {
+            return Err(
+                "it is not convex: round a non-convex mesh's edges in the mesh itself".into(),
+            );
+        }
+        let inradius = crate::model::mass::inradius(self);
+        let too_big = || {
+            format!(
+                "a rounding of {} mm leaves no die: it must be below the distance from its \
+                 centroid to its nearest face, {:.4} mm",
+                radius * 1e3,
+                inradius * 1e3
+            )
+        };
+        if !(radius.is_finite() && radius > 0.0 && radius < inradius) {
+            return Err(too_big());
+        }
+        let (inner, body) =
+            crate::model::mass::rounded_hull(&self.planes(), radius).ok_or_else(too_big)?;
+        let c = body.centroid;
+        let keeper = self.keeper();
+        let mut s = Shape {
+            name: format!("{}, edges rounded {} mm", self.name, radius * 1e3),
+            solid: Solid::Hull {
+                points: inner.iter().map(|&v| (v - c).into()).collect(),
+            },
+            volume: body.volume,
+            second: second_moments(&body.inertia, body.volume),
+            faces: Vec::new(),
+            printed: keeper.printed,
+            reads: keeper.reads,
+            radius,
+            facets: Default::default(),
+        };
+        let faces = s.outcomes_at(&Vector3::zeros(), true)?;
+        if let Some(lost) = self
+            .outcome_labels()
+            .into_iter()
+            .find(|l| !faces.iter().any(|f| f.label == *l))
+        {
+            return Err(format!(
+                "rounded by {} mm it no longer rests on the face labelled {lost}",
+                radius * 1e3
+            ));
+        }
+        s.faces = self.in_order(faces);
         Ok(s)
     }
 
@@ -503,7 +583,8 @@ impl Shape {
             .collect()
     }
 
-    /// The hull's vertices (a cylinder: none), m, body axes, from the centroid.
+    /// The hull's vertices (a cylinder: none), m, body axes, from the centroid; a rounded
+    /// die's inner body's (its surface lies `radius` out from their hull).
     pub fn points(&self) -> Vec<Vector3<f64>> {
         match &self.solid {
             Solid::Hull { points } => points.iter().map(|&p| Vector3::from(p)).collect(),
@@ -520,6 +601,10 @@ impl Shape {
         let Solid::Hull { points } = &self.solid else {
             return None;
         };
+        if self.radius > 0.0 {
+            // The box's own rounding is the cuboid's (`Features::edge_radius`).
+            return None;
+        }
         if points.len() != 8 {
             return None;
         }
@@ -568,10 +653,13 @@ impl Shape {
     /// The largest distance from the centroid to any point of the die, m.
     pub fn circumradius(&self) -> f64 {
         match &self.solid {
-            Solid::Hull { points } => points
-                .iter()
-                .map(|p| Vector3::from(*p).norm())
-                .fold(0.0, f64::max),
+            Solid::Hull { points } => {
+                points
+                    .iter()
+                    .map(|p| Vector3::from(*p).norm())
+                    .fold(0.0, f64::max)
+                    + self.radius
+            }
             Solid::Cylinder { diameter, height } => (0.5 * diameter).hypot(0.5 * height),
         }
     }
@@ -583,7 +671,7 @@ impl Shape {
                 let (lo, hi) = points.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
                     (lo.min(p[i]), hi.max(p[i]))
                 });
-                hi - lo
+                hi - lo + 2.0 * self.radius
             }),
             Solid::Cylinder { diameter, height } => [*diameter, *diameter, *height],
         }
@@ -595,17 +683,22 @@ impl Shape {
         Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
     }
 
-    /// True if `p` (m, body axes, from the centroid) lies strictly inside the die's hull.
+    /// True if `p` (m, body axes, from the centroid) lies strictly inside the die's hull (a
+    /// rounded die's: inside its outer faces, which its rounded corners cut a little from).
     pub fn contains(&self, p: &Vector3<f64>) -> bool {
         match &self.solid {
             Solid::Cylinder { diameter, height } => {
                 p.x.hypot(p.y) < 0.5 * diameter && p.z.abs() < 0.5 * height
             }
-            Solid::Hull { .. } => self.planes().iter().all(|(n, d)| n.dot(p) < *d),
+            Solid::Hull { .. } => self
+                .planes()
+                .iter()
+                .all(|(n, d)| n.dot(p) < *d + self.radius),
         }
     }
 
-    /// The hull's facets, from the centroid (none for a cylinder), found once.
+    /// The hull's facets, from the centroid (none for a cylinder), found once; a rounded
+    /// die's inner body's, each with the normal of the outer face it rests on.
     pub fn facets(&self) -> std::sync::Arc<Vec<polytope::Facet>> {
         self.facets
             .get_or_init(|| {
@@ -620,7 +713,8 @@ impl Shape {
             .clone()
     }
 
-    /// The hull's facet planes (outward normal n, offset d: n·x = d on the facet).
+    /// The hull's facet planes (outward normal n, offset d: n·x = d on the facet); a rounded
+    /// die's outer faces lie `radius` beyond them.
     pub fn planes(&self) -> Vec<(Vector3<f64>, f64)> {
         self.facets().iter().map(|f| (f.normal, f.offset)).collect()
     }
@@ -630,6 +724,10 @@ impl Shape {
     /// is less. The hull is kept this far out, its edges so rounded: a hundredth of the die's
     /// size at most, far below what changes a face's odds.
     pub fn margin(&self) -> f64 {
+        if self.radius > 0.0 {
+            // A rounded die: its rounding is its margin (`Collider::Hull`).
+            return self.radius;
+        }
         let inradius = match &self.solid {
             Solid::Cylinder { diameter, height } => (0.5 * diameter).min(0.5 * height),
             Solid::Hull { .. } => self

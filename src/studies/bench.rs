@@ -259,9 +259,9 @@ pub const Z_BOUND: f64 = 2.0;
 
 /// Every die `dice_costs` times, as a scene: the made cubes of [`made_dice`], then dice of
 /// other shapes (`--shape`: a d6, which takes the box's path as the cuboid does, with and
-/// without pips; a d20 and a d4 on the general hull path), and the sharp cube under issue 72's
-/// candidates (a hand's toss, a flip, a printed shell and infill, rolling resistance, a soft
-/// contact). Each with the throw it is thrown in: a tumble but for the toss and the flip.
+/// without pips; a d20 and a d4 on the general hull path, and the d20 rounded 1 mm), and the
+/// sharp cube under issue 72's candidates (a hand's toss, a flip, a printed shell and infill,
+/// rolling resistance, a soft contact). Each with the throw it is thrown in: a tumble but for the toss and the flip.
 /// Not a coin: a thin one spins like Euler's disk, about 100 ms a roll, and would double the
 /// benchmark's time (its cost is on docs/results/shapes.md).
 pub fn bench_dice() -> crate::Result<Vec<(String, Scene, ThrowStyle)>> {
@@ -307,6 +307,16 @@ pub fn bench_dice() -> crate::Result<Vec<(String, Scene, ThrowStyle)>> {
         out.len() - 2,
         ("--shape d6 --pips 3,1".to_string(), d6_pips, tumble),
     );
+    // Issue 72's rounded mesh: the d20's hull rounded 1 mm (`Shape::rounded`), against the
+    // sharp d20 above.
+    let d20 = crate::model::shape::named("d20", None)?
+        .rounded(0.001)
+        .map_err(|e| crate::Error::Invalid(format!("the rounded d20: {e}")))?;
+    out.push((
+        "--shape d20 --edge-radius 1".into(),
+        Scene::paper_shape(d20, Mode::ThreeD),
+        tumble,
+    ));
     Ok(out)
 }
 

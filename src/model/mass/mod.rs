@@ -11,14 +11,17 @@
 //!
 //! By concern: the description (`features`), its checks (`validate`), the die file
 //! (`die_file`), the pips' geometry (`pips`), a printed die's inner solid (`shell`), a part's
-//! moments (`moments`), the mass integration (`integrate`) and the frame an engine's body is
-//! turned by (`turn`).
+//! moments (`moments`), the mass integration (`integrate`), a convex die's rounded edges
+//! (`rounded`) and the frame an engine's body is turned by (`turn`).
 
 mod die_file;
 mod features;
 mod integrate;
 mod moments;
 mod pips;
+mod rounded;
+#[cfg(test)]
+mod rounded_tests;
 mod shell;
 #[cfg(test)]
 mod shell_tests;
@@ -31,5 +34,6 @@ pub use die_file::{is_mesh, DieFile, LabelDef, ReadFile, MAX_DIE_FILE};
 pub use features::{pattern, Features, Insert, PipShape, Pips, Shell, DEFAULT_WALL};
 pub use integrate::{rounded_box, Composition, MassProps};
 pub use pips::{cavity, pip_places};
+pub use rounded::rounded_hull;
 pub use shell::{inner_hull, inradius};
 pub use turn::BodyTurn;

@@ -100,10 +100,20 @@ impl Features {
             ));
         }
         if self.edge_radius != 0.0 {
+            // A die of any shape takes its rounding in its hull (`Shape::rounded`), which
+            // resolving the die does; a rounding left here was never applied.
             return Err(Error::field(
                 Field::EdgeRadius,
                 mm(self.edge_radius),
-                "rounded edges are the cuboid's; round a mesh's edges in the mesh itself",
+                "a die of any shape is rounded in its hull (Shape::rounded), not here",
+            ));
+        }
+        if shape.radius > 0.0 && self.shell.is_some() {
+            return Err(Error::field(
+                Field::ShellWall,
+                "",
+                "a printed shell inside a die of any shape with rounded edges is not modelled \
+                 (its inner solid is the sharp die's)",
             ));
         }
         if let Some(c) = self.com {
