@@ -219,6 +219,14 @@ fn shaped(shape: &Shape, com: &Vector3<f64>) -> DieView {
         .collect();
     let printed = |n: &Vector3<f64>| printed_label(shape, n);
     let polys: Vec<Poly> = match &shape.solid {
+        Solid::Hull { .. } if shape.radius > 0.0 => rounded_facets(shape)
+            .iter()
+            .map(|f| Poly {
+                corners: f.polygon.iter().map(|p| round(&(p - com))).collect(),
+                label: printed(&f.normal),
+                pips: Vec::new(),
+            })
+            .collect(),
         Solid::Hull { .. } => shape
             .facets()
             .iter()
@@ -249,6 +257,23 @@ fn shaped(shape: &Shape, com: &Vector3<f64>) -> DieView {
         reach,
         pip_radius: 0.0,
     }
+}
+
+/// A rounded die as drawn (`Shape::rounded`): its flat faces where they are, each of its inner
+/// body's facets moved out by the radius, and its rounded edges and corners as the flat strips
+/// and corners of the hull between them (the hull of every inner corner moved by the radius
+/// along every facet's normal).
+fn rounded_facets(shape: &Shape) -> Vec<crate::model::polytope::Facet> {
+    use crate::model::polytope;
+    let normals: Vec<Vector3<f64>> = shape.facets().iter().map(|f| f.normal).collect();
+    let points: Vec<Vector3<f64>> = shape
+        .points()
+        .iter()
+        .flat_map(|p| normals.iter().map(move |n| p + n * shape.radius))
+        .collect();
+    polytope::hull(&points)
+        .map(|h| polytope::facets(&h, polytope::COPLANAR_TOLERANCE))
+        .unwrap_or_default()
 }
 
 /// The label printed on the facet with outward normal `n`.
@@ -313,6 +338,28 @@ mod tests {
             .collect();
         labels.sort();
         assert_eq!(labels, (1..=20).collect::<Vec<_>>());
+    }
+
+    /// A rounded d20 is drawn with its twenty labelled faces where the sharp one's are (each
+    /// face's plane as far from the centre) and unlabelled strips between them.
+    #[test]
+    fn a_rounded_d20_shows_its_faces_where_they_are_and_strips_between() {
+        let sharp = crate::model::shape::named("d20", None).unwrap();
+        let d = sharp.planes()[0].1;
+        let v = shaped(&sharp.rounded(0.002).unwrap(), &Vector3::zeros());
+        let labelled: Vec<&Poly> = v.polys.iter().filter(|p| p.label.is_some()).collect();
+        assert_eq!(labelled.len(), 20);
+        assert!(v.polys.len() > 20);
+        for p in labelled {
+            let c: Vector3<f64> = p
+                .corners
+                .iter()
+                .map(|c| Vector3::from(*c))
+                .sum::<Vector3<f64>>()
+                / p.corners.len() as f64;
+            // The corners are rounded to the µm for the page.
+            assert!((c.norm() - d).abs() < 2e-6, "{} against {d}", c.norm());
+        }
     }
 
     /// A 16 × 16 × 16 mm box with 3 mm pips 0.5 mm deep and edges rounded `r` mm, as drawn.
