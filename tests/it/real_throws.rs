@@ -27,6 +27,18 @@ fn v1() -> String {
     )
 }
 
+/// V1 as a die file in `dir`, its mesh scaled by `scale` and its sides labelled by class
+/// (docs/results/real-dice/v1.toml's at `14.821972`, 24 mm).
+fn v1_toml(dir: &Scratch, scale: &str) -> std::path::PathBuf {
+    let toml = dir.join("v1.toml");
+    std::fs::write(
+        &toml,
+        format!("mesh = \"{}\"\nscale = {scale}\n{}", v1(), V1_LABELS),
+    )
+    .unwrap();
+    toml
+}
+
 fn rolled(extra: &[&str]) -> serde_json::Value {
     let mut args = vec![
         "roll",
@@ -186,12 +198,7 @@ fn a_side_split_into_two_triangles_is_one_printed_side() {
     // "no label for the facet with normal (0.0000, 0.1005, -0.9949)"), and every roll is
     // counted on a face.
     let dir = Scratch::new("v1-side");
-    let toml = dir.join("v1.toml");
-    std::fs::write(
-        &toml,
-        format!("mesh = \"{}\"\nscale = 14.821972\n{}", v1(), V1_LABELS),
-    )
-    .unwrap();
+    let toml = v1_toml(&dir, "14.821972");
     let o = json(&dicephys(&[
         "roll",
         "--die",
@@ -249,12 +256,7 @@ labels = [
 #[test]
 fn released_at_rest_a_rounded_mesh_rolls_down_as_its_inner_bodys_theory_says() {
     let dir = Scratch::new("v1-rounded");
-    let toml = dir.join("v1.toml");
-    std::fs::write(
-        &toml,
-        format!("mesh = \"{}\"\nscale = 177.863664\n{}", v1(), V1_LABELS),
-    )
-    .unwrap();
+    let toml = v1_toml(&dir, "177.863664");
     let roll = |radius: &str, rolls: &str| {
         json(&dicephys(&[
             "roll",
@@ -322,12 +324,7 @@ fn released_at_rest_a_rounded_mesh_rolls_down_as_its_inner_bodys_theory_says() {
 #[test]
 fn a_dies_rounding_is_a_fit_parameter() {
     let dir = Scratch::new("v1-rounding-fit");
-    let toml = dir.join("v1.toml");
-    std::fs::write(
-        &toml,
-        format!("mesh = \"{}\"\nscale = 14.821972\n{}", v1(), V1_LABELS),
-    )
-    .unwrap();
+    let toml = v1_toml(&dir, "14.821972");
     let data = dir.join("v1.csv");
     std::fs::write(
         &data,

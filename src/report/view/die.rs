@@ -219,23 +219,21 @@ fn shaped(shape: &Shape, com: &Vector3<f64>) -> DieView {
         .collect();
     let printed = |n: &Vector3<f64>| printed_label(shape, n);
     let polys: Vec<Poly> = match &shape.solid {
-        Solid::Hull { .. } if shape.radius > 0.0 => rounded_facets(shape)
-            .iter()
-            .map(|f| Poly {
-                corners: f.polygon.iter().map(|p| round(&(p - com))).collect(),
-                label: printed(&f.normal),
-                pips: Vec::new(),
-            })
-            .collect(),
-        Solid::Hull { .. } => shape
-            .facets()
-            .iter()
-            .map(|f| Poly {
-                corners: f.polygon.iter().map(|p| round(&(p - com))).collect(),
-                label: printed(&f.normal),
-                pips: Vec::new(),
-            })
-            .collect(),
+        Solid::Hull { .. } => {
+            let facets = if shape.radius > 0.0 {
+                std::sync::Arc::new(rounded_facets(shape))
+            } else {
+                shape.facets()
+            };
+            facets
+                .iter()
+                .map(|f| Poly {
+                    corners: f.polygon.iter().map(|p| round(&(p - com))).collect(),
+                    label: printed(&f.normal),
+                    pips: Vec::new(),
+                })
+                .collect()
+        }
         Solid::Cylinder { diameter, height } => cylinder(0.5 * diameter, 0.5 * height, com)
             .into_iter()
             .map(|(corners, n)| Poly {
