@@ -72,16 +72,12 @@ impl Convex {
                 (Vec::new(), Some((0.5 * diameter, 0.5 * height)))
             }
         };
-        let reach = match cylinder {
-            Some((r, h)) => centroid.norm() + r.hypot(h),
-            None => {
-                points
-                    .iter()
-                    .map(|p: &Vector3<f64>| p.norm())
-                    .fold(0.0, f64::max)
-                    + radius
-            }
-        };
+        // A coin is never rounded (`Shape::rounded`): the radius adds to a hull's alone.
+        let reach = radius
+            + match cylinder {
+                Some((r, h)) => centroid.norm() + r.hypot(h),
+                None => points.iter().map(|p| p.norm()).fold(0.0, f64::max),
+            };
         let thickness = match cylinder {
             Some((r, h)) => (2.0 * r).min(2.0 * h),
             None => shape

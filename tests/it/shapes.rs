@@ -351,9 +351,15 @@ fn bad_meshes_and_combinations_are_refused_in_one_line() {
     );
     refused(&["roll", "--shape", "d20", "--2d"], &["--shape", "3D"]);
     refused(&["roll", "--shape", "d20", "--pips", "3,1"], &["pips"]);
+    // A convex die takes a rounding (issue 72's fifth round; refused before it), but not
+    // past its inradius, and a coin's rim is its own.
     refused(
-        &["roll", "--shape", "d20", "--edge-radius", "1"],
-        &["--edge-radius"],
+        &["roll", "--shape", "d20", "--edge-radius", "50"],
+        &["--edge-radius", "leaves no die"],
+    );
+    refused(
+        &["roll", "--shape", "coin:24,2", "--edge-radius", "0.5"],
+        &["--edge-radius", "coin"],
     );
     refused(
         &["roll", "--shape", "d20", "--com", "0,0,30"],

@@ -60,10 +60,10 @@ fn a_box_rounded_through_its_hull_has_the_rounded_boxs_closed_form_mass() {
     assert!((0..3).all(|i| (bb[i] - 2.0 * h[i]).abs() < 1e-12), "{bb:?}");
 }
 
-/// Steiner's formula, exact for any convex body K swept by a ball: V(K ⊕ rB) = V + S r + M r²
-/// + (4/3)π r³, M = ½ Σ over K's edges of length × exterior angle. For the d8 (a regular
-/// octahedron, inradius ρ − r inside, edge a = ρ√6 at inradius ρ, exterior angle π − arccos(−1/3))
-/// the rounded d8's volume matches it to 1e-4 (measured 6.4e-5).
+/// Steiner's formula, exact for any convex body K swept by a ball: V(K ⊕ rB) is V + S r +
+/// M r² + (4/3)π r³, M = ½ Σ over K's edges of length × exterior angle. For the d8 (a regular
+/// octahedron, inradius ρ − r inside, edge a = ρ√6 at inradius ρ, exterior angle
+/// π − arccos(−1/3)) the rounded d8's volume matches it to 1e-4 (measured 6.4e-5).
 #[test]
 fn a_rounded_octahedrons_volume_is_steiners() {
     let d8 = shape::named("d8", Some(16.0)).unwrap();
