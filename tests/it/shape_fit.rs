@@ -106,12 +106,15 @@ fn a_fitted_d20_predicts_its_faces_as_a_fresh_roll_at_the_fitted_centre_gives_th
     // often as those near −z), fitted, then predicted at 8 posterior draws × 1,500 rolls;
     // beside 12,000 fresh throws at the fitted centre of mass (another seed), every face within
     // 4 combined standard errors, and the faces' χ² on 19 below its 0.1 % point (43.8). (How
-    // near the fitted centre comes to the truth is the recovery's test, above.)
+    // near the fitted centre comes to the truth is the recovery's test, above.) Every roll at
+    // dt = 1/250, as the recovery's: the prediction and the fresh roll share the step, and the
+    // test took 84 s at dt = 1/1000, the suite's third-longest.
     let dir = Scratch::new("shape-fit-predict");
     let labels = d20_labels();
     let roll_at = |com: &str, seed: &str, rolls: &str| {
         let v = json(&dicephys(&[
-            "roll", "--shape", "d20", "--com", com, "--rolls", rolls, "--seed", seed, "--json",
+            "roll", "--shape", "d20", "--com", com, "--rolls", rolls, "--seed", seed, "--dt",
+            "1/250", "--json",
         ]));
         let f = v["shape"]["faces"].as_array().unwrap().clone();
         let got: Vec<String> = f
@@ -129,7 +132,15 @@ fn a_fitted_d20_predicts_its_faces_as_a_fresh_roll_at_the_fitted_centre_gives_th
         &[
             &["fit", "--data", &csv][..],
             &SMALL,
-            &["--seed", "5", "--out", out.to_str().unwrap(), "--json"],
+            &[
+                "--dt",
+                "1/250",
+                "--seed",
+                "5",
+                "--out",
+                out.to_str().unwrap(),
+                "--json",
+            ],
         ]
         .concat(),
     );
