@@ -682,22 +682,17 @@ impl Method {
         if let Some(d) = self.density {
             scene.density = d;
         }
-        // A die of any shape but a box takes its rounding in its hull (`Shape::rounded`; a
-        // rounding it cannot take stays in the features, which the scene's checks refuse),
+        // A die of any shape but a box takes its rounding in its hull (`mass::take_rounding`;
+        // a rounding it cannot take stays in the features, which the scene's checks refuse),
         // and rests on the facets it rests on at this centre of mass, each labelled as the
         // rows count it.
-        if let Some(s) = &self.shape {
-            let mut base = s.clone();
-            if scene.features.edge_radius > 0.0 && s.as_box().is_none() {
-                if let Ok(r) = s.rounded(scene.features.edge_radius) {
-                    base = std::sync::Arc::new(r);
-                    scene.features.edge_radius = 0.0;
-                    scene.shape = Some(base.clone());
+        if self.shape.is_some() {
+            let _ = crate::model::mass::take_rounding(&mut scene.shape, &mut scene.features);
+            if let Some(base) = scene.shape.clone() {
+                let com = crate::model::mass::MassProps::compute(&scene).com;
+                if let Ok(at) = base.resting_at_keeping(&com) {
+                    scene.shape = Some(std::sync::Arc::new(at));
                 }
-            }
-            let com = crate::model::mass::MassProps::compute(&scene).com;
-            if let Ok(at) = base.resting_at_keeping(&com) {
-                scene.shape = Some(std::sync::Arc::new(at));
             }
         }
         let mut throws = match v.throw {

@@ -90,21 +90,19 @@ impl DieRequest {
             // The numbering is the run's (in its specification), pips or none.
             features.layout = l;
         }
-        // A die of any shape but a box has its edges rounded in its hull (`Shape::rounded`); a
-        // box's rounding stays the cuboid's (`Features::edge_radius`, its closed forms).
-        let shape = match shape {
-            Some(s) if features.edge_radius > 0.0 && s.as_box().is_none() => {
-                let r = features.edge_radius;
-                let rounded = s.rounded(r).map_err(|why| {
-                    Error::field(Field::EdgeRadius, r * 1e3, format!("{}: {why}", s.name))
-                })?;
-                features.edge_radius = 0.0;
-                Some(rounded)
-            }
-            other => other,
-        };
+        // A die of any shape but a box has its edges rounded in its hull; a box's rounding
+        // stays the cuboid's (`mass::take_rounding`).
+        let mut shape = shape.map(std::sync::Arc::new);
+        let (r, name) = (features.edge_radius, shape.as_ref().map(|s| s.name.clone()));
+        crate::model::mass::take_rounding(&mut shape, &mut features).map_err(|why| {
+            Error::field(
+                Field::EdgeRadius,
+                r * 1e3,
+                format!("{}: {why}", name.unwrap_or_default()),
+            )
+        })?;
         Ok(ResolvedDie {
-            shape,
+            shape: shape.map(|s| std::sync::Arc::unwrap_or_clone(s)),
             features,
             density,
         })

@@ -687,14 +687,12 @@ impl Varied {
                 }
                 Some(_) => return Err(at("the die is not a block: give --block LxBxW")),
             },
-            // A die of any shape but a box is rounded in its hull (`Shape::rounded`).
-            Varied::EdgeRadius if scene.hull_shape().is_some() => {
-                let shape = scene.hull_shape().expect("a hull");
-                s.shape = Some(std::sync::Arc::new(
-                    shape.rounded(mm / 1000.0).map_err(|e| at(&e))?,
-                ));
+            _ => {
+                s.features = self.set(&scene.features, mm)?;
+                // A die of any shape but a box is rounded in its hull (`mass::take_rounding`).
+                crate::model::mass::take_rounding(&mut s.shape, &mut s.features)
+                    .map_err(|e| at(&e))?;
             }
-            _ => s.features = self.set(&scene.features, mm)?,
         }
         Ok(s)
     }

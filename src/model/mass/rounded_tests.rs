@@ -117,3 +117,43 @@ fn a_rounded_die_keeps_its_labels_and_refuses_what_it_cannot_be() {
     assert!(coin.rounded(0.0005).is_err());
     assert_eq!(v1.rounded(0.0).unwrap(), v1);
 }
+
+/// Where a rounding goes (`take_rounding`): a box keeps it in its features (the cuboid's
+/// closed forms), a d8 takes it in its hull, its features' radius then 0, and a coin refuses
+/// it leaving both as they were; a rounding asked again of the same die at the same radius is
+/// the one already made (`rounded_shared`), and another radius is another die.
+#[test]
+fn a_rounding_goes_to_a_boxs_features_or_a_hulls_shape_and_is_made_once() {
+    use std::sync::Arc;
+    let with_r = |r: f64| Features {
+        edge_radius: r,
+        ..Features::default()
+    };
+    let d6 = Arc::new(shape::named("d6", None).unwrap());
+    let (mut s, mut f) = (Some(d6.clone()), with_r(0.001));
+    take_rounding(&mut s, &mut f).unwrap();
+    assert!(Arc::ptr_eq(s.as_ref().unwrap(), &d6) && f.edge_radius == 0.001);
+    let d8 = Arc::new(shape::named("d8", None).unwrap());
+    let (mut s, mut f) = (Some(d8.clone()), with_r(0.001));
+    take_rounding(&mut s, &mut f).unwrap();
+    let once = s.unwrap();
+    assert_eq!(f.edge_radius, 0.0);
+    assert_eq!(once.radius, 0.001);
+    let (mut again, mut f) = (Some(d8.clone()), with_r(0.001));
+    take_rounding(&mut again, &mut f).unwrap();
+    assert!(Arc::ptr_eq(&once, again.as_ref().unwrap()), "made twice");
+    let other = rounded_shared(&d8, 0.0015).unwrap();
+    assert_eq!(other.radius, 0.0015);
+    assert_eq!(
+        *rounded_shared(&d8, 0.001).unwrap(),
+        d8.rounded(0.001).unwrap()
+    );
+    let coin = Arc::new(shape::named("coin:24,2", None).unwrap());
+    let (mut s, mut f) = (Some(coin.clone()), with_r(0.0005));
+    assert!(take_rounding(&mut s, &mut f).is_err());
+    assert!(Arc::ptr_eq(s.as_ref().unwrap(), &coin) && f.edge_radius == 0.0005);
+    // No die of any shape: the cuboid's rounding, in its features.
+    let (mut s, mut f) = (None, with_r(0.001));
+    take_rounding(&mut s, &mut f).unwrap();
+    assert!(s.is_none() && f.edge_radius == 0.001);
+}
