@@ -40,7 +40,8 @@ pub struct FitRequest {
     pub engine: EngineKind,
     /// The time step, s.
     pub dt: f64,
-    /// The step cap per roll.
+    /// The step cap per roll; left at [`DEFAULT_MAX_STEPS`], a die of any shape takes its own
+    /// (`roll::SHAPE_MAX_STEPS`), as `roll` gives it.
     pub max_steps: u64,
     /// Parameter points per block per pass.
     pub points: usize,
@@ -177,13 +178,23 @@ impl FitRequest {
             .max()
             .unwrap_or(6);
         let (degree, max_degree) = DesignSpec::degrees(self.degree, self.max_degree, outcomes);
+        // The step cap left at DicePhys's is the die's, as `roll`'s (`roll::default_max_steps`):
+        // a die of any shape that never comes to rest (a rounded die rocking, a coin rolling on
+        // its rim) ends unconverged at 200 s, not at 20,000 s, which made a rounding fit of V1
+        // take hours.
+        let max_steps =
+            if self.max_steps == DEFAULT_MAX_STEPS && (shape.is_some() || !dice.is_empty()) {
+                crate::sim::roll::SHAPE_MAX_STEPS
+            } else {
+                self.max_steps
+            };
         let cfg = FitConfig {
             rows,
             model: self.model(shape.is_some() || !dice.is_empty())?,
             method: Method {
                 engine: self.engine,
                 dt: self.dt,
-                max_steps: self.max_steps,
+                max_steps,
                 die,
                 density,
                 shape: shape.map(std::sync::Arc::new),

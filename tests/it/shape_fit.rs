@@ -507,3 +507,41 @@ fn ctrl_c_in_the_likelihood_ratios_scale_ends_a_d20_fit_at_once() {
     );
     assert!(!out.join("fit.json").exists());
 }
+
+#[test]
+fn a_fits_step_cap_left_at_its_default_is_the_dies_as_rolls_is() {
+    // `roll` caps a die of any shape at 200,000 steps unless asked (`roll::default_max_steps`);
+    // a fit of one took DicePhys's 20,000,000, so a rounded die rocking for ever was simulated
+    // for 20,000 s a roll. Now a fit takes the die's cap too; a block's stays DicePhys's and a
+    // cap given is kept.
+    use dicephys::calibration::data;
+    use dicephys::calibration::request::FitRequest;
+    use dicephys::sim::roll::{DEFAULT_MAX_STEPS, SHAPE_MAX_STEPS};
+    let labels = d20_labels();
+    let d20 = format!(
+        "label,surface,{}\nd,felt,{}\n",
+        labels
+            .iter()
+            .map(|l| format!("face_{l}"))
+            .collect::<Vec<_>>()
+            .join(","),
+        vec!["10"; 20].join(",")
+    );
+    let cap = |rows: &str, shape: Option<&str>, asked: u64| {
+        let req = FitRequest {
+            rows: data::parse(rows, "counts.csv").unwrap(),
+            max_steps: asked,
+            die: dicephys::run::request::DieRequest {
+                shape: shape.map(String::from),
+                ..Default::default()
+            },
+            ..FitRequest::default()
+        };
+        req.config().unwrap().method.max_steps
+    };
+    assert_eq!(cap(&d20, Some("d20"), DEFAULT_MAX_STEPS), SHAPE_MAX_STEPS);
+    assert_eq!(cap(&d20, Some("d20"), 5_000), 5_000);
+    let block = "label,surface,length_mm,breadth_mm,width_mm,mode,length_vertical,\
+                 breadth_vertical,width_vertical\na,felt,140,24,20,3d,0,200,400\n";
+    assert_eq!(cap(block, None, DEFAULT_MAX_STEPS), DEFAULT_MAX_STEPS);
+}
