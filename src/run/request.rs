@@ -102,7 +102,7 @@ impl DieRequest {
             )
         })?;
         Ok(ResolvedDie {
-            shape: shape.map(|s| std::sync::Arc::unwrap_or_clone(s)),
+            shape: shape.map(std::sync::Arc::unwrap_or_clone),
             features,
             density,
         })
