@@ -7,7 +7,6 @@ use crate::calibration::data::{self, DataRow};
 use crate::calibration::params::Method;
 use crate::error::{Error, Field, Result};
 use crate::model::mass::Features;
-use crate::model::scene::{Mode, Scene};
 use crate::model::shape::Shape;
 use crate::run::request::DieRequest;
 use serde::{Deserialize, Serialize};
@@ -30,16 +29,6 @@ pub struct RowDie {
     pub density: Option<f64>,
 }
 
-/// A die of any shape and its features, resting on the facets it rests on at its own centre of
-/// mass (a box's pips drilled as its labels number its faces).
-pub fn resting(shape: Shape, features: Features) -> std::result::Result<(Shape, Features), String> {
-    let mut scene = Scene::paper_shape(shape, Mode::ThreeD);
-    scene.features = features;
-    let scene = scene.resting_at_com()?;
-    let shape = scene.shape.map(|s| (*s).clone()).expect("a shape");
-    Ok((shape, scene.features))
-}
-
 impl RowDie {
     /// The die a `die` cell names: a die file (by its extension, [`data::is_die_file`]) or a
     /// shape name, as `--die` and `--shape` take them.
@@ -55,7 +44,7 @@ impl RowDie {
                 ..DieRequest::default()
             }
         };
-        let got = req.resolve()?;
+        let got = req.resolve_resting()?;
         let Some(shape) = got.shape else {
             return Err(Error::Invalid(
                 "describes no shape or mesh (a cuboid's rows count its sides, in a file of \
@@ -63,12 +52,10 @@ impl RowDie {
                     .into(),
             ));
         };
-        let (shape, die) = resting(shape, got.features)
-            .map_err(|e| Error::Invalid(format!("at its centre of mass: {e}")))?;
         Ok(RowDie {
             name: name.into(),
             shape: Arc::new(shape),
-            die,
+            die: got.features,
             density: got.density,
         })
     }

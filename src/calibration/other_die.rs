@@ -11,7 +11,6 @@ use crate::calibration::FitResult;
 use crate::error::{Error, Field, Result};
 use crate::model::block::Block;
 use crate::model::mass::Features;
-use crate::model::scene::{Mode, Scene};
 use crate::model::shape::Shape;
 use crate::run::request::DieRequest;
 use serde::{Deserialize, Serialize};
@@ -36,21 +35,10 @@ impl OtherDie {
     /// The die `req` describes (as `roll` and `fit` read it), its outcomes the facets it rests
     /// on at its own centre of mass.
     pub fn resolve(req: &DieRequest) -> Result<OtherDie> {
-        let d = req.resolve()?;
-        let (shape, features) = match d.shape {
-            Some(s) => {
-                let mut scene = Scene::paper_shape(s, Mode::ThreeD);
-                scene.features = d.features;
-                let scene = scene.resting_at_com().map_err(|e| {
-                    Error::field(Field::Shape, "", format!("at its centre of mass: {e}"))
-                })?;
-                (scene.shape, scene.features)
-            }
-            None => (None, d.features),
-        };
+        let d = req.resolve_resting()?;
         Ok(OtherDie {
-            shape,
-            features,
+            shape: d.shape.map(Arc::new),
+            features: d.features,
             density: d.density,
         })
     }

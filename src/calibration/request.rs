@@ -140,23 +140,12 @@ impl FitRequest {
 
     /// The fit's configuration, checked.
     pub fn config(&self) -> Result<FitConfig> {
+        // A loaded die's outcomes are the facets it rests on at its own centre of mass.
         let crate::run::request::ResolvedDie {
             shape,
-            features: mut die,
+            features: die,
             density,
-        } = self.die.resolve()?;
-        // A loaded die's outcomes are the facets it rests on at its own centre of mass.
-        let shape = match shape {
-            Some(s) => {
-                let (s, features) = super::dice::resting(s, die).map_err(|e| {
-                    Error::field(Field::Shape, "", format!("at its centre of mass: {e}"))
-                })?;
-                // A box's pips are drilled as its labels number its faces.
-                die = features;
-                Some(s)
-            }
-            None => None,
-        };
+        } = self.die.resolve_resting()?;
         // The rows' own dice (a `die` column): each row read against its die, the rest
         // against the command line's.
         let dice = super::dice::resolve_rows(&self.rows)?;

@@ -107,6 +107,37 @@ impl DieRequest {
             density,
         })
     }
+
+    /// The die asked ([`DieRequest::resolve`]), a die of any shape resting on the facets it
+    /// rests on at its own centre of mass (a loaded die's outcomes; a box's pips drilled as
+    /// its labels number its faces): as `fit`, `predict`'s other die and a `die` column's take
+    /// it. An error names the flag or file that gave the die.
+    pub fn resolve_resting(&self) -> Result<ResolvedDie> {
+        let d = self.resolve()?;
+        let Some(shape) = d.shape else {
+            return Ok(d);
+        };
+        let mut scene = Scene::paper_shape(shape, Mode::ThreeD);
+        scene.features = d.features;
+        let scene = scene
+            .resting_at_com()
+            .map_err(|e| self.at_its_centre_of_mass(&e))?;
+        Ok(ResolvedDie {
+            shape: scene.shape.map(std::sync::Arc::unwrap_or_clone),
+            features: scene.features,
+            density: d.density,
+        })
+    }
+
+    /// Why the die cannot rest at its own centre of mass, named by the flag or file that gave
+    /// it.
+    fn at_its_centre_of_mass(&self, why: &str) -> Error {
+        let (field, value) = match &self.file {
+            Some(p) => (Field::Die, p.display().to_string()),
+            None => (Field::Shape, self.shape.clone().unwrap_or_default()),
+        };
+        Error::field(field, value, format!("at its centre of mass: {why}"))
+    }
 }
 
 /// The scene asked: the die, its surface, its floor, the time step.
@@ -243,22 +274,9 @@ impl SceneRequest {
         }
         scene.validate(self.allow_restitution_above_one)?;
         // A loaded die's outcomes are the facets it rests on at its own centre of mass.
-        let scene = scene.resting_at_com().map_err(|e| {
-            Error::field(
-                if d.file.is_some() {
-                    Field::Die
-                } else {
-                    Field::Shape
-                },
-                d.file
-                    .as_ref()
-                    .map(|p| p.display().to_string())
-                    .or(d.shape.clone())
-                    .unwrap_or_default(),
-                format!("at its centre of mass: {e}"),
-            )
-        })?;
-        Ok(scene)
+        scene
+            .resting_at_com()
+            .map_err(|e| d.at_its_centre_of_mass(&e))
     }
 }
 
