@@ -21,7 +21,7 @@ use dicephys::model::scene::Mode;
 use dicephys::model::throws::DEFAULT_SEED;
 use dicephys::model::throws::{Range, ThrowRanges, ThrowStyle};
 use dicephys::report::per_roll::PerRoll;
-use dicephys::report::summary::Target;
+use dicephys::report::precision::Target;
 use dicephys::run::request::{DieRequest, EndRequest, RollRequest, SceneRequest, ThrowRequest};
 use dicephys::run::runner::{ChunkShare, Runner};
 use dicephys::run::spec::RunSpec;

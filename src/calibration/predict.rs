@@ -113,7 +113,7 @@ pub struct BlockPrediction {
     /// Each row of counts given (`--counts`), the prediction scored against it beside the
     /// baselines.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub tests: Vec<crate::calibration::proper::CountsTest>,
+    pub tests: Vec<crate::calibration::scores::CountsTest>,
 }
 
 impl BlockPrediction {

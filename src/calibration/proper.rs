@@ -296,23 +296,6 @@ pub struct DieScores {
     pub scores: Scores,
 }
 
-/// A row of counts a prediction was scored against.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct CountsTest {
-    /// The row's label.
-    pub label: String,
-    /// The outcomes it counts.
-    pub outcomes: Vec<String>,
-    /// Its counts.
-    pub counts: Vec<u64>,
-    /// The prediction of each outcome counted (a group of faces the counts merge summed, its
-    /// errors in quadrature), as scored.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub predicted: Vec<crate::calibration::predict::Predicted>,
-    /// The prediction's scores beside the baselines'.
-    pub scores: Scores,
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

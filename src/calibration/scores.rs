@@ -7,6 +7,10 @@
 use crate::theory::stats::{self, Ratio};
 use serde::{Deserialize, Serialize};
 
+/// Rolls of the default scene for each row a fit's leave-one-out scores (its uncalibrated
+/// baseline), per roll of one of the fit's design points: ten points' worth.
+pub const LOO_BASELINE_POINTS: u64 = 10;
+
 /// A predicted probability.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Predicted {
@@ -126,4 +130,21 @@ pub struct LooRow {
 /// A number JSON wrote as null (NaN, or an infinity), read back as NaN.
 fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
     Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
+/// A row of counts a prediction was scored against.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CountsTest {
+    /// The row's label.
+    pub label: String,
+    /// The outcomes it counts.
+    pub outcomes: Vec<String>,
+    /// Its counts.
+    pub counts: Vec<u64>,
+    /// The prediction of each outcome counted (a group of faces the counts merge summed, its
+    /// errors in quadrature), as scored.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub predicted: Vec<Predicted>,
+    /// The prediction's scores beside the baselines'.
+    pub scores: crate::calibration::proper::Scores,
 }

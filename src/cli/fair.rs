@@ -150,7 +150,7 @@ pub fn run(mut a: FairArgs) -> Result<()> {
         &a.roll,
         &spec,
         "fair",
-        dicephys::report::summary::Target::Faces,
+        dicephys::report::precision::Target::Faces,
     )?;
     if let (None, Some(dir)) = (&a.roll.resume, &a.roll.checkpoint) {
         store_null(dir, &null)?;
@@ -159,7 +159,7 @@ pub fn run(mut a: FairArgs) -> Result<()> {
     // shown, and the run fails saying what to change.
     if !summary.partial {
         if let Err(e) =
-            dicephys::report::summary::check_settled(&summary.tally, &summary.spec.scene)
+            dicephys::report::shape_outcomes::check_settled(&summary.tally, &summary.spec.scene)
         {
             if *a.roll.json {
                 outln!("{}", dicephys::run::seal::to_string(&summary, true)?);

@@ -6,8 +6,8 @@ use super::error::{Error, Result};
 use super::term::{out, outln};
 use clap::Args;
 use dicephys::engine::EngineKind;
+use dicephys::report::precision::Target;
 use dicephys::report::progress::{Progress, Unit};
-use dicephys::report::summary::Target;
 use dicephys::run::request::RollRequest;
 use dicephys::run::runner::{Checkpoint, Runner};
 use dicephys::run::spec::{RunSpec, Shard};
@@ -169,7 +169,7 @@ pub fn run(a: &RollArgs) -> Result<()> {
     // A die of any shape none of whose rolls came to rest on a face has no shares to give.
     if let Some(shape) = summary.shape.as_ref().filter(|_| !summary.partial) {
         if summary.rolls > 0 && shape.faces.iter().all(|f| f.count == 0) {
-            let why = dicephys::report::summary::check_settled(&summary.tally, &spec.scene)
+            let why = dicephys::report::shape_outcomes::check_settled(&summary.tally, &spec.scene)
                 .err()
                 .map_or_else(
                     || "no roll came to rest on a face".into(),
@@ -188,7 +188,7 @@ pub fn rolled(
     a: &RollArgs,
     spec: &RunSpec,
     command: &'static str,
-    target: dicephys::report::summary::Target,
+    target: dicephys::report::precision::Target,
 ) -> Result<(dicephys::report::summary::RunSummary, Result<()>)> {
     // The flag that set the precision: fair's target is its faces (--within).
     let flag = match target {

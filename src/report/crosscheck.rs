@@ -57,7 +57,7 @@ pub struct OutcomeCompared {
 /// A run's outcomes by name: a die of any shape's faces, a made cube's six faces (when
 /// every settled roll's face is known), else the block's sides.
 pub fn outcome_counts(r: &RunSummary) -> Vec<(String, u64)> {
-    if let Some(f) = crate::report::summary::shape_faces(&r.tally, &r.spec.scene) {
+    if let Some(f) = crate::report::shape_outcomes::shape_faces(&r.tally, &r.spec.scene) {
         return f;
     }
     if let (Some(f), false) = (&r.faces, r.spec.scene.features.plain()) {
@@ -132,7 +132,7 @@ pub struct Crosscheck {
     pub versus: Vec<Versus>,
     /// With --precision: asked, reached (the worst engine's) and the rolls each engine made.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub precision: Option<crate::report::summary::Reached>,
+    pub precision: Option<crate::report::precision::Reached>,
 }
 
 /// The report as `crosscheck` prints it: each engine's run, then a line per engine against

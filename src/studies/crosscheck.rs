@@ -6,7 +6,7 @@ use crate::engine::EngineKind;
 use crate::error::{Error, Field, Result};
 use crate::model::scene::Preset;
 use crate::report::crosscheck::{Crosscheck, Versus};
-use crate::report::summary::Reached;
+use crate::report::precision::Reached;
 use crate::report::summary::{Cost, RunSummary};
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::runner::{Checkpoint, Runner, CHUNK_ROLLS};

@@ -34,7 +34,7 @@ fn critical(p: f64, dof: usize) -> f64 {
 fn null_probabilities(s: &RunSummary, null: &Null) -> Result<(Vec<f64>, Option<String>)> {
     let scene = &s.spec.scene;
     if let (Some(f), Some(shape)) = (
-        crate::report::summary::shape_faces(&s.tally, scene),
+        crate::report::shape_outcomes::shape_faces(&s.tally, scene),
         scene.shape.as_deref(),
     ) {
         let labels: Vec<String> = f.into_iter().map(|(l, _)| l).collect();
@@ -194,7 +194,7 @@ fn face_counts(
 /// The faces of the run `s` set against `null`.
 pub fn assess(s: &RunSummary, null: &Null) -> Result<Fairness> {
     let (q, note) = null_probabilities(s, null)?;
-    let shape = crate::report::summary::shape_faces(&s.tally, &s.spec.scene);
+    let shape = crate::report::shape_outcomes::shape_faces(&s.tally, &s.spec.scene);
     if shape.is_none() && !s.tally.faces_complete() {
         return Err(Error::Invalid(
             "some of these rolls were read from chunks written before faces were kept: roll \

@@ -175,7 +175,7 @@ pub fn planned(lay: &Layout) -> Result<(StudyConfig, Place, u64)> {
 
 /// A precision to roll to: the fraction, what it is of, and a hook told the rolls expected in
 /// all as the run goes.
-pub type Precision<'a> = (f64, crate::report::summary::Target, &'a dyn Fn(u64));
+pub type Precision<'a> = (f64, crate::report::precision::Target, &'a dyn Fn(u64));
 
 /// `roll`: one run, its chunks kept in `checkpoint` if given (a run there is continued), one
 /// CSV row per throw into `per_roll` if given (grown chunk by chunk in a temporary file, put

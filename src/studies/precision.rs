@@ -6,7 +6,7 @@ use super::departure::{chunks_to_resolve, paired_departure, rolls_for_ratio};
 use super::stream::{Stream, STREAM_ROLLS};
 use super::study::Study;
 use crate::error::Result;
-use crate::report::summary::{Reached, Target};
+use crate::report::precision::{Reached, Target};
 use crate::run::runner::{Checkpoint, Rolled, Runner, CHUNK_ROLLS};
 use crate::run::spec::RunSpec;
 use crate::run::tally::Tally;

@@ -113,7 +113,7 @@ pub fn outcome_shares(scene: &crate::model::scene::Scene) -> Option<Result<Vec<f
 }
 
 /// [`shape`] summed over the outcomes that show the same label, in the order of their first
-/// appearance (`report::summary::shape_faces`'s).
+/// appearance (`report::shape_outcomes::shape_faces`'s).
 pub fn shape_labels(shape_: &Shape, com: &Vector3<f64>) -> Result<Vec<(String, f64)>, String> {
     Ok(shape_.by_label(shape(shape_, com)?))
 }

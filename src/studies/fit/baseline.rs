@@ -11,16 +11,14 @@ use crate::calibration::discrepancy::{self, Discrepancy};
 use crate::calibration::params::{Fixed, Method};
 use crate::calibration::predict::Predicted;
 use crate::calibration::predict::{BlockPrediction, PredictConfig};
-use crate::calibration::proper::{self, CountsTest, DieScores, Score, Scores};
+use crate::calibration::proper::{self, DieScores, Score, Scores};
+use crate::calibration::scores::CountsTest;
+use crate::calibration::scores::LOO_BASELINE_POINTS;
 use crate::calibration::{FitConfig, FitResult};
 use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::scene::Mode;
 use crate::run::runner::Runner;
-
-/// Rolls of the default scene for each row a fit's leave-one-out scores, per roll of one of
-/// the fit's design points: ten points' worth.
-pub const LOO_BASELINE_POINTS: u64 = 10;
 
 /// A seed of the baselines' own, apart from every design's and prediction's.
 const BASELINE_SEED: u64 = 0x0ba5_e11e;
