@@ -1,16 +1,14 @@
 //! Several dice in one fit (issue 71.1): a counts file's `die` column names each row's die, a
 //! shape or a die file ([`crate::calibration::data`]); the fit keeps each die resolved once
-//! ([`RowDie`], in [`Method::dice`]) and simulates a row as its own die ([`Method::for_die`]),
+//! ([`RowDie`], in `Method::dice`) and simulates a row as its own die (`Method::for_die`),
 //! with the surface's and the thrower's parameters shared across dice as across blocks.
 
 use crate::calibration::data::{self, DataRow};
-use crate::calibration::params::Method;
 use crate::error::{Error, Field, Result};
 use crate::model::mass::Features;
 use crate::model::shape::Shape;
 use crate::run::request::DieRequest;
 use serde::{Deserialize, Serialize};
-use std::borrow::Cow;
 use std::sync::Arc;
 
 /// A row's own die: its name as the rows give it, its shape resting on the facets it rests on
@@ -107,26 +105,4 @@ pub fn names(rows: &[DataRow]) -> Vec<&str> {
         }
     }
     out
-}
-
-impl Method {
-    /// How a row of die `die` is simulated: this method with that die's shape, features and
-    /// density in place of the fit's own (`None`, or a die it does not hold: the fit's own).
-    pub fn for_die(&self, die: Option<&str>) -> Cow<'_, Method> {
-        match die.and_then(|n| self.dice.iter().find(|d| d.name == n)) {
-            None => Cow::Borrowed(self),
-            Some(d) => Cow::Owned(Method {
-                shape: Some(d.shape.clone()),
-                die: d.die,
-                density: d.density,
-                dice: Vec::new(),
-                ..self.clone()
-            }),
-        }
-    }
-
-    /// How `row` is simulated: as its own die ([`Method::for_die`]).
-    pub fn of_row(&self, row: &DataRow) -> Cow<'_, Method> {
-        self.for_die(row.die.as_deref())
-    }
 }

@@ -21,6 +21,7 @@
 //! does not. Measured (`fit --common-throws`, docs/results/calibration.md): on 20 paired
 //! recoveries no difference is resolved, and none favours common throws.
 
+pub mod bootstrap;
 pub mod check;
 pub mod compare;
 pub mod crossval;

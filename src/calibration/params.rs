@@ -734,6 +734,28 @@ impl Method {
     }
 }
 
+impl Method {
+    /// How a row of die `die` is simulated: this method with that die's shape, features and
+    /// density in place of the fit's own (`None`, or a die it does not hold: the fit's own).
+    pub fn for_die(&self, die: Option<&str>) -> std::borrow::Cow<'_, Method> {
+        match die.and_then(|n| self.dice.iter().find(|d| d.name == n)) {
+            None => std::borrow::Cow::Borrowed(self),
+            Some(d) => std::borrow::Cow::Owned(Method {
+                shape: Some(d.shape.clone()),
+                die: d.die,
+                density: d.density,
+                dice: Vec::new(),
+                ..self.clone()
+            }),
+        }
+    }
+
+    /// How `row` is simulated: as its own die ([`Method::for_die`]).
+    pub fn of_row(&self, row: &DataRow) -> std::borrow::Cow<'_, Method> {
+        self.for_die(row.die.as_deref())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -21,7 +21,6 @@ pub mod sweeps;
 pub mod term;
 pub mod theory;
 pub mod trace;
-pub mod trace_html;
 pub mod validate;
 
 #[derive(Parser, Debug)]

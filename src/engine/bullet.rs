@@ -1,9 +1,10 @@
 //! Bullet (Debian's libbullet, double precision) through the C++ shim in `cpp/`.
 
-use super::{BodyState, Engine};
+use super::interface::Engine;
 use crate::model::collider::Collider;
 use crate::model::mass::{BodyTurn, MassProps};
 use crate::model::scene::{Floor, Mode, Preset, Scene};
+use crate::model::state::BodyState;
 use cxx::UniquePtr;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 

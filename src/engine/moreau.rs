@@ -29,10 +29,11 @@
 //! Its errors are O(dt): a finer step converges it, which is how it is used (`--dt 1e-4` and
 //! finer). 3D only, a polyhedron only (no rounded edges, no cylinder), no rolling resistance.
 
-use super::{BodyState, Engine};
+use super::interface::Engine;
 use crate::model::collider::Collider;
 use crate::model::mass::MassProps;
 use crate::model::scene::{Mode, Scene};
+use crate::model::state::BodyState;
 use nalgebra::{Matrix3, UnitQuaternion, Vector2, Vector3};
 
 /// An approach slower than this, m/s, does not bounce: a die resting on the floor approaches

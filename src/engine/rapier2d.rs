@@ -6,8 +6,9 @@
 //! kg/m³ would give neither. The 2D state is reported as the 3D `BodyState` the rest of the
 //! crate reads: position (x, y, 0), rotation about z, velocity (vx, vy, 0), spin (0, 0, ω).
 
-use super::{BodyState, Engine};
+use super::interface::Engine;
 use crate::model::scene::{Floor, Mode, Scene};
+use crate::model::state::BodyState;
 use nalgebra::{UnitQuaternion, Vector3};
 use rapier2d_f64::prelude::*;
 

@@ -4,10 +4,11 @@
 //! Rapier's public math is glam (`DVec3`, `DQuat`), not nalgebra; `to_na`/`from_na` below copy
 //! the components across, exactly.
 
-use super::{BodyState, Engine};
+use super::interface::Engine;
 use crate::model::collider::Collider;
 use crate::model::mass::{BodyTurn, MassProps};
 use crate::model::scene::{Floor, Mode, Preset, Scene};
+use crate::model::state::BodyState;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use rapier3d_f64::prelude::*;
 

@@ -32,7 +32,8 @@ mod validate;
 
 pub use die_file::{is_mesh, DieFile, LabelDef, ReadFile, MAX_DIE_FILE};
 pub use features::{pattern, Features, Insert, PipShape, Pips, Shell, DEFAULT_WALL};
-pub use integrate::{rounded_box, Composition, MassProps};
+pub use integrate::{Composition, MassProps};
+pub use moments::rounded_box;
 pub use pips::{cavity, pip_places};
 pub use rounded::{rounded_hull, rounded_shared, take_rounding};
 pub use shell::{inner_hull, inradius};

@@ -12,8 +12,7 @@
 //! O(N log N) on the N facets, where intersecting every triple is O(N⁴): a designed hull has
 //! hundreds of facets.
 
-use super::integrate::rounded_box;
-use super::moments::Moments;
+use super::moments::{rounded_box, Moments};
 use crate::model::polytope::{self, Cylinder, VolumeIntegrals};
 use crate::model::shape::{Shape, Solid};
 use nalgebra::{Matrix3, Vector3};
