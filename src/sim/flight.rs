@@ -200,14 +200,16 @@ impl Flight {
         let mut vy = [0.0; REST_WINDOW];
         // The loop is made twice, its landing test inline for a body not turned (every die
         // but a made one off its principal axes: the plain roll's every jumped step is here).
+        let leg = Leg {
+            dq,
+            max,
+            spinning,
+            reach,
+        };
         let n = if self.die.turn.turned() {
-            self.fly(s, dq, max, spinning, reach, &mut vy, |b| {
-                self.turned_lowest(b)
-            })
+            self.fly(s, &leg, &mut vy, |b| self.turned_lowest(b))
         } else {
-            self.fly(s, dq, max, spinning, reach, &mut vy, |b| {
-                self.lowest_point(b)
-            })
+            self.fly(s, &leg, &mut vy, |b| self.lowest_point(b))
         };
         // The window keeps the last ten: the earlier states only move its count on.
         let first = n.saturating_sub(REST_WINDOW as u64);
@@ -220,26 +222,28 @@ impl Flight {
         n
     }
 
-    /// `jump`'s steps: from `s`, at most `max`, while each is awake (`spinning`, or fast
-    /// enough) and its state clear of the floor (`lowest`, asked only where the centre is
-    /// within `reach` of it); each state's vertical velocity kept in `vy` by step number
+    /// `jump`'s steps: from `s`, at most `leg.max`, while each is awake (`leg.spinning`, or
+    /// fast enough) and its state clear of the floor (`lowest`, asked only where the centre is
+    /// within `leg.reach` of it); each state's vertical velocity kept in `vy` by step number
     /// modulo `REST_WINDOW`. Leaves `s` at the last state reached; returns how many.
     ///
     /// The state stepped is a local, written back once at the end, and its slot in `vy`
     /// counts round by itself: every jumped step passes here, and so the loop keeps the
     /// state in registers.
-    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn fly(
         &self,
         s: &mut BodyState,
-        dq: &UnitQuaternion<f64>,
-        max: u64,
-        spinning: bool,
-        reach: f64,
+        leg: &Leg,
         vy: &mut [f64; REST_WINDOW],
         lowest: impl Fn(&BodyState) -> f64,
     ) -> u64 {
+        let Leg {
+            dq,
+            max,
+            spinning,
+            reach,
+        } = *leg;
         let mut at = *s;
         let (mut n, mut slot) = (0u64, 0);
         while n < max {
@@ -273,6 +277,17 @@ impl Flight {
         // A non-finite state ends the roll as a failure in the roll's own check.
         awake.then_some(next)
     }
+}
+
+/// What a jump's loop holds fixed over its steps (`Flight::jump`, `Flight::fly`): the step's
+/// rotation, the most steps it may take, whether ω alone keeps the die awake, and how far
+/// below its centre the die can reach.
+#[derive(Clone, Copy)]
+struct Leg<'a> {
+    dq: &'a UnitQuaternion<f64>,
+    max: u64,
+    spinning: bool,
+    reach: f64,
 }
 
 #[cfg(test)]
