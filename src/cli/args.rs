@@ -475,6 +475,10 @@ pub fn parse_layout(
 pub fn parse_null(s: &str) -> std::result::Result<dicephys::studies::fair::Null, dicephys::Error> {
     s.parse().map_err(dicephys::Error::Invalid)
 }
+/// `--engines`'s default, spelt as clap takes it: the library's
+/// `studies::paper::DEFAULT_ENGINES` (a test holds the two together).
+pub const DEFAULT_ENGINES: &str = "bullet,rapier";
+
 /// `--engine` as clap reads it.
 pub fn parse_engine(s: &str) -> std::result::Result<EngineKind, dicephys::Error> {
     parse_name("engine", s)

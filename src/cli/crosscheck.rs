@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 #[derive(Args, Debug)]
 pub struct CrosscheckArgs {
     /// Engines to compare (comma-separated); the first is the baseline.
-    #[arg(long, value_delimiter = ',', default_value = "bullet,rapier", value_parser = parse_engine)]
+    #[arg(long, value_delimiter = ',', default_value = super::args::DEFAULT_ENGINES, value_parser = parse_engine)]
     pub engines: Vec<EngineKind>,
     #[command(flatten)]
     pub scene: SceneArgs,

@@ -22,7 +22,7 @@ pub struct PaperArgs {
     #[command(flatten)]
     pub seed: Seed,
     /// Engines to simulate with (comma-separated).
-    #[arg(long, value_delimiter = ',', default_value = "bullet,rapier", value_parser = parse_engine)]
+    #[arg(long, value_delimiter = ',', default_value = super::args::DEFAULT_ENGINES, value_parser = parse_engine)]
     pub engines: Vec<EngineKind>,
     /// Fixed time step, s or 1/N.
     #[arg(long, default_value_t = dicephys::run::request::SceneRequest::default().dt, value_parser = super::args::parse_step)]

@@ -28,7 +28,7 @@ pub struct ConvergeArgs {
     #[arg(long, value_delimiter = ',', default_value = "1/60,1/250,1/1000,1/5000", value_parser = parse_dt)]
     pub dts: Vec<f64>,
     /// Engines to simulate with (comma-separated): bullet, rapier, rapier-locked.
-    #[arg(long, value_delimiter = ',', default_value = "bullet,rapier", value_parser = parse_engine)]
+    #[arg(long, value_delimiter = ',', default_value = super::args::DEFAULT_ENGINES, value_parser = parse_engine)]
     pub engines: Vec<EngineKind>,
     /// Rolls per cell (block × engine × mode × dt).
     #[arg(long, default_value_t = 200)]
@@ -130,7 +130,7 @@ fn parse_dt_or_none(s: &str) -> std::result::Result<Option<f64>, String> {
 #[derive(Args, Debug)]
 pub struct StabilityArgs {
     /// Engines to simulate with (comma-separated): bullet, rapier, rapier-locked.
-    #[arg(long, value_delimiter = ',', default_value = "bullet,rapier", value_parser = parse_engine)]
+    #[arg(long, value_delimiter = ',', default_value = super::args::DEFAULT_ENGINES, value_parser = parse_engine)]
     pub engines: Vec<EngineKind>,
     /// Time steps of the dt × restitution grid.
     #[arg(long, value_delimiter = ',', default_value = "1/1000,1/240,1/60,1/30", value_parser = parse_dt)]

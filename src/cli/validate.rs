@@ -18,7 +18,7 @@ use dicephys::studies::StudyConfig;
 #[derive(Args, Debug)]
 pub struct ValidateArgs {
     /// Engines to simulate with (comma-separated): bullet, rapier, rapier-locked.
-    #[arg(long, value_delimiter = ',', default_value = "bullet,rapier", value_parser = parse_engine)]
+    #[arg(long, value_delimiter = ',', default_value = super::args::DEFAULT_ENGINES, value_parser = parse_engine)]
     pub engines: Vec<EngineKind>,
     /// Rolls per limit cell (block × engine × case).
     #[arg(long, default_value_t = v::Config::default().rolls)]

@@ -64,7 +64,7 @@ fn fibonacci(n: usize) -> impl Iterator<Item = Vector3<f64>> {
 /// were.
 pub fn take_rounding(
     shape: &mut Option<Arc<Shape>>,
-    features: &mut super::Features,
+    features: &mut super::features::Features,
 ) -> Result<(), String> {
     let r = features.edge_radius;
     if let Some(s) = shape.as_ref().filter(|s| r > 0.0 && s.as_box().is_none()) {

@@ -2,10 +2,10 @@
 //! where they started, what they did at the cap, the free flights, the trend.
 
 use super::flight::at_one_ms;
-use super::Config;
 use crate::engine::EngineKind;
 use crate::model::scene::Mode;
 use crate::report::text::dt_label;
+use crate::report::validate::Config;
 use crate::report::validate::{
     Case, FlightRun, Integrator, LimitCell, Row, TrendPoint, Verdict, Z_PASS,
 };

@@ -12,7 +12,7 @@
 //! Bullet's implicit gyroscopic term (its `bullet3` preset) and Rapier's explicit one turn ω as
 //! L requires, with an error that falls with dt.
 
-use super::{Config, Rows, DRIFT_PASS, LOSS_TOLERANCE};
+use super::rows::Rows;
 use crate::engine::{new_engine, EngineKind};
 use crate::error::{Error, Result};
 use crate::model::block::Block;
@@ -21,10 +21,18 @@ use crate::model::scene::{Mode, Preset, Scene};
 use crate::model::state::BodyState;
 use crate::model::throws::{haar_quaternion, unit_vector};
 use crate::report::text::dt_label;
+use crate::report::validate::Config;
 use crate::report::validate::{Case, FlightRun, Integrator, Row, Verdict};
 use crate::run::stop::Stop;
 use crate::sim::flight::Flight;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+
+/// A conserved quantity passes if it drifts by at most this fraction over the flight at
+/// dt = 1 ms and its drift falls as dt does.
+pub const DRIFT_PASS: f64 = 0.01;
+
+/// Symplectic Euler's loss is matched if measured/predicted is within this of 1 (rounding).
+pub const LOSS_TOLERANCE: f64 = 1e-6;
 
 impl Integrator {
     /// The integrators that stand for the engines asked for: Bullet brings its two presets

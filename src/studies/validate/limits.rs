@@ -1,12 +1,13 @@
 //! The limit cases: a die released at rest, e = 0, high friction, heavy damping (or the
 //! damping lifted), against eq. (InElasK) in 2D and the solid angles in 3D.
 
-use super::{Config, Rows};
+use super::rows::Rows;
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
 use crate::model::block::{Block, Outcome};
 use crate::model::scene::{Mode, Scene};
 use crate::model::throws::ThrowStyle;
+use crate::report::validate::Config;
 use crate::report::validate::{Case, Faces, LimitCell, Row, Verdict, Z_PASS};
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::io::write_atomic;

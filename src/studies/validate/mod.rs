@@ -33,6 +33,7 @@
 mod findings;
 pub mod flight;
 pub mod limits;
+mod rows;
 mod trend;
 
 use crate::engine::EngineKind;
@@ -41,11 +42,12 @@ use crate::model::block::Block;
 use crate::model::scene::{Mode, MAX_DAMPING};
 use crate::model::throws::ThrowStyle;
 pub use crate::report::validate::Config;
-use crate::report::validate::{format_row, Row, Validation, Verdict};
+use crate::report::validate::{Validation, Verdict};
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::spec::{RunSpec, ThrowSpec};
 use crate::studies::study::{Progress, Study};
 use limits::{limit_roll, limit_scene};
+use rows::Rows;
 use trend::trend_scene;
 
 /// The limit cases' damping, 1/s, linear and angular: the most Bullet can hold
@@ -61,13 +63,6 @@ pub const LIMIT_FRICTION: f64 = 1.0;
 /// between 5 and 20 s; counted at the cap on the face region they are certified in, they land
 /// where they would have, at a quarter of the cost.
 pub const LIMIT_MAX_STEPS: u64 = 5_000;
-
-/// A conserved quantity passes if it drifts by at most this fraction over the flight at
-/// dt = 1 ms and its drift falls as dt does.
-pub const DRIFT_PASS: f64 = 0.01;
-
-/// Symplectic Euler's loss is matched if measured/predicted is within this of 1 (rounding).
-pub const LOSS_TOLERANCE: f64 = 1e-6;
 
 impl Default for Config {
     fn default() -> Config {
@@ -156,22 +151,6 @@ impl Config {
         }
         .validate(false)?;
         limit_roll(self.trend_max_steps).validate()
-    }
-}
-
-/// The rows so far, each logged as it is measured.
-pub(crate) struct Rows<'a> {
-    rows: Vec<Row>,
-    log: &'a dyn Fn(&str),
-    progress: Progress<'a>,
-    total: usize,
-}
-
-impl Rows<'_> {
-    fn push(&mut self, r: Row) {
-        (self.log)(&format_row(&r));
-        self.rows.push(r);
-        (self.progress)(self.rows.len() as f64, self.total as f64);
     }
 }
 

@@ -1,9 +1,10 @@
 //! The trend: the paper's throw in 2D as e and μ rise together, from near the no-bounce ratio
 //! towards eq. (MasterEqu). A curve, not a verdict.
 
-use super::{Config, Rows};
+use super::rows::Rows;
 use crate::error::Result;
 use crate::model::scene::{Mode, Scene};
+use crate::report::validate::Config;
 use crate::report::validate::{Case, Row, TrendPoint, Verdict};
 use crate::sim::roll::{RollConfig, Rule};
 use crate::studies::study::Study;
