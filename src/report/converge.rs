@@ -140,7 +140,7 @@ const TABLE: Columns = Columns(&[
 
 /// report.md: how the cells were rolled, the table, the verdict and the figures. `precision`
 /// is the study's (`--precision`), if it rolled to one.
-pub fn markdown(res: &Converge, precision: Option<f64>, figures: &[&str]) -> String {
+fn markdown(res: &Converge, precision: Option<f64>, figures: &[&str]) -> String {
     let mut md = format!(
         "# Convergence in dt\n\n{}, seed {}, rolls ended by {}.\n\n```\n{}\n",
         match precision {
@@ -168,11 +168,7 @@ pub fn markdown(res: &Converge, precision: Option<f64>, figures: &[&str]) -> Str
 }
 
 /// Draws the ratio against dt, a line per block, engine and mode, into `dir`; returns its stem.
-pub fn write_figures(
-    dir: &Path,
-    res: &Converge,
-    precision: Option<f64>,
-) -> Result<Vec<&'static str>> {
+fn write_figures(dir: &Path, res: &Converge, precision: Option<f64>) -> Result<Vec<&'static str>> {
     let lines: Vec<fig::Line> = group(&res.cells, |c| {
         format!("{} {} {}", c.block, c.engine, c.mode)
     })
@@ -202,4 +198,22 @@ pub fn write_figures(
         &lines,
     )?;
     Ok(vec!["converge"])
+}
+
+/// The convergence test's report: its results and the precision the study rolled to
+/// (`--precision`), which the results do not carry.
+pub struct ConvergeReport<'a> {
+    /// The results.
+    pub res: &'a Converge,
+    /// The study's precision, if it rolled to one.
+    pub precision: Option<f64>,
+}
+
+impl super::Report for ConvergeReport<'_> {
+    fn write_figures(&self, dir: &Path) -> Result<Vec<String>> {
+        Ok(super::owned(write_figures(dir, self.res, self.precision)?))
+    }
+    fn markdown(&self, stems: &[String]) -> String {
+        markdown(self.res, self.precision, &super::stems(stems))
+    }
 }

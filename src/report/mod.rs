@@ -23,3 +23,24 @@ pub mod trace;
 pub mod tradeoff;
 pub mod validate;
 pub mod view;
+
+/// A study's report, written the one way every study's is (`studies::outputs`): its figures
+/// drawn into the output folder, then its Markdown showing them (`report.md`, or
+/// `calibrated.md`). Its JSON is its results' own serialization, written beside it.
+pub trait Report {
+    /// Draws the figures into `dir`; returns their stems, in the order the report shows them.
+    fn write_figures(&self, dir: &std::path::Path) -> crate::Result<Vec<String>>;
+    /// The Markdown, showing the figures `stems` (a partial run's report names the figures
+    /// of its last complete one).
+    fn markdown(&self, stems: &[String]) -> String;
+}
+
+/// Figure stems as the reports' own functions take them.
+fn stems(s: &[String]) -> Vec<&str> {
+    s.iter().map(String::as_str).collect()
+}
+
+/// Figure stems as [`Report::write_figures`] returns them.
+fn owned(s: Vec<&str>) -> Vec<String> {
+    s.into_iter().map(String::from).collect()
+}

@@ -103,7 +103,7 @@ pub fn cell(res: &PaperResults, row: usize, engine: EngineKind, mode: Mode) -> O
 /// report.md: the verdict first (what `paper` prints), then the tables by subject — the theory
 /// against the paper's rows, each engine's simulations against experiment, the three
 /// outcomes — and the figures.
-pub fn markdown(res: &PaperResults, figures: &[&str]) -> String {
+fn markdown(res: &PaperResults, figures: &[&str]) -> String {
     let engines = engines_of(res);
     let mut s = heading(res);
     s += &format!(
@@ -537,7 +537,7 @@ pub fn results_csv(res: &PaperResults) -> Result<String> {
 }
 
 /// The paper's figures, drawn from the results; returns their names (each has .svg and .png).
-pub fn write_figures(dir: &std::path::Path, res: &PaperResults) -> Result<Vec<&'static str>> {
+fn write_figures(dir: &std::path::Path, res: &PaperResults) -> Result<Vec<&'static str>> {
     use crate::report::figures::{paper as figures, Point, SimSeries};
     let mut sims = Vec::new();
     for engine in &res.provenance.engines_short {
@@ -581,5 +581,14 @@ fn engine_label(engine: EngineKind) -> &'static str {
         EngineKind::Rapier => "Rapier",
         EngineKind::RapierLocked => "Rapier (locked 3D)",
         EngineKind::Moreau => "Moreau–Jean",
+    }
+}
+
+impl super::Report for PaperResults {
+    fn write_figures(&self, dir: &std::path::Path) -> Result<Vec<String>> {
+        Ok(super::owned(write_figures(dir, self)?))
+    }
+    fn markdown(&self, stems: &[String]) -> String {
+        markdown(self, &super::stems(stems))
     }
 }

@@ -195,7 +195,7 @@ fn floor_note(thickness: f64) -> String {
 
 /// Draws a heat map per failure kind (a panel per engine and mode over the dt × restitution
 /// grid) into `dir`; returns their stems.
-pub fn write_figures(dir: &Path, res: &Stability) -> Result<Vec<String>> {
+fn write_figures(dir: &Path, res: &Stability) -> Result<Vec<String>> {
     let mut figures = Vec::new();
     for kind in KINDS {
         let panels: Vec<fig::Panel> = group(
@@ -248,7 +248,7 @@ pub fn write_figures(dir: &Path, res: &Stability) -> Result<Vec<String>> {
 }
 
 /// report.md: the settings, every cell, the findings and the figures.
-pub fn markdown(res: &Stability, figures: &[String]) -> String {
+fn markdown(res: &Stability, figures: &[String]) -> String {
     let mut md = format!(
         "# Where methods fail\n\n{} rolls per cell, seed {}, cap {} steps, energy-gain tolerance \
          {} % of the starting energy{}. Each fraction f carries a binomial standard error \
@@ -277,4 +277,13 @@ pub fn markdown(res: &Stability, figures: &[String]) -> String {
         md += &format!("![{f}]({f}.svg)\n");
     }
     md
+}
+
+impl super::Report for Stability {
+    fn write_figures(&self, dir: &Path) -> Result<Vec<String>> {
+        write_figures(dir, self)
+    }
+    fn markdown(&self, stems: &[String]) -> String {
+        markdown(self, stems)
+    }
 }

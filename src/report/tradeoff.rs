@@ -226,7 +226,7 @@ const TABLE: Columns = Columns(&[
 
 /// report.md: how the methods were rolled, each mode's table, front and verdict, and the
 /// figure.
-pub fn markdown(res: &Tradeoff, figures: &[&str]) -> String {
+fn markdown(res: &Tradeoff, figures: &[&str]) -> String {
     let mut md = format!(
         "# Accuracy against cost\n\n{}, seed {}; every departure rolled until 2σ ≤ {:.2} % or \
          {:.0} CPU s spent; reference: Bullet, box floor, the exact levers (early stop, fast \
@@ -288,7 +288,7 @@ fn departure_cell(r: &Row) -> String {
 /// report.md of a run on several blocks: per mode, every method's departure on every block
 /// (± 2σ) with its worst and its mean cost, the cheapest within the precision on all blocks;
 /// then each block's own tables; and the figure.
-pub fn markdown_blocks(res: &TradeoffBlocks, figures: &[&str]) -> String {
+fn markdown_blocks(res: &TradeoffBlocks, figures: &[&str]) -> String {
     let p = 100.0 * res.precision;
     let mut md = format!(
         "# Accuracy against cost, {} blocks\n\nBlocks {}; seed {}; on each block and mode every \
@@ -497,7 +497,7 @@ fn band_notes() -> Vec<String> {
 /// Draws cost against departure for one block, every method numbered and keyed, with the
 /// paper's experimental error on the block and Rapier's converged departure as yardsticks,
 /// into `dir`; returns its stem.
-pub fn write_figures(dir: &Path, res: &Tradeoff) -> Result<Vec<&'static str>> {
+fn write_figures(dir: &Path, res: &Tradeoff) -> Result<Vec<&'static str>> {
     let key = figure_key(&[res]);
     let figure = fig::Figure {
         title: format!(
@@ -517,7 +517,7 @@ pub fn write_figures(dir: &Path, res: &Tradeoff) -> Result<Vec<&'static str>> {
 
 /// The figure of a run on several blocks: a panel per block on shared axes, every method
 /// numbered the same in every panel and keyed beside them.
-pub fn write_figures_blocks(dir: &Path, res: &TradeoffBlocks) -> Result<Vec<&'static str>> {
+fn write_figures_blocks(dir: &Path, res: &TradeoffBlocks) -> Result<Vec<&'static str>> {
     let studies: Vec<&Tradeoff> = res.per_block.iter().collect();
     let key = figure_key(&studies);
     let figure = fig::Figure {
@@ -537,4 +537,22 @@ pub fn write_figures_blocks(dir: &Path, res: &TradeoffBlocks) -> Result<Vec<&'st
     };
     fig::write(dir, "tradeoff", &figure)?;
     Ok(vec!["tradeoff"])
+}
+
+impl super::Report for Tradeoff {
+    fn write_figures(&self, dir: &Path) -> Result<Vec<String>> {
+        Ok(super::owned(write_figures(dir, self)?))
+    }
+    fn markdown(&self, stems: &[String]) -> String {
+        markdown(self, &super::stems(stems))
+    }
+}
+
+impl super::Report for TradeoffBlocks {
+    fn write_figures(&self, dir: &Path) -> Result<Vec<String>> {
+        Ok(super::owned(write_figures_blocks(dir, self)?))
+    }
+    fn markdown(&self, stems: &[String]) -> String {
+        markdown_blocks(self, &super::stems(stems))
+    }
 }

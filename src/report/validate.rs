@@ -443,7 +443,7 @@ pub fn format_row(r: &Row) -> String {
 }
 
 /// report.md: the settings, the table, the findings and the figures.
-pub fn markdown(res: &Validation, figures: &[&str]) -> String {
+fn markdown(res: &Validation, figures: &[&str]) -> String {
     let c = &res.config;
     let mut md = format!(
         "# Engine validation against exact limits\n\n\
@@ -489,7 +489,7 @@ fn rows(res: &Validation, case: Case) -> impl Iterator<Item = &Row> {
 }
 
 /// Draws the figures into `out`; returns their stems (for `markdown`).
-pub fn write_figures(out: &Path, res: &Validation) -> Result<Vec<&'static str>> {
+fn write_figures(out: &Path, res: &Validation) -> Result<Vec<&'static str>> {
     let mut stems = Vec::new();
     for figure in [figure_2d, figure_3d, figure_flight, figure_trend] {
         stems.extend(figure(out, res)?);
@@ -665,4 +665,13 @@ fn figure_trend(out: &Path, res: &Validation) -> Result<Option<&'static str>> {
         return Ok(Some("validate_trend"));
     }
     Ok(None)
+}
+
+impl super::Report for Validation {
+    fn write_figures(&self, dir: &Path) -> Result<Vec<String>> {
+        Ok(super::owned(write_figures(dir, self)?))
+    }
+    fn markdown(&self, stems: &[String]) -> String {
+        markdown(self, &super::stems(stems))
+    }
 }

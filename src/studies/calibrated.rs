@@ -23,6 +23,7 @@ use crate::error::{Error, Field, Result};
 use crate::model::scene::Mode;
 use crate::report::fit as report;
 use crate::report::progress::Unit;
+use crate::report::Report;
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::runner::Runner;
 use crate::run::seal;
@@ -593,8 +594,8 @@ fn run_study(study: &CalibratedStudy, place: &Place, hooks: &Hooks) -> Result<Do
         return Ok(place.interrupted());
     };
     (hooks.progress)(total, total);
-    let figures = report::write_calibrated_figures(&place.out, &res)?;
-    let md = report::calibrated_markdown(&res, &figures);
+    let figures = res.write_figures(&place.out)?;
+    let md = res.markdown(&figures);
     let json = to_json(&res)?;
     outputs.write("calibrated.json", json.as_bytes())?;
     outputs.write("calibrated.md", md.as_bytes())?;

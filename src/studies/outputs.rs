@@ -13,6 +13,7 @@ use crate::report;
 use crate::report::per_roll::PerRoll;
 pub use crate::report::progress::Unit;
 use crate::report::summary::{Cost, RunSummary};
+use crate::report::Report;
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::io::Output;
 use crate::run::runner::{Checkpoint, ChunkShare, Runner};
@@ -262,15 +263,15 @@ fn paper(cfg: &studies::paper::PaperConfig, place: &Place, hooks: &Hooks) -> Res
     }
     if res.partial {
         // A partial run leaves the last complete outputs alone: its report goes to stdout.
-        let figures = ["master_graph", "prob_2d", "len_graph", "dreidel"];
+        let figures = ["master_graph", "prob_2d", "len_graph", "dreidel"].map(String::from);
         return Ok(Done {
-            stdout: format!("{}\n", report::paper::markdown(&res, &figures)),
+            stdout: format!("{}\n", res.markdown(&figures)),
             note: None,
             interrupted: place.interrupted().interrupted,
         });
     }
-    let figures = report::paper::write_figures(&place.out, &res)?;
-    let md = report::paper::markdown(&res, &figures);
+    let figures = res.write_figures(&place.out)?;
+    let md = res.markdown(&figures);
     let json = to_json(&res)?;
     outputs.write("results.json", json.as_bytes())?;
     outputs.write("results.csv", report::paper::results_csv(&res)?.as_bytes())?;
@@ -331,9 +332,11 @@ fn converge(cfg: &studies::converge::Config, place: &Place, hooks: &Hooks) -> Re
     else {
         return Ok(Done::default());
     };
-    let figures = report::converge::write_figures(&place.out, &res, cfg.precision)?;
-    let md = report::converge::markdown(&res, cfg.precision, &figures);
-    write(place, &outputs, &res, &md, "converge.json")
+    let rep = report::converge::ConvergeReport {
+        res: &res,
+        precision: cfg.precision,
+    };
+    write(place, &outputs, &rep, &res, "converge.json")
 }
 
 /// `tradeoff`: tradeoff.json, report.md and its figure; or the plan; or the rolls ahead. A run
@@ -378,16 +381,8 @@ fn tradeoff(cfg: &studies::tradeoff::Config, place: &Place, hooks: &Hooks) -> Re
         });
     }
     match one {
-        Some(one) => {
-            let figures = report::tradeoff::write_figures(&place.out, one)?;
-            let md = report::tradeoff::markdown(one, &figures);
-            write(place, &outputs, one, &md, "tradeoff.json")
-        }
-        None => {
-            let figures = report::tradeoff::write_figures_blocks(&place.out, &res)?;
-            let md = report::tradeoff::markdown_blocks(&res, &figures);
-            write(place, &outputs, &res, &md, "tradeoff.json")
-        }
+        Some(one) => write(place, &outputs, one, one, "tradeoff.json"),
+        None => write(place, &outputs, &res, &res, "tradeoff.json"),
     }
 }
 
@@ -400,9 +395,7 @@ fn stability(cfg: &studies::stability::Config, place: &Place, hooks: &Hooks) -> 
     else {
         return Ok(Done::default());
     };
-    let figures = report::stability::write_figures(&place.out, &res)?;
-    let md = report::stability::markdown(&res, &figures);
-    write(place, &outputs, &res, &md, "stability.json")
+    write(place, &outputs, &res, &res, "stability.json")
 }
 
 /// `validate`: validate.json, report.md and its figures.
@@ -414,23 +407,24 @@ fn validate(cfg: &studies::validate::Config, place: &Place, hooks: &Hooks) -> Re
     else {
         return Ok(Done::default());
     };
-    let figures = report::validate::write_figures(&place.out, &res)?;
-    let md = report::validate::markdown(&res, &figures);
-    write(place, &outputs, &res, &md, "validate.json")
+    write(place, &outputs, &res, &res, "validate.json")
 }
 
-/// Writes the JSON and the report into the outputs checked before the run.
+/// Writes a study's report (its figures, then `report.md`, [`Report`]) and its results' JSON
+/// into the outputs checked before the run.
 fn write<T: Serialize>(
     place: &Place,
     outputs: &Outputs,
+    report: &dyn Report,
     res: &T,
-    report: &str,
     file: &str,
 ) -> Result<Done> {
+    let figures = report.write_figures(&place.out)?;
+    let md = report.markdown(&figures);
     let json = to_json(res)?;
     outputs.write(file, json.as_bytes())?;
-    outputs.write("report.md", report.as_bytes())?;
-    Ok(place.done(&json, report, file))
+    outputs.write("report.md", md.as_bytes())?;
+    Ok(place.done(&json, &md, file))
 }
 
 /// Runs a sweep, logging its header and each cell unless the output is JSON. A cluster task's

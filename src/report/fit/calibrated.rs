@@ -11,7 +11,7 @@ use std::fmt::Write;
 use std::path::Path;
 
 /// `calibrated.md`: `paper --calibrated`'s report; `figures` are the stems written beside it.
-pub fn calibrated_markdown(c: &CalibratedPaper, figures: &[&str]) -> String {
+fn calibrated_markdown(c: &CalibratedPaper, figures: &[&str]) -> String {
     let f = &c.fit;
     let mut s = String::new();
     let _ = writeln!(
@@ -264,7 +264,7 @@ fn check_section(s: &mut String, c: &CalibratedPaper) {
 }
 
 /// Writes `paper --calibrated`'s figures into `dir`; returns their stems.
-pub fn write_calibrated_figures(dir: &Path, c: &CalibratedPaper) -> Result<Vec<&'static str>> {
+fn write_calibrated_figures(dir: &Path, c: &CalibratedPaper) -> Result<Vec<&'static str>> {
     let rows: Vec<RowRatio> = c
         .loo
         .iter()
@@ -302,4 +302,13 @@ pub fn write_calibrated_figures(dir: &Path, c: &CalibratedPaper) -> Result<Vec<&
     let mut stems = vec!["calibrated_rows"];
     stems.extend(write_figures(dir, &c.fit)?);
     Ok(stems)
+}
+
+impl crate::report::Report for CalibratedPaper {
+    fn write_figures(&self, dir: &Path) -> Result<Vec<String>> {
+        Ok(crate::report::owned(write_calibrated_figures(dir, self)?))
+    }
+    fn markdown(&self, stems: &[String]) -> String {
+        calibrated_markdown(self, &crate::report::stems(stems))
+    }
 }

@@ -388,7 +388,7 @@ fn passes(res: &FitResult) -> String {
 }
 
 /// `report.md` for a fit; `figures` are the stems written beside it.
-pub fn markdown(res: &FitResult, figures: &[&str]) -> String {
+pub(super) fn markdown(res: &FitResult, figures: &[&str]) -> String {
     let e = &res.estimate;
     let c = &res.config;
     let mut s = String::new();
@@ -763,7 +763,7 @@ pub fn row_ratios(res: &FitResult) -> Vec<RowRatio> {
 }
 
 /// Writes the fit's figures into `dir`; returns their stems.
-pub fn write_figures(dir: &Path, res: &FitResult) -> Result<Vec<&'static str>> {
+pub(super) fn write_figures(dir: &Path, res: &FitResult) -> Result<Vec<&'static str>> {
     let profiles: Vec<Profile> = res
         .estimate
         .params
@@ -908,4 +908,13 @@ pub fn recovery_text(r: &Recovery) -> String {
         );
     }
     s
+}
+
+impl crate::report::Report for FitResult {
+    fn write_figures(&self, dir: &Path) -> Result<Vec<String>> {
+        Ok(crate::report::owned(write_figures(dir, self)?))
+    }
+    fn markdown(&self, stems: &[String]) -> String {
+        markdown(self, &crate::report::stems(stems))
+    }
 }

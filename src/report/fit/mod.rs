@@ -5,10 +5,9 @@ mod calibrated;
 mod fitted;
 mod predictions;
 
-pub use calibrated::{calibrated_markdown, write_calibrated_figures};
 pub use fitted::{
-    bootstrap_line, discrepancy_text, first_pass_text, fixed_text, markdown, maxima_text,
-    misfit_line, recovery_text, row_ratios, write_figures,
+    bootstrap_line, discrepancy_text, first_pass_text, fixed_text, maxima_text, misfit_line,
+    recovery_text, row_ratios,
 };
 pub use predictions::{
     dice_csv, prediction_text, predictions_csv, predictions_figure, predictions_markdown,

@@ -7,6 +7,7 @@ use crate::error::Error;
 use crate::error::Result;
 use crate::report::fit as report;
 use crate::report::progress::Unit;
+use crate::report::Report;
 use crate::run::seal;
 use crate::studies::kind::Kind;
 use crate::studies::place::{interrupted, to_json, unless_stopped, Done, Hooks, Place};
@@ -147,8 +148,8 @@ fn fit(study: &FitStudy, place: &Place, hooks: &Hooks) -> Result<Done> {
         });
         return Ok(done);
     }
-    let figures = report::write_figures(&place.out, &res)?;
-    let md = report::markdown(&res, &figures);
+    let figures = res.write_figures(&place.out)?;
+    let md = res.markdown(&figures);
     outputs.write("fit.json", json.as_bytes())?;
     outputs.write("report.md", md.as_bytes())?;
     Ok(place.done(&json, &md, "fit.json"))
