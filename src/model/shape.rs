@@ -370,7 +370,7 @@ impl Shape {
     }
 
     /// The same die with its edges and corners rounded by `radius`, m: its facets moved in by
-    /// the radius and the inner body swept by a ball of it (`mass::rounded_hull`), its outer
+    /// the radius and the inner body swept by a ball of it (`polytope::rounded_hull`), its outer
     /// faces where they were. Its mass properties are the rounded body's, about its own
     /// centroid (this die's points move by the few µm the centroid does); its outcomes are the
     /// same facets with the same labels, and a rounding that leaves a labelled face no facet
@@ -394,7 +394,7 @@ impl Shape {
                 "it is not convex: round a non-convex mesh's edges in the mesh itself".into(),
             );
         }
-        let inradius = crate::model::mass::inradius(self);
+        let inradius = self.inradius();
         let too_big = || {
             format!(
                 "a rounding of {} mm leaves no die: it must be below the distance from its \
@@ -406,8 +406,7 @@ impl Shape {
         if !(radius.is_finite() && radius > 0.0 && radius < inradius) {
             return Err(too_big());
         }
-        let (inner, body) =
-            crate::model::mass::rounded_hull(&self.planes(), radius).ok_or_else(too_big)?;
+        let (inner, body) = polytope::rounded_hull(&self.planes(), radius).ok_or_else(too_big)?;
         let c = body.centroid;
         let keeper = self.keeper();
         let mut s = Shape {
@@ -713,6 +712,20 @@ impl Shape {
             .clone()
     }
 
+    /// The die's inradius: the distance from its centroid to its nearest facet (a coin: its
+    /// radius or half its height), m. The thickest wall a shell can have is less, and a
+    /// rounding must be less.
+    pub fn inradius(&self) -> f64 {
+        match &self.solid {
+            Solid::Cylinder { diameter, height } => (0.5 * diameter).min(0.5 * height),
+            Solid::Hull { .. } => self
+                .planes()
+                .iter()
+                .map(|(_, d)| *d)
+                .fold(f64::INFINITY, f64::min),
+        }
+    }
+
     /// The hull's facet planes (outward normal n, offset d: n·x = d on the facet); a rounded
     /// die's outer faces lie `radius` beyond them.
     pub fn planes(&self) -> Vec<(Vector3<f64>, f64)> {
@@ -810,167 +823,6 @@ impl Shape {
     pub fn labels(&self) -> Vec<&str> {
         self.faces.iter().map(|f| f.label.as_str()).collect()
     }
-}
-
-/// The largest mesh file read: 256 MiB (a printed die's STL is rarely above a few MiB).
-pub const MAX_MESH_FILE: u64 = 256 << 20;
-
-/// The die of any shape the front ends describe, if any: `name` (`--shape`, sized by
-/// `size_mm`), or a die `file` that is a mesh (.obj, .stl) or a TOML die file naming one
-/// (`mesh`, with its `scale`, `reads` and `labels`), the mesh's lengths times `scale` (the
-/// file's, else 1). Both a name and a mesh, or a size or scale with nothing to size, are
-/// refused with the reason.
-pub fn described(
-    file: Option<&std::path::Path>,
-    name: Option<&str>,
-    size_mm: Option<f64>,
-    scale: Option<f64>,
-    read: crate::model::mass::ReadFile,
-) -> Result<Option<Shape>> {
-    use crate::model::mass::{is_mesh, DieFile};
-    let mesh = match file {
-        Some(p) if is_mesh(p) => Some((p.to_path_buf(), DieFile::default())),
-        Some(p) => {
-            let f = DieFile::read(p, read)?;
-            let dir = p.parent().unwrap_or(std::path::Path::new("."));
-            let bad = |why: &str| Err(Error::field(Field::Die, p.display(), why.to_string()));
-            if f.mesh.is_none() && (f.labels.is_some() || f.reads.is_some() || f.scale.is_some()) {
-                return bad(
-                    "labels, reads and scale describe a mesh: give its mesh (or leave them out)",
-                );
-            }
-            if f.mesh.is_some() && (f.layout.is_some() || f.faces.is_some()) {
-                return bad(
-                    "layout and faces number a cuboid's faces; a mesh's faces show its labels",
-                );
-            }
-            f.mesh.clone().map(|m| (dir.join(m), f))
-        }
-        None => None,
-    };
-    if let Some(s) = size_mm {
-        if name.is_none() {
-            return Err(Error::field(
-                Field::Size,
-                s,
-                crate::text![
-                    "sizes a named shape: give it with ",
-                    Field::Shape,
-                    " (a mesh is sized by ",
-                    Field::Scale,
-                    ")"
-                ],
-            ));
-        }
-        if !(s.is_finite() && s > 0.0) {
-            return Err(Error::field(
-                Field::Size,
-                s,
-                "must be a positive number of mm",
-            ));
-        }
-    }
-    if let Some(s) = scale {
-        if !(s.is_finite() && s > 0.0) || mesh.is_none() {
-            return Err(Error::field(
-                Field::Scale,
-                s,
-                "must be a positive factor, with a mesh die file (--die FILE.obj|.stl)",
-            ));
-        }
-    }
-    match (name, mesh) {
-        (Some(n), Some(_)) => Err(Error::field(
-            Field::Shape,
-            n,
-            "give a named shape or a mesh die file (--die), not both",
-        )),
-        (Some(n), None) => named(n, size_mm).map(Some),
-        (None, None) => Ok(None),
-        (None, Some((path, f))) => {
-            // A mesh a die file names is refused naming the die file (the one the user gave).
-            let toml = file.filter(|f| !is_mesh(f));
-            from_mesh_file(&path, &f, toml, scale, read).map(Some)
-        }
-    }
-}
-
-/// The die of the mesh at `path`, with a die file's `f` (its scale, reads and labels; from
-/// the file `toml`, if one named the mesh), its lengths times `scale` (else the file's, else
-/// 1). A refusal names `toml` if given, and the mesh.
-fn from_mesh_file(
-    path: &std::path::Path,
-    f: &crate::model::mass::DieFile,
-    toml: Option<&std::path::Path>,
-    scale: Option<f64>,
-    read: crate::model::mass::ReadFile,
-) -> Result<Shape> {
-    let bytes = read(path, MAX_MESH_FILE)?;
-    let file_name = path.file_name().map_or_else(
-        || path.display().to_string(),
-        |n| n.to_string_lossy().into(),
-    );
-    let bad = |why: String| match toml {
-        Some(toml) if why.starts_with(&file_name) => Error::field(Field::Die, toml.display(), why),
-        Some(toml) => Error::field(Field::Die, toml.display(), format!("{file_name}: {why}")),
-        None => Error::field(Field::Die, path.display(), why),
-    };
-    let mesh = crate::model::mesh_file::read_mesh(&bytes, &file_name).map_err(bad)?;
-    let k = scale.or(f.scale).unwrap_or(1.0);
-    if !(k.is_finite() && k > 0.0) {
-        return Err(bad(format!("scale {k}: must be a positive factor")));
-    }
-    let labels = f.mesh_labels().map_err(bad)?;
-    let name = format!(
-        "{file_name}{} fnv1a64:{:016x}",
-        if k == 1.0 {
-            String::new()
-        } else {
-            format!(" ×{k}")
-        },
-        fnv64(&bytes)
-    );
-    let shape = from_mesh(
-        &mesh.scaled(k),
-        name,
-        labels.as_deref(),
-        f.reads.unwrap_or(if f.labels.is_some() {
-            Reads::Up
-        } else {
-            Reads::Down
-        }),
-    )
-    .map_err(|e| match e.starts_with("its ") && e.contains(" size, ") {
-        true => bad(format!("{e} (is the mesh in mm? --scale)")),
-        false => bad(e),
-    })?;
-    // Every label given names a resting facet: one that names none is a mistake (a
-    // normal mistyped, or a facet the die cannot rest on), not a label to drop.
-    for (n, label) in labels.iter().flatten() {
-        if !shape
-            .faces
-            .iter()
-            .any(|f| Vector3::from(f.normal).dot(n) > 1.0 - 1e-6)
-        {
-            return Err(bad(format!(
-                "label '{label}': its normal ({:.4}, {:.4}, {:.4}) is no resting facet's \
-                 (the die rests on {} facets)",
-                n.x,
-                n.y,
-                n.z,
-                shape.faces.len()
-            )));
-        }
-    }
-    Ok(shape)
-}
-
-/// FNV-1a, 64 bits: a mesh file's fingerprint in the die's name (its geometry itself is in
-/// the run's specification, under its checksum).
-fn fnv64(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-    })
 }
 
 #[cfg(test)]

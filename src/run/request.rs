@@ -67,7 +67,7 @@ impl DieRequest {
     /// labels).
     pub fn resolve(&self) -> Result<ResolvedDie> {
         let read: crate::model::mass::ReadFile = &crate::run::io::read_die_bytes;
-        let shape = crate::model::shape::described(
+        let shape = crate::model::mass::described_shape(
             self.file.as_deref(),
             self.shape.as_deref(),
             self.size,

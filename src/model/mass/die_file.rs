@@ -1,8 +1,11 @@
-//! Reading a die file (TOML, lengths in mm) and the features it describes.
+//! Reading a die file (TOML, lengths in mm): the features it describes, and the die of any
+//! shape it (or `--shape`) names.
 
 use super::features::{Features, Insert, Pips, Shell};
 use crate::error::{Error, Field, Result};
 use crate::model::faces::Layout;
+use crate::model::shape::{self, Shape};
+use nalgebra::Vector3;
 use serde::Deserialize;
 
 /// A die file (TOML), every length in mm, every key optional:
@@ -228,4 +231,164 @@ impl Features {
         let f = file.features()?.with_mm(com, pips, edge_radius, shell);
         Ok((f, density.or(file.density)))
     }
+}
+
+/// The largest mesh file read: 256 MiB (a printed die's STL is rarely above a few MiB).
+pub const MAX_MESH_FILE: u64 = 256 << 20;
+
+/// The die of any shape the front ends describe, if any: `name` (`--shape`, sized by
+/// `size_mm`), or a die `file` that is a mesh (.obj, .stl) or a TOML die file naming one
+/// (`mesh`, with its `scale`, `reads` and `labels`), the mesh's lengths times `scale` (the
+/// file's, else 1). Both a name and a mesh, or a size or scale with nothing to size, are
+/// refused with the reason.
+pub fn described_shape(
+    file: Option<&std::path::Path>,
+    name: Option<&str>,
+    size_mm: Option<f64>,
+    scale: Option<f64>,
+    read: ReadFile,
+) -> Result<Option<Shape>> {
+    let mesh = match file {
+        Some(p) if is_mesh(p) => Some((p.to_path_buf(), DieFile::default())),
+        Some(p) => {
+            let f = DieFile::read(p, read)?;
+            let dir = p.parent().unwrap_or(std::path::Path::new("."));
+            let bad = |why: &str| Err(Error::field(Field::Die, p.display(), why.to_string()));
+            if f.mesh.is_none() && (f.labels.is_some() || f.reads.is_some() || f.scale.is_some()) {
+                return bad(
+                    "labels, reads and scale describe a mesh: give its mesh (or leave them out)",
+                );
+            }
+            if f.mesh.is_some() && (f.layout.is_some() || f.faces.is_some()) {
+                return bad(
+                    "layout and faces number a cuboid's faces; a mesh's faces show its labels",
+                );
+            }
+            f.mesh.clone().map(|m| (dir.join(m), f))
+        }
+        None => None,
+    };
+    if let Some(s) = size_mm {
+        if name.is_none() {
+            return Err(Error::field(
+                Field::Size,
+                s,
+                crate::text![
+                    "sizes a named shape: give it with ",
+                    Field::Shape,
+                    " (a mesh is sized by ",
+                    Field::Scale,
+                    ")"
+                ],
+            ));
+        }
+        if !(s.is_finite() && s > 0.0) {
+            return Err(Error::field(
+                Field::Size,
+                s,
+                "must be a positive number of mm",
+            ));
+        }
+    }
+    if let Some(s) = scale {
+        if !(s.is_finite() && s > 0.0) || mesh.is_none() {
+            return Err(Error::field(
+                Field::Scale,
+                s,
+                "must be a positive factor, with a mesh die file (--die FILE.obj|.stl)",
+            ));
+        }
+    }
+    match (name, mesh) {
+        (Some(n), Some(_)) => Err(Error::field(
+            Field::Shape,
+            n,
+            "give a named shape or a mesh die file (--die), not both",
+        )),
+        (Some(n), None) => shape::named(n, size_mm).map(Some),
+        (None, None) => Ok(None),
+        (None, Some((path, f))) => {
+            // A mesh a die file names is refused naming the die file (the one the user gave).
+            let toml = file.filter(|f| !is_mesh(f));
+            from_mesh_file(&path, &f, toml, scale, read).map(Some)
+        }
+    }
+}
+
+/// The die of the mesh at `path`, with a die file's `f` (its scale, reads and labels; from
+/// the file `toml`, if one named the mesh), its lengths times `scale` (else the file's, else
+/// 1). A refusal names `toml` if given, and the mesh.
+fn from_mesh_file(
+    path: &std::path::Path,
+    f: &DieFile,
+    toml: Option<&std::path::Path>,
+    scale: Option<f64>,
+    read: ReadFile,
+) -> Result<Shape> {
+    let bytes = read(path, MAX_MESH_FILE)?;
+    let file_name = path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into(),
+    );
+    let bad = |why: String| match toml {
+        Some(toml) if why.starts_with(&file_name) => Error::field(Field::Die, toml.display(), why),
+        Some(toml) => Error::field(Field::Die, toml.display(), format!("{file_name}: {why}")),
+        None => Error::field(Field::Die, path.display(), why),
+    };
+    let mesh = crate::model::mesh_file::read_mesh(&bytes, &file_name).map_err(bad)?;
+    let k = scale.or(f.scale).unwrap_or(1.0);
+    if !(k.is_finite() && k > 0.0) {
+        return Err(bad(format!("scale {k}: must be a positive factor")));
+    }
+    let labels = f.mesh_labels().map_err(bad)?;
+    let name = format!(
+        "{file_name}{} fnv1a64:{:016x}",
+        if k == 1.0 {
+            String::new()
+        } else {
+            format!(" ×{k}")
+        },
+        fnv64(&bytes)
+    );
+    let shape = shape::from_mesh(
+        &mesh.scaled(k),
+        name,
+        labels.as_deref(),
+        f.reads.unwrap_or(if f.labels.is_some() {
+            shape::Reads::Up
+        } else {
+            shape::Reads::Down
+        }),
+    )
+    .map_err(|e| match e.starts_with("its ") && e.contains(" size, ") {
+        true => bad(format!("{e} (is the mesh in mm? --scale)")),
+        false => bad(e),
+    })?;
+    // Every label given names a resting facet: one that names none is a mistake (a
+    // normal mistyped, or a facet the die cannot rest on), not a label to drop.
+    for (n, label) in labels.iter().flatten() {
+        if !shape
+            .faces
+            .iter()
+            .any(|f| Vector3::from(f.normal).dot(n) > 1.0 - 1e-6)
+        {
+            return Err(bad(format!(
+                "label '{label}': its normal ({:.4}, {:.4}, {:.4}) is no resting facet's \
+                 (the die rests on {} facets)",
+                n.x,
+                n.y,
+                n.z,
+                shape.faces.len()
+            )));
+        }
+    }
+    Ok(shape)
+}
+
+/// FNV-1a, 64 bits: a mesh file's fingerprint in the die's name (its geometry itself is in
+/// the run's specification, under its checksum).
+fn fnv64(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
 }

@@ -30,11 +30,12 @@ mod tests;
 mod turn;
 mod validate;
 
-pub use die_file::{is_mesh, DieFile, LabelDef, ReadFile, MAX_DIE_FILE};
+pub use die_file::{
+    described_shape, is_mesh, DieFile, LabelDef, ReadFile, MAX_DIE_FILE, MAX_MESH_FILE,
+};
 pub use features::{pattern, Features, Insert, PipShape, Pips, Shell, DEFAULT_WALL};
 pub use integrate::{Composition, MassProps};
 pub use moments::rounded_box;
 pub use pips::{cavity, pip_places};
-pub use rounded::{rounded_hull, rounded_shared, take_rounding};
-pub use shell::{inner_hull, inradius};
+pub use rounded::{rounded_shared, take_rounding};
 pub use turn::BodyTurn;

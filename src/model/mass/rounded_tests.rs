@@ -67,7 +67,7 @@ fn a_box_rounded_through_its_hull_has_the_rounded_boxs_closed_form_mass() {
 #[test]
 fn a_rounded_octahedrons_volume_is_steiners() {
     let d8 = shape::named("d8", Some(16.0)).unwrap();
-    let rho = inradius(&d8);
+    let rho = d8.inradius();
     let r = 0.0015;
     let rounded = d8.rounded(r).unwrap();
     let a = (rho - r) * 6f64.sqrt();
@@ -111,7 +111,7 @@ fn a_rounded_die_keeps_its_labels_and_refuses_what_it_cannot_be() {
         .rounded(0.001)
         .unwrap_err()
         .contains("rounded already"));
-    let too_big = v1.rounded(inradius(&v1) * 1.01).unwrap_err();
+    let too_big = v1.rounded(v1.inradius() * 1.01).unwrap_err();
     assert!(too_big.contains("leaves no die"), "{too_big}");
     let coin = shape::named("coin:24,2", None).unwrap();
     assert!(coin.rounded(0.0005).is_err());

@@ -3,14 +3,10 @@
 //!
 //! The box's (rounded or sharp) is a closed form: a box of half sides h rounded with radius r,
 //! offset inward by t, is the box of half sides h − t rounded with r − t, or sharp once t ≥ r.
-//! A convex die's is the intersection of its facets' half-spaces, each moved inward by t. Its
-//! corners are found through the dual: with the origin (the centroid) strictly inside, the
-//! half-space n·x ≤ d − t is the point n/(d − t), the inner solid's facets are the points on
-//! the convex hull of those points (a facet that the offset squeezes out falls inside it), and
-//! each triangle of that hull is a corner: the x with x·q = 1 for its three points q. The
-//! corners' hull is then integrated exactly (`Mesh::mass_properties`). Quickhull's
-//! O(N log N) on the N facets, where intersecting every triple is O(N⁴): a designed hull has
-//! hundreds of facets.
+//! A convex die's is the intersection of its facets' half-spaces, each moved inward by t
+//! (`polytope::inner_hull`, through the dual: quickhull's O(N log N) on the N facets, where
+//! intersecting every triple is O(N⁴), and a designed hull has hundreds of facets), its
+//! corners' hull then integrated exactly (`Mesh::mass_properties`).
 
 use super::moments::{rounded_box, Moments};
 use crate::model::polytope::{self, Cylinder, VolumeIntegrals};
@@ -44,31 +40,9 @@ pub(super) fn inner_shape(shape: &Shape, wall: f64) -> Option<Moments> {
             }
             .mass_properties()
         }
-        Solid::Hull { .. } => inner_hull(&shape.planes(), wall)?.mass_properties(),
+        Solid::Hull { .. } => polytope::inner_hull(&shape.planes(), wall)?.mass_properties(),
     };
     Some(moments_of(&integrals))
-}
-
-/// The corners of the intersection of the half-spaces n·x ≤ d − `wall` (n unit, outward; the
-/// origin inside every one of them, else `None`), as their convex hull.
-pub fn inner_hull(planes: &[(Vector3<f64>, f64)], wall: f64) -> Option<polytope::Mesh> {
-    if !planes.iter().all(|(_, d)| d - wall > 0.0) {
-        return None;
-    }
-    let dual: Vec<Vector3<f64>> = planes.iter().map(|(n, d)| n / (d - wall)).collect();
-    let hull = polytope::hull(&dual).ok()?;
-    let size = planes.iter().map(|(_, d)| d - wall).fold(0.0, f64::max);
-    let mut corners: Vec<Vector3<f64>> = Vec::new();
-    for t in &hull.triangles {
-        let q = t.map(|k| hull.vertices[k]);
-        let m = Matrix3::from_rows(&[q[0].transpose(), q[1].transpose(), q[2].transpose()]);
-        let x = m.lu().solve(&Vector3::repeat(1.0))?;
-        // Four or more planes through one corner (a d8's apex) give it once per triangle.
-        if !corners.iter().any(|c| (c - x).norm() <= 1e-12 * size) {
-            corners.push(x);
-        }
-    }
-    polytope::hull(&corners).ok()
 }
 
 /// A solid's moments about the origin from its volume, centroid and inertia about the
@@ -79,18 +53,5 @@ fn moments_of(v: &VolumeIntegrals) -> Moments {
         mass: v.volume,
         first: v.centroid * v.volume,
         second: about_centroid + v.centroid * v.centroid.transpose() * v.volume,
-    }
-}
-
-/// The die's inradius: the distance from its centroid to its nearest facet (a coin: its
-/// radius or half its height), m. The thickest wall a shell can have is less.
-pub fn inradius(shape: &Shape) -> f64 {
-    match &shape.solid {
-        Solid::Cylinder { diameter, height } => (0.5 * diameter).min(0.5 * height),
-        Solid::Hull { .. } => shape
-            .planes()
-            .iter()
-            .map(|(_, d)| *d)
-            .fold(f64::INFINITY, f64::min),
     }
 }

@@ -147,7 +147,7 @@ fn a_platonic_dies_inner_solid_is_itself_scaled() {
     // facets through each corner, the d20 five: corners the dual finds more than once.
     for name in ["d4", "d6", "d8", "d12", "d20"] {
         let s = shape::named(name, None).unwrap();
-        let r = inradius(&s);
+        let r = s.inradius();
         let t = 0.3 * r;
         let k = (r - t) / r;
         let f = 0.15;
@@ -261,7 +261,7 @@ fn a_shell_is_refused_where_the_model_does_not_hold_it() {
     assert!(shell(0.001, 0.2).validate(&half, Mode::TwoD).is_err());
     // On a die of any shape: under its inradius, and convex.
     let d20 = shape::named("d20", None).unwrap();
-    let r = inradius(&d20);
+    let r = d20.inradius();
     let on = |s: &Shape, f: Features| match f.validate_on(s, Mode::ThreeD) {
         Err(Error::Field { field, why, .. }) => format!("{}: {why}", field.name()),
         Ok(()) => "ok".into(),

@@ -214,11 +214,7 @@ impl Features {
                 ),
             ));
         }
-        self.validate_shell(
-            sh,
-            super::shell::inradius(shape),
-            "the nearest facet from its centroid",
-        )?;
+        self.validate_shell(sh, shape.inradius(), "the nearest facet from its centroid")?;
         if super::shell::inner_shape(shape, sh.wall).is_none() {
             return Err(Error::field(
                 Field::ShellWall,

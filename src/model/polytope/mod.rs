@@ -24,15 +24,17 @@
 //!
 //! Errors are `Result<_, String>`: one line saying what is wrong and where.
 
-// Three rooms, one re-exported surface: `mesh` (the mesh and its exact volume integrals, a
-// cylinder's), `hull` (the convex hull, its facets, the resting test), `catalogue` (the named
-// dice and their labels).
+// Four rooms, one re-exported surface: `mesh` (the mesh and its exact volume integrals, a
+// cylinder's), `hull` (the convex hull, its facets, the resting test), `offset` (facets moved
+// in, a hull swept by a ball), `catalogue` (the named dice and their labels).
 mod catalogue;
 mod hull;
 mod mesh;
+mod offset;
 #[cfg(test)]
 mod tests;
 
 pub use catalogue::*;
 pub use hull::*;
 pub use mesh::*;
+pub use offset::{inner_hull, rounded_hull, DIRECTIONS};

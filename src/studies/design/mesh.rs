@@ -281,7 +281,7 @@ impl Family {
     /// The die at `theta`: the solid its planes bound, each plane's label on its facet.
     fn shape(&self, theta: &[f64]) -> std::result::Result<Shape, String> {
         let planes = self.planes(theta);
-        let mesh = crate::model::mass::inner_hull(&planes, 0.0)
+        let mesh = crate::model::polytope::inner_hull(&planes, 0.0)
             .ok_or("its facets' planes no longer bound a solid about its centre")?;
         let labels: Vec<(Vector3<f64>, String)> = planes
             .iter()
@@ -293,7 +293,7 @@ impl Family {
 
     /// The die's mesh at `theta`: its corners, mm, from its centroid, and its triangles.
     fn mesh(&self, theta: &[f64]) -> std::result::Result<Corners, String> {
-        let mesh = crate::model::mass::inner_hull(&self.planes(theta), 0.0)
+        let mesh = crate::model::polytope::inner_hull(&self.planes(theta), 0.0)
             .ok_or("its facets' planes no longer bound a solid")?;
         let c = mesh.mass_properties().centroid;
         Ok((
@@ -888,7 +888,7 @@ mod tests {
         let file = std::env::temp_dir().join(format!("v1-numbers-{}-{k}.toml", std::process::id()));
         std::fs::write(&file, text).unwrap();
         let read: crate::model::mass::ReadFile = &crate::run::io::read_die_bytes;
-        let shape = crate::model::shape::described(Some(&file), None, None, None, read);
+        let shape = crate::model::mass::described_shape(Some(&file), None, None, None, read);
         let _ = std::fs::remove_file(&file);
         shape.unwrap().unwrap()
     }
