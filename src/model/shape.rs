@@ -741,15 +741,7 @@ impl Shape {
             // A rounded die: its rounding is its margin (`Collider::Hull`).
             return self.radius;
         }
-        let inradius = match &self.solid {
-            Solid::Cylinder { diameter, height } => (0.5 * diameter).min(0.5 * height),
-            Solid::Hull { .. } => self
-                .planes()
-                .iter()
-                .map(|(_, d)| *d)
-                .fold(f64::INFINITY, f64::min),
-        };
-        (1e-4f64).min(0.01 * inradius)
+        (1e-4f64).min(0.01 * self.inradius())
     }
 
     /// A note for a die whose solid is not convex (a mesh with a dent or a hollow): what rolls
