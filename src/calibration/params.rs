@@ -21,6 +21,7 @@ use crate::model::throws::{Range, ThrowRanges, ThrowStyle};
 use crate::run::spec::{RunSpec, ThrowSpec, MAX_KAPPA};
 use crate::sim::roll::{early_stop_exact, RollConfig, Rule};
 use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
 
 /// A kind of parameter.
 #[derive(
@@ -623,6 +624,26 @@ pub struct Method {
 }
 
 impl Method {
+    /// How a row of die `die` is simulated: this method with that die's shape, features and
+    /// density in place of the fit's own (`None`, or a die it does not hold: the fit's own).
+    pub fn for_die(&self, die: Option<&str>) -> Cow<'_, Method> {
+        match die.and_then(|n| self.dice.iter().find(|d| d.name == n)) {
+            None => Cow::Borrowed(self),
+            Some(d) => Cow::Owned(Method {
+                shape: Some(d.shape.clone()),
+                die: d.die,
+                density: d.density,
+                dice: Vec::new(),
+                ..self.clone()
+            }),
+        }
+    }
+
+    /// How `row` is simulated: as its own die ([`Method::for_die`]).
+    pub fn of_row(&self, row: &DataRow) -> Cow<'_, Method> {
+        self.for_die(row.die.as_deref())
+    }
+
     /// How each roll is carried out: the fast defaults, ended by the exact early stop where it
     /// is exact (`roll::EARLY_STOP_MAX_DT`), else by DicePhys's rest rule.
     pub fn roll(&self) -> RollConfig {
@@ -731,28 +752,6 @@ impl Method {
             rolls,
             shard: None,
         }
-    }
-}
-
-impl Method {
-    /// How a row of die `die` is simulated: this method with that die's shape, features and
-    /// density in place of the fit's own (`None`, or a die it does not hold: the fit's own).
-    pub fn for_die(&self, die: Option<&str>) -> std::borrow::Cow<'_, Method> {
-        match die.and_then(|n| self.dice.iter().find(|d| d.name == n)) {
-            None => std::borrow::Cow::Borrowed(self),
-            Some(d) => std::borrow::Cow::Owned(Method {
-                shape: Some(d.shape.clone()),
-                die: d.die,
-                density: d.density,
-                dice: Vec::new(),
-                ..self.clone()
-            }),
-        }
-    }
-
-    /// How `row` is simulated: as its own die ([`Method::for_die`]).
-    pub fn of_row(&self, row: &DataRow) -> std::borrow::Cow<'_, Method> {
-        self.for_die(row.die.as_deref())
     }
 }
 
