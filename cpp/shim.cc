@@ -192,10 +192,16 @@ class DiceWorld : public btDiscreteDynamicsWorld {
 // one that holds each point's friction to Coulomb's law (solveSingleIteration, below).
 class DieSolver : public btSequentialImpulseConstraintSolver {
  public:
+  // Static friction over sliding friction (`Scene::static_ratio`; 1: one friction, as Bullet)
+  // and the slip, m/s, below which a point counts as not sliding (`Scene::stick_speed`).
+  btScalar static_ratio = 1;
+  btScalar stick_speed = 0;
+
   btScalar solveGroup(btCollisionObject** bodies, int numBodies, btPersistentManifold** manifolds,
                       int numManifolds, btTypedConstraint** constraints, int numConstraints,
                       const btContactSolverInfo& info, btIDebugDraw* debugDrawer,
                       btDispatcher* dispatcher) override {
+    if (static_ratio != 1) hold(manifolds, numManifolds);
     btRigidBody* die = numBodies == 1 ? btRigidBody::upcast(bodies[0]) : nullptr;
     if (numConstraints != 0 || !die || !fits(die, manifolds, numManifolds, info)) {
       return btSequentialImpulseConstraintSolver::solveGroup(bodies, numBodies, manifolds,
@@ -275,6 +281,42 @@ class DieSolver : public btSequentialImpulseConstraintSolver {
   }
 
  private:
+  // Static against sliding friction. Each point's friction, before any row is set up from it,
+  // is the pair's sliding friction (Bullet's product of the two bodies' frictions), times
+  // static_ratio where the point does not slide as the step begins: its two bodies'
+  // velocities there (as the last step left them; gravity's impulse, added in the solve, is
+  // along the floor's normal) differ along the contact's plane by no more than stick_speed.
+  // A point that held through the last step ends it slipping by the solver's residual only;
+  // one whose grip gives way slides at static friction until its slip passes stick_speed
+  // (g dt: a few steps), then at sliding friction. Every point is set every step, so a point
+  // kept from an earlier step carries no stale value.
+  void hold(btPersistentManifold** manifolds, int numManifolds) const {
+    for (int i = 0; i < numManifolds; i++) {
+      btPersistentManifold* m = manifolds[i];
+      const btCollisionObject* a = m->getBody0();
+      const btCollisionObject* b = m->getBody1();
+      const btScalar sliding = btManifoldResult::calculateCombinedFriction(a, b);
+      const btScalar holding = btMin(sliding * static_ratio, btScalar(10));
+      const btRigidBody* ra = btRigidBody::upcast(a);
+      const btRigidBody* rb = btRigidBody::upcast(b);
+      for (int j = 0; j < m->getNumContacts(); j++) {
+        btManifoldPoint& cp = m->getContactPoint(j);
+        btVector3 v(0, 0, 0);
+        if (ra) {
+          v += ra->getVelocityInLocalPoint(cp.getPositionWorldOnA() -
+                                           a->getWorldTransform().getOrigin());
+        }
+        if (rb) {
+          v -= rb->getVelocityInLocalPoint(cp.getPositionWorldOnB() -
+                                           b->getWorldTransform().getOrigin());
+        }
+        const btVector3 slip = v - cp.m_normalWorldOnB * cp.m_normalWorldOnB.dot(v);
+        cp.m_combinedFriction =
+            slip.length2() <= stick_speed * stick_speed ? holding : sliding;
+      }
+    }
+  }
+
   // One row, the die's side of it: its normal and r x n, and what an impulse along it does
   // to the die (n times the inverse mass, and the angular component).
   struct Row {
@@ -762,9 +804,15 @@ BulletWorld::BulletWorld(const BulletScene& s)
   // Two bodies: the simplest broadphase does (the pair is the same; measured identical).
   broadphase_ = std::make_unique<btSimpleBroadphase>(4);
   if (s.stock_world) {
+    if (s.static_ratio != 1) {
+      throw std::invalid_argument("Bullet's own solver has one friction: no static ratio");
+    }
     solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
   } else {
-    solver_ = std::make_unique<DieSolver>();
+    auto solver = std::make_unique<DieSolver>();
+    solver->static_ratio = s.static_ratio;
+    solver->stick_speed = s.stick_speed;
+    solver_ = std::move(solver);
   }
   if (s.stock_world) {
     world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),

@@ -276,6 +276,8 @@ pub enum Field {
     BounceThreshold,
     /// `contact_time`.
     ContactTime,
+    /// `static_ratio`.
+    StaticRatio,
     /// `reference_budget_s`.
     ReferenceBudgetS,
     /// `reference_dt`.

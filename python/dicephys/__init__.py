@@ -460,6 +460,7 @@ def roll(
     rolling_resistance: Optional[float] = None,
     bounce_threshold: float = 0.0,
     contact_time: float = 0.0,
+    static_ratio: float = 1.0,
     sleep: bool = True,
     settle: Optional[str] = None,
     flight: str = "fast",
@@ -504,7 +505,8 @@ def roll(
     bounce_threshold: m/s, impacts slower than this do not bounce (0: every one does);
         contact_time: ms, a soft table whose flat landing lasts this long and leaves at
         ``restitution`` times its speed (0: the rigid contact; else at least two steps of
-        ``dt``). Both Bullet only.
+        ``dt``); static_ratio: static over sliding friction (a contact point not sliding
+        holds up to this times ``friction``; 1: one friction). All three Bullet only.
     settle: None (the exact early stop where it is audited exact), "certificate" or
         "dicephys".  flight: "fast" or "stepped".  faithful: DicePhys as the paper ran it.
     com: the centre of mass (x, y, z) in mm from the geometric centre; pips: (diameter,
@@ -524,7 +526,7 @@ def roll(
         dt=dt, restitution=restitution, friction=friction, density=density, preset=preset,
         floor=floor, floor_thickness=floor_thickness, linear_damping=linear_damping,
         angular_damping=angular_damping, rolling_resistance=rolling_resistance, sleep=sleep,
-        bounce_threshold=bounce_threshold, contact_time=contact_time,
+        bounce_threshold=bounce_threshold, contact_time=contact_time, static_ratio=static_ratio,
         throw=throw, kappa=kappa, source=source, velocity=velocity, spin=spin,
         drop_height=drop_height, settle=settle, flight=flight, faithful=faithful,
         max_steps=max_steps, margin=margin, com=com, pips=pips, edge_radius=edge_radius,
@@ -614,6 +616,7 @@ def fair(
     rolling_resistance: Optional[float] = None,
     bounce_threshold: float = 0.0,
     contact_time: float = 0.0,
+    static_ratio: float = 1.0,
     sleep: bool = True,
     settle: Optional[str] = None,
     flight: str = "fast",
@@ -683,7 +686,7 @@ def fair(
         dt=dt, restitution=restitution, friction=friction, density=density, preset=preset,
         floor=floor, floor_thickness=floor_thickness, linear_damping=linear_damping,
         angular_damping=angular_damping, rolling_resistance=rolling_resistance, sleep=sleep,
-        bounce_threshold=bounce_threshold, contact_time=contact_time,
+        bounce_threshold=bounce_threshold, contact_time=contact_time, static_ratio=static_ratio,
         throw=throw, kappa=kappa, source=source, velocity=velocity, spin=spin,
         drop_height=drop_height, settle=settle, flight=flight, faithful=faithful,
         max_steps=max_steps, margin=margin, com=com, pips=pips, edge_radius=edge_radius,
@@ -1289,6 +1292,7 @@ def trace(
     rolling_resistance: Optional[float] = None,
     bounce_threshold: float = 0.0,
     contact_time: float = 0.0,
+    static_ratio: float = 1.0,
     sleep: bool = True,
     com: Optional[Sequence[float]] = None,
     pips: Optional[Sequence[float]] = None,
@@ -1332,7 +1336,7 @@ def trace(
         drop_height=_pair("drop_height", drop_height), preset=preset, floor=floor,
         floor_thickness=floor_thickness, linear_damping=linear_damping,
         angular_damping=angular_damping, rolling_resistance=rolling_resistance, sleep=sleep,
-        bounce_threshold=bounce_threshold, contact_time=contact_time,
+        bounce_threshold=bounce_threshold, contact_time=contact_time, static_ratio=static_ratio,
         com=_triple("com", com, 3), pips=_triple("pips", pips, 2), edge_radius=edge_radius,
         shell=_triple("shell", shell, 2), max_steps=max_steps, flight=flight, every=every,
         html=None if html is None else os.fspath(html),

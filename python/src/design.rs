@@ -17,7 +17,7 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 
 /// What a fit's calibration sets: refused beside `fit`, as the command line refuses its flags.
-const FIT_SETS: [&str; 23] = [
+const FIT_SETS: [&str; 24] = [
     "engine",
     "mode",
     "dt",
@@ -31,6 +31,7 @@ const FIT_SETS: [&str; 23] = [
     "rolling_resistance",
     "bounce_threshold",
     "contact_time",
+    "static_ratio",
     "sleep",
     "source",
     "velocity",

@@ -363,6 +363,7 @@ fn scene_of(block_: Option<&str>, o: &Options, layout: Option<Layout>) -> PyResu
         rolling_resistance_mm: o.maybe("rolling_resistance")?,
         bounce_threshold: o.get("bounce_threshold", d.bounce_threshold)?,
         contact_time_ms: o.get("contact_time", d.contact_time_ms)?,
+        static_ratio: o.get("static_ratio", d.static_ratio)?,
         sleep: o.get("sleep", d.sleep)?,
     })
 }

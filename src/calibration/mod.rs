@@ -289,13 +289,18 @@ impl FitConfig {
         Ok(())
     }
 
-    /// The contact's own laws (rolling resistance, a bounce threshold, a soft table) are
+    /// The contact's own laws (rolling resistance, a bounce threshold, a soft table, static
+    /// friction) are
     /// Bullet's; a soft table's range must last two steps of the fit's.
     fn check_contact_laws(&self) -> Result<()> {
         for (kind, what) in [
             (params::Kind::Rolling, "rolling resistance"),
             (params::Kind::Bounce, "bounce threshold"),
             (params::Kind::ContactTime, "soft contact"),
+            (
+                params::Kind::StaticRatio,
+                "static friction apart from sliding friction",
+            ),
         ] {
             if self.model.is_free(kind) && self.method.engine != crate::engine::EngineKind::Bullet {
                 return Err(Error::field(

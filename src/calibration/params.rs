@@ -56,6 +56,9 @@ pub enum Kind {
     /// The contact time, ms: a soft table whose flat landing lasts this long
     /// (`Scene::contact_time`, `model::compliance`; per surface; Bullet only).
     ContactTime,
+    /// Static friction over sliding friction, μs/μk (`Scene::static_ratio`; per surface;
+    /// Bullet only).
+    StaticRatio,
     /// The hand's concentration κ (per thrower).
     Kappa,
     /// A factor on the paper's spin range, 31 to 160 rad/s (per thrower).
@@ -85,12 +88,13 @@ pub enum Kind {
 
 impl Kind {
     /// Every kind, in the order a row's coordinates take them.
-    pub const ALL: [Kind; 15] = [
+    pub const ALL: [Kind; 16] = [
         Kind::E,
         Kind::Mu,
         Kind::Rolling,
         Kind::Bounce,
         Kind::ContactTime,
+        Kind::StaticRatio,
         Kind::Kappa,
         Kind::Spin,
         Kind::Height,
@@ -103,7 +107,7 @@ impl Kind {
         Kind::Infill,
     ];
 
-    /// "e", "mu", "rolling", "bounce", "contact_time", "kappa", "spin", "height", "speed", "com_x", "com_y",
+    /// "e", "mu", "rolling", "bounce", "contact_time", "static_ratio", "kappa", "spin", "height", "speed", "com_x", "com_y",
     /// "com_z", "pip_depth", "edge_radius" or "infill".
     pub fn name(self) -> &'static str {
         self.into()
@@ -114,7 +118,12 @@ impl Kind {
     pub fn of_surface(self) -> bool {
         matches!(
             self,
-            Kind::E | Kind::Mu | Kind::Rolling | Kind::Bounce | Kind::ContactTime
+            Kind::E
+                | Kind::Mu
+                | Kind::Rolling
+                | Kind::Bounce
+                | Kind::ContactTime
+                | Kind::StaticRatio
         )
     }
 
@@ -139,6 +148,7 @@ impl Kind {
             Kind::Rolling => (0.0, MAX_ROLLING_RESISTANCE * 1e3),
             Kind::Bounce => (0.0, crate::model::scene::MAX_BOUNCE_THRESHOLD),
             Kind::ContactTime => (0.0, crate::model::scene::MAX_CONTACT_TIME * 1e3),
+            Kind::StaticRatio => (1.0, crate::model::scene::MAX_STATIC_RATIO),
             Kind::Kappa => (0.0, MAX_KAPPA),
             Kind::Spin => (0.05, 20.0),
             Kind::Height => (0.05, 10.0),
@@ -190,6 +200,11 @@ impl Kind {
             // contact, is not its limit: backward Euler's damping takes the bounce first) to
             // 10 ms, a die landing on thick felt or cloth; a hard table's 0.1 ms lies below.
             Kind::ContactTime => Range::new(2.0, 10.0),
+            // One friction (1, the paper's engines) to static friction twice the sliding: the
+            // handbooks' dry pairs lie inside (steel on steel 0.74/0.57 = 1.3, rubber on
+            // concrete 1.25, wood on wood 1.25 to 2). Fixed before the first fit (issue 72's
+            // sixth round).
+            Kind::StaticRatio => Range::new(1.0, 2.0),
         }
     }
 
@@ -205,7 +220,8 @@ impl Kind {
             | Kind::EdgeRadius
             | Kind::Infill
             | Kind::Bounce
-            | Kind::ContactTime => v,
+            | Kind::ContactTime
+            | Kind::StaticRatio => v,
             Kind::Kappa => (1.0 + v).log10(),
             Kind::Spin | Kind::Height | Kind::Speed => v.ln(),
         }
@@ -223,7 +239,8 @@ impl Kind {
             | Kind::EdgeRadius
             | Kind::Infill
             | Kind::Bounce
-            | Kind::ContactTime => w,
+            | Kind::ContactTime
+            | Kind::StaticRatio => w,
             Kind::Kappa => 10f64.powf(w) - 1.0,
             Kind::Spin | Kind::Height | Kind::Speed => w.exp(),
         }
@@ -287,6 +304,9 @@ pub struct Fixed {
     /// The contact time, ms (0: the rigid contact, the paper's).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub contact_time: f64,
+    /// Static friction over sliding friction (1: one friction, the paper's).
+    #[serde(default = "unit", skip_serializing_if = "is_unit")]
+    pub static_ratio: f64,
     /// The throw.
     pub throw: FixedThrow,
     /// The spin scale.
@@ -337,6 +357,7 @@ impl Default for Fixed {
             rolling: 0.0,
             bounce: 0.0,
             contact_time: 0.0,
+            static_ratio: 1.0,
             throw: FixedThrow::Paper,
             spin: 1.0,
             height: 1.0,
@@ -388,6 +409,7 @@ pub fn values(fixed: &Fixed, axes: &[(Kind, Range)], x: &[f64]) -> Fixed {
             Kind::Rolling => v.rolling = value,
             Kind::Bounce => v.bounce = value,
             Kind::ContactTime => v.contact_time = value,
+            Kind::StaticRatio => v.static_ratio = value,
             // A toss's κ turns its directions a hand's way; any other throw's makes it a hand's.
             Kind::Kappa => {
                 v.throw = match v.throw {
@@ -477,6 +499,7 @@ impl ModelSpec {
             (Kind::Rolling, f.rolling),
             (Kind::Bounce, f.bounce),
             (Kind::ContactTime, f.contact_time),
+            (Kind::StaticRatio, f.static_ratio),
             (Kind::Spin, f.spin),
             (Kind::Height, f.height),
             (Kind::Speed, f.speed),
@@ -699,6 +722,7 @@ impl Method {
         }
         scene.bounce_threshold = v.bounce;
         scene.contact_time = v.contact_time / 1000.0;
+        scene.static_ratio = v.static_ratio;
         scene.features = self.die_at(v);
         if let Some(d) = self.density {
             scene.density = d;

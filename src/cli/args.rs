@@ -163,6 +163,17 @@ pub struct SceneArgs {
         allow_hyphen_values = true
     )]
     pub contact_time: f64,
+    /// Static friction over sliding friction, μs/μk: a contact point that is not sliding (its
+    /// slip under g·dt as a step begins) holds up to this times --friction; a sliding one drags
+    /// with --friction (1 to 3; steel on steel about 1.3, wood on wood up to 2; DicePhys: 1, one
+    /// friction). Bullet only.
+    #[arg(
+        long,
+        value_name = "RATIO",
+        default_value_t = 1.0,
+        allow_hyphen_values = true
+    )]
+    pub static_ratio: f64,
     /// Never let the engine put the die to sleep (for slow, over-damped rolls, which it would
     /// freeze mid-fall).
     #[arg(long)]
@@ -508,6 +519,7 @@ impl SceneArgs {
             rolling_resistance_mm: self.rolling_resistance,
             bounce_threshold: self.bounce_threshold,
             contact_time_ms: self.contact_time,
+            static_ratio: self.static_ratio,
             sleep: !self.no_sleep,
         }
     }

@@ -85,7 +85,7 @@ pub struct DesignArgs {
 }
 
 /// What a fit's calibration sets: refused beside --fit.
-const FIT_SETS: [&str; 24] = [
+const FIT_SETS: [&str; 25] = [
     "engine",
     "two_d",
     "dt",
@@ -100,6 +100,7 @@ const FIT_SETS: [&str; 24] = [
     "rolling_resistance",
     "bounce_threshold",
     "contact_time",
+    "static_ratio",
     "no_sleep",
     "source",
     "velocity",

@@ -105,6 +105,7 @@ pub fn flag(field: Field) -> &'static str {
         Field::RollingResistance => "--rolling-resistance",
         Field::BounceThreshold => "--bounce-threshold",
         Field::ContactTime => "--contact-time",
+        Field::StaticRatio => "--static-ratio",
         Field::Margin => "--margin",
         Field::MaxSteps => "--max-steps",
         Field::Modes => "--modes",

@@ -11,7 +11,7 @@ use dicephys::studies::fair::{assess, Null};
 
 /// The flags that say how a die is rolled: refused beside `--counts`, which rolls nothing
 /// (the die's own flags stay: the quasi-static null reads them).
-const SIMULATION: [&str; 30] = [
+const SIMULATION: [&str; 31] = [
     "engine",
     "dt",
     "friction",
@@ -25,6 +25,7 @@ const SIMULATION: [&str; 30] = [
     "rolling_resistance",
     "bounce_threshold",
     "contact_time",
+    "static_ratio",
     "no_sleep",
     "seed",
     "source",

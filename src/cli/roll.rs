@@ -16,7 +16,7 @@ use std::path::PathBuf;
 use std::sync::atomic::Ordering::Relaxed;
 
 /// The options that define a run: `--resume` takes them from the checkpoint instead.
-const DEFINING: [&str; 35] = [
+const DEFINING: [&str; 36] = [
     "shape",
     "size",
     "scale",
@@ -50,6 +50,7 @@ const DEFINING: [&str; 35] = [
     "rolling_resistance",
     "bounce_threshold",
     "contact_time",
+    "static_ratio",
     "no_sleep",
     "style",
 ];

@@ -91,6 +91,12 @@ mod ffi {
         /// the contact's are the die's); 0: the rigid contact, as DicePhys.
         contact_stiffness: f64,
         contact_damping: f64,
+        /// Static friction over sliding friction (`Scene::static_ratio`): a contact point
+        /// slipping no faster than `stick_speed`, m/s, as a step begins holds with this
+        /// times its combined friction; 1: one friction, as DicePhys. The shim's solver
+        /// sets it (`DieSolver`), so the stock world refuses anything but 1.
+        static_ratio: f64,
+        stick_speed: f64,
         /// Bullet's own world and solver, every part of a step as Bullet does it, without the
         /// shim's shortcuts (`DiceWorld`, `DieSolver` in cpp/shim.cc): for the check that
         /// they change nothing.
@@ -311,6 +317,8 @@ impl Bullet {
             },
             contact_stiffness,
             contact_damping,
+            static_ratio: scene.static_ratio,
+            stick_speed: scene.stick_speed(),
             stock_world,
         };
         let world =

@@ -90,6 +90,9 @@ pub fn models(scene: &Scene) -> crate::Result<()> {
     if scene.contact_time > 0.0 {
         return refuse("no soft contact");
     }
+    if scene.static_ratio != 1.0 {
+        return refuse("one friction coefficient (no static friction apart)");
+    }
     Ok(())
 }
 

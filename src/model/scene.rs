@@ -150,6 +150,14 @@ pub struct Scene {
     /// least two steps. Written into a specification only when not 0.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub contact_time: f64,
+    /// Static friction over sliding friction, μs/μk: a contact point that is not sliding as a
+    /// step begins (its slip slower than `Scene::stick_speed`) holds up to μs = this × μ times
+    /// its push, a sliding one μ (the sliding friction, `friction` × `floor_friction`). A real
+    /// pair of surfaces holds more than it drags (steel on steel 0.74 against 0.57, wood on wood
+    /// up to twice), which one μ cannot say. DicePhys: 1, one μ. Bullet only. Written into a
+    /// specification only when not 1.
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub static_ratio: f64,
     /// The engine may put a die that has slowed down to sleep (Bullet's deactivation after
     /// 2 s under 0.8 m/s and 1 rad/s, Rapier's after 0.5 s under its thresholds), as DicePhys
     /// let Bullet do. False: never, for a die that moves slowly for long (an over-damped roll,
@@ -173,6 +181,14 @@ fn is_zero(v: &f64) -> bool {
     *v == 0.0
 }
 
+fn is_one(v: &f64) -> bool {
+    *v == 1.0
+}
+
+fn one() -> f64 {
+    1.0
+}
+
 fn is_true(v: &bool) -> bool {
     *v
 }
@@ -194,6 +210,10 @@ pub const MAX_FRICTION: f64 = 10.0;
 /// The largest rolling resistance accepted, m: 1 mm, already the lever arm of soft felt
 /// under a heavy die (hard surfaces are near 0.01 mm).
 pub const MAX_ROLLING_RESISTANCE: f64 = 1e-3;
+
+/// The largest ratio of static to sliding friction a scene takes: 3, beyond the largest of
+/// the handbooks' dry pairs (wood on wood, leather on metal: about 2 to 2.5).
+pub const MAX_STATIC_RATIO: f64 = 3.0;
 
 /// The largest bounce threshold a scene takes, m/s: a die dropped from 20 cm meets the table at
 /// 2 m/s, so every impact of a throw is below it.
@@ -329,6 +349,17 @@ impl Scene {
                 format!("must be in [0, {MAX_BOUNCE_THRESHOLD}] m/s"),
             );
         }
+        if !(self.static_ratio.is_finite() && (1.0..=MAX_STATIC_RATIO).contains(&self.static_ratio))
+        {
+            return bad(
+                Field::StaticRatio,
+                self.static_ratio,
+                format!(
+                    "must be in [1, {MAX_STATIC_RATIO}]: static friction holds at least what \
+                     sliding friction drags"
+                ),
+            );
+        }
         self.check_contact()?;
         if let (Some(shape), Mode::TwoD) = (&self.shape, self.mode) {
             // A box-shaped die too: its mass is the box's (`Scene::hull_shape`), its outcomes
@@ -411,10 +442,20 @@ impl Scene {
             rolling_resistance: 0.0,
             bounce_threshold: 0.0,
             contact_time: 0.0,
+            static_ratio: 1.0,
             sleeping: true,
             features: Features::default(),
             shape: None,
         }
+    }
+
+    /// The slip below which a contact point counts as not sliding (static friction holds it,
+    /// `static_ratio`): g dt, what gravity adds to a speed in one step. A point that held
+    /// through the last step ends it slipping by no more than the solver's residual, far
+    /// below this; a point found slower than this cannot be told from one at rest by a step
+    /// of this length.
+    pub fn stick_speed(&self) -> f64 {
+        self.gravity * self.dt
     }
 
     /// True if the die's velocities are damped (either rate above 0).

@@ -331,6 +331,12 @@ impl RunSummary {
         if scene.contact_time > 0.0 {
             extra.push(format!("a soft contact of {} ms", scene.contact_time * 1e3));
         }
+        if scene.static_ratio != 1.0 {
+            extra.push(format!(
+                "static friction {} × the sliding",
+                scene.static_ratio
+            ));
+        }
         if extra.is_empty() {
             String::new()
         } else {

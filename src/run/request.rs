@@ -172,6 +172,8 @@ pub struct SceneRequest {
     pub bounce_threshold: f64,
     /// The contact time, ms (0: the rigid contact).
     pub contact_time_ms: f64,
+    /// Static friction over sliding friction (1: one friction).
+    pub static_ratio: f64,
     /// Let the engine put the die to sleep.
     pub sleep: bool,
 }
@@ -195,6 +197,7 @@ impl Default for SceneRequest {
             rolling_resistance_mm: None,
             bounce_threshold: 0.0,
             contact_time_ms: 0.0,
+            static_ratio: paper.static_ratio,
             sleep: paper.sleeping,
         }
     }
@@ -263,6 +266,7 @@ impl SceneRequest {
         scene.rolling_resistance = self.rolling_resistance_mm.unwrap_or(0.0) / 1000.0;
         scene.bounce_threshold = self.bounce_threshold;
         scene.contact_time = self.contact_time_ms / 1000.0;
+        scene.static_ratio = self.static_ratio;
         scene.angular_damping = self.angular_damping;
         scene.sleeping = self.sleep;
         scene.features = features;

@@ -240,6 +240,12 @@ impl RunSpec {
                 s.contact_time * 1e3,
                 "soft contact",
             ),
+            (
+                s.static_ratio != 1.0,
+                Field::StaticRatio,
+                s.static_ratio,
+                "static friction apart from sliding friction",
+            ),
         ] {
             if on && self.engine != EngineKind::Bullet {
                 return Err(Error::field(

@@ -15,6 +15,7 @@ mod dice_fit;
 mod docs;
 mod faces;
 mod fit;
+mod friction;
 mod fuzz;
 mod impact;
 mod inputs;

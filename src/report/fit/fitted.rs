@@ -44,6 +44,9 @@ pub fn fixed_text(res: &FitResult) -> String {
     if !m.is_free(Kind::ContactTime) && f.contact_time > 0.0 {
         parts.push(format!("contact time {} ms", f.contact_time));
     }
+    if !m.is_free(Kind::StaticRatio) && f.static_ratio != 1.0 {
+        parts.push(format!("static friction {} × the sliding", f.static_ratio));
+    }
     if !m.is_free(Kind::Kappa) {
         parts.push(match f.throw {
             FixedThrow::Paper => "the paper's throw".into(),

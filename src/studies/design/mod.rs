@@ -804,6 +804,9 @@ fn scene_words(c: &DesignConfig) -> String {
     if sc.contact_time > 0.0 {
         table += &format!(", contact time {:.3} ms", sc.contact_time * 1000.0);
     }
+    if sc.static_ratio != 1.0 {
+        table += &format!(", static friction {:.3} × the sliding", sc.static_ratio);
+    }
     match &c.calibration {
         Some(k) => format!(
             "the calibration of {} (surface {}, thrower {}; at its maximum): {table}, throw {}",
