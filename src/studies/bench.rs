@@ -287,9 +287,12 @@ pub fn bench_dice() -> crate::Result<Vec<(String, Scene, ThrowStyle)>> {
     let mut rolling = sharp.clone();
     rolling.rolling_resistance = 1e-4;
     out.push(("--rolling-resistance 0.1".into(), rolling, tumble));
-    let mut soft = sharp;
+    let mut soft = sharp.clone();
     soft.contact_time = 0.005;
     out.push(("--contact-time 5".into(), soft, tumble));
+    let mut holding = sharp;
+    holding.static_ratio = 1.5;
+    out.push(("--static-ratio 1.5".into(), holding, tumble));
     for name in ["d6", "d20", "d4"] {
         let shape = crate::model::shape::named(name, None)?;
         out.push((
@@ -410,7 +413,9 @@ pub fn dice_costs(
         let models = |scene: &Scene| {
             (engine != EngineKind::Moreau || crate::engine::moreau::models(scene).is_ok())
                 && (engine == EngineKind::Bullet
-                    || (scene.rolling_resistance == 0.0 && scene.contact_time == 0.0))
+                    || (scene.rolling_resistance == 0.0
+                        && scene.contact_time == 0.0
+                        && scene.static_ratio == 1.0))
         };
         let mut best = vec![(f64::INFINITY, Vec::new()); dice.len()];
         for _ in 0..repeat.max(1) {
