@@ -747,9 +747,9 @@ const ODD: [&str; 10] = [
     "--no-sleep",
 ];
 
-/// A toss in a hand's directions beside a bounce threshold: `spec.throws.kappa` and
-/// `spec.scene.bounce_threshold`.
-const TOSSED: [&str; 8] = [
+/// A toss in a hand's directions beside a bounce threshold and static friction:
+/// `spec.throws.kappa`, `spec.scene.bounce_threshold` and `spec.scene.static_ratio`.
+const TOSSED: [&str; 10] = [
     "--block",
     "16x16x16",
     "--throw",
@@ -758,6 +758,8 @@ const TOSSED: [&str; 8] = [
     "5",
     "--bounce-threshold",
     "0.1",
+    "--static-ratio",
+    "1.5",
 ];
 
 #[test]
@@ -847,7 +849,7 @@ fn json_md_lists_the_keys_of_roll_and_merge() {
         ("roll --max-steps 1", &none),
         ("roll --shape d6", &shaped),
         (
-            "roll --throw toss --kappa 5 --bounce-threshold 0.1",
+            "roll --throw toss --kappa 5 --bounce-threshold 0.1 --static-ratio 1.5",
             &tossed,
         ),
         (
