@@ -500,8 +500,8 @@ def roll(
     preset, floor, floor_thickness, linear_damping, angular_damping, sleep: the scene
         (as ``dicephys roll --help`` says).
     rolling_resistance: mm, the lever arm of the floor's push against rolling and turning in
-        place (so that a coin rolling on its rim stops); Bullet only; None: 0.05 for a coin
-        on Bullet (a hard table), else 0.
+        place (so that a coin rolling on its rim stops); Bullet, and Rapier in 3D; None:
+        0.05 for a coin (a hard table), else 0.
     bounce_threshold: m/s, impacts slower than this do not bounce (0: every one does);
         contact_time: ms, a soft table whose flat landing lasts this long and leaves at
         ``restitution`` times its speed (0: the rigid contact; else at least two steps of
@@ -890,7 +890,7 @@ def fit(
     data: the counts — a CSV path (docs/guide.md, "Calibrating"), "paper" (the paper's 19
         rows), a pandas DataFrame or a list of dicts with the CSV's columns.
     free: the free parameters, among "e", "mu", "rolling" (the contact's rolling resistance,
-        mm; Bullet only), "kappa", "spin", "height", "speed" (the last three factors on the
+        mm; Bullet and Rapier), "kappa", "spin", "height", "speed" (the last three factors on the
         throw's spin, launch height and launch speed); for a die,
         "com_x", "com_y", "com_z" (its centre of mass, mm), "pip_depth" (mm) and "infill" (a
         printed die's infill fraction, 0 to 1, in its shell's wall or a 1 mm one).

@@ -289,20 +289,29 @@ impl FitConfig {
         Ok(())
     }
 
-    /// The contact's own laws (rolling resistance, a bounce threshold, a soft table, static
-    /// friction) are
-    /// Bullet's; a soft table's range must last two steps of the fit's.
+    /// The contact's own laws (a bounce threshold, a soft table, static friction) are
+    /// Bullet's, rolling resistance Bullet's and Rapier's; a soft table's range must last two
+    /// steps of the fit's.
     fn check_contact_laws(&self) -> Result<()> {
-        for (kind, what) in [
-            (params::Kind::Rolling, "rolling resistance"),
-            (params::Kind::Bounce, "bounce threshold"),
-            (params::Kind::ContactTime, "soft contact"),
+        use crate::engine::EngineKind;
+        let rapier = matches!(
+            self.method.engine,
+            EngineKind::Rapier | EngineKind::RapierLocked
+        );
+        for (kind, what, on_rapier) in [
+            (params::Kind::Rolling, "rolling resistance", true),
+            (params::Kind::Bounce, "bounce threshold", false),
+            (params::Kind::ContactTime, "soft contact", false),
             (
                 params::Kind::StaticRatio,
                 "static friction apart from sliding friction",
+                false,
             ),
         ] {
-            if self.model.is_free(kind) && self.method.engine != crate::engine::EngineKind::Bullet {
+            if self.model.is_free(kind)
+                && self.method.engine != EngineKind::Bullet
+                && !(on_rapier && rapier)
+            {
                 return Err(Error::field(
                     Field::Free,
                     kind.name(),

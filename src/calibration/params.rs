@@ -48,7 +48,7 @@ pub enum Kind {
     /// The contact's coefficient of friction μ (per surface).
     Mu,
     /// The contact's rolling resistance, mm: the lever arm of the floor's push against a die
-    /// rolling or turning on it (`Scene::rolling_resistance`; per surface; Bullet only).
+    /// rolling or turning on it (`Scene::rolling_resistance`; per surface; Bullet and Rapier in 3D).
     Rolling,
     /// The contact's bounce threshold, m/s: slower impacts do not bounce
     /// (`Scene::bounce_threshold`; per surface; Bullet only).
@@ -715,9 +715,10 @@ impl Method {
         scene.restitution = v.e;
         scene.friction = v.mu;
         scene.rolling_resistance = v.rolling / 1000.0;
-        // A coin on Bullet at 0 takes its own default, as `roll` gives it one: with none, a
-        // coin rolling on its rim never stops (a fit's 0 is no rolling resistance measured).
-        if v.rolling == 0.0 && scene.is_coin() && self.engine == crate::engine::EngineKind::Bullet {
+        // A coin at 0 takes its own default, as `roll` gives it one where the engine has
+        // rolling resistance: with none, a coin rolling on its rim never stops (a fit's 0 is
+        // no rolling resistance measured).
+        if v.rolling == 0.0 && scene.is_coin() && self.engine.resists_rolling(scene.mode) {
             scene.rolling_resistance = crate::model::scene::COIN_ROLLING_RESISTANCE;
         }
         scene.bounce_threshold = v.bounce;

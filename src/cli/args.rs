@@ -139,8 +139,8 @@ pub struct SceneArgs {
     pub angular_damping: f64,
     /// Rolling resistance, mm: the lever arm of the floor's push against a die rolling or
     /// turning in place, so that a cylinder rolling on its side or a coin spinning on its rim
-    /// stops (0 to 1; hard surfaces about 0.01, felt more; DicePhys: 0). Bullet only
-    /// [default: 0.05 for a coin on Bullet, else 0].
+    /// stops (0 to 1; hard surfaces about 0.01, felt more; DicePhys: 0). Bullet, and Rapier
+    /// in 3D [default: 0.05 for a coin, else 0].
     #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     pub rolling_resistance: Option<f64>,
     /// Bounce threshold, m/s: an impact slower than this along the contact's normal does not

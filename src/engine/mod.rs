@@ -59,6 +59,17 @@ impl EngineKind {
         self.into()
     }
 
+    /// Whether the engine takes rolling resistance in this mode: Bullet's rolling and
+    /// spinning friction, Rapier's 3D body's couple after each step
+    /// (`Rapier3d::resist_rolling`); not Rapier's 2D body, not the arbiter.
+    pub fn resists_rolling(self, mode: crate::model::scene::Mode) -> bool {
+        match self {
+            EngineKind::Bullet | EngineKind::RapierLocked => true,
+            EngineKind::Rapier => mode == crate::model::scene::Mode::ThreeD,
+            EngineKind::Moreau => false,
+        }
+    }
+
     /// The engine and its version, for provenance.
     pub fn version(self) -> String {
         match self {

@@ -10,6 +10,10 @@ use crate::model::mass::{BodyTurn, MassProps};
 use crate::model::scene::{Floor, Mode, Preset, Scene};
 use crate::model::state::BodyState;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use rapier3d_f64::parry;
+use rapier3d_f64::parry::query::{
+    DefaultQueryDispatcher, PersistentQueryDispatcher, QueryDispatcher, Unsupported,
+};
 use rapier3d_f64::prelude::*;
 
 /// Rapier's version, from the crate itself (`rapier3d_f64::VERSION`, its CARGO_PKG_VERSION).
@@ -42,8 +46,8 @@ pub struct Rapier3d {
     made: bool,
     /// How the body is turned from the die's axes.
     turn: BodyTurn,
-    /// A made die's mass properties, about the body's frame.
-    mass_props: MassProperties,
+    /// Rolling resistance, m (`Scene::rolling_resistance`; 0: none, Rapier's own).
+    rolling: f64,
 }
 
 /// The die's free flight, flown here exactly as Rapier steps it (see `fly`), and what Rapier's
@@ -238,18 +242,32 @@ impl Rapier3d {
             ip.warmstart_coefficient = 0.0;
             ip.num_internal_stabilization_iterations = 3;
         }
+        world.narrow_phase =
+            NarrowPhase::with_query_dispatcher(RoundContacts.chain(DefaultQueryDispatcher));
         let made = Collider::made(scene);
         let mp = MassProps::of(scene)?;
         let die_collider = if made {
             // The solid in body axes, centred; the body in its principal frame P at the centre
-            // of mass c: the solid sits at Pᵀ(−c), turned by Pᵀ, and weighs nothing itself (the
-            // body carries the exact mass properties).
+            // of mass c: the solid sits at Pᵀ(−c), turned by Pᵀ. It carries the exact mass
+            // properties, put in its own frame so that, moved by its pose onto the body, they
+            // are the body's: the centre of mass at the origin and the principal axes the
+            // body's. Rapier sums a body's colliders and its additional mass properties by
+            // rediagonalising the sum (parry's `MassProperties::with_inertia_matrix`), which
+            // sorts the moments and, for a diagonal tensor whose moments are not in ascending
+            // order, turns the axes wrongly (a thick coin's axis took a side's moment, 13 %
+            // off; a prism's 130 %); one collider's mass properties are taken as they are.
             let (solid, own) = collider(&Collider::of(scene))?;
             let p = mp.principal.quaternion();
             let turn = Rotation::from_xyzw(p.i, p.j, p.k, p.w).inverse();
-            solid
-                .position(Pose::from_parts(turn * -from_na(&mp.com), turn * own))
-                .density(0.0)
+            let pose = Pose::from_parts(turn * -from_na(&mp.com), turn * own);
+            let inv = pose.inverse();
+            let props = MassProperties::with_principal_inertia_frame(
+                inv * Vector::ZERO,
+                mp.mass,
+                from_na(&mp.moments),
+                inv.rotation,
+            );
+            solid.position(pose).mass_properties(props)
         } else {
             let [bx, by, bz] = scene.body_sides();
             ColliderBuilder::cuboid(0.5 * bx, 0.5 * by, 0.5 * bz)
@@ -280,8 +298,53 @@ impl Rapier3d {
             flight: None,
             made,
             turn: mp.turn(),
-            mass_props: MassProperties::new(Vector::ZERO, mp.mass, from_na(&mp.moments)),
+            rolling: scene.rolling_resistance,
         })
+    }
+
+    /// The die's inverse inertia in world axes, kg⁻¹ m⁻², as Rapier holds it after its last
+    /// reset or step (`None` before the first reset): for the check that Rapier's body has
+    /// the mass properties dicephys computed.
+    pub fn world_inverse_inertia(&self) -> Option<nalgebra::Matrix3<f64>> {
+        let m = self.world.bodies[self.die?]
+            .mass_properties()
+            .effective_world_inv_inertia;
+        Some(nalgebra::Matrix3::new(
+            m.m11, m.m12, m.m13, m.m12, m.m22, m.m23, m.m13, m.m23, m.m33,
+        ))
+    }
+
+    /// Rolling resistance, which Rapier has not: after each step, a couple against the die's
+    /// turning on the floor, as large as δ times the step's normal impulse (the floor's push
+    /// over the step) but no larger than what stops the turn. A couple is the same about
+    /// every point, so about the contact too: a die rolling without slipping slows as
+    /// (I + m r²) ω̇ = −δ N says, friction carrying the turn's loss to its speed over the next
+    /// steps. It opposes the whole turn, rolling and spinning in place together (Bullet bounds
+    /// each of the three axes on its own); in flight, with no push, it does nothing.
+    fn resist_rolling(&mut self) {
+        let Some(h) = self.die else {
+            return;
+        };
+        let w = &mut self.world;
+        let co = w.bodies[h].colliders()[0];
+        let push: f64 = w
+            .narrow_phase
+            .contact_pairs_with(co)
+            .map(|p| p.total_impulse_magnitude())
+            .sum();
+        let b = &mut w.bodies[h];
+        let turn = b.angvel();
+        let speed = turn.length();
+        if !(push > 0.0 && speed > 0.0) {
+            return;
+        }
+        let axis = turn / speed;
+        let inv = b.mass_properties().effective_world_inv_inertia;
+        // The couple s along −axis changes the turn by −s I⁻¹ axis; past speed/(axisᵀ I⁻¹
+        // axis) it would turn the die the other way.
+        let most = speed / axis.dot(inv * axis);
+        let s = (self.rolling * push).min(most);
+        b.set_angvel(turn - (inv * axis) * s, false);
     }
 
     /// The body's orientation from the die's (turned by the principal frame if need be).
@@ -396,7 +459,7 @@ impl Engine for Rapier3d {
             from_na(&start.position),
             self.body_rotation(&start.rotation),
         );
-        let mut body = RigidBodyBuilder::dynamic()
+        let body = RigidBodyBuilder::dynamic()
             .pose(pose)
             .linvel(from_na(&start.linear_velocity))
             .angvel(from_na(&start.angular_velocity))
@@ -404,9 +467,6 @@ impl Engine for Rapier3d {
             .linear_damping(self.damping.0)
             .angular_damping(self.damping.1)
             .can_sleep(self.can_sleep);
-        if self.made {
-            body = body.additional_mass_properties(self.mass_props);
-        }
         let (h, _) = self.world.insert(body, self.die_collider.clone());
         if self.made {
             // Rapier sums a body's mass properties at its next step; the flight below reads
@@ -499,6 +559,9 @@ impl Engine for Rapier3d {
     }
 
     fn step(&mut self) -> crate::Result<()> {
+        if self.rolling > 0.0 {
+            self.resist_rolling();
+        }
         step_world(&mut self.world, self.die, &mut self.flight)
     }
 
@@ -523,6 +586,121 @@ impl Engine for Rapier3d {
 /// The die's collider in Rapier's terms, and the turn from its own axes to the die's (a
 /// parry cylinder's axis is its y, turned onto the die's z): the one place a solid becomes
 /// Rapier's.
+/// Contacts recomputed every step where a round surface touches. Parry keeps a pair's
+/// contact points from the last step, carried with the bodies, while their normals turn less
+/// than 1° (`ContactManifold::try_update_contacts_eps`); on a round die those points ride
+/// round with it as it rolls, and the floor pushes behind the true contact: a cylinder
+/// rolling on its side slower than 1° a step is driven up to 1° a step (17.45 rad/s at
+/// 1 ms) and held there, against any rolling resistance below about 0.2 mm, and a thick
+/// coin rolls to the step cap. Marked as deformed, the manifold is computed afresh, its old
+/// points kept to warm-start the new (`tests/it/bullet.rs`). A polyhedron's contacts sit at
+/// its corners, which the body carries, and keep Rapier's reuse.
+struct RoundContacts;
+
+impl RoundContacts {
+    fn round(g: &dyn Shape) -> bool {
+        matches!(
+            g.shape_type(),
+            ShapeType::Cylinder | ShapeType::RoundCuboid | ShapeType::RoundConvexPolyhedron
+        )
+    }
+}
+
+/// Every query but the manifolds' is left to the next dispatcher of the chain.
+impl QueryDispatcher for RoundContacts {
+    fn intersection_test(
+        &self,
+        _: &Pose,
+        _: &dyn Shape,
+        _: &dyn Shape,
+    ) -> Result<parry::query::ShapeIntersection, Unsupported> {
+        Err(Unsupported)
+    }
+    fn distance(
+        &self,
+        _: &Pose,
+        _: &dyn Shape,
+        _: &dyn Shape,
+    ) -> Result<parry::query::ShapeDistance, Unsupported> {
+        Err(Unsupported)
+    }
+    fn contact(
+        &self,
+        _: &Pose,
+        _: &dyn Shape,
+        _: &dyn Shape,
+        _: Real,
+    ) -> Result<Option<parry::query::Contact>, Unsupported> {
+        Err(Unsupported)
+    }
+    fn closest_points(
+        &self,
+        _: &Pose,
+        _: &dyn Shape,
+        _: &dyn Shape,
+        _: Real,
+    ) -> Result<parry::query::ClosestPoints, Unsupported> {
+        Err(Unsupported)
+    }
+    fn cast_shapes(
+        &self,
+        _: &Pose,
+        _: Vector,
+        _: &dyn Shape,
+        _: &dyn Shape,
+        _: parry::query::ShapeCastOptions,
+    ) -> Result<Option<parry::query::ShapeCastHit>, Unsupported> {
+        Err(Unsupported)
+    }
+    fn cast_shapes_nonlinear(
+        &self,
+        _: &parry::query::NonlinearRigidMotion,
+        _: &dyn Shape,
+        _: &parry::query::NonlinearRigidMotion,
+        _: &dyn Shape,
+        _: Real,
+        _: Real,
+        _: bool,
+    ) -> Result<Option<parry::query::ShapeCastHit>, Unsupported> {
+        Err(Unsupported)
+    }
+}
+
+/// Marks a round shape's manifolds deformed, then leaves them to Rapier's own dispatcher.
+impl PersistentQueryDispatcher<ContactManifoldData, ContactData> for RoundContacts {
+    fn contact_manifolds(
+        &self,
+        _: &Pose,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+        _: Real,
+        manifolds: &mut Vec<ContactManifold>,
+        _: &mut Option<parry::query::ContactManifoldsWorkspace>,
+    ) -> Result<(), Unsupported> {
+        if Self::round(g1) || Self::round(g2) {
+            manifolds
+                .iter_mut()
+                .for_each(ContactManifold::mark_shapes_deformed);
+        }
+        Err(Unsupported)
+    }
+    fn contact_manifold_convex_convex(
+        &self,
+        _: &Pose,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+        _: Option<&dyn parry::query::details::NormalConstraints>,
+        _: Option<&dyn parry::query::details::NormalConstraints>,
+        _: Real,
+        manifold: &mut ContactManifold,
+    ) -> Result<(), Unsupported> {
+        if Self::round(g1) || Self::round(g2) {
+            manifold.mark_shapes_deformed();
+        }
+        Err(Unsupported)
+    }
+}
+
 fn collider(c: &Collider) -> crate::Result<(ColliderBuilder, Rotation)> {
     Ok(match c {
         Collider::Box { half, radius } if *radius > 0.0 => {

@@ -133,7 +133,8 @@ pub struct Scene {
     /// turning in place on it, so that a torque up to this length times the contact force
     /// opposes both (Bullet's rolling and spinning friction). DicePhys: 0, none, as neither
     /// engine has by default; then a cylinder rolling on its side or a coin spinning on its
-    /// rim never stops. Bullet only. Written into a specification only when not 0.
+    /// rim never stops. Bullet, and Rapier's 3D body (a couple after each step,
+    /// `Rapier3d::resist_rolling`). Written into a specification only when not 0.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub rolling_resistance: f64,
     /// The bounce threshold, m/s: a contact met slower than this along its normal does not

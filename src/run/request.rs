@@ -463,12 +463,12 @@ impl RollRequest {
         // The default die is thrown in a tumble, as the d6 it stands for (the paper's throw
         // spins a cube about one axis).
         let defaulted = self.scene.die.block.is_none() && scene.shape.is_none();
-        // Unless one is asked: a coin on Bullet rolls against a hard table's resistance (with
-        // none, a coin on its rim rolls to the step cap); every other die against none, as
-        // DicePhys (Rapier has none).
+        // Unless one is asked: a coin rolls against a hard table's resistance where the engine
+        // has it (with none, a coin on its rim rolls to the step cap); every other die against
+        // none, as DicePhys.
         if self.scene.rolling_resistance_mm.is_none()
             && scene.is_coin()
-            && self.engine == EngineKind::Bullet
+            && self.engine.resists_rolling(scene.mode)
         {
             scene.rolling_resistance = crate::model::scene::COIN_ROLLING_RESISTANCE;
         }

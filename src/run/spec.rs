@@ -219,39 +219,50 @@ impl RunSpec {
         self.scene.validate(allow_restitution_above_one)?;
         self.throws.validate()?;
         self.roll.validate()?;
-        // The contact laws Bullet alone has: each refused on another engine, by its flag.
+        // The contact laws Bullet has and the others lack: each refused where it is not, by
+        // its flag, with the engines that have it. Rapier's 3D body takes rolling resistance
+        // (`Rapier3d::resist_rolling`).
         let s = &self.scene;
-        for (on, field, shown, what) in [
+        let bullet = self.engine == EngineKind::Bullet;
+        for (on, has, field, shown, what, hint) in [
             (
                 s.rolling_resistance > 0.0,
+                self.engine.resists_rolling(s.mode),
                 Field::RollingResistance,
                 s.rolling_resistance * 1e3,
                 "rolling resistance",
+                "give --engine bullet, or rapier in 3D",
             ),
             (
                 s.bounce_threshold > 0.0,
+                bullet,
                 Field::BounceThreshold,
                 s.bounce_threshold,
                 "bounce threshold",
+                "give --engine bullet",
             ),
             (
                 s.contact_time > 0.0,
+                bullet,
                 Field::ContactTime,
                 s.contact_time * 1e3,
                 "soft contact",
+                "give --engine bullet",
             ),
             (
                 s.static_ratio != 1.0,
+                bullet,
                 Field::StaticRatio,
                 s.static_ratio,
                 "static friction apart from sliding friction",
+                "give --engine bullet",
             ),
         ] {
-            if on && self.engine != EngineKind::Bullet {
+            if on && !has {
                 return Err(Error::field(
                     field,
                     shown,
-                    format!("{} has no {what}; give --engine bullet", self.engine.name()),
+                    format!("{} has no {what}; {hint}", self.engine.name()),
                 ));
             }
         }
@@ -295,9 +306,10 @@ impl RunSpec {
         if s.rolling_resistance > 0.0 {
             return None;
         }
-        let remedy = match self.engine {
-            EngineKind::Bullet => "--rolling-resistance 0.05 (mm) lets it stop",
-            _ => "--engine bullet --rolling-resistance 0.05 (mm) lets it stop",
+        let remedy = if self.engine.resists_rolling(s.mode) {
+            "--rolling-resistance 0.05 (mm) lets it stop"
+        } else {
+            "--engine bullet --rolling-resistance 0.05 (mm) lets it stop"
         };
         let cap = self.roll.max_steps;
         let coin = matches!(

@@ -295,53 +295,71 @@ fn the_shims_shortcuts_leave_every_state_as_bullets_own_world_has_it() {
 }
 
 /// Rolling resistance's exact limit: a cylinder (30 mm across, 30 long) set rolling on its
-/// side at 0.3 m/s with `--rolling-resistance` δ. A torque δN against the roll (N = mg) and
-/// rolling without slipping, (I + m r²) ω̇ = −δ m g with I = m r²/2, so it slows at
-/// a = 2δg/(3r). Measured over 0.2 s: 0.04376 m/s² against 0.04360 at δ = 0.1 mm, 0.08737
-/// against 0.08720 at 0.2 mm (0.4 %), and 0.00014 without (it rolls on).
+/// side with `--rolling-resistance` δ. A torque δN against the roll (N = mg) and rolling
+/// without slipping, (I + m r²) ω̇ = −δ m g with I = m r²/2, so it slows at a = 2δg/(3r).
+/// Each engine's deceleration less its own without resistance is held to the law within 2 %,
+/// and without resistance each rolls on.
+/// - Bullet (its rolling friction), from 0.3 m/s over 0.2 s: 0.04376 m/s² against 0.04360 at
+///   δ = 0.1 mm, 0.08737 against 0.08720 at 0.2 mm (0.4 %), 0.00014 without. Not slower or
+///   longer: Bullet keeps a contact point while it drifts less than its breaking threshold,
+///   and on a round die the kept point rides round with the roll, behind the true contact,
+///   where the floor's push drives the roll on: from 0.15 m/s (10 rad/s) over 1 s this
+///   cylinder gains 0.027 m/s without resistance (as if δ were −0.06 mm), and the law is met
+///   to 16 % and 9 %. A known limit of Bullet's persistent manifold, not mended here.
+/// - Rapier (its couple after each step, `Rapier3d::resist_rolling`), from 0.15 m/s over 1 s,
+///   slower than 1° a step, where Rapier too carried its contact round with the die until
+///   dicephys recomputed a round die's contacts every step (`RoundContacts`,
+///   `engine/rapier3d.rs`): before, this cylinder sped up to 17.45 rad/s, 1° a step, with or
+///   without δ = 0.1 mm; now 0.04370 and 0.08729, of which 0.00012 it loses without any:
+///   the resistance's own 0.04359 and 0.08717 (0.04 %).
 #[test]
 fn a_cylinder_rolling_on_its_side_slows_as_rolling_resistance_says() {
     let shape = dicephys::model::shape::coin(30.0, 30.0).unwrap();
     let r = 0.015;
-    let decel = |delta: f64| {
-        let mut scene = Scene::paper_shape(shape.clone(), Mode::ThreeD);
-        scene.rolling_resistance = delta;
-        scene.sleeping = false;
-        let mut e = new_engine(EngineKind::Bullet, &scene).unwrap();
-        // Body z (the axis) along world x; rolling along world z about world x.
-        let v0 = 0.3;
-        let start = BodyState {
-            position: Vector3::new(0.0, r, 0.0),
-            rotation: UnitQuaternion::from_axis_angle(&Vector3::y_axis(), FRAC_PI_2),
-            linear_velocity: Vector3::new(0.0, 0.0, v0),
-            angular_velocity: Vector3::new(v0 / r, 0.0, 0.0),
-            sleeping: false,
+    for (engine, v0, secs) in [
+        (EngineKind::Bullet, 0.3, 0.2),
+        (EngineKind::Rapier, 0.15, 1.0),
+    ] {
+        let decel = |delta: f64| {
+            let mut scene = Scene::paper_shape(shape.clone(), Mode::ThreeD);
+            scene.rolling_resistance = delta;
+            scene.sleeping = false;
+            let mut e = new_engine(engine, &scene).unwrap();
+            // Body z (the axis) along world x; rolling along world z about world x.
+            let start = BodyState {
+                position: Vector3::new(0.0, r, 0.0),
+                rotation: UnitQuaternion::from_axis_angle(&Vector3::y_axis(), FRAC_PI_2),
+                linear_velocity: Vector3::new(0.0, 0.0, v0),
+                angular_velocity: Vector3::new(v0 / r, 0.0, 0.0),
+                sleeping: false,
+            };
+            e.reset(&start).unwrap();
+            // The speed after `secs` against the start: the mean deceleration.
+            let steps = (secs / scene.dt) as usize;
+            for _ in 0..steps {
+                e.step().unwrap();
+            }
+            let s = e.state();
+            assert!(
+                s.rotation.transform_vector(&Vector3::z()).x.abs() > 0.99,
+                "{engine:?}: still on its side"
+            );
+            (v0 - s.linear_velocity.z) / secs
         };
-        e.reset(&start).unwrap();
-        // The speed after 0.2 s against the start: the mean deceleration.
-        let steps = (0.2 / scene.dt) as usize;
-        for _ in 0..steps {
-            e.step().unwrap();
+        let law = |delta: f64| 2.0 * delta * 9.81 / (3.0 * r);
+        let (a1, a2) = (decel(1e-4), decel(2e-4));
+        let none = decel(0.0);
+        assert!(
+            none.abs() < 0.05 * law(1e-4),
+            "{engine:?}: without resistance it rolls on: {none}"
+        );
+        for (a, delta) in [(a1, 1e-4), (a2, 2e-4)] {
+            let a = a - none;
+            assert!(
+                (a / law(delta) - 1.0).abs() < 0.02,
+                "{engine:?} δ {delta}: {a} against {}",
+                law(delta)
+            );
         }
-        let s = e.state();
-        assert!(
-            s.rotation.transform_vector(&Vector3::z()).x.abs() > 0.99,
-            "still on its side"
-        );
-        (v0 - s.linear_velocity.z) / 0.2
-    };
-    let law = |delta: f64| 2.0 * delta * 9.81 / (3.0 * r);
-    let (a1, a2) = (decel(1e-4), decel(2e-4));
-    let none = decel(0.0);
-    assert!(
-        none.abs() < 0.01 * law(1e-4),
-        "without resistance it rolls on: {none}"
-    );
-    for (a, delta) in [(a1, 1e-4), (a2, 2e-4)] {
-        assert!(
-            (a / law(delta) - 1.0).abs() < 0.02,
-            "δ {delta}: {a} against {}",
-            law(delta)
-        );
     }
 }

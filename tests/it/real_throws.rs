@@ -87,11 +87,11 @@ fn a_toss_with_every_scale_zero_is_the_release_at_rest() {
 
 #[test]
 fn rolling_resistance_is_a_fit_parameter_of_bullets_contact() {
-    // Free on Rapier, which has none, it is refused in one line before anything runs; a soft
-    // table's contact time likewise, and, on Bullet, a range that starts below two of the
-    // fit's steps (2 ms at a 5 ms step).
+    // Free on the arbiter, which has none, it is refused in one line before anything runs; a
+    // soft table's contact time on Rapier likewise, and, on Bullet, a range that starts below
+    // two of the fit's steps (2 ms at a 5 ms step).
     for (free, extra, says) in [
-        ("e,rolling", ["--engine", "rapier"], "rolling"),
+        ("e,rolling", ["--engine", "moreau"], "rolling"),
         ("e,contact_time", ["--engine", "rapier"], "contact_time"),
         ("e,contact_time", ["--dt", "0.005"], "contact_time"),
     ] {

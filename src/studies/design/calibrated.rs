@@ -3,7 +3,8 @@
 //! the fit's, as `predict --die` carries a calibration to a die it never saw
 //! (`calibration::other_die`).
 //!
-//! A coin keeps its own rolling resistance (0.05 mm on Bullet) where the fit measured none.
+//! A coin keeps its own rolling resistance (0.05 mm, where the engine has it) where the fit
+//! measured none.
 //!
 //! The design takes the fit at its maximum (its best values), not at its posterior draws: the
 //! design's interval is the simulation's error at those values, and the calibration's own
@@ -59,7 +60,7 @@ pub fn calibrated(
     // A coin keeps its own rolling resistance where the fit measured none (not free, and 0:
     // its dice's default, not a finding): with none, a coin rolling on its rim never stops,
     // and every roll that ends there runs to the step cap.
-    let coin_engine = fit.config.method.engine == crate::engine::EngineKind::Bullet;
+    let coin_engine = fit.config.method.engine.resists_rolling(spec.scene.mode);
     if spec.scene.is_coin()
         && coin_engine
         && values.rolling == 0.0
