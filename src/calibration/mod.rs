@@ -294,24 +294,22 @@ impl FitConfig {
     /// steps of the fit's.
     fn check_contact_laws(&self) -> Result<()> {
         use crate::engine::EngineKind;
-        let rapier = matches!(
-            self.method.engine,
-            EngineKind::Rapier | EngineKind::RapierLocked
-        );
-        for (kind, what, on_rapier) in [
-            (params::Kind::Rolling, "rolling resistance", true),
-            (params::Kind::Bounce, "bounce threshold", false),
-            (params::Kind::ContactTime, "soft contact", false),
+        let engine = self.method.engine;
+        // Rolling resistance where the engine has it in 3D (a 2D row on Rapier's 2D body is
+        // refused by its run's own specification).
+        let rolling = engine.resists_rolling(crate::model::scene::Mode::ThreeD);
+        let bullet = engine == EngineKind::Bullet;
+        for (kind, what, has) in [
+            (params::Kind::Rolling, "rolling resistance", rolling),
+            (params::Kind::Bounce, "bounce threshold", bullet),
+            (params::Kind::ContactTime, "soft contact", bullet),
             (
                 params::Kind::StaticRatio,
                 "static friction apart from sliding friction",
-                false,
+                bullet,
             ),
         ] {
-            if self.model.is_free(kind)
-                && self.method.engine != EngineKind::Bullet
-                && !(on_rapier && rapier)
-            {
+            if self.model.is_free(kind) && !has {
                 return Err(Error::field(
                     Field::Free,
                     kind.name(),

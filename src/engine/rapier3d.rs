@@ -583,9 +583,6 @@ impl Engine for Rapier3d {
     }
 }
 
-/// The die's collider in Rapier's terms, and the turn from its own axes to the die's (a
-/// parry cylinder's axis is its y, turned onto the die's z): the one place a solid becomes
-/// Rapier's.
 /// Contacts recomputed every step where a round surface touches. Parry keeps a pair's
 /// contact points from the last step, carried with the bodies, while their normals turn less
 /// than 1° (`ContactManifold::try_update_contacts_eps`); on a round die those points ride
@@ -701,6 +698,9 @@ impl PersistentQueryDispatcher<ContactManifoldData, ContactData> for RoundContac
     }
 }
 
+/// The die's collider in Rapier's terms, and the turn from its own axes to the die's (a
+/// parry cylinder's axis is its y, turned onto the die's z): the one place a solid becomes
+/// Rapier's.
 fn collider(c: &Collider) -> crate::Result<(ColliderBuilder, Rotation)> {
     Ok(match c {
         Collider::Box { half, radius } if *radius > 0.0 => {

@@ -413,7 +413,7 @@ pub fn dice_costs(
         let models = |scene: &Scene| {
             (engine != EngineKind::Moreau || crate::engine::moreau::models(scene).is_ok())
                 && (engine == EngineKind::Bullet
-                    || ((scene.rolling_resistance == 0.0 || engine == EngineKind::Rapier)
+                    || ((scene.rolling_resistance == 0.0 || engine.resists_rolling(scene.mode))
                         && scene.contact_time == 0.0
                         && scene.static_ratio == 1.0))
         };
