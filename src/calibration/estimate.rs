@@ -961,6 +961,7 @@ mod tests {
     use rand::Rng;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
+    use rayon::prelude::*;
 
     #[test]
     fn the_bootstraps_multinomial_has_the_right_moments_at_any_size() {
@@ -1293,7 +1294,9 @@ mod tests {
         // the estimate); the bound from 30 bootstrap sets whose designs are drawn again must
         // hold it as stated, 95.45 %: in ≥ 90 of 100 (2.5 binomial standard errors below).
         let truth = [0.45, 0.6, 0.4];
+        // The repetitions are independent (each its own seed): rolled side by side, in order.
         let d: Vec<(f64, f64)> = (0..100)
+            .into_par_iter()
             .map(|s| faces_repetition(9000 + s, &truth, 100, 30))
             .collect();
         let wilks = region_delta(3, TWO_SIGMA);
@@ -1343,19 +1346,25 @@ mod tests {
         const N: usize = 50;
         let truth = [0.45, 0.6, 0.4];
         let (mut z2, mut held, mut zs) = (0.0, 0usize, 0.0);
-        for s in 0..REPS {
-            let (rows, designs) = faces_data(4100 + s, &truth, 100);
-            let model = ModelSpec::free(&[Kind::E, Kind::Mu, Kind::Kappa]);
-            let params = model.params(&rows);
-            let lik = Likelihood::new(&rows, &designs, &model, &params);
-            let (held_lik, (best, _)) = maximise_held(&lik, 3, 4).unwrap();
-            let sets = bootstrap_sets(&held_lik, &best.x, 3, N, s, 1.0);
-            let check = bootstrap_sets(&held_lik, &best.x, 3, N, s ^ CHECK_SEED, 1.0);
-            let a: Vec<f64> = sets.iter().map(|x| x.0).collect();
-            let b: Vec<f64> = check.iter().map(|x| x.0).collect();
-            let z = rank_sum_z(&a, &b);
-            let bound = joint_bound(&sets, 3);
-            let h = b.iter().filter(|&&d| d <= bound).count();
+        // Each fit its own seed, fitted side by side; summed in order below.
+        let fits: Vec<(f64, usize)> = (0..REPS)
+            .into_par_iter()
+            .map(|s| {
+                let (rows, designs) = faces_data(4100 + s, &truth, 100);
+                let model = ModelSpec::free(&[Kind::E, Kind::Mu, Kind::Kappa]);
+                let params = model.params(&rows);
+                let lik = Likelihood::new(&rows, &designs, &model, &params);
+                let (held_lik, (best, _)) = maximise_held(&lik, 3, 4).unwrap();
+                let sets = bootstrap_sets(&held_lik, &best.x, 3, N, s, 1.0);
+                let check = bootstrap_sets(&held_lik, &best.x, 3, N, s ^ CHECK_SEED, 1.0);
+                let a: Vec<f64> = sets.iter().map(|x| x.0).collect();
+                let b: Vec<f64> = check.iter().map(|x| x.0).collect();
+                let z = rank_sum_z(&a, &b);
+                let bound = joint_bound(&sets, 3);
+                (z, b.iter().filter(|&&d| d <= bound).count())
+            })
+            .collect();
+        for (s, (z, h)) in fits.into_iter().enumerate() {
             held += h;
             z2 += z * z;
             zs += z;
@@ -1409,6 +1418,7 @@ mod tests {
         let block = "140x24x20".parse().unwrap();
         let truth = [0.4, 0.5, 0.5];
         let d: Vec<(f64, f64)> = (0..40)
+            .into_par_iter()
             .map(|seed| {
                 let mut rng = ChaCha8Rng::seed_from_u64(700 + seed);
                 let rows = vec![DataRow {
