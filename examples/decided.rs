@@ -9,7 +9,7 @@
 //! Bullet, the paper's throws (keyed, seed 2385), dt 1 ms, the fast defaults.
 
 use dicephys::engine::{new_engine, Engine, EngineKind};
-use dicephys::model::die::{up_in_body, DieShape};
+use dicephys::model::die::{up_in_body, DieBody};
 use dicephys::model::scene::{Mode, Scene};
 use dicephys::model::state::BodyState;
 use dicephys::model::throws::{ThrowKind, ThrowRanges, Throws};
@@ -68,7 +68,7 @@ fn main() {
     let n: u64 = args.get(2).map_or(2000, |s| s.parse().expect("ROLLS"));
     let block = args.get(3).map_or("140x24x20", String::as_str);
     let scene = Scene::paper(block.parse().expect("BLOCK"), mode);
-    let die = DieShape::of(&scene);
+    let die = DieBody::of(&scene);
     let counter = Arc::new(AtomicU64::new(0));
     let mut engine = Counting(
         new_engine(EngineKind::Bullet, &scene).expect("bullet"),

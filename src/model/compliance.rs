@@ -50,7 +50,7 @@ pub fn landing(zeta: f64) -> (f64, f64) {
 
 /// ω₀ (rad/s) and ζ of the contact whose landing has restitution `e` in (0, 1] and lasts
 /// `tau` > 0 s. e(ζ) falls from 1 to 0 as ζ grows, so ζ is found by bisection, to the last
-/// bit (about 65 halvings; every roll's die asks it once: `DieShape::of`).
+/// bit (about 65 halvings; every roll's die asks it once: `DieBody::of`).
 pub fn solve(e: f64, tau: f64) -> (f64, f64) {
     let (mut lo, mut hi) = (0.0, ZETA_MAX);
     loop {

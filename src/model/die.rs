@@ -273,10 +273,10 @@ impl Convex {
     }
 }
 
-/// The die as the roll, the energy watch and the certificate see it. Its state's position is
-/// its centre of mass; its orientation, its body axes (the faces').
+/// The die as a rigid body, as the roll, the energy watch and the certificate see it. Its
+/// state's position is its centre of mass; its orientation, its body axes (the faces').
 #[derive(Clone, Debug)]
-pub struct DieShape {
+pub struct DieBody {
     /// Half the sides along body x, y, z (breadth, width, length; in 2D, z is half the 1 m
     /// depth), m.
     pub half: Vector3<f64>,
@@ -319,7 +319,7 @@ pub struct DieShape {
     pub spring: f64,
 }
 
-impl DieShape {
+impl DieBody {
     /// The die of a scene: its sides, mass properties (`MassProps`) and barriers.
     ///
     /// The barriers: seen from the centre of mass c, call face (i, s)'s region the downward
@@ -330,7 +330,7 @@ impl DieShape {
     /// edge shared with face (j, t). The least over its four edges is the face's barrier (for
     /// the centred sharp block, the paper's edge-balance height √(hᵢ² + hⱼ²)). Where c is not
     /// inside the inner box along i, the argument fails and no barrier is known.
-    pub fn of(scene: &Scene) -> DieShape {
+    pub fn of(scene: &Scene) -> DieBody {
         let [a, b, c] = scene.body_sides();
         let mp = MassProps::compute(scene);
         let half = Vector3::new(a, b, c) / 2.0;
@@ -373,7 +373,7 @@ impl DieShape {
         } else {
             barrier
         };
-        DieShape {
+        DieBody {
             half,
             radius,
             core,

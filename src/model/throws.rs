@@ -304,8 +304,8 @@ impl Throw {
                     sleeping: false,
                 };
                 // In 2D the rotation is about z only, so the 1 m depth adds nothing here. The
-                // position is the centre of mass's (`DieShape::lowest_point`).
-                let touching = -crate::model::die::DieShape::of(scene).lowest_point(&at_zero);
+                // position is the centre of mass's (`DieBody::lowest_point`).
+                let touching = -crate::model::die::DieBody::of(scene).lowest_point(&at_zero);
                 if self.style == ThrowStyle::Rest {
                     return BodyState {
                         position: Vector3::new(0.0, touching, 0.0),

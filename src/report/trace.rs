@@ -1,7 +1,7 @@
 //! One throw's trajectory as CSV (`trace`): step, time, position, orientation, velocities,
 //! energies, and the line that says how the throw ended.
 
-use crate::model::die::DieShape;
+use crate::model::die::DieBody;
 use crate::model::state::BodyState;
 use crate::model::throws::Throw;
 use crate::sim::roll::{Fate, RollRecord};
@@ -11,7 +11,7 @@ pub const HEADER: &str =
     "step,time_s,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,kinetic_j,potential_j,total_j,sleeping";
 
 /// The CSV row of the state after `step` steps of `dt`.
-pub fn row(die: &DieShape, dt: f64, step: u64, s: &BodyState) -> String {
+pub fn row(die: &DieBody, dt: f64, step: u64, s: &BodyState) -> String {
     let q = s.rotation.quaternion();
     let (k, p) = (die.kinetic(s), die.potential(s));
     format!(
@@ -117,7 +117,7 @@ pub fn roll(
     settle: &crate::sim::roll::RollConfig,
     mut observe: impl FnMut(u64, &BodyState),
 ) -> crate::Result<RollRecord> {
-    let die = DieShape::of(scene);
+    let die = DieBody::of(scene);
     let mut engine = crate::engine::new_engine(kind, scene)?;
     let mut end_state = None;
     let record =
@@ -144,7 +144,7 @@ pub fn rows(
     mut line: impl FnMut(&str),
     mut tick: impl FnMut(u64),
 ) -> crate::Result<RollRecord> {
-    let die = DieShape::of(scene);
+    let die = DieBody::of(scene);
     let mut last = None;
     let record = roll(kind, scene, throw, settle, |step, s| {
         tick(step);
@@ -190,7 +190,7 @@ pub fn page(
         max_steps,
         fast_flight,
     } = stepping;
-    let die = DieShape::of(scene);
+    let die = DieBody::of(scene);
     let settle = config(scene, max_steps, fast_flight, true);
     let labels: Vec<String> = scene
         .shape

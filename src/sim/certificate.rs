@@ -2,7 +2,7 @@
 //! its outcome can no longer change.
 
 use crate::model::block::Outcome;
-use crate::model::die::{up_in_body, DieShape};
+use crate::model::die::{up_in_body, DieBody};
 use crate::model::state::BodyState;
 
 /// The paper's "static" states made exact: once the die's mechanical energy is below the
@@ -34,9 +34,9 @@ const SIDES: [Outcome; 3] = [Outcome::Breadth, Outcome::Width, Outcome::Length];
 impl Certificate {
     /// The height E/(mg) must be below for the certificate to hold in any face region: the
     /// largest over faces of rest height + (1 − margin) × (barrier − rest height). A state
-    /// whose energy is above it (`DieShape::energy_height_at_least`) is never certain, so
+    /// whose energy is above it (`DieBody::energy_height_at_least`) is never certain, so
     /// the check can be skipped there (`flight::Flight::jump`).
-    pub fn energy_ceiling(&self, die: &DieShape) -> f64 {
+    pub fn energy_ceiling(&self, die: &DieBody) -> f64 {
         if let Some(c) = &die.convex {
             return c.ceiling(self.margin);
         }
@@ -51,7 +51,7 @@ impl Certificate {
     }
 
     /// The outcome, if it is already certain.
-    pub fn certain(&self, die: &DieShape, s: &BodyState) -> Option<Outcome> {
+    pub fn certain(&self, die: &DieBody, s: &BodyState) -> Option<Outcome> {
         let up = up_in_body(&s.rotation);
         let (i, k) = die.face_region(&up);
         let rest = die.rest[i][k];
@@ -85,7 +85,7 @@ impl Certificate {
     pub fn certain_convex(
         &self,
         c: &crate::model::die::Convex,
-        die: &DieShape,
+        die: &DieBody,
         s: &BodyState,
     ) -> Option<u8> {
         let up = &up_in_body(&s.rotation);
@@ -121,7 +121,7 @@ mod tests {
     #[test]
     fn a_die_at_rest_is_certain_and_a_flying_one_is_not() {
         let scene = Scene::paper("140x24x20".parse().unwrap(), Mode::ThreeD);
-        let die = DieShape::of(&scene);
+        let die = DieBody::of(&scene);
         let c = Certificate { margin: 0.1 };
         let id = UnitQuaternion::identity();
         assert_eq!(
@@ -143,7 +143,7 @@ mod tests {
     fn the_barrier_is_the_edge_balance_height() {
         // 2D, width face down (identity): barrier ½√(b² + w²) above the floor.
         let scene = Scene::paper("140x24x20".parse().unwrap(), Mode::TwoD);
-        let die = DieShape::of(&scene);
+        let die = DieBody::of(&scene);
         let c = Certificate { margin: 0.0 };
         let id = UnitQuaternion::identity();
         let b = 0.5 * (0.024f64).hypot(0.020);

@@ -24,7 +24,7 @@
 //! (`Engine::own_flight`; `engine::rapier3d::Flight` says when a Rapier step is pure flight),
 //! and the roll walks and jumps it as it does this one (`roll::jump_own`).
 
-use crate::model::die::DieShape;
+use crate::model::die::DieBody;
 use crate::model::scene::{Floor, Scene};
 use crate::model::state::BodyState;
 use crate::sim::rest::{RestDetector, REST_WINDOW};
@@ -54,9 +54,9 @@ pub struct Flight {
     /// Gravity's magnitude, m/s², along −y.
     pub gravity: f64,
     /// The die: its lowest point, reach, and how the engine's body is turned from its axes
-    /// (`DieShape::turn`: the body state flown, `next` and `jump`, is the engine's,
+    /// (`DieBody::turn`: the body state flown, `next` and `jump`, is the engine's,
     /// `Engine::body_state`, turned back into the die's by `to_die`).
-    pub die: DieShape,
+    pub die: DieBody,
     /// How far above the floor the die's lowest point must be for a step to be pure flight
     /// (`CLEAR` or `CLEAR_OF_PLANE`).
     pub clear: f64,
@@ -66,11 +66,11 @@ impl Flight {
     /// The flight of a scene's die: its time step, gravity, half sides, and the clearance its
     /// floor needs.
     pub fn of(scene: &Scene) -> Flight {
-        Flight::of_die(scene, DieShape::of(scene))
+        Flight::of_die(scene, DieBody::of(scene))
     }
 
-    /// `of`, given the scene's die (`DieShape::of`) already made.
-    pub fn of_die(scene: &Scene, die: DieShape) -> Flight {
+    /// `of`, given the scene's die (`DieBody::of`) already made.
+    pub fn of_die(scene: &Scene, die: DieBody) -> Flight {
         // A rounded die, or one of any shape, meets the floor through Bullet's convex test
         // (GJK), which, as the plane's, reports points up to the breaking threshold away.
         let clear = match scene.floor {
@@ -85,7 +85,7 @@ impl Flight {
         }
     }
 
-    /// Height of the die's lowest point above the floor (`DieShape::lowest_point`: for the
+    /// Height of the die's lowest point above the floor (`DieBody::lowest_point`: for the
     /// centred sharp block y − Σ hᵢ |(Rᵀ ŷ)ᵢ|).
     #[inline]
     pub fn lowest_point(&self, s: &BodyState) -> f64 {

@@ -4,7 +4,7 @@
 use crate::engine::Engine;
 use crate::error::Field;
 use crate::model::block::Outcome;
-use crate::model::die::DieShape;
+use crate::model::die::DieBody;
 use crate::model::faces::up_direction;
 use crate::model::scene::Scene;
 use crate::model::state::BodyState;
@@ -287,7 +287,7 @@ impl Default for RollConfig {
 
 /// Energy gain: a real roll never gains mechanical energy (contacts only dissipate; free flight
 /// keeps it, and the engines' symplectic Euler loses ½mg²dt² a step). So a rise of the
-/// kinetic plus potential energy (`DieShape::energy`) above its lowest value so far by more than this
+/// kinetic plus potential energy (`DieBody::energy`) above its lowest value so far by more than this
 /// fraction of the starting energy is the engine injecting energy: at a contact (restitution
 /// above 1, a penetration pushed out too hard) or between contacts.
 pub const ENERGY_GAIN_TOLERANCE: f64 = 0.01;
@@ -295,7 +295,7 @@ pub const ENERGY_GAIN_TOLERANCE: f64 = 0.01;
 /// Checks a state for failure: non-finite, or through the floor (`Dip::through`, with the
 /// roll's dips so far, this state's included).
 #[inline]
-pub fn check(s: &BodyState, die: &DieShape, dip: &Dip, floor_bottom: f64) -> Option<Failure> {
+pub fn check(s: &BodyState, die: &DieBody, dip: &Dip, floor_bottom: f64) -> Option<Failure> {
     if !s.is_finite() {
         Some(Failure::NonFinite)
     } else if dip.through(die, s, floor_bottom) {
@@ -348,7 +348,7 @@ impl Dip {
     /// modules changed the crate's layout: +4.6 M to +8.3 M instructions on the callgrind
     /// referee; inlined, 983.1 M).
     #[inline]
-    pub fn push(&mut self, die: &DieShape, s: &BodyState) {
+    pub fn push(&mut self, die: &DieBody, s: &BodyState) {
         let depth = -die.lowest_point(s);
         // max() keeps the old value if depth is NaN (a non-finite state fails in `check`).
         self.penetration = self.penetration.max(depth);
@@ -382,7 +382,7 @@ impl Dip {
     ///   times as often as the theory). The cuboid keeps the two rules above, which the
     ///   coarse steps' study measured.
     #[inline]
-    pub fn through(&self, die: &DieShape, s: &BodyState, floor_bottom: f64) -> bool {
+    pub fn through(&self, die: &DieBody, s: &BodyState, floor_bottom: f64) -> bool {
         let reach = s.position.y - die.lowest_point(s);
         s.position.y + reach < floor_bottom
             || self.run > MAX_DIP_STEPS
@@ -404,7 +404,7 @@ pub struct EnergyWatch {
 
 impl EnergyWatch {
     /// A watch from `start`'s energy; the allowance is `ENERGY_GAIN_TOLERANCE` of it.
-    pub fn new(die: &DieShape, start: &BodyState) -> EnergyWatch {
+    pub fn new(die: &DieBody, start: &BodyState) -> EnergyWatch {
         let e0 = die.energy(start);
         EnergyWatch {
             lowest: e0,
@@ -416,7 +416,7 @@ impl EnergyWatch {
     /// Takes one state's energy: flags a gain, keeps the lowest value so far. On a soft table
     /// a die pressed into it holds energy in its springs that kinetic plus potential leave
     /// out, and gets it back: only states clear of the table are compared.
-    pub fn push(&mut self, die: &DieShape, s: &BodyState) {
+    pub fn push(&mut self, die: &DieBody, s: &BodyState) {
         if die.spring > 0.0 && die.lowest_point(s) < 0.0 {
             return;
         }
@@ -468,9 +468,9 @@ fn record_of(throw: &Throw, end: End) -> RollRecord {
 /// How many steps of free flight from `s` the certificate cannot fire on: its energy height
 /// (E/mg) is above `ceiling` (`Certificate::energy_ceiling`) and falls by exactly ½g·dt² a
 /// step in flight (symplectic Euler: ½(v − g dt)² − ½v² + g(v − g dt)dt = −½g²dt², per unit
-/// mass, over g), while the bound `DieShape::energy_height_at_least` keeps its rotational
+/// mass, over g), while the bound `DieBody::energy_height_at_least` keeps its rotational
 /// part constant. Room is left for rounding.
-fn quiet_steps(die: &DieShape, s: &BodyState, ceiling: f64, f: &Flight) -> u64 {
+fn quiet_steps(die: &DieBody, s: &BodyState, ceiling: f64, f: &Flight) -> u64 {
     if ceiling == f64::NEG_INFINITY {
         return u64::MAX;
     }
@@ -581,7 +581,7 @@ pub fn run_from(
 
 /// The checks every step's state goes through, and what they keep between steps.
 struct Watch {
-    die: DieShape,
+    die: DieBody,
     certificate: Certificate,
     /// The certificate ends the roll (`Rule::Certificate`).
     stop_early: bool,
@@ -597,7 +597,7 @@ struct Watch {
 
 impl Watch {
     fn new(scene: &Scene, start: &BodyState, cfg: &RollConfig) -> Watch {
-        let die = DieShape::of(scene);
+        let die = DieBody::of(scene);
         let certificate = Certificate { margin: cfg.margin };
         let stop_early = cfg.rule == Rule::Certificate;
         let watch = stop_early || cfg.audit;
@@ -706,7 +706,7 @@ impl Flier {
     fn new(
         engine: &dyn Engine,
         scene: &Scene,
-        die: DieShape,
+        die: DieBody,
         start: &BodyState,
         cfg: &RollConfig,
     ) -> Flier {

@@ -54,7 +54,7 @@ fn null_probabilities(s: &RunSummary, null: &Null) -> Result<(Vec<f64>, Option<S
         }
         (Null::QuasiStatic, Mode::ThreeD) if !scene.features.plain() => {
             // A made die: each face's solid angle from the centre of mass, of the inner box.
-            let die = crate::model::die::DieShape::of(scene);
+            let die = crate::model::die::DieBody::of(scene);
             Ok((theory::quasi_static::faces_up(&die).to_vec(), None))
         }
         (Null::QuasiStatic, Mode::ThreeD) => {
@@ -294,7 +294,7 @@ pub fn assess_counts(
                         .collect()
                 }
                 None => {
-                    let die = crate::model::die::DieShape::of(scene);
+                    let die = crate::model::die::DieBody::of(scene);
                     let up = theory::quasi_static::faces_up(&die);
                     layout
                         .numbers()

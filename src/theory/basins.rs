@@ -572,7 +572,7 @@ mod tests {
         ] {
             let mut s = Scene::paper(block.parse().unwrap(), Mode::ThreeD);
             s.features.com = Some(com);
-            let die = crate::model::die::DieShape::of(&s);
+            let die = crate::model::die::DieBody::of(&s);
             let want = super::super::quasi_static::faces_up(&die);
             let h = die.half;
             let corners: Vec<V3> = (0..8)

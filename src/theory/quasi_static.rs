@@ -16,7 +16,7 @@
 //! through the inner box's proportions (a rounded cube stays fair), a centre off the centre
 //! through its distances to the faces.
 
-use crate::model::die::DieShape;
+use crate::model::die::DieBody;
 use crate::model::shape::{Shape, Solid};
 use nalgebra::Vector3;
 
@@ -31,7 +31,7 @@ pub fn rectangle(d: f64, [x1, x2]: [f64; 2], [y1, y2]: [f64; 2]) -> f64 {
 /// The probability of each face being up, in `faces::DIRECTIONS`' order (+x, −x, +y, −y, +z,
 /// −z), for a die released at rest in a uniformly random orientation (3D): the solid angle of
 /// the opposite face of the inner box, seen from the centre of mass, over 4π.
-pub fn faces_up(die: &DieShape) -> [f64; 6] {
+pub fn faces_up(die: &DieBody) -> [f64; 6] {
     let (k, c) = (die.core, die.com);
     std::array::from_fn(|d| {
         let i = d / 2;
@@ -123,11 +123,11 @@ mod tests {
     use super::*;
     use crate::model::scene::{Mode, Scene};
 
-    fn die(block: &str, com: Option<[f64; 3]>, r: f64) -> DieShape {
+    fn die(block: &str, com: Option<[f64; 3]>, r: f64) -> DieBody {
         let mut s = Scene::paper(block.parse().unwrap(), Mode::ThreeD);
         s.features.com = com;
         s.features.edge_radius = r;
-        DieShape::of(&s)
+        DieBody::of(&s)
     }
 
     #[test]

@@ -4,7 +4,7 @@
 
 use dicephys::engine::{new_engine, EngineKind};
 use dicephys::model::block::Outcome;
-use dicephys::model::die::DieShape;
+use dicephys::model::die::DieBody;
 use dicephys::model::scene::{Mode, Scene};
 use dicephys::model::state::BodyState;
 use dicephys::model::throws::{ThrowKind, ThrowRanges, Throws};
@@ -119,7 +119,7 @@ fn throw_6() -> (Scene, dicephys::model::throws::Throw) {
 fn a_dip_the_engine_pushes_back_out_of_is_not_a_failure() {
     let (sc, throw) = throw_6();
     let mut engine = new_engine(EngineKind::Bullet, &sc).unwrap();
-    let die = DieShape::of(&sc);
+    let die = DieBody::of(&sc);
     let mut lowest_centre = f64::INFINITY;
     let mut wholly_under = false;
     let r =
@@ -182,7 +182,7 @@ fn the_certificate_counts_a_sunk_die_at_the_height_it_will_be_pushed_back_to() {
     // 2D 140x22x13 balanced on its edge, still, sunk 3 mm into the floor. Its energy with
     // the centre where it is lies under the barrier; pushed back out, it is on the barrier.
     let sc = scene("140x22x13", Mode::TwoD, DT_60);
-    let die = DieShape::of(&sc);
+    let die = DieBody::of(&sc);
     let (b, w) = (die.half.x, die.half.y);
     // Turned about z so that the diagonal of the cross-section is vertical.
     let rot = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), b.atan2(w));

@@ -1110,7 +1110,7 @@ fn on_a_soft_table_the_early_stop_names_what_every_step_does() {
 /// Issue 72's fifth round, a rounded mesh (`Shape::rounded`): each engine collides the die the
 /// model's geometry describes (the inner body's hull swept by the radius: Bullet's hull margin,
 /// Rapier's round hull). V1 rounded 2 mm, dropped from 0.5 mm onto its lowest corner at a step
-/// of 0.1 ms (e 0), is first stopped with its lowest point, as `DieShape::lowest_point`
+/// of 0.1 ms (e 0), is first stopped with its lowest point, as `DieBody::lowest_point`
 /// computes it, between 0.1 r below the floor and 0.05 r above it, and comes to rest on a face
 /// within 0.05 r of it. Measured: Bullet stops the corner 134 µm deep (it finds a large
 /// margin's contact late, six steps at this speed; 66 µm at r = 1 mm) and rests at 0; Rapier
@@ -1119,7 +1119,7 @@ fn on_a_soft_table_the_early_stop_names_what_every_step_does() {
 /// without its radius 2 mm: either would fail.
 #[test]
 fn a_rounded_mesh_touches_the_floor_where_its_geometry_says_on_both_engines() {
-    use dicephys::model::die::DieShape;
+    use dicephys::model::die::DieBody;
     use dicephys::model::shape::{from_mesh, Reads};
     let bytes = include_bytes!("../data/hendecahedron_v1.obj");
     let mesh = dicephys::model::mesh_file::read_mesh(bytes, "v1").unwrap();
@@ -1136,10 +1136,10 @@ fn a_rounded_mesh_touches_the_floor_where_its_geometry_says_on_both_engines() {
         s
     };
     let scene = scene_of(rounded);
-    let die = DieShape::of(&scene);
+    let die = DieBody::of(&scene);
     let probe = at_rest(Vector3::zeros(), turn);
     let reach = -die.lowest_point(&probe);
-    let sharp_reach = -DieShape::of(&scene_of(sharp)).lowest_point(&probe);
+    let sharp_reach = -DieBody::of(&scene_of(sharp)).lowest_point(&probe);
     assert!(
         sharp_reach - reach > 0.1 * r,
         "{sharp_reach} against {reach}"

@@ -134,7 +134,7 @@ fn a_made_die_released_at_rest_on_a_face_stays_there() {
         ..Default::default()
     };
     scene.validate(false).unwrap();
-    let die = dicephys::model::die::DieShape::of(&scene);
+    let die = dicephys::model::die::DieBody::of(&scene);
     for kind in [EngineKind::Bullet, EngineKind::Rapier] {
         let mut engine = new_engine(kind, &scene).unwrap();
         for d in 0..6 {

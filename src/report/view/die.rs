@@ -3,7 +3,7 @@
 //! and its outcomes' resting normals, from which the page reads the face a frame shows.
 
 use crate::model::block::Outcome;
-use crate::model::die::DieShape;
+use crate::model::die::DieBody;
 use crate::model::scene::{Mode, Scene};
 use crate::model::shape::{Reads, Shape, Solid};
 use nalgebra::Vector3;
@@ -66,7 +66,7 @@ fn round(v: &Vector3<f64>) -> [f64; 3] {
 
 impl DieView {
     /// The die of `scene`, whose body `die` is.
-    pub fn of(scene: &Scene, die: &DieShape) -> DieView {
+    pub fn of(scene: &Scene, die: &DieBody) -> DieView {
         match scene.shape.as_deref() {
             Some(shape) => shaped(shape, &die.com),
             None => block(scene, die),
@@ -80,7 +80,7 @@ impl DieView {
 /// edges ([`rounded_face`]) as the box swept by a sphere of the edge radius: each face's flat
 /// middle carries its number, its rim the quarter circles of its edges and corners. In 2D its
 /// 1 m depth is drawn as deep as its breadth.
-fn block(scene: &Scene, die: &DieShape) -> DieView {
+fn block(scene: &Scene, die: &DieBody) -> DieView {
     let mut half = die.half;
     if scene.mode == Mode::TwoD {
         half.z = half.x.max(half.y);
@@ -366,7 +366,7 @@ mod tests {
         let mut scene = Scene::paper(Block::from_mm(16.0, 16.0, 16.0).unwrap(), Mode::ThreeD);
         scene.features.pips = Some(crate::model::mass::Pips::caps(3e-3, 0.5e-3));
         scene.features.edge_radius = r * 1e-3;
-        let die = DieShape::of(&scene);
+        let die = DieBody::of(&scene);
         (block(&scene, &die), die.com)
     }
 

@@ -6,7 +6,7 @@
 pub mod die;
 
 use crate::model::block::Outcome;
-use crate::model::die::DieShape;
+use crate::model::die::DieBody;
 use crate::model::state::BodyState;
 use crate::sim::roll::{Fate, RollRecord};
 use serde::Serialize;
@@ -83,7 +83,7 @@ impl Recorder {
     }
 
     /// The state after `step` steps.
-    pub fn push(&mut self, die: &DieShape, step: u64, s: &BodyState) {
+    pub fn push(&mut self, die: &DieBody, step: u64, s: &BodyState) {
         if step.is_multiple_of(self.every) {
             self.keep(die, step, s);
             if self.frames.t.len() > MAX_FRAMES {
@@ -94,7 +94,7 @@ impl Recorder {
         }
     }
 
-    fn keep(&mut self, die: &DieShape, step: u64, s: &BodyState) {
+    fn keep(&mut self, die: &DieBody, step: u64, s: &BodyState) {
         let f = &mut self.frames;
         let q = s.rotation.quaternion();
         f.t.push(fixed(step as f64 * self.dt, 7));
@@ -126,7 +126,7 @@ impl Recorder {
     }
 
     /// The frames, the last state among them.
-    pub fn finish(mut self, die: &DieShape) -> Frames {
+    pub fn finish(mut self, die: &DieBody) -> Frames {
         if let Some((step, s)) = self.last.take() {
             self.keep(die, step, &s);
         }

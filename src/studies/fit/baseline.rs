@@ -75,7 +75,7 @@ pub fn quasi_static(
             return None;
         }
         let up =
-            crate::theory::quasi_static::faces_up(&crate::model::die::DieShape::of(&spec.scene));
+            crate::theory::quasi_static::faces_up(&crate::model::die::DieBody::of(&spec.scene));
         return Some(vec![up[4] + up[5], up[0] + up[1], up[2] + up[3]]);
     };
     let com = crate::model::mass::MassProps::compute(&spec.scene).com;

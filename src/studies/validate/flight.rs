@@ -16,7 +16,7 @@ use super::rows::Rows;
 use crate::engine::{new_engine, EngineKind};
 use crate::error::{Error, Result};
 use crate::model::block::Block;
-use crate::model::die::DieShape;
+use crate::model::die::DieBody;
 use crate::model::scene::{Mode, Preset, Scene};
 use crate::model::state::BodyState;
 use crate::model::throws::{haar_quaternion, unit_vector};
@@ -108,7 +108,7 @@ pub fn fly_until(
         _ => Preset::Dicephys281,
     };
     let scene = scene(block, dt, preset);
-    let die = DieShape::of(&scene);
+    let die = DieBody::of(&scene);
     let steps = (time / dt).round().max(1.0) as u64;
     let s0 = start(spin);
     let rot = |s: &BodyState| {

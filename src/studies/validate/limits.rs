@@ -151,7 +151,7 @@ pub fn measure_limit(spec: &RunSpec, study: &Study) -> Result<LimitCell> {
 /// `s`: the body axis i (of x, y in 2D) with the largest |uᵢ|/sᵢ, u the vertical in body axes
 /// and sᵢ the half sides; the face a die released there at rest, without momentum, ends on.
 pub fn start_face(scene: &Scene, s: &crate::model::state::BodyState) -> Outcome {
-    let die = crate::model::die::DieShape::of(scene);
+    let die = crate::model::die::DieBody::of(scene);
     let up = crate::model::die::up_in_body(&s.rotation);
     let (i, _) = die.face_region(&up);
     [Outcome::Breadth, Outcome::Width, Outcome::Length][i]
