@@ -9,7 +9,9 @@ use crate::calibration::data::DataRow;
 use crate::calibration::design::Design;
 use crate::calibration::params::{ModelSpec, Param};
 use crate::error::{Error, Result};
-use crate::inference::likelihood::{concentration, ln_dirichlet_multinomial, merge, pearson};
+use crate::inference::likelihood::{
+    concentration, ln_dirichlet_multinomial, merge, merge_p, pearson,
+};
 use crate::inference::optimize::{interval, minimize_until, profile, Interval, Minimum};
 use crate::inference::posterior;
 use crate::model::scene::Mode;
@@ -141,20 +143,41 @@ impl<'a> Likelihood<'a> {
     pub fn predict(&self, r: usize, x: &[f64]) -> RowPrediction {
         let design = &self.designs[self.row_design[r]];
         let pr = design.surrogate.predict(&self.local(r, x));
-        // Groups index [length, breadth, width]; a 2D surrogate has only breadth and width (a
-        // design of faces: the six, as the row's).
-        let shift = usize::from(design.mode == Mode::TwoD && !design.faces);
-        let groups: Vec<Vec<usize>> = self.rows[r]
-            .groups
-            .iter()
-            .map(|g| g.iter().map(|k| k - shift).collect())
-            .collect();
-        let (p, cov) = merge(&pr.p, &pr.cov, &groups);
+        let (p, cov) = merge(&pr.p, &pr.cov, &self.groups(r));
         let c = match &self.held {
             Some(held) => held[r],
             None => concentration(&p, &cov),
         };
         RowPrediction { p, cov, c }
+    }
+
+    /// Row `r`'s outcome groups as indices into its design's outcomes: groups index [length,
+    /// breadth, width]; a 2D surrogate has only breadth and width (a design of faces: the
+    /// six, as the row's).
+    fn groups(&self, r: usize) -> Vec<Vec<usize>> {
+        let design = &self.designs[self.row_design[r]];
+        let shift = usize::from(design.mode == Mode::TwoD && !design.faces);
+        self.rows[r]
+            .groups
+            .iter()
+            .map(|g| g.iter().map(|k| k - shift).collect())
+            .collect()
+    }
+
+    /// Row `r`'s probabilities and concentration at `x`: where the concentrations are held,
+    /// the probabilities alone (their covariance only sets a concentration that is not held).
+    fn probabilities(&self, r: usize, x: &[f64]) -> (Vec<f64>, f64) {
+        match &self.held {
+            Some(held) => {
+                let design = &self.designs[self.row_design[r]];
+                let p = design.surrogate.probabilities(&self.local(r, x));
+                (merge_p(&p, &self.groups(r)), held[r])
+            }
+            None => {
+                let pr = self.predict(r, x);
+                (pr.p, pr.c)
+            }
+        }
     }
 
     /// −2 ln L at `x` (unit coordinates), up to a constant.
@@ -167,8 +190,8 @@ impl<'a> Likelihood<'a> {
             if !self.include[r] {
                 continue;
             }
-            let pr = self.predict(r, x);
-            ll += ln_dirichlet_multinomial(&self.rows[r].grouped(), &pr.p, pr.c);
+            let (p, c) = self.probabilities(r, x);
+            ll += ln_dirichlet_multinomial(&self.rows[r].grouped(), &p, c);
         }
         -2.0 * ll
     }

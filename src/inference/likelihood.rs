@@ -22,15 +22,20 @@ use nalgebra::DMatrix;
 /// count, and the multinomial is used.
 pub const MAX_CONCENTRATION: f64 = 1e12;
 
+/// The grouped probabilities of [`merge`] alone.
+pub fn merge_p(p: &[f64], groups: &[Vec<usize>]) -> Vec<f64> {
+    groups
+        .iter()
+        .map(|m| m.iter().map(|&k| p[k]).sum())
+        .collect()
+}
+
 /// Merges outcomes into groups (outcomes counted together because their faces are congruent,
 /// or a 2D row's two side outcomes): each group's probability is its members' sum, and the
 /// covariance is summed over the members' pairs.
 pub fn merge(p: &[f64], cov: &DMatrix<f64>, groups: &[Vec<usize>]) -> (Vec<f64>, DMatrix<f64>) {
     let g = groups.len();
-    let pm: Vec<f64> = groups
-        .iter()
-        .map(|m| m.iter().map(|&k| p[k]).sum())
-        .collect();
+    let pm = merge_p(p, groups);
     let mut cm = DMatrix::zeros(g, g);
     for (a, ma) in groups.iter().enumerate() {
         for (b, mb) in groups.iter().enumerate() {
