@@ -165,12 +165,13 @@ impl<'a> Likelihood<'a> {
     }
 
     /// Row `r`'s probabilities and concentration at `x`: where the concentrations are held,
-    /// the probabilities alone (their covariance only sets a concentration that is not held).
+    /// the probabilities alone (`Surrogate::p`; their covariance, O(outcomes² × features²) for
+    /// a many-faced die, only sets a concentration that is not held).
     fn probabilities(&self, r: usize, x: &[f64]) -> (Vec<f64>, f64) {
         match &self.held {
             Some(held) => {
                 let design = &self.designs[self.row_design[r]];
-                let p = design.surrogate.probabilities(&self.local(r, x));
+                let p = design.surrogate.p(&self.local(r, x));
                 (merge_p(&p, &self.groups(r)), held[r])
             }
             None => {

@@ -408,13 +408,6 @@ impl Surrogate {
         softmax(&self.eta(&features(x, &self.exps, self.degree)))
     }
 
-    /// The probabilities at `x` alone, as [`Surrogate::predict`] gives them, without their
-    /// covariance (O(outcomes² × features²) for a many-faced die): what a likelihood whose
-    /// concentrations are held needs.
-    pub fn probabilities(&self, x: &[f64]) -> Vec<f64> {
-        softmax(&self.eta(&features(x, &self.exps, self.degree)))
-    }
-
     /// The probabilities at `x` with their covariance, by the delta method:
     /// ∂p_k/∂β_a = p_k (δ_ka − p_a) φ. Read from the stored coefficients and covariance in
     /// place (this runs for every row at every step of every search).
