@@ -1091,7 +1091,9 @@ fn predict<'py>(
     let block = other.as_ref().map_or(block, |o| o.block(block));
     let shape = other
         .as_ref()
-        .map_or(fit.config.method.shape.as_deref(), |o| o.shape.as_deref());
+        .map_or(fit.config.method.die.shape.as_deref(), |o| {
+            o.shape.as_deref()
+        });
     let counts = match counts {
         Some(c) => counts_of(c, shape)?,
         None => Vec::new(),
@@ -1122,9 +1124,9 @@ fn other_die(
     fit: &calibration::FitResult,
     block: Option<Block>,
     die: Option<Bound<'_, PyDict>>,
-) -> PyResult<Option<calibration::other_die::OtherDie>> {
+) -> PyResult<Option<dicephys::model::die::Die>> {
     let described = die.as_ref().is_some_and(|d| !d.is_empty());
-    let block_of_shape_fit = block.is_some() && fit.config.method.shape.is_some();
+    let block_of_shape_fit = block.is_some() && fit.config.method.die.shape.is_some();
     if !described && !block_of_shape_fit {
         return Ok(None);
     }
@@ -1132,9 +1134,7 @@ fn other_die(
         block,
         ..fit_die(die)?
     };
-    calibration::other_die::OtherDie::resolve(&request)
-        .map(Some)
-        .map_err(py_err)
+    request.resolve_resting().map(Some).map_err(py_err)
 }
 
 /// `predict`'s counts (a CSV file or CSV text in `fit`'s format), read against the die of any

@@ -639,12 +639,7 @@ pub fn on_shape(rows: &[DataRow], shape: &crate::model::shape::Shape) -> Result<
     let labels = shape.outcome_labels();
     let want: Vec<&str> = labels.iter().map(String::as_str).collect();
     let bad = |m: String| Error::Invalid(m);
-    let [x, y, z] = shape.bounding_box();
-    let block = Block {
-        breadth: x,
-        width: y,
-        length: z,
-    };
+    let block = shape.block();
     rows.iter()
         .map(|r| {
             if !r.of_shape() {

@@ -5,26 +5,20 @@
 
 use crate::calibration::data::{self, DataRow};
 use crate::error::{Error, Field, Result};
-use crate::model::mass::Features;
-use crate::model::shape::Shape;
+use crate::model::die::Die;
 use crate::run::request::DieRequest;
 use serde::{Deserialize, Serialize};
-use std::sync::Arc;
 
-/// A row's own die: its name as the rows give it, its shape resting on the facets it rests on
-/// at its own centre of mass, what departs from the uniform solid, and its density.
+/// A row's own die: its name as the rows give it, and the die, of a shape (never the cuboid,
+/// whose rows count its sides in a file of blocks), resting on the facets it rests on at its
+/// own centre of mass.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RowDie {
     /// The row's `die` cell (a die file's path joined to the counts file's folder).
     pub name: String,
-    /// The die.
-    pub shape: Arc<Shape>,
-    /// Its centre of mass, pips, shell… as its file gives them.
-    #[serde(default, skip_serializing_if = "Features::is_default")]
-    pub die: Features,
-    /// kg/m³, where its file gives one.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub density: Option<f64>,
+    /// The die, written as its fields.
+    #[serde(flatten)]
+    pub die: Die,
 }
 
 impl RowDie {
@@ -42,19 +36,17 @@ impl RowDie {
                 ..DieRequest::default()
             }
         };
-        let got = req.resolve_resting()?;
-        let Some(shape) = got.shape else {
+        let die = req.resolve_resting()?;
+        if die.shape.is_none() {
             return Err(Error::Invalid(
                 "describes no shape or mesh (a cuboid's rows count its sides, in a file of \
                  blocks)"
                     .into(),
             ));
-        };
+        }
         Ok(RowDie {
             name: name.into(),
-            shape: Arc::new(shape),
-            die: got.features,
-            density: got.density,
+            die,
         })
     }
 }

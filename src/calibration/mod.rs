@@ -210,6 +210,7 @@ impl FitConfig {
         let method = self.method.of_row(&self.rows[0]);
         if self.model.is_free(params::Kind::PipDepth)
             && method
+                .die
                 .shape
                 .as_deref()
                 .is_some_and(|s| s.as_box().is_none())
@@ -221,7 +222,7 @@ impl FitConfig {
                  com_x, com_y or com_z",
             ));
         }
-        if self.model.is_free(params::Kind::PipDepth) && method.die.pips.is_none() {
+        if self.model.is_free(params::Kind::PipDepth) && method.die.features.pips.is_none() {
             return Err(Error::field(
                 Field::Free,
                 "pip_depth",
@@ -262,7 +263,7 @@ impl FitConfig {
         let hi = self.model.range(params::Kind::EdgeRadius).hi;
         for row in &self.rows {
             let method = self.method.of_row(row);
-            let Some(shape) = method.shape.as_deref().filter(|s| s.as_box().is_none()) else {
+            let Some(shape) = method.die.shape.as_deref().filter(|s| s.as_box().is_none()) else {
                 continue;
             };
             let why = if shape.radius > 0.0 {
@@ -350,7 +351,7 @@ impl FitConfig {
             .rows
             .iter()
             .find(|r| r.die.is_none())
-            .and(self.method.shape.as_ref())
+            .and(self.method.die.shape.as_ref())
         {
             dice.push(s.name.clone());
         }
@@ -388,7 +389,7 @@ impl FitConfig {
         let mut shaped = None;
         for r in &self.rows {
             let method = self.method.of_row(r);
-            let Some(shape) = &method.shape else {
+            let Some(shape) = &method.die.shape else {
                 if r.of_shape() {
                     return Err(Error::Invalid(format!(
                         "row '{}' counts the faces of a die of any shape (face_{}…): give the \

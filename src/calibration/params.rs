@@ -15,6 +15,7 @@ use crate::calibration::data::DataRow;
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
 use crate::model::block::Block;
+use crate::model::die::Die;
 use crate::model::mass::Features;
 use crate::model::scene::{Mode, Scene, MAX_ROLLING_RESISTANCE};
 use crate::model::throws::{Range, ThrowRanges, ThrowStyle};
@@ -629,17 +630,13 @@ pub struct Method {
     pub dt: f64,
     /// The step cap per roll.
     pub max_steps: u64,
-    /// The die thrown, where it is not the paper's ideal block (a centre of mass off centre,
-    /// pips, rounded edges, its faces' numbers): every row's, 3D only.
-    #[serde(default, skip_serializing_if = "Features::is_default")]
-    pub die: Features,
-    /// The die's density, kg/m³, where it is not the paper's.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub density: Option<f64>,
-    /// A die of any shape (`model::shape`) in place of every row's block: its rows count its
-    /// faces by label ([`crate::calibration::data::on_shape`]), thrown in a tumble.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub shape: Option<std::sync::Arc<crate::model::shape::Shape>>,
+    /// The die thrown, where it is not the paper's ideal block: a die of any shape
+    /// (`model::shape`) in place of every row's block, whose rows count its faces by label
+    /// ([`crate::calibration::data::on_shape`]), thrown in a tumble; what departs from the
+    /// uniform solid (a centre of mass off centre, pips, rounded edges, its faces' numbers;
+    /// 3D only); its density where it is not the paper's. Written as its fields.
+    #[serde(flatten)]
+    pub die: Die,
     /// The rows' own dice, where a `die` column names them (`calibration::dice`): a row is
     /// simulated as its die (`Method::for_die`), the rest as above.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -653,9 +650,7 @@ impl Method {
         match die.and_then(|n| self.dice.iter().find(|d| d.name == n)) {
             None => Cow::Borrowed(self),
             Some(d) => Cow::Owned(Method {
-                shape: Some(d.shape.clone()),
-                die: d.die,
-                density: d.density,
+                die: d.die.clone(),
                 dice: Vec::new(),
                 ..self.clone()
             }),
@@ -685,7 +680,7 @@ impl Method {
     /// free from the die's description, else 0), a free pip depth on the die's pips, a free
     /// infill in the die's shell (else a `DEFAULT_WALL` one).
     pub fn die_at(&self, v: &Fixed) -> Features {
-        let mut die = self.die;
+        let mut die = self.die.features;
         for (axis, mm) in v.com.iter().enumerate() {
             if let Some(mm) = mm {
                 die = die.with_com_on(axis, mm / 1000.0);
@@ -707,10 +702,7 @@ impl Method {
     /// `seed`.
     pub fn spec(&self, block: Block, mode: Mode, v: &Fixed, seed: u64, rolls: u64) -> RunSpec {
         let mut scene = Scene::paper(block, mode);
-        if let Some(s) = &self.shape {
-            scene.block = block;
-            scene.shape = Some(s.clone());
-        }
+        scene.shape = self.die.shape.clone();
         scene.dt = self.dt;
         scene.restitution = v.e;
         scene.friction = v.mu;
@@ -725,14 +717,14 @@ impl Method {
         scene.contact_time = v.contact_time / 1000.0;
         scene.static_ratio = v.static_ratio;
         scene.features = self.die_at(v);
-        if let Some(d) = self.density {
+        if let Some(d) = self.die.density {
             scene.density = d;
         }
         // A die of any shape but a box takes its rounding in its hull (`mass::take_rounding`;
         // a rounding it cannot take stays in the features, which the scene's checks refuse),
         // and rests on the facets it rests on at this centre of mass, each labelled as the
         // rows count it.
-        if self.shape.is_some() {
+        if self.die.shape.is_some() {
             let _ = crate::model::mass::take_rounding(&mut scene.shape, &mut scene.features);
             if let Some(base) = scene.shape.clone() {
                 let com = crate::model::mass::MassProps::compute(&scene).com;
@@ -827,15 +819,38 @@ mod tests {
             .contains("range of e"));
     }
 
+    #[test]
+    fn a_method_writes_its_die_as_a_fit_always_has_and_reads_it_back() {
+        let mut m = bullet_at_1ms();
+        m.die = Die {
+            shape: Some(std::sync::Arc::new(
+                crate::model::shape::named("d8", None).unwrap(),
+            )),
+            features: Features::default().with_com_on(2, -1e-3),
+            density: Some(1200.0),
+        };
+        let v = serde_json::to_value(&m).unwrap();
+        // Its features under `die`, its shape and density beside them: a fit's directory
+        // and `fit.json` read as before the die became one value.
+        assert_eq!(v["die"]["com"], serde_json::json!([0.0, 0.0, -1e-3]), "{v}");
+        assert_eq!(v["density"], 1200.0);
+        assert_eq!(v["shape"]["name"], "d8");
+        assert!(v.get("features").is_none(), "{v}");
+        assert_eq!(serde_json::from_value::<Method>(v).unwrap(), m);
+        // The cuboid's plain die writes none of them.
+        let plain = serde_json::to_value(bullet_at_1ms()).unwrap();
+        for k in ["die", "shape", "density", "dice"] {
+            assert!(plain.get(k).is_none(), "{plain}");
+        }
+    }
+
     /// Bullet at the fits' 1 ms step, the plain die, 1,000 steps a roll.
     fn bullet_at_1ms() -> Method {
         Method {
             engine: EngineKind::Bullet,
             dt: 1e-3,
             max_steps: 1000,
-            die: Features::default(),
-            density: None,
-            shape: None,
+            die: Default::default(),
             dice: vec![],
         }
     }

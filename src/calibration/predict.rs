@@ -210,7 +210,7 @@ pub struct PredictConfig {
     /// Another die than the fit's, thrown by the same hand on the same table; `None`: the
     /// fit's own die (a fit of blocks: `block`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub other: Option<Box<crate::calibration::other_die::OtherDie>>,
+    pub other: Option<Box<crate::model::die::Die>>,
     /// Counts of the die predicted, to score the prediction against (`fit --data`'s rows).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub counts: Vec<crate::calibration::data::DataRow>,
@@ -220,7 +220,7 @@ pub struct PredictConfig {
 /// shape predicts that die (its rows' block is its bounding box); a fit of blocks needs one,
 /// and so does a fit whose rows all name their own dice (which of them?).
 pub fn own_block(fit: &FitResult) -> Option<Block> {
-    fit.config.method.shape.as_ref()?;
+    fit.config.method.die.shape.as_ref()?;
     // A row of the fit's own die, not one that names another (a `die` column's).
     fit.config
         .rows

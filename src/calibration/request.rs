@@ -141,29 +141,26 @@ impl FitRequest {
     /// The fit's configuration, checked.
     pub fn config(&self) -> Result<FitConfig> {
         // A loaded die's outcomes are the facets it rests on at its own centre of mass.
-        let crate::run::request::ResolvedDie {
-            shape,
-            features: die,
-            density,
-        } = self.die.resolve_resting()?;
+        let die = self.die.resolve_resting()?;
         // The rows' own dice (a `die` column): each row read against its die, the rest
         // against the command line's.
         let dice = super::dice::resolve_rows(&self.rows)?;
         let own = |r: &DataRow| dice.iter().find(|d| Some(&d.name) == r.die.as_ref());
         let mut rows = Vec::with_capacity(self.rows.len());
         for r in &self.rows {
-            let read = match (own(r), &shape) {
-                (Some(d), _) => data::on_shape(std::slice::from_ref(r), &d.shape),
-                (None, Some(s)) => data::on_shape(std::slice::from_ref(r), s),
-                (None, None) => Ok(vec![r.clone()]),
+            let read = match own(r).map_or(&die.shape, |d| &d.die.shape) {
+                Some(s) => data::on_shape(std::slice::from_ref(r), s),
+                None => Ok(vec![r.clone()]),
             };
             rows.extend(read.map_err(|e| Error::field(Field::Data, "", e.to_string()))?);
         }
         // The surrogate's degree for the die of most outcomes.
         let outcomes = dice
             .iter()
-            .map(|d| d.shape.outcome_labels().len())
-            .chain(shape.as_ref().map(|s| s.outcome_labels().len()))
+            .map(|d| &d.die)
+            .chain([&die])
+            .filter_map(|d| d.shape.as_ref())
+            .map(|s| s.outcome_labels().len())
             .max()
             .unwrap_or(6);
         let (degree, max_degree) = DesignSpec::degrees(self.degree, self.max_degree, outcomes);
@@ -172,21 +169,19 @@ impl FitRequest {
         // its rim) ends unconverged at 200 s, not at 20,000 s, which made a rounding fit of V1
         // take hours.
         let max_steps =
-            if self.max_steps == DEFAULT_MAX_STEPS && (shape.is_some() || !dice.is_empty()) {
+            if self.max_steps == DEFAULT_MAX_STEPS && (die.shape.is_some() || !dice.is_empty()) {
                 crate::sim::roll::SHAPE_MAX_STEPS
             } else {
                 self.max_steps
             };
         let cfg = FitConfig {
             rows,
-            model: self.model(shape.is_some() || !dice.is_empty())?,
+            model: self.model(die.shape.is_some() || !dice.is_empty())?,
             method: Method {
                 engine: self.engine,
                 dt: self.dt,
                 max_steps,
                 die,
-                density,
-                shape: shape.map(std::sync::Arc::new),
                 dice,
             },
             design: DesignSpec {

@@ -391,7 +391,9 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
             path,
             other
                 .as_ref()
-                .map_or(fit.config.method.shape.as_deref(), |o| o.shape.as_deref()),
+                .map_or(fit.config.method.die.shape.as_deref(), |o| {
+                    o.shape.as_deref()
+                }),
         )?,
         None => Vec::new(),
     };
@@ -422,10 +424,7 @@ pub fn predict(a: &PredictArgs) -> Result<()> {
 
 /// The die `predict` throws in place of the fit's: --shape or --die (or another flag of the
 /// die), or --block from a fit of a die of any shape; `None`: the fit's own.
-fn other_die(
-    a: &PredictArgs,
-    fit: &FitResult,
-) -> Result<Option<dicephys::calibration::other_die::OtherDie>> {
+fn other_die(a: &PredictArgs, fit: &FitResult) -> Result<Option<dicephys::model::die::Die>> {
     let d = &a.other;
     let described = d.shape.is_some()
         || d.die.is_some()
@@ -434,11 +433,12 @@ fn other_die(
         || d.edge_radius.is_some()
         || d.shell.is_some()
         || d.density.is_some();
-    let block_of_shape_fit = a.block.is_some() && fit.config.method.shape.is_some();
+    let block_of_shape_fit = a.block.is_some() && fit.config.method.die.shape.is_some();
     if !described && !block_of_shape_fit {
         return Ok(None);
     }
-    dicephys::calibration::other_die::OtherDie::resolve(&d.request(a.block, None))
+    d.request(a.block, None)
+        .resolve_resting()
         .map(Some)
         .map_err(|e| d.named(e))
 }

@@ -89,13 +89,11 @@ impl PaperArgs {
         let a = self;
         dicephys::studies::calibrated::CalibratedConfig {
             method: Method {
-                shape: None,
                 dice: Vec::new(),
                 engine: EngineKind::Bullet,
                 dt: a.dt,
                 max_steps: *a.max_steps,
                 die: Default::default(),
-                density: None,
             },
             design: DesignSpec {
                 points: a.points,

@@ -1,12 +1,67 @@
-//! The die as a rigid body: its half sides, mass, inertia and barriers, its energies, and
-//! where its lowest point is.
+//! The die: what it is, as every command takes it ([`Die`]), and as a rigid body
+//! ([`DieBody`]): its half sides, mass, inertia and barriers, its energies, and where its
+//! lowest point is.
 
-use crate::model::mass::{BodyTurn, MassProps};
+use crate::model::block::Block;
+use crate::model::mass::{BodyTurn, Features, MassProps};
 use crate::model::scene::{Mode, Scene};
+use crate::model::shape::Shape;
 pub use crate::model::state::up_in_body;
 use crate::model::state::BodyState;
 use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
 use std::sync::Arc;
+
+/// A die as asked, resolved once wherever one is given (`roll`'s and `fair`'s flags, a die
+/// file, `fit`'s die, a counts file's `die` column, `predict`'s other die, Python's
+/// arguments): its shape, what departs from the uniform solid, and its density. The cuboid
+/// has no shape: its sides are the scene's block.
+///
+/// Written as a fit has always written its die (its features under `die`), so that a fit, its
+/// directory and its `fit.json` read the same; `features` is read too.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Die {
+    /// A named die, a mesh or a die file's mesh; `None`: the cuboid.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<Arc<Shape>>,
+    /// Its centre of mass, pips, rounding, insert, inertia, shell and numbering.
+    #[serde(
+        default,
+        rename = "die",
+        alias = "features",
+        skip_serializing_if = "Features::is_default"
+    )]
+    pub features: Features,
+    /// kg/m³, where it is not the scene's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<f64>,
+}
+
+impl Die {
+    /// The block a scene of it holds: its shape's bounding box, else `block` (the cuboid's).
+    pub fn block(&self, block: Block) -> Block {
+        self.shape.as_ref().map_or(block, |s| s.block())
+    }
+
+    /// The paper's scene (`Scene::paper`) of it: its shape (its block the shape's bounding
+    /// box), else the cuboid `block`; its features, and its density where it gives one.
+    pub fn scene(&self, block: Block, mode: Mode) -> Scene {
+        let mut scene = Scene::paper(self.block(block), mode);
+        scene.shape = self.shape.clone();
+        scene.features = self.features;
+        if let Some(d) = self.density {
+            scene.density = d;
+        }
+        scene
+    }
+
+    /// What it is, in a few words: its shape's name, else the block `block`.
+    pub fn name(&self, block: Block) -> String {
+        self.shape
+            .as_ref()
+            .map_or_else(|| format!("the block {block}"), |s| s.name.clone())
+    }
+}
 
 /// A die of any shape as the roll sees it (`model::shape`): what its lowest point and its face
 /// on the floor are computed from.

@@ -505,12 +505,7 @@ impl Scene {
     /// The paper's scene (`Scene::paper`) for a die of any shape; its block is the shape's
     /// bounding box, for what reads the die's size (the drop, the reports).
     pub fn paper_shape(shape: Shape, mode: Mode) -> Scene {
-        let [x, y, z] = shape.bounding_box();
-        let block = Block {
-            breadth: x,
-            width: y,
-            length: z,
-        };
+        let block = shape.block();
         Scene {
             shape: Some(std::sync::Arc::new(shape)),
             ..Scene::paper(block, mode)

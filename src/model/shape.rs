@@ -676,6 +676,17 @@ impl Shape {
         }
     }
 
+    /// Its bounding box as a block (breadth, width, length along body x, y, z): what a scene
+    /// of it holds for what reads the die's size (the drop, the reports).
+    pub fn block(&self) -> crate::model::block::Block {
+        let [breadth, width, length] = self.bounding_box();
+        crate::model::block::Block {
+            breadth,
+            width,
+            length,
+        }
+    }
+
     /// The second moments as a matrix.
     pub fn second_matrix(&self) -> Matrix3<f64> {
         let [xx, yy, zz, xy, xz, yz] = self.second;

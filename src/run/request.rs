@@ -7,6 +7,7 @@
 use crate::engine::EngineKind;
 use crate::error::{Error, Field, Result};
 use crate::model::block::Block;
+use crate::model::die::Die;
 use crate::model::faces::Layout;
 use crate::model::mass::Features;
 use crate::model::scene::{Floor, Mode, Preset, Scene};
@@ -48,24 +49,11 @@ pub struct DieRequest {
     pub layout: Option<Layout>,
 }
 
-/// A die as asked, resolved once for every command that takes one (`roll`, `fair`, `fit`):
-/// its shape (`None`: the cuboid, or no die named), what departs from the uniform solid, with
-/// the numbering asked, and its density (`None`: the scene's).
-#[derive(Clone, Debug)]
-pub struct ResolvedDie {
-    /// A named die, a mesh or a die file's mesh.
-    pub shape: Option<crate::model::shape::Shape>,
-    /// Its centre of mass, pips, rounding, insert, inertia, shell and numbering.
-    pub features: Features,
-    /// kg/m³.
-    pub density: Option<f64>,
-}
-
 impl DieRequest {
     /// The die asked, from its flags and its die file (the flags override the file's
     /// values), checked; a layout beside a die of any shape is refused (it shows its own
     /// labels).
-    pub fn resolve(&self) -> Result<ResolvedDie> {
+    pub fn resolve(&self) -> Result<Die> {
         let read: crate::model::mass::ReadFile = &crate::run::io::read_die_bytes;
         let shape = crate::model::mass::described_shape(
             self.file.as_deref(),
@@ -101,8 +89,8 @@ impl DieRequest {
                 format!("{}: {why}", name.unwrap_or_default()),
             )
         })?;
-        Ok(ResolvedDie {
-            shape: shape.map(std::sync::Arc::unwrap_or_clone),
+        Ok(Die {
+            shape,
             features,
             density,
         })
@@ -112,18 +100,19 @@ impl DieRequest {
     /// rests on at its own centre of mass (a loaded die's outcomes; a box's pips drilled as
     /// its labels number its faces): as `fit`, `predict`'s other die and a `die` column's take
     /// it. An error names the flag or file that gave the die.
-    pub fn resolve_resting(&self) -> Result<ResolvedDie> {
+    pub fn resolve_resting(&self) -> Result<Die> {
         let d = self.resolve()?;
-        let Some(shape) = d.shape else {
+        if d.shape.is_none() {
             return Ok(d);
-        };
-        let mut scene = Scene::paper_shape(shape, Mode::ThreeD);
-        scene.features = d.features;
-        let scene = scene
+        }
+        // At its own density: an insert's weight moves the centre of mass by its density
+        // against the body's.
+        let scene = d
+            .scene(DEFAULT_CUBOID, Mode::ThreeD)
             .resting_at_com()
             .map_err(|e| self.at_its_centre_of_mass(&e))?;
-        Ok(ResolvedDie {
-            shape: scene.shape.map(std::sync::Arc::unwrap_or_clone),
+        Ok(Die {
+            shape: scene.shape,
             features: scene.features,
             density: d.density,
         })
@@ -228,13 +217,9 @@ impl SceneRequest {
     /// The scene, with every value checked before anything runs.
     pub fn scene(&self) -> Result<Scene> {
         let d = &self.die;
-        let ResolvedDie {
-            shape,
-            features,
-            density,
-        } = d.resolve()?;
+        let mut die = d.resolve()?;
         let mode = if self.two_d { Mode::TwoD } else { Mode::ThreeD };
-        let mut scene = match (d.block, shape) {
+        let block = match (d.block, &die.shape) {
             (Some(_), Some(_)) => {
                 return Err(Error::field(
                     Field::Block,
@@ -248,15 +233,19 @@ impl SceneRequest {
                     ],
                 ))
             }
-            (Some(b), None) => Scene::paper(b, mode),
-            (None, Some(s)) => Scene::paper_shape(s, mode),
+            (Some(b), None) => b,
+            (None, Some(_)) => DEFAULT_CUBOID,
             // No die given: a 16 mm d6 (rolled as the box it is); the 16 mm cube as the
             // cuboid where the die is made as only a cuboid is (pips, rounded edges, an
             // insert, its inertia, its faces' numbering), so that what is asked applies to
             // the die rolled as before.
-            (None, None) if self.default_is_cuboid(&features) => Scene::paper(DEFAULT_CUBOID, mode),
-            (None, None) => Scene::paper_shape(crate::model::shape::named("d6", None)?, mode),
+            (None, None) if self.default_is_cuboid(&die.features) => DEFAULT_CUBOID,
+            (None, None) => {
+                die.shape = Some(std::sync::Arc::new(crate::model::shape::named("d6", None)?));
+                DEFAULT_CUBOID
+            }
         };
+        let mut scene = die.scene(block, mode);
         scene.dt = self.dt;
         scene.friction = self.friction;
         scene.restitution = self.restitution;
@@ -269,10 +258,6 @@ impl SceneRequest {
         scene.static_ratio = self.static_ratio;
         scene.angular_damping = self.angular_damping;
         scene.sleeping = self.sleep;
-        scene.features = features;
-        if let Some(density) = density {
-            scene.density = density;
-        }
         if let Some(t) = self.floor_thickness {
             scene.set_floor_thickness(t)?;
         }

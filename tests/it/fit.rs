@@ -420,8 +420,6 @@ fn counted_at_e_03(runner: &Runner) -> FitConfig {
             dt: 1.0 / 250.0,
             max_steps: dicephys::sim::roll::DEFAULT_MAX_STEPS,
             die: Default::default(),
-            density: None,
-            shape: None,
             dice: Vec::new(),
         },
         design: DesignSpec {

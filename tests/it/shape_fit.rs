@@ -411,9 +411,10 @@ fn a_fit_simulates_a_die_of_any_shape_as_roll_does_throw_for_throw() {
         engine: dicephys::engine::EngineKind::Bullet,
         dt: 1e-3,
         max_steps: dicephys::sim::roll::DEFAULT_MAX_STEPS,
-        die: Default::default(),
-        density: None,
-        shape: Some(std::sync::Arc::new(shape)),
+        die: dicephys::model::die::Die {
+            shape: Some(std::sync::Arc::new(shape)),
+            ..Default::default()
+        },
         dice: Vec::new(),
     };
     let values = Fixed {

@@ -296,9 +296,10 @@ fn a_fits_free_infill_fills_the_dies_own_wall_or_a_millimetre() {
         engine: crate::engine::EngineKind::Bullet,
         dt: 1e-3,
         max_steps: 1000,
-        die,
-        density: None,
-        shape: None,
+        die: crate::model::die::Die {
+            features: die,
+            ..Default::default()
+        },
         dice: Vec::new(),
     };
     let v = Fixed {

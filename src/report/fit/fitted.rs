@@ -63,7 +63,7 @@ pub fn fixed_text(res: &FitResult) -> String {
     if !m.is_free(Kind::Spin) {
         parts.push(format!("spin scale {}", f.spin));
     }
-    let die = &res.config.method.die;
+    let die = &res.config.method.die.features;
     if let Some(c) = die.com {
         let free = [Kind::ComX, Kind::ComY, Kind::ComZ].map(|k| m.is_free(k));
         if free.iter().any(|x| !x) {
@@ -410,7 +410,7 @@ pub(super) fn markdown(res: &FitResult, figures: &[&str]) -> String {
         c.method.dt,
         c.rows.len(),
         res.designs.len(),
-        match &c.method.shape {
+        match &c.method.die.shape {
             Some(shape) => format!("designs of {}", shape.name),
             None => "blocks".into(),
         },
@@ -451,6 +451,7 @@ pub(super) fn markdown(res: &FitResult, figures: &[&str]) -> String {
             s,
             "| {} | {} | {:.1} / {} | {:.3} | {:.2} | {} of {} |",
             c.method
+                .die
                 .shape
                 .as_ref()
                 .map_or_else(|| d.name(), |shape| shape.name.clone()),

@@ -10,11 +10,12 @@
 //! design's interval is the simulation's error at those values, and the calibration's own
 //! uncertainty is not carried into it (`predict` carries it, for one die).
 
-use crate::calibration::other_die::{without_die_params, OtherDie};
+use crate::calibration::other_die::{check, method, without_die_params};
 use crate::calibration::params::Fixed;
 use crate::calibration::predict::group;
 use crate::calibration::FitResult;
 use crate::error::Result;
+use crate::model::die::Die;
 use crate::run::spec::RunSpec;
 use serde::Serialize;
 
@@ -47,12 +48,12 @@ pub fn calibrated(
 ) -> Result<(RunSpec, Calibration)> {
     let surface = group(fit, true, surface, "surface")?;
     let thrower = group(fit, false, thrower, "thrower")?;
-    let die = OtherDie {
+    let die = Die {
         shape: spec.scene.shape.clone(),
         features: spec.scene.features,
         density: Some(spec.scene.density),
     };
-    die.check(fit)?;
+    check(&die, fit)?;
     // A new row's coordinates, as `predict` builds them: the fit's parameters of this surface
     // and thrower, at the fit's maximum.
     let row = FitResult::new_row(&surface, &thrower, spec.scene.block, spec.scene.mode);
@@ -71,7 +72,7 @@ pub fn calibrated(
     {
         values.rolling = crate::model::scene::COIN_ROLLING_RESISTANCE * 1e3;
     }
-    let method = die.method(&fit.config.method);
+    let method = method(&die, &fit.config.method);
     let out = method.spec(
         spec.scene.block,
         spec.scene.mode,

@@ -476,12 +476,7 @@ pub fn check(cfg: &MeshConfig) -> Result<()> {
 /// The run of `spec` with its die `shape`.
 fn with_shape(spec: &RunSpec, shape: Shape, rolls: u64, seed: u64) -> Result<RunSpec> {
     let mut s = spec.clone();
-    let [x, y, z] = shape.bounding_box();
-    s.scene.block = crate::model::block::Block {
-        breadth: x,
-        width: y,
-        length: z,
-    };
+    s.scene.block = shape.block();
     s.scene.shape = Some(std::sync::Arc::new(shape));
     s.rolls = rolls;
     s.throws.seed = seed;

@@ -70,7 +70,7 @@ pub fn quasi_static(
     (block, mode, faces): (Block, Mode, bool),
 ) -> Option<Vec<f64>> {
     let spec = method.spec(block, Mode::ThreeD, v, 0, 1);
-    let Some(shape) = method.shape.as_deref() else {
+    let Some(shape) = method.die.shape.as_deref() else {
         if mode != Mode::ThreeD || faces {
             return None;
         }
@@ -257,7 +257,8 @@ pub fn test_counts(
     (own, p): (&BlockPrediction, &BlockPrediction),
     runner: &Runner,
 ) -> Result<Option<Vec<CountsTest>>> {
-    let faces = method.shape.is_some() || cfg.counts.iter().any(|r| r.outcomes == Outcomes::Faces);
+    let faces =
+        method.die.shape.is_some() || cfg.counts.iter().any(|r| r.outcomes == Outcomes::Faces);
     if faces && own.faces.is_none() {
         return Err(Error::Invalid(
             "--counts counts faces, and this prediction gives none (a block in 2D?)".into(),
@@ -328,8 +329,6 @@ mod tests {
             dt: 1.0 / 250.0,
             max_steps: 20_000,
             die: Default::default(),
-            density: None,
-            shape: None,
             dice: Vec::new(),
         }
     }

@@ -6,6 +6,7 @@ use crate::calibration::params::{Kind, Method};
 use crate::calibration::predict::{group, BlockPrediction, PredictConfig, Predicted};
 use crate::calibration::FitResult;
 use crate::error::{Error, Field, Result};
+use crate::model::die::Die;
 use crate::run::runner::Runner;
 use std::path::Path;
 
@@ -33,7 +34,7 @@ pub fn check(fit: &FitResult, cfg: &PredictConfig) -> Result<()> {
     group(fit, true, &cfg.surface, "surface")?;
     group(fit, false, &cfg.thrower, "thrower")?;
     if let Some(other) = &cfg.other {
-        other.check(fit)?;
+        crate::calibration::other_die::check(other, fit)?;
         if other.shape.is_some() && cfg.mode != crate::model::scene::Mode::ThreeD {
             return Err(Error::field(
                 Field::Shape,
@@ -42,7 +43,7 @@ pub fn check(fit: &FitResult, cfg: &PredictConfig) -> Result<()> {
             ));
         }
     } else if let (Some(s), Some(own)) = (
-        &fit.config.method.shape,
+        &fit.config.method.die.shape,
         crate::calibration::predict::own_block(fit),
     ) {
         if cfg.block != own || cfg.mode != crate::model::scene::Mode::ThreeD {
@@ -118,14 +119,14 @@ fn predicts_faces(fit: &FitResult, cfg: &PredictConfig, method: &Method) -> bool
             .iter()
             .any(|r| r.outcomes == crate::calibration::data::Outcomes::Faces);
     cfg.mode == crate::model::scene::Mode::ThreeD
-        && (!method.die.is_default() || method.shape.is_some() || faces_fit)
+        && (!method.die.features.is_default() || method.die.shape.is_some() || faces_fit)
 }
 
 /// How the prediction throws: the fit's method, or the fit's with another die in place of its
 /// own.
 pub fn method_of(fit: &FitResult, cfg: &PredictConfig) -> Method {
     match &cfg.other {
-        Some(o) => o.method(&fit.config.method),
+        Some(o) => crate::calibration::other_die::method(o, &fit.config.method),
         None => fit.config.method.clone(),
     }
 }
@@ -174,7 +175,7 @@ fn fit_prediction(
     let surface = group(fit, true, &cfg.surface, "surface")?;
     let thrower = group(fit, false, &cfg.thrower, "thrower")?;
     let method = &method_of(fit, cfg);
-    let shape = method.shape.as_deref();
+    let shape = method.die.shape.as_deref();
     let with_faces = predicts_faces(fit, cfg, method);
     let mut freq: [Vec<f64>; 3] = Default::default();
     let mut face_freq: Vec<Vec<f64>> = vec![Vec::new(); super::simulate::face_count(method)];
@@ -263,7 +264,7 @@ fn fit_prediction(
         unsettled,
         overdispersion: fit.estimate.overdispersion,
         discrepancy: None,
-        extrapolation: (shape.is_none() && fit.config.method.shape.is_none())
+        extrapolation: (shape.is_none() && fit.config.method.die.shape.is_none())
             .then(|| extrapolation(fit, &cfg.block))
             .flatten(),
         other_die: cfg.other.as_ref().map(|o| o.name(cfg.block)),
@@ -361,8 +362,7 @@ pub fn die_configs(
     rolls: u64,
     seed: u64,
 ) -> Result<Vec<PredictConfig>> {
-    use crate::calibration::other_die::OtherDie;
-    let mut dice: Vec<(String, OtherDie)> = Vec::new();
+    let mut dice: Vec<(String, Die)> = Vec::new();
     rows.into_iter()
         .map(|row| {
             let at = |e: Error| Error::Invalid(format!("row '{}': {e}", row.label));
@@ -374,13 +374,9 @@ pub fn die_configs(
             let die = match dice.iter().find(|(n, _)| *n == name) {
                 Some((_, d)) => d.clone(),
                 None => {
-                    let r = crate::calibration::dice::RowDie::resolve(&name)
-                        .map_err(|e| at(Error::Invalid(format!("die '{name}': {e}"))))?;
-                    let d = OtherDie {
-                        shape: Some(r.shape),
-                        features: r.die,
-                        density: r.density,
-                    };
+                    let d = crate::calibration::dice::RowDie::resolve(&name)
+                        .map_err(|e| at(Error::Invalid(format!("die '{name}': {e}"))))?
+                        .die;
                     dice.push((name, d.clone()));
                     d
                 }

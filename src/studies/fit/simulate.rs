@@ -195,6 +195,7 @@ pub fn settled(t: &Tally) -> u64 {
 /// How many faces a fit of faces counts: a die of any shape's labels, else a cube's six.
 pub fn face_count(method: &Method) -> usize {
     method
+        .die
         .shape
         .as_ref()
         .map_or(6, |s| s.outcome_labels().len())
@@ -213,7 +214,7 @@ pub fn outcome_counts(
     if !faces {
         return Ok(vec![t.counts.length, t.counts.breadth, t.counts.width]);
     }
-    if let Some(shape) = &method.shape {
+    if let Some(shape) = &method.die.shape {
         // Each facet's count under its label (the tally keeps faces up to the last that came
         // up: the rest are 0).
         let labels = shape.outcome_labels();
@@ -237,7 +238,7 @@ pub fn outcome_counts(
                 .into(),
         ));
     }
-    let numbers = method.die.layout.numbers();
+    let numbers = method.die.features.layout.numbers();
     let mut out = vec![0; 6];
     for (d, &n) in numbers.iter().enumerate() {
         out[usize::from(n) - 1] = t.up[d];
