@@ -158,9 +158,8 @@ impl FitRequest {
         let outcomes = dice
             .iter()
             .map(|d| &d.die)
-            .chain([&die])
-            .filter_map(|d| d.shape.as_ref())
-            .map(|s| s.outcome_labels().len())
+            .chain(die.shape.is_some().then_some(&die))
+            .map(crate::model::die::Die::outcomes)
             .max()
             .unwrap_or(6);
         let (degree, max_degree) = DesignSpec::degrees(self.degree, self.max_degree, outcomes);

@@ -55,6 +55,12 @@ impl Die {
         scene
     }
 
+    /// How many outcomes its faces' counts have: a die of any shape's labels (a label on
+    /// several facets one outcome), else a cube's six numbers.
+    pub fn outcomes(&self) -> usize {
+        self.shape.as_ref().map_or(6, |s| s.outcome_labels().len())
+    }
+
     /// What it is, in a few words: its shape's name, else the block `block`.
     pub fn name(&self, block: Block) -> String {
         self.shape

@@ -178,7 +178,7 @@ fn fit_prediction(
     let shape = method.die.shape.as_deref();
     let with_faces = predicts_faces(fit, cfg, method);
     let mut freq: [Vec<f64>; 3] = Default::default();
-    let mut face_freq: Vec<Vec<f64>> = vec![Vec::new(); super::simulate::face_count(method)];
+    let mut face_freq: Vec<Vec<f64>> = vec![Vec::new(); method.die.outcomes()];
     let mut ratios = Vec::new();
     let mut unsettled = 0;
     for (m, spec) in draw_specs(fit, cfg, &surface, &thrower)?.iter().enumerate() {

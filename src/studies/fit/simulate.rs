@@ -170,7 +170,7 @@ pub fn surrogate(
 ) -> Surrogate {
     let dims = key.axes.len();
     let (outcomes, pts): (usize, Vec<DesignPoint>) = match key.mode {
-        _ if key.faces => (face_count(method), points.to_vec()),
+        _ if key.faces => (method.die.outcomes(), points.to_vec()),
         Mode::ThreeD => (3, points.to_vec()),
         Mode::TwoD => (
             2,
@@ -190,15 +190,6 @@ pub fn surrogate(
 pub fn settled(t: &Tally) -> u64 {
     let c = &t.counts;
     c.length + c.breadth + c.width + c.face
-}
-
-/// How many faces a fit of faces counts: a die of any shape's labels, else a cube's six.
-pub fn face_count(method: &Method) -> usize {
-    method
-        .die
-        .shape
-        .as_ref()
-        .map_or(6, |s| s.outcome_labels().len())
 }
 
 /// A tally's outcomes as a fit counts them: length, breadth and width vertical, or (`faces`)
