@@ -119,3 +119,68 @@ fn a_box_of_any_shape_keeps_the_shapes_rules() {
         super::helpers::stderr(&o)
     );
 }
+
+/// One die resolved once: `fit` reads a loaded die's outcomes where `roll` rolls it, at its
+/// own density. V1 (tests/data) light (50 kg/m³) with a 3 mm tungsten cube 6 mm off its
+/// centroid rests on 7 of its 11 facets; read at the paper's 800 kg/m³ instead (as `fit` did),
+/// the insert moves its centre of mass less and it rests on all 11. A counts file with the 11
+/// columns is refused, naming the four it never rests on; `roll`'s 7 are what it asks for.
+#[test]
+fn a_fit_reads_a_loaded_die_at_its_own_density_as_roll_rolls_it() {
+    let d = scratch("one-die-density");
+    let die = d.join("light.toml");
+    std::fs::write(
+        &die,
+        format!(
+            "mesh = \"{}/tests/data/hendecahedron_v1.obj\"\nscale = 14.821972\n\
+             density = 50.0\n[insert]\nsize = [3.0, 3.0, 3.0]\ncentre = [0.0, 6.0, 0.0]\n\
+             density = 19300.0\n",
+            env!("CARGO_MANIFEST_DIR")
+        ),
+    )
+    .unwrap();
+    let die = die.display().to_string();
+    let rolled = json(&dicephys(&[
+        "roll", "--die", &die, "--rolls", "1", "--json",
+    ]));
+    let labels: Vec<String> = rolled["shape"]["faces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| format!("face_{}", f["label"].as_str().unwrap()))
+        .collect();
+    assert_eq!(labels.len(), 7, "{labels:?}");
+    let all: Vec<String> = (1..=11).map(|k| format!("face_{k}")).collect();
+    let csv = d.join("v1.csv");
+    std::fs::write(
+        &csv,
+        format!(
+            "label,surface,{}\nv1,felt,{}\n",
+            all.join(","),
+            ["10"; 11].join(",")
+        ),
+    )
+    .unwrap();
+    let o = dicephys(&[
+        "fit",
+        "--data",
+        &csv.display().to_string(),
+        "--die",
+        &die,
+        "--free",
+        "e",
+        "--out",
+        &d.join("fit").display().to_string(),
+    ]);
+    super::helpers::refused(&o, 2, "the columns must be");
+    let e = super::helpers::stderr(&o);
+    assert!(e.contains(&labels.join(",")), "{e}");
+    let e = &e[e
+        .find("not its faces")
+        .expect("the faces it never rests on")..];
+    let never: Vec<&String> = all.iter().filter(|l| !labels.contains(l)).collect();
+    assert_eq!(never.len(), 4);
+    for l in never {
+        assert!(e.contains(l.as_str()), "{l} not named in: {e}");
+    }
+}
