@@ -159,9 +159,7 @@ pub fn run(mut a: FairArgs) -> Result<()> {
     // No verdict over the rolls at rest alone when many did not come to rest: the counts are
     // shown, and the run fails saying what to change.
     if !summary.partial {
-        if let Err(e) =
-            dicephys::report::shape_outcomes::check_settled(&summary.tally, &summary.spec.scene)
-        {
+        if let Err(e) = dicephys::report::shape_outcomes::check_settled(&summary.tally) {
             if *a.roll.json {
                 outln!("{}", dicephys::run::seal::to_string(&summary, true)?);
             } else {

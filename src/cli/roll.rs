@@ -170,7 +170,7 @@ pub fn run(a: &RollArgs) -> Result<()> {
     // A die of any shape none of whose rolls came to rest on a face has no shares to give.
     if let Some(shape) = summary.shape.as_ref().filter(|_| !summary.partial) {
         if summary.rolls > 0 && shape.faces.iter().all(|f| f.count == 0) {
-            let why = dicephys::report::shape_outcomes::check_settled(&summary.tally, &spec.scene)
+            let why = dicephys::report::shape_outcomes::check_settled(&summary.tally)
                 .err()
                 .map_or_else(
                     || "no roll came to rest on a face".into(),

@@ -45,7 +45,7 @@ impl Target {
         match self {
             Target::Ratio => ratio_two_sigma(&tally.counts),
             Target::Faces => {
-                let n: u64 = face_counts(tally).iter().sum();
+                let n: u64 = tally.faces.iter().sum();
                 let worst = face_variance(tally)?;
                 Some(2.0 * (worst / n as f64).sqrt())
             }
@@ -59,7 +59,7 @@ impl Target {
             // 2σ = 2 √(p(1 − p)/n) ≤ P at the largest p(1 − p): n = 4 p(1 − p)/P², scaled from
             // the faces' rolls to all rolls (some may not settle on a face).
             Target::Faces => {
-                let faced: u64 = face_counts(tally).iter().sum();
+                let faced: u64 = tally.faces.iter().sum();
                 let v = face_variance(tally)?;
                 let n = 4.0 * v / (precision * precision) * tally.rolls as f64 / faced as f64;
                 Some(n.ceil() as u64)
@@ -68,21 +68,12 @@ impl Target {
     }
 }
 
-/// The rolls at rest by face a tally counts: a die of any shape's by its resting facet, the
-/// cuboid's by the face up (a shape's `up` stays empty: counting it never ended a run).
-fn face_counts(tally: &Tally) -> &[u64] {
-    if tally.faces.is_empty() {
-        &tally.up
-    } else {
-        &tally.faces
-    }
-}
-
 /// The largest p(1 − p) over the faces a tally counts; `None` before any face.
 fn face_variance(tally: &Tally) -> Option<f64> {
-    let n: u64 = face_counts(tally).iter().sum();
+    let n: u64 = tally.faces.iter().sum();
     (n > 0).then(|| {
-        face_counts(tally)
+        tally
+            .faces
             .iter()
             .map(|&c| {
                 let p = c as f64 / n as f64;

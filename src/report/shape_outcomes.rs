@@ -90,11 +90,8 @@ pub const MAX_UNSETTLED_SHARE: f64 = 0.01;
 /// Refused, saying why and what to change, when more than [`MAX_UNSETTLED_SHARE`] of the
 /// rolls of `tally` did not come to rest on a face, or none did: a verdict over the settled
 /// rolls alone would be biased.
-pub fn check_settled(tally: &Tally, scene: &crate::model::scene::Scene) -> crate::Result<()> {
-    let faced: u64 = match scene.shape {
-        Some(_) => tally.faces.iter().sum(),
-        None => tally.up.iter().sum(),
-    };
+pub fn check_settled(tally: &Tally) -> crate::Result<()> {
+    let faced: u64 = tally.faces.iter().sum();
     let off = tally.rolls.saturating_sub(faced);
     let lean = tally.counts.unknown;
     let why = format!(
@@ -195,7 +192,7 @@ impl ShapeOutcomes {
             against_quasi_static,
             quasi_static_missing,
             unsettled: tally.rolls.saturating_sub(faced),
-            no_verdict: check_settled(tally, scene).err().map(|e| e.to_string()),
+            no_verdict: check_settled(tally).err().map(|e| e.to_string()),
         })
     }
 

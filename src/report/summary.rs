@@ -167,7 +167,7 @@ pub struct Audit {
 /// Settled rolls by the number on the face up, under `layout` (the faces a 2D die can show
 /// only); `None` if some were read from chunks written before faces were kept.
 pub fn faces_up(tally: &Tally, mode: Mode, layout: faces::Layout) -> Option<BTreeMap<String, u64>> {
-    if tally.counts.face > 0 || !tally.faces.is_empty() {
+    if tally.counts.face > 0 {
         return None;
     }
     if !tally.faces_complete() {
@@ -180,7 +180,7 @@ pub fn faces_up(tally: &Tally, mode: Mode, layout: faces::Layout) -> Option<BTre
     };
     Some(
         (0..shown)
-            .map(|d| (numbers[d].to_string(), tally.up[d]))
+            .map(|d| (numbers[d].to_string(), tally.by_direction()[d]))
             .collect(),
     )
 }

@@ -43,15 +43,72 @@ pub struct Tally {
     /// nanometres, rounded up (an integer, so that tallies merge exactly, by the maximum).
     #[serde(default)]
     pub deepest_dip_nm: u64,
-    /// Settled rolls by the face up: the direction of `faces::DIRECTIONS` (+x, −x, +y, −y,
-    /// +z, −z). They add up to the settled rolls on a side, except in a tally that holds
-    /// rolls from chunks written before faces were kept ([`Tally::faces_complete`]).
+    /// Settled rolls by the face they came to rest with: the cuboid's by the direction of its
+    /// face up (`faces::DIRECTIONS`: +x, −x, +y, −y, +z, −z; six, once a roll settled on a
+    /// side), a die of any shape's by its outcome, in the order of its faces (`Shape::faces`;
+    /// up to the last that came up). They add up to the rolls settled on a side or a face
+    /// (`counts`, their view by side), except in a tally that holds rolls from chunks written
+    /// before faces were kept ([`Tally::faces_complete`]). Written as `faces`; a cuboid's
+    /// `up`, as tallies wrote it before, is read into it.
+    #[serde(flatten)]
+    pub faces: FaceCounts,
+}
+
+/// A tally's counts by face (`Tally::faces`): a list, written as the tally's `faces` (absent
+/// when empty).
+#[derive(Clone, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(from = "FacesRead")]
+pub struct FaceCounts(pub Vec<u64>);
+
+impl std::ops::Deref for FaceCounts {
+    type Target = Vec<u64>;
+    fn deref(&self) -> &Vec<u64> {
+        &self.0
+    }
+}
+
+impl std::ops::DerefMut for FaceCounts {
+    fn deref_mut(&mut self) -> &mut Vec<u64> {
+        &mut self.0
+    }
+}
+
+impl PartialEq<Vec<u64>> for FaceCounts {
+    fn eq(&self, o: &Vec<u64>) -> bool {
+        self.0 == *o
+    }
+}
+
+impl Serialize for FaceCounts {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut m = s.serialize_map(None)?;
+        if !self.0.is_empty() {
+            m.serialize_entry("faces", &self.0)?;
+        }
+        m.end()
+    }
+}
+
+/// What a tally's faces are read from: `faces`, or, from a tally written before the cuboid's
+/// faces were counted there, its `up` (a die of any shape's tallies wrote `up` as zeros beside
+/// their `faces`).
+#[derive(Deserialize)]
+struct FacesRead {
     #[serde(default)]
-    pub up: [u64; 6],
-    /// A die of any shape (`model::shape`): settled rolls by its outcome, in the order of its
-    /// faces (`Shape::faces`); they add up to `counts.face`. Empty for the cuboid.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub faces: Vec<u64>,
+    faces: Vec<u64>,
+    #[serde(default)]
+    up: [u64; 6],
+}
+
+impl From<FacesRead> for FaceCounts {
+    fn from(r: FacesRead) -> FaceCounts {
+        FaceCounts(if r.faces.is_empty() && r.up.iter().any(|&n| n > 0) {
+            r.up.to_vec()
+        } else {
+            r.faces
+        })
+    }
 }
 
 /// Settled rolls by the side standing vertical.
@@ -122,16 +179,14 @@ impl Tally {
                 Fate::Failed(_) => {}
             }
         }
-        match (r.fate, r.up) {
-            (Fate::Settled(Outcome::Face), Some(d)) => {
-                let d = usize::from(d);
-                if self.faces.len() <= d {
-                    self.faces.resize(d + 1, 0);
-                }
-                plus(&mut self.faces[d], 1)?;
+        if let (Fate::Settled(o), Some(d)) = (r.fate, r.up) {
+            let d = usize::from(d);
+            // A cuboid's six directions at once; a shape's faces up to this one.
+            let len = if o == Outcome::Face { d + 1 } else { 6 };
+            if self.faces.len() < len {
+                self.faces.resize(len, 0);
             }
-            (Fate::Settled(_), Some(d)) => plus(&mut self.up[usize::from(d).min(5)], 1)?,
-            _ => {}
+            plus(&mut self.faces[d], 1)?;
         }
         match r.fate {
             Fate::Settled(o) => self.counts.add(o),
@@ -155,6 +210,21 @@ impl Tally {
         .into_iter()
         .chain(self.failed.values().copied())
         .try_fold(0u64, u64::checked_add);
+        let sides = c.breadth.saturating_add(c.width).saturating_add(c.length);
+        let faced = self.faces.iter().try_fold(0u64, |a, &b| a.checked_add(b));
+        // A die of any shape's faces add up to its rolls on a face; the cuboid's six
+        // directions to at most its rolls on a side, each pair to at most its side's.
+        let faces_fine = if c.face > 0 || sides == 0 {
+            faced == Some(c.face)
+        } else {
+            self.faces.len() <= 6
+                && faced.is_some_and(|n| n <= sides)
+                && (0..3).all(|k| {
+                    let side = [c.breadth, c.width, c.length][k];
+                    let at = |d: usize| self.faces.get(d).copied().unwrap_or(0);
+                    at(2 * k).saturating_add(at(2 * k + 1)) <= side
+                })
+        };
         let fine = ended == Some(self.rolls)
             && self.certified <= self.rolls
             && self
@@ -163,20 +233,7 @@ impl Tally {
                 .is_some_and(|n| n <= self.certified)
             && self.energy_gain <= self.rolls
             && self.dipped <= self.rolls
-            && self
-                .up
-                .iter()
-                .try_fold(0u64, |a, &b| a.checked_add(b))
-                .is_some_and(|n| n <= c.breadth.saturating_add(c.width).saturating_add(c.length))
-            && (0..3).all(|k| {
-                let side = [c.breadth, c.width, c.length][k];
-                self.up[2 * k].saturating_add(self.up[2 * k + 1]) <= side
-            })
-            && self
-                .faces
-                .iter()
-                .try_fold(0u64, |a, &b| a.checked_add(b))
-                .is_some_and(|n| n == c.face);
+            && faces_fine;
         if fine {
             Ok(())
         } else {
@@ -208,7 +265,7 @@ impl Tally {
         if self.faces.len() < o.faces.len() {
             self.faces.resize(o.faces.len(), 0);
         }
-        for (a, b) in self.faces.iter_mut().zip(&o.faces) {
+        for (a, b) in self.faces.iter_mut().zip(o.faces.iter()) {
             plus(a, *b)?;
         }
         plus(&mut self.unconverged, o.unconverged)?;
@@ -225,9 +282,6 @@ impl Tally {
         plus(&mut self.energy_gain, o.energy_gain)?;
         plus(&mut self.dipped, o.dipped)?;
         self.deepest_dip_nm = self.deepest_dip_nm.max(o.deepest_dip_nm);
-        for (a, b) in self.up.iter_mut().zip(o.up) {
-            plus(a, b)?;
-        }
         Ok(())
     }
 
@@ -235,7 +289,16 @@ impl Tally {
     /// written before faces were kept).
     pub fn faces_complete(&self) -> bool {
         let c = &self.counts;
-        self.up.iter().sum::<u64>() == c.breadth.saturating_add(c.width).saturating_add(c.length)
+        let settled = [c.breadth, c.width, c.length, c.face]
+            .into_iter()
+            .fold(0u64, u64::saturating_add);
+        self.faces.iter().fold(0u64, |a, &b| a.saturating_add(b)) == settled
+    }
+
+    /// The cuboid's settled rolls by the direction of the face up (`faces::DIRECTIONS`), six
+    /// (zeros before any roll settled on a side).
+    pub fn by_direction(&self) -> [u64; 6] {
+        std::array::from_fn(|d| self.faces.get(d).copied().unwrap_or(0))
     }
 
     /// `deepest_dip_nm` in metres.
@@ -304,6 +367,39 @@ impl Agreement {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn faces_are_one_count_read_from_a_tally_written_either_way() {
+        let counts = r#""counts": {"breadth": 3, "width": 4, "length": 0, "unknown": 1}"#;
+        // A cuboid's tally as written before: its faces up under `up`.
+        let old: Tally = serde_json::from_str(&format!(
+            r#"{{{counts}, "unconverged": 0, "failed": {{}}, "rolls": 8, "steps": 80,
+            "engine_steps": 80, "certified": 0, "certified_wrong": 0, "certified_steps": 0,
+            "up": [1, 2, 3, 1, 0, 0]}}"#
+        ))
+        .unwrap();
+        assert_eq!(old.faces, vec![1, 2, 3, 1, 0, 0]);
+        assert!(old.check().is_ok() && old.faces_complete());
+        // Written now: `faces`, no `up`; read back the same.
+        let v = serde_json::to_value(&old).unwrap();
+        assert!(v.get("up").is_none(), "{v}");
+        assert_eq!(v["faces"], serde_json::json!([1, 2, 3, 1, 0, 0]));
+        assert_eq!(serde_json::from_value::<Tally>(v).unwrap(), old);
+        // A die of any shape's, as written before: zeros under `up` beside its faces.
+        let shape: Tally = serde_json::from_str(
+            r#"{"counts": {"breadth": 0, "width": 0, "length": 0, "unknown": 0, "face": 5},
+            "unconverged": 0, "failed": {}, "rolls": 5, "steps": 50, "engine_steps": 50,
+            "certified": 0, "certified_wrong": 0, "certified_steps": 0,
+            "up": [0, 0, 0, 0, 0, 0], "faces": [0, 2, 0, 0, 0, 0, 0, 3]}"#,
+        )
+        .unwrap();
+        assert_eq!(shape.faces, vec![0, 2, 0, 0, 0, 0, 0, 3]);
+        assert!(shape.check().is_ok());
+        // A cuboid's directions past its sides are refused.
+        let mut forged = old.clone();
+        forged.faces[2] = 9;
+        assert!(forged.check().is_err());
+    }
 
     #[test]
     fn a_sum_past_u64_max_is_an_error_not_a_wrap() {

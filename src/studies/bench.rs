@@ -466,13 +466,12 @@ pub fn dice_costs(
                 cpu_ms_per_roll: ms,
                 vs_sharp: ms / sharp_ms,
                 engine_steps_per_roll: t.engine_steps as f64 / n as f64,
-                faces: if t.faces.is_empty() {
-                    Layout::Right
+                faces: match scene.shape {
+                    None => Layout::Right
                         .numbers()
-                        .map(|k| t.up[Layout::Right.direction_of(k).unwrap_or(0)])
-                        .to_vec()
-                } else {
-                    t.faces.clone()
+                        .map(|k| t.by_direction()[Layout::Right.direction_of(k).unwrap_or(0)])
+                        .to_vec(),
+                    Some(_) => t.faces.to_vec(),
                 },
             };
             log(&format!(

@@ -186,7 +186,7 @@ fn face_counts(
         None => (
             s.layout.numbers().to_vec(),
             DIRECTIONS.iter().map(|d| d.to_string()).collect(),
-            s.tally.up[..shown].to_vec(),
+            s.tally.by_direction()[..shown].to_vec(),
         ),
     }
 }

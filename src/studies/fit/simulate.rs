@@ -232,7 +232,7 @@ pub fn outcome_counts(
     let numbers = method.die.features.layout.numbers();
     let mut out = vec![0; 6];
     for (d, &n) in numbers.iter().enumerate() {
-        out[usize::from(n) - 1] = t.up[d];
+        out[usize::from(n) - 1] = t.by_direction()[d];
     }
     Ok(out)
 }
