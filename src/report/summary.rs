@@ -173,14 +173,14 @@ pub fn faces_up(tally: &Tally, mode: Mode, layout: faces::Layout) -> Option<BTre
     if !tally.faces_complete() {
         return None;
     }
-    let numbers = layout.numbers();
+    let (numbers, up) = (layout.numbers(), tally.by_direction());
     let shown = match mode {
         Mode::ThreeD => 6,
         Mode::TwoD => 4,
     };
     Some(
         (0..shown)
-            .map(|d| (numbers[d].to_string(), tally.by_direction()[d]))
+            .map(|d| (numbers[d].to_string(), up[d]))
             .collect(),
     )
 }

@@ -467,10 +467,13 @@ pub fn dice_costs(
                 vs_sharp: ms / sharp_ms,
                 engine_steps_per_roll: t.engine_steps as f64 / n as f64,
                 faces: match scene.shape {
-                    None => Layout::Right
-                        .numbers()
-                        .map(|k| t.by_direction()[Layout::Right.direction_of(k).unwrap_or(0)])
-                        .to_vec(),
+                    None => {
+                        let up = t.by_direction();
+                        Layout::Right
+                            .numbers()
+                            .map(|k| up[Layout::Right.direction_of(k).unwrap_or(0)])
+                            .to_vec()
+                    }
                     Some(_) => t.faces.to_vec(),
                 },
             };

@@ -230,9 +230,9 @@ pub fn outcome_counts(
         ));
     }
     let numbers = method.die.features.layout.numbers();
-    let mut out = vec![0; 6];
+    let (up, mut out) = (t.by_direction(), vec![0; 6]);
     for (d, &n) in numbers.iter().enumerate() {
-        out[usize::from(n) - 1] = t.by_direction()[d];
+        out[usize::from(n) - 1] = up[d];
     }
     Ok(out)
 }
