@@ -27,8 +27,8 @@ use dicephys::run::runner::{ChunkShare, Runner};
 use dicephys::run::spec::RunSpec;
 use dicephys::run::stop::Stop;
 use dicephys::sim::roll::{RollRecord, Rule, DEFAULT_MARGIN, DEFAULT_MAX_STEPS};
-use dicephys::studies::outputs;
 use dicephys::studies::place::{Done, Hooks, Place};
+use dicephys::studies::roll::RollStudy;
 use dicephys::studies::StudyConfig;
 use dicephys::Error;
 use pyo3::conversion::FromPyObjectOwned;
@@ -429,15 +429,15 @@ fn end_of(o: &Options) -> PyResult<EndRequest> {
 /// and, if asked, the per-roll CSV's bytes.
 fn rolled(
     py: Python<'_>,
-    spec: &RunSpec,
+    study: &RollStudy,
     layout: Layout,
     threads_: usize,
     per_roll: bool,
-    precision: Option<(f64, Target)>,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<(dicephys::report::summary::RunSummary, Option<Vec<u8>>)> {
     let threads = threads(threads_)?;
-    if let Some((p, target)) = precision {
+    let spec = &study.spec;
+    if let Some((p, target)) = study.precision.map(|p| (p, study.target())) {
         if !(p > 0.0 && p < 1.0) {
             // fair's target is every face's probability, given as `within`.
             return Err(match target {
@@ -471,8 +471,7 @@ fn rolled(
             Some(c) => c.write(recs),
             None => Ok(()),
         };
-        let precision = precision.map(|(p, t)| (p, t, &expect as &dyn Fn(u64)));
-        let summary = outputs::roll_into(spec, None, &mut sink, precision, &runner)?;
+        let summary = study.roll(&runner, None, &mut sink, &expect)?;
         if summary.partial {
             return Err(Error::Stopped);
         }
@@ -543,41 +542,17 @@ fn roll<'py>(
         let (json, text) = varied(py, &spec, layout, &v, &null_or_uniform, threads, progress)?;
         return Ok((json, text, None));
     }
-    let target = if null.is_some() {
-        Target::Faces
-    } else {
-        Target::Ratio
-    };
-    let precision = precision.map(|p| (p, target));
-    let (summary, csv) = rolled(
-        py,
-        &spec,
-        layout,
-        threads,
-        per_roll,
+    let study = RollStudy {
+        spec,
+        fair: null,
         precision,
-        progress.as_ref(),
-    )?;
-    // The document and the text the command line prints for it (`summary()` in Python).
-    let (json, text) = match null {
-        None => (
-            dicephys::run::seal::to_string(&summary, true),
-            summary.human(),
-        ),
-        Some(null) => {
-            let fair = dicephys::studies::fair::assess(&summary, &null).map_err(py_err)?;
-            let doc = serde_json::json!({ "fairness": fair, "summary": summary });
-            (
-                dicephys::run::seal::to_string(&doc, true),
-                fair.text(&summary),
-            )
-        }
+        per_roll: None,
+        resumed: false,
     };
-    Ok((
-        json.map_err(py_err)?,
-        text,
-        csv.map(|b| PyBytes::new(py, &b)),
-    ))
+    let (summary, csv) = rolled(py, &study, layout, threads, per_roll, progress.as_ref())?;
+    // The document and the text the command line prints for it (`summary()` in Python).
+    let (json, text) = study.render(&summary).map_err(py_err)?;
+    Ok((json, text, csv.map(|b| PyBytes::new(py, &b))))
 }
 
 /// `fair`'s measured counts as Python gives them: the command line's text (`1=170,2=160,…`),

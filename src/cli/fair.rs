@@ -3,11 +3,11 @@
 //! less than it favours the ends), then each face set against a fair die's.
 
 use super::error::{Error, Result};
-use super::roll::{rolled, RollArgs};
+use super::roll::RollArgs;
 use super::term::{out, outln};
 use clap::Args;
 use dicephys::model::throws::ThrowStyle;
-use dicephys::studies::fair::{assess, Null};
+use dicephys::studies::fair::Null;
 
 /// The flags that say how a die is rolled: refused beside `--counts`, which rolls nothing
 /// (the die's own flags stay: the quasi-static null reads them).
@@ -117,148 +117,12 @@ pub fn run(mut a: FairArgs) -> Result<()> {
     }
     // A checkpointed run keeps its null beside its specification, so that --resume judges it
     // as it was asked (the Ctrl-C message gives that command).
-    let null = match (&a.roll.resume, &a.roll.checkpoint) {
-        (Some(dir), _) => stored_null(dir)?,
-        (None, Some(dir)) => {
-            check_null(dir, &asked)?;
-            asked
-        }
-        (None, None) => asked,
+    let null = match &a.roll.resume {
+        Some(dir) => dicephys::studies::roll::kept_null(dir)
+            .map_err(|e| Error::Usage(format!("--resume {}: {e}", dir.display())))?,
+        None => asked,
     };
-    let _held = match &a.out {
-        Some(dir) => {
-            let identity = serde_json::json!({
-                "spec": spec, "null": (null.spec()), "layout": a.roll.layout(&spec)
-            });
-            Some(claim_out(dir, &identity)?)
-        }
-        None => None,
-    };
-    if let Some(w) = spec.endless_roll_warning() {
-        eprintln!("dicephys: warning: {w}");
-    }
-    if let Some(n) = super::roll::hull_note(&spec).filter(|_| !*a.roll.json) {
-        eprintln!("dicephys: note: {n}");
-    }
-    if let Some(n) = spec
-        .loaded_die_note(&[spec.engine])
-        .filter(|_| !*a.roll.json)
-    {
-        eprintln!("dicephys: note: {n}");
-    }
-    // The precision (--within) here is every face's probability's.
-    let (summary, done) = rolled(
-        &a.roll,
-        &spec,
-        "fair",
-        dicephys::report::precision::Target::Faces,
-    )?;
-    if let (None, Some(dir)) = (&a.roll.resume, &a.roll.checkpoint) {
-        store_null(dir, &null)?;
-    }
-    // No verdict over the rolls at rest alone when many did not come to rest: the counts are
-    // shown, and the run fails saying what to change.
-    if !summary.partial {
-        if let Err(e) = dicephys::report::shape_outcomes::check_settled(&summary.tally) {
-            if *a.roll.json {
-                outln!("{}", dicephys::run::seal::to_string(&summary, true)?);
-            } else {
-                out!("{}", summary.human());
-            }
-            return Err(Error::Run(format!("no verdict: {e}")));
-        }
-    }
-    let fair = assess(&summary, &null)?;
-    // Broken physics says so on the terminal too, whatever goes to stdout (as `roll`).
-    if *a.roll.json {
-        for w in &summary.warnings {
-            eprintln!("dicephys: warning: {w}");
-        }
-    }
-    let doc = serde_json::json!({ "fairness": fair, "summary": summary });
-    let json = dicephys::run::seal::to_string(&doc, true)?;
-    if let (Some(dir), false) = (&a.out, summary.partial) {
-        write_out(dir, &json, &fair, &summary)?;
-        if !*a.roll.json {
-            eprintln!(
-                "wrote {}/fairness.json, report.md, report.html and die_map.svg, .png",
-                dir.display()
-            );
-        }
-    }
-    if *a.roll.json {
-        outln!("{}", json);
-    } else {
-        out!("{}", fair.text(&summary));
-    }
-    done
-}
-
-/// A simulated `fair --out`: fairness.json and the figures (`studies::fair::write`), and the
-/// verdict as printed with them as report.md and report.html.
-fn write_out(
-    dir: &std::path::Path,
-    json: &str,
-    fair: &dicephys::report::fair::Fairness,
-    summary: &dicephys::report::summary::RunSummary,
-) -> Result<()> {
-    dicephys::studies::fair::write(dir, json, fair, summary)?;
-    dicephys::report::html::write_text_report(
-        dir,
-        "Is this die fair?",
-        &fair.text(summary),
-        &["die_map", "faces"],
-    )?;
-    Ok(())
-}
-
-/// The file in a `fair` run's checkpoint that keeps its null.
-const NULL_FILE: &str = "fair-null.json";
-
-/// Refused if the checkpoint `dir` keeps another null than `null`.
-fn check_null(dir: &std::path::Path, null: &Null) -> Result<()> {
-    let file = dir.join(NULL_FILE);
-    if file.exists() {
-        let kept = stored_null(dir)?;
-        if kept != *null {
-            return Err(Error::Usage(format!(
-                "--checkpoint {}: it holds a fair run against {kept}, not {null}: resume that \
-                 run (dicephys fair --resume {}), or use a new directory",
-                dir.display(),
-                dir.display()
-            )));
-        }
-    }
-    Ok(())
-}
-
-/// Keeps `null` in the checkpoint `dir` (the run's, opened by now) for `--resume`.
-fn store_null(dir: &std::path::Path, against: &Null) -> Result<()> {
-    if !dir.join("spec.json").exists() {
-        return Ok(());
-    }
-    let file = dir.join(NULL_FILE);
-    let json = serde_json::to_string(&serde_json::json!({ "null": against }))
-        .map_err(|e| Error::Usage(e.to_string()))?;
-    dicephys::run::io::write_atomic(&file, json.as_bytes())?;
-    Ok(())
-}
-
-/// The null a checkpointed `fair` run keeps (a `roll` checkpoint, which keeps none: uniform).
-fn stored_null(dir: &std::path::Path) -> Result<Null> {
-    let file = dir.join(NULL_FILE);
-    if !file.exists() {
-        return Ok(Null::default());
-    }
-    let text = std::fs::read_to_string(&file)
-        .map_err(|e| Error::Usage(format!("--resume {}: {e}", file.display())))?;
-    #[derive(serde::Deserialize)]
-    struct Kept {
-        null: Null,
-    }
-    serde_json::from_str::<Kept>(&text)
-        .map(|k| k.null)
-        .map_err(|e| Error::Usage(format!("{} is damaged ({e})", file.display())))
+    super::roll::study(&a.roll, spec, Some(null), a.out.as_deref())
 }
 
 /// `--out DIR` made, claimed and held for this `fair` run (another run's directory is refused,

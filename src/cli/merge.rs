@@ -6,6 +6,7 @@ use super::error::{Error, Result};
 use super::term::{out, outln};
 use clap::Args;
 use dicephys::report::summary::{RunSummary, ShardResult};
+use dicephys::studies::roll::RollStudy;
 use std::path::PathBuf;
 
 /// `dicephys merge`'s arguments.
@@ -68,25 +69,17 @@ pub fn run(a: &MergeArgs) -> Result<()> {
         ));
     }
     let out = RunSummary::merge(&parts)?;
-    if let Some(Some(null)) = nulls.first() {
-        let fair = dicephys::studies::fair::assess(&out, null)?;
-        let doc = serde_json::json!({ "fairness": fair, "summary": out });
-        if *a.json {
-            outln!("{}", dicephys::run::seal::to_string(&doc, true)?);
-        } else {
-            out!("{}", fair.text(&out));
-        }
-        return Ok(());
-    }
+    // The one machine's `roll` (or `fair`) rendering of the merged run.
+    let fair = nulls.into_iter().next().flatten();
+    let (json, text) = RollStudy::new(out.spec.clone(), fair).render(&out)?;
     if *a.json {
-        outln!("{}", dicephys::run::seal::to_string(&out, true)?);
+        outln!("{json}");
     } else {
-        out!("{}", out.human());
+        out!("{text}");
     }
     Ok(())
 }
 
-/// The most a shard's `roll --json` output is read of: it is a few kilobytes.
 const MAX_SHARD_BYTES: u64 = 16 << 20;
 
 /// The text of `f`, read no further than [`MAX_SHARD_BYTES`] (a file larger than that is not

@@ -3,17 +3,16 @@
 use super::args::Json;
 use super::args::{parse_engine, RunArgs, SceneArgs, ThrowArgs};
 use super::error::{Error, Result};
-use super::term::{out, outln};
 use clap::Args;
 use dicephys::engine::EngineKind;
-use dicephys::report::precision::Target;
-use dicephys::report::progress::{Progress, Unit};
+use dicephys::report::fair::Null;
 use dicephys::run::request::RollRequest;
-use dicephys::run::runner::{Checkpoint, Runner};
+use dicephys::run::runner::{Checkpoint, ChunkShare};
 use dicephys::run::spec::{RunSpec, Shard};
-use dicephys::studies::outputs;
-use std::path::PathBuf;
-use std::sync::atomic::Ordering::Relaxed;
+use dicephys::studies::place::Place;
+use dicephys::studies::roll::RollStudy;
+use dicephys::studies::StudyConfig;
+use std::path::{Path, PathBuf};
 
 /// The options that define a run: `--resume` takes them from the checkpoint instead.
 const DEFINING: [&str; 36] = [
@@ -143,131 +142,45 @@ pub fn run(a: &RollArgs) -> Result<()> {
                 .into(),
         ));
     }
-    if let Some(w) = paper_throw_warning(&spec) {
-        eprintln!("{w}");
-    }
-    if let Some(w) = spec.endless_roll_warning() {
-        eprintln!("dicephys: warning: {w}");
-    }
-    if let Some(n) = hull_note(&spec).filter(|_| !*a.json) {
-        eprintln!("dicephys: note: {n}");
-    }
-    if let Some(n) = spec.loaded_die_note(&[spec.engine]).filter(|_| !*a.json) {
-        eprintln!("dicephys: note: {n}");
-    }
-    let (summary, done) = rolled(a, &spec, "roll", Target::Ratio)?;
-    // Broken physics says so on the terminal too, whatever goes to stdout.
-    if *a.json {
-        for w in &summary.warnings {
-            eprintln!("dicephys: warning: {w}");
-        }
-    }
-    if *a.json {
-        outln!("{}", dicephys::run::seal::to_string(&summary, true)?);
-    } else {
-        out!("{}", summary.human());
-    }
-    // A die of any shape none of whose rolls came to rest on a face has no shares to give.
-    if let Some(shape) = summary.shape.as_ref().filter(|_| !summary.partial) {
-        if summary.rolls > 0 && shape.faces.iter().all(|f| f.count == 0) {
-            let why = dicephys::report::shape_outcomes::check_settled(&summary.tally)
-                .err()
-                .map_or_else(
-                    || "no roll came to rest on a face".into(),
-                    |e| e.to_string(),
-                );
-            return Err(Error::Run(why));
-        }
-    }
-    done
+    study(a, spec, None, None)
 }
 
-/// Rolls `spec` as `roll` does (its checkpoint, per-roll CSV, precision and progress bar,
-/// named `command`): its summary, numbered by `--layout`, and what to end with once it is
-/// printed (a stop request's interruption, with how to continue).
-pub fn rolled(
-    a: &RollArgs,
-    spec: &RunSpec,
-    command: &'static str,
-    target: dicephys::report::precision::Target,
-) -> Result<(dicephys::report::summary::RunSummary, Result<()>)> {
-    // The flag that set the precision: fair's target is its faces (--within).
-    let flag = match target {
-        Target::Ratio => "--precision",
-        Target::Faces => "--within",
-    };
+/// Rolls `spec` as `a` asks (its checkpoint, per-roll CSV, precision), as every study runs
+/// (`studies::roll`: its bar, its notes, what it prints, how it ends); with `fair`, its faces
+/// judged against that null, and its files written into `out` if given.
+pub fn study(a: &RollArgs, spec: RunSpec, fair: Option<Null>, out: Option<&Path>) -> Result<()> {
     if let (Some(_), Some(_)) = (a.run.precision, spec.shard) {
+        // The flag that set the precision: fair's target is its faces (--within).
+        let flag = if fair.is_some() {
+            "--within"
+        } else {
+            "--precision"
+        };
         return Err(Error::Usage(format!(
             "{flag} with --shard: a shard rolls a fixed share of the throws; give --rolls"
         )));
     }
     let threads = a.run.threads()?;
-    let per_roll = a
-        .per_roll
-        .as_deref()
-        .map(|p| super::term::output(p).map(|o| (o, a.layout(spec))))
-        .transpose()?;
-    let dir = a.resume.as_ref().or(a.checkpoint.as_ref());
-    let total = spec.indices().len();
-    let unit = Unit::Rolls { per_cell: 0 };
-    let bar = Progress::new(command, unit, true, *a.json, super::study::every());
-    // Under --precision the total is the rolls expected so far, not the cap.
-    let expected = std::sync::atomic::AtomicU64::new(total);
-    let progress = |n: u64| bar.set(n as f64, expected.load(Relaxed) as f64);
-    let expect = |n: u64| expected.store(n, Relaxed);
-    let runner = Runner::new(threads, super::term::stop().clone());
-    let runner = runner.with_progress(&progress);
-    let summary = outputs::roll(
-        spec,
-        dir.map(PathBuf::as_path),
-        per_roll,
-        a.run
-            .precision
-            .map(|p| (p, target, &expect as &dyn Fn(u64))),
-        &runner,
-    );
-    bar.finish();
-    let summary = summary?.with_layout(a.layout(spec));
-    let rolled = summary.rolls;
-    if summary.partial {
-        let resume = dir.map(|d| {
-            format!(
-                "dicephys {command} --resume {}{}",
-                d.display(),
-                a.run
-                    .precision
-                    .map_or(String::new(), |p| format!(" {flag} {}", 100.0 * p))
-            )
-        });
-        let why = Error::Interrupted(dicephys::run::stop::interrupted(
-            &dicephys::run::stop::Kept::Rolls {
-                done: rolled,
-                of: total,
-                resume,
-            },
-        ));
-        return Ok((summary, Err(why)));
+    if let Some(dir) = out {
+        std::fs::create_dir_all(dir).map_err(|e| {
+            Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
+        })?;
+        dicephys::run::owner::refuse_cluster_run(dir)?;
     }
-    Ok((summary, Ok(())))
-}
-
-/// A warning when the paper's throw meets a block whose long axis is not unique (a cube): the
-/// throw spins it about body z, so the two z faces come up less often than a tester's throw
-/// would show them (issue 50: "a fair cube that looks loaded").
-fn paper_throw_warning(spec: &RunSpec) -> Option<String> {
-    let b = &spec.scene.block;
-    let paper = spec.throws.style == dicephys::model::throws::ThrowStyle::Paper;
-    (paper && spec.scene.shape.is_none() && b.length <= b.breadth * (1.0 + 1e-9)).then(|| {
-        format!(
-            "dicephys: warning: the paper's throw spins the block about its length, and {} has \
-             no longer length: faces 1 and 6 will come up less often than on a tester's throw; \
-             --throw tumble throws it without a preferred axis",
-            b
-        )
-    })
-}
-
-/// The note for a die of any shape that is not convex (it rolls on its hull), if it is one.
-pub fn hull_note(spec: &RunSpec) -> Option<String> {
-    spec.scene.shape.as_ref().and_then(|s| s.hull_note())
+    let study = RollStudy {
+        spec,
+        fair,
+        precision: a.run.precision,
+        per_roll: a.per_roll.clone(),
+        resumed: a.resume.is_some(),
+    };
+    let place = Place {
+        out: out.map(Path::to_path_buf).unwrap_or_default(),
+        checkpoint: a.resume.clone().or_else(|| a.checkpoint.clone()),
+        threads,
+        share: ChunkShare::All,
+        json: *a.json,
+        command_line: super::term::command_line(),
+    };
+    super::study::run(&StudyConfig::Roll(study), &place)
 }

@@ -93,8 +93,9 @@ fn with_hooks(
     if let Some(n) = done.note {
         eprintln!("{}", super::error::flags_in(&n));
     }
-    match done.interrupted {
-        Some(m) => Err(Error::Interrupted(m)),
-        None => Ok(()),
+    match (done.interrupted, done.failed) {
+        (Some(m), _) => Err(Error::Interrupted(m)),
+        (None, Some(m)) => Err(Error::Run(m)),
+        (None, None) => Ok(()),
     }
 }

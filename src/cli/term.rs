@@ -34,11 +34,6 @@ macro_rules! out {
 }
 pub(crate) use {out, outln};
 
-/// Checks an output path before anything runs (exit 2 if it cannot be written).
-pub fn output(path: &std::path::Path) -> error::Result<dicephys::run::io::Output> {
-    Ok(dicephys::run::io::Output::check(path)?)
-}
-
 /// This process's command line, to be named in reports (never parsed): its arguments as
 /// given, a byte that is not UTF-8 (in a path, say) shown as U+FFFD rather than a panic.
 pub fn command_line() -> String {

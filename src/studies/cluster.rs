@@ -316,14 +316,7 @@ pub fn finishing(dir: &Path) -> Result<Finishing> {
         Plan::Roll { spec, tasks, fair } => {
             let merged = merge_shards(&lay, &spec, tasks)?;
             // What the one machine's `roll --json` (or `fair --json`) prints, and its text.
-            let (json, text) = match fair {
-                None => (crate::run::seal::to_string(&merged, true)?, merged.human()),
-                Some(null) => {
-                    let f = crate::studies::fair::assess(&merged, &null)?;
-                    let doc = serde_json::json!({ "fairness": f, "summary": merged });
-                    (crate::run::seal::to_string(&doc, true)?, f.text(&merged))
-                }
-            };
+            let (json, text) = super::roll::RollStudy::new(*spec, fair).render(&merged)?;
             let (j, t) = (
                 Output::check(&lay.result_json())?,
                 Output::check(&lay.result_text())?,

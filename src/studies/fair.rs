@@ -785,7 +785,7 @@ pub fn vary(
         let base = i as u64 * spec.rolls;
         let progress = |n| (runner.progress)(base + n);
         let summary =
-            crate::studies::outputs::roll(s, None, None, None, &runner.with_progress(&progress))?
+            crate::studies::roll::roll(s, None, None, None, &runner.with_progress(&progress))?
                 .with_layout(layout);
         if summary.partial {
             return Ok(None);

@@ -19,6 +19,7 @@ pub mod outputs;
 pub mod paper;
 pub mod place;
 pub mod precision;
+pub mod roll;
 pub mod stability;
 pub mod stream;
 pub mod study;
@@ -63,6 +64,8 @@ pub enum StudyConfig {
     PredictBlocks(fit::BlocksStudy),
     /// `paper --calibrated`, or one of its two stages.
     Calibrated(calibrated::CalibratedStudy),
+    /// `roll`, or `fair` rolling its die.
+    Roll(roll::RollStudy),
 }
 
 impl StudyConfig {
@@ -80,6 +83,7 @@ impl StudyConfig {
             StudyConfig::Predict(c) => c,
             StudyConfig::PredictBlocks(c) => c,
             StudyConfig::Calibrated(c) => c,
+            StudyConfig::Roll(c) => c,
         }
     }
 
@@ -94,6 +98,7 @@ impl StudyConfig {
         let id = match self {
             StudyConfig::Converge(c) => StudyConfig::Converge(c.identity()),
             StudyConfig::Tradeoff(c) => StudyConfig::Tradeoff(c.identity()),
+            StudyConfig::Roll(c) => return c.identity(),
             other => other.clone(),
         };
         serde_json::to_value(id).unwrap_or_default()

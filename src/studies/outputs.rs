@@ -10,21 +10,14 @@ use super::study::Study;
 use super::StudyConfig;
 use crate::error::{Error, Field, Result};
 use crate::report;
-use crate::report::per_roll::PerRoll;
 pub use crate::report::progress::Unit;
-use crate::report::summary::{Cost, RunSummary};
 use crate::report::Report;
-use crate::run::cputime::process_cpu_seconds;
-use crate::run::io::Output;
-use crate::run::runner::{Checkpoint, ChunkShare, Runner};
+use crate::run::runner::ChunkShare;
 use crate::run::slurm::{Layout, Plan};
-use crate::run::spec::RunSpec;
 
-use crate::sim::roll::RollRecord;
 use crate::studies;
 use serde::Serialize;
 use std::path::Path;
-use std::time::Instant;
 
 impl Kind for studies::paper::PaperConfig {
     fn name(&self) -> &'static str {
@@ -174,79 +167,6 @@ pub fn planned(lay: &Layout) -> Result<(StudyConfig, Place, u64)> {
     Ok((cfg, place, tasks))
 }
 
-/// A precision to roll to: the fraction, what it is of, and a hook told the rolls expected in
-/// all as the run goes.
-pub type Precision<'a> = (f64, crate::report::precision::Target, &'a dyn Fn(u64));
-
-/// `roll`: one run, its chunks kept in `checkpoint` if given (a run there is continued), one
-/// CSV row per throw into `per_roll` if given (grown chunk by chunk in a temporary file, put
-/// in place at the end). Its summary is partial if a stop request ended it; a resumed run's
-/// cost is the sum over its segments (the resumed chunks carry theirs).
-/// With `precision` (a fraction, what it is of, and a hook told the rolls expected in all as it
-/// goes), the run stops at the first chunk boundary where the ratio's relative 2σ error (or
-/// every face's 2σ) is at most that, `spec.rolls` its cap (`studies::precision`).
-pub fn roll(
-    spec: &RunSpec,
-    checkpoint: Option<&Path>,
-    per_roll: Option<(Output, crate::model::faces::Layout)>,
-    precision: Option<Precision>,
-    runner: &Runner,
-) -> Result<RunSummary> {
-    let mut csv = match &per_roll {
-        Some((out, layout)) => Some(PerRoll::for_scene(out.writer()?, &spec.scene, *layout)?),
-        None => None,
-    };
-    let mut sink = |recs: &[RollRecord]| -> Result<()> {
-        match csv.as_mut() {
-            Some(c) => c.write(recs),
-            None => Ok(()),
-        }
-    };
-    let summary = roll_into(spec, checkpoint, &mut sink, precision, runner)?;
-    if let Some(c) = csv {
-        c.finish()?.commit()?;
-    }
-    Ok(summary)
-}
-
-/// `roll` with every finished chunk's records, in throw order, handed to `sink` (the per-roll
-/// CSV, or a caller's own table: the Python package's arrays are these same rows).
-pub fn roll_into(
-    spec: &RunSpec,
-    checkpoint: Option<&Path>,
-    sink: &mut dyn FnMut(&[RollRecord]) -> Result<()>,
-    precision: Option<Precision>,
-    runner: &Runner,
-) -> Result<RunSummary> {
-    let checkpoint = checkpoint.map(|d| Checkpoint::open(d, spec)).transpose()?;
-    let wall = Instant::now();
-    let cpu = process_cpu_seconds();
-    let (done, reached) = match precision {
-        Some((p, target, expect)) => {
-            let (done, reached) = studies::precision::roll_to_precision(
-                runner,
-                spec,
-                checkpoint.as_ref(),
-                p,
-                target,
-                expect,
-                sink,
-            )?;
-            (done, Some(reached))
-        }
-        None => (runner.run(spec, checkpoint.as_ref(), sink)?, None),
-    };
-    let cost = Cost {
-        wall_s: wall.elapsed().as_secs_f64() + done.resumed_wall_s,
-        cpu_s: process_cpu_seconds() - cpu + done.resumed_cpu_s,
-        threads: runner.threads,
-    };
-    let mut summary = RunSummary::new(spec, &done.tally, cost);
-    summary.partial = !done.complete;
-    summary.precision = reached;
-    Ok(summary)
-}
-
 /// `paper`: results.json, results.csv, report.md and the figures, in `place.out`; its cells
 /// under `place.checkpoint`, so that the same study run again continues where it stopped.
 fn paper(cfg: &studies::paper::PaperConfig, place: &Place, hooks: &Hooks) -> Result<Done> {
@@ -266,8 +186,8 @@ fn paper(cfg: &studies::paper::PaperConfig, place: &Place, hooks: &Hooks) -> Res
         let figures = ["master_graph", "prob_2d", "len_graph", "dreidel"].map(String::from);
         return Ok(Done {
             stdout: format!("{}\n", res.markdown(&figures)),
-            note: None,
             interrupted: place.interrupted().interrupted,
+            ..Done::default()
         });
     }
     let figures = res.write_figures(&place.out)?;

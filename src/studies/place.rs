@@ -50,6 +50,9 @@ pub struct Done {
     pub note: Option<crate::error::Text>,
     /// Stopped before the end, and what was kept: the caller ends with its own exit code.
     pub interrupted: Option<String>,
+    /// Ended, its result printed, but failed (a die none of whose rolls came to rest on a
+    /// face): the caller prints its output, then ends as a failed run, saying this.
+    pub failed: Option<String>,
 }
 
 impl Place {
@@ -120,7 +123,7 @@ impl Place {
             note: (!self.json).then(|| {
                 format!("wrote {}/{file}, report.md and figures", self.out.display()).into()
             }),
-            interrupted: None,
+            ..Done::default()
         }
     }
 }

@@ -226,8 +226,7 @@ fn faces_at(
     layout: Layout,
     runner: &Runner,
 ) -> Result<Option<(Vec<String>, Vec<u64>)>> {
-    let summary =
-        crate::studies::outputs::roll(spec, None, None, None, runner)?.with_layout(layout);
+    let summary = crate::studies::roll::roll(spec, None, None, None, runner)?.with_layout(layout);
     if summary.partial {
         return Ok(None);
     }
@@ -285,8 +284,8 @@ fn batched_at(
         }
         Ok(())
     };
-    let summary = crate::studies::outputs::roll_into(spec, None, &mut sink, None, runner)?
-        .with_layout(layout);
+    let summary =
+        crate::studies::roll::roll_into(spec, None, &mut sink, None, runner)?.with_layout(layout);
     if summary.partial {
         return Ok(None);
     }
@@ -440,7 +439,7 @@ pub fn run(cfg: &DesignConfig, runner: &Runner) -> Result<Option<Design>> {
     let progress = |n| (runner.progress)(base + n);
     let runner = runner.with_progress(&progress);
     let summary =
-        crate::studies::outputs::roll(&spec, None, None, None, &runner)?.with_layout(cfg.layout);
+        crate::studies::roll::roll(&spec, None, None, None, &runner)?.with_layout(cfg.layout);
     if summary.partial {
         return Ok(None);
     }
