@@ -175,6 +175,10 @@ pub enum Field {
     Data,
     /// `density`.
     Density,
+    /// `dicephys`: DicePhys 2.81's binary, run beside `bench`.
+    Dicephys,
+    /// `dice_rolls`.
+    DiceRolls,
     /// `die`.
     Die,
     /// `dir`.
@@ -284,6 +288,8 @@ pub enum Field {
     ReferenceDt,
     /// `refine`.
     Refine,
+    /// `repeat`: `bench`'s rounds, each measurement's fastest kept.
+    Repeat,
     /// `repeats`.
     Repeats,
     /// `resolve`.

@@ -144,6 +144,7 @@ impl Session {
         let progress = |d, t| self.set(d, t);
         f(&Hooks {
             log: &log,
+            print: &log,
             progress: &progress,
             stop: self.stop.clone(),
         })

@@ -1,10 +1,11 @@
 //! `dicephys bench`: speed of every engine and lever against the faithful configuration.
 
 use super::args::{Json, Seed, Threads};
-use super::error::{Error, Result};
-use super::term::outln;
+use super::error::Result;
 use clap::Args;
-use dicephys::studies::bench;
+use dicephys::run::runner::ChunkShare;
+use dicephys::studies::place::Place;
+use dicephys::studies::{bench, StudyConfig};
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
@@ -36,59 +37,21 @@ pub struct BenchArgs {
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
-    if a.rolls == 0 {
-        return Err(Error::Usage("--rolls 0: need at least one roll".into()));
-    }
-    if a.repeat == 0 {
-        return Err(Error::Usage("--repeat 0: need at least one run".into()));
-    }
-    if a.dice_rolls > 1_000_000 {
-        return Err(Error::Usage(format!(
-            "--dice-rolls {}: at most 1000000",
-            a.dice_rolls
-        )));
-    }
-    if a.rolls > 10_000_000 {
-        return Err(Error::Usage(format!(
-            "--rolls {}: at most 10000000",
-            a.rolls
-        )));
-    }
-    let threads = a.threads.checked()?;
-    if let Some(p) = &a.dicephys {
-        if !p.is_file() {
-            return Err(Error::Usage(format!(
-                "--dicephys {}: not a file (DicePhys 2.81's binary)",
-                p.display()
-            )));
-        }
-    }
-    let quiet = *a.json;
-    if !quiet {
-        outln!("{}", dicephys::report::bench::header());
-    }
-    // A progress line that cannot be written (a closed pipe) is dropped; the result is
-    // written, or its failure reported, at the end.
     let cfg = bench::Config {
         rolls: a.rolls,
         dice_rolls: a.dice_rolls,
         seed: *a.seed,
-        threads,
+        threads: a.threads.checked()?,
         repeat: a.repeat,
         dicephys: a.dicephys.clone(),
     };
-    let b = bench::run(&cfg, super::term::stop(), &|line| {
-        if !quiet {
-            let _ = super::term::stdout(&format!("{line}\n"));
-        }
-    })?;
-    if *a.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&b).map_err(|e| Error::Run(e.to_string()))?
-        );
-    } else {
-        outln!("peak RSS {:.1} MB", b.peak_rss_mb);
-    }
-    Ok(())
+    let place = Place {
+        out: std::path::PathBuf::new(),
+        checkpoint: None,
+        threads: cfg.threads,
+        share: ChunkShare::All,
+        json: *a.json,
+        command_line: super::term::command_line(),
+    };
+    super::study::run(&StudyConfig::Bench(cfg), &place)
 }

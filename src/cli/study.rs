@@ -82,8 +82,16 @@ fn with_hooks(
     let progress = Progress::new(command, unit, true, json, every());
     let log = |l: &str| progress.suspend(|| eprintln!("{l}"));
     let set = |done: f64, total: f64| progress.set(done, total);
+    // A line of the result as it comes goes to stdout; one that cannot be written (a closed
+    // pipe) is dropped, and the result's own write at the end reports it.
+    let print = |l: &str| {
+        progress.suspend(|| {
+            let _ = super::term::stdout(&format!("{l}\n"));
+        })
+    };
     let done = run(&Hooks {
         log: &log,
+        print: &print,
         progress: &set,
         stop: super::term::stop().clone(),
     });

@@ -19,6 +19,9 @@ pub enum Unit {
     Cells,
     /// Estimated CPU seconds of a study rolled to a precision.
     Cpu,
+    /// Nothing counted: the study prints its rows as it makes them (`bench`), which are its
+    /// progress; no bar, no progress lines.
+    Rows,
 }
 
 /// A command's progress: `set` it as work is done.
@@ -42,12 +45,12 @@ impl Progress {
         every: Duration,
     ) -> Progress {
         let terminal = std::io::stderr().is_terminal();
-        let b = if terminal && bar && !quiet {
+        let b = if terminal && bar && !quiet && unit != Unit::Rows {
             let b = ProgressBar::with_draw_target(Some(1), ProgressDrawTarget::stderr());
             let template = match unit {
                 Unit::Rolls { .. } => "{elapsed_precise} [{wide_bar}] {pos}/{len} rolls, ETA {eta}",
                 Unit::Cells => "{elapsed_precise} [{wide_bar}] {pos}/{len} cells, ETA {eta}",
-                Unit::Cpu => {
+                Unit::Cpu | Unit::Rows => {
                     "{elapsed_precise} [{wide_bar}] {percent}% of the planned CPU, ETA {eta}"
                 }
             };
@@ -64,7 +67,7 @@ impl Progress {
             command,
             unit,
             bar: b,
-            lines: (!terminal).then(|| (now, Mutex::new(now))),
+            lines: (!terminal && unit != Unit::Rows).then(|| (now, Mutex::new(now))),
             every,
         }
     }
@@ -92,7 +95,7 @@ impl Progress {
             ),
             Unit::Rolls { .. } => format!("{done:.0} of {total:.0} rolls"),
             Unit::Cells => format!("{done:.0} of {total:.0} cells done"),
-            Unit::Cpu => "of the planned CPU".to_string(),
+            Unit::Cpu | Unit::Rows => "of the planned CPU".to_string(),
         };
         let eta = if f > 0.0 {
             let left = start.elapsed().as_secs_f64() * (1.0 - f) / f;

@@ -15,7 +15,7 @@ use crate::run::cputime::{peak_rss_bytes, process_cpu_seconds};
 use crate::run::tally::{Agreement, Tally};
 use crate::sim::roll::{RollConfig, RollRecord, Rule};
 use crate::theory::stats;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
 /// The children's CPU seconds so far (user and system).
@@ -488,7 +488,7 @@ pub fn dice_costs(
 }
 
 /// What the benchmark measures.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Config {
     /// Throws per method, mode and thread count.
     pub rolls: u64,
@@ -502,6 +502,47 @@ pub struct Config {
     pub repeat: u32,
     /// DicePhys 2.81's binary, to run beside (`None`: no ratio to DicePhys).
     pub dicephys: Option<std::path::PathBuf>,
+}
+
+/// The most throws per method a bench takes.
+pub const MAX_ROLLS: u64 = 10_000_000;
+
+/// The most throws per made die a bench takes.
+pub const MAX_DICE_ROLLS: u64 = 1_000_000;
+
+impl Config {
+    /// Checks every value before anything runs.
+    pub fn validate(&self) -> crate::Result<()> {
+        use crate::error::{Error, Field};
+        if self.rolls == 0 {
+            return Err(Error::field(Field::Rolls, 0, "need at least one roll"));
+        }
+        if self.rolls > MAX_ROLLS {
+            return Err(Error::field(
+                Field::Rolls,
+                self.rolls,
+                format!("at most {MAX_ROLLS}"),
+            ));
+        }
+        if self.repeat == 0 {
+            return Err(Error::field(Field::Repeat, 0, "need at least one run"));
+        }
+        if self.dice_rolls > MAX_DICE_ROLLS {
+            return Err(Error::field(
+                Field::DiceRolls,
+                self.dice_rolls,
+                format!("at most {MAX_DICE_ROLLS}"),
+            ));
+        }
+        if let Some(p) = self.dicephys.as_ref().filter(|p| !p.is_file()) {
+            return Err(Error::field(
+                Field::Dicephys,
+                p.display(),
+                "not a file (DicePhys 2.81's binary)",
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// A method's records (the same every run: runs are reproducible) and its fastest run's wall

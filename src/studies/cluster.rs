@@ -71,6 +71,7 @@ fn stage(s: &Submitted, job: &Job, dry: bool) -> Result<Staged> {
         let place = Place::cluster(lay, s.threads, s.json, ChunkShare::DryRun, s.command_line);
         let quiet = Hooks {
             log: &|_| {},
+            print: &|_| {},
             progress: &|_, _| {},
             stop: Stop::new(),
         };

@@ -66,6 +66,8 @@ pub enum StudyConfig {
     Calibrated(calibrated::CalibratedStudy),
     /// `roll`, or `fair` rolling its die.
     Roll(roll::RollStudy),
+    /// `bench`.
+    Bench(bench::Config),
 }
 
 impl StudyConfig {
@@ -84,6 +86,7 @@ impl StudyConfig {
             StudyConfig::PredictBlocks(c) => c,
             StudyConfig::Calibrated(c) => c,
             StudyConfig::Roll(c) => c,
+            StudyConfig::Bench(c) => c,
         }
     }
 

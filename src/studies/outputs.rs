@@ -145,6 +145,53 @@ impl Kind for studies::validate::Config {
     }
 }
 
+impl Kind for studies::bench::Config {
+    fn name(&self) -> &'static str {
+        "bench"
+    }
+    fn validate(&self) -> Result<()> {
+        studies::bench::Config::validate(self)
+    }
+    /// Its rows, printed as they are measured, are its progress.
+    fn unit(&self) -> Unit {
+        Unit::Rows
+    }
+    fn owns<'a>(&self, _: &'a Place) -> Option<&'a Path> {
+        None
+    }
+    fn check_splittable(&self) -> Result<()> {
+        Err(Error::Invalid(
+            "bench times the methods side by side on one machine: a cluster's tasks would \
+             time each on another"
+                .into(),
+        ))
+    }
+    fn run(&self, place: &Place, hooks: &Hooks) -> Result<Done> {
+        bench(self, place, hooks)
+    }
+}
+
+/// `bench`: each measurement's row printed as it is made (not with `--json`), then the
+/// whole result as JSON, or the peak memory.
+fn bench(cfg: &studies::bench::Config, place: &Place, hooks: &Hooks) -> Result<Done> {
+    let quiet = place.json;
+    if !quiet {
+        (hooks.print)(&report::bench::header());
+    }
+    let b = studies::bench::run(cfg, &hooks.stop, &|line| {
+        if !quiet {
+            (hooks.print)(line)
+        }
+    })?;
+    Ok(Done {
+        stdout: match place.json {
+            true => format!("{}\n", to_json(&b)?),
+            false => format!("peak RSS {:.1} MB\n", b.peak_rss_mb),
+        },
+        ..Done::default()
+    })
+}
+
 /// The study stored in a cluster run's plan, where it runs (on all its chunks: a task narrows
 /// the share) and the run's tasks.
 pub fn planned(lay: &Layout) -> Result<(StudyConfig, Place, u64)> {

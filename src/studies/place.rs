@@ -35,6 +35,9 @@ pub struct Place {
 pub struct Hooks<'a> {
     /// A line of the log (a cell, a row, the plan).
     pub log: &'a (dyn Fn(&str) + Sync),
+    /// A line of the result, printed as it is made (on the command line's stdout): `bench`'s
+    /// rows, each a measurement minutes apart. Every other study's result is its `Done`.
+    pub print: &'a (dyn Fn(&str) + Sync),
     /// Progress: done and in all.
     pub progress: Progress<'a>,
     /// Checked before every roll.

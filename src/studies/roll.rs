@@ -490,6 +490,7 @@ mod tests {
         };
         let hooks = Hooks {
             log: &|_| {},
+            print: &|_| {},
             progress: &|_, _| {},
             stop: crate::run::stop::Stop::new(),
         };
