@@ -540,7 +540,7 @@ fn roll<'py>(
         ));
     }
     if let Some(v) = vary {
-        let (json, text) = varied(py, &spec, layout, &v, &null_or_uniform, threads, progress)?;
+        let (json, text) = varied(py, &spec, &v, &null_or_uniform, threads, progress)?;
         return Ok((json, text, None));
     }
     let study = RollStudy {
@@ -605,32 +605,31 @@ fn counts_given(c: &Bound<'_, PyAny>, spec: &RunSpec) -> PyResult<Vec<(String, u
 }
 
 /// `fair --vary`: the die of `spec` at each value `vary` names (`NAME=LO:HI:N`), each judged
-/// against `null` (`studies::fair::vary`): `fair --vary --json`'s document and its table.
+/// against `null` (`studies::bias::BiasStudy`): `fair --vary --json`'s document and its table.
 fn varied(
     py: Python<'_>,
     spec: &RunSpec,
-    layout: Layout,
     vary: &str,
     null: &dicephys::studies::fair::Null,
     threads_: usize,
     progress: Option<Bound<'_, PyAny>>,
 ) -> PyResult<(String, String)> {
-    use dicephys::studies::fair::{bias_document, bias_table, check_null, parse_vary};
-    check_null(spec, null).map_err(py_err)?;
-    let (what, values) = parse_vary(vary).map_err(py_err)?;
-    dicephys::studies::fair::varied_specs(spec, what, &values).map_err(py_err)?;
+    use dicephys::studies::kind::Kind;
+    let study = dicephys::studies::bias::BiasStudy {
+        spec: spec.clone(),
+        null: null.clone(),
+        vary: vary.to_string(),
+    };
+    study.validate().map_err(py_err)?;
     let threads = threads(threads_)?;
     let points = detached(py, progress.as_ref(), None, |session| {
-        let total = (spec.rolls * values.len() as u64) as f64;
+        let total = study.rolls()? as f64;
         let tell = |n: u64| session.set(n as f64, total);
         let runner = Runner::new(threads, session.stop.clone());
         let runner = runner.with_progress(&tell);
-        dicephys::studies::fair::vary(spec, layout, what, &values, null, &runner)?
-            .ok_or(Error::Stopped)
+        study.points(&runner)?.ok_or(Error::Stopped)
     })?;
-    let json = dicephys::run::seal::to_string(&bias_document(spec, what, null, &points), true)
-        .map_err(py_err)?;
-    Ok((json, bias_table(what, &points)))
+    study.render(&points).map_err(py_err)
 }
 
 /// One throw traced: its index, `trace`'s CSV (header and rows), its ending line and the

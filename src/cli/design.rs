@@ -6,10 +6,11 @@ use super::roll::RollArgs;
 use super::term::{out, outln};
 use clap::Args;
 use dicephys::model::throws::ThrowStyle;
+use dicephys::studies::bias::Varied;
 use dicephys::studies::design::mesh::{self, MeshConfig};
 use dicephys::studies::design::named::Named;
 use dicephys::studies::design::{DesignConfig, DEFAULT_CHECK_ROLLS, DEFAULT_POINTS, DEFAULT_ROLLS};
-use dicephys::studies::fair::{Null, Varied};
+use dicephys::studies::fair::Null;
 use std::path::PathBuf;
 
 /// `--target`: each label's probability, or a named law.

@@ -113,7 +113,7 @@ pub fn run(mut a: FairArgs) -> Result<()> {
     }
     dicephys::studies::fair::check_null(&spec, &asked)?;
     if let Some(v) = &a.vary {
-        return vary(a, &spec, v, &asked);
+        return vary(a, spec, v, asked);
     }
     // A checkpointed run keeps its null beside its specification, so that --resume judges it
     // as it was asked (the Ctrl-C message gives that command).
@@ -177,63 +177,23 @@ fn counted(
 
 /// `fair --vary`: the die at each value of one feature, judged, as a table (or JSON) and,
 /// with `--out`, the bias figure.
-fn vary(a: &FairArgs, spec: &dicephys::run::spec::RunSpec, v: &str, null: &Null) -> Result<()> {
-    use dicephys::studies::fair::{parse_vary, varied_specs, vary, write_bias};
-    let (what, values) = parse_vary(v)?;
-    // Every value checked before the directory is claimed: a refused one writes nothing.
-    varied_specs(spec, what, &values)?;
-    let identity = serde_json::json!({ "spec": spec, "null": (null.spec()), "vary": v });
-    let _held = a
-        .out
-        .as_ref()
-        .map(|dir| claim_out(dir, &identity))
-        .transpose()?;
-    let threads = a.roll.run.threads()?;
-    let total = spec.rolls * values.len() as u64;
-    let bar = dicephys::report::progress::Progress::new(
-        "fair",
-        dicephys::report::progress::Unit::Rolls { per_cell: 0 },
-        true,
-        *a.roll.json,
-        super::study::every(),
-    );
-    let progress = |n: u64| bar.set(n as f64, total as f64);
-    let runner = dicephys::run::runner::Runner::new(threads, super::term::stop().clone());
-    let runner = runner.with_progress(&progress);
-    let layout = a.roll.layout(spec);
-    let points = vary(spec, layout, what, &values, null, &runner);
-    bar.finish();
-    let Some(points) = points? else {
-        return Err(Error::Interrupted(dicephys::run::stop::interrupted(
-            &dicephys::run::stop::Kept::Nothing(Some("a --vary run does not resume")),
-        )));
+fn vary(a: &FairArgs, spec: dicephys::run::spec::RunSpec, v: &str, null: Null) -> Result<()> {
+    let study = dicephys::studies::bias::BiasStudy {
+        spec,
+        null,
+        vary: v.to_string(),
     };
-    let json = dicephys::run::seal::to_string(
-        &dicephys::studies::fair::bias_document(spec, what, null, &points),
-        true,
-    )?;
+    let out = a.out.clone().unwrap_or_default();
     if let Some(dir) = &a.out {
-        let die = match &spec.scene.shape {
-            Some(shape) => shape.name.clone(),
-            None => format!("{} mm", spec.scene.block),
-        };
-        let title = format!(
-            "{die}, {}, {}: {} rolls a value; lines: {}",
-            spec.engine.name(),
-            spec.throws.style,
-            spec.rolls,
-            null
-        );
-        write_bias(dir, what, &title, &points)?;
-        dicephys::run::io::write_atomic(&dir.join("bias.json"), json.as_bytes())?;
-        if !*a.roll.json {
-            eprintln!("wrote {}/bias.json and bias.svg, .png", dir.display());
-        }
+        dicephys::run::owner::refuse_cluster_run(dir)?;
     }
-    if *a.roll.json {
-        outln!("{}", json);
-        return Ok(());
-    }
-    out!("{}", dicephys::studies::fair::bias_table(what, &points));
-    Ok(())
+    let place = dicephys::studies::place::Place {
+        out,
+        checkpoint: None,
+        threads: a.roll.run.threads()?,
+        share: dicephys::run::runner::ChunkShare::All,
+        json: *a.roll.json,
+        command_line: super::term::command_line(),
+    };
+    super::study::run(&dicephys::studies::StudyConfig::Bias(study), &place)
 }

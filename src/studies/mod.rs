@@ -6,6 +6,7 @@
 //! ([`StudyConfig::run`]).
 
 pub mod bench;
+pub mod bias;
 pub mod calibrated;
 pub mod cluster;
 pub mod converge;
@@ -68,6 +69,8 @@ pub enum StudyConfig {
     Roll(roll::RollStudy),
     /// `bench`.
     Bench(bench::Config),
+    /// `fair --vary`.
+    Bias(bias::BiasStudy),
 }
 
 impl StudyConfig {
@@ -87,6 +90,7 @@ impl StudyConfig {
             StudyConfig::Calibrated(c) => c,
             StudyConfig::Roll(c) => c,
             StudyConfig::Bench(c) => c,
+            StudyConfig::Bias(c) => c,
         }
     }
 
@@ -102,6 +106,7 @@ impl StudyConfig {
             StudyConfig::Converge(c) => StudyConfig::Converge(c.identity()),
             StudyConfig::Tradeoff(c) => StudyConfig::Tradeoff(c.identity()),
             StudyConfig::Roll(c) => return c.identity(),
+            StudyConfig::Bias(c) => return c.identity(),
             other => other.clone(),
         };
         serde_json::to_value(id).unwrap_or_default()

@@ -37,7 +37,8 @@ use crate::error::{Error, Field, Result};
 use crate::model::faces::Layout;
 use crate::run::runner::Runner;
 use crate::run::spec::RunSpec;
-use crate::studies::fair::{assess, Null, Varied};
+use crate::studies::bias::Varied;
+use crate::studies::fair::{assess, Null};
 use crate::theory::stats;
 use serde::Serialize;
 
@@ -367,7 +368,7 @@ pub fn check(cfg: &DesignConfig) -> Result<Vec<Vec<usize>>> {
         ));
     }
     // A value the die cannot take is named as the range gave it, not as `fair --vary`.
-    crate::studies::fair::varied_specs(&cfg.spec, cfg.what, &[lo, hi]).map_err(|e| match e {
+    crate::studies::bias::varied_specs(&cfg.spec, cfg.what, &[lo, hi]).map_err(|e| match e {
         Error::Field {
             field: Field::Vary,
             value,
@@ -394,7 +395,7 @@ pub fn run(cfg: &DesignConfig, runner: &Runner) -> Result<Option<Design>> {
         let values = spread(span, cfg.points);
         let mut spec = cfg.spec.clone();
         spec.throws.seed = cfg.spec.throws.seed.wrapping_add(stage);
-        let specs = crate::studies::fair::varied_specs(&spec, cfg.what, &values)?;
+        let specs = crate::studies::bias::varied_specs(&spec, cfg.what, &values)?;
         let mut batches = Vec::new();
         for (i, s) in specs.iter().enumerate() {
             let base = stage * per_scan + i as u64 * cfg.spec.rolls;
@@ -432,7 +433,7 @@ pub fn run(cfg: &DesignConfig, runner: &Runner) -> Result<Option<Design>> {
     let mut spec = cfg.spec.clone();
     spec.throws.seed = cfg.spec.throws.seed ^ CHECK_SEED;
     spec.rolls = cfg.check_rolls;
-    let spec = crate::studies::fair::varied_specs(&spec, cfg.what, &[value])?
+    let spec = crate::studies::bias::varied_specs(&spec, cfg.what, &[value])?
         .pop()
         .expect("one");
     let base = 2 * per_scan;
