@@ -10,6 +10,7 @@ use dicephys::run::runner::Runner;
 use dicephys::studies::bias::Varied;
 use dicephys::studies::design::mesh::{self, MeshConfig};
 use dicephys::studies::design::named::Named;
+use dicephys::studies::design::study::DesignStudy;
 use dicephys::studies::design::{self as design_, DesignConfig};
 use dicephys::studies::fair::Null;
 use dicephys::Error;
@@ -87,11 +88,7 @@ pub fn design<'py>(
     let progress = o.object("progress")?;
     let cfg = config(block, o)?;
     // The range is `range` here (a fit's are `ranges`).
-    let checked = match &cfg {
-        Config::Feature(c) => design_::check(c).map(|_| ()),
-        Config::Facets(c) => mesh::check(c),
-    };
-    checked.map_err(|e| match e {
+    cfg.check().map_err(|e| match e {
         Error::Field {
             field: dicephys::error::Field::Range,
             value,
@@ -103,38 +100,15 @@ pub fn design<'py>(
         let _held = match &out {
             Some(dir) => {
                 std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-                Some(match &cfg {
-                    Config::Feature(c) => design_::claim(dir, c)?,
-                    Config::Facets(c) => mesh::claim(dir, c)?,
-                })
+                Some(cfg.claim(dir)?)
             }
             None => None,
         };
-        let total = match &cfg {
-            Config::Feature(c) => c.spec.rolls * 2 * c.points as u64 + c.check_rolls,
-            Config::Facets(c) => c.spec.rolls * (c.rounds as u64 + 1) + 2 * c.check_rolls,
-        } as f64;
+        let total = cfg.rolls() as f64;
         let tell = |n: u64| session.set(n as f64, total);
         let runner = Runner::new(threads, session.stop.clone());
         let runner = runner.with_progress(&tell);
-        match &cfg {
-            Config::Feature(c) => {
-                let d = design_::run(c, &runner)?.ok_or(Error::Stopped)?;
-                let json = dicephys::run::seal::to_string(&d, true)?;
-                if let Some(dir) = &out {
-                    design_::write(dir, &json, &d)?;
-                }
-                Ok((json, d.text()))
-            }
-            Config::Facets(c) => {
-                let d = mesh::run(c, &runner)?.ok_or(Error::Stopped)?;
-                let json = dicephys::run::seal::to_string(&d, true)?;
-                if let Some(dir) = &out {
-                    mesh::write(dir, &json, &d)?;
-                }
-                Ok((json, d.text()))
-            }
-        }
+        cfg.make(&runner, out.as_deref())?.ok_or(Error::Stopped)
     })
 }
 
@@ -156,15 +130,9 @@ fn scans_or_rounds(facets: bool, points: Option<usize>, rounds: Option<usize>) -
     }
 }
 
-/// What a design designs: one feature, or a convex die's facets.
-enum Config {
-    Feature(DesignConfig),
-    Facets(MeshConfig),
-}
-
 /// The design the options ask for (every one read: any other is refused): the die and its
 /// scene by `roll`'s names, or in a fit's calibration; the target set over its labels.
-fn config(block: Option<&str>, o: Options) -> PyResult<Config> {
+fn config(block: Option<&str>, o: Options) -> PyResult<DesignStudy> {
     let free = o
         .maybe::<String>("free")?
         .ok_or_else(|| bad("free", "None", "name the feature to design"))?;
@@ -236,7 +204,7 @@ fn config(block: Option<&str>, o: Options) -> PyResult<Config> {
     };
     let (target, named_target) = target_of(&target, &spec, layout)?;
     Ok(match what {
-        Some(what) => Config::Feature(DesignConfig {
+        Some(what) => DesignStudy::Feature(DesignConfig {
             layout,
             spec,
             what,
@@ -247,7 +215,7 @@ fn config(block: Option<&str>, o: Options) -> PyResult<Config> {
             named_target,
             calibration,
         }),
-        None => Config::Facets(MeshConfig {
+        None => DesignStudy::Facets(MeshConfig {
             layout,
             spec,
             range: [range.0, range.1],

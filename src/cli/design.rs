@@ -3,14 +3,17 @@
 
 use super::error::{Error, Result};
 use super::roll::RollArgs;
-use super::term::{out, outln};
 use clap::Args;
 use dicephys::model::throws::ThrowStyle;
+use dicephys::run::runner::ChunkShare;
 use dicephys::studies::bias::Varied;
 use dicephys::studies::design::mesh::{self, MeshConfig};
 use dicephys::studies::design::named::Named;
+use dicephys::studies::design::study::DesignStudy;
 use dicephys::studies::design::{DesignConfig, DEFAULT_CHECK_ROLLS, DEFAULT_POINTS, DEFAULT_ROLLS};
 use dicephys::studies::fair::Null;
+use dicephys::studies::place::Place;
+use dicephys::studies::StudyConfig;
 use std::path::PathBuf;
 
 /// `--target`: each label's probability, or a named law.
@@ -114,12 +117,6 @@ const FIT_SETS: [&str; 25] = [
     "faithful",
 ];
 
-/// What `design` designs: one feature, or a convex die's facets.
-enum Config {
-    Feature(DesignConfig),
-    Mesh(MeshConfig),
-}
-
 /// What every design shares: the die and its scene (calibrated where `--fit` is given), its
 /// numbering, the target over its labels.
 struct Common {
@@ -132,7 +129,7 @@ struct Common {
 
 /// The design `a` asks for, every value checked (the fit read, the named target set over the
 /// die's labels) before anything rolls or is written.
-fn config_of(a: &DesignArgs) -> Result<Config> {
+fn config_of(a: &DesignArgs) -> Result<DesignStudy> {
     let r = &a.roll;
     for (given, flag) in [
         (r.checkpoint.is_some(), "--checkpoint"),
@@ -165,7 +162,7 @@ fn config_of(a: &DesignArgs) -> Result<Config> {
             calibration: c.calibration,
         };
         mesh::check(&cfg)?;
-        return Ok(Config::Mesh(cfg));
+        return Ok(DesignStudy::Facets(cfg));
     }
     let what: Varied = dicephys::error::parse_name("feature", a.free.trim())?;
     if a.rounds.is_some() {
@@ -188,7 +185,7 @@ fn config_of(a: &DesignArgs) -> Result<Config> {
         calibration: c.calibration,
     };
     dicephys::studies::design::check(&cfg)?;
-    Ok(Config::Feature(cfg))
+    Ok(DesignStudy::Feature(cfg))
 }
 
 /// The die, scene, calibration and target `a` gives, `rolls` throws a run.
@@ -246,87 +243,25 @@ fn common(a: &DesignArgs, rolls: u64) -> Result<Common> {
     })
 }
 
-/// Runs `dicephys design`.
+/// Runs `dicephys design`, as every study runs.
 pub fn run(a: &DesignArgs) -> Result<()> {
-    let r = &a.roll;
     let cfg = config_of(a)?;
     // The directory is claimed once everything is checked: a refused design writes nothing.
-    let _held = match &a.out {
-        Some(dir) => {
-            std::fs::create_dir_all(dir).map_err(|e| {
-                Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
-            })?;
-            Some(match &cfg {
-                Config::Feature(c) => dicephys::studies::design::claim(dir, c)?,
-                Config::Mesh(c) => mesh::claim(dir, c)?,
-            })
-        }
-        None => None,
-    };
-    let threads = r.run.threads()?;
-    let total = match &cfg {
-        Config::Feature(c) => c.spec.rolls * 2 * c.points as u64 + c.check_rolls,
-        Config::Mesh(c) => c.spec.rolls * (c.rounds as u64 + 1) + 2 * c.check_rolls,
-    } as f64;
-    let bar = dicephys::report::progress::Progress::new(
-        "design",
-        dicephys::report::progress::Unit::Rolls { per_cell: 0 },
-        true,
-        *r.json,
-        super::study::every(),
-    );
-    let progress = |n: u64| bar.set(n as f64, total);
-    let runner = dicephys::run::runner::Runner::new(threads, super::term::stop().clone());
-    let runner = runner.with_progress(&progress);
-    let done = match &cfg {
-        Config::Feature(c) => dicephys::studies::design::run(c, &runner).map(|d| {
-            d.map(|d| {
-                let json = dicephys::run::seal::to_string(&d, true);
-                (json, d.text(), Done::Feature(Box::new(d)))
-            })
-        }),
-        Config::Mesh(c) => mesh::run(c, &runner).map(|d| {
-            d.map(|d| {
-                let json = dicephys::run::seal::to_string(&d, true);
-                (json, d.text(), Done::Mesh(Box::new(d)))
-            })
-        }),
-    };
-    bar.finish();
-    let Some((json, text, design)) = done? else {
-        return Err(Error::Interrupted(dicephys::run::stop::interrupted(
-            &dicephys::run::stop::Kept::Nothing(Some("a design does not resume")),
-        )));
-    };
-    let json = json?;
     if let Some(dir) = &a.out {
-        match &design {
-            Done::Feature(d) => dicephys::studies::design::write(dir, &json, d)?,
-            Done::Mesh(d) => mesh::write(dir, &json, d)?,
-        }
+        std::fs::create_dir_all(dir).map_err(|e| {
+            Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
+        })?;
+        dicephys::run::owner::refuse_cluster_run(dir)?;
     }
-    if *r.json {
-        outln!("{}", json);
-    } else {
-        out!("{}", text);
-    }
-    if let (Some(dir), false) = (&a.out, *r.json) {
-        let die = match design {
-            Done::Feature(_) => "",
-            Done::Mesh(_) => ", the die design.obj and its die file design.toml",
-        };
-        eprintln!(
-            "wrote {}/design.json, report.md, report.html and design.svg, .png{die}",
-            dir.display()
-        );
-    }
-    Ok(())
-}
-
-/// A design made.
-enum Done {
-    Feature(Box<dicephys::studies::design::Design>),
-    Mesh(Box<mesh::MeshDesign>),
+    let place = Place {
+        out: a.out.clone().unwrap_or_default(),
+        checkpoint: None,
+        threads: a.roll.run.threads()?,
+        share: ChunkShare::All,
+        json: *a.roll.json,
+        command_line: super::term::command_line(),
+    };
+    super::study::run(&StudyConfig::Design(cfg), &place)
 }
 
 /// `--range NAME=LO:HI`, for the feature `--free` names.

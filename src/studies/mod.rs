@@ -71,6 +71,8 @@ pub enum StudyConfig {
     Bench(bench::Config),
     /// `fair --vary`.
     Bias(bias::BiasStudy),
+    /// `design`.
+    Design(design::study::DesignStudy),
 }
 
 impl StudyConfig {
@@ -91,6 +93,7 @@ impl StudyConfig {
             StudyConfig::Roll(c) => c,
             StudyConfig::Bench(c) => c,
             StudyConfig::Bias(c) => c,
+            StudyConfig::Design(c) => c,
         }
     }
 
@@ -107,6 +110,7 @@ impl StudyConfig {
             StudyConfig::Tradeoff(c) => StudyConfig::Tradeoff(c.identity()),
             StudyConfig::Roll(c) => return c.identity(),
             StudyConfig::Bias(c) => return c.identity(),
+            StudyConfig::Design(c) => return c.identity(),
             other => other.clone(),
         };
         serde_json::to_value(id).unwrap_or_default()

@@ -20,7 +20,7 @@ use crate::run::spec::RunSpec;
 use serde::Serialize;
 
 /// Which calibration a design was made under.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct Calibration {
     /// The fit, as it was named (its fit.json's path).
     pub fit: String,

@@ -48,7 +48,7 @@ const CHECK_SEED: u64 = 0xc4ec_0000_0073;
 pub const FACETS: &str = "facets";
 
 /// What `design --free facets` asks for.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct MeshConfig {
     /// The die (a mesh), its scene and throws; its `rolls` the throws of each round.
     pub spec: RunSpec,
@@ -849,12 +849,6 @@ pub fn write(dir: &std::path::Path, json: &str, d: &MeshDesign) -> Result<()> {
     )?;
     crate::run::io::write_atomic(&dir.join("design.json"), json.as_bytes())?;
     crate::report::html::write_text_report(dir, "Design", &d.text(), &["design"])
-}
-
-/// Claims `dir` for this design, as [`super::claim`].
-pub fn claim(dir: &std::path::Path, cfg: &MeshConfig) -> Result<crate::run::lock::Held> {
-    crate::studies::place::claim(dir, "design", cfg, crate::studies::place::Claimant::Here)?;
-    crate::run::owner::hold(dir)
 }
 
 #[cfg(test)]

@@ -32,6 +32,7 @@
 pub mod calibrated;
 pub mod mesh;
 pub mod named;
+pub mod study;
 
 use crate::error::{Error, Field, Result};
 use crate::model::faces::Layout;
@@ -63,7 +64,7 @@ pub const DEFAULT_POINTS: usize = 9;
 pub const DEFAULT_CHECK_ROLLS: u64 = 20_000;
 
 /// What `design` asks for.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct DesignConfig {
     /// The die, its scene and throws; its `rolls` the throws at each scan's value.
     pub spec: RunSpec,
@@ -838,13 +839,6 @@ pub fn write(dir: &std::path::Path, json: &str, d: &Design) -> Result<()> {
     crate::report::figures::design::design(dir, "design", &title, &d.bars())?;
     crate::run::io::write_atomic(&dir.join("design.json"), json.as_bytes())?;
     crate::report::html::write_text_report(dir, "Design", &d.text(), &["design"])
-}
-
-/// Claims `dir` for this design (`run::owner`) and holds it while the returned file lives:
-/// refused if another command or another run owns it.
-pub fn claim(dir: &std::path::Path, cfg: &DesignConfig) -> Result<crate::run::lock::Held> {
-    super::place::claim(dir, "design", cfg, super::place::Claimant::Here)?;
-    crate::run::owner::hold(dir)
 }
 
 #[cfg(test)]

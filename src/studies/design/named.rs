@@ -16,8 +16,8 @@ use serde::Serialize;
 pub const MAX_BINOMIAL: u32 = 64;
 
 /// A named target.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(into = "String")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[serde(into = "String", try_from = "String")]
 pub enum Named {
     /// The sum of two fair d6.
     TwoD6,
@@ -28,6 +28,13 @@ pub enum Named {
 impl From<Named> for String {
     fn from(n: Named) -> String {
         n.to_string()
+    }
+}
+
+impl TryFrom<String> for Named {
+    type Error = String;
+    fn try_from(s: String) -> Result<Named, String> {
+        Named::parse(&s)?.ok_or_else(|| format!("'{s}': not a named target (2d6, binomial:N)"))
     }
 }
 
@@ -132,6 +139,23 @@ impl Named {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A design's named target is written as its name and read back from it (a design's
+    /// configuration is a study's, which a plan or Python hands over as JSON).
+    #[test]
+    fn a_named_target_is_read_back_from_the_name_it_is_written_as() {
+        for n in [Named::TwoD6, Named::Binomial(5)] {
+            let v = serde_json::to_value(n).unwrap();
+            assert_eq!(v, serde_json::json!(n.to_string()));
+            assert_eq!(serde_json::from_value::<Named>(v).unwrap(), n);
+        }
+        for bad in ["binomial:0", "3d6", "binomial:x"] {
+            assert!(
+                serde_json::from_value::<Named>(serde_json::json!(bad)).is_err(),
+                "{bad}"
+            );
+        }
+    }
 
     fn labels(s: &[&str]) -> Vec<String> {
         s.iter().map(|l| l.to_string()).collect()
