@@ -195,6 +195,8 @@ pub enum Field {
     EdgeRadius,
     /// `engines`.
     Engines,
+    /// `every`: `trace`'s rows, every Nth step's.
+    Every,
     /// `faces`.
     Faces,
     /// `flight_dts`.
@@ -211,6 +213,8 @@ pub enum Field {
     Friction,
     /// `frictions`.
     Frictions,
+    /// `index`: the throws `trace` follows.
+    Index,
     /// `inertia`.
     Inertia,
     #[strum(serialize = "insert.centre")]

@@ -681,45 +681,35 @@ fn trace<'py>(
         .map(|p| dicephys::run::io::Output::check(&p))
         .transpose()
         .map_err(py_err)?;
-    let source = throws.source(last + 1);
-    let labels = scene.shape.as_ref().map(|s| s.labels()).unwrap_or_default();
+    // Each throw's CSV is the study of that one throw; the page plays them all.
+    let study = |first, last| dicephys::studies::trace::TraceStudy {
+        engine,
+        scene: scene.clone(),
+        throws,
+        first,
+        last,
+        every,
+        max_steps,
+        fast_flight,
+        html: None,
+    };
     let (traced, page) = detached(py, None, None, |session| {
-        let settle = trace::config(&scene, max_steps, fast_flight, false);
+        let abandon = || session.stop.requested();
         let mut traced = Vec::new();
         for index in first..=last {
-            let throw = source.get(index);
-            let mut csv = format!("{}\n", trace::HEADER);
-            let record = trace::rows(
-                engine,
-                &scene,
-                &throw,
-                &settle,
-                every,
-                |l| {
-                    csv.push_str(l);
-                    csv.push('\n');
-                },
-                |_| {},
-            )?;
-            if session.stop.requested() {
-                return Err(Error::Stopped);
-            }
-            let ending = trace::ending(index, &throw, &record, &labels);
-            let note = trace::capped(&record, settle.max_steps, max_steps.is_some());
+            let mut csv = String::new();
+            let line = |l: &str| {
+                csv.push_str(l);
+                csv.push('\n');
+            };
+            let (ending, note) = study(index, index)
+                .csv(line, &abandon)?
+                .map_err(|_| Error::Stopped)?;
             traced.push((index, csv, ending, note));
         }
-        let page = trace::page(
-            engine,
-            &scene,
-            &source,
-            first..=last,
-            trace::Stepping {
-                max_steps,
-                fast_flight,
-            },
-            |_, _| {},
-            |_| {},
-        )?;
+        let page = study(first, last)
+            .page(|_, _| {}, &abandon)?
+            .ok_or(Error::Stopped)?;
         Ok((traced, page))
     })?;
     if let Some(out) = out {

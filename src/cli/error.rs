@@ -86,6 +86,7 @@ pub fn flag(field: Field) -> &'static str {
         Field::Dts => "--dts",
         Field::EdgeRadius => "--edge-radius",
         Field::Engines => "--engines",
+        Field::Every => "--every",
         Field::Faces => "--die's [faces]",
         Field::FlightDts => "--flight-dts",
         // Set by no command (validate's free flight lasts its default).
@@ -95,6 +96,7 @@ pub fn flag(field: Field) -> &'static str {
         Field::Free => "--free",
         Field::Friction => "--friction",
         Field::Frictions => "--frictions",
+        Field::Index => "--index",
         Field::Inertia => "--die's inertia",
         Field::InsertCentre => "--die's insert.centre",
         Field::InsertDensity => "--die's insert.density",

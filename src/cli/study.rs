@@ -80,14 +80,27 @@ fn with_hooks(
     run: impl FnOnce(&Hooks) -> dicephys::Result<Done>,
 ) -> Result<()> {
     let progress = Progress::new(command, unit, true, json, every());
-    let log = |l: &str| progress.suspend(|| eprintln!("{l}"));
+    // A line of the result as it comes (`bench`'s rows, `trace`'s CSV) goes to stdout. The
+    // first that cannot be written is kept, and the command ends with it once the study has
+    // run (a closed pipe quietly, another failure as one line): no later line is tried, and
+    // the log, which would only say what was not printed, falls silent.
+    let unwritten: std::sync::Mutex<Option<Error>> = std::sync::Mutex::new(None);
+    let failed = || unwritten.lock().map_or(true, |u| u.is_some());
+    let log = |l: &str| {
+        if !failed() {
+            progress.suspend(|| eprintln!("{l}"))
+        }
+    };
     let set = |done: f64, total: f64| progress.set(done, total);
-    // A line of the result as it comes goes to stdout; one that cannot be written (a closed
-    // pipe) is dropped, and the result's own write at the end reports it.
     let print = |l: &str| {
-        progress.suspend(|| {
-            let _ = super::term::stdout(&format!("{l}\n"));
-        })
+        if failed() {
+            return;
+        }
+        if let Err(e) = progress.suspend(|| super::term::stdout(&format!("{l}\n"))) {
+            if let Ok(mut u) = unwritten.lock() {
+                *u = Some(e);
+            }
+        }
     };
     let done = run(&Hooks {
         log: &log,
@@ -96,6 +109,9 @@ fn with_hooks(
         stop: super::term::stop().clone(),
     });
     progress.finish();
+    if let Some(e) = unwritten.into_inner().ok().flatten() {
+        return Err(e);
+    }
     let done = done?;
     out!("{}", done.stdout);
     if let Some(n) = done.note {

@@ -109,32 +109,55 @@ pub fn config(
 
 /// `throw` rolled on a new engine of `kind` as `trace` rolls it, each step's state passed to
 /// `observe`: its record, where a die still moving at the cap keeps the face it was on then
-/// (a record keeps a face only for a settled roll), for the ending's line.
+/// (a record keeps a face only for a settled roll), for the ending's line. [`Ended::Stopped`]
+/// where `abandon` said so (asked every 4,096 steps: a stop request).
 pub fn roll(
     kind: crate::engine::EngineKind,
     scene: &crate::model::scene::Scene,
     throw: &Throw,
     settle: &crate::sim::roll::RollConfig,
     mut observe: impl FnMut(u64, &BodyState),
-) -> crate::Result<RollRecord> {
+    abandon: &dyn Fn() -> bool,
+) -> crate::Result<Ended> {
     let die = DieBody::of(scene);
     let mut engine = crate::engine::new_engine(kind, scene)?;
     let mut end_state = None;
-    let record =
-        crate::sim::roll::roll_observed(engine.as_mut(), scene, throw, settle, |step, s| {
+    let mut last = 0;
+    let record = crate::sim::roll::roll_observed_or_abandon(
+        engine.as_mut(),
+        scene,
+        throw,
+        settle,
+        |step, s| {
             end_state = Some(*s);
+            last = step;
             observe(step, s);
-        });
-    let mut ended = record;
-    if let (Fate::Unconverged(_), Some(s)) = (record.fate, end_state) {
+        },
+        abandon,
+    );
+    let Some(mut ended) = record else {
+        return Ok(Ended::Stopped { step: last });
+    };
+    if let (Fate::Unconverged(_), Some(s)) = (ended.fate, end_state) {
         ended.up = die.outcome(&s).1;
     }
-    Ok(ended)
+    Ok(Ended::Rolled(ended))
+}
+
+/// How a traced throw ended: rolled to its end, or stopped (a stop request) after `step` steps.
+#[derive(Clone, Copy, Debug)]
+pub enum Ended {
+    /// Its record.
+    Rolled(RollRecord),
+    /// Abandoned: the last step observed.
+    Stopped {
+        /// The last step observed.
+        step: u64,
+    },
 }
 
 /// The CSV's rows of `throw` (`trace`'s, without the header), each passed to `line`: every
-/// `every`th step's, and the last's; `tick` is called at every step (a front end's stop).
-/// Its record (`roll`).
+/// `every`th step's, and the last's (not when stopped: the rows up to the stop are written).
 pub fn rows(
     kind: crate::engine::EngineKind,
     scene: &crate::model::scene::Scene,
@@ -142,24 +165,30 @@ pub fn rows(
     settle: &crate::sim::roll::RollConfig,
     every: u64,
     mut line: impl FnMut(&str),
-    mut tick: impl FnMut(u64),
-) -> crate::Result<RollRecord> {
+    abandon: &dyn Fn() -> bool,
+) -> crate::Result<Ended> {
     let die = DieBody::of(scene);
     let mut last = None;
-    let record = roll(kind, scene, throw, settle, |step, s| {
-        tick(step);
-        let l = row(&die, scene.dt, step, s);
-        if step % every == 0 {
-            line(&l);
-            last = None;
-        } else {
-            last = Some(l);
-        }
-    })?;
-    if let Some(l) = last {
+    let ended = roll(
+        kind,
+        scene,
+        throw,
+        settle,
+        |step, s| {
+            let l = row(&die, scene.dt, step, s);
+            if step % every == 0 {
+                line(&l);
+                last = None;
+            } else {
+                last = Some(l);
+            }
+        },
+        abandon,
+    )?;
+    if let (Some(l), Ended::Rolled(_)) = (last, ended) {
         line(&l);
     }
-    Ok(record)
+    Ok(ended)
 }
 
 /// How `trace` steps its throws: the step cap asked (`None`: the scene's own) and whether free
@@ -175,7 +204,7 @@ pub struct Stepping {
 /// The page (`report::view`) that plays throws `indices` of `throws` of `scene` on `kind`,
 /// each rolled as `trace --html` rolls it (the early stop audited: noted where it would have
 /// fired, the roll carried on to rest); each throw's ending line, with the cap's note where
-/// the cap ended it (`capped`), passed to `say`; `tick` is called at every step (a front end's stop).
+/// the cap ended it (`capped`), passed to `say`. `None` if `abandon` stopped it.
 pub fn page(
     kind: crate::engine::EngineKind,
     scene: &crate::model::scene::Scene,
@@ -183,8 +212,8 @@ pub fn page(
     indices: std::ops::RangeInclusive<u64>,
     stepping: Stepping,
     mut say: impl FnMut(&str, Option<&str>),
-    mut tick: impl FnMut(u64),
-) -> crate::Result<String> {
+    abandon: &dyn Fn() -> bool,
+) -> crate::Result<Option<String>> {
     use crate::report::view::{self, DieView, Recorder, ThrowView};
     let Stepping {
         max_steps,
@@ -202,10 +231,10 @@ pub fn page(
     for index in indices {
         let throw = throws.get(index);
         let mut rec = Recorder::new(scene.dt);
-        let record = roll(kind, scene, &throw, &settle, |step, s| {
-            tick(step);
-            rec.push(&die, step, s);
-        })?;
+        let observe = |step, s: &BodyState| rec.push(&die, step, s);
+        let Ended::Rolled(record) = roll(kind, scene, &throw, &settle, observe, abandon)? else {
+            return Ok(None);
+        };
         let ending = ending(index, &throw, &record, &label_refs);
         say(
             &ending,
@@ -220,12 +249,12 @@ pub fn page(
             rec.finish(&die),
         ));
     }
-    Ok(view::page(
+    Ok(Some(view::page(
         &DieView::of(scene, &die),
         scene.dt,
         kind.into(),
         &views,
-    ))
+    )))
 }
 
 /// The most throws one page plays.

@@ -437,6 +437,20 @@ pub fn roll_observed(
     cfg: &RollConfig,
     observe: impl FnMut(u64, &BodyState),
 ) -> RollRecord {
+    roll_observed_or_abandon(engine, scene, throw, cfg, observe, &|| false)
+        .expect("never abandoned")
+}
+
+/// [`roll_observed`], abandoned (`None`) when `abandon` says so, asked every 4,096 steps as
+/// [`roll_or_abandon`] asks it (`trace` stopped mid-roll).
+pub fn roll_observed_or_abandon(
+    engine: &mut dyn Engine,
+    scene: &Scene,
+    throw: &Throw,
+    cfg: &RollConfig,
+    observe: impl FnMut(u64, &BodyState),
+    abandon: &dyn Fn() -> bool,
+) -> Option<RollRecord> {
     let end = run(
         engine,
         scene,
@@ -444,10 +458,9 @@ pub fn roll_observed(
         cfg,
         observe,
         false,
-        &|| false,
-    )
-    .expect("never abandoned");
-    record_of(throw, end)
+        abandon,
+    )?;
+    Some(record_of(throw, end))
 }
 
 /// A roll's record: its throw and how it ended.

@@ -25,6 +25,7 @@ pub mod stability;
 pub mod stream;
 pub mod study;
 pub mod sweep;
+pub mod trace;
 pub mod tradeoff;
 pub mod validate;
 
@@ -73,6 +74,8 @@ pub enum StudyConfig {
     Bias(bias::BiasStudy),
     /// `design`.
     Design(design::study::DesignStudy),
+    /// `trace`.
+    Trace(trace::TraceStudy),
 }
 
 impl StudyConfig {
@@ -94,6 +97,7 @@ impl StudyConfig {
             StudyConfig::Bench(c) => c,
             StudyConfig::Bias(c) => c,
             StudyConfig::Design(c) => c,
+            StudyConfig::Trace(c) => c,
         }
     }
 

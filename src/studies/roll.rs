@@ -205,6 +205,14 @@ impl RollStudy {
             true => format!("{doc}\n"),
             false => text.to_string(),
         };
+        // The run's summary as printed: its JSON or its text, only the one asked for (the text
+        // works out the theory beside the counts, which `--json` does not print).
+        let summary_printed = || -> Result<String> {
+            Ok(match json {
+                true => format!("{}\n", crate::run::seal::to_string(summary, true)?),
+                false => summary.human(),
+            })
+        };
         let unsettled = match summary.partial {
             true => None,
             false => crate::report::shape_outcomes::check_settled(&summary.tally).err(),
@@ -222,16 +230,15 @@ impl RollStudy {
         let mut written: Option<String> = None;
         if self.fair.is_some() {
             if let Some(e) = unsettled {
-                let (doc, text) = (crate::run::seal::to_string(summary, true)?, summary.human());
                 return Ok(Done {
-                    stdout: print(&doc, &text),
+                    stdout: summary_printed()?,
                     failed: Some(format!("no verdict: {e}")),
                     ..Done::default()
                 });
             }
         }
-        let (doc, text) = match &self.fair {
-            None => self.render(summary)?,
+        let stdout = match &self.fair {
+            None => summary_printed()?,
             Some(null) => {
                 let (fair, doc, text) = judged(summary, null)?;
                 let out = &place.out;
@@ -250,7 +257,7 @@ impl RollStudy {
                         ));
                     }
                 }
-                (doc, text)
+                print(&doc, &text)
             }
         };
         let note = written.map(Into::into).or(warnings);
@@ -266,7 +273,7 @@ impl RollStudy {
             )
         });
         Ok(Done {
-            stdout: print(&doc, &text),
+            stdout,
             note,
             failed,
             ..Done::default()
