@@ -185,6 +185,11 @@ fn vary(a: &FairArgs, spec: dicephys::run::spec::RunSpec, v: &str, null: Null) -
     };
     let out = a.out.clone().unwrap_or_default();
     if let Some(dir) = &a.out {
+        // Every value checked before the directory is made: a refused one writes nothing.
+        dicephys::studies::kind::Kind::validate(&study)?;
+        std::fs::create_dir_all(dir).map_err(|e| {
+            Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
+        })?;
         dicephys::run::owner::refuse_cluster_run(dir)?;
     }
     let place = dicephys::studies::place::Place {
