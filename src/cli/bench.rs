@@ -3,8 +3,6 @@
 use super::args::{Json, Seed, Threads};
 use super::error::Result;
 use clap::Args;
-use dicephys::run::runner::ChunkShare;
-use dicephys::studies::place::Place;
 use dicephys::studies::{bench, StudyConfig};
 
 #[derive(Args, Debug)]
@@ -45,13 +43,6 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         repeat: a.repeat,
         dicephys: a.dicephys.clone(),
     };
-    let place = Place {
-        out: std::path::PathBuf::new(),
-        checkpoint: None,
-        threads: cfg.threads,
-        share: ChunkShare::All,
-        json: *a.json,
-        command_line: super::term::command_line(),
-    };
+    let place = super::study::here(None, None, cfg.threads, *a.json)?;
     super::study::run(&StudyConfig::Bench(cfg), &place)
 }

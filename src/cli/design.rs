@@ -5,14 +5,12 @@ use super::error::{Error, Result};
 use super::roll::RollArgs;
 use clap::Args;
 use dicephys::model::throws::ThrowStyle;
-use dicephys::run::runner::ChunkShare;
 use dicephys::studies::bias::Varied;
 use dicephys::studies::design::mesh::{self, MeshConfig};
 use dicephys::studies::design::named::Named;
 use dicephys::studies::design::study::DesignStudy;
 use dicephys::studies::design::{DesignConfig, DEFAULT_CHECK_ROLLS, DEFAULT_POINTS, DEFAULT_ROLLS};
 use dicephys::studies::fair::Null;
-use dicephys::studies::place::Place;
 use dicephys::studies::StudyConfig;
 use std::path::PathBuf;
 
@@ -247,20 +245,7 @@ fn common(a: &DesignArgs, rolls: u64) -> Result<Common> {
 pub fn run(a: &DesignArgs) -> Result<()> {
     let cfg = config_of(a)?;
     // The directory is claimed once everything is checked: a refused design writes nothing.
-    if let Some(dir) = &a.out {
-        std::fs::create_dir_all(dir).map_err(|e| {
-            Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
-        })?;
-        dicephys::run::owner::refuse_cluster_run(dir)?;
-    }
-    let place = Place {
-        out: a.out.clone().unwrap_or_default(),
-        checkpoint: None,
-        threads: a.roll.run.threads()?,
-        share: ChunkShare::All,
-        json: *a.roll.json,
-        command_line: super::term::command_line(),
-    };
+    let place = super::study::here(a.out.as_deref(), None, a.roll.run.threads()?, *a.roll.json)?;
     super::study::run(&StudyConfig::Design(cfg), &place)
 }
 

@@ -183,22 +183,11 @@ fn vary(a: &FairArgs, spec: dicephys::run::spec::RunSpec, v: &str, null: Null) -
         null,
         vary: v.to_string(),
     };
-    let out = a.out.clone().unwrap_or_default();
-    if let Some(dir) = &a.out {
-        // Every value checked before the directory is made: a refused one writes nothing.
+    // Every value checked before the directory is made: a refused one writes nothing.
+    if a.out.is_some() {
         dicephys::studies::kind::Kind::validate(&study)?;
-        std::fs::create_dir_all(dir).map_err(|e| {
-            Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
-        })?;
-        dicephys::run::owner::refuse_cluster_run(dir)?;
     }
-    let place = dicephys::studies::place::Place {
-        out,
-        checkpoint: None,
-        threads: a.roll.run.threads()?,
-        share: dicephys::run::runner::ChunkShare::All,
-        json: *a.roll.json,
-        command_line: super::term::command_line(),
-    };
+    let threads = a.roll.run.threads()?;
+    let place = super::study::here(a.out.as_deref(), None, threads, *a.roll.json)?;
     super::study::run(&dicephys::studies::StudyConfig::Bias(study), &place)
 }

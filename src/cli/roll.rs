@@ -7,9 +7,8 @@ use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::report::fair::Null;
 use dicephys::run::request::RollRequest;
-use dicephys::run::runner::{Checkpoint, ChunkShare};
+use dicephys::run::runner::Checkpoint;
 use dicephys::run::spec::{RunSpec, Shard};
-use dicephys::studies::place::Place;
 use dicephys::studies::roll::RollStudy;
 use dicephys::studies::StudyConfig;
 use std::path::{Path, PathBuf};
@@ -161,26 +160,14 @@ pub fn study(a: &RollArgs, spec: RunSpec, fair: Option<Null>, out: Option<&Path>
         )));
     }
     let threads = a.run.threads()?;
-    if let Some(dir) = out {
-        std::fs::create_dir_all(dir).map_err(|e| {
-            Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
-        })?;
-        dicephys::run::owner::refuse_cluster_run(dir)?;
-    }
+    let checkpoint = a.resume.clone().or_else(|| a.checkpoint.clone());
+    let place = super::study::here(out, checkpoint, threads, *a.json)?;
     let study = RollStudy {
         spec,
         fair,
         precision: a.run.precision,
         per_roll: a.per_roll.clone(),
         resumed: a.resume.is_some(),
-    };
-    let place = Place {
-        out: out.map(Path::to_path_buf).unwrap_or_default(),
-        checkpoint: a.resume.clone().or_else(|| a.checkpoint.clone()),
-        threads,
-        share: ChunkShare::All,
-        json: *a.json,
-        command_line: super::term::command_line(),
     };
     super::study::run(&StudyConfig::Roll(study), &place)
 }

@@ -53,6 +53,31 @@ pub fn local(out: &Path, cfg: &StudyConfig, threads: usize, json: bool) -> Resul
     })
 }
 
+/// Where a command run here on all its chunks writes, for a study that keeps no cells of its
+/// own: `out` if given (made, and refused if a cluster's run owns it; `fair --out`, `design
+/// --out`), else nowhere; its checkpoint, if any (`roll --checkpoint`).
+pub fn here(
+    out: Option<&Path>,
+    checkpoint: Option<std::path::PathBuf>,
+    threads: usize,
+    json: bool,
+) -> Result<Place> {
+    if let Some(dir) = out {
+        std::fs::create_dir_all(dir).map_err(|e| {
+            Error::Usage(format!("--out {}: cannot create it ({e})", dir.display()))
+        })?;
+        dicephys::run::owner::refuse_cluster_run(dir)?;
+    }
+    Ok(Place {
+        out: out.map(Path::to_path_buf).unwrap_or_default(),
+        checkpoint,
+        threads,
+        share: ChunkShare::All,
+        json,
+        command_line: super::term::command_line(),
+    })
+}
+
 /// Runs a study, with a bar (or progress lines) and its log on stderr: every command that
 /// runs a study, here or as a cluster's task, runs it this way.
 pub fn run(cfg: &StudyConfig, place: &Place) -> Result<()> {

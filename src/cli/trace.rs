@@ -7,8 +7,6 @@ use super::error::Result;
 use clap::Args;
 use dicephys::engine::EngineKind;
 use dicephys::report::trace;
-use dicephys::run::runner::ChunkShare;
-use dicephys::studies::place::Place;
 use dicephys::studies::trace::TraceStudy;
 use dicephys::studies::StudyConfig;
 
@@ -75,13 +73,6 @@ pub fn run(a: &TraceArgs) -> Result<()> {
         fast_flight: a.flight == FlightArg::Fast,
         html: a.html.clone(),
     };
-    let place = Place {
-        out: std::path::PathBuf::new(),
-        checkpoint: None,
-        threads: 1,
-        share: ChunkShare::All,
-        json: false,
-        command_line: super::term::command_line(),
-    };
+    let place = super::study::here(None, None, 1, false)?;
     super::study::run(&StudyConfig::Trace(study), &place)
 }
