@@ -60,7 +60,10 @@ JobRequeue=1
 ReturnToService=2
 KillWait=5
 MinJobAge=600
-SchedulerParameters=defer_batch
+# The main scheduling loop every second, not every 60 s: a requeued task becomes eligible
+# cred_expire + 1 s after its requeue but waits for that loop (a minute of the Slurm tests'
+# serial chain); a batch job scheduled 1 s after its submission, not 3. One node: cheap.
+SchedulerParameters=defer_batch,sched_interval=1,batch_sched_delay=1
 $node State=UNKNOWN
 PartitionName=debug Nodes=ALL Default=YES MaxTime=INFINITE State=UP
 EOF
