@@ -6,7 +6,7 @@
 //! unresolved, with the rolls that would resolve it.
 
 use crate::error::{Error, Field, Result};
-use crate::model::faces::{side_of, Layout, DIRECTIONS};
+use crate::model::faces::{Layout, DIRECTIONS};
 use crate::model::scene::Mode;
 pub use crate::report::fair::{FaceVerdict, Fairness, Null};
 use crate::report::summary::RunSummary;
@@ -50,23 +50,12 @@ fn null_probabilities(s: &RunSummary, null: &Null) -> Result<(Vec<f64>, Option<S
                 .map_err(|e| Error::field(Field::Null, null.spec(), e))?;
             Ok((q, None))
         }
-        (Null::QuasiStatic, Mode::ThreeD) if !scene.features.plain() => {
-            // A made die: each face's solid angle from the centre of mass, of the inner box.
+        (Null::QuasiStatic, Mode::ThreeD) => {
+            // Each face's solid angle from the centre of mass, of the inner box: for the plain
+            // block Simpson's (the paper's), for a made die its centre's and rounding's; the
+            // one formula `fair --counts` takes too.
             let die = crate::model::die::DieBody::of(scene);
             Ok((theory::quasi_static::faces_up(&die).to_vec(), None))
-        }
-        (Null::QuasiStatic, Mode::ThreeD) => {
-            let (p, _) = theory::simpson_3d(&scene.block);
-            Ok((
-                (0..6)
-                    .map(|d| match side_of(d) {
-                        crate::model::block::Outcome::Breadth => p.breadth_vertical / 2.0,
-                        crate::model::block::Outcome::Width => p.width_vertical / 2.0,
-                        _ => p.length_vertical / 2.0,
-                    })
-                    .collect(),
-                None,
-            ))
         }
         (Null::QuasiStatic, Mode::TwoD) => Err(Error::field(
             Field::Null,

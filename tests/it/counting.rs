@@ -395,3 +395,47 @@ fn a_die_sunk_deeper_than_it_is_thick_is_a_failure() {
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("tunnelled"), "{text}");
 }
+
+/// The quasi-static null of a block is one formula whether `fair` rolls it or is given its
+/// counts: the paper's block and a made die, each rolled, then its faces' counts judged by
+/// `fair --counts`, give the same null face for face, to the last bit. (The rolled plain block
+/// took Simpson's solid angles and the counts `theory::quasi_static::faces_up`, equal to
+/// 3 × 10⁻¹⁵; the two verdicts' JSON differed.)
+#[test]
+fn a_blocks_quasi_static_null_is_the_same_rolled_or_counted() {
+    for die in [
+        &["--block", "140x24x20"][..],
+        &["--block", "16x16x15", "--com", "0,0,-1"],
+    ] {
+        let rolled = json(&dicephys(
+            &[
+                &["fair", "--null", "quasi-static", "--rolls", "300", "--json"][..],
+                die,
+            ]
+            .concat(),
+        ));
+        let faces = rolled["fairness"]["faces"].as_array().unwrap();
+        let counts: Vec<String> = faces
+            .iter()
+            .map(|f| format!("{}={}", f["number"], f["count"]))
+            .collect();
+        let counted = json(&dicephys(
+            &[
+                &["fair", "--null", "quasi-static", "--json", "--counts"][..],
+                &[counts.join(",").as_str()],
+                die,
+            ]
+            .concat(),
+        ));
+        let null = |v: &serde_json::Value| -> Vec<serde_json::Value> {
+            v["fairness"]["faces"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|f| f["null"].clone())
+                .collect()
+        };
+        assert_eq!(null(&rolled).len(), 6, "{die:?}");
+        assert_eq!(null(&rolled), null(&counted), "{die:?}");
+    }
+}
