@@ -130,7 +130,8 @@ fn fmt_mm(v: f64) -> String {
     format!("{r}")
 }
 
-/// The side of the block that stands vertical when it comes to rest.
+/// The side of the block that stands vertical when it comes to rest: the paper's view of a
+/// cuboid's outcome (`faces::Outcome::side`), not an outcome of its own.
 #[derive(
     Clone,
     Copy,
@@ -147,7 +148,7 @@ fn fmt_mm(v: f64) -> String {
 )]
 #[serde(rename_all = "snake_case")]
 #[strum(serialize_all = "snake_case")]
-pub enum Outcome {
+pub enum Side {
     /// The breadth stands upright: the block lies on a length × width face.
     Breadth,
     /// The width stands upright: the block lies on a length × breadth face (the likelier one).
@@ -156,21 +157,13 @@ pub enum Outcome {
     Length,
     /// No body axis is vertical within the tolerance (resting on an edge, or leaning).
     Unknown,
-    /// A die of any shape (`model::shape`) at rest on one of its faces, which the roll's
-    /// record names (`RollRecord::up`).
-    Face,
 }
 
-impl Outcome {
-    /// Every outcome: breadth, width, length, unknown.
-    pub const ALL: [Outcome; 4] = [
-        Outcome::Breadth,
-        Outcome::Width,
-        Outcome::Length,
-        Outcome::Unknown,
-    ];
+impl Side {
+    /// Every side: breadth, width, length, unknown.
+    pub const ALL: [Side; 4] = [Side::Breadth, Side::Width, Side::Length, Side::Unknown];
 
-    /// The outcome's name in reports: "breadth", "width", "length" or "unknown".
+    /// The side's name in reports: "breadth", "width", "length" or "unknown".
     pub fn name(self) -> &'static str {
         self.into()
     }

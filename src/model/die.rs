@@ -2,7 +2,8 @@
 //! ([`DieBody`]): its half sides, mass, inertia and barriers, its energies, and where its
 //! lowest point is.
 
-use crate::model::block::Block;
+use crate::model::block::{Block, Side};
+use crate::model::faces::Outcome;
 use crate::model::mass::{BodyTurn, Features, MassProps};
 use crate::model::scene::{Mode, Scene};
 use crate::model::shape::Shape;
@@ -483,52 +484,34 @@ impl DieBody {
             + self.com.norm()
     }
 
-    /// How a die at rest in `s` came out: its side (`Outcome::Face` for a die of any shape)
-    /// and its face (`RollRecord::up`: a direction of `faces::DIRECTIONS`, or a shape's
-    /// outcome).
-    pub fn outcome(&self, s: &BodyState) -> (crate::model::block::Outcome, Option<u8>) {
-        use crate::model::block::Outcome;
+    /// How a die at rest in `s` came out: the face it rests on (`Outcome`: a cuboid's by the
+    /// direction of its face up, a die of any shape's by its outcome), or none.
+    pub fn outcome(&self, s: &BodyState) -> Outcome {
         if let Some(c) = &self.convex {
             return match c.face_down(&up_in_body(&s.rotation)) {
-                Some(k) => (Outcome::Face, Some(k)),
-                None => (Outcome::Unknown, None),
+                Some(k) => Outcome::Face(k),
+                None => Outcome::Unknown,
             };
         }
-        let o = classify(s);
-        self.labelled(o, s)
+        self.labelled(classify(s), s)
     }
 
-    /// The certificate's side `o` as the roll records it (`RollRecord::certified`, and its
-    /// face): the cuboid's side alone, a box-shaped die of any shape's face (`labelled`).
-    /// Out of line and cold: it runs once a roll, and inlined it cost the plain roll's step
-    /// loop 0.2 % more instructions (callgrind).
+    /// The face of a box whose side `side` stands vertical at `s`: the cuboid's by the
+    /// direction of its face up, a box-shaped die of any shape's by its outcome on the face
+    /// opposite. What the certificate names (`RollRecord::certified`): out of line and cold,
+    /// it runs once a roll, and inlined it cost the plain roll's step loop 0.2 % more
+    /// instructions (callgrind).
     #[cold]
     #[inline(never)]
-    pub fn certified(
-        &self,
-        o: crate::model::block::Outcome,
-        s: &BodyState,
-    ) -> (crate::model::block::Outcome, Option<u8>) {
-        match self.box_faces {
-            None => (o, None),
-            Some(_) => self.labelled(o, s),
-        }
-    }
-
-    /// A box's side `o` as the die counts it, at `s`: the cuboid's side and the direction
-    /// of its face up (`RollRecord::up`); a box-shaped die of any shape's face (its outcome).
-    pub fn labelled(
-        &self,
-        o: crate::model::block::Outcome,
-        s: &BodyState,
-    ) -> (crate::model::block::Outcome, Option<u8>) {
-        use crate::model::block::Outcome;
-        let up = crate::model::faces::up_direction(&s.rotation, o);
-        match (self.box_faces, up) {
-            (None, _) => (o, up),
+    pub fn labelled(&self, side: Side, s: &BodyState) -> Outcome {
+        match (
+            self.box_faces,
+            crate::model::faces::up_direction(&s.rotation, side),
+        ) {
+            (None, Some(d)) => Outcome::Face(d),
             // Resting on the face opposite the one up (`DIRECTIONS` pairs them: d ^ 1).
-            (Some(faces), Some(d)) => (Outcome::Face, Some(faces[usize::from(d ^ 1)])),
-            (Some(_), None) => (Outcome::Unknown, None),
+            (Some(faces), Some(d)) => Outcome::Face(faces[usize::from(d ^ 1)]),
+            (_, None) => Outcome::Unknown,
         }
     }
 
@@ -622,10 +605,9 @@ pub const VERTICAL_TOLERANCE: f64 = 1e-4;
 
 /// The side standing vertical: the body axis (x = breadth, y = width, z = length, tested in
 /// that order, as DicePhys) whose direction is vertical within the tolerance; else unknown.
-pub fn classify(s: &BodyState) -> crate::model::block::Outcome {
-    use crate::model::block::Outcome;
+pub fn classify(s: &BodyState) -> Side {
     let up = Vector3::y();
-    let sides = [Outcome::Breadth, Outcome::Width, Outcome::Length];
+    let sides = [Side::Breadth, Side::Width, Side::Length];
     for (axis, side) in [Vector3::x(), Vector3::y(), Vector3::z()].iter().zip(sides) {
         let dir = (s.rotation * axis).normalize();
         let dot = up.dot(&dir).abs();
@@ -633,5 +615,5 @@ pub fn classify(s: &BodyState) -> crate::model::block::Outcome {
             return side;
         }
     }
-    Outcome::Unknown
+    Side::Unknown
 }

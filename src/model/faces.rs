@@ -3,7 +3,7 @@
 //! vertical) are the faces taken in opposite pairs; a face tells which of the pair is up.
 
 use crate::error::Field;
-use crate::model::block::Outcome;
+use crate::model::block::Side;
 use crate::model::state::up_in_body;
 use nalgebra::UnitQuaternion;
 use serde::{Deserialize, Serialize};
@@ -115,26 +115,61 @@ impl Layout {
     }
 }
 
+/// How a roll came to rest, for every die: on one of its faces, or on none. The face is its
+/// index among the die's outcomes: a cuboid's by the direction of its face up
+/// ([`DIRECTIONS`]; four in 2D), a die of any shape's in the order of its faces
+/// (`Shape::faces`, a box-shaped one's too). What it shows is the die's to say (its layout's
+/// number, its label); the paper's view of a cuboid's outcome, the side standing vertical, is
+/// [`Outcome::side`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcome {
+    /// At rest on one of its faces: the face's index among the die's outcomes.
+    Face(u8),
+    /// At rest on none: no face down within the tolerance (on an edge, or leaning).
+    Unknown,
+}
+
+impl Outcome {
+    /// The face's index, if it came to rest on one.
+    pub fn face(self) -> Option<u8> {
+        match self {
+            Outcome::Face(k) => Some(k),
+            Outcome::Unknown => None,
+        }
+    }
+
+    /// A cuboid's outcome as the paper sees it: the side standing vertical when the face of
+    /// direction `d` is up. Only a cuboid's faces are directions; a die of any shape has no
+    /// sides.
+    pub fn side(self) -> Side {
+        match self {
+            Outcome::Face(d) => side_of(usize::from(d)),
+            Outcome::Unknown => Side::Unknown,
+        }
+    }
+}
+
 /// The direction (index into [`DIRECTIONS`]) whose face is up on a die at `rotation` whose
 /// `side` axis stands vertical: that axis's positive end if it points up, else its negative
 /// end. `None` when no side is vertical.
-pub fn up_direction(rotation: &UnitQuaternion<f64>, side: Outcome) -> Option<u8> {
+pub fn up_direction(rotation: &UnitQuaternion<f64>, side: Side) -> Option<u8> {
     let axis = match side {
-        Outcome::Breadth => 0,
-        Outcome::Width => 1,
-        Outcome::Length => 2,
-        Outcome::Unknown | Outcome::Face => return None,
+        Side::Breadth => 0,
+        Side::Width => 1,
+        Side::Length => 2,
+        Side::Unknown => return None,
     };
     let up = up_in_body(rotation);
     Some(2 * axis + u8::from(up[axis as usize] < 0.0))
 }
 
 /// The side standing vertical when the face of direction `d` is up.
-pub fn side_of(d: usize) -> Outcome {
+pub fn side_of(d: usize) -> Side {
     match d / 2 {
-        0 => Outcome::Breadth,
-        1 => Outcome::Width,
-        _ => Outcome::Length,
+        0 => Side::Breadth,
+        1 => Side::Width,
+        _ => Side::Length,
     }
 }
 
@@ -216,17 +251,17 @@ mod tests {
     fn the_face_up_is_the_end_of_the_vertical_axis_that_points_up() {
         // At the identity, body y is world up: the +y face (3) is up.
         let id = UnitQuaternion::identity();
-        assert_eq!(up_direction(&id, Outcome::Width), Some(2));
+        assert_eq!(up_direction(&id, Side::Width), Some(2));
         // Turned half a turn about x: −y up (4).
         let flip = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI);
-        assert_eq!(up_direction(&flip, Outcome::Width), Some(3));
+        assert_eq!(up_direction(&flip, Side::Width), Some(3));
         // A quarter turn about x takes +z to world +y... (R ẑ = −ŷ for +90°, so −z is up).
         let quarter =
             UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2);
         let up_z = (quarter * Vector3::z()).y;
-        let d = up_direction(&quarter, Outcome::Length).unwrap();
+        let d = up_direction(&quarter, Side::Length).unwrap();
         assert_eq!(d == 4, up_z > 0.0, "{d} {up_z}");
-        assert_eq!(up_direction(&id, Outcome::Unknown), None);
-        assert_eq!(side_of(5), Outcome::Length);
+        assert_eq!(up_direction(&id, Side::Unknown), None);
+        assert_eq!(side_of(5), Side::Length);
     }
 }

@@ -543,6 +543,13 @@ impl Scene {
         crate::model::faces::Layout::from_numbers(numbers)
     }
 
+    /// True if the die is the cuboid, whose outcomes (its faces, by the direction up) the
+    /// paper counts by the side standing vertical (`faces::Outcome::side`); a die of any
+    /// shape, a box-shaped one too, is counted by its faces alone.
+    pub fn counts_sides(&self) -> bool {
+        self.shape.is_none()
+    }
+
     /// True if the die is a coin (a cylinder), which can roll on its rim for ever.
     pub fn is_coin(&self) -> bool {
         matches!(

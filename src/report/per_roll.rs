@@ -3,6 +3,7 @@
 
 use crate::error::{Error, Result};
 use crate::model::faces::Layout;
+use crate::model::faces::Outcome;
 use crate::sim::roll::{Fate, RollRecord};
 use serde::Serialize;
 use std::io::Write;
@@ -107,10 +108,21 @@ impl<W: Write> PerRoll<W> {
     /// Writes one row per record, in order.
     pub fn write(&mut self, records: &[RollRecord]) -> Result<()> {
         for r in records {
+            // A cuboid's outcome by its side; a die of any shape's as "face" (which one: the
+            // face column).
+            let side = |o: Outcome| match (o, &self.labels) {
+                (Outcome::Face(_), Some(_)) => "face",
+                _ => o.side().name(),
+            };
             let (status, outcome) = match r.fate {
-                Fate::Settled(o) => ("settled", o.name()),
-                Fate::Unconverged(o) => ("unconverged", o.name()),
+                Fate::Settled(o) => ("settled", side(o)),
+                Fate::Unconverged(o) => ("unconverged", side(o)),
                 Fate::Failed(f) => (f.name(), ""),
+            };
+            // The face of a roll at rest (at the step cap it is the record's only).
+            let up = match r.fate {
+                Fate::Settled(o) => o.face(),
+                _ => None,
             };
             let t = &r.throw;
             self.csv
@@ -127,7 +139,7 @@ impl<W: Write> PerRoll<W> {
                     dip_steps: r.dip.steps,
                     longest_dip_steps: r.dip.longest,
                     penetration_m: r.dip.penetration,
-                    face: r.up.map_or(String::new(), |d| match &self.labels {
+                    face: up.map_or(String::new(), |d| match &self.labels {
                         Some(l) => l.get(usize::from(d)).cloned().unwrap_or_default(),
                         None => self.numbers[usize::from(d).min(5)].to_string(),
                     }),

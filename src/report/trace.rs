@@ -2,6 +2,7 @@
 //! energies, and the line that says how the throw ended.
 
 use crate::model::die::DieBody;
+use crate::model::faces::Outcome;
 use crate::model::state::BodyState;
 use crate::model::throws::Throw;
 use crate::sim::roll::{Fate, RollRecord};
@@ -40,23 +41,20 @@ pub fn row(die: &DieBody, dt: f64, step: u64, s: &BodyState) -> String {
 
 /// How throw `index` ended, in one line; a die of any shape's face named by `labels`.
 pub fn ending(index: u64, throw: &Throw, record: &RollRecord, labels: &[&str]) -> String {
+    // A die of any shape's face by its label; a cuboid's (no labels) by its side.
+    let shown = |o: Outcome| match (o, labels.is_empty()) {
+        (Outcome::Face(k), false) => Err(*labels.get(usize::from(k)).unwrap_or(&"?")),
+        _ => Ok(o.side().name()),
+    };
     let fate = match record.fate {
-        Fate::Settled(crate::model::block::Outcome::Face) => format!(
-            "settled, showing {}",
-            record
-                .up
-                .and_then(|k| labels.get(usize::from(k)))
-                .unwrap_or(&"?")
-        ),
-        Fate::Settled(o) => format!("settled, {} vertical", o.name()),
-        Fate::Unconverged(crate::model::block::Outcome::Face) => format!(
-            "unconverged (showing {} at the cap)",
-            record
-                .up
-                .and_then(|k| labels.get(usize::from(k)))
-                .unwrap_or(&"?")
-        ),
-        Fate::Unconverged(o) => format!("unconverged ({} vertical at the cap)", o.name()),
+        Fate::Settled(o) => match shown(o) {
+            Err(label) => format!("settled, showing {label}"),
+            Ok(side) => format!("settled, {side} vertical"),
+        },
+        Fate::Unconverged(o) => match shown(o) {
+            Err(label) => format!("unconverged (showing {label} at the cap)"),
+            Ok(side) => format!("unconverged ({side} vertical at the cap)"),
+        },
         Fate::Failed(f) => format!("failed: {}", f.name()),
     };
     format!(
@@ -108,9 +106,9 @@ pub fn config(
 }
 
 /// `throw` rolled on a new engine of `kind` as `trace` rolls it, each step's state passed to
-/// `observe`: its record, where a die still moving at the cap keeps the face it was on then
-/// (a record keeps a face only for a settled roll), for the ending's line. [`Ended::Stopped`]
-/// where `abandon` said so (asked every 4,096 steps: a stop request).
+/// `observe`: its record (a die still moving at the cap with the face it was on then, for the
+/// ending's line). [`Ended::Stopped`] where `abandon` said so (asked every 4,096 steps: a stop
+/// request).
 pub fn roll(
     kind: crate::engine::EngineKind,
     scene: &crate::model::scene::Scene,
@@ -119,9 +117,7 @@ pub fn roll(
     mut observe: impl FnMut(u64, &BodyState),
     abandon: &dyn Fn() -> bool,
 ) -> crate::Result<Ended> {
-    let die = DieBody::of(scene);
     let mut engine = crate::engine::new_engine(kind, scene)?;
-    let mut end_state = None;
     let mut last = 0;
     let record = crate::sim::roll::roll_observed_or_abandon(
         engine.as_mut(),
@@ -129,18 +125,14 @@ pub fn roll(
         throw,
         settle,
         |step, s| {
-            end_state = Some(*s);
             last = step;
             observe(step, s);
         },
         abandon,
     );
-    let Some(mut ended) = record else {
+    let Some(ended) = record else {
         return Ok(Ended::Stopped { step: last });
     };
-    if let (Fate::Unconverged(_), Some(s)) = (ended.fate, end_state) {
-        ended.up = die.outcome(&s).1;
-    }
     Ok(Ended::Rolled(ended))
 }
 

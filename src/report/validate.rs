@@ -4,7 +4,7 @@
 
 use crate::engine::EngineKind;
 use crate::error::Result;
-use crate::model::block::{Block, Outcome};
+use crate::model::block::{Block, Side};
 use crate::model::scene::Mode;
 use crate::report::figures::validate as fig;
 use crate::report::figures::Point;
@@ -132,12 +132,12 @@ pub struct Faces {
 }
 
 impl Faces {
-    pub(crate) fn add(&mut self, o: Outcome) {
+    pub(crate) fn add(&mut self, o: Side) {
         match o {
-            Outcome::Breadth => self.breadth += 1,
-            Outcome::Width => self.width += 1,
-            Outcome::Length => self.length += 1,
-            Outcome::Unknown | Outcome::Face => {}
+            Side::Breadth => self.breadth += 1,
+            Side::Width => self.width += 1,
+            Side::Length => self.length += 1,
+            Side::Unknown => {}
         }
     }
 
@@ -147,12 +147,12 @@ impl Faces {
     }
 
     /// The count of one face.
-    pub fn of(&self, o: Outcome) -> u64 {
+    pub fn of(&self, o: Side) -> u64 {
         match o {
-            Outcome::Breadth => self.breadth,
-            Outcome::Width => self.width,
-            Outcome::Length => self.length,
-            Outcome::Unknown | Outcome::Face => 0,
+            Side::Breadth => self.breadth,
+            Side::Width => self.width,
+            Side::Length => self.length,
+            Side::Unknown => 0,
         }
     }
 }

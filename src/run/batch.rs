@@ -165,10 +165,8 @@ fn roll_one(
         steps: 0,
         engine_steps: 0,
         certified: None,
-        certified_face: None,
         energy_gain: false,
         dip: Default::default(),
-        up: None,
     };
     let Some(w) = world.as_mut() else {
         return Some(failed);

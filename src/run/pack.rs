@@ -1,51 +1,35 @@
 //! A chunk's rolls, packed: what a roll ended with, in a few bytes, its throw left out (a
 //! pure function of the run's specification and its index, recomputed on reading).
 //!
-//! Format `rolls-v1` (the chunk file's `format`): the rolls in index order, each
+//! Format `rolls-v2` (the chunk file's `format`): the rolls in index order, each
 //!
-//! - a tag, a LEB128 varint: bits 0-1 the fate (0 settled, 1 unconverged, 2 failed); bits
-//!   2-3 its outcome (0 breadth, 1 width, 2 length, 3 unknown) or failure (0 non_finite,
-//!   1 tunnelled, 2 engine_error); bit 4 certified; bit 5 the energy-gain flag; bit 6 a
-//!   non-zero dip depth; bits 7-8 the certified outcome; bit 9 a face kept (a settled roll
-//!   from this version on), bit 10 its end of the axis (0 positive, 1 negative), so that
-//!   the face up is direction 2 × outcome + bit 10 of `faces::DIRECTIONS` (chunks written
-//!   before faces were kept have neither bit, and their rolls no face); bit 11 a die of any
-//!   shape's face (`Outcome::Face`, bits 2-3 then 0), its index a varint right after the
-//!   tag when bit 9 is set; bit 12 a die of any shape's certified face, a varint after the
-//!   certified step (a cuboid's rolls set neither, so their bytes are as before);
-//! - `steps`, `engine_steps`, varints; if certified, its step, a varint;
+//! - a tag, a LEB128 varint: bits 0-1 the fate (0 settled, 1 unconverged, 2 failed); bit 2,
+//!   settled or unconverged, on a face (else on none), and for a failure bits 2-3 why (0
+//!   non_finite, 1 tunnelled, 2 engine_error); bit 4 certified; bit 5 the energy-gain flag;
+//!   bit 6 a non-zero dip depth;
+//! - on a face, its index (`faces::Outcome::Face`: a cuboid's direction up, a die of any
+//!   shape's outcome), a varint;
+//! - `steps`, `engine_steps`, varints; if certified, its step and its face plus one (0: none),
+//!   varints;
 //! - the dip's `steps` and `longest`, varints; if bit 6, its depth `penetration`, the 8
 //!   bytes of the f64, little-endian (exact).
 //!
 //! and the whole in standard base64 (RFC 4648, padded) in the chunk's JSON, under its
 //! checksum ([`crate::run::seal`]). A 2D roll of the paper's scene takes about 20 bytes, 27
 //! in base64 (the JSON records took 285).
+//!
+//! Format `rolls-v1`, which dicephys wrote before every outcome was a face, is still read
+//! ([`unpack_v1`]): it kept a cuboid's side, and its face only at rest.
 
-use crate::model::block::Outcome;
+use crate::model::faces::Outcome;
 use crate::model::throws::Throws;
 use crate::sim::roll::{Dip, Failure, Fate, RollRecord};
 
 /// The format's name, as the chunk file gives it.
-pub const FORMAT: &str = "rolls-v1";
+pub const FORMAT: &str = "rolls-v2";
 
-fn outcome_bits(o: Outcome) -> u64 {
-    match o {
-        Outcome::Breadth => 0,
-        Outcome::Width => 1,
-        Outcome::Length => 2,
-        Outcome::Unknown => 3,
-        Outcome::Face => 0,
-    }
-}
-
-fn outcome_of(b: u64) -> Outcome {
-    match b & 3 {
-        0 => Outcome::Breadth,
-        1 => Outcome::Width,
-        2 => Outcome::Length,
-        _ => Outcome::Unknown,
-    }
-}
+/// The format dicephys wrote before this one, still read.
+pub const FORMAT_V1: &str = "rolls-v1";
 
 fn varint(out: &mut Vec<u8>, mut v: u64) {
     loop {
@@ -64,44 +48,27 @@ pub fn pack(records: &[RollRecord]) -> Vec<u8> {
     let mut out = Vec::with_capacity(records.len() * 24);
     for r in records {
         let (fate, what) = match r.fate {
-            Fate::Settled(o) => (0, outcome_bits(o)),
-            Fate::Unconverged(o) => (1, outcome_bits(o)),
+            Fate::Settled(o) => (0, o.face().is_some() as u64),
+            Fate::Unconverged(o) => (1, o.face().is_some() as u64),
             Fate::Failed(Failure::NonFinite) => (2, 0),
             Fate::Failed(Failure::Tunnelled) => (2, 1),
             Fate::Failed(Failure::Engine) => (2, 2),
         };
         let deep = r.dip.penetration.to_bits() != 0;
-        let mut tag = fate | what << 2 | (r.energy_gain as u64) << 5 | (deep as u64) << 6;
-        if let Some((_, o)) = r.certified {
-            tag |= 1 << 4 | outcome_bits(o) << 7;
-        }
-        let shaped = matches!(
-            r.fate,
-            Fate::Settled(Outcome::Face) | Fate::Unconverged(Outcome::Face)
-        );
-        if shaped {
-            tag |= 1 << 11;
-        }
-        if r.certified.is_some() && r.certified_face.is_some() {
-            tag |= 1 << 12;
-        }
-        match r.up {
-            Some(_) if shaped => tag |= 1 << 9,
-            Some(d) => tag |= 1 << 9 | u64::from(d & 1) << 10,
-            None => {}
-        }
+        let tag = fate
+            | what << 2
+            | (r.certified.is_some() as u64) << 4
+            | (r.energy_gain as u64) << 5
+            | (deep as u64) << 6;
         varint(&mut out, tag);
-        if let (true, Some(d)) = (shaped, r.up) {
-            varint(&mut out, u64::from(d));
+        if let Fate::Settled(Outcome::Face(k)) | Fate::Unconverged(Outcome::Face(k)) = r.fate {
+            varint(&mut out, u64::from(k));
         }
         varint(&mut out, r.steps);
         varint(&mut out, r.engine_steps);
-        if let Some((step, _)) = r.certified {
+        if let Some((step, o)) = r.certified {
             varint(&mut out, step);
-            // A die of any shape's certified face (bit 12).
-            if let Some(k) = r.certified_face {
-                varint(&mut out, u64::from(k));
-            }
+            varint(&mut out, o.face().map_or(0, |k| u64::from(k) + 1));
         }
         varint(&mut out, r.dip.steps);
         varint(&mut out, r.dip.longest);
@@ -143,8 +110,90 @@ impl Reader<'_> {
     }
 }
 
-/// The rolls of throws `indices`, unpacked from `bytes`, each with its throw from `throws`.
-pub fn unpack(bytes: &[u8], indices: &[u64], throws: &Throws) -> Result<Vec<RollRecord>, String> {
+/// A face's index as packed: at most 255.
+fn face(i: u64, k: u64) -> Result<u8, String> {
+    u8::try_from(k).map_err(|_| format!("roll {i}: face {k} past 255"))
+}
+
+/// The rolls of throws `indices`, unpacked from `bytes` of format `format` (`FORMAT`, or
+/// `FORMAT_V1`), each with its throw from `throws`.
+pub fn unpack(
+    bytes: &[u8],
+    indices: &[u64],
+    throws: &Throws,
+    format: &str,
+) -> Result<Vec<RollRecord>, String> {
+    if format == FORMAT_V1 {
+        return unpack_v1(bytes, indices, throws);
+    }
+    let mut r = Reader(bytes);
+    let mut out = Vec::with_capacity(indices.len());
+    for &i in indices {
+        let tag = r.varint()?;
+        if tag >> 7 != 0 {
+            return Err(format!("roll {i}: unknown tag bits"));
+        }
+        let what = tag >> 2 & 3;
+        let mut outcome = || -> Result<Outcome, String> {
+            Ok(match what {
+                0 => Outcome::Unknown,
+                1 => Outcome::Face(face(i, r.varint()?)?),
+                _ => return Err(format!("roll {i}: unknown outcome")),
+            })
+        };
+        let fate = match tag & 3 {
+            0 => Fate::Settled(outcome()?),
+            1 => Fate::Unconverged(outcome()?),
+            2 => Fate::Failed(match what {
+                0 => Failure::NonFinite,
+                1 => Failure::Tunnelled,
+                2 => Failure::Engine,
+                _ => return Err(format!("roll {i}: unknown failure")),
+            }),
+            _ => return Err(format!("roll {i}: unknown fate")),
+        };
+        let steps = r.varint()?;
+        let engine_steps = r.varint()?;
+        let certified = if tag >> 4 & 1 == 1 {
+            let step = r.varint()?;
+            let o = match r.varint()? {
+                0 => Outcome::Unknown,
+                k => Outcome::Face(face(i, k - 1)?),
+            };
+            Some((step, o))
+        } else {
+            None
+        };
+        let (dip_steps, longest) = (r.varint()?, r.varint()?);
+        let penetration = if tag >> 6 & 1 == 1 { r.f64()? } else { 0.0 };
+        out.push(RollRecord {
+            throw: throws.get(i),
+            fate,
+            steps,
+            engine_steps,
+            certified,
+            energy_gain: tag >> 5 & 1 == 1,
+            dip: Dip::of(dip_steps, longest, penetration),
+        });
+    }
+    if !r.0.is_empty() {
+        return Err(format!("{} bytes after the last roll", r.0.len()));
+    }
+    Ok(out)
+}
+
+/// The rolls of a chunk of format `rolls-v1`. Its tag: bits 0-1 the fate; bits 2-3 a cuboid's
+/// side (0 breadth, 1 width, 2 length, 3 unknown) or the failure; bit 4 certified; bit 5 the
+/// energy gain; bit 6 a dip depth; bits 7-8 the certified side; bit 9 a face kept at rest,
+/// bit 10 its end of the axis (the face up is direction 2 × side + bit 10); bit 11 a die of
+/// any shape's face, its index a varint after the tag when bit 9 is set; bit 12 a die of any
+/// shape's certified face, a varint after the certified step. It kept no face at the step
+/// cap, and a cuboid's certified side but not its face: read as none, and the certified face
+/// as the face it came to rest on where that is on the certified side, else none (so the
+/// audit's wrong and unknown counts are the ones it had, but for a certified roll left
+/// unconverged, now unknown). A roll at rest from a chunk written before faces were kept
+/// (no bit 9) is refused: its face is not known.
+fn unpack_v1(bytes: &[u8], indices: &[u64], throws: &Throws) -> Result<Vec<RollRecord>, String> {
     let mut r = Reader(bytes);
     let mut out = Vec::with_capacity(indices.len());
     for &i in indices {
@@ -154,10 +203,17 @@ pub fn unpack(bytes: &[u8], indices: &[u64], throws: &Throws) -> Result<Vec<Roll
         }
         let what = tag >> 2 & 3;
         let shaped = tag >> 11 & 1 == 1;
-        let side = |b| if shaped { Outcome::Face } else { outcome_of(b) };
+        let kept = tag >> 9 & 1 == 1;
         let fate = match tag & 3 {
-            0 => Fate::Settled(side(what)),
-            1 => Fate::Unconverged(side(what)),
+            0 if what == 3 && !shaped => Fate::Settled(Outcome::Unknown),
+            0 if !kept => {
+                return Err(format!(
+                    "roll {i}: written before faces were kept (roll the run afresh)"
+                ))
+            }
+            0 if shaped => Fate::Settled(Outcome::Face(face(i, r.varint()?)?)),
+            0 => Fate::Settled(Outcome::Face((2 * what + (tag >> 10 & 1)) as u8)),
+            1 => Fate::Unconverged(Outcome::Unknown),
             2 => Fate::Failed(match what {
                 0 => Failure::NonFinite,
                 1 => Failure::Tunnelled,
@@ -166,46 +222,33 @@ pub fn unpack(bytes: &[u8], indices: &[u64], throws: &Throws) -> Result<Vec<Roll
             }),
             _ => return Err(format!("roll {i}: unknown fate")),
         };
-        let face = if shaped && tag >> 9 & 1 == 1 {
-            let d = r.varint()?;
-            Some(u8::try_from(d).map_err(|_| format!("roll {i}: face {d} past 255"))?)
+        let steps = r.varint()?;
+        let engine_steps = r.varint()?;
+        let certified = if tag >> 4 & 1 == 1 {
+            let step = r.varint()?;
+            let o = if tag >> 12 & 1 == 1 {
+                Outcome::Face(face(i, r.varint()?)?)
+            } else {
+                let side = tag >> 7 & 3;
+                match fate {
+                    Fate::Settled(o @ Outcome::Face(d)) if u64::from(d / 2) == side => o,
+                    _ => Outcome::Unknown,
+                }
+            };
+            Some((step, o))
         } else {
             None
         };
-        let steps = r.varint()?;
-        let engine_steps = r.varint()?;
-        let (certified, certified_face) = if tag >> 4 & 1 == 1 {
-            let step = r.varint()?;
-            if tag >> 12 & 1 == 1 {
-                let k = r.varint()?;
-                let k = u8::try_from(k).map_err(|_| format!("roll {i}: face {k} past 255"))?;
-                (Some((step, Outcome::Face)), Some(k))
-            } else {
-                (Some((step, outcome_of(tag >> 7))), None)
-            }
-        } else {
-            (None, None)
-        };
         let (dip_steps, longest) = (r.varint()?, r.varint()?);
         let penetration = if tag >> 6 & 1 == 1 { r.f64()? } else { 0.0 };
-        let up = match (tag >> 9 & 1, fate) {
-            (1, Fate::Settled(Outcome::Face)) => face,
-            (1, Fate::Settled(o)) if o != crate::model::block::Outcome::Unknown => {
-                Some(2 * outcome_bits(o) as u8 + (tag >> 10 & 1) as u8)
-            }
-            (1, _) => return Err(format!("roll {i}: a face on a roll not settled on a side")),
-            _ => None,
-        };
         out.push(RollRecord {
             throw: throws.get(i),
             fate,
             steps,
             engine_steps,
             certified,
-            certified_face,
             energy_gain: tag >> 5 & 1 == 1,
             dip: Dip::of(dip_steps, longest, penetration),
-            up,
         });
     }
     if !r.0.is_empty() {
@@ -278,6 +321,110 @@ mod tests {
         assert_eq!(base64(b"fo"), "Zm8=");
         assert!(unbase64("Zm8").is_err());
         assert!(unbase64("Z=8=").is_err());
+    }
+
+    fn throws() -> Throws {
+        use crate::model::throws::{ThrowKind, ThrowRanges, ThrowStyle};
+        Throws::styled(
+            ThrowKind::Keyed,
+            ThrowStyle::Paper,
+            None,
+            7,
+            ThrowRanges::default(),
+            0,
+        )
+    }
+
+    fn record(i: u64, fate: Fate, certified: Option<(u64, Outcome)>) -> RollRecord {
+        RollRecord {
+            throw: throws().get(i),
+            fate,
+            steps: 1000 + i,
+            engine_steps: 900 + i,
+            certified,
+            energy_gain: i % 2 == 1,
+            dip: Dip::of(
+                i,
+                i / 2,
+                if i.is_multiple_of(3) {
+                    0.0
+                } else {
+                    1e-6 * i as f64
+                },
+            ),
+        }
+    }
+
+    #[test]
+    fn every_fate_and_face_round_trips() {
+        let face = Outcome::Face;
+        let recs = [
+            record(0, Fate::Settled(face(3)), Some((700, face(3)))),
+            record(1, Fate::Settled(Outcome::Unknown), None),
+            record(2, Fate::Unconverged(face(200)), Some((9, face(1)))),
+            record(3, Fate::Unconverged(Outcome::Unknown), None),
+            record(4, Fate::Failed(Failure::Tunnelled), Some((5, face(0)))),
+            record(5, Fate::Settled(face(255)), Some((6, Outcome::Unknown))),
+            record(6, Fate::Failed(Failure::Engine), None),
+        ];
+        let bytes = pack(&recs);
+        let back = unpack(&bytes, &[0, 1, 2, 3, 4, 5, 6], &throws(), FORMAT).unwrap();
+        assert_eq!(back, recs);
+        // A byte short, or one too many, is an error.
+        assert!(unpack(
+            &bytes[..bytes.len() - 1],
+            &[0, 1, 2, 3, 4, 5, 6],
+            &throws(),
+            FORMAT
+        )
+        .is_err());
+        let mut more = bytes.clone();
+        more.push(0);
+        assert!(unpack(&more, &[0, 1, 2, 3, 4, 5, 6], &throws(), FORMAT).is_err());
+    }
+
+    /// One roll in `rolls-v1`: its tag, then what follows it (no dip).
+    fn v1(tag: u64, after_tag: &[u64], steps: &[u64]) -> Vec<u8> {
+        let mut b = Vec::new();
+        varint(&mut b, tag);
+        for &v in after_tag.iter().chain(steps).chain(&[0, 0]) {
+            varint(&mut b, v);
+        }
+        b
+    }
+
+    #[test]
+    fn a_v1_chunk_reads_as_faces() {
+        let read = |b: &[u8]| unpack(b, &[0], &throws(), FORMAT_V1).map(|r| r[0]);
+        // A cuboid at rest, width vertical (bits 2-3: 1), its face kept (bit 9) at the
+        // negative end (bit 10): direction 3, −y up.
+        let r = read(&v1(1 << 2 | 1 << 9 | 1 << 10, &[], &[50, 40])).unwrap();
+        assert_eq!(r.fate, Fate::Settled(Outcome::Face(3)));
+        assert_eq!((r.steps, r.engine_steps, r.certified), (50, 40, None));
+        // Certified width (bits 7-8) at step 30, at rest on −y: the certificate named that
+        // face; certified length, a side it did not rest on: wrong, so no face.
+        let tag = 1 << 2 | 1 << 4 | 1 << 9 | 1 << 10;
+        let r = read(&v1(tag | 1 << 7, &[], &[50, 40, 30])).unwrap();
+        assert_eq!(r.certified, Some((30, Outcome::Face(3))));
+        let r = read(&v1(tag | 2 << 7, &[], &[50, 40, 30])).unwrap();
+        assert_eq!(r.certified, Some((30, Outcome::Unknown)));
+        // Unknown at rest, and a cuboid moving at the cap (its side only): no face.
+        let r = read(&v1(3 << 2, &[], &[50, 40])).unwrap();
+        assert_eq!(r.fate, Fate::Settled(Outcome::Unknown));
+        let r = read(&v1(1 | 2 << 2, &[], &[50, 40])).unwrap();
+        assert_eq!(r.fate, Fate::Unconverged(Outcome::Unknown));
+        // A die of any shape at rest on its face 7 (bit 11, the index after the tag), and
+        // certified on face 7 (bit 12, after the certified step).
+        let tag = 1 << 4 | 1 << 9 | 1 << 11 | 1 << 12;
+        let r = read(&v1(tag, &[7], &[50, 40, 30, 7])).unwrap();
+        assert_eq!(r.fate, Fate::Settled(Outcome::Face(7)));
+        assert_eq!(r.certified, Some((30, Outcome::Face(7))));
+        // A failure.
+        let r = read(&v1(2 | 1 << 2, &[], &[50, 40])).unwrap();
+        assert_eq!(r.fate, Fate::Failed(Failure::Tunnelled));
+        // A cuboid at rest from a chunk written before faces were kept: refused.
+        let e = read(&v1(1 << 2, &[], &[50, 40])).unwrap_err();
+        assert!(e.contains("before faces were kept"), "{e}");
     }
 
     #[test]

@@ -156,7 +156,7 @@ pub struct Rolled {
 }
 
 /// One chunk file, `chunk-FIRST-LEN.json`: the run's key, what the chunk cost, and its rolls
-/// packed ([`crate::run::pack`], format `rolls-v1`, in base64), under a checksum
+/// packed ([`crate::run::pack`], format `rolls-v2`, or an older `rolls-v1`, in base64), under a checksum
 /// ([`crate::run::seal`]). A chunk of the JSON records an older dicephys wrote has no
 /// checksum: it is read as damaged, named, and rolled again.
 #[derive(Serialize, Deserialize)]
@@ -269,6 +269,7 @@ impl<'a> Runner<'a> {
                 .min(end.saturating_mul(CHUNK_ROLLS) * indices.n.max(1)),
         );
         let key = spec.key();
+        let sides = spec.scene.counts_sides();
         let mut done = Rolled {
             tally: Tally::default(),
             complete: false,
@@ -293,7 +294,9 @@ impl<'a> Runner<'a> {
                         done.resumed += file.records.len() as u64;
                         done.resumed_cpu_s += file.cpu_s;
                         done.resumed_wall_s += file.wall_s;
-                        file.records.iter().try_for_each(|r| done.tally.add(r))?;
+                        file.records
+                            .iter()
+                            .try_for_each(|r| done.tally.add(r, sides))?;
                         sink(&file.records)?;
                         (self.progress)(done.tally.rolls);
                         continue;
@@ -344,10 +347,10 @@ impl<'a> Runner<'a> {
                 };
                 let json = crate::run::seal::to_string(&file, false)?;
                 write_atomic(p, json.as_bytes())?;
-                recs.iter().try_for_each(|r| done.tally.add(r))?;
+                recs.iter().try_for_each(|r| done.tally.add(r, sides))?;
                 sink(&recs)?;
             } else {
-                recs.iter().try_for_each(|r| done.tally.add(r))?;
+                recs.iter().try_for_each(|r| done.tally.add(r, sides))?;
                 sink(&recs)?;
             }
             if !whole {
@@ -395,7 +398,8 @@ fn read_chunk(
         ))));
     }
     let refuse = |why: String| Chunk::Refused(Error::Mismatch(format!("{}: {why}", p.display())));
-    if file.format != crate::run::pack::FORMAT {
+    use crate::run::pack::{FORMAT, FORMAT_V1};
+    if file.format != FORMAT && file.format != FORMAT_V1 {
         return Err(refuse(format!(
             "format {:?}, not {:?} (a newer dicephys's?)",
             file.format,
@@ -403,7 +407,7 @@ fn read_chunk(
         )));
     }
     let records = crate::run::pack::unbase64(&file.rolls)
-        .and_then(|b| crate::run::pack::unpack(&b, chunk, throws))
+        .and_then(|b| crate::run::pack::unpack(&b, chunk, throws, &file.format))
         .map_err(|e| refuse(format!("its rolls are not this chunk's ({e})")))?;
     Ok(Chunked {
         cpu_s: file.cpu_s,

@@ -1,7 +1,8 @@
 //! Exact integer counts over a set of rolls: the same whatever the thread count, order, shard
 //! or resumed segment they were rolled in.
 
-use crate::model::block::Outcome;
+use crate::model::block::Side;
+use crate::model::faces::Outcome;
 use crate::sim::roll::{Failure, Fate, RollRecord};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -132,14 +133,18 @@ fn is_zero(n: &u64) -> bool {
 }
 
 impl Counts {
-    /// Counts one outcome.
-    pub fn add(&mut self, o: Outcome) -> crate::Result<()> {
-        let n = match o {
-            Outcome::Breadth => &mut self.breadth,
-            Outcome::Width => &mut self.width,
-            Outcome::Length => &mut self.length,
-            Outcome::Unknown => &mut self.unknown,
-            Outcome::Face => &mut self.face,
+    /// Counts one roll at rest on `o`: a cuboid's (`sides`) by the side standing vertical
+    /// (`Outcome::side`), a die of any shape's as on a face.
+    pub fn add(&mut self, o: Outcome, sides: bool) -> crate::Result<()> {
+        let n = match (o, sides) {
+            (Outcome::Unknown, _) => &mut self.unknown,
+            (Outcome::Face(_), false) => &mut self.face,
+            (Outcome::Face(_), true) => match o.side() {
+                Side::Breadth => &mut self.breadth,
+                Side::Width => &mut self.width,
+                Side::Length => &mut self.length,
+                Side::Unknown => &mut self.unknown,
+            },
         };
         plus(n, 1)
     }
@@ -156,8 +161,10 @@ fn plus(a: &mut u64, b: u64) -> crate::Result<()> {
 }
 
 impl Tally {
-    /// Counts one roll; an error if a count would overflow.
-    pub fn add(&mut self, r: &RollRecord) -> crate::Result<()> {
+    /// Counts one roll of a die whose outcomes are `sides` (a cuboid's, also counted by the
+    /// side standing vertical) or not (a die of any shape's); an error if a count would
+    /// overflow.
+    pub fn add(&mut self, r: &RollRecord, sides: bool) -> crate::Result<()> {
         plus(&mut self.rolls, 1)?;
         plus(&mut self.steps, r.steps)?;
         plus(&mut self.engine_steps, r.engine_steps)?;
@@ -171,25 +178,24 @@ impl Tally {
                 Fate::Settled(Outcome::Unknown) | Fate::Unconverged(Outcome::Unknown) => {
                     plus(&mut self.certified_unknown, 1)?
                 }
+                // Another face than it named.
                 Fate::Settled(s) | Fate::Unconverged(s) => {
-                    // A die of any shape: the same face, not only a face.
-                    let wrong = s != o || (s == Outcome::Face && r.up != r.certified_face);
-                    plus(&mut self.certified_wrong, wrong as u64)?
+                    plus(&mut self.certified_wrong, (s != o) as u64)?
                 }
                 Fate::Failed(_) => {}
             }
         }
-        if let (Fate::Settled(o), Some(d)) = (r.fate, r.up) {
+        if let Fate::Settled(Outcome::Face(d)) = r.fate {
             let d = usize::from(d);
             // A cuboid's six directions at once; a shape's faces up to this one.
-            let len = if o == Outcome::Face { d + 1 } else { 6 };
+            let len = if sides { 6 } else { d + 1 };
             if self.faces.len() < len {
                 self.faces.resize(len, 0);
             }
             plus(&mut self.faces[d], 1)?;
         }
         match r.fate {
-            Fate::Settled(o) => self.counts.add(o),
+            Fate::Settled(o) => self.counts.add(o, sides),
             Fate::Unconverged(_) => plus(&mut self.unconverged, 1),
             Fate::Failed(f) => plus(self.failed.entry(f).or_insert(0), 1),
         }
@@ -306,11 +312,11 @@ impl Tally {
         self.deepest_dip_nm as f64 * 1e-9
     }
 
-    /// The tally of these records.
-    pub fn of(records: &[RollRecord]) -> crate::Result<Tally> {
+    /// The tally of these records, of a die whose outcomes are `sides` or not (`add`).
+    pub fn of(records: &[RollRecord], sides: bool) -> crate::Result<Tally> {
         let mut t = Tally::default();
         for r in records {
-            t.add(r)?;
+            t.add(r, sides)?;
         }
         Ok(t)
     }
@@ -327,27 +333,28 @@ fn nanometres(m: f64) -> u64 {
 }
 
 /// How two runs of the same throws agree, throw for throw. "Same outcome" means both rolls
-/// settled, on the same side; a roll that did not settle agrees with nothing.
+/// settled, a cuboid's on the same side, a die of any shape's on the same face; a roll that
+/// did not settle agrees with nothing.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Agreement {
     /// Throws compared.
     pub rolls: u64,
     /// Throws both runs settled.
     pub both_settled: u64,
-    /// Throws both runs settled on the same side.
+    /// Throws both runs settled on the same side (a die of any shape: the same face).
     pub same: u64,
 }
 
 impl Agreement {
-    /// Compares records of the same throws, in the same order.
-    pub fn of(a: &[RollRecord], b: &[RollRecord]) -> Agreement {
+    /// Compares records of the same throws, in the same order, of a die whose outcomes are
+    /// `sides` (compared by the side standing vertical, as the paper counts) or not (by face).
+    pub fn of(a: &[RollRecord], b: &[RollRecord], sides: bool) -> Agreement {
         let mut g = Agreement::default();
         for (x, y) in a.iter().zip(b) {
             g.rolls += 1;
             if let (Fate::Settled(p), Fate::Settled(q)) = (x.fate, y.fate) {
                 g.both_settled += 1;
-                // A die of any shape: the same face, not only both on a face.
-                g.same += (p == q && (p != Outcome::Face || x.up == y.up)) as u64;
+                g.same += if sides { p.side() == q.side() } else { p == q } as u64;
             }
         }
         g

@@ -1,7 +1,7 @@
 //! The exact early stop: once the die's energy is below the barrier out of its face region,
 //! its outcome can no longer change.
 
-use crate::model::block::Outcome;
+use crate::model::block::Side;
 use crate::model::die::{up_in_body, DieBody};
 use crate::model::state::BodyState;
 
@@ -29,7 +29,7 @@ pub struct Certificate {
     /// Fraction of the barrier kept in reserve, in [0, 1).
     pub margin: f64,
 }
-const SIDES: [Outcome; 3] = [Outcome::Breadth, Outcome::Width, Outcome::Length];
+const SIDES: [Side; 3] = [Side::Breadth, Side::Width, Side::Length];
 
 impl Certificate {
     /// The height E/(mg) must be below for the certificate to hold in any face region: the
@@ -51,7 +51,7 @@ impl Certificate {
     }
 
     /// The outcome, if it is already certain.
-    pub fn certain(&self, die: &DieBody, s: &BodyState) -> Option<Outcome> {
+    pub fn certain(&self, die: &DieBody, s: &BodyState) -> Option<Side> {
         let up = up_in_body(&s.rotation);
         let (i, k) = die.face_region(&up);
         let rest = die.rest[i][k];
@@ -126,12 +126,12 @@ mod tests {
         let id = UnitQuaternion::identity();
         assert_eq!(
             c.certain(&die, &state(0.010, id, 0.0, 0.0)),
-            Some(Outcome::Width)
+            Some(Side::Width)
         );
         let on_side = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 1.5);
         assert_eq!(
             c.certain(&die, &state(0.012, on_side, 0.0, 0.0)),
-            Some(Outcome::Breadth)
+            Some(Side::Breadth)
         );
         // Dropped from 0.3 m: far above every barrier.
         assert_eq!(c.certain(&die, &state(0.3, id, 0.0, 0.0)), None);
@@ -149,7 +149,7 @@ mod tests {
         let b = 0.5 * (0.024f64).hypot(0.020);
         assert_eq!(
             c.certain(&die, &state(b - 1e-6, id, 0.0, 0.0)),
-            Some(Outcome::Width)
+            Some(Side::Width)
         );
         assert_eq!(c.certain(&die, &state(b + 1e-6, id, 0.0, 0.0)), None);
     }

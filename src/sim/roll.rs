@@ -3,9 +3,8 @@
 
 use crate::engine::Engine;
 use crate::error::Field;
-use crate::model::block::Outcome;
 use crate::model::die::DieBody;
-use crate::model::faces::up_direction;
+use crate::model::faces::Outcome;
 use crate::model::scene::Scene;
 use crate::model::state::BodyState;
 use crate::model::throws::Throw;
@@ -83,12 +82,23 @@ impl Failure {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Fate {
-    /// At rest; the side standing vertical.
+    /// At rest; the face it rests on (`faces::Outcome`), or none.
     Settled(Outcome),
-    /// Still moving at the step cap; the side vertical at that moment, for the record only.
+    /// Still moving at the step cap; its face at that moment, for the record only.
     Unconverged(Outcome),
     /// The roll failed, and why.
     Failed(Failure),
+}
+
+impl Fate {
+    /// A cuboid's roll as the paper sees it: the side standing vertical where it came to rest
+    /// (`Outcome::side`); `None` for a roll that did not.
+    pub fn settled_side(self) -> Option<crate::model::block::Side> {
+        match self {
+            Fate::Settled(o) => Some(o.side()),
+            _ => None,
+        }
+    }
 }
 
 /// One roll: its throw, how it ended, and how many steps it took.
@@ -103,13 +113,9 @@ pub struct RollRecord {
     /// Steps the engine itself took (fewer than `steps` where free flight was coasted).
     pub engine_steps: u64,
     /// With `RollConfig::audit` or the certificate rule: the first step at which the energy
-    /// certificate held, and the outcome it certified (under the certificate rule, the step
+    /// certificate held, and the face it certified (under the certificate rule, the step
     /// the roll ended).
     pub certified: Option<(u64, Outcome)>,
-    /// A die of any shape: the face the certificate named (`certified`'s outcome is then
-    /// `Outcome::Face`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub certified_face: Option<u8>,
     /// The engine injected energy: the die's kinetic + potential energy rose above its lowest
     /// value so far by more than `ENERGY_GAIN_TOLERANCE` of its starting energy. A flag, not a
     /// failure: the roll goes on and may still settle.
@@ -118,11 +124,6 @@ pub struct RollRecord {
     /// The die's dips into the floor (`DipWatch`): a flag, not a failure.
     #[serde(default)]
     pub dip: Dip,
-    /// Settled on a face: the direction whose face is up (`faces::DIRECTIONS`; in 2D one of
-    /// the four sides). `None` for a roll of any other fate, or read from a chunk written
-    /// before faces were kept.
-    #[serde(default)]
-    pub up: Option<u8>,
 }
 
 impl RollRecord {
@@ -471,10 +472,8 @@ fn record_of(throw: &Throw, end: End) -> RollRecord {
         steps: end.steps,
         engine_steps: end.engine_steps,
         certified: end.certified,
-        certified_face: end.certified_face,
         energy_gain: end.energy_gain,
         dip: end.dip,
-        up: end.up,
     }
 }
 
@@ -568,16 +567,12 @@ pub struct End {
     /// Steps the engine took.
     pub engine_steps: u64,
     /// With an audit or the certificate rule: the first step at which the energy certificate
-    /// held, and the outcome it certified.
+    /// held, and the face it certified.
     pub certified: Option<(u64, Outcome)>,
-    /// See `RollRecord::certified_face`.
-    pub certified_face: Option<u8>,
     /// See `RollRecord::energy_gain`.
     pub energy_gain: bool,
     /// See `RollRecord::dip`.
     pub dip: Dip,
-    /// See `RollRecord::up`.
-    pub up: Option<u8>,
 }
 
 /// Steps the die from `start` until it is at rest (or certain), reaches the step cap, or
@@ -654,25 +649,23 @@ impl Watch {
         let under = state.position.y < 0.0;
         if self.watch && end.certified.is_none() && !under {
             let certain = match &die.convex {
-                // A box: its side, and a box-shaped die of any shape its face (`labelled`).
+                // A box: the face of its side's region (`labelled`: the end of the axis up).
                 None => self
                     .certificate
                     .certain(die, state)
-                    .map(|o| die.certified(o, state)),
+                    .map(|side| die.labelled(side, state)),
                 // A die of any shape: the face of the region it cannot leave.
                 Some(c) => self
                     .certificate
                     .certain_convex(c, die, state)
-                    .map(|k| (Outcome::Face, Some(k))),
+                    .map(Outcome::Face),
             };
-            if let Some((o, face)) = certain {
+            if let Some(o) = certain {
                 end.certified = Some((end.steps, o));
-                end.certified_face = face;
                 if self.stop_early {
-                    // Certain of its side, and so of its face: the die cannot leave the
-                    // face region it is in (the barrier it cannot climb is the edge between).
+                    // Certain of its face: the die cannot leave the face region it is in
+                    // (the barrier it cannot climb is the edge between).
                     end.fate = Fate::Settled(o);
-                    end.up = face.or_else(|| up_direction(&state.rotation, o));
                     return true;
                 }
             }
@@ -681,9 +674,7 @@ impl Watch {
             end.fate = if under {
                 Fate::Failed(Failure::Tunnelled)
             } else {
-                let (o, up) = self.die.outcome(state);
-                end.up = up;
-                Fate::Settled(o)
+                Fate::Settled(self.die.outcome(state))
             };
             return true;
         }
@@ -860,10 +851,8 @@ fn run(
         steps: 0,
         engine_steps: 0,
         certified: None,
-        certified_face: None,
         energy_gain: false,
         dip: Dip::default(),
-        up: None,
     };
     if engine.reset(start).is_err() {
         return Some(end);
@@ -916,7 +905,7 @@ fn run(
             return Some(end);
         }
     }
-    end.fate = Fate::Unconverged(w.die.outcome(&state).0);
+    end.fate = Fate::Unconverged(w.die.outcome(&state));
     Some(end)
 }
 

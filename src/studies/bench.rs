@@ -457,7 +457,7 @@ pub fn dice_costs(
             if !models(scene) {
                 continue;
             }
-            let t = Tally::of(recs)?;
+            let t = Tally::of(recs, scene.counts_sides())?;
             let ms = 1000.0 * cpu_s / n as f64;
             let row = DiceCost {
                 engine: engine.name().into(),
@@ -688,18 +688,19 @@ fn bench_row(
 ) -> crate::Result<BenchRow> {
     let (wall_s, cpu_s) = (*wall_s, *cpu_s);
     let rolls = recs.len() as u64;
-    let t = Tally::of(recs)?;
+    // The paper's block, counted by its sides.
+    let t = Tally::of(recs, true)?;
     let r = stats::ratio(t.counts.breadth, t.counts.width);
     let rolls_per_s = rolls as f64 / wall_s;
     let (speedup, z, same) = match &faithful {
         None => (1.0, 0.0, 1.0),
         Some((f, f_rps)) => {
-            let ft = Tally::of(f)?;
+            let ft = Tally::of(f, true)?;
             let fr = stats::ratio(ft.counts.breadth, ft.counts.width);
             (
                 rolls_per_s / f_rps,
                 stats::z_score(r.value, r.err, fr.value, fr.err),
-                Agreement::of(f, recs).of_rolls(),
+                Agreement::of(f, recs, true).of_rolls(),
             )
         }
     };

@@ -148,7 +148,7 @@ pub fn run(cfg: &Config, study: &Study) -> Result<Crosscheck> {
     }
     let versus: Vec<Versus> = (1..runs.len())
         .map(|i| {
-            let agree = Agreement::of(&records[0], &records[i]);
+            let agree = Agreement::of(&records[0], &records[i], runs[0].spec.scene.counts_sides());
             Versus {
                 engine: runs[i].engine,
                 baseline: runs[0].engine,

@@ -7,7 +7,7 @@ use super::study::Study;
 use super::sweep::{cell_spec, Measured};
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
-use crate::model::block::Outcome;
+use crate::model::block::Side;
 use crate::model::scene::Scene;
 use crate::run::cputime::process_cpu_seconds;
 use crate::run::runner::CHUNK_ROLLS;
@@ -24,8 +24,11 @@ pub const STREAM_ROLLS: u64 = crate::run::spec::MAX_ROLLS;
 /// else (length vertical, unknown, unconverged, failed).
 fn class(r: &RollRecord) -> u8 {
     match r.fate {
-        Fate::Settled(Outcome::Breadth) => 1,
-        Fate::Settled(Outcome::Width) => 2,
+        Fate::Settled(o) => match o.side() {
+            Side::Breadth => 1,
+            Side::Width => 2,
+            _ => 0,
+        },
         _ => 0,
     }
 }
@@ -103,7 +106,7 @@ impl Stream {
             have..chunks,
             &mut |recs| {
                 outcomes.extend(recs.iter().map(class));
-                recs.iter().try_for_each(|r| tally.add(r))
+                recs.iter().try_for_each(|r| tally.add(r, true))
             },
         )?;
         if !run.complete {

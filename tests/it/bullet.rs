@@ -2,7 +2,7 @@
 //! (`cargo test --release`): each rolls thousands of real throws.
 
 use dicephys::engine::{new_engine, EngineKind};
-use dicephys::model::block::{Block, Outcome};
+use dicephys::model::block::{Block, Side};
 use dicephys::model::scene::{Mode, Scene};
 use dicephys::model::state::BodyState;
 use dicephys::model::throws::{ThrowKind, ThrowRanges, Throws};
@@ -53,29 +53,29 @@ fn a_box_at_rest_on_each_face_classifies_right() {
     let b = block();
     // Body x = breadth, y = width, z = length. Identity: width vertical.
     let cases_3d = [
-        (UnitQuaternion::identity(), b.width / 2.0, Outcome::Width),
+        (UnitQuaternion::identity(), b.width / 2.0, Side::Width),
         (
             UnitQuaternion::from_axis_angle(&Vector3::z_axis(), FRAC_PI_2),
             b.breadth / 2.0,
-            Outcome::Breadth,
+            Side::Breadth,
         ),
         (
             UnitQuaternion::from_axis_angle(&Vector3::x_axis(), FRAC_PI_2),
             b.length / 2.0,
-            Outcome::Length,
+            Side::Length,
         ),
     ];
     for (rot, half, want) in cases_3d {
         assert_eq!(
-            settle_at_rest(EngineKind::Bullet, Mode::ThreeD, rot, half),
-            Fate::Settled(want),
+            settle_at_rest(EngineKind::Bullet, Mode::ThreeD, rot, half).settled_side(),
+            Some(want),
             "3D, {want:?} vertical"
         );
     }
     for (rot, half, want) in &cases_3d[..2] {
         assert_eq!(
-            settle_at_rest(EngineKind::Bullet, Mode::TwoD, *rot, *half),
-            Fate::Settled(*want),
+            settle_at_rest(EngineKind::Bullet, Mode::TwoD, *rot, *half).settled_side(),
+            Some(*want),
             "2D, {want:?} vertical"
         );
     }
@@ -107,7 +107,10 @@ fn same_seed_same_counts_for_any_thread_count() {
     )
     .unwrap();
     assert_eq!(one, two, "records differ between 1 and 2 threads");
-    assert_eq!(Tally::of(&one).unwrap(), Tally::of(&two).unwrap());
+    assert_eq!(
+        Tally::of(&one, true).unwrap(),
+        Tally::of(&two, true).unwrap()
+    );
 }
 
 #[test]
@@ -160,7 +163,7 @@ fn match_dicephys(mode: Mode, block: &str, file: &str) -> f64 {
     let same = got
         .iter()
         .zip(&want)
-        .filter(|(r, w)| matches!(r.fate, Fate::Settled(o) if o.name() == w.as_str()))
+        .filter(|(r, w)| matches!(r.fate, Fate::Settled(o) if o.side().name() == w.as_str()))
         .count();
     same as f64 / n as f64
 }
@@ -202,7 +205,7 @@ fn keyed_throws_agree_with_dicephys_ratio_within_3_sigma() {
         &|_| {},
     )
     .unwrap();
-    let t = Tally::of(&recs).unwrap();
+    let t = Tally::of(&recs, true).unwrap();
     let ours = dicephys::theory::stats::ratio(t.counts.breadth, t.counts.width);
     let theirs = dicephys::theory::stats::ratio(14163, 25837);
     let z = dicephys::theory::stats::z_score(ours.value, ours.err, theirs.value, theirs.err);

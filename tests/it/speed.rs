@@ -43,7 +43,7 @@ fn the_early_stop_names_the_outcome_of_the_full_settle() {
             },
             n,
         );
-        let t = Tally::of(&audit).unwrap();
+        let t = Tally::of(&audit, true).unwrap();
         assert_eq!(
             t.certified_wrong, 0,
             "{kind} {mode:?}: the certificate was wrong"
@@ -132,7 +132,7 @@ fn the_plane_floor_is_not_the_box_floor() {
             ..RollConfig::default()
         };
         let recs = rolls_on(floor, EngineKind::Bullet, Mode::TwoD, settle, 1500);
-        let c = Tally::of(&recs).unwrap().counts;
+        let c = Tally::of(&recs, true).unwrap().counts;
         dicephys::theory::stats::ratio(c.breadth, c.width)
     };
     let (b, p) = (ratio(Floor::Box), ratio(Floor::Plane));

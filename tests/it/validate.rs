@@ -8,7 +8,7 @@
 
 use super::helpers::{bin, dicephys, exit_within, json, scratch, Scratch};
 use dicephys::engine::{new_engine, EngineKind};
-use dicephys::model::block::{Block, Outcome};
+use dicephys::model::block::{Block, Side};
 use dicephys::model::scene::{Mode, Scene};
 use dicephys::model::state::BodyState;
 use dicephys::model::throws::ThrowStyle;
@@ -99,9 +99,9 @@ fn released_at_rest_in_3d_a_die_lands_on_the_solid_angle_it_started_in() {
             let f = c.faces();
             let (p, _) = theory::simpson_3d(&block(b));
             for (o, want) in [
-                (Outcome::Breadth, p.breadth_vertical),
-                (Outcome::Width, p.width_vertical),
-                (Outcome::Length, p.length_vertical),
+                (Side::Breadth, p.breadth_vertical),
+                (Side::Width, p.width_vertical),
+                (Side::Length, p.length_vertical),
             ] {
                 let zz = z(f.of(o), f.total(), want);
                 assert!(zz.abs() <= Z_MAX, "{engine} {b} {o:?}: z {zz}");

@@ -2,7 +2,7 @@
 //! mass (the frame the trace's positions and quaternions move), the label printed on each,
 //! and its outcomes' resting normals, from which the page reads the face a frame shows.
 
-use crate::model::block::Outcome;
+use crate::model::block::Side;
 use crate::model::die::DieBody;
 use crate::model::scene::{Mode, Scene};
 use crate::model::shape::{Reads, Shape, Solid};
@@ -116,7 +116,7 @@ fn block(scene: &Scene, die: &DieBody) -> DieView {
                 pips: if middle { pips.clone() } else { Vec::new() },
             });
         }
-        let vertical = [Outcome::Breadth, Outcome::Width, Outcome::Length][axis];
+        let vertical = [Side::Breadth, Side::Width, Side::Length][axis];
         outcomes.push(Resting {
             normal: n.into(),
             label: format!("{} vertical", vertical.name()),

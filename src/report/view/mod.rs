@@ -5,8 +5,8 @@
 
 pub mod die;
 
-use crate::model::block::Outcome;
 use crate::model::die::DieBody;
+use crate::model::faces::Outcome;
 use crate::model::state::BodyState;
 use crate::sim::roll::{Fate, RollRecord};
 use serde::Serialize;
@@ -162,12 +162,12 @@ impl ThrowView {
         frames: Frames,
     ) -> ThrowView {
         let outcome = match record.fate {
-            Fate::Settled(o) | Fate::Unconverged(o) => named(o, record.up, labels),
+            Fate::Settled(o) | Fate::Unconverged(o) => named(o, labels),
             Fate::Failed(_) => None,
         };
-        let early_stop = record.certified.and_then(|(step, o)| {
-            Some((step as f64 * dt, named(o, record.certified_face, labels)?))
-        });
+        let early_stop = record
+            .certified
+            .and_then(|(step, o)| Some((step as f64 * dt, named(o, labels)?)));
         ThrowView {
             index,
             ending,
@@ -178,13 +178,13 @@ impl ThrowView {
     }
 }
 
-/// The outcome `o` (a die of any shape's `face`, named by `labels`) as the page's die names
-/// its outcomes: a label, or "breadth vertical".
-fn named(o: Outcome, face: Option<u8>, labels: &[String]) -> Option<String> {
-    match o {
-        Outcome::Face => face.and_then(|k| labels.get(usize::from(k)).cloned()),
-        Outcome::Unknown => None,
-        o => Some(format!("{} vertical", o.name())),
+/// The outcome `o` as the page's die names its outcomes: a die of any shape's face by its
+/// label (`labels`), a cuboid's (no labels) as "breadth vertical".
+fn named(o: Outcome, labels: &[String]) -> Option<String> {
+    match (o, labels.is_empty()) {
+        (Outcome::Unknown, _) => None,
+        (Outcome::Face(k), false) => labels.get(usize::from(k)).cloned(),
+        (Outcome::Face(_), true) => Some(format!("{} vertical", o.side().name())),
     }
 }
 

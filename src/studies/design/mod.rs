@@ -267,12 +267,9 @@ fn batched_at(
     let mut batches = vec![vec![0u64; target.len()]; nb];
     let mut sink = |recs: &[crate::sim::roll::RollRecord]| -> Result<()> {
         for r in recs {
-            let (Fate::Settled(o), Some(d)) = (r.fate, r.up) else {
+            let Fate::Settled(crate::model::faces::Outcome::Face(d)) = r.fate else {
                 continue;
             };
-            if o == crate::model::block::Outcome::Unknown {
-                continue;
-            }
             let d = usize::from(d);
             let label = match &labels {
                 Some(l) => l.get(d).cloned().unwrap_or_default(),

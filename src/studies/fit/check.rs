@@ -6,7 +6,7 @@ use crate::calibration::data::DataRow;
 use crate::calibration::design::{blocks, point_seed};
 use crate::calibration::params::{Fixed, Method};
 use crate::error::Result;
-use crate::model::block::Outcome;
+use crate::model::block::Side;
 use crate::run::runner::Runner;
 use crate::sim::roll::Fate;
 
@@ -68,22 +68,22 @@ pub fn run(
                 return Ok(None);
             }
         }
-        // Throws settled by both methods, paired.
-        let both: Vec<(Outcome, Outcome)> = fates[0]
+        // Throws settled by both methods, paired, by the side standing vertical.
+        let both: Vec<(Side, Side)> = fates[0]
             .iter()
             .zip(&fates[1])
             .filter_map(|(a, b)| match (a, b) {
-                (Fate::Settled(a), Fate::Settled(b)) => Some((*a, *b)),
+                (Fate::Settled(a), Fate::Settled(b)) => Some((a.side(), b.side())),
                 _ => None,
             })
             .collect();
-        let ind = |o: Outcome, k: usize| -> Vec<bool> {
+        let ind = |o: Side, k: usize| -> Vec<bool> {
             both.iter()
                 .map(|p| if k == 0 { p.0 == o } else { p.1 == o })
                 .collect()
         };
-        let breadth = Departure::paired(&ind(Outcome::Breadth, 0), &ind(Outcome::Breadth, 1));
-        let length = Departure::paired(&ind(Outcome::Length, 0), &ind(Outcome::Length, 1));
+        let breadth = Departure::paired(&ind(Side::Breadth, 0), &ind(Side::Breadth, 1));
+        let length = Departure::paired(&ind(Side::Length, 0), &ind(Side::Length, 1));
         let data_err = block_rows
             .iter()
             .map(|r| {

@@ -4,7 +4,7 @@
 use super::rows::Rows;
 use crate::engine::EngineKind;
 use crate::error::{Error, Result};
-use crate::model::block::{Block, Outcome};
+use crate::model::block::{Block, Side};
 use crate::model::scene::{Mode, Scene};
 use crate::model::throws::ThrowStyle;
 use crate::report::validate::Config;
@@ -39,18 +39,19 @@ impl LimitCell {
     }
 
     pub(super) fn add(&mut self, scene: &Scene, r: &RollRecord) -> Result<()> {
-        self.tally.add(r)?;
+        // The paper's blocks, counted by the side standing vertical.
+        self.tally.add(r, true)?;
         let face = match r.fate {
             Fate::Settled(o) => {
-                self.at_rest.add(o);
-                o
+                self.at_rest.add(o.side());
+                o.side()
             }
             Fate::Unconverged(_) => match r.certified {
                 Some((_, o)) => {
-                    self.moving_at_cap.add(o);
-                    o
+                    self.moving_at_cap.add(o.side());
+                    o.side()
                 }
-                None => Outcome::Unknown,
+                None => Side::Unknown,
             },
             Fate::Failed(_) => {
                 self.failed += 1;
@@ -58,17 +59,17 @@ impl LimitCell {
                 return Ok(());
             }
         };
-        if face == Outcome::Unknown {
+        if face == Side::Unknown {
             self.unknown += 1;
         } else {
             self.ended_on_a_face += 1;
             self.ended_where_started += (face == start_face(scene, &r.throw.start(scene))) as u64;
         }
         self.outcomes.push(match face {
-            Outcome::Breadth => 'b',
-            Outcome::Width => 'w',
-            Outcome::Length => 'l',
-            Outcome::Unknown | Outcome::Face => '?',
+            Side::Breadth => 'b',
+            Side::Width => 'w',
+            Side::Length => 'l',
+            Side::Unknown => '?',
         });
         Ok(())
     }
@@ -150,11 +151,11 @@ pub fn measure_limit(spec: &RunSpec, study: &Study) -> Result<LimitCell> {
 /// The face whose solid angle the downward vertical from the centre passes through in state
 /// `s`: the body axis i (of x, y in 2D) with the largest |uᵢ|/sᵢ, u the vertical in body axes
 /// and sᵢ the half sides; the face a die released there at rest, without momentum, ends on.
-pub fn start_face(scene: &Scene, s: &crate::model::state::BodyState) -> Outcome {
+pub fn start_face(scene: &Scene, s: &crate::model::state::BodyState) -> Side {
     let die = crate::model::die::DieBody::of(scene);
     let up = crate::model::die::up_in_body(&s.rotation);
     let (i, _) = die.face_region(&up);
-    [Outcome::Breadth, Outcome::Width, Outcome::Length][i]
+    [Side::Breadth, Side::Width, Side::Length][i]
 }
 
 /// The 2D case: per engine and block, over-damped, then the damping lifted, on the same throws;
@@ -222,8 +223,8 @@ pub(super) fn quasi_static_3d(
             let f = c.faces();
             for (o, q) in SIDES {
                 let want = match o {
-                    Outcome::Breadth => p.breadth_vertical,
-                    Outcome::Width => p.width_vertical,
+                    Side::Breadth => p.breadth_vertical,
+                    Side::Width => p.width_vertical,
                     _ => p.length_vertical,
                 };
                 let mut r = probability_row(
@@ -334,8 +335,8 @@ fn subject_2d(block: &Block) -> String {
     format!("{block} (R {:.3})", block.r())
 }
 
-const SIDES: [(Outcome, &str); 3] = [
-    (Outcome::Breadth, "P(breadth vertical)"),
-    (Outcome::Width, "P(width vertical)"),
-    (Outcome::Length, "P(length vertical)"),
+const SIDES: [(Side, &str); 3] = [
+    (Side::Breadth, "P(breadth vertical)"),
+    (Side::Width, "P(width vertical)"),
+    (Side::Length, "P(length vertical)"),
 ];
