@@ -543,6 +543,16 @@ impl Scene {
         crate::model::faces::Layout::from_numbers(numbers)
     }
 
+    /// What each of the die's outcomes shows, by its index (`faces::Outcome::Face`): a die of
+    /// any shape's labels (`Shape::labels`; a label on several facets at each), the cuboid's
+    /// numbers under `layout` by the direction of its face up (`faces::DIRECTIONS`).
+    pub fn face_labels(&self, layout: crate::model::faces::Layout) -> Vec<String> {
+        match &self.shape {
+            Some(s) => s.labels().iter().map(|l| l.to_string()).collect(),
+            None => layout.numbers().iter().map(u8::to_string).collect(),
+        }
+    }
+
     /// True if the die is the cuboid, whose outcomes (its faces, by the direction up) the
     /// paper counts by the side standing vertical (`faces::Outcome::side`); a die of any
     /// shape, a box-shaped one too, is counted by its faces alone.

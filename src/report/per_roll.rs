@@ -66,9 +66,11 @@ pub const COLUMNS: [&str; 13] = [
 pub struct PerRoll<W: Write> {
     csv: csv::Writer<W>,
     dt: f64,
-    numbers: [u8; 6],
-    /// A die of any shape's labels, by its outcome.
-    labels: Option<Vec<String>>,
+    /// What each outcome shows, by its index (`Scene::face_labels`).
+    labels: Vec<String>,
+    /// The cuboid's outcome column is its side (`Scene::counts_sides`); a die of any shape's
+    /// is "face".
+    sides: bool,
 }
 
 fn failed(e: csv::Error) -> Error {
@@ -86,8 +88,8 @@ impl<W: Write> PerRoll<W> {
         Ok(PerRoll {
             csv,
             dt,
-            numbers: layout.numbers(),
-            labels: None,
+            labels: layout.numbers().iter().map(u8::to_string).collect(),
+            sides: true,
         })
     }
 
@@ -98,10 +100,8 @@ impl<W: Write> PerRoll<W> {
         layout: Layout,
     ) -> Result<PerRoll<W>> {
         let mut p = PerRoll::new(out, scene.dt, layout)?;
-        p.labels = scene
-            .shape
-            .as_ref()
-            .map(|s| s.labels().iter().map(|l| l.to_string()).collect());
+        p.labels = scene.face_labels(layout);
+        p.sides = scene.counts_sides();
         Ok(p)
     }
 
@@ -110,8 +110,8 @@ impl<W: Write> PerRoll<W> {
         for r in records {
             // A cuboid's outcome by its side; a die of any shape's as "face" (which one: the
             // face column).
-            let side = |o: Outcome| match (o, &self.labels) {
-                (Outcome::Face(_), Some(_)) => "face",
+            let side = |o: Outcome| match o {
+                Outcome::Face(_) if !self.sides => "face",
                 _ => o.side().name(),
             };
             let (status, outcome) = match r.fate {
@@ -139,10 +139,9 @@ impl<W: Write> PerRoll<W> {
                     dip_steps: r.dip.steps,
                     longest_dip_steps: r.dip.longest,
                     penetration_m: r.dip.penetration,
-                    face: up.map_or(String::new(), |d| match &self.labels {
-                        Some(l) => l.get(usize::from(d)).cloned().unwrap_or_default(),
-                        None => self.numbers[usize::from(d).min(5)].to_string(),
-                    }),
+                    face: up
+                        .and_then(|d| self.labels.get(usize::from(d)).cloned())
+                        .unwrap_or_default(),
                 })
                 .map_err(failed)?;
         }

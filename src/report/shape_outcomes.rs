@@ -137,12 +137,14 @@ impl ShapeOutcomes {
             .zip(&fair)
             .map(|((_, c), q)| (*c as f64 - nf * q).powi(2) / (nf * q))
             .sum();
-        let (theory, quasi_static_missing) =
-            match crate::theory::quasi_static::outcome_shares(scene) {
-                Some(Ok(q)) => (Some(q), None),
-                Some(Err(e)) => (None, Some(e)),
-                None => (None, None),
-            };
+        let shares = crate::theory::quasi_static::label_shares(scene, scene.features.layout);
+        let (theory, quasi_static_missing) = match shares {
+            Ok(q) => (
+                Some(q.into_iter().map(|(_, q)| q).collect::<Vec<f64>>()),
+                None,
+            ),
+            Err(e) => (None, Some(e)),
+        };
         let against_quasi_static = theory.as_ref().map(|q| {
             let (mut chi2, mut k) = (0.0, 0usize);
             for ((_, c), q) in counts.iter().zip(q) {

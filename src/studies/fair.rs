@@ -31,37 +31,39 @@ fn critical(p: f64, dof: usize) -> f64 {
 /// (a uniform null on a die whose faces are not alike).
 fn null_probabilities(s: &RunSummary, null: &Null) -> Result<(Vec<f64>, Option<String>)> {
     let scene = &s.spec.scene;
-    if let (Some(f), Some(shape)) = (
-        crate::report::shape_outcomes::shape_faces(&s.tally, scene),
-        scene.shape.as_deref(),
-    ) {
-        let labels: Vec<String> = f.into_iter().map(|(l, _)| l).collect();
-        return shape_null(shape, scene, &labels, null);
-    }
-    let shown = if s.mode == Mode::ThreeD { 6 } else { 4 };
-    match (null, s.mode) {
-        (Null::Uniform, _) => Ok((vec![1.0 / shown as f64; shown], block_unlike(scene))),
-        (Null::Target(t), _) => {
-            let numbers: Vec<String> = s.layout.numbers()[..shown]
-                .iter()
-                .map(u8::to_string)
-                .collect();
-            let q = theory::null::target_for(t, &numbers)
-                .map_err(|e| Error::field(Field::Null, null.spec(), e))?;
-            Ok((q, None))
+    // The labels counted, in the order of the counts (`face_counts`'): a die of any shape's
+    // by label, a block's numbers by direction.
+    let labels: Vec<String> = match crate::report::shape_outcomes::shape_faces(&s.tally, scene) {
+        Some(f) => f.into_iter().map(|(l, _)| l).collect(),
+        None => die_labels(scene, s.layout),
+    };
+    match null {
+        // Every die's outcomes by one theory, in the same order.
+        Null::QuasiStatic => {
+            let shares = theory::quasi_static::label_shares(scene, s.layout)
+                .map_err(|e| Error::field(Field::Null, "quasi-static", e))?;
+            Ok((shares.into_iter().map(|(_, q)| q).collect(), None))
         }
-        (Null::QuasiStatic, Mode::ThreeD) => {
-            // Each face's solid angle from the centre of mass, of the inner box: for the plain
-            // block Simpson's (the paper's), for a made die its centre's and rounding's; the
-            // one formula `fair --counts` takes too.
-            let die = crate::model::die::DieBody::of(scene);
-            Ok((theory::quasi_static::faces_up(&die).to_vec(), None))
-        }
-        (Null::QuasiStatic, Mode::TwoD) => Err(Error::field(
-            Field::Null,
-            "quasi-static",
-            "the quasi-static theory is 3D; in 2D give uniform",
+        Null::Target(t) => Ok((
+            theory::null::target_for(t, &labels)
+                .map_err(|e| Error::field(Field::Null, null.spec(), e))?,
+            None,
         )),
+        // Each label its facets' share; a block's faces each 1/N.
+        Null::Uniform => match scene.shape.as_deref() {
+            Some(shape) => {
+                let shares = theory::null::uniform_shares(shape);
+                let q = labels
+                    .iter()
+                    .map(|l| shares.iter().find(|(m, _)| m == l).map_or(0.0, |s| s.1))
+                    .collect();
+                Ok((q, theory::null::alike(shape)))
+            }
+            None => Ok((
+                vec![1.0 / labels.len() as f64; labels.len()],
+                block_unlike(scene),
+            )),
+        },
     }
 }
 
@@ -85,22 +87,18 @@ pub fn check_null(spec: &RunSpec, null: &Null) -> Result<()> {
     }
 }
 
-/// The labels a die shows: a die of any shape's (in its faces' order), else the numbers on a
-/// block's faces under `layout` (four in 2D).
+/// The labels a die shows, each once, in the order of its outcomes (`Scene::face_labels`: a
+/// die of any shape's labels, a block's numbers under `layout`, four in 2D).
 pub fn die_labels(scene: &crate::model::scene::Scene, layout: Layout) -> Vec<String> {
-    match scene.shape.as_deref() {
-        Some(shape) => theory::null::uniform_shares(shape)
-            .into_iter()
-            .map(|(l, _)| l)
-            .collect(),
-        None => {
-            let shown = if scene.mode == Mode::ThreeD { 6 } else { 4 };
-            layout.numbers()[..shown]
-                .iter()
-                .map(u8::to_string)
-                .collect()
+    let shown = if scene.mode == Mode::ThreeD { 6 } else { 4 };
+    let mut out: Vec<String> = Vec::new();
+    for (k, l) in scene.face_labels(layout).into_iter().enumerate() {
+        // A block in 2D shows the four faces about z.
+        if (scene.shape.is_some() || k < shown) && !out.contains(&l) {
+            out.push(l);
         }
     }
+    out
 }
 
 /// A cuboid's faces are alike when it is (nearly) a cube: each face's solid angle from its
@@ -117,39 +115,6 @@ fn block_unlike(scene: &crate::model::scene::Scene) -> Option<String> {
             ])
         }
         Mode::TwoD => theory::null::unlike(&[b.breadth, b.width]),
-    }
-}
-
-/// A die of any shape's null for each of `labels` (its labels, in `shape_faces`' order), and
-/// the uniform null's note where its faces are not alike.
-fn shape_null(
-    shape: &crate::model::shape::Shape,
-    scene: &crate::model::scene::Scene,
-    labels: &[String],
-    null: &Null,
-) -> Result<(Vec<f64>, Option<String>)> {
-    let by_label = |shares: Vec<(String, f64)>| -> Vec<f64> {
-        labels
-            .iter()
-            .map(|l| shares.iter().find(|(m, _)| m == l).map_or(0.0, |s| s.1))
-            .collect()
-    };
-    match null {
-        Null::Uniform => Ok((
-            by_label(theory::null::uniform_shares(shape)),
-            theory::null::alike(shape),
-        )),
-        Null::QuasiStatic => {
-            let p = theory::quasi_static::outcome_shares(scene)
-                .expect("a die of any shape")
-                .map_err(|e| Error::field(Field::Null, "quasi-static", e))?;
-            Ok((p, None))
-        }
-        Null::Target(t) => Ok((
-            theory::null::target_for(t, labels)
-                .map_err(|e| Error::field(Field::Null, null.spec(), e))?,
-            None,
-        )),
     }
 }
 
@@ -268,29 +233,9 @@ pub fn assess_counts(
         Null::Target(t) => theory::null::target_for(t, &given)
             .map_err(|e| Error::field(Field::Null, null.spec(), e))?,
         Null::QuasiStatic => {
-            let shares: Vec<(String, f64)> = match &scene.shape {
-                Some(shape) => {
-                    let p = theory::quasi_static::outcome_shares(scene)
-                        .expect("a die of any shape")
-                        .map_err(|e| Error::field(Field::Null, "quasi-static", e))?;
-                    shape
-                        .labels()
-                        .iter()
-                        .map(|l| l.to_string())
-                        .zip(p)
-                        .collect()
-                }
-                None => {
-                    let die = crate::model::die::DieBody::of(scene);
-                    let up = theory::quasi_static::faces_up(&die);
-                    layout
-                        .numbers()
-                        .iter()
-                        .zip(up)
-                        .map(|(n, p)| (n.to_string(), p))
-                        .collect()
-                }
-            };
+            // The die's labels, each once, and their shares: one theory for every die.
+            let shares = theory::quasi_static::label_shares(scene, layout)
+                .map_err(|e| Error::field(Field::Null, "quasi-static", e))?;
             let mut labels: Vec<&str> = shares.iter().map(|(l, _)| l.as_str()).collect();
             labels.sort_by_key(|l| (l.parse::<u32>().unwrap_or(u32::MAX), l.to_string()));
             if counted.len() != shares.len() {

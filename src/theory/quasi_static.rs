@@ -99,17 +99,31 @@ pub fn shape(shape: &Shape, com: &Vector3<f64>) -> Result<Vec<f64>, String> {
     }
 }
 
-/// The quasi-static share of each outcome of a scene's die of any shape, by label
-/// ([`shape_labels`], at its centre of mass), of the rolls that end on one of them (a facet
-/// that holds the die only at this centre of mass is no outcome): what `fair --null
-/// quasi-static` and `roll`'s summary set the counts against. `None` for the cuboid.
-pub fn outcome_shares(scene: &crate::model::scene::Scene) -> Option<Result<Vec<f64>, String>> {
-    let s = scene.shape.as_deref()?;
-    let com = crate::model::mass::MassProps::compute(scene).com;
-    Some(shape_labels(s, &com).map(|p| {
-        let listed: f64 = p.iter().map(|(_, q)| q).sum();
-        p.iter().map(|(_, q)| q / listed).collect()
-    }))
+/// The quasi-static share of each label a scene's die shows, of the rolls that end on one of
+/// its outcomes, each label once in the order of its outcomes (`Scene::face_labels`): for every
+/// die the solid angle of each resting face's basin seen from the centre of mass. A block's
+/// numbers under `layout`, each by the face up ([`faces_up`], of its inner box); a die of any
+/// shape's labels ([`shape_labels`], at its centre of mass; a facet that holds the die only at
+/// this centre is no outcome). What `fair --null quasi-static` sets a run's counts and a
+/// tester's against, and `roll`'s summary a die of any shape's; an error in 2D (the theory is
+/// 3D) and where it is not built (a coin loaded off its axis).
+pub fn label_shares(
+    scene: &crate::model::scene::Scene,
+    layout: crate::model::faces::Layout,
+) -> Result<Vec<(String, f64)>, String> {
+    if scene.mode != crate::model::scene::Mode::ThreeD {
+        return Err("the quasi-static theory is 3D; in 2D give uniform".into());
+    }
+    let p = match scene.shape.as_deref() {
+        None => {
+            let up = faces_up(&DieBody::of(scene));
+            let numbers = layout.numbers().map(|n| n.to_string());
+            numbers.into_iter().zip(up).collect()
+        }
+        Some(s) => shape_labels(s, &crate::model::mass::MassProps::compute(scene).com)?,
+    };
+    let listed: f64 = p.iter().map(|(_, q)| q).sum();
+    Ok(p.into_iter().map(|(l, q)| (l, q / listed)).collect())
 }
 
 /// [`shape`] summed over the outcomes that show the same label, in the order of their first

@@ -258,9 +258,7 @@ fn batched_at(
     use crate::sim::roll::Fate;
     let rolls = spec.rolls.max(1);
     let nb = (BATCHES as u64).min(rolls) as usize;
-    let numbers = layout.numbers();
-    let labels: Option<Vec<String>> =
-        (spec.scene.shape.as_ref()).map(|s| s.labels().iter().map(|l| l.to_string()).collect());
+    let labels = spec.scene.face_labels(layout);
     // Each label's target outcome: its own, or `rest` for a label not named.
     let named = |l: &str| target.iter().position(|(t, _)| t == l);
     let rest = target.iter().position(|(t, _)| t == "rest");
@@ -270,12 +268,8 @@ fn batched_at(
             let Fate::Settled(crate::model::faces::Outcome::Face(d)) = r.fate else {
                 continue;
             };
-            let d = usize::from(d);
-            let label = match &labels {
-                Some(l) => l.get(d).cloned().unwrap_or_default(),
-                None => numbers[d.min(5)].to_string(),
-            };
-            if let Some(k) = named(&label).or(rest) {
+            let label = labels.get(usize::from(d)).map_or("", String::as_str);
+            if let Some(k) = named(label).or(rest) {
                 let b =
                     (r.throw.index.min(rolls - 1) as u128 * nb as u128 / rolls as u128) as usize;
                 batches[b][k] += 1;
