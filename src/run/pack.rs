@@ -19,7 +19,7 @@
 //! in base64 (the JSON records took 285).
 //!
 //! Format `rolls-v1`, which dicephys wrote before every outcome was a face, is still read
-//! ([`unpack_v1`]): it kept a cuboid's side, and its face only at rest.
+//! ([`unpack`]): it kept a cuboid's side, and its face only at rest.
 
 use crate::model::faces::Outcome;
 use crate::model::throws::Throws;
@@ -123,27 +123,32 @@ pub fn unpack(
     throws: &Throws,
     format: &str,
 ) -> Result<Vec<RollRecord>, String> {
-    if format == FORMAT_V1 {
-        return unpack_v1(bytes, indices, throws);
-    }
+    let v1 = format == FORMAT_V1;
     let mut r = Reader(bytes);
     let mut out = Vec::with_capacity(indices.len());
     for &i in indices {
         let tag = r.varint()?;
-        if tag >> 7 != 0 {
+        if tag >> (if v1 { 13 } else { 7 }) != 0 {
             return Err(format!("roll {i}: unknown tag bits"));
         }
         let what = tag >> 2 & 3;
-        let mut outcome = || -> Result<Outcome, String> {
-            Ok(match what {
-                0 => Outcome::Unknown,
-                1 => Outcome::Face(face(i, r.varint()?)?),
-                _ => return Err(format!("roll {i}: unknown outcome")),
-            })
-        };
         let fate = match tag & 3 {
-            0 => Fate::Settled(outcome()?),
-            1 => Fate::Unconverged(outcome()?),
+            0 | 1 => {
+                let o = if v1 {
+                    outcome_v1(&mut r, i, tag)?
+                } else {
+                    match what {
+                        0 => Outcome::Unknown,
+                        1 => Outcome::Face(face(i, r.varint()?)?),
+                        _ => return Err(format!("roll {i}: unknown outcome")),
+                    }
+                };
+                if tag & 3 == 0 {
+                    Fate::Settled(o)
+                } else {
+                    Fate::Unconverged(o)
+                }
+            }
             2 => Fate::Failed(match what {
                 0 => Failure::NonFinite,
                 1 => Failure::Tunnelled,
@@ -156,9 +161,13 @@ pub fn unpack(
         let engine_steps = r.varint()?;
         let certified = if tag >> 4 & 1 == 1 {
             let step = r.varint()?;
-            let o = match r.varint()? {
-                0 => Outcome::Unknown,
-                k => Outcome::Face(face(i, k - 1)?),
+            let o = if v1 {
+                certified_v1(&mut r, i, tag, fate)?
+            } else {
+                match r.varint()? {
+                    0 => Outcome::Unknown,
+                    k => Outcome::Face(face(i, k - 1)?),
+                }
             };
             Some((step, o))
         } else {
@@ -182,79 +191,44 @@ pub fn unpack(
     Ok(out)
 }
 
-/// The rolls of a chunk of format `rolls-v1`. Its tag: bits 0-1 the fate; bits 2-3 a cuboid's
-/// side (0 breadth, 1 width, 2 length, 3 unknown) or the failure; bit 4 certified; bit 5 the
-/// energy gain; bit 6 a dip depth; bits 7-8 the certified side; bit 9 a face kept at rest,
-/// bit 10 its end of the axis (the face up is direction 2 × side + bit 10); bit 11 a die of
-/// any shape's face, its index a varint after the tag when bit 9 is set; bit 12 a die of any
-/// shape's certified face, a varint after the certified step. It kept no face at the step
-/// cap, and a cuboid's certified side but not its face: read as none, and the certified face
-/// as the face it came to rest on where that is on the certified side, else none (so the
-/// audit's wrong and unknown counts are the ones it had, but for a certified roll left
-/// unconverged, now unknown). A roll at rest from a chunk written before faces were kept
-/// (no bit 9) is refused: its face is not known.
-fn unpack_v1(bytes: &[u8], indices: &[u64], throws: &Throws) -> Result<Vec<RollRecord>, String> {
-    let mut r = Reader(bytes);
-    let mut out = Vec::with_capacity(indices.len());
-    for &i in indices {
-        let tag = r.varint()?;
-        if tag >> 13 != 0 {
-            return Err(format!("roll {i}: unknown tag bits"));
+// Format `rolls-v1`: what it had in place of this format's faces. Its tag: bits 0-1 the fate;
+// bits 2-3 a cuboid's side (0 breadth, 1 width, 2 length, 3 unknown) or the failure; bit 4
+// certified; bit 5 the energy gain; bit 6 a dip depth; bits 7-8 the certified side; bit 9 a
+// face kept at rest, bit 10 its end of the axis (the face up is direction 2 × side + bit 10);
+// bit 11 a die of any shape's face, its index a varint after the tag when bit 9 is set; bit 12
+// a die of any shape's certified face, a varint after the certified step. The rest is laid out
+// as in `rolls-v2`.
+
+/// A settled or unconverged roll's outcome in `rolls-v1`. It kept no face at the step cap
+/// (read as none), and a roll at rest from a chunk written before faces were kept (no bit 9)
+/// is refused: its face is not known.
+fn outcome_v1(r: &mut Reader, i: u64, tag: u64) -> Result<Outcome, String> {
+    let (side, shaped, kept) = (tag >> 2 & 3, tag >> 11 & 1 == 1, tag >> 9 & 1 == 1);
+    Ok(match tag & 3 {
+        0 if side == 3 && !shaped => Outcome::Unknown,
+        0 if !kept => {
+            return Err(format!(
+                "roll {i}: written before faces were kept (roll the run afresh)"
+            ))
         }
-        let what = tag >> 2 & 3;
-        let shaped = tag >> 11 & 1 == 1;
-        let kept = tag >> 9 & 1 == 1;
-        let fate = match tag & 3 {
-            0 if what == 3 && !shaped => Fate::Settled(Outcome::Unknown),
-            0 if !kept => {
-                return Err(format!(
-                    "roll {i}: written before faces were kept (roll the run afresh)"
-                ))
-            }
-            0 if shaped => Fate::Settled(Outcome::Face(face(i, r.varint()?)?)),
-            0 => Fate::Settled(Outcome::Face((2 * what + (tag >> 10 & 1)) as u8)),
-            1 => Fate::Unconverged(Outcome::Unknown),
-            2 => Fate::Failed(match what {
-                0 => Failure::NonFinite,
-                1 => Failure::Tunnelled,
-                2 => Failure::Engine,
-                _ => return Err(format!("roll {i}: unknown failure")),
-            }),
-            _ => return Err(format!("roll {i}: unknown fate")),
-        };
-        let steps = r.varint()?;
-        let engine_steps = r.varint()?;
-        let certified = if tag >> 4 & 1 == 1 {
-            let step = r.varint()?;
-            let o = if tag >> 12 & 1 == 1 {
-                Outcome::Face(face(i, r.varint()?)?)
-            } else {
-                let side = tag >> 7 & 3;
-                match fate {
-                    Fate::Settled(o @ Outcome::Face(d)) if u64::from(d / 2) == side => o,
-                    _ => Outcome::Unknown,
-                }
-            };
-            Some((step, o))
-        } else {
-            None
-        };
-        let (dip_steps, longest) = (r.varint()?, r.varint()?);
-        let penetration = if tag >> 6 & 1 == 1 { r.f64()? } else { 0.0 };
-        out.push(RollRecord {
-            throw: throws.get(i),
-            fate,
-            steps,
-            engine_steps,
-            certified,
-            energy_gain: tag >> 5 & 1 == 1,
-            dip: Dip::of(dip_steps, longest, penetration),
-        });
+        0 if shaped => Outcome::Face(face(i, r.varint()?)?),
+        0 => Outcome::Face((2 * side + (tag >> 10 & 1)) as u8),
+        _ => Outcome::Unknown,
+    })
+}
+
+/// The certified face in `rolls-v1`: a die of any shape's (bit 12); for a cuboid, which kept
+/// only its side, the face it came to rest on where that is on the certified side, else none
+/// (so the audit's wrong and unknown counts are the ones it had, but for a certified roll left
+/// unconverged, now unknown).
+fn certified_v1(r: &mut Reader, i: u64, tag: u64, fate: Fate) -> Result<Outcome, String> {
+    if tag >> 12 & 1 == 1 {
+        return Ok(Outcome::Face(face(i, r.varint()?)?));
     }
-    if !r.0.is_empty() {
-        return Err(format!("{} bytes after the last roll", r.0.len()));
-    }
-    Ok(out)
+    Ok(match fate {
+        Fate::Settled(o @ Outcome::Face(d)) if u64::from(d / 2) == tag >> 7 & 3 => o,
+        _ => Outcome::Unknown,
+    })
 }
 
 const B64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
