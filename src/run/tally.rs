@@ -187,6 +187,12 @@ impl Tally {
         }
         if let Fate::Settled(Outcome::Face(d)) = r.fate {
             let d = usize::from(d);
+            if sides && d >= 6 {
+                // Only from a damaged or forged chunk: a cuboid has six faces.
+                return Err(crate::Error::Mismatch(format!(
+                    "a cuboid's roll on face {d} (it has six, 0 to 5)"
+                )));
+            }
             // A cuboid's six directions at once; a shape's faces up to this one.
             let len = if sides { 6 } else { d + 1 };
             if self.faces.len() < len {
@@ -406,6 +412,33 @@ mod tests {
         let mut forged = old.clone();
         forged.faces[2] = 9;
         assert!(forged.check().is_err());
+    }
+
+    #[test]
+    fn a_cuboid_s_face_past_its_six_is_an_error_not_a_panic() {
+        use crate::model::throws::{ThrowKind, ThrowRanges, ThrowStyle, Throws};
+        let throws = Throws::styled(
+            ThrowKind::Keyed,
+            ThrowStyle::Paper,
+            None,
+            1,
+            ThrowRanges::default(),
+            0,
+        );
+        let r = RollRecord {
+            throw: throws.get(0),
+            fate: Fate::Settled(Outcome::Face(6)),
+            steps: 10,
+            engine_steps: 10,
+            certified: None,
+            energy_gain: false,
+            dip: Default::default(),
+        };
+        assert!(Tally::of(&[r], true).is_err());
+        // A die of any shape's seventh face is a face.
+        let t = Tally::of(&[r], false).unwrap();
+        assert_eq!(t.faces, vec![0, 0, 0, 0, 0, 0, 1]);
+        assert_eq!(t.counts.face, 1);
     }
 
     #[test]
