@@ -90,11 +90,15 @@ pub fn check_null(spec: &RunSpec, null: &Null) -> Result<()> {
 /// The labels a die shows, each once, in the order of its outcomes (`Scene::face_labels`: a
 /// die of any shape's labels, a block's numbers under `layout`, four in 2D).
 pub fn die_labels(scene: &crate::model::scene::Scene, layout: Layout) -> Vec<String> {
-    let shown = if scene.mode == Mode::ThreeD { 6 } else { 4 };
+    // A block in 2D shows the four faces about z (a die of any shape is 3D only).
+    let shown = if scene.mode == Mode::ThreeD {
+        usize::MAX
+    } else {
+        4
+    };
     let mut out: Vec<String> = Vec::new();
-    for (k, l) in scene.face_labels(layout).into_iter().enumerate() {
-        // A block in 2D shows the four faces about z.
-        if (scene.shape.is_some() || k < shown) && !out.contains(&l) {
+    for l in scene.face_labels(layout).into_iter().take(shown) {
+        if !out.contains(&l) {
             out.push(l);
         }
     }
