@@ -568,7 +568,7 @@ fn counts_given(c: &Bound<'_, PyAny>, spec: &RunSpec) -> PyResult<Vec<(String, u
     } else if let Ok(pairs) = c.extract::<Vec<(String, u64)>>() {
         pairs
     } else if let Ok(counts) = c.extract::<Vec<u64>>() {
-        let labels: Vec<String> = match &spec.scene.shape {
+        let labels: Vec<String> = match spec.scene.die.as_shape() {
             Some(shape) => {
                 // Numbers in their order (a d6's 1 … 6, whatever its facets' order), other
                 // labels in the die's (a coin's heads, tails, edge).

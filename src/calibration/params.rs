@@ -17,7 +17,7 @@ use crate::error::{Error, Result};
 use crate::model::block::Block;
 use crate::model::die::Die;
 use crate::model::mass::Features;
-use crate::model::scene::{Mode, Scene, MAX_ROLLING_RESISTANCE};
+use crate::model::scene::{Form, Mode, Scene, MAX_ROLLING_RESISTANCE};
 use crate::model::throws::{Range, ThrowRanges, ThrowStyle};
 use crate::run::spec::{RunSpec, ThrowSpec, MAX_KAPPA};
 use crate::sim::roll::{early_stop_exact, RollConfig, Rule};
@@ -702,7 +702,7 @@ impl Method {
     /// `seed`.
     pub fn spec(&self, block: Block, mode: Mode, v: &Fixed, seed: u64, rolls: u64) -> RunSpec {
         let mut scene = Scene::paper(block, mode);
-        scene.shape = self.die.shape.clone();
+        scene.die = self.die.form(block);
         scene.dt = self.dt;
         scene.restitution = v.e;
         scene.friction = v.mu;
@@ -710,7 +710,7 @@ impl Method {
         // A coin at 0 takes its own default, as `roll` gives it one where the engine has
         // rolling resistance: with none, a coin rolling on its rim never stops (a fit's 0 is
         // no rolling resistance measured).
-        if v.rolling == 0.0 && scene.is_coin() && self.engine.resists_rolling(scene.mode) {
+        if v.rolling == 0.0 && scene.die.is_coin() && self.engine.resists_rolling(scene.mode) {
             scene.rolling_resistance = crate::model::scene::COIN_ROLLING_RESISTANCE;
         }
         scene.bounce_threshold = v.bounce;
@@ -724,13 +724,11 @@ impl Method {
         // a rounding it cannot take stays in the features, which the scene's checks refuse),
         // and rests on the facets it rests on at this centre of mass, each labelled as the
         // rows count it.
-        if self.die.shape.is_some() {
-            let _ = crate::model::mass::take_rounding(&mut scene.shape, &mut scene.features);
-            if let Some(base) = scene.shape.clone() {
-                let com = crate::model::mass::MassProps::compute(&scene).com;
-                if let Ok(at) = base.resting_at_keeping(&com) {
-                    scene.shape = Some(std::sync::Arc::new(at));
-                }
+        let _ = crate::model::mass::take_rounding(scene.die.shape_mut(), &mut scene.features);
+        if let Some(base) = scene.die.as_shape() {
+            let com = crate::model::mass::MassProps::compute(&scene).com;
+            if let Ok(at) = base.resting_at_keeping(&com) {
+                scene.die = Form::shape(at);
             }
         }
         let mut throws = match v.throw {

@@ -133,7 +133,7 @@ impl RollArgs {
 /// Runs `dicephys roll`.
 pub fn run(a: &RollArgs) -> Result<()> {
     let spec = a.spec()?;
-    if spec.scene.shape.is_some() && a.run.precision.is_some() {
+    if spec.scene.die.as_shape().is_some() && a.run.precision.is_some() {
         return Err(Error::Usage(
             "--precision is the ratio's (breadth against width vertical), which a die of any \
              shape has not: `dicephys fair --within PP` rolls until every face's probability is \

@@ -40,7 +40,7 @@ pub enum Collider {
 impl Collider {
     /// The scene's die's.
     pub fn of(scene: &Scene) -> Collider {
-        match scene.hull_shape().map(|s| (s, &s.solid)) {
+        match scene.die.hull().map(|s| (s, &s.solid)) {
             None => {
                 let [a, b, c] = scene.body_sides();
                 Collider::Box {
@@ -65,6 +65,6 @@ impl Collider {
     /// the paper's. Any other die is "made" (`model::mass`): its body is its principal frame
     /// at its centre of mass, its mass properties computed here.
     pub fn made(scene: &Scene) -> bool {
-        !scene.features.plain() || scene.hull_shape().is_some()
+        !scene.features.plain() || scene.die.hull().is_some()
     }
 }

@@ -4,6 +4,7 @@
 
 use crate::model::block::{Block, Side};
 use crate::model::faces::Outcome;
+use crate::model::form::Form;
 use crate::model::mass::{BodyTurn, Features, MassProps};
 use crate::model::scene::{Mode, Scene};
 use crate::model::shape::Shape;
@@ -16,7 +17,8 @@ use std::sync::Arc;
 /// A die as asked, resolved once wherever one is given (`roll`'s and `fair`'s flags, a die
 /// file, `fit`'s die, a counts file's `die` column, `predict`'s other die, Python's
 /// arguments): its shape, what departs from the uniform solid, and its density. The cuboid
-/// has no shape: its sides are the scene's block.
+/// has no shape: its sides are given where it is thrown (`roll`'s `--block`, each of a fit's
+/// rows), and [`Die::form`] makes it the scene's form with them.
 ///
 /// Written as a fit has always written its die (its features under `die`), so that a fit, its
 /// directory and its `fit.json` read the same; `features` is read too.
@@ -44,11 +46,16 @@ impl Die {
         self.shape.as_ref().map_or(block, |s| s.block())
     }
 
-    /// The paper's scene (`Scene::paper`) of it: its shape (its block the shape's bounding
-    /// box), else the cuboid `block`; its features, and its density where it gives one.
+    /// Its form in a scene: its shape, else the cuboid `block`.
+    pub fn form(&self, block: Block) -> Form {
+        self.shape.clone().map_or(Form::Cuboid(block), Form::Shape)
+    }
+
+    /// The paper's scene (`Scene::paper`) of it: its shape, else the cuboid `block`; its
+    /// features, and its density where it gives one.
     pub fn scene(&self, block: Block, mode: Mode) -> Scene {
-        let mut scene = Scene::paper(self.block(block), mode);
-        scene.shape = self.shape.clone();
+        let mut scene = Scene::paper(block, mode);
+        scene.die = self.form(block);
         scene.features = self.features;
         if let Some(d) = self.density {
             scene.density = d;
@@ -374,7 +381,7 @@ pub struct DieBody {
     /// from its hull (`Convex`); `None` for a box, which takes the cuboid's closed forms.
     pub convex: Option<Arc<Convex>>,
     /// A die of any shape that is a box (a d6, a box-shaped mesh): its outcome resting on
-    /// each face, in `faces::DIRECTIONS`' order (`Scene::box_faces`); `None` for the cuboid.
+    /// each face, in `faces::DIRECTIONS`' order (`Form::box_faces`); `None` for the cuboid.
     pub box_faces: Option<[u8; 6]>,
     /// A soft contact's stiffness for a flat landing, N/m: m ω₀², the four points' together
     /// (`model::compliance`); 0 for the rigid contact.
@@ -428,7 +435,7 @@ impl DieBody {
         });
         let diagonal = (mp.inertia == Matrix3::from_diagonal(&mp.inertia.diagonal()))
             .then(|| mp.inertia.diagonal());
-        let convex = scene.hull_shape().map(|s| Arc::new(Convex::of(s, &com)));
+        let convex = scene.die.hull().map(|s| Arc::new(Convex::of(s, &com)));
         // A die of any shape: no barrier is known (the early stop is proven for the cuboid).
         let barrier = if convex.is_some() {
             [[f64::NEG_INFINITY; 2]; 3]
@@ -451,7 +458,7 @@ impl DieBody {
             rest,
             barrier,
             convex,
-            box_faces: scene.box_faces(),
+            box_faces: scene.die.box_faces(),
             spring: if scene.contact_time > 0.0 {
                 let (w0, _) =
                     crate::model::compliance::solve(scene.restitution, scene.contact_time);

@@ -7,6 +7,7 @@ pub mod collider;
 pub mod compliance;
 pub mod die;
 pub mod faces;
+pub mod form;
 pub mod glibc;
 pub mod mass;
 pub mod mesh_file;

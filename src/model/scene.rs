@@ -5,9 +5,11 @@
 use crate::error::{Error, Field, Result};
 use crate::model::block::Block;
 pub use crate::model::block::Mode;
+pub use crate::model::form::Form;
 use crate::model::mass::{Composition, Features, MassProps};
 use crate::model::shape::Shape;
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 /// Gravity, m/s², along −y.
 pub const GRAVITY: f64 = 9.81;
@@ -94,9 +96,10 @@ pub const COIN_ROLLING_RESISTANCE: f64 = 5e-5;
 
 /// Everything a throw happens in.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(into = "Written", from = "Written")]
 pub struct Scene {
-    /// The die's sides.
-    pub block: Block,
+    /// The die: the paper's cuboid, or a die of any shape.
+    pub die: Form,
     /// 2D or 3D.
     pub mode: Mode,
     /// kg/m³. The paper does not give it; outcomes should not depend on it.
@@ -124,10 +127,8 @@ pub struct Scene {
     /// DicePhys: 0 (none). How each engine applies it: [`Scene::bullet_damping`],
     /// [`Scene::rapier_damping`]. Written into a specification only when not 0, so that a
     /// default run's specification, and the key its checkpoints carry, are unchanged.
-    #[serde(default, skip_serializing_if = "is_zero")]
     pub linear_damping: f64,
     /// Angular damping, a rate in 1/s, as `linear_damping` but for the angular velocity.
-    #[serde(default, skip_serializing_if = "is_zero")]
     pub angular_damping: f64,
     /// Rolling resistance, m: the lever arm of the floor's push against a die rolling or
     /// turning in place on it, so that a torque up to this length times the contact force
@@ -135,7 +136,6 @@ pub struct Scene {
     /// engine has by default; then a cylinder rolling on its side or a coin spinning on its
     /// rim never stops. Bullet, and Rapier's 3D body (a couple after each step,
     /// `Rapier3d::resist_rolling`). Written into a specification only when not 0.
-    #[serde(default, skip_serializing_if = "is_zero")]
     pub rolling_resistance: f64,
     /// The bounce threshold, m/s: a contact met slower than this along its normal does not
     /// bounce (restitution 0), a faster one bounces with e, as Bullet 3 drops restitution below
@@ -143,13 +143,11 @@ pub struct Scene {
     /// of the two holds). A real die's slow impacts lose what a fast one keeps (a plastic or
     /// sticky contact), which one e cannot say. DicePhys: 0, every impact bounces. Bullet only.
     /// Written into a specification only when not 0.
-    #[serde(default, skip_serializing_if = "is_zero")]
     pub bounce_threshold: f64,
     /// The contact time, s: a soft table (`model::compliance`), each impact a spring and a
     /// dashpot whose flat landing lasts this long and leaves at `restitution` times its
     /// speed. 0: the rigid contact (DicePhys's), an impulse in one step. Bullet only; at
     /// least two steps. Written into a specification only when not 0.
-    #[serde(default, skip_serializing_if = "is_zero")]
     pub contact_time: f64,
     /// Static friction over sliding friction, μs/μk: a contact point that is not sliding as a
     /// step begins (its slip slower than `Scene::stick_speed`) holds up to μs = this × μ times
@@ -157,25 +155,113 @@ pub struct Scene {
     /// pair of surfaces holds more than it drags (steel on steel 0.74 against 0.57, wood on wood
     /// up to twice), which one μ cannot say. DicePhys: 1, one μ. Bullet only. Written into a
     /// specification only when not 1.
-    #[serde(default = "one", skip_serializing_if = "is_one")]
     pub static_ratio: f64,
     /// The engine may put a die that has slowed down to sleep (Bullet's deactivation after
     /// 2 s under 0.8 m/s and 1 rad/s, Rapier's after 0.5 s under its thresholds), as DicePhys
     /// let Bullet do. False: never, for a die that moves slowly for long (an over-damped roll,
     /// which sleeping would freeze mid-fall). Written into a specification only when false.
-    #[serde(default = "yes", skip_serializing_if = "is_true")]
     pub sleeping: bool,
     /// How the die departs from the ideal block: its centre of mass, pips, rounded edges
     /// (`model::mass`), and how its faces are numbered (`layout`, which decides what its
     /// faces read, so it is the run's too). Written into a specification only when any is
     /// not the default.
-    #[serde(default, skip_serializing_if = "Features::is_default")]
     pub features: Features,
-    /// A die of any shape (`model::shape`: d4 … d20, a coin, a mesh) in place of the cuboid
-    /// `block`; `block` then holds its bounding box. Written into a specification only when
-    /// set, so a cuboid's specification is unchanged.
+}
+
+/// A scene as its specification writes it: every field in the order and the form it has
+/// always had, since a checkpoint's key is the hash of these bytes (`run::spec::RunSpec::key`)
+/// — the die's block first (a die of any shape's bounding box), its shape last and only where
+/// there is one. Read back, a shape's block is its own bounding box, not the one written.
+#[derive(Serialize, Deserialize)]
+struct Written {
+    block: Block,
+    mode: Mode,
+    density: f64,
+    friction: f64,
+    restitution: f64,
+    floor_friction: f64,
+    floor_restitution: f64,
+    dt: f64,
+    preset: Preset,
+    floor: Floor,
+    floor_thickness: f64,
+    gravity: f64,
+    #[serde(default, skip_serializing_if = "is_zero")]
+    linear_damping: f64,
+    #[serde(default, skip_serializing_if = "is_zero")]
+    angular_damping: f64,
+    #[serde(default, skip_serializing_if = "is_zero")]
+    rolling_resistance: f64,
+    #[serde(default, skip_serializing_if = "is_zero")]
+    bounce_threshold: f64,
+    #[serde(default, skip_serializing_if = "is_zero")]
+    contact_time: f64,
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    static_ratio: f64,
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    sleeping: bool,
+    #[serde(default, skip_serializing_if = "Features::is_default")]
+    features: Features,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub shape: Option<std::sync::Arc<Shape>>,
+    shape: Option<Arc<Shape>>,
+}
+
+impl From<Scene> for Written {
+    fn from(s: Scene) -> Written {
+        Written {
+            block: s.die.block(),
+            shape: match s.die {
+                Form::Cuboid(_) => None,
+                Form::Shape(shape) => Some(shape),
+            },
+            mode: s.mode,
+            density: s.density,
+            friction: s.friction,
+            restitution: s.restitution,
+            floor_friction: s.floor_friction,
+            floor_restitution: s.floor_restitution,
+            dt: s.dt,
+            preset: s.preset,
+            floor: s.floor,
+            floor_thickness: s.floor_thickness,
+            gravity: s.gravity,
+            linear_damping: s.linear_damping,
+            angular_damping: s.angular_damping,
+            rolling_resistance: s.rolling_resistance,
+            bounce_threshold: s.bounce_threshold,
+            contact_time: s.contact_time,
+            static_ratio: s.static_ratio,
+            sleeping: s.sleeping,
+            features: s.features,
+        }
+    }
+}
+
+impl From<Written> for Scene {
+    fn from(w: Written) -> Scene {
+        Scene {
+            die: w.shape.map_or(Form::Cuboid(w.block), Form::Shape),
+            mode: w.mode,
+            density: w.density,
+            friction: w.friction,
+            restitution: w.restitution,
+            floor_friction: w.floor_friction,
+            floor_restitution: w.floor_restitution,
+            dt: w.dt,
+            preset: w.preset,
+            floor: w.floor,
+            floor_thickness: w.floor_thickness,
+            gravity: w.gravity,
+            linear_damping: w.linear_damping,
+            angular_damping: w.angular_damping,
+            rolling_resistance: w.rolling_resistance,
+            bounce_threshold: w.bounce_threshold,
+            contact_time: w.contact_time,
+            static_ratio: w.static_ratio,
+            sleeping: w.sleeping,
+            features: w.features,
+        }
+    }
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -362,8 +448,8 @@ impl Scene {
             );
         }
         self.check_contact()?;
-        if let (Some(shape), Mode::TwoD) = (&self.shape, self.mode) {
-            // A box-shaped die too: its mass is the box's (`Scene::hull_shape`), its outcomes
+        if let (Some(shape), Mode::TwoD) = (self.die.as_shape(), self.mode) {
+            // A box-shaped die too: its mass is the box's (`Form::hull`), its outcomes
             // its faces in 3D.
             return Err(Error::field(
                 Field::Shape,
@@ -426,7 +512,7 @@ impl Scene {
     /// The paper's MDF scene (μ = 0.29, e = 0.5, dt = 1 ms) for a block.
     pub fn paper(block: Block, mode: Mode) -> Scene {
         Scene {
-            block,
+            die: Form::Cuboid(block),
             mode,
             density: 800.0,
             friction: 0.29,
@@ -446,7 +532,6 @@ impl Scene {
             static_ratio: 1.0,
             sleeping: true,
             features: Features::default(),
-            shape: None,
         }
     }
 
@@ -483,7 +568,7 @@ impl Scene {
     /// Full sides along the body's x, y, z axes (breadth, width, length); in 2D the depth
     /// along z is 1 m, as DicePhys's 2D die.
     pub fn body_sides(&self) -> [f64; 3] {
-        let b = &self.block;
+        let b = self.die.block();
         match self.mode {
             Mode::ThreeD => [b.breadth, b.width, b.length],
             Mode::TwoD => [b.breadth, b.width, 1.0],
@@ -498,42 +583,24 @@ impl Scene {
             plain_mass: self.mass(),
             mode: self.mode,
             features: &self.features,
-            shape: self.hull_shape(),
+            shape: self.die.hull(),
         }
     }
 
-    /// The paper's scene (`Scene::paper`) for a die of any shape; its block is the shape's
-    /// bounding box, for what reads the die's size (the drop, the reports).
+    /// The paper's scene (`Scene::paper`) for a die of any shape.
     pub fn paper_shape(shape: Shape, mode: Mode) -> Scene {
         let block = shape.block();
         Scene {
-            shape: Some(std::sync::Arc::new(shape)),
+            die: Form::shape(shape),
             ..Scene::paper(block, mode)
         }
-    }
-
-    /// The die's shape when its solid is not a box (a hull, a cylinder): what the engines,
-    /// the mass and the roll take from a die of any shape. `None` for a box (the cuboid, a d6,
-    /// a box-shaped mesh: `Shape::as_box`), which they all take by the box's closed forms, the
-    /// paper's fast path, whatever its name.
-    pub fn hull_shape(&self) -> Option<&Shape> {
-        self.shape.as_deref().filter(|s| s.as_box().is_none())
-    }
-
-    /// A die of any shape that is a box (`Shape::as_box`): its outcome resting on each face,
-    /// in `faces::DIRECTIONS`' order. `None` for the cuboid and for any other solid.
-    pub fn box_faces(&self) -> Option<[u8; 6]> {
-        self.shape
-            .as_deref()
-            .and_then(Shape::as_box)
-            .map(|b| b.faces)
     }
 
     /// A box-shaped die whose labels are the numbers 1 to 6: the layout they make, which
     /// places its pips (`model::mass`).
     pub fn box_layout(&self) -> Option<crate::model::faces::Layout> {
-        let shape = self.shape.as_deref()?;
-        let faces = self.box_faces()?;
+        let shape = self.die.as_shape()?;
+        let faces = self.die.box_faces()?;
         // A layout numbers the face up: each direction's number is what the die shows
         // resting on the face opposite.
         let mut numbers = [0u8; 6];
@@ -543,55 +610,30 @@ impl Scene {
         crate::model::faces::Layout::from_numbers(numbers)
     }
 
-    /// What each of the die's outcomes shows, by its index (`faces::Outcome::Face`): a die of
-    /// any shape's labels (`Shape::labels`; a label on several facets at each), the cuboid's
-    /// numbers under `layout` by the direction of its face up (`faces::DIRECTIONS`).
-    pub fn face_labels(&self, layout: crate::model::faces::Layout) -> Vec<String> {
-        match &self.shape {
-            Some(s) => s.labels().iter().map(|l| l.to_string()).collect(),
-            None => layout.numbers().iter().map(u8::to_string).collect(),
-        }
-    }
-
-    /// True if the die is the cuboid, whose outcomes (its faces, by the direction up) the
-    /// paper counts by the side standing vertical (`faces::Outcome::side`); a die of any
-    /// shape, a box-shaped one too, is counted by its faces alone.
-    pub fn counts_sides(&self) -> bool {
-        self.shape.is_none()
-    }
-
-    /// True if the die is a coin (a cylinder), which can roll on its rim for ever.
-    pub fn is_coin(&self) -> bool {
-        matches!(
-            self.shape.as_deref().map(|s| &s.solid),
-            Some(crate::model::shape::Solid::Cylinder { .. })
-        )
-    }
-
     /// The scene with its die's outcomes at its own centre of mass (`Shape::resting_at`): a
     /// die of any shape loaded off its centroid rests on the facets it rests on there, and a
     /// facet it rolls off is no outcome. Unchanged for the cuboid, a coin, or a centred die.
     /// A box-shaped die with pips has them drilled as its labels number its faces
     /// (`Scene::box_layout`).
     pub fn resting_at_com(mut self) -> std::result::Result<Scene, String> {
-        if self.shape.is_some() && self.features.pips.is_some() {
+        if let (Form::Shape(_), Some(_)) = (&self.die, self.features.pips) {
             self.features.layout = self.box_layout().ok_or_else(|| {
                 "pips are drilled in a box's faces numbered 1 to 6; this die is not one".to_string()
             })?;
         }
-        if let Some(shape) = &self.shape {
+        if let Form::Shape(shape) = &self.die {
             let com = MassProps::compute(&self).com;
-            self.shape = Some(std::sync::Arc::new(shape.resting_at(&com)?));
+            self.die = Form::shape(shape.resting_at(&com)?);
         }
         Ok(self)
     }
 
     /// The die's mass, multiplied in DicePhys's order so that the numbers agree to the bit.
     pub fn mass(&self) -> f64 {
-        if let Some(s) = self.hull_shape() {
+        if let Some(s) = self.die.hull() {
             return s.volume * self.density;
         }
-        let b = &self.block;
+        let b = self.die.block();
         match self.mode {
             Mode::ThreeD => b.breadth * b.width * b.length * self.density,
             Mode::TwoD => b.breadth * b.width * self.density,
@@ -609,8 +651,8 @@ impl Scene {
 
     /// The drop height is added to this: the longest side (in 2D, of breadth and width).
     pub fn drop_base(&self) -> f64 {
-        let b = &self.block;
-        if let Some(s) = &self.shape {
+        let b = self.die.block();
+        if let Some(s) = self.die.as_shape() {
             // Its bounding box's longest side, or its reach from the centroid if that is more
             // (with a centre of mass moved inside it), so it starts clear however it is turned.
             let com = self
@@ -690,5 +732,28 @@ mod tests {
         );
         let back: Scene = serde_json::from_str(&json).unwrap();
         assert_eq!(back, s);
+    }
+
+    /// A die of any shape is written as its specification always wrote it, its bounding box
+    /// first and its shape after every other field, and read back as its own bounding box
+    /// whatever block the specification holds.
+    #[test]
+    fn a_shape_s_scene_is_written_block_first_and_read_as_its_own_box() {
+        let d20 = crate::model::shape::named("d20", None).unwrap();
+        let own = d20.block();
+        let s = Scene::paper_shape(d20, Mode::ThreeD);
+        let json = serde_json::to_string(&s).unwrap();
+        assert!(json.starts_with(&format!(
+            "{{\"block\":{}",
+            serde_json::to_string(&own).unwrap()
+        )));
+        let shape_at = json.find("\"shape\":").unwrap();
+        assert!(json.find("\"gravity\":").unwrap() < shape_at, "{json}");
+        let back: Scene = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, s);
+        let stale = json.replacen(&format!("{}", own.length), "0.5", 1);
+        assert_ne!(stale, json);
+        let back: Scene = serde_json::from_str(&stale).unwrap();
+        assert_eq!(back.die.block(), own);
     }
 }

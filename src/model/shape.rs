@@ -134,6 +134,10 @@ pub struct Shape {
     /// for them.
     #[serde(skip)]
     facets: std::sync::OnceLock<std::sync::Arc<Vec<polytope::Facet>>>,
+    /// Its bounding box, found once on first use (`Shape::bounding_box`): a scene's die's
+    /// block (`model::form::Form::block`), which every throw's drop asks for.
+    #[serde(skip)]
+    bounds: std::sync::OnceLock<[f64; 3]>,
 }
 
 fn is_up(r: &Reads) -> bool {
@@ -224,6 +228,7 @@ pub fn coin(d: f64, h: f64) -> std::result::Result<Shape, String> {
         volume: mp.volume,
         second: second_moments(&mp.inertia, mp.volume),
         facets: Default::default(),
+        bounds: Default::default(),
         printed: None,
         reads: Reads::Up,
         radius: 0.0,
@@ -310,6 +315,7 @@ pub fn from_mesh(
         radius: 0.0,
         // The facets just found, so that the outcomes are numbered in this hull's order.
         facets: std::sync::OnceLock::from(std::sync::Arc::new(facets)),
+        bounds: Default::default(),
     };
     shape.faces = shape.outcomes_at(&Vector3::zeros(), false)?;
     // Found again from the hull's points on first use, as by a run that reads the die back
@@ -421,6 +427,7 @@ impl Shape {
             reads: keeper.reads,
             radius,
             facets: Default::default(),
+            bounds: Default::default(),
         };
         let faces = s.outcomes_at(&Vector3::zeros(), true)?;
         if let Some(lost) = self
@@ -665,7 +672,7 @@ impl Shape {
 
     /// The sides of its bounding box along body x, y, z, m.
     pub fn bounding_box(&self) -> [f64; 3] {
-        match &self.solid {
+        *self.bounds.get_or_init(|| match &self.solid {
             Solid::Hull { points } => std::array::from_fn(|i| {
                 let (lo, hi) = points.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
                     (lo.min(p[i]), hi.max(p[i]))
@@ -673,7 +680,7 @@ impl Shape {
                 hi - lo + 2.0 * self.radius
             }),
             Solid::Cylinder { diameter, height } => [*diameter, *diameter, *height],
-        }
+        })
     }
 
     /// Its bounding box as a block (breadth, width, length along body x, y, z): what a scene
@@ -854,7 +861,7 @@ mod tests {
         assert_eq!(d6.faces[usize::from(b.faces[0])].label, "5");
         let s = scene(d6.clone());
         assert_eq!(s.box_layout(), Some(crate::model::faces::Layout::Right));
-        assert!(s.hull_shape().is_none());
+        assert!(s.die.hull().is_none());
         let prism = named("prism:4,20,30", None).unwrap();
         assert!(prism.as_box().is_some());
         for other in ["d4", "d8", "d20", "prism:6,20,30"] {
@@ -864,7 +871,7 @@ mod tests {
         let mut hollow = d6;
         hollow.volume *= 0.9;
         assert!(hollow.as_box().is_none());
-        assert!(scene(hollow).hull_shape().is_some());
+        assert!(scene(hollow).die.hull().is_some());
     }
 
     #[test]

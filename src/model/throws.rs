@@ -221,7 +221,7 @@ impl ThrowStyle {
     /// The throw a scene's die gets when none is asked: the paper's for the cuboid, a tumble
     /// for a die of any shape (it has no long axis to spin about).
     pub fn default_for(scene: &crate::model::scene::Scene) -> ThrowStyle {
-        if scene.shape.is_some() {
+        if scene.die.as_shape().is_some() {
             ThrowStyle::Tumble
         } else {
             ThrowStyle::Paper

@@ -182,14 +182,10 @@ impl Fairness {
 
     /// The human report.
     pub fn text(&self, s: &RunSummary) -> String {
-        let die = match &s.spec.scene.shape {
-            Some(shape) => shape.name.clone(),
-            None => format!(
-                "{} mm, {} layout",
-                s.block_mm.map(|v| v.to_string()).join("x"),
-                s.layout
-            ),
-        };
+        let mut die = s.spec.scene.die.title();
+        if s.spec.scene.die.counts_sides() {
+            die += &format!(", {} layout", s.layout);
+        }
         let mut out = format!(
             "Is this die fair? {die}, {} {}, throw {}, {} rolls ({} at rest on a face), \
              against {}\n",

@@ -66,9 +66,9 @@ pub const COLUMNS: [&str; 13] = [
 pub struct PerRoll<W: Write> {
     csv: csv::Writer<W>,
     dt: f64,
-    /// What each outcome shows, by its index (`Scene::face_labels`).
+    /// What each outcome shows, by its index (`Form::face_labels`).
     labels: Vec<String>,
-    /// The cuboid's outcome column is its side (`Scene::counts_sides`); a die of any shape's
+    /// The cuboid's outcome column is its side (`Form::counts_sides`); a die of any shape's
     /// is "face".
     sides: bool,
 }
@@ -100,8 +100,8 @@ impl<W: Write> PerRoll<W> {
         layout: Layout,
     ) -> Result<PerRoll<W>> {
         let mut p = PerRoll::new(out, scene.dt, layout)?;
-        p.labels = scene.face_labels(layout);
-        p.sides = scene.counts_sides();
+        p.labels = scene.die.face_labels(layout);
+        p.sides = scene.die.counts_sides();
         Ok(p)
     }
 

@@ -11,7 +11,7 @@ pub fn shape_faces(
     tally: &Tally,
     scene: &crate::model::scene::Scene,
 ) -> Option<Vec<(String, u64)>> {
-    let shape = scene.shape.as_ref()?;
+    let shape = scene.die.as_shape()?;
     let counts = (0..shape.faces.len()).map(|k| tally.faces.get(k).copied().unwrap_or(0));
     Some(shape.by_label(counts))
 }
@@ -122,7 +122,7 @@ pub fn check_settled(tally: &Tally) -> crate::Result<()> {
 impl ShapeOutcomes {
     /// The outcomes of a die of any shape from its tally; `None` for the cuboid.
     pub fn of(tally: &Tally, scene: &crate::model::scene::Scene) -> Option<ShapeOutcomes> {
-        let shape = scene.shape.as_deref()?;
+        let shape = scene.die.as_shape()?;
         let counts = shape_faces(tally, scene)?;
         let n: u64 = counts.iter().map(|(_, c)| c).sum();
         let k = counts.len();

@@ -227,12 +227,12 @@ impl RunSummary {
         } = cost;
         let r = crate::theory::stats::ratio(tally.counts.breadth, tally.counts.width);
         let (ratio, ratio_err) = (r.value, r.err);
-        let theory_ratio = crate::theory::ratio_from_r(scene.block.r());
+        let theory_ratio = crate::theory::ratio_from_r(scene.die.block().r());
         RunSummary {
             engine: spec.engine,
             engine_version: spec.engine.version(),
             preset: scene.preset,
-            block_mm: scene.block.mm(),
+            block_mm: scene.die.block().mm(),
             mode: scene.mode,
             rolls: tally.rolls,
             seed: spec.throws.seed,
@@ -259,7 +259,7 @@ impl RunSummary {
             theory_ratio,
             outcomes: match scene.mode {
                 Mode::ThreeD => {
-                    crate::report::outcomes::Outcomes3d::of(&scene.block, &tally.counts)
+                    crate::report::outcomes::Outcomes3d::of(&scene.die.block(), &tally.counts)
                 }
                 Mode::TwoD => None,
             },
@@ -298,7 +298,7 @@ impl RunSummary {
 
     /// The same summary with its faces numbered by `layout`.
     pub fn with_layout(mut self, layout: faces::Layout) -> RunSummary {
-        if self.spec.scene.shape.is_some() {
+        if self.spec.scene.die.as_shape().is_some() {
             return self;
         }
         self.layout = layout;
@@ -380,19 +380,7 @@ impl RunSummary {
         for w in &self.warnings {
             s += &format!("WARNING: {w}\n");
         }
-        let die = match &self.spec.scene.shape {
-            Some(shape) => shape.name.clone(),
-            None => format!(
-                "{} mm",
-                crate::model::block::Block::from_mm(
-                    self.block_mm[0],
-                    self.block_mm[1],
-                    self.block_mm[2]
-                )
-                .map(|b| b.to_string())
-                .unwrap_or_default()
-            ),
-        };
+        let die = self.spec.scene.die.title();
         // The throw is always named: a fair cube under the paper's throw shows 1 and 6 less
         // often, and a reader must see which throw made the counts.
         let throw = throw_name(&self.spec.throws);

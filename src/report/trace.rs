@@ -214,8 +214,8 @@ pub fn page(
     let die = DieBody::of(scene);
     let settle = config(scene, max_steps, fast_flight, true);
     let labels: Vec<String> = scene
-        .shape
-        .as_ref()
+        .die
+        .as_shape()
         .map(|s| s.labels().into_iter().map(String::from).collect())
         .unwrap_or_default();
     let label_refs: Vec<&str> = labels.iter().map(String::as_str).collect();

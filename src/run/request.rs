@@ -82,7 +82,7 @@ impl DieRequest {
         // stays the cuboid's (`mass::take_rounding`).
         let mut shape = shape.map(std::sync::Arc::new);
         let (r, name) = (features.edge_radius, shape.as_ref().map(|s| s.name.clone()));
-        crate::model::mass::take_rounding(&mut shape, &mut features).map_err(|why| {
+        crate::model::mass::take_rounding(shape.as_mut(), &mut features).map_err(|why| {
             Error::field(
                 Field::EdgeRadius,
                 r * 1e3,
@@ -112,7 +112,7 @@ impl DieRequest {
             .resting_at_com()
             .map_err(|e| self.at_its_centre_of_mass(&e))?;
         Ok(Die {
-            shape: scene.shape,
+            shape: scene.die.into_shape(),
             features: scene.features,
             density: d.density,
         })
@@ -447,12 +447,12 @@ impl RollRequest {
         let mut scene = self.scene.scene()?;
         // The default die is thrown in a tumble, as the d6 it stands for (the paper's throw
         // spins a cube about one axis).
-        let defaulted = self.scene.die.block.is_none() && scene.shape.is_none();
+        let defaulted = self.scene.die.block.is_none() && scene.die.as_shape().is_none();
         // Unless one is asked: a coin rolls against a hard table's resistance where the engine
         // has it (with none, a coin on its rim rolls to the step cap); every other die against
         // none, as DicePhys.
         if self.scene.rolling_resistance_mm.is_none()
-            && scene.is_coin()
+            && scene.die.is_coin()
             && self.engine.resists_rolling(scene.mode)
         {
             scene.rolling_resistance = crate::model::scene::COIN_ROLLING_RESISTANCE;

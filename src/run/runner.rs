@@ -269,7 +269,7 @@ impl<'a> Runner<'a> {
                 .min(end.saturating_mul(CHUNK_ROLLS) * indices.n.max(1)),
         );
         let key = spec.key();
-        let sides = spec.scene.counts_sides();
+        let sides = spec.scene.die.counts_sides();
         let mut done = Rolled {
             tally: Tally::default(),
             complete: false,

@@ -266,7 +266,7 @@ impl RunSpec {
                 ));
             }
         }
-        if let Some(shape) = &self.scene.shape {
+        if let Some(shape) = self.scene.die.as_shape() {
             use crate::model::throws::ThrowStyle;
             let hands = self.throws.style == ThrowStyle::Toss && self.throws.kappa.is_some();
             if hands || matches!(self.throws.style, ThrowStyle::Paper | ThrowStyle::Hand) {
@@ -313,7 +313,7 @@ impl RunSpec {
         };
         let cap = self.roll.max_steps;
         let coin = matches!(
-            s.shape.as_deref().map(|x| &x.solid),
+            s.die.as_shape().map(|x| &x.solid),
             Some(crate::model::shape::Solid::Cylinder { .. })
         );
         if coin {
@@ -322,9 +322,15 @@ impl RunSpec {
                  step cap ({cap} steps), counted unconverged: {remedy}"
             ));
         }
-        let half = s.block.breadth.min(s.block.width).min(s.block.length) / 2.0;
+        let half = s
+            .die
+            .block()
+            .breadth
+            .min(s.die.block().width)
+            .min(s.die.block().length)
+            / 2.0;
         let flat = half - s.features.edge_radius;
-        (s.hull_shape().is_none() && s.features.edge_radius > 0.0 && flat < 0.1 * half).then(|| {
+        (s.die.hull().is_none() && s.features.edge_radius > 0.0 && flat < 0.1 * half).then(|| {
             format!(
                 "the die's faces are flat over only {:.3} mm of their {:.1} mm half side \
                  (edge radius {} mm): it rolls like a ball and may reach the step cap ({cap} \
@@ -353,7 +359,7 @@ impl RunSpec {
         if s.preset == Preset::Laws || !bodies {
             return None;
         }
-        let b = &s.block;
+        let b = &s.die.block();
         let half = b.breadth.min(b.width).min(b.length) / 2.0;
         let off = MassProps::compute(s).com.norm();
         (off >= 0.02 * half).then(|| {

@@ -28,7 +28,7 @@ pub const SHAPE_MAX_STEPS: u64 = 200_000;
 /// default cap from here (`roll`, `fair` and `crosscheck` through `EndRequest`, and `trace`),
 /// so that the same die is capped alike.
 pub fn default_max_steps(scene: &Scene) -> u64 {
-    if scene.shape.is_some() {
+    if scene.die.as_shape().is_some() {
         SHAPE_MAX_STEPS
     } else {
         DEFAULT_MAX_STEPS

@@ -457,7 +457,7 @@ pub fn dice_costs(
             if !models(scene) {
                 continue;
             }
-            let t = Tally::of(recs, scene.counts_sides())?;
+            let t = Tally::of(recs, scene.die.counts_sides())?;
             let ms = 1000.0 * cpu_s / n as f64;
             let row = DiceCost {
                 engine: engine.name().into(),
@@ -466,7 +466,7 @@ pub fn dice_costs(
                 cpu_ms_per_roll: ms,
                 vs_sharp: ms / sharp_ms,
                 engine_steps_per_roll: t.engine_steps as f64 / n as f64,
-                faces: match scene.shape {
+                faces: match scene.die.as_shape() {
                     None => {
                         let up = t.by_direction();
                         Layout::Right

@@ -10,6 +10,7 @@ use super::place::{Done, Hooks, Place};
 use crate::error::{Error, Field, Result};
 use crate::model::faces::{Layout, DIRECTIONS};
 use crate::model::mass::Features;
+use crate::model::scene::Form;
 use crate::report::progress::Unit;
 use crate::run::runner::Runner;
 use crate::run::spec::RunSpec;
@@ -104,10 +105,7 @@ impl Kind for BiasStudy {
         let out = &place.out;
         if !out.as_os_str().is_empty() {
             let spec = &self.spec;
-            let die = match &spec.scene.shape {
-                Some(shape) => shape.name.clone(),
-                None => format!("{} mm", spec.scene.block),
-            };
+            let die = spec.scene.die.title();
             let title = format!(
                 "{die}, {}, {}: {} rolls a value; lines: {}",
                 spec.engine.name(),
@@ -183,23 +181,24 @@ impl Varied {
         let mut s = scene.clone();
         match self {
             Varied::Thickness => {
-                let Some(Solid::Cylinder { diameter, .. }) =
-                    scene.shape.as_deref().map(|x| &x.solid)
+                let Some(Solid::Cylinder { diameter, .. }) = scene.die.as_shape().map(|x| &x.solid)
                 else {
                     return Err(at("the die is not a coin: give --shape coin:D,H"));
                 };
                 let coin =
                     crate::model::shape::named(&format!("coin:{},{mm}", diameter * 1e3), None)
                         .map_err(|e| at(&e.to_string()))?;
-                s.shape = Some(std::sync::Arc::new(coin));
+                s.die = Form::shape(coin);
             }
-            Varied::Length | Varied::Breadth | Varied::Width => match scene.shape.as_deref() {
+            Varied::Length | Varied::Breadth | Varied::Width => match scene.die.as_shape() {
                 None => {
-                    let b = &scene.block;
+                    let b = scene.die.block();
                     let mut sides = [b.length, b.breadth, b.width].map(|v| v * 1e3);
                     sides[self as usize - Varied::Length as usize] = mm;
-                    s.block = crate::model::block::Block::from_mm(sides[0], sides[1], sides[2])
-                        .map_err(|e| at(&e.to_string()))?;
+                    s.die = Form::Cuboid(
+                        crate::model::block::Block::from_mm(sides[0], sides[1], sides[2])
+                            .map_err(|e| at(&e.to_string()))?,
+                    );
                 }
                 Some(shape) if self == Varied::Length && shape.name.starts_with("prism:") => {
                     // prism:N,D,L: its sides and breadth kept, its length this.
@@ -209,7 +208,7 @@ impl Varied {
                         None,
                     )
                     .map_err(|e| at(&e.to_string()))?;
-                    s.shape = Some(std::sync::Arc::new(prism));
+                    s.die = Form::shape(prism);
                 }
                 Some(_) if self == Varied::Length => {
                     return Err(at(
@@ -222,7 +221,7 @@ impl Varied {
             _ => {
                 s.features = self.set(&scene.features, mm)?;
                 // A die of any shape but a box is rounded in its hull (`mass::take_rounding`).
-                crate::model::mass::take_rounding(&mut s.shape, &mut s.features)
+                crate::model::mass::take_rounding(s.die.shape_mut(), &mut s.features)
                     .map_err(|e| at(&e))?;
             }
         }
@@ -334,7 +333,7 @@ pub fn vary(
 /// what a front end checks before it claims an output directory, so that a value the die
 /// cannot take is refused with nothing written.
 pub fn varied_specs(spec: &RunSpec, what: Varied, values: &[f64]) -> Result<Vec<RunSpec>> {
-    if let (Varied::PipDepth, Some(shape)) = (what, spec.scene.hull_shape()) {
+    if let (Varied::PipDepth, Some(shape)) = (what, spec.scene.die.hull()) {
         return Err(Error::field(
             Field::Vary,
             "pip_depth",

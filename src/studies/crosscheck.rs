@@ -148,7 +148,11 @@ pub fn run(cfg: &Config, study: &Study) -> Result<Crosscheck> {
     }
     let versus: Vec<Versus> = (1..runs.len())
         .map(|i| {
-            let agree = Agreement::of(&records[0], &records[i], runs[0].spec.scene.counts_sides());
+            let agree = Agreement::of(
+                &records[0],
+                &records[i],
+                runs[0].spec.scene.die.counts_sides(),
+            );
             Versus {
                 engine: runs[i].engine,
                 baseline: runs[0].engine,

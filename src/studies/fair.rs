@@ -50,7 +50,7 @@ fn null_probabilities(s: &RunSummary, null: &Null) -> Result<(Vec<f64>, Option<S
             None,
         )),
         // Each label its facets' share; a block's faces each 1/N.
-        Null::Uniform => match scene.shape.as_deref() {
+        Null::Uniform => match scene.die.as_shape() {
             Some(shape) => {
                 let shares = theory::null::uniform_shares(shape);
                 let q = labels
@@ -87,7 +87,7 @@ pub fn check_null(spec: &RunSpec, null: &Null) -> Result<()> {
     }
 }
 
-/// The labels a die shows, each once, in the order of its outcomes (`Scene::face_labels`: a
+/// The labels a die shows, each once, in the order of its outcomes (`Form::face_labels`: a
 /// die of any shape's labels, a block's numbers under `layout`, four in 2D).
 pub fn die_labels(scene: &crate::model::scene::Scene, layout: Layout) -> Vec<String> {
     // A block in 2D shows the four faces about z (a die of any shape is 3D only).
@@ -97,7 +97,7 @@ pub fn die_labels(scene: &crate::model::scene::Scene, layout: Layout) -> Vec<Str
         4
     };
     let mut out: Vec<String> = Vec::new();
-    for l in scene.face_labels(layout).into_iter().take(shown) {
+    for l in scene.die.face_labels(layout).into_iter().take(shown) {
         if !out.contains(&l) {
             out.push(l);
         }
@@ -108,7 +108,7 @@ pub fn die_labels(scene: &crate::model::scene::Scene, layout: Layout) -> Vec<Str
 /// A cuboid's faces are alike when it is (nearly) a cube: each face's solid angle from its
 /// centre (`theory::null::unlike`); in 2D, when its breadth and width are.
 fn block_unlike(scene: &crate::model::scene::Scene) -> Option<String> {
-    let b = &scene.block;
+    let b = &scene.die.block();
     match scene.mode {
         Mode::ThreeD => {
             let (p, _) = theory::simpson_3d(b);
@@ -223,7 +223,7 @@ pub fn assess_counts(
     let q = match null {
         // The die's own labels: each its facets' share (a die whose labels merge facets);
         // other labels: 1/N over the faces given.
-        Null::Uniform => match scene.shape.as_deref() {
+        Null::Uniform => match scene.die.as_shape() {
             Some(shape) if same_labels(&given, &shape.labels()) => {
                 let shares = theory::null::uniform_shares(shape);
                 note = theory::null::alike(shape);
@@ -294,11 +294,11 @@ pub fn assess_counts(
 /// (`counted` by its layout: counts give the numbers, not the directions); nothing in 2D or
 /// for a label the die has not.
 fn place_faces(fair: &mut Fairness, scene: &crate::model::scene::Scene, counted: Option<Layout>) {
-    let places: Vec<(String, Option<[f64; 3]>, f64)> = match (&scene.shape, scene.mode) {
+    let places: Vec<(String, Option<[f64; 3]>, f64)> = match (scene.die.as_shape(), scene.mode) {
         (Some(shape), _) => shape.outcome_geometry(),
         (None, Mode::TwoD) => return,
         (None, Mode::ThreeD) => {
-            let b = &scene.block;
+            let b = &scene.die.block();
             // Body x is the breadth, y the width, z the length.
             let side = [
                 b.width * b.length,
@@ -449,10 +449,7 @@ pub fn claim(
 /// Writes `fairness.json` (the document `json`, as `--json` prints it) and the die map
 /// (`die_map.svg`, `die_map.png`) into `dir`, each whole or not at all.
 pub fn write(dir: &std::path::Path, json: &str, fair: &Fairness, s: &RunSummary) -> Result<()> {
-    let die = match &s.spec.scene.shape {
-        Some(shape) => shape.name.clone(),
-        None => format!("{} mm", s.block_mm.map(|v| v.to_string()).join("x")),
-    };
+    let die = s.spec.scene.die.title();
     let title = format!(
         "{die}, {} {}, throw {}: {} rolls at rest; {}",
         s.engine,
@@ -477,7 +474,7 @@ pub fn write(dir: &std::path::Path, json: &str, fair: &Fairness, s: &RunSummary)
         })
         .collect();
     // The die map: a cube's net, or a die of any shape seen from two sides.
-    match &s.spec.scene.shape {
+    match s.spec.scene.die.as_shape() {
         None => crate::report::figures::die::die_map(dir, "die_map", &title, &faces)?,
         Some(shape) => {
             let by_label: Vec<crate::report::figures::die::ShapeFace> = shape
@@ -496,7 +493,7 @@ pub fn write(dir: &std::path::Path, json: &str, fair: &Fairness, s: &RunSummary)
         }
     }
     // A cube's faces by number; any other die's by the label it shows.
-    let by_number = s.spec.scene.shape.is_none();
+    let by_number = s.spec.scene.die.as_shape().is_none();
     write_faces(dir, json, fair, &title, by_number)
 }
 

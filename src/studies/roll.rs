@@ -128,7 +128,7 @@ impl RollStudy {
         if let Some(w) = spec.endless_roll_warning() {
             lines.push(format!("dicephys: warning: {w}"));
         }
-        let hull = spec.scene.shape.as_ref().and_then(|s| s.hull_note());
+        let hull = spec.scene.die.as_shape().and_then(|s| s.hull_note());
         let loaded = spec.loaded_die_note(&[spec.engine]);
         if !json {
             lines.extend(
@@ -385,16 +385,18 @@ impl Kind for RollStudy {
 /// throw spins it about body z, so the two z faces come up less often than a tester's throw
 /// would show them (issue 50: "a fair cube that looks loaded").
 fn paper_throw_warning(spec: &RunSpec) -> Option<String> {
-    let b = &spec.scene.block;
+    let b = &spec.scene.die.block();
     let paper = spec.throws.style == crate::model::throws::ThrowStyle::Paper;
-    (paper && spec.scene.shape.is_none() && b.length <= b.breadth * (1.0 + 1e-9)).then(|| {
-        format!(
-            "the paper's throw spins the block about its length, and {} has no longer length: \
+    (paper && spec.scene.die.as_shape().is_none() && b.length <= b.breadth * (1.0 + 1e-9)).then(
+        || {
+            format!(
+                "the paper's throw spins the block about its length, and {} has no longer length: \
              faces 1 and 6 will come up less often than on a tester's throw; --throw tumble \
              throws it without a preferred axis",
-            b
-        )
-    })
+                b
+            )
+        },
+    )
 }
 
 /// A precision to roll to: the fraction, what it is of, and a hook told the rolls expected in

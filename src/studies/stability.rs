@@ -132,7 +132,7 @@ fn cell(
     scene: Scene,
 ) -> Result<Cell> {
     let (block, mode, dt, e, mu) = (
-        scene.block,
+        scene.die.block(),
         scene.mode,
         scene.dt,
         scene.restitution,

@@ -69,8 +69,8 @@ impl TraceStudy {
         };
         let labels = self
             .scene
-            .shape
-            .as_ref()
+            .die
+            .as_shape()
             .map(|s| s.labels())
             .unwrap_or_default();
         Ok(Ok((

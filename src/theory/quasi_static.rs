@@ -100,7 +100,7 @@ pub fn shape(shape: &Shape, com: &Vector3<f64>) -> Result<Vec<f64>, String> {
 }
 
 /// The quasi-static share of each label a scene's die shows, of the rolls that end on one of
-/// its outcomes, each label once in the order of its outcomes (`Scene::face_labels`): for every
+/// its outcomes, each label once in the order of its outcomes (`Form::face_labels`): for every
 /// die the solid angle of each resting face's basin seen from the centre of mass. A block's
 /// numbers under `layout`, each by the face up ([`faces_up`], of its inner box); a die of any
 /// shape's labels ([`shape_labels`], at its centre of mass; a facet that holds the die only at
@@ -114,7 +114,7 @@ pub fn label_shares(
     if scene.mode != crate::model::scene::Mode::ThreeD {
         return Err("the quasi-static theory is 3D; in 2D give uniform".into());
     }
-    let p = match scene.shape.as_deref() {
+    let p = match scene.die.as_shape() {
         None => {
             let up = faces_up(&DieBody::of(scene));
             let numbers = layout.numbers().map(|n| n.to_string());

@@ -407,6 +407,36 @@ fn fair_varies_a_feature_and_draws_its_bias() {
     }
 }
 
+/// A varied die is that die rolled by itself, throw for throw, where the feature changes its
+/// form: a prism's length, a d8's rounding. The scene's die is one form, so a varied shape
+/// has no block left over from the die it was varied from; when it had (a scene held a shape
+/// and a block beside it), these points kept the first die's block, which sets the drop, and
+/// fell from its height: the prism at 30 mm from the 40 mm prism's, the rounded d8 from the
+/// sharp one's.
+#[test]
+fn a_varied_form_is_that_die_rolled_by_itself() {
+    let base = ["fair", "--rolls", "200", "--seed", "3", "--json"];
+    for (die, vary, alone) in [
+        (
+            &["--shape", "prism:6,16,40"][..],
+            "length=30:40:2",
+            &["--shape", "prism:6,16,30"][..],
+        ),
+        (
+            &["--shape", "d8"],
+            "edge_radius=1:2:2",
+            &["--shape", "d8", "--edge-radius", "1"],
+        ),
+    ] {
+        let v = json(&dicephys(&[&base[..], die, &["--vary", vary]].concat()));
+        let one = json(&dicephys(&[&base[..], alone].concat()));
+        assert_eq!(
+            v["points"][0]["fairness"]["faces"], one["fairness"]["faces"],
+            "{vary}"
+        );
+    }
+}
+
 /// Reliability round 5, classes A and B: the numbering is the run's. `--layout left` and a
 /// die file's layout used to live only in the live run: a resumed checkpoint, a merge of
 /// shards read faces as a right-handed die's, shards of two layouts merged, and a die file

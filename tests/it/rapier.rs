@@ -96,7 +96,7 @@ fn length_up() -> UnitQuaternion<f64> {
 #[test]
 fn a_3d_box_laid_on_each_face_rests_on_it() {
     let s = scene(Mode::ThreeD);
-    let b = s.block;
+    let b = s.die.block();
     for kind in [EngineKind::Rapier, EngineKind::RapierLocked] {
         assert_settles_on(kind, &s, laid(breadth_up(), b.breadth), Side::Breadth);
         assert_settles_on(
@@ -112,7 +112,7 @@ fn a_3d_box_laid_on_each_face_rests_on_it() {
 #[test]
 fn a_2d_box_laid_on_each_side_rests_on_it() {
     let s = scene(Mode::TwoD);
-    let b = s.block;
+    let b = s.die.block();
     for kind in [EngineKind::Rapier, EngineKind::RapierLocked] {
         assert_settles_on(kind, &s, laid(breadth_up(), b.breadth), Side::Breadth);
         assert_settles_on(
@@ -131,7 +131,7 @@ fn a_throw_that_starts_just_above_the_floor_rolls_to_width_vertical() {
     for mode in [Mode::ThreeD, Mode::TwoD] {
         let s = scene(mode);
         let mut t = throws().get(0);
-        t.drop_height = 0.5 * s.block.width + 1e-6 - s.drop_base();
+        t.drop_height = 0.5 * s.die.block().width + 1e-6 - s.drop_base();
         t.velocity = 0.0;
         t.spin = 0.0;
         for kind in [EngineKind::Rapier, EngineKind::RapierLocked] {
@@ -160,7 +160,7 @@ fn the_die_has_the_scenes_mass_and_inertia() {
     let mut e = Rapier2d::new(&s).unwrap();
     e.reset(&rest).unwrap();
     let (m, i) = e.die_mass_inertia().unwrap();
-    let (b, w) = (s.block.breadth, s.block.width);
+    let (b, w) = (s.die.block().breadth, s.die.block().width);
     let want_i = s.mass() / 12.0 * (b * b + w * w);
     assert!(
         (m - s.mass()).abs() <= 1e-15 * s.mass(),
@@ -236,7 +236,7 @@ fn a_batch_is_the_same_on_one_thread_and_two() {
 /// stops it in 0.5 / (μ g) ≈ 0.18 s.
 fn slides_to_a_stop(kind: EngineKind, mode: Mode) -> bool {
     let s = scene(mode);
-    let mut start = laid(UnitQuaternion::identity(), s.block.width);
+    let mut start = laid(UnitQuaternion::identity(), s.die.block().width);
     start.linear_velocity.x = 0.5;
     let mut e = new_engine(kind, &s).unwrap();
     e.reset(&start).unwrap();

@@ -700,3 +700,41 @@ fn merge_refuses_a_sum_past_2_to_the_64_rather_than_wrapping() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("overflow"), "{}", stderr(&out));
 }
+
+/// A checkpoint's key is the hash of its run's specification, so a checkpoint an earlier
+/// version made resumes only if the specification is still written byte for byte as it was
+/// (`model::scene`'s `Written`). The keys of four runs as the version of session 41
+/// (`d74e6c7`) wrote them: the paper's block, a d20, a coin, and a d8 rounded and loaded (a
+/// die of any shape's specification: its bounding box first, its shape last).
+#[test]
+fn a_run_s_specification_is_written_as_earlier_versions_wrote_it() {
+    for (die, rolls, key) in [
+        (&["--block", "140x24x20"][..], "300", "cbfd5e6f0d250956"),
+        (&["--shape", "d20"], "300", "10e6b34c353f665f"),
+        (&["--shape", "coin:24,2"], "200", "8ea7fed360783076"),
+        (
+            &["--shape", "d8", "--edge-radius", "1", "--com", "0,0,-1"],
+            "200",
+            "29b1f4785ed35264",
+        ),
+    ] {
+        let dir = tmp("spec-key");
+        let out = dicephys(
+            &[
+                &[
+                    "roll",
+                    "--rolls",
+                    rolls,
+                    "--checkpoint",
+                    dir.to_str().unwrap(),
+                ][..],
+                die,
+            ]
+            .concat(),
+        );
+        assert!(out.status.success(), "{die:?}: {}", stderr(&out));
+        let spec: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("spec.json")).unwrap()).unwrap();
+        assert_eq!(spec["key"], key, "{die:?}");
+    }
+}

@@ -25,13 +25,12 @@ use std::sync::{Arc, Mutex};
 /// An error (a rounding the die cannot take, `Shape::rounded`'s reason) leaves both as they
 /// were.
 pub fn take_rounding(
-    shape: &mut Option<Arc<Shape>>,
+    shape: Option<&mut Arc<Shape>>,
     features: &mut super::features::Features,
 ) -> Result<(), String> {
     let r = features.edge_radius;
-    if let Some(s) = shape.as_ref().filter(|s| r > 0.0 && s.as_box().is_none()) {
-        let rounded = rounded_shared(s, r)?;
-        *shape = Some(rounded);
+    if let Some(s) = shape.filter(|s| r > 0.0 && s.as_box().is_none()) {
+        *s = rounded_shared(s, r)?;
         features.edge_radius = 0.0;
     }
     Ok(())

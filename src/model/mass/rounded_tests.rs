@@ -131,16 +131,16 @@ fn a_rounding_goes_to_a_boxs_features_or_a_hulls_shape_and_is_made_once() {
     };
     let d6 = Arc::new(shape::named("d6", None).unwrap());
     let (mut s, mut f) = (Some(d6.clone()), with_r(0.001));
-    take_rounding(&mut s, &mut f).unwrap();
+    take_rounding(s.as_mut(), &mut f).unwrap();
     assert!(Arc::ptr_eq(s.as_ref().unwrap(), &d6) && f.edge_radius == 0.001);
     let d8 = Arc::new(shape::named("d8", None).unwrap());
     let (mut s, mut f) = (Some(d8.clone()), with_r(0.001));
-    take_rounding(&mut s, &mut f).unwrap();
+    take_rounding(s.as_mut(), &mut f).unwrap();
     let once = s.unwrap();
     assert_eq!(f.edge_radius, 0.0);
     assert_eq!(once.radius, 0.001);
     let (mut again, mut f) = (Some(d8.clone()), with_r(0.001));
-    take_rounding(&mut again, &mut f).unwrap();
+    take_rounding(again.as_mut(), &mut f).unwrap();
     assert!(Arc::ptr_eq(&once, again.as_ref().unwrap()), "made twice");
     let other = rounded_shared(&d8, 0.0015).unwrap();
     assert_eq!(other.radius, 0.0015);
@@ -150,10 +150,10 @@ fn a_rounding_goes_to_a_boxs_features_or_a_hulls_shape_and_is_made_once() {
     );
     let coin = Arc::new(shape::named("coin:24,2", None).unwrap());
     let (mut s, mut f) = (Some(coin.clone()), with_r(0.0005));
-    assert!(take_rounding(&mut s, &mut f).is_err());
+    assert!(take_rounding(s.as_mut(), &mut f).is_err());
     assert!(Arc::ptr_eq(s.as_ref().unwrap(), &coin) && f.edge_radius == 0.0005);
     // No die of any shape: the cuboid's rounding, in its features.
     let (mut s, mut f) = (None, with_r(0.001));
-    take_rounding(&mut s, &mut f).unwrap();
+    take_rounding(s.as_mut(), &mut f).unwrap();
     assert!(s.is_none() && f.edge_radius == 0.001);
 }

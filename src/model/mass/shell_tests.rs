@@ -91,7 +91,7 @@ fn a_full_infill_is_the_uniform_solid() {
     ] {
         let solid = MassProps::of(&scene).unwrap();
         let full = MassProps::of(&with_shell(scene.clone(), printed(0.001, 1.0))).unwrap();
-        same(&full, &solid, 1e-12, &format!("{:?}", scene.block));
+        same(&full, &solid, 1e-12, &format!("{:?}", scene.die.block()));
     }
 }
 

@@ -67,7 +67,7 @@ fn round(v: &Vector3<f64>) -> [f64; 3] {
 impl DieView {
     /// The die of `scene`, whose body `die` is.
     pub fn of(scene: &Scene, die: &DieBody) -> DieView {
-        match scene.shape.as_deref() {
+        match scene.die.as_shape() {
             Some(shape) => shaped(shape, &die.com),
             None => block(scene, die),
         }
@@ -123,7 +123,7 @@ fn block(scene: &Scene, die: &DieBody) -> DieView {
         });
     }
     let reach = (half + die.com.abs()).norm();
-    let b = &scene.block;
+    let b = &scene.die.block();
     DieView {
         name: format!(
             "block {}x{}x{}",

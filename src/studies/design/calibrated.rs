@@ -49,20 +49,20 @@ pub fn calibrated(
     let surface = group(fit, true, surface, "surface")?;
     let thrower = group(fit, false, thrower, "thrower")?;
     let die = Die {
-        shape: spec.scene.shape.clone(),
+        shape: spec.scene.die.clone().into_shape(),
         features: spec.scene.features,
         density: Some(spec.scene.density),
     };
     check(&die, fit)?;
     // A new row's coordinates, as `predict` builds them: the fit's parameters of this surface
     // and thrower, at the fit's maximum.
-    let row = FitResult::new_row(&surface, &thrower, spec.scene.block, spec.scene.mode);
+    let row = FitResult::new_row(&surface, &thrower, spec.scene.die.block(), spec.scene.mode);
     let mut values = without_die_params(fit.values_at(&row, &fit.estimate.x));
     // A coin keeps its own rolling resistance where the fit measured none (not free, and 0:
     // its dice's default, not a finding): with none, a coin rolling on its rim never stops,
     // and every roll that ends there runs to the step cap.
     let coin_engine = fit.config.method.engine.resists_rolling(spec.scene.mode);
-    if spec.scene.is_coin()
+    if spec.scene.die.is_coin()
         && coin_engine
         && values.rolling == 0.0
         && !fit
@@ -74,7 +74,7 @@ pub fn calibrated(
     }
     let method = method(&die, &fit.config.method);
     let out = method.spec(
-        spec.scene.block,
+        spec.scene.die.block(),
         spec.scene.mode,
         &values,
         spec.throws.seed,

@@ -76,8 +76,8 @@ impl MeshConfig {
     fn die_name(&self) -> &str {
         self.spec
             .scene
-            .shape
-            .as_ref()
+            .die
+            .as_shape()
             .map_or("the die", |s| s.name.as_str())
     }
 }
@@ -442,7 +442,7 @@ fn family(cfg: &MeshConfig) -> Result<(Family, Vec<Vec<usize>>)> {
         ));
     }
     let scene = &cfg.spec.scene;
-    let Some(shape) = scene.shape.as_deref() else {
+    let Some(shape) = scene.die.as_shape() else {
         return Err(Error::field(
             Field::Free,
             FACETS,
@@ -476,8 +476,7 @@ pub fn check(cfg: &MeshConfig) -> Result<()> {
 /// The run of `spec` with its die `shape`.
 fn with_shape(spec: &RunSpec, shape: Shape, rolls: u64, seed: u64) -> Result<RunSpec> {
     let mut s = spec.clone();
-    s.scene.block = shape.block();
-    s.scene.shape = Some(std::sync::Arc::new(shape));
+    s.scene.die = crate::model::scene::Form::shape(shape);
     s.rolls = rolls;
     s.throws.seed = seed;
     s.validate(false)?;
@@ -801,7 +800,7 @@ impl MeshDesign {
     pub fn die_file(&self, obj: &str) -> String {
         use std::fmt::Write;
         let c = &self.config;
-        let reads = c.spec.scene.shape.as_ref().map_or(Reads::Up, |s| {
+        let reads = c.spec.scene.die.as_shape().map_or(Reads::Up, |s| {
             if s.printed.is_some() {
                 s.reads
             } else {

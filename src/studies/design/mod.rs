@@ -238,7 +238,7 @@ fn faces_at(
 /// A run's faces: each face's label and count, as `fair` counts them.
 fn faces_of(summary: &crate::report::summary::RunSummary) -> Result<(Vec<String>, Vec<u64>)> {
     let f = assess(summary, &Null::Uniform)?;
-    let shape = summary.spec.scene.shape.is_some();
+    let shape = summary.spec.scene.die.as_shape().is_some();
     Ok((
         f.faces.iter().map(|v| face_label(v, shape)).collect(),
         f.faces.iter().map(|v| v.count).collect(),
@@ -258,7 +258,7 @@ fn batched_at(
     use crate::sim::roll::Fate;
     let rolls = spec.rolls.max(1);
     let nb = (BATCHES as u64).min(rolls) as usize;
-    let labels = spec.scene.face_labels(layout);
+    let labels = spec.scene.die.face_labels(layout);
     // Each label's target outcome: its own, or `rest` for a label not named.
     let named = |l: &str| target.iter().position(|(t, _)| t == l);
     let rest = target.iter().position(|(t, _)| t == "rest");
@@ -436,7 +436,7 @@ pub fn run(cfg: &DesignConfig, runner: &Runner) -> Result<Option<Design>> {
     if summary.partial {
         return Ok(None);
     }
-    let shape = spec.scene.shape.is_some();
+    let shape = spec.scene.die.as_shape().is_some();
     let label = |v: &crate::report::fair::FaceVerdict| face_label(v, shape);
     let (names, faces) = faces_of(&summary)?;
     let counts = gathered(&names, &faces, &cfg.target);
@@ -694,7 +694,7 @@ impl Design {
             "design: {} of {} ({}, {}), range {}–{} mm; two scans of {} values × {} throws, the \
              check {} throws at a fresh seed",
             c.what,
-            die_name(&c.spec),
+            c.spec.scene.die.title(),
             c.spec.engine.name(),
             c.spec.throws.style,
             c.range[0],
@@ -772,14 +772,6 @@ fn bars(
         .collect()
 }
 
-/// The die, in a few words.
-fn die_name(spec: &RunSpec) -> String {
-    match &spec.scene.shape {
-        Some(shape) => shape.name.clone(),
-        None => format!("{} mm", spec.scene.block),
-    }
-}
-
 /// The scene and throw a design was made under: a fit's calibration, named with its values,
 /// or the scene as given.
 fn scene_words(c: &DesignConfig) -> String {
@@ -817,7 +809,7 @@ pub fn write(dir: &std::path::Path, json: &str, d: &Design) -> Result<()> {
         "{} = {:.3} mm of {}, {}, {}{}: {} fresh throws",
         c.what,
         d.value,
-        die_name(&c.spec),
+        c.spec.scene.die.title(),
         c.spec.engine.name(),
         c.spec.throws.style,
         if c.calibration.is_some() {

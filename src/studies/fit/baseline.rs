@@ -50,7 +50,7 @@ pub fn shares_at(
         return Ok(None);
     }
     let counts =
-        super::simulate::outcome_counts(&done.tally, faces, method, spec.scene.shape.as_deref())?;
+        super::simulate::outcome_counts(&done.tally, faces, method, spec.scene.die.as_shape())?;
     let settled: u64 = counts.iter().sum();
     let n = settled.max(1) as f64;
     Ok(Some((

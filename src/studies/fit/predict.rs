@@ -213,7 +213,7 @@ fn fit_prediction(
             ratios.push(c.breadth as f64 / c.width.max(1) as f64);
         }
         if with_faces {
-            let rolled = spec.scene.shape.as_deref();
+            let rolled = spec.scene.die.as_shape();
             let faces = super::simulate::outcome_counts(&done.tally, true, method, rolled)?;
             for (k, v) in faces.iter().enumerate() {
                 face_freq[k].push(*v as f64 / settled as f64);

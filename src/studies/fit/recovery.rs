@@ -44,7 +44,7 @@ pub fn simulate_data(
             return Ok(None);
         }
         let faces = row.outcomes == Outcomes::Faces;
-        let counts = outcome_counts(&done.tally, faces, &method, spec.scene.shape.as_deref())?;
+        let counts = outcome_counts(&done.tally, faces, &method, spec.scene.die.as_shape())?;
         // Merged groups keep their count in the first member, as the data file does.
         let grouped: Vec<u64> = row
             .groups

@@ -130,7 +130,7 @@ pub fn simulate(
             rolls += t.rolls;
             design_points.push(DesignPoint {
                 x: x.clone(),
-                counts: outcome_counts(t, key.faces, &method, spec.scene.shape.as_deref())?,
+                counts: outcome_counts(t, key.faces, &method, spec.scene.die.as_shape())?,
             });
         }
         if runner.share.is_partial() {

@@ -24,7 +24,7 @@ impl LimitCell {
         LimitCell {
             engine: spec.engine,
             mode: spec.scene.mode,
-            block: spec.scene.block.to_string(),
+            block: spec.scene.die.block().to_string(),
             damping: spec.scene.linear_damping,
             tally: Tally::default(),
             at_rest: Faces::default(),
