@@ -703,8 +703,8 @@ fn merge_refuses_a_sum_past_2_to_the_64_rather_than_wrapping() {
 
 /// A checkpoint's key is the hash of its run's specification, so a checkpoint an earlier
 /// version made resumes only if the specification is still written byte for byte as it was
-/// (`model::scene`'s `Written`). The keys of four runs as the version of session 41
-/// (`d74e6c7`) wrote them: the paper's block, a d20, a coin, and a d8 rounded and loaded (a
+/// (`model::scene`'s `Written`). The keys of four runs as the version before the scene's die
+/// became one form (`d74e6c7`) wrote them: the paper's block, a d20, a coin, and a d8 rounded and loaded (a
 /// die of any shape's specification: its bounding box first, its shape last).
 #[test]
 fn a_run_s_specification_is_written_as_earlier_versions_wrote_it() {
