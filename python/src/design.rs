@@ -54,7 +54,7 @@ type Target = (Vec<(String, f64)>, Option<Named>);
 fn target_of(text: &str, spec: &dicephys::run::spec::RunSpec, layout: Layout) -> PyResult<Target> {
     let shown = format!("'{text}'");
     if let Some(n) = Named::parse(text).map_err(|e| bad("target", &shown, e))? {
-        let labels = dicephys::studies::fair::die_labels(&spec.scene, layout);
+        let labels = spec.scene.labels(layout);
         let t = n.over(&labels).map_err(|e| bad("target", &shown, e))?;
         return Ok((t, Some(n)));
     }

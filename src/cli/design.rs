@@ -225,7 +225,7 @@ fn common(a: &DesignArgs, rolls: u64) -> Result<Common> {
             ))
         }
         TargetArg::Named(n) => {
-            let labels = dicephys::studies::fair::die_labels(&spec.scene, layout);
+            let labels = spec.scene.labels(layout);
             let t = n
                 .over(&labels)
                 .map_err(|e| Error::Usage(format!("--target {e}")))?;

@@ -610,6 +610,23 @@ impl Scene {
         crate::model::faces::Layout::from_numbers(numbers)
     }
 
+    /// The labels its die shows, each once, in the order of its outcomes (`Form::face_labels`:
+    /// a die of any shape's labels, a block's numbers under `layout`; a block in 2D shows the
+    /// four faces about z, and a die of any shape is 3D only).
+    pub fn labels(&self, layout: crate::model::faces::Layout) -> Vec<String> {
+        let shown = match self.mode {
+            Mode::ThreeD => usize::MAX,
+            Mode::TwoD => 4,
+        };
+        let mut out: Vec<String> = Vec::new();
+        for l in self.die.face_labels(layout).into_iter().take(shown) {
+            if !out.contains(&l) {
+                out.push(l);
+            }
+        }
+        out
+    }
+
     /// The scene with its die's outcomes at its own centre of mass (`Shape::resting_at`): a
     /// die of any shape loaded off its centroid rests on the facets it rests on there, and a
     /// facet it rolls off is no outcome. Unchanged for the cuboid, a coin, or a centred die.

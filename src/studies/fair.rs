@@ -35,7 +35,7 @@ fn null_probabilities(s: &RunSummary, null: &Null) -> Result<(Vec<f64>, Option<S
     // by label, a block's numbers by direction.
     let labels: Vec<String> = match crate::report::shape_outcomes::shape_faces(&s.tally, scene) {
         Some(f) => f.into_iter().map(|(l, _)| l).collect(),
-        None => die_labels(scene, s.layout),
+        None => scene.labels(s.layout),
     };
     match null {
         // Every die's outcomes by one theory, in the same order.
@@ -50,20 +50,10 @@ fn null_probabilities(s: &RunSummary, null: &Null) -> Result<(Vec<f64>, Option<S
             None,
         )),
         // Each label its facets' share; a block's faces each 1/N.
-        Null::Uniform => match scene.die.as_shape() {
-            Some(shape) => {
-                let shares = theory::null::uniform_shares(shape);
-                let q = labels
-                    .iter()
-                    .map(|l| shares.iter().find(|(m, _)| m == l).map_or(0.0, |s| s.1))
-                    .collect();
-                Ok((q, theory::null::alike(shape)))
-            }
-            None => Ok((
-                vec![1.0 / labels.len() as f64; labels.len()],
-                block_unlike(scene),
-            )),
-        },
+        Null::Uniform => {
+            let (shares, note) = theory::null::uniform_label_shares(scene, s.layout);
+            Ok((share_of(&shares, &labels), note))
+        }
     }
 }
 
@@ -73,7 +63,7 @@ pub fn check_null(spec: &RunSpec, null: &Null) -> Result<()> {
     let scene = &spec.scene;
     match null {
         Null::Target(t) => {
-            let labels = die_labels(scene, scene.features.layout);
+            let labels = scene.labels(scene.features.layout);
             theory::null::target_for(t, &labels)
                 .map(|_| ())
                 .map_err(|e| Error::field(Field::Null, null.spec(), e))
@@ -84,41 +74,6 @@ pub fn check_null(spec: &RunSpec, null: &Null) -> Result<()> {
             "the quasi-static theory is 3D; in 2D give uniform",
         )),
         _ => Ok(()),
-    }
-}
-
-/// The labels a die shows, each once, in the order of its outcomes (`Form::face_labels`: a
-/// die of any shape's labels, a block's numbers under `layout`, four in 2D).
-pub fn die_labels(scene: &crate::model::scene::Scene, layout: Layout) -> Vec<String> {
-    // A block in 2D shows the four faces about z (a die of any shape is 3D only).
-    let shown = if scene.mode == Mode::ThreeD {
-        usize::MAX
-    } else {
-        4
-    };
-    let mut out: Vec<String> = Vec::new();
-    for l in scene.die.face_labels(layout).into_iter().take(shown) {
-        if !out.contains(&l) {
-            out.push(l);
-        }
-    }
-    out
-}
-
-/// A cuboid's faces are alike when it is (nearly) a cube: each face's solid angle from its
-/// centre (`theory::null::unlike`); in 2D, when its breadth and width are.
-fn block_unlike(scene: &crate::model::scene::Scene) -> Option<String> {
-    let b = &scene.die.block();
-    match scene.mode {
-        Mode::ThreeD => {
-            let (p, _) = theory::simpson_3d(b);
-            theory::null::unlike(&[
-                p.breadth_vertical / 2.0,
-                p.width_vertical / 2.0,
-                p.length_vertical / 2.0,
-            ])
-        }
-        Mode::TwoD => theory::null::unlike(&[b.breadth, b.width]),
     }
 }
 
@@ -223,17 +178,16 @@ pub fn assess_counts(
     let q = match null {
         // The die's own labels: each its facets' share (a die whose labels merge facets);
         // other labels: 1/N over the faces given.
-        Null::Uniform => match scene.die.as_shape() {
-            Some(shape) if same_labels(&given, &shape.labels()) => {
-                let shares = theory::null::uniform_shares(shape);
-                note = theory::null::alike(shape);
-                given
-                    .iter()
-                    .map(|l| shares.iter().find(|(m, _)| m == l).map_or(0.0, |s| s.1))
-                    .collect()
+        Null::Uniform => {
+            let (shares, unlike) = theory::null::uniform_label_shares(scene, layout);
+            let own: Vec<&str> = shares.iter().map(|(l, _)| l.as_str()).collect();
+            if same_labels(&given, &own) {
+                note = unlike;
+                share_of(&shares, &given)
+            } else {
+                vec![1.0 / counted.len() as f64; counted.len()]
             }
-            _ => vec![1.0 / counted.len() as f64; counted.len()],
-        },
+        }
         Null::Target(t) => theory::null::target_for(t, &given)
             .map_err(|e| Error::field(Field::Null, null.spec(), e))?,
         Null::QuasiStatic => {
@@ -331,6 +285,14 @@ fn place_faces(fair: &mut Fairness, scene: &crate::model::scene::Scene, counted:
 }
 
 /// True if `a` and `b` hold the same labels (each once in `a`).
+/// Each of `labels`' share in `shares` (0 for a label the die does not show).
+fn share_of(shares: &[(String, f64)], labels: &[String]) -> Vec<f64> {
+    labels
+        .iter()
+        .map(|l| shares.iter().find(|(m, _)| m == l).map_or(0.0, |s| s.1))
+        .collect()
+}
+
 fn same_labels(a: &[String], b: &[&str]) -> bool {
     let mut b: Vec<&str> = b.to_vec();
     b.sort_unstable();

@@ -8,6 +8,9 @@
 //! several kinds, and the uniform null is then flagged ([`alike`]) for what it is, a design
 //! target the die was not made for.
 
+use crate::model::block::{Block, Mode};
+use crate::model::faces::Layout;
+use crate::model::scene::Scene;
 use crate::model::shape::Shape;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
@@ -179,6 +182,39 @@ pub fn target_for(target: &[(String, f64)], labels: &[String]) -> Result<Vec<f64
 pub fn uniform_shares(shape: &Shape) -> Vec<(String, f64)> {
     let n = shape.faces.len();
     shape.by_label(std::iter::repeat_n(1.0 / n as f64, n))
+}
+
+/// Each label a scene's die shows (`Scene::labels`, each once) with the share a fair die gives
+/// it, and why "fair" is not what the die was made for where its faces are not alike: a die of
+/// any shape's labels by their facets ([`uniform_shares`], [`alike`]), a block's numbers 1/N
+/// each (four in 2D), alike when it is nearly a cube. What `fair --null uniform` sets a run's
+/// counts and a tester's against, for every die.
+pub fn uniform_label_shares(scene: &Scene, layout: Layout) -> (Vec<(String, f64)>, Option<String>) {
+    match scene.die.as_shape() {
+        Some(shape) => (uniform_shares(shape), alike(shape)),
+        None => {
+            let labels = scene.labels(layout);
+            let q = 1.0 / labels.len() as f64;
+            let shares = labels.into_iter().map(|l| (l, q)).collect();
+            (shares, block_unlike(&scene.die.block(), scene.mode))
+        }
+    }
+}
+
+/// [`unlike`] for a block: each face's solid angle from its centre (Simpson's, the paper's
+/// 3D theory); in 2D, its breadth against its width.
+fn block_unlike(b: &Block, mode: Mode) -> Option<String> {
+    match mode {
+        Mode::ThreeD => {
+            let (p, _) = crate::theory::simpson_3d(b);
+            unlike(&[
+                p.breadth_vertical / 2.0,
+                p.width_vertical / 2.0,
+                p.length_vertical / 2.0,
+            ])
+        }
+        Mode::TwoD => unlike(&[b.breadth, b.width]),
+    }
 }
 
 /// How far apart (relative) a die's facets' quasi-static shares may be for its faces to count

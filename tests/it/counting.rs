@@ -439,3 +439,28 @@ fn a_blocks_quasi_static_null_is_the_same_rolled_or_counted() {
         assert_eq!(null(&rolled), null(&counted), "{die:?}");
     }
 }
+
+/// The uniform null is one for every die, counted or rolled (`theory::null::
+/// uniform_label_shares`): the paper's long block counted by its numbers is noted as not made
+/// to be fair, as the block rolled always was (counted, it was judged against 1/6 without a
+/// word); a cube counted is not noted, nor are counts whose labels are not the die's (judged
+/// against 1/N over the labels given).
+#[test]
+fn counts_are_judged_against_the_null_a_roll_of_the_die_is() {
+    let counts = "1=10,2=12,3=9,4=11,5=30,6=28";
+    let note = |args: &[&str]| {
+        let doc = json(&dicephys(&[&["fair", "--json"][..], args].concat()));
+        let f = &doc["fairness"];
+        let q = f["faces"][0]["null"].as_f64().unwrap();
+        (f.get("note").and_then(|n| n.as_str()).map(String::from), q)
+    };
+    let (counted, q) = note(&["--block", "140x24x20", "--counts", counts]);
+    let (rolled, _) = note(&["--block", "140x24x20", "--rolls", "200"]);
+    assert!(counted.as_deref().is_some_and(|n| n.contains("not alike")));
+    assert_eq!(counted, rolled);
+    assert!((q - 1.0 / 6.0).abs() < 1e-15, "{q}");
+    assert_eq!(note(&["--block", "16x16x16", "--counts", counts]).0, None);
+    let (other, q) = note(&["--block", "140x24x20", "--counts", "a=5,b=7"]);
+    assert_eq!(other, None);
+    assert!((q - 0.5).abs() < 1e-15, "{q}");
+}

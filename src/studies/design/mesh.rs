@@ -461,10 +461,7 @@ fn family(cfg: &MeshConfig) -> Result<(Family, Vec<Vec<usize>>)> {
         return Err(Error::field(Field::Free, FACETS, "a mesh is a 3D die"));
     }
     let fam = Family::of(shape).map_err(|e| Error::field(Field::Free, FACETS, e))?;
-    let groups = super::groups(
-        &cfg.target,
-        &crate::studies::fair::die_labels(scene, cfg.layout),
-    )?;
+    let groups = super::groups(&cfg.target, &scene.labels(cfg.layout))?;
     Ok((fam, groups))
 }
 

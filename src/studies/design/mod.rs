@@ -368,10 +368,7 @@ pub fn check(cfg: &DesignConfig) -> Result<Vec<Vec<usize>>> {
         } => Error::field(Field::Range, value, why),
         e => e,
     })?;
-    groups(
-        &cfg.target,
-        &crate::studies::fair::die_labels(&cfg.spec.scene, cfg.layout),
-    )
+    groups(&cfg.target, &cfg.spec.scene.labels(cfg.layout))
 }
 
 /// Runs the design. `None` if a stop request ended it.
