@@ -312,23 +312,14 @@ impl RunSpec {
             "--engine bullet --rolling-resistance 0.05 (mm) lets it stop"
         };
         let cap = self.roll.max_steps;
-        let coin = matches!(
-            s.die.as_shape().map(|x| &x.solid),
-            Some(crate::model::shape::Solid::Cylinder { .. })
-        );
-        if coin {
+        if s.die.is_coin() {
             return Some(format!(
                 "a coin with no rolling resistance may roll on its rim or its side until the \
                  step cap ({cap} steps), counted unconverged: {remedy}"
             ));
         }
-        let half = s
-            .die
-            .block()
-            .breadth
-            .min(s.die.block().width)
-            .min(s.die.block().length)
-            / 2.0;
+        let b = s.die.block();
+        let half = b.breadth.min(b.width).min(b.length) / 2.0;
         let flat = half - s.features.edge_radius;
         (s.die.hull().is_none() && s.features.edge_radius > 0.0 && flat < 0.1 * half).then(|| {
             format!(
@@ -359,7 +350,7 @@ impl RunSpec {
         if s.preset == Preset::Laws || !bodies {
             return None;
         }
-        let b = &s.die.block();
+        let b = s.die.block();
         let half = b.breadth.min(b.width).min(b.length) / 2.0;
         let off = MassProps::compute(s).com.norm();
         (off >= 0.02 * half).then(|| {

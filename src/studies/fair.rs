@@ -252,7 +252,7 @@ fn place_faces(fair: &mut Fairness, scene: &crate::model::scene::Scene, counted:
         (Some(shape), _) => shape.outcome_geometry(),
         (None, Mode::TwoD) => return,
         (None, Mode::ThreeD) => {
-            let b = &scene.die.block();
+            let b = scene.die.block();
             // Body x is the breadth, y the width, z the length.
             let side = [
                 b.width * b.length,

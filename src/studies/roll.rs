@@ -385,7 +385,7 @@ impl Kind for RollStudy {
 /// throw spins it about body z, so the two z faces come up less often than a tester's throw
 /// would show them (issue 50: "a fair cube that looks loaded").
 fn paper_throw_warning(spec: &RunSpec) -> Option<String> {
-    let b = &spec.scene.die.block();
+    let b = spec.scene.die.block();
     let paper = spec.throws.style == crate::model::throws::ThrowStyle::Paper;
     (paper && spec.scene.die.as_shape().is_none() && b.length <= b.breadth * (1.0 + 1e-9)).then(
         || {

@@ -123,7 +123,7 @@ fn block(scene: &Scene, die: &DieBody) -> DieView {
         });
     }
     let reach = (half + die.com.abs()).norm();
-    let b = &scene.die.block();
+    let b = scene.die.block();
     DieView {
         name: format!(
             "block {}x{}x{}",
