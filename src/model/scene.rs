@@ -210,10 +210,7 @@ impl From<Scene> for Written {
     fn from(s: Scene) -> Written {
         Written {
             block: s.die.block(),
-            shape: match s.die {
-                Form::Cuboid(_) => None,
-                Form::Shape(shape) => Some(shape),
-            },
+            shape: s.die.into_shape(),
             mode: s.mode,
             density: s.density,
             friction: s.friction,
